@@ -1,0 +1,37 @@
+# kinestat: every set-up step lives here. `make run` and `make test` build the
+# virtual environment themselves from the pinned requirements files.
+PY ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+RUN_STAMP := $(VENV)/.run-installed
+DEV_STAMP := $(VENV)/.dev-installed
+
+.PHONY: run test lint bench clean
+
+$(BIN)/python:
+	$(PY) -m venv $(VENV)
+	$(BIN)/pip install -q --upgrade pip
+
+$(RUN_STAMP): $(BIN)/python requirements/run.txt pyproject.toml
+	$(BIN)/pip install -q -r requirements/run.txt
+	$(BIN)/pip install -q --no-deps -e .
+	touch $@
+
+$(DEV_STAMP): $(RUN_STAMP) requirements/dev.txt
+	$(BIN)/pip install -q -r requirements/dev.txt
+	touch $@
+
+# The main job, on the embedded defaults.
+run: $(RUN_STAMP)
+	$(BIN)/kinestat demo
+
+# The whole test suite (lint first, then pytest; pytest fails when no test runs).
+test: $(DEV_STAMP)
+	$(BIN)/ruff check kinestat tests benchmarks
+	$(BIN)/pytest
+
+lint: $(DEV_STAMP)
+	$(BIN)/ruff check kinestat tests benchmarks
+
+clean:
+	rm -rf $(VENV) build *.egg-info

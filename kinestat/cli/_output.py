@@ -1,0 +1,67 @@
+"""Shared output helpers for the CLI: JSON for machines, rich tables for people."""
+
+from __future__ import annotations
+
+import json
+import math
+from typing import Any
+
+import numpy as np
+from rich.console import Console
+from rich.table import Table
+
+console = Console()
+err_console = Console(stderr=True)
+
+
+def to_jsonable(obj: Any) -> Any:
+    """Convert numpy arrays/scalars (recursively) to plain Python; inf/nan become strings."""
+    if isinstance(obj, dict):
+        return {str(k): to_jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return to_jsonable(obj.tolist())
+    if isinstance(obj, (np.bool_,)):
+        return bool(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        x = float(obj)
+        if math.isnan(x):
+            return "nan"
+        if math.isinf(x):
+            return "inf" if x > 0 else "-inf"
+        return x
+    return obj
+
+
+def print_json(obj: Any) -> None:
+    """Print ``obj`` as JSON on stdout (no rich markup, no wrapping)."""
+    print(json.dumps(to_jsonable(obj), indent=2))
+
+
+def table(title: str, columns: list[str], rows: list[list[Any]], fmt: str = "{:.4f}") -> Table:
+    """A rich table; floats formatted with ``fmt``."""
+    t = Table(title=title)
+    for c in columns:
+        t.add_column(c, justify="right")
+    for r in rows:
+        t.add_row(*[fmt.format(v) if isinstance(v, (float, np.floating)) else str(v) for v in r])
+    return t
+
+
+def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.ndarray:
+    """Parse ``"1,2,3"`` into floats, checking the count; raises InputError."""
+    from kinestat.errors import InputError
+
+    try:
+        vals = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
+    except ValueError as exc:
+        raise InputError(f"--{name}: cannot read {text!r} as comma-separated numbers") from exc
+    if n is not None and len(vals) != n:
+        raise InputError(f"--{name}: expected {n} comma-separated numbers, got {len(vals)}")
+    arr = np.asarray(vals)
+    if not np.all(np.isfinite(arr)):
+        raise InputError(f"--{name}: values must be finite, got {text!r}")
+    return arr

@@ -1,0 +1,65 @@
+"""The ``kinestat`` command.
+
+Each command group lives in its own module ``kinestat.cli.<name>`` exposing
+``register(app: typer.Typer) -> None``; the modules are listed in ``COMMAND_MODULES``.
+Errors derived from :class:`kinestat.errors.KinestatError` are printed as one clear message
+(no traceback) and exit with status 2.
+"""
+
+from __future__ import annotations
+
+import importlib
+import sys
+
+import typer
+
+from kinestat.errors import KinestatError
+
+# Order is the order of the help listing.
+COMMAND_MODULES: list[str] = [
+]
+
+app = typer.Typer(
+    name="kinestat",
+    help="Kinematics and statics of robot manipulators (kinestat).",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+
+
+@app.callback()
+def _root() -> None:
+    """Kinematics and statics of robot manipulators."""
+
+
+for _name in COMMAND_MODULES:
+    importlib.import_module(f"kinestat.cli.{_name}").register(app)
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Console-script entry point; returns the exit status."""
+    try:
+        app(args=argv, standalone_mode=False)
+    except KinestatError as exc:
+        typer.echo(f"kinestat: error: {exc}", err=True)
+        return 2
+    except typer.Exit as exc:  # pragma: no cover - typer control flow
+        return exc.exit_code
+    except typer.Abort:
+        typer.echo("kinestat: aborted", err=True)
+        return 130
+    except Exception as exc:  # click usage errors
+        import click
+
+        if isinstance(exc, click.exceptions.ClickException):
+            exc.show()
+            return exc.exit_code
+        if isinstance(exc, click.exceptions.Exit):
+            return exc.exit_code
+        raise
+    return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
