@@ -1,0 +1,271 @@
+"""TOML model files: read, write, round trip.
+
+Schema (angles in the file's ``angle_unit``, default degrees; lengths in ``length_unit``)::
+
+    name = "puma762"
+    notation = "modified_dh"      # standard_dh | modified_dh | nadkarni
+    length_unit = "mm"
+    angle_unit = "deg"            # deg | rad
+    description = "..."
+    base = [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]   # optional (not for nadkarni)
+    tool = [[...]]                                      # optional (not for nadkarni)
+    q_home = [0, 0, 0, 0, 0, 0]                         # optional, file units
+
+    # nadkarni only: SET FIVE and the seventh (hand) joint
+    frame_points = [[0,0,0],[0,0,1],[1,0,0]]
+    [hand]
+    r = 0.0
+    alpha = 0.0
+    a = 1.0
+    theta = 0.0
+
+    [[joints]]
+    name = "1"
+    type = "revolute"             # revolute | prismatic | screw
+    # standard_dh: theta d a alpha | modified_dh: alpha a theta d | nadkarni: r alpha a theta
+    alpha = 90.0
+    a = 0.0
+    theta = 0.0
+    d = 0.0
+    pitch = 0.0                   # screw joints: length per radian
+    limits = [-160.0, 160.0]      # angle_unit for rotating joints, length_unit for prismatic
+
+For ``standard_dh`` and ``modified_dh`` the joint's θ (or d, prismatic) is an offset added to
+the joint value; for ``nadkarni`` the values are the initial configuration (as in DISP).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import tempfile
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import tomli_w
+
+from kinestat.errors import ModelError, ParseError
+from kinestat.mechanism.chain import (
+    ChainModel,
+    from_modified_dh,
+    from_nadkarni,
+    from_standard_dh,
+)
+from kinestat.mechanism.joints import PRISMATIC_PITCH_THRESHOLD
+
+__all__ = ["read_model", "loads_model", "write_model", "dumps_model"]
+
+_FIELDS = {
+    "standard_dh": ("theta", "d", "a", "alpha"),
+    "modified_dh": ("alpha", "a", "theta", "d"),
+    "nadkarni": ("r", "alpha", "a", "theta"),
+}
+_ANGLES = {"theta", "alpha"}
+
+
+def _err(msg: str, source: str, field: str | None = None) -> ParseError:
+    return ParseError(msg, file=source, field=field)
+
+
+def _num(v, source: str, field: str) -> float:
+    if isinstance(v, bool) or not isinstance(v, (int, float)):
+        raise _err(f"expected a number, got {v!r}", source, field)
+    x = float(v)
+    if not math.isfinite(x):
+        raise _err(f"expected a finite number, got {v!r}", source, field)
+    return x
+
+
+def _matrix(v, source: str, field: str, shape: tuple[int, int]) -> np.ndarray:
+    try:
+        a = np.array(v, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise _err(f"expected a {shape[0]}x{shape[1]} array of numbers", source, field) from exc
+    if a.shape != shape or not np.all(np.isfinite(a)):
+        raise _err(f"expected a finite {shape[0]}x{shape[1]} array, got shape {a.shape}",
+                   source, field)
+    return a
+
+
+def loads_model(text: str, source: str = "<string>") -> ChainModel:
+    """Parse a TOML model from text."""
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise _err(f"not valid TOML: {exc}", source) from exc
+    return _from_doc(doc, source)
+
+
+def read_model(path: str | os.PathLike) -> ChainModel:
+    """Read a TOML model file."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ParseError(f"cannot read model file: {exc.strerror}", file=str(p)) from exc
+    return loads_model(text, source=str(p))
+
+
+def _from_doc(doc: dict, source: str) -> ChainModel:
+    known = {"name", "notation", "length_unit", "angle_unit", "description", "base", "tool",
+             "q_home", "frame_points", "hand", "joints", "source"}
+    unknown = set(doc) - known
+    if unknown:
+        raise _err(f"unknown top-level keys {sorted(unknown)}; expected some of {sorted(known)}",
+                   source)
+    notation = doc.get("notation")
+    if notation not in _FIELDS:
+        raise _err(f"notation must be one of {sorted(_FIELDS)}, got {notation!r}", source,
+                   "notation")
+    angle_unit = doc.get("angle_unit", "deg")
+    if angle_unit not in ("deg", "rad"):
+        raise _err(f"angle_unit must be 'deg' or 'rad', got {angle_unit!r}", source, "angle_unit")
+    to_rad = math.pi / 180.0 if angle_unit == "deg" else 1.0
+    name = str(doc.get("name", Path(source).stem))
+    length_unit = str(doc.get("length_unit", "mm"))
+    joints = doc.get("joints")
+    if not isinstance(joints, list) or not joints:
+        raise _err("expected at least one [[joints]] table", source, "joints")
+    fields = _FIELDS[notation]
+    rows, kinds, pitches, limits, names = [], [], [], [], []
+    for i, j in enumerate(joints, start=1):
+        where = f"joints[{i}]"
+        if not isinstance(j, dict):
+            raise _err("each joint must be a table", source, where)
+        extra = set(j) - set(fields) - {"name", "type", "pitch", "limits"}
+        if extra:
+            raise _err(f"unknown keys {sorted(extra)}", source, where)
+        kind = j.get("type", "revolute")
+        if kind not in ("revolute", "prismatic", "screw"):
+            raise _err(f"unknown joint type {kind!r}; expected revolute, prismatic or screw",
+                       source, f"{where}.type")
+        row = []
+        for f in fields:
+            v = _num(j.get(f, 0.0), source, f"{where}.{f}")
+            row.append(v * to_rad if f in _ANGLES else v)
+        rows.append(row)
+        kinds.append(kind)
+        pitch = _num(j.get("pitch", 0.0), source, f"{where}.pitch")
+        if kind == "screw" and pitch == 0.0:
+            raise _err("a screw joint needs a non-zero pitch", source, f"{where}.pitch")
+        pitches.append(pitch)
+        lim = j.get("limits", [-math.inf, math.inf])
+        if not isinstance(lim, list) or len(lim) != 2:
+            raise _err("limits must be [lower, upper]", source, f"{where}.limits")
+        lo, hi = (float(x) if isinstance(x, (int, float)) else math.nan for x in lim)
+        if math.isnan(lo) or math.isnan(hi) or lo > hi:
+            raise _err(f"limits {lim!r} are not an interval", source, f"{where}.limits")
+        scale = 1.0 if kind == "prismatic" else to_rad
+        limits.append((lo * scale, hi * scale))
+        names.append(str(j.get("name", i)))
+    description = str(doc.get("description", ""))
+    try:
+        if notation == "nadkarni":
+            for k in ("base", "tool"):
+                if k in doc:
+                    raise _err(f"'{k}' is not used with the nadkarni notation "
+                               "(use frame_points and [hand])", source, k)
+            fp = _matrix(doc.get("frame_points"), source, "frame_points", (3, 3))
+            full = []
+            for row, kind, pitch in zip(rows, kinds, pitches, strict=True):
+                ph = {"prismatic": 2 * PRISMATIC_PITCH_THRESHOLD, "revolute": 0.0}.get(kind, pitch)
+                full.append(row + [ph])
+            n_active: int | None = None
+            if "hand" in doc:
+                h = doc["hand"]
+                if not isinstance(h, dict):
+                    raise _err("[hand] must be a table of r, alpha, a, theta", source, "hand")
+                hr = [_num(h.get(f, 0.0), source, f"hand.{f}") * (to_rad if f in _ANGLES else 1)
+                      for f in fields]
+                full.append(hr + [0.0])
+                n_active = len(rows)
+            model = from_nadkarni(full, fp, n_active=n_active, limits=limits, name=name,
+                                  length_unit=length_unit, description=description)
+            object.__setattr__(model, "joints", tuple(
+                type(jt)(kind=jt.kind, pitch=jt.pitch, lower=jt.lower, upper=jt.upper, name=nm)
+                for jt, nm in zip(model.joints, names, strict=True)))
+        else:
+            base = _matrix(doc["base"], source, "base", (4, 4)) if "base" in doc else None
+            tool = _matrix(doc["tool"], source, "tool", (4, 4)) if "tool" in doc else None
+            build = from_standard_dh if notation == "standard_dh" else from_modified_dh
+            q_home = None
+            if "q_home" in doc:
+                qh = np.array([_num(v, source, "q_home") for v in doc["q_home"]])
+                if qh.shape != (len(rows),):
+                    raise _err(f"q_home must have {len(rows)} values", source, "q_home")
+                q_home = np.where(np.array(kinds) == "prismatic", qh, qh * to_rad)
+            model = build(rows, kinds, pitches=pitches, limits=limits, names=names, base=base,
+                          tool=tool, name=name, length_unit=length_unit, q_home=q_home,
+                          description=description)
+    except ModelError as exc:
+        if isinstance(exc, ParseError):
+            raise
+        raise _err(str(exc), source) from exc
+    return model
+
+
+def _clean(x: float) -> float:
+    """Round-trip-safe float for TOML (drop -0.0 and tiny float noise is NOT done: exact)."""
+    return 0.0 if x == 0.0 else float(x)
+
+
+def dumps_model(model: ChainModel, angle_unit: str = "deg") -> str:
+    """Serialise a model to TOML in its own notation (``chain`` models cannot be written)."""
+    if model.notation not in _FIELDS:
+        raise ModelError(f"model {model.name!r} in notation {model.notation!r} has no TOML form; "
+                         "build it from a DH table or Nadkarni's notation")
+    to_file = 180.0 / math.pi if angle_unit == "deg" else 1.0
+    fields = _FIELDS[model.notation]
+    doc: dict = {"name": model.name, "notation": model.notation,
+                 "length_unit": model.length_unit, "angle_unit": angle_unit}
+    if model.description:
+        doc["description"] = model.description
+    joints = []
+    if model.notation == "nadkarni":
+        ex = model.extra_dict()
+        rows = np.asarray(ex["rows"])
+        n_active = int(ex["n_active"])
+        doc["frame_points"] = [[_clean(v) for v in p] for p in np.asarray(ex["frame_points"])]
+        params = rows[:, :4]
+        if n_active < rows.shape[0]:
+            h = rows[n_active]
+            doc["hand"] = {f: _clean(h[k] * (to_file if f in _ANGLES else 1.0))
+                           for k, f in enumerate(fields)}
+        params = params[:n_active]
+    else:
+        params = np.asarray(model.parameters)
+        if not np.array_equal(model.base, np.eye(4)):
+            doc["base"] = [[_clean(v) for v in r] for r in model.base]
+        if not np.array_equal(model.tool, np.eye(4)):
+            doc["tool"] = [[_clean(v) for v in r] for r in model.tool]
+        if np.any(model.q_home != 0):
+            doc["q_home"] = [_clean(v if j.kind == "prismatic" else v * to_file)
+                             for v, j in zip(model.q_home, model.joints, strict=True)]
+    for jt, row in zip(model.joints, params, strict=True):
+        entry: dict = {"name": jt.name, "type": jt.kind}
+        for k, f in enumerate(fields):
+            entry[f] = _clean(row[k] * (to_file if f in _ANGLES else 1.0))
+        if jt.kind == "screw":
+            entry["pitch"] = _clean(jt.pitch)
+        if math.isfinite(jt.lower) or math.isfinite(jt.upper):
+            s = 1.0 if jt.kind == "prismatic" else to_file
+            entry["limits"] = [jt.lower * s, jt.upper * s]  # TOML has inf
+        joints.append(entry)
+    doc["joints"] = joints
+    return tomli_w.dumps(doc)
+
+
+def write_model(model: ChainModel, path: str | os.PathLike, angle_unit: str = "deg") -> None:
+    """Write a model as TOML, atomically (a temporary file renamed into place)."""
+    text = dumps_model(model, angle_unit=angle_unit)
+    p = Path(path)
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", dir=p.parent or ".")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as fh:
+            fh.write(text)
+        os.replace(tmp, p)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise

@@ -1,0 +1,72 @@
+"""Joints of a serial chain: revolute, prismatic and screw (helical).
+
+Every joint moves along/about the local z axis of the frame that precedes it
+(DESIGN.md, "One internal chain model"):
+
+- revolute:  ``Z(q) = Rz(q)``
+- prismatic: ``Z(q) = Tz(q)``
+- screw:     ``Z(q) = Rz(q) · Tz(h q)`` with pitch ``h`` in length per radian (Nadkarni eq. 2-14,
+  ``δr = h δθ``).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from kinestat.errors import ModelError
+
+__all__ = ["Joint", "JOINT_KINDS", "PRISMATIC_PITCH_THRESHOLD", "kind_from_pitch"]
+
+JOINT_KINDS = ("revolute", "prismatic", "screw")
+
+#: DISP's rule (Nadkarni App. I, SET FOUR): a joint whose pitch exceeds 1e5 is prismatic.
+PRISMATIC_PITCH_THRESHOLD = 1e5
+
+
+def kind_from_pitch(pitch: float) -> str:
+    """Joint kind from a DISP pitch: > 1e5 prismatic, 0 revolute, otherwise screw."""
+    if not math.isfinite(pitch):
+        raise ModelError(f"joint pitch must be finite, got {pitch!r}")
+    if pitch > PRISMATIC_PITCH_THRESHOLD:
+        return "prismatic"
+    if pitch == 0.0:
+        return "revolute"
+    return "screw"
+
+
+@dataclass(frozen=True)
+class Joint:
+    """One single-degree-of-freedom joint.
+
+    ``lower``/``upper`` are limits on the joint value q (radians for revolute and screw joints,
+    length for prismatic ones); infinite when the joint is unlimited.
+    """
+
+    kind: str = "revolute"
+    pitch: float = 0.0
+    lower: float = -math.inf
+    upper: float = math.inf
+    name: str = ""
+
+    def __post_init__(self) -> None:
+        if self.kind not in JOINT_KINDS:
+            raise ModelError(
+                f"unknown joint kind {self.kind!r} for joint {self.name or '?'}; "
+                f"expected one of {', '.join(JOINT_KINDS)}"
+            )
+        if not math.isfinite(self.pitch):
+            raise ModelError(f"joint {self.name or '?'}: pitch must be finite")
+        if self.kind == "revolute" and self.pitch != 0.0:
+            object.__setattr__(self, "kind", "screw")
+        if self.kind != "screw" and self.kind != "revolute":
+            object.__setattr__(self, "pitch", 0.0)
+        if math.isnan(self.lower) or math.isnan(self.upper) or self.lower > self.upper:
+            raise ModelError(
+                f"joint {self.name or '?'}: limits [{self.lower}, {self.upper}] are not an interval"
+            )
+
+    @property
+    def rotates(self) -> bool:
+        """True for revolute and screw joints (their value is an angle)."""
+        return self.kind != "prismatic"

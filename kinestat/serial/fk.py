@@ -1,0 +1,77 @@
+"""Forward kinematics of serial chains, batched.
+
+``T(q) = C0 · Z(q1) · C1 · … · Z(qn) · Cn`` (DESIGN.md; the lecture notes'
+``H_n^0 = H_1^0 H_2^1 … H_n^{n-1}``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from kinestat.mechanism.chain import ChainModel
+
+__all__ = ["joint_motion", "fk", "fk_frames", "joint_axes"]
+
+
+def joint_motion(model: ChainModel, q: np.ndarray) -> np.ndarray:
+    """The joint transforms ``Z(qi)``, shape ``(..., n, 4, 4)``.
+
+    Revolute ``Rz(q)``, prismatic ``Tz(q)``, screw ``Rz(q) Tz(h q)`` (Nadkarni eq. 2-14).
+    """
+    q = np.asarray(q, dtype=float)
+    kinds = model.kind_codes
+    rot = kinds != 1
+    ang = np.where(rot, q, 0.0)
+    c, s = np.cos(ang), np.sin(ang)
+    Z = np.zeros(q.shape + (4, 4))
+    Z[..., 0, 0] = c
+    Z[..., 0, 1] = -s
+    Z[..., 1, 0] = s
+    Z[..., 1, 1] = c
+    Z[..., 2, 2] = 1.0
+    Z[..., 3, 3] = 1.0
+    Z[..., 2, 3] = np.where(kinds == 1, q, 0.0) + np.where(kinds == 2, model.pitches * q, 0.0)
+    return Z
+
+
+def fk(model: ChainModel, q) -> np.ndarray:
+    """End pose(s) ``(..., 4, 4)`` for joint values ``q`` of shape ``(..., n)``."""
+    q = model.check_q(q)
+    Z = joint_motion(model, q)
+    C = model.constants
+    T = np.broadcast_to(C[0], q.shape[:-1] + (4, 4))
+    for i in range(model.n):
+        T = T @ Z[..., i, :, :] @ C[i + 1]
+    return T
+
+
+def fk_frames(model: ChainModel, q) -> np.ndarray:
+    """Every link frame ``F_i = C0 Z(q1) C1 … Z(qi) Ci`` for i = 0..n, shape ``(..., n+1, 4, 4)``.
+
+    ``F_0 = C0`` is the frame in which joint 1 moves (its z axis is joint 1's axis), ``F_{i-1}``
+    the frame of joint i, and ``F_n`` the end pose. For chains built from standard DH (and
+    Nadkarni's notation) ``F_i`` is the DH frame x(i).
+    """
+    q = model.check_q(q)
+    Z = joint_motion(model, q)
+    C = model.constants
+    out = np.empty(q.shape[:-1] + (model.n + 1, 4, 4))
+    T = np.broadcast_to(C[0], q.shape[:-1] + (4, 4))
+    out[..., 0, :, :] = T
+    for i in range(model.n):
+        T = T @ Z[..., i, :, :] @ C[i + 1]
+        out[..., i + 1, :, :] = T
+    return out
+
+
+def joint_axes(model: ChainModel, q) -> tuple[np.ndarray, np.ndarray]:
+    """Joint axes as lines in the base frame: unit directions U(i) and feet of perpendicular ρn(i).
+
+    Returns ``(u, rho_n)`` each ``(..., n, 3)``; ρn(i) is the point of axis i nearest the origin
+    (Nadkarni's "normal vector to the joint axis from the origin").
+    """
+    F = fk_frames(model, q)[..., :-1, :, :]
+    u = F[..., :3, 2]
+    p = F[..., :3, 3]
+    rho = p - np.sum(p * u, axis=-1, keepdims=True) * u
+    return u, rho
