@@ -1,0 +1,50 @@
+"""``kinestat fk`` end to end."""
+
+import json
+
+import numpy as np
+import pytest
+
+import kinestat
+from kinestat.cli.main import main
+
+
+def run_json(capsys, *args):
+    assert main(list(args)) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_fk_puma762_tool_point(capsys):
+    q_deg = [200, 10, 20, 30, 40, 50]
+    out = run_json(capsys, "fk", "puma762", "--q-deg", ",".join(map(str, q_deg)),
+                   "--tool-point-6", "0,0,235", "--json")
+    T = kinestat.fk(kinestat.load("puma762"), np.deg2rad(q_deg))
+    np.testing.assert_allclose(out["pose"], T, atol=1e-9)
+    np.testing.assert_allclose(out["tool_point"], T[:3, 3] + 235 * T[:3, 2], atol=1e-9)
+    np.testing.assert_allclose(out["s6"], T[:3, 2], atol=1e-12)
+    np.testing.assert_allclose(out["a67"], T[:3, 0], atol=1e-12)
+    assert set(out) >= {"tool_point", "s6", "a67", "pose"}
+
+
+def test_fk_radians_and_degrees_agree(capsys):
+    a = run_json(capsys, "fk", "puma560", "--q", "0.1,0.2,0.3,0.4,0.5,0.6", "--json")
+    b = run_json(capsys, "fk", "puma560", "--q-deg",
+                 ",".join(str(np.rad2deg(x)) for x in [0.1, 0.2, 0.3, 0.4, 0.5, 0.6]), "--json")
+    np.testing.assert_allclose(a["pose"], b["pose"], atol=1e-12)
+
+
+def test_fk_prismatic_values_are_lengths(capsys):
+    out = run_json(capsys, "fk", "nadkarni-config2", "--q-deg", "0,25,8,0,90,0", "--json")
+    m = kinestat.load("nadkarni-config2")
+    np.testing.assert_allclose(out["pose"], kinestat.fk(m, m.q_home), atol=1e-12)
+
+
+@pytest.mark.parametrize("args,msg", [
+    (["fk", "puma762", "--q-deg", "1,2"], "expected 6"),
+    (["fk", "puma762"], "exactly one"),
+    (["fk", "nosuchmodel", "--q", "0"], "unknown model"),
+    (["fk", "puma762", "--q", "1,2,3,4,5,nan"], "finite"),
+])
+def test_fk_errors(capsys, args, msg):
+    assert main(args) == 2
+    assert msg in capsys.readouterr().err
