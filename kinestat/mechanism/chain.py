@@ -120,9 +120,15 @@ class ChainModel:
         if qh.shape != (n,) or not np.all(np.isfinite(qh)):
             raise ModelError(f"model {self.name!r}: q_home must be {n} finite values")
         object.__setattr__(self, "q_home", _readonly(qh))
-        object.__setattr__(self, "_kinds", _readonly(
-            np.array([{"revolute": 0, "prismatic": 1, "screw": 2}[j.kind] for j in joints])
-        ))
+        kinds = _readonly(
+            np.array([{"revolute": 0, "prismatic": 1, "screw": 2}[j.kind] for j in joints],
+                     dtype=np.int64)
+        )
+        pitches = _readonly(np.array([j.pitch if j.kind == "screw" else 0.0 for j in joints]))
+        object.__setattr__(self, "_kinds", kinds)
+        object.__setattr__(self, "_pitches", pitches)
+        # the arguments of the compiled kernels, contiguous and ready (kinestat.serial._kernels)
+        object.__setattr__(self, "kernel_args", (self.constants, kinds, pitches))
 
     # -- derived, cheap views ------------------------------------------------------------------
     @property
@@ -142,8 +148,8 @@ class ChainModel:
 
     @property
     def pitches(self) -> np.ndarray:
-        """Pitch of each joint (0 for revolute and prismatic)."""
-        return np.array([j.pitch if j.kind == "screw" else 0.0 for j in self.joints])
+        """Pitch of each joint (0 for revolute and prismatic), read-only."""
+        return self._pitches  # type: ignore[attr-defined]
 
     @property
     def lower(self) -> np.ndarray:

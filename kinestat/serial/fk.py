@@ -2,15 +2,26 @@
 
 ``T(q) = C0 · Z(q1) · C1 · … · Z(qn) · Cn`` (DESIGN.md; the lecture notes'
 ``H_n^0 = H_1^0 H_2^1 … H_n^{n-1}``).
+
+:func:`fk` runs compiled kernels (:mod:`kinestat.serial._kernels`); :func:`fk_reference` is the
+plain NumPy implementation they are tested against.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+
 import numpy as np
 
+from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
+from kinestat.serial import _kernels
 
-__all__ = ["joint_motion", "fk", "fk_frames", "joint_axes"]
+__all__ = ["joint_motion", "fk", "fk_reference", "fk_frames", "joint_axes", "iter_fk",
+           "CHUNK_ROWS"]
+
+#: rows per chunk for the NumPy paths and for :func:`iter_fk` (bounded temporaries)
+CHUNK_ROWS = 1 << 15
 
 
 def joint_motion(model: ChainModel, q: np.ndarray) -> np.ndarray:
@@ -34,15 +45,67 @@ def joint_motion(model: ChainModel, q: np.ndarray) -> np.ndarray:
     return Z
 
 
+def _as_q(model: ChainModel, q) -> np.ndarray:
+    if type(q) is not np.ndarray or q.dtype != np.float64:
+        try:
+            q = np.asarray(q, dtype=np.float64)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"q must be numbers of shape (..., {model.n}): {exc}") from exc
+    if q.ndim == 0 or q.shape[-1] != model.n:
+        raise InputError(
+            f"q must have shape (..., {model.n}) for model {model.name!r}, got {q.shape}"
+        )
+    return q
+
+
+def _nonfinite() -> InputError:
+    return InputError("q contains NaN or infinity")
+
+
 def fk(model: ChainModel, q) -> np.ndarray:
     """End pose(s) ``(..., 4, 4)`` for joint values ``q`` of shape ``(..., n)``."""
+    q = _as_q(model, q)
+    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
+    if q.ndim == 1:
+        out = _kernels.fk_one(C, kinds, pitch, q)
+        if out is None:
+            raise _nonfinite()
+        return out
+    lead = q.shape[:-1]
+    Q = np.ascontiguousarray(q.reshape(-1, model.n))
+    out = np.empty((Q.shape[0], 4, 4))
+    if _kernels.fk_batch(C, kinds, pitch, Q, out):
+        raise _nonfinite()
+    return out.reshape(lead + (4, 4))
+
+
+def iter_fk(
+    model: ChainModel, q, chunk_rows: int = CHUNK_ROWS
+) -> Iterator[tuple[slice, np.ndarray]]:
+    """Stream end poses over a large batch ``q (N, n)`` chunk by chunk: yields
+    ``(rows, poses)`` so that 10^7 configurations need only one chunk of output at a time."""
+    q = _as_q(model, q)
+    Q = q.reshape(-1, model.n)
+    for start in range(0, Q.shape[0], chunk_rows):
+        rows = slice(start, min(start + chunk_rows, Q.shape[0]))
+        yield rows, fk(model, Q[rows])
+
+
+def fk_reference(model: ChainModel, q) -> np.ndarray:
+    """Plain NumPy forward kinematics (the reference the kernels are tested against)."""
     q = model.check_q(q)
-    Z = joint_motion(model, q)
+    lead = q.shape[:-1]
+    Q = q.reshape(-1, model.n)
+    out = np.empty((Q.shape[0], 4, 4))
     C = model.constants
-    T = np.broadcast_to(C[0], q.shape[:-1] + (4, 4))
-    for i in range(model.n):
-        T = T @ Z[..., i, :, :] @ C[i + 1]
-    return T
+    for start in range(0, Q.shape[0], CHUNK_ROWS):
+        part = Q[start:start + CHUNK_ROWS]
+        Z = joint_motion(model, part)
+        T = np.broadcast_to(C[0], part.shape[:-1] + (4, 4))
+        for i in range(model.n):
+            T = T @ Z[:, i] @ C[i + 1]
+        out[start:start + CHUNK_ROWS] = T
+    return out.reshape(lead + (4, 4))
 
 
 def fk_frames(model: ChainModel, q) -> np.ndarray:

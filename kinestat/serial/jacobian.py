@@ -10,10 +10,12 @@ from __future__ import annotations
 
 import numpy as np
 
+from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.fk import fk_frames
+from kinestat.serial import _kernels
+from kinestat.serial.fk import _as_q, fk_frames
 
-__all__ = ["jacobian", "jacobian_from_frames"]
+__all__ = ["jacobian", "jacobian_reference", "jacobian_from_frames", "fk_and_jacobian"]
 
 
 def jacobian_from_frames(model: ChainModel, frames: np.ndarray) -> np.ndarray:
@@ -28,6 +30,36 @@ def jacobian_from_frames(model: ChainModel, frames: np.ndarray) -> np.ndarray:
     return np.swapaxes(np.concatenate([w, v], axis=-1), -1, -2)
 
 
+def jacobian_reference(model: ChainModel, q) -> np.ndarray:
+    """Plain NumPy Jacobian (the reference the kernels are tested against)."""
+    return jacobian_from_frames(model, fk_frames(model, q))
+
+
 def jacobian(model: ChainModel, q) -> np.ndarray:
     """Space Jacobian ``(..., 6, n)`` mapping joint rates to the end twist ``[ω; v_O]``."""
-    return jacobian_from_frames(model, fk_frames(model, q))
+    q = _as_q(model, q)
+    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
+    if q.ndim == 1:
+        J = _kernels.jacobian_one(C, kinds, pitch, q)
+        if J is None:
+            raise InputError("q contains NaN or infinity")
+        return J
+    lead = q.shape[:-1]
+    Q = np.ascontiguousarray(q.reshape(-1, model.n))
+    out = np.empty((Q.shape[0], 6, model.n))
+    if _kernels.jacobian_batch(C, kinds, pitch, Q, out):
+        raise InputError("q contains NaN or infinity")
+    return out.reshape(lead + (6, model.n))
+
+
+def fk_and_jacobian(model: ChainModel, q) -> tuple[np.ndarray, np.ndarray]:
+    """End poses ``(..., 4, 4)`` and Jacobians ``(..., 6, n)`` in one pass."""
+    q = _as_q(model, q)
+    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
+    lead = q.shape[:-1]
+    Q = np.ascontiguousarray(q.reshape(-1, model.n))
+    T = np.empty((Q.shape[0], 4, 4))
+    J = np.empty((Q.shape[0], 6, model.n))
+    if _kernels.fk_jacobian_batch(C, kinds, pitch, Q, T, J):
+        raise InputError("q contains NaN or infinity")
+    return T.reshape(lead + (4, 4)), J.reshape(lead + (6, model.n))

@@ -1,0 +1,186 @@
+"""Compiled kernels (Numba) for forward kinematics and the Jacobian of serial chains.
+
+They compute exactly what :func:`kinestat.serial.fk.fk_reference` and
+:func:`kinestat.serial.jacobian.jacobian_reference` compute, without temporaries: the running
+transform is held in twelve scalars, ``T · Z(q)`` touches only the columns it changes and
+``T · C`` is an affine product. Batches are split over the cores with ``prange``.
+
+Compiled on first use and cached on disk (``cache=True``, in ``__pycache__``): the first call in
+a fresh checkout compiles for a few seconds, later processes load the cache.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+_OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
+
+
+@nb.njit(inline="always", **_OPTS)
+def _step(C, kind, h, qi, t):
+    """Apply ``Z(qi) · C`` to the running transform ``t`` (12 values, row-major 3x4)."""
+    r00, r01, r02, p0, r10, r11, r12, p1, r20, r21, r22, p2 = t
+    if kind != 1:
+        c = math.cos(qi)
+        s = math.sin(qi)
+        a0 = c * r00 + s * r01
+        a1 = c * r10 + s * r11
+        a2 = c * r20 + s * r21
+        r01 = c * r01 - s * r00
+        r11 = c * r11 - s * r10
+        r21 = c * r21 - s * r20
+        r00, r10, r20 = a0, a1, a2
+        if kind == 2:
+            d = h * qi
+            p0 += d * r02
+            p1 += d * r12
+            p2 += d * r22
+    else:
+        p0 += qi * r02
+        p1 += qi * r12
+        p2 += qi * r22
+    n00 = r00 * C[0, 0] + r01 * C[1, 0] + r02 * C[2, 0]
+    n01 = r00 * C[0, 1] + r01 * C[1, 1] + r02 * C[2, 1]
+    n02 = r00 * C[0, 2] + r01 * C[1, 2] + r02 * C[2, 2]
+    n03 = r00 * C[0, 3] + r01 * C[1, 3] + r02 * C[2, 3] + p0
+    n10 = r10 * C[0, 0] + r11 * C[1, 0] + r12 * C[2, 0]
+    n11 = r10 * C[0, 1] + r11 * C[1, 1] + r12 * C[2, 1]
+    n12 = r10 * C[0, 2] + r11 * C[1, 2] + r12 * C[2, 2]
+    n13 = r10 * C[0, 3] + r11 * C[1, 3] + r12 * C[2, 3] + p1
+    n20 = r20 * C[0, 0] + r21 * C[1, 0] + r22 * C[2, 0]
+    n21 = r20 * C[0, 1] + r21 * C[1, 1] + r22 * C[2, 1]
+    n22 = r20 * C[0, 2] + r21 * C[1, 2] + r22 * C[2, 2]
+    n23 = r20 * C[0, 3] + r21 * C[1, 3] + r22 * C[2, 3] + p2
+    return (n00, n01, n02, n03, n10, n11, n12, n13, n20, n21, n22, n23)
+
+
+@nb.njit(inline="always", **_OPTS)
+def _start(C0):
+    return (C0[0, 0], C0[0, 1], C0[0, 2], C0[0, 3], C0[1, 0], C0[1, 1], C0[1, 2], C0[1, 3],
+            C0[2, 0], C0[2, 1], C0[2, 2], C0[2, 3])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _store(t, out):
+    out[0, 0], out[0, 1], out[0, 2], out[0, 3] = t[0], t[1], t[2], t[3]
+    out[1, 0], out[1, 1], out[1, 2], out[1, 3] = t[4], t[5], t[6], t[7]
+    out[2, 0], out[2, 1], out[2, 2], out[2, 3] = t[8], t[9], t[10], t[11]
+    out[3, 0], out[3, 1], out[3, 2], out[3, 3] = 0.0, 0.0, 0.0, 1.0
+
+
+@nb.njit(**_OPTS)
+def fk_one(C, kinds, pitch, q):
+    """End pose of one configuration; returns None if q has a non-finite value."""
+    n = kinds.shape[0]
+    for i in range(n):
+        if not math.isfinite(q[i]):
+            return None
+    t = _start(C[0])
+    for i in range(n):
+        t = _step(C[i + 1], kinds[i], pitch[i], q[i], t)
+    out = np.empty((4, 4))
+    _store(t, out)
+    return out
+
+
+@nb.njit(parallel=True, **_OPTS)
+def fk_batch(C, kinds, pitch, Q, out):
+    """End poses of ``Q (N, n)`` into ``out (N, 4, 4)``; returns the number of non-finite rows."""
+    N = Q.shape[0]
+    n = kinds.shape[0]
+    bad = 0
+    for k in nb.prange(N):
+        ok = True
+        for i in range(n):
+            if not math.isfinite(Q[k, i]):
+                ok = False
+        if not ok:
+            bad += 1
+            continue
+        t = _start(C[0])
+        for i in range(n):
+            t = _step(C[i + 1], kinds[i], pitch[i], Q[k, i], t)
+        _store(t, out[k])
+    return bad
+
+
+@nb.njit(inline="always", **_OPTS)
+def _jac_column(t, kind, h, J, j):
+    ux, uy, uz = t[2], t[6], t[10]
+    px, py, pz = t[3], t[7], t[11]
+    if kind == 1:
+        J[0, j] = 0.0
+        J[1, j] = 0.0
+        J[2, j] = 0.0
+        J[3, j] = ux
+        J[4, j] = uy
+        J[5, j] = uz
+    else:
+        J[0, j] = ux
+        J[1, j] = uy
+        J[2, j] = uz
+        # h u - u x p = h u + p x u
+        J[3, j] = h * ux + py * uz - pz * uy
+        J[4, j] = h * uy + pz * ux - px * uz
+        J[5, j] = h * uz + px * uy - py * ux
+
+
+@nb.njit(**_OPTS)
+def jacobian_one(C, kinds, pitch, q):
+    """Space Jacobian ``(6, n)`` of one configuration; None if q has a non-finite value."""
+    n = kinds.shape[0]
+    for i in range(n):
+        if not math.isfinite(q[i]):
+            return None
+    J = np.empty((6, n))
+    t = _start(C[0])
+    for i in range(n):
+        _jac_column(t, kinds[i], pitch[i], J, i)
+        t = _step(C[i + 1], kinds[i], pitch[i], q[i], t)
+    return J
+
+
+@nb.njit(parallel=True, **_OPTS)
+def jacobian_batch(C, kinds, pitch, Q, out):
+    """Jacobians of ``Q (N, n)`` into ``out (N, 6, n)``; returns the number of non-finite rows."""
+    N = Q.shape[0]
+    n = kinds.shape[0]
+    bad = 0
+    for k in nb.prange(N):
+        ok = True
+        for i in range(n):
+            if not math.isfinite(Q[k, i]):
+                ok = False
+        if not ok:
+            bad += 1
+            continue
+        t = _start(C[0])
+        for i in range(n):
+            _jac_column(t, kinds[i], pitch[i], out[k], i)
+            t = _step(C[i + 1], kinds[i], pitch[i], Q[k, i], t)
+    return bad
+
+
+@nb.njit(parallel=True, **_OPTS)
+def fk_jacobian_batch(C, kinds, pitch, Q, T_out, J_out):
+    """End poses and Jacobians together (one pass) for ``Q (N, n)``."""
+    N = Q.shape[0]
+    n = kinds.shape[0]
+    bad = 0
+    for k in nb.prange(N):
+        ok = True
+        for i in range(n):
+            if not math.isfinite(Q[k, i]):
+                ok = False
+        if not ok:
+            bad += 1
+            continue
+        t = _start(C[0])
+        for i in range(n):
+            _jac_column(t, kinds[i], pitch[i], J_out[k], i)
+            t = _step(C[i + 1], kinds[i], pitch[i], Q[k, i], t)
+        _store(t, T_out[k])
+    return bad

@@ -1,0 +1,73 @@
+"""The compiled kernels against the plain NumPy reference, on random chains and inputs."""
+
+import numpy as np
+import pytest
+
+import kinestat
+from kinestat.errors import InputError
+from kinestat.mechanism.chain import from_modified_dh, from_standard_dh
+from kinestat.serial.fk import fk_reference, iter_fk
+from kinestat.serial.jacobian import fk_and_jacobian, jacobian_reference
+
+
+def random_chain(rng):
+    n = int(rng.integers(1, 10))
+    rows = np.c_[rng.uniform(-3, 3, n), rng.uniform(-2, 2, n), rng.uniform(-2, 2, n),
+                 rng.uniform(-3, 3, n)]
+    kinds = list(rng.choice(["revolute", "prismatic", "screw"], n))
+    pitches = [rng.uniform(-1, 1) if k == "screw" else 0.0 for k in kinds]
+    build = from_standard_dh if rng.random() < 0.5 else from_modified_dh
+    base = kinestat.fk(from_standard_dh(rows[:1]), rng.uniform(-3, 3, 1))
+    return build(rows, kinds, pitches=pitches, base=base)
+
+
+def test_kernels_match_reference(rng):
+    for _ in range(40):
+        m = random_chain(rng)
+        q = rng.uniform(-4, 4, (int(rng.integers(1, 50)), m.n))
+        np.testing.assert_allclose(kinestat.fk(m, q), fk_reference(m, q), atol=1e-12)
+        np.testing.assert_allclose(kinestat.jacobian(m, q), jacobian_reference(m, q), atol=1e-12)
+        np.testing.assert_allclose(kinestat.fk(m, q[0]), fk_reference(m, q[0]), atol=1e-12)
+        np.testing.assert_allclose(kinestat.jacobian(m, q[0]), jacobian_reference(m, q[0]),
+                                   atol=1e-12)
+        T, J = fk_and_jacobian(m, q)
+        np.testing.assert_allclose(T, fk_reference(m, q), atol=1e-12)
+        np.testing.assert_allclose(J, jacobian_reference(m, q), atol=1e-12)
+
+
+def test_leading_dimensions_and_layouts(rng):
+    m = kinestat.load("puma762")
+    q = rng.uniform(-3, 3, (4, 5, 6))
+    np.testing.assert_allclose(kinestat.fk(m, q), fk_reference(m, q), atol=1e-12)
+    qt = np.asfortranarray(q[:, 0, :])
+    np.testing.assert_allclose(kinestat.fk(m, qt), fk_reference(m, qt), atol=1e-12)
+    np.testing.assert_allclose(kinestat.fk(m, q[0, :, ::-1][:, ::-1]), fk_reference(m, q[0]),
+                               atol=1e-12)
+    assert kinestat.fk(m, [0, 1, 2, 3, 4, 5]).shape == (4, 4)
+    assert kinestat.fk(m, np.zeros((0, 6))).shape == (0, 4, 4)
+
+
+def test_iter_fk_streams_chunks(rng):
+    m = kinestat.load("puma560")
+    q = rng.uniform(-3, 3, (1000, 6))
+    parts = list(iter_fk(m, q, chunk_rows=300))
+    assert [r.start for r, _ in parts] == [0, 300, 600, 900]
+    np.testing.assert_allclose(np.concatenate([p for _, p in parts]), fk_reference(m, q),
+                               atol=1e-12)
+
+
+@pytest.mark.parametrize("bad", [[np.nan, 0, 0, 0, 0, 0], [[0] * 6, [0, 0, np.inf, 0, 0, 0]]])
+def test_nonfinite_rejected(bad):
+    m = kinestat.load("puma560")
+    with pytest.raises(InputError, match="NaN"):
+        kinestat.fk(m, bad)
+    with pytest.raises(InputError, match="NaN"):
+        kinestat.jacobian(m, bad)
+
+
+def test_wrong_shape_and_type():
+    m = kinestat.load("puma560")
+    with pytest.raises(InputError):
+        kinestat.fk(m, np.zeros((3, 5)))
+    with pytest.raises(InputError):
+        kinestat.fk(m, "abc")
