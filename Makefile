@@ -27,11 +27,11 @@ run: $(RUN_STAMP)
 
 # The whole test suite (lint first, then pytest; pytest fails when no test runs).
 test: $(DEV_STAMP)
-	$(BIN)/ruff check kinestat tests benchmarks
+	$(BIN)/ruff check kinestat tests $(wildcard benchmarks)
 	$(BIN)/pytest
 
 lint: $(DEV_STAMP)
-	$(BIN)/ruff check kinestat tests benchmarks
+	$(BIN)/ruff check kinestat tests $(wildcard benchmarks)
 
 clean:
 	rm -rf $(VENV) build *.egg-info
