@@ -1,0 +1,191 @@
+"""URDF import and export for serial chains.
+
+Export writes the chain ``C0 · Z(q1) · C1 · … · Z(qn) · Cn`` as links ``base`` → ``link1`` … →
+``link<n>`` → ``tool``: joint i has origin ``C_{i-1}`` and axis +z; a fixed joint carries ``Cn``.
+Import follows the chain from the root link to a tip link; a joint whose axis is not +z is
+rotated onto z (``A`` with ``A·z = axis``) so that the model stays in kinestat's canonical form.
+URDF lengths are metres: ``scale`` converts (e.g. ``scale=1e-3`` exports a millimetre model).
+Screw joints have no URDF form and are refused.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import warnings
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from kinestat.errors import ModelError, ParseError
+from kinestat.mechanism.chain import ChainModel
+from kinestat.mechanism.joints import Joint
+
+__all__ = ["to_urdf", "from_urdf", "read_urdf"]
+
+
+def _origin(T: np.ndarray, scale: float) -> str:
+    xyz = " ".join(f"{v * scale:.17g}" for v in T[:3, 3])
+    with warnings.catch_warnings():  # gimbal lock is harmless: any valid rpy reproduces R
+        warnings.simplefilter("ignore", UserWarning)
+        rpy_v = Rotation.from_matrix(T[:3, :3]).as_euler("xyz")
+    rpy = " ".join(f"{v:.17g}" for v in rpy_v)
+    return f'<origin xyz="{xyz}" rpy="{rpy}"/>'
+
+
+def to_urdf(model: ChainModel, *, scale: float = 1.0, name: str | None = None) -> str:
+    """URDF text of a serial chain (lengths multiplied by ``scale``)."""
+    if any(j.kind == "screw" for j in model.joints):
+        raise ModelError(f"model {model.name!r} has a screw joint, which URDF cannot express")
+    lines = [f'<robot name="{name or model.name}">', '  <link name="base"/>']
+    C = model.constants
+    for i, j in enumerate(model.joints, start=1):
+        lines.append(f'  <link name="link{i}"/>')
+        lo, hi = j.lower, j.upper
+        if j.kind == "revolute" and not (math.isfinite(lo) and math.isfinite(hi)):
+            jtype, limit = "continuous", ""
+        else:
+            s = scale if j.kind == "prismatic" else 1.0
+            lo = lo * s if math.isfinite(lo) else -1e9
+            hi = hi * s if math.isfinite(hi) else 1e9
+            jtype = j.kind
+            limit = f'<limit lower="{lo:.17g}" upper="{hi:.17g}" effort="0" velocity="0"/>'
+        parent = "base" if i == 1 else f"link{i - 1}"
+        lines.append(
+            f'  <joint name="{j.name or i}" type="{jtype}"><parent link="{parent}"/>'
+            f'<child link="link{i}"/>{_origin(C[i - 1], scale)}<axis xyz="0 0 1"/>{limit}</joint>'
+        )
+    lines.append('  <link name="tool"/>')
+    lines.append(
+        f'  <joint name="tool_fixed" type="fixed"><parent link="link{model.n}"/>'
+        f'<child link="tool"/>{_origin(C[model.n], scale)}</joint>'
+    )
+    lines.append("</robot>")
+    return "\n".join(lines) + "\n"
+
+
+def _floats(text: str | None, n: int, where: str, source: str) -> np.ndarray:
+    if text is None:
+        return np.zeros(n)
+    try:
+        v = np.array([float(x) for x in text.split()])
+    except ValueError as exc:
+        raise ParseError(f"cannot read numbers from {text!r}", file=source, field=where) from exc
+    if v.shape != (n,) or not np.all(np.isfinite(v)):
+        raise ParseError(f"expected {n} finite numbers, got {text!r}", file=source, field=where)
+    return v
+
+
+def _pose(xyz: np.ndarray, rpy: np.ndarray) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = Rotation.from_euler("xyz", rpy).as_matrix()
+    T[:3, 3] = xyz
+    return T
+
+
+def _align_z(axis: np.ndarray) -> np.ndarray:
+    """A rotation (4x4) taking +z onto ``axis`` (unit)."""
+    z = np.array([0.0, 0.0, 1.0])
+    v = np.cross(z, axis)
+    s, c = np.linalg.norm(v), float(z @ axis)
+    T = np.eye(4)
+    if s < 1e-15:
+        if c < 0:
+            T[:3, :3] = np.diag([1.0, -1.0, -1.0])
+        return T
+    T[:3, :3] = Rotation.from_rotvec(v / s * math.atan2(s, c)).as_matrix()
+    return T
+
+
+def from_urdf(
+    text: str,
+    *,
+    tip: str | None = None,
+    scale: float = 1.0,
+    name: str | None = None,
+    length_unit: str = "m",
+    source: str = "<urdf>",
+) -> ChainModel:
+    """Serial chain from URDF text, from the root link to ``tip`` (default: the only leaf).
+
+    Lengths are multiplied by ``scale`` (``scale=1000`` gives millimetres).
+    """
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise ParseError(f"not valid XML: {exc}", file=source) from exc
+    if root.tag != "robot":
+        raise ParseError("the root element must be <robot>", file=source)
+    joints = {}
+    children = set()
+    for j in root.findall("joint"):
+        parent, child = j.find("parent"), j.find("child")
+        if parent is None or child is None:
+            raise ParseError(f"joint {j.get('name')!r} lacks a parent or child", file=source)
+        joints[child.get("link")] = j
+        children.add(child.get("link"))
+    links = [lk.get("name") for lk in root.findall("link")]
+    roots = [lk for lk in links if lk not in children]
+    if len(roots) != 1:
+        raise ParseError(f"expected one root link, found {roots}", file=source)
+    parents_of = {c: j.find("parent").get("link") for c, j in joints.items()}
+    leaves = [lk for lk in links if lk not in set(parents_of.values())]
+    if tip is None:
+        if len(leaves) != 1:
+            raise ParseError(f"several leaf links {leaves}: choose one with tip=", file=source)
+        tip = leaves[0]
+    if tip not in links:
+        raise ParseError(f"no link named {tip!r}", file=source)
+    path = []
+    link = tip
+    while link in joints:
+        path.append(joints[link])
+        link = parents_of[link]
+    path.reverse()
+    consts = [np.eye(4)]
+    kinds: list[Joint] = []
+    for j in path:
+        where = f"joint {j.get('name')!r}"
+        o = j.find("origin")
+        xyz = _floats(o.get("xyz") if o is not None else None, 3, where + " origin xyz", source)
+        rpy = _floats(o.get("rpy") if o is not None else None, 3, where + " origin rpy", source)
+        Tj = _pose(xyz * scale, rpy)
+        jtype = j.get("type")
+        if jtype == "fixed":
+            consts[-1] = consts[-1] @ Tj
+            continue
+        if jtype not in ("revolute", "continuous", "prismatic"):
+            raise ParseError(f"{where}: joint type {jtype!r} is not supported in a serial chain",
+                             file=source)
+        ax = j.find("axis")
+        axis = _floats(ax.get("xyz") if ax is not None else "1 0 0", 3, where + " axis", source)
+        nrm = np.linalg.norm(axis)
+        if nrm < 1e-12:
+            raise ParseError(f"{where}: zero axis", file=source)
+        A = _align_z(axis / nrm)
+        consts[-1] = consts[-1] @ Tj @ A
+        consts.append(np.linalg.inv(A))
+        lim = j.find("limit")
+        lo, hi = -math.inf, math.inf
+        if lim is not None and jtype != "continuous":
+            s = scale if jtype == "prismatic" else 1.0
+            lo = float(lim.get("lower", "-inf")) * s
+            hi = float(lim.get("upper", "inf")) * s
+        kinds.append(Joint(kind="prismatic" if jtype == "prismatic" else "revolute",
+                           lower=lo, upper=hi, name=str(j.get("name"))))
+    if not kinds:
+        raise ModelError(f"{source}: no moving joint between the root and {tip!r}")
+    return ChainModel(name=name or str(root.get("name", "urdf")), joints=tuple(kinds),
+                      constants=np.array(consts), length_unit=length_unit)
+
+
+def read_urdf(path: str | os.PathLike, **kwargs) -> ChainModel:
+    """Read a URDF file (see :func:`from_urdf`)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ParseError(f"cannot read URDF: {exc.strerror}", file=str(p)) from exc
+    return from_urdf(text, source=str(p), **kwargs)
