@@ -129,6 +129,8 @@ class ChainModel:
         object.__setattr__(self, "_pitches", pitches)
         # the arguments of the compiled kernels, contiguous and ready (kinestat.serial._kernels)
         object.__setattr__(self, "kernel_args", (self.constants, kinds, pitches))
+        packed = np.concatenate([self.constants.ravel(), kinds.astype(float), pitches])
+        object.__setattr__(self, "kernel_packed", _readonly(packed))
 
     # -- derived, cheap views ------------------------------------------------------------------
     @property

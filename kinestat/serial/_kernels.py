@@ -72,15 +72,17 @@ def _store(t, out):
 
 
 @nb.njit(**_OPTS)
-def fk_one(C, kinds, pitch, q):
-    """End pose of one configuration; returns None if q has a non-finite value."""
-    n = kinds.shape[0]
+def fk_one(P, q):
+    """End pose of one configuration of the packed chain ``P``; None if q is not finite."""
+    n = q.shape[0]
     for i in range(n):
         if not math.isfinite(q[i]):
             return None
+    C = P[: (n + 1) * 16].reshape((n + 1, 4, 4))
+    o = (n + 1) * 16
     t = _start(C[0])
     for i in range(n):
-        t = _step(C[i + 1], kinds[i], pitch[i], q[i], t)
+        t = _step(C[i + 1], int(P[o + i]), P[o + n + i], q[i], t)
     out = np.empty((4, 4))
     _store(t, out)
     return out
@@ -129,17 +131,21 @@ def _jac_column(t, kind, h, J, j):
 
 
 @nb.njit(**_OPTS)
-def jacobian_one(C, kinds, pitch, q):
-    """Space Jacobian ``(6, n)`` of one configuration; None if q has a non-finite value."""
-    n = kinds.shape[0]
+def jacobian_one(P, q):
+    """Space Jacobian ``(6, n)`` of one configuration of the packed chain ``P``."""
+    n = q.shape[0]
     for i in range(n):
         if not math.isfinite(q[i]):
             return None
+    C = P[: (n + 1) * 16].reshape((n + 1, 4, 4))
+    o = (n + 1) * 16
     J = np.empty((6, n))
     t = _start(C[0])
     for i in range(n):
-        _jac_column(t, kinds[i], pitch[i], J, i)
-        t = _step(C[i + 1], kinds[i], pitch[i], q[i], t)
+        kind = int(P[o + i])
+        h = P[o + n + i]
+        _jac_column(t, kind, h, J, i)
+        t = _step(C[i + 1], kind, h, q[i], t)
     return J
 
 

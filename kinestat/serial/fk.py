@@ -62,15 +62,23 @@ def _nonfinite() -> InputError:
     return InputError("q contains NaN or infinity")
 
 
+_F64 = np.dtype(np.float64)
+
+
 def fk(model: ChainModel, q) -> np.ndarray:
     """End pose(s) ``(..., 4, 4)`` for joint values ``q`` of shape ``(..., n)``."""
-    q = _as_q(model, q)
-    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
-    if q.ndim == 1:
-        out = _kernels.fk_one(C, kinds, pitch, q)
+    if type(q) is np.ndarray and q.dtype is _F64 and q.shape == model.q_home.shape:
+        out = _kernels.fk_one(model.kernel_packed, q)  # type: ignore[attr-defined]
         if out is None:
             raise _nonfinite()
         return out
+    q = _as_q(model, q)
+    if q.ndim == 1:
+        out = _kernels.fk_one(model.kernel_packed, q)  # type: ignore[attr-defined]
+        if out is None:
+            raise _nonfinite()
+        return out
+    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
     lead = q.shape[:-1]
     Q = np.ascontiguousarray(q.reshape(-1, model.n))
     out = np.empty((Q.shape[0], 4, 4))

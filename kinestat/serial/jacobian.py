@@ -13,7 +13,7 @@ import numpy as np
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import _kernels
-from kinestat.serial.fk import _as_q, fk_frames
+from kinestat.serial.fk import _F64, _as_q, fk_frames
 
 __all__ = ["jacobian", "jacobian_reference", "jacobian_from_frames", "fk_and_jacobian"]
 
@@ -37,13 +37,18 @@ def jacobian_reference(model: ChainModel, q) -> np.ndarray:
 
 def jacobian(model: ChainModel, q) -> np.ndarray:
     """Space Jacobian ``(..., 6, n)`` mapping joint rates to the end twist ``[ω; v_O]``."""
-    q = _as_q(model, q)
-    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
-    if q.ndim == 1:
-        J = _kernels.jacobian_one(C, kinds, pitch, q)
+    if type(q) is np.ndarray and q.dtype is _F64 and q.shape == model.q_home.shape:
+        J = _kernels.jacobian_one(model.kernel_packed, q)  # type: ignore[attr-defined]
         if J is None:
             raise InputError("q contains NaN or infinity")
         return J
+    q = _as_q(model, q)
+    if q.ndim == 1:
+        J = _kernels.jacobian_one(model.kernel_packed, q)  # type: ignore[attr-defined]
+        if J is None:
+            raise InputError("q contains NaN or infinity")
+        return J
+    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
     lead = q.shape[:-1]
     Q = np.ascontiguousarray(q.reshape(-1, model.n))
     out = np.empty((Q.shape[0], 6, model.n))
