@@ -18,6 +18,7 @@ from kinestat.errors import KinestatError
 # Order is the order of the help listing.
 COMMAND_MODULES: list[str] = [
     "fk",
+    "screw",
     "dh_from_axes",
 ]
 

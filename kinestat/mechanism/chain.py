@@ -291,30 +291,15 @@ def from_modified_dh(
 def frame_from_three_points(p1, p2, p3, *, what: str = "frame points") -> np.ndarray:
     """Pose with origin p1, z towards p2 and p3 in the z-x half plane (Nadkarni eqs. 3-1..3-3).
 
-    ``z = (p2-p1)/|p2-p1|``, ``y = (p2-p1) × (p3-p1)`` normalised, ``x = y × z``.
+    :func:`kinestat.spatial.displacement.frame_from_points`, with ``what`` naming the points in
+    error messages (e.g. "SET FIVE frame points").
     """
-    p1, p2, p3 = (np.asarray(p, dtype=float) for p in (p1, p2, p3))
-    if not (np.all(np.isfinite(p1)) and np.all(np.isfinite(p2)) and np.all(np.isfinite(p3))):
-        raise InputError(f"{what}: coordinates contain NaN or infinity")
-    z = p2 - p1
-    nz = np.linalg.norm(z, axis=-1, keepdims=True)
-    b = np.cross(z, p3 - p1)
-    nb = np.linalg.norm(b, axis=-1, keepdims=True)
-    scale = np.maximum(np.maximum(nz, np.linalg.norm(p3 - p1, axis=-1, keepdims=True)), 1e-300)
-    if np.any(nz <= 1e-12 * scale):
-        raise InputError(f"{what}: the first and second points coincide")
-    if np.any(nb <= 1e-12 * scale**2):
-        raise InputError(f"{what}: the three points are collinear")
-    z = z / nz
-    y = b / nb
-    x = np.cross(y, z)
-    T = np.zeros(np.broadcast_shapes(p1.shape, p2.shape, p3.shape)[:-1] + (4, 4))
-    T[..., :3, 0] = x
-    T[..., :3, 1] = y
-    T[..., :3, 2] = z
-    T[..., :3, 3] = p1
-    T[..., 3, 3] = 1.0
-    return T
+    from kinestat.spatial.displacement import frame_from_points
+
+    try:
+        return frame_from_points(p1, p2, p3)
+    except InputError as exc:
+        raise InputError(f"{what}: {exc}") from exc
 
 
 def from_nadkarni(

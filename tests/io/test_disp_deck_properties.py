@@ -100,7 +100,11 @@ def _blank_separated(deck: DispDeck) -> str:
     if deck.frame_points is not None:
         cards += [tuple(p) for p in deck.frame_points]
     def text(v):
-        return repr(v if isinstance(v, int) else float(v))
+        if isinstance(v, int):
+            return repr(v)
+        r = repr(float(v))
+        # a decimal point in every real, as Fortran wants when the card happens to fit columns
+        return r if "." in r or "e" not in r else r.replace("e", ".e", 1)
 
     return "\n".join("  ".join(text(v) for v in card) for card in cards)
 

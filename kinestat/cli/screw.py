@@ -1,0 +1,113 @@
+"""``kinestat screw``: the screw axis of the displacement between two body positions."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from kinestat.cli._output import console, parse_floats, print_json, table
+from kinestat.errors import InputError, ParseError
+from kinestat.spatial.displacement import ScrewDisplacement, screw_from_points, screw_from_poses
+
+
+def _read_pose_file(path: Path) -> np.ndarray:
+    """Numbers separated by spaces/commas, ``#`` comments; 16 (4x4) or 12 (top 3x4 rows)."""
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise InputError(f"cannot read pose file {str(path)!r}: {exc.strerror}") from exc
+    vals: list[float] = []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        for tok in line.split("#", 1)[0].replace(",", " ").split():
+            try:
+                vals.append(float(tok))
+            except ValueError as exc:
+                raise ParseError(f"{tok!r} is not a number", file=str(path), line=lineno) from exc
+    if len(vals) not in (12, 16):
+        raise ParseError(
+            f"expected 16 numbers (a 4x4 pose, row by row) or 12 (its top three rows), "
+            f"got {len(vals)}", file=str(path),
+        )
+    T = np.eye(4)
+    T[: len(vals) // 4] = np.reshape(vals, (-1, 4))
+    if not np.all(np.isfinite(T)):
+        raise ParseError("pose contains NaN or infinity", file=str(path))
+    return T
+
+
+def _pose(value: str, name: str) -> np.ndarray:
+    path = Path(value)
+    if path.is_file():
+        return _read_pose_file(path)
+    if "," not in value:
+        raise InputError(
+            f"--{name}: {value!r} is neither a file nor 16 comma-separated numbers "
+            "(a 4x4 pose, row by row)"
+        )
+    return parse_floats(value, 16, name).reshape(4, 4)
+
+
+def _points(value: str, name: str) -> np.ndarray:
+    return parse_floats(value, 9, name).reshape(3, 3)
+
+
+def screw_json(sc: ScrewDisplacement) -> dict:
+    """The JSON record of one screw displacement."""
+    return {
+        "axis": sc.axis,
+        "point": sc.point,
+        "translation": sc.d,
+        "angle_deg": sc.angle_deg,
+        "pitch": sc.pitch,
+        "pure_translation": sc.is_translation,
+    }
+
+
+def screw(
+    pose1: str = typer.Option(None, "--pose1", help="First pose: a file (4x4 or 3x4 numbers) "
+                              "or 16 comma-separated numbers, row by row."),
+    pose2: str = typer.Option(None, "--pose2", help="Second pose, as --pose1."),
+    points1: str = typer.Option(None, "--points1", help="First position by three body points "
+                                "x,y,z,x,y,z,x,y,z: origin, a point on +z, a point in the z-x "
+                                "half plane with x > 0 (Nadkarni eqs. 3-1 to 3-3)."),
+    points2: str = typer.Option(None, "--points2", help="Second position, as --points1."),
+    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+) -> None:
+    """Screw axis of the displacement between two positions of a body (Nadkarni ch. III).
+
+    Axis direction u (with u3 >= 0), the foot of the perpendicular from the origin to the axis,
+    the rotation angle in (-180, 180] degrees, the translation along u and the pitch (inf for a
+    pure translation).
+    """
+    by_pose = pose1 is not None or pose2 is not None
+    by_points = points1 is not None or points2 is not None
+    if by_pose == by_points:
+        raise InputError("give either --pose1 and --pose2, or --points1 and --points2")
+    if by_pose:
+        if pose1 is None or pose2 is None:
+            raise InputError("both --pose1 and --pose2 are needed")
+        sc = screw_from_poses(_pose(pose1, "pose1"), _pose(pose2, "pose2"))
+    else:
+        if points1 is None or points2 is None:
+            raise InputError("both --points1 and --points2 are needed")
+        sc = screw_from_points(_points(points1, "points1"), _points(points2, "points2"))
+    if as_json:
+        print_json(screw_json(sc))
+        return
+    u, p = sc.axis, sc.point
+    rows = [
+        ["axis u", f"{u[0]:.6f}, {u[1]:.6f}, {u[2]:.6f}"],
+        ["point on axis (foot from origin)", f"{p[0]:.6g}, {p[1]:.6g}, {p[2]:.6g}"],
+        ["rotation (deg)", f"{float(sc.angle_deg):.6f}"],
+        ["translation along u", f"{float(sc.d):.6g}"],
+        ["pitch", "inf" if bool(sc.is_translation) else f"{float(sc.pitch):.6g}"],
+        ["pure translation", "yes" if bool(sc.is_translation) else "no"],
+    ]
+    console.print(table("Screw displacement", ["quantity", "value"], rows))
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``screw`` command to the ``kinestat`` app."""
+    app.command("screw")(screw)
