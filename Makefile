@@ -5,6 +5,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 RUN_STAMP := $(VENV)/.run-installed
 DEV_STAMP := $(VENV)/.dev-installed
+BENCH_STAMP := $(VENV)/.bench-installed
 
 .PHONY: run test lint bench clean
 
@@ -29,6 +30,14 @@ run: $(RUN_STAMP)
 test: $(DEV_STAMP)
 	$(BIN)/ruff check kinestat tests $(wildcard benchmarks)
 	$(BIN)/pytest
+
+$(BENCH_STAMP): $(DEV_STAMP) requirements/bench.txt
+	$(BIN)/pip install -q -r requirements/bench.txt
+	touch $@
+
+# Side-by-side speed comparison with the peer libraries (prints a table; JSON with ARGS=--json).
+bench: $(BENCH_STAMP)
+	$(BIN)/python benchmarks/bench.py $(ARGS)
 
 lint: $(DEV_STAMP)
 	$(BIN)/ruff check kinestat tests $(wildcard benchmarks)

@@ -19,6 +19,7 @@ from kinestat.errors import KinestatError
 COMMAND_MODULES: list[str] = [
     "fk",
     "screw",
+    "ik",
     "dh_from_axes",
 ]
 
@@ -41,26 +42,22 @@ for _name in COMMAND_MODULES:
 
 
 def main(argv: list[str] | None = None) -> int:
-    """Console-script entry point; returns the exit status."""
+    """Console-script entry point; returns the exit status.
+
+    Usage errors and ``--help`` are handled by Typer (usage errors exit with status 2); a
+    :class:`KinestatError` is printed as one line on stderr and exits with status 2.
+    """
     try:
-        app(args=argv, standalone_mode=False)
+        app(args=argv, standalone_mode=True)
+    except SystemExit as exc:
+        code = exc.code
+        return code if isinstance(code, int) else (0 if code is None else 1)
     except KinestatError as exc:
         typer.echo(f"kinestat: error: {exc}", err=True)
         return 2
-    except typer.Exit as exc:  # pragma: no cover - typer control flow
-        return exc.exit_code
-    except typer.Abort:
-        typer.echo("kinestat: aborted", err=True)
+    except KeyboardInterrupt:
+        typer.echo("kinestat: interrupted", err=True)
         return 130
-    except Exception as exc:  # click usage errors
-        import click
-
-        if isinstance(exc, click.exceptions.ClickException):
-            exc.show()
-            return exc.exit_code
-        if isinstance(exc, click.exceptions.Exit):
-            return exc.exit_code
-        raise
     return 0
 
 

@@ -1,0 +1,295 @@
+"""``kinestat ik``: inverse kinematics — the PUMA 762 in closed form, any model numerically."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from kinestat.cli._output import console, parse_floats, print_json, table
+from kinestat.errors import InputError, KinestatError
+
+
+def register(app: typer.Typer) -> None:
+    app.command("ik")(ik_command)
+
+
+def _read_poses(text: str) -> np.ndarray:
+    """``--pose``: 16 comma-separated numbers (row-major 4x4) or a JSON file holding a 4x4
+    matrix, 16 numbers, a list of 4x4 matrices, or an object with a "pose" key (as written by
+    ``kinestat fk --json``)."""
+    p = Path(text)
+    if text.strip().endswith(".json") or (p.exists() and p.is_file()):
+        if not p.exists():
+            raise InputError(f"--pose: file {text!r} does not exist")
+        try:
+            data = json.loads(p.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+            raise InputError(f"--pose: cannot read {text!r} as JSON: {exc}") from exc
+        if isinstance(data, dict):
+            if "pose" not in data:
+                raise InputError(f"--pose: {text!r} is a JSON object without a \"pose\" key")
+            data = data["pose"]
+        try:
+            arr = np.asarray(data, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"--pose: {text!r} does not hold numbers in a 4x4 layout") from exc
+        if arr.shape == (16,):
+            arr = arr.reshape(4, 4)
+        if arr.ndim < 2 or arr.shape[-2:] != (4, 4):
+            raise InputError(
+                f"--pose: {text!r} must hold a 4x4 matrix (or a list of them), got shape "
+                f"{arr.shape}"
+            )
+        if not np.all(np.isfinite(arr)):
+            raise InputError(f"--pose: {text!r} contains NaN or infinity")
+        return arr
+    return parse_floats(text, 16, "pose").reshape(4, 4)
+
+
+def _deg(x) -> list[float]:
+    return [float(v) for v in np.degrees(np.asarray(x, dtype=float))]
+
+
+def ik_command(
+    model: str = typer.Argument(
+        ..., help="puma762 (closed form with --tool-point/--s6/--a67) or any model name or TOML "
+        "file (numerical, with --pose)."
+    ),
+    tool_point: str = typer.Option(
+        None, "--tool-point", help="PUMA 762: P_tool_F, the tool point in the fixed frame, x,y,z "
+        "(mm)."
+    ),
+    s6: str = typer.Option(
+        None, "--s6", help="PUMA 762: S6_F, the sixth joint axis (unit), x,y,z."
+    ),
+    a67: str = typer.Option(None, "--a67", help="PUMA 762: a67_F (unit, perpendicular to S6_F)."),
+    tool_point_6: str = typer.Option(
+        "0,0,0", "--tool-point-6", help="PUMA 762: P_tool_6, the tool point in frame 6, x,y,z (mm)."
+    ),
+    current_deg: str = typer.Option(
+        None, "--current-deg", help="PUMA 762: current joint angles φ1,θ2..θ6 (degrees); selects "
+        "the nearest solution within the axis limits."
+    ),
+    current_axis_deg: str = typer.Option(
+        None, "--current-axis-deg", help="PUMA 762: the current configuration as robot axis "
+        "angles (degrees; axis 1 = φ1 + 180)."
+    ),
+    limits: str = typer.Option(
+        "matlab", "--limits", help="PUMA 762 axis limits: 'matlab' (puma_rev_analysis.m, joint 5 "
+        "±100°) or 'table' (Table 2-1, joint 5 ±110°)."
+    ),
+    normalize: bool = typer.Option(
+        False, "--normalize", help="PUMA 762: unitise S6_F and a67_F first (as Crane's program "
+        "does); they must still be perpendicular."
+    ),
+    pose: str = typer.Option(
+        None, "--pose", help="Numerical IK target: 16 comma-separated numbers (row-major 4x4) or "
+        "a JSON file (4x4, list of 4x4, or {\"pose\": ...})."
+    ),
+    q0_deg: str = typer.Option(
+        None, "--q0-deg", help="Numerical IK start: joint values, rotating joints in degrees."
+    ),
+    restarts: int = typer.Option(20, "--restarts", help="Numerical IK: random restarts."),
+    max_iter: int = typer.Option(100, "--max-iter", help="Numerical IK: iterations per attempt."),
+    seed: int = typer.Option(0, "--seed", help="Numerical IK: seed of the random restarts."),
+    ignore_limits: bool = typer.Option(
+        False, "--ignore-limits", help="Numerical IK: ignore the model's joint limits."
+    ),
+    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+) -> None:
+    """Joint angles that reach a pose.
+
+    PUMA 762, closed form (Vibhute 2011 §2.2): every solution (up to 8) and every wrist-singular
+    family; JSON {"solutions": [{"q_deg", "axis_deg", "branch", "within_limits", ...}],
+    "singular_families": [...], "selected" (with --current-deg)}.
+
+    Any model, numerically (--pose): JSON {"q", "q_deg", "success", "position_error",
+    "rotation_error", "iterations", "attempts"}.
+    """
+    closed = any(v is not None for v in (tool_point, s6, a67))
+    if closed and pose is not None:
+        raise InputError("give either --pose (numerical IK) or --tool-point/--s6/--a67 "
+                         "(PUMA 762 closed form), not both")
+    if closed:
+        _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_axis_deg,
+                     limits, normalize, as_json)
+        return
+    if pose is None:
+        raise InputError("give the target: --pose for any model, or --tool-point, --s6 and "
+                         "--a67 for the PUMA 762 closed form")
+    _numerical(model, pose, q0_deg, restarts, max_iter, seed, ignore_limits, as_json)
+
+
+def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_axis_deg,
+                 limits, normalize, as_json) -> None:
+    from kinestat.serial import puma762 as P
+
+    if model != "puma762":
+        raise InputError(
+            f"the closed-form reverse analysis (--tool-point/--s6/--a67) exists only for "
+            f"puma762, not {model!r}; use --pose for numerical IK"
+        )
+    missing = [n for n, v in (("--tool-point", tool_point), ("--s6", s6), ("--a67", a67))
+               if v is None]
+    if missing:
+        raise InputError(f"the PUMA 762 closed form needs {', '.join(missing)} as well")
+    if limits not in ("matlab", "table"):
+        raise InputError(f"--limits must be 'matlab' or 'table', got {limits!r}")
+    lim = P.AXIS_LIMITS_MATLAB_DEG if limits == "matlab" else P.AXIS_LIMITS_TABLE_2_1_DEG
+    p = parse_floats(tool_point, 3, "tool-point")
+    z = parse_floats(s6, 3, "s6")
+    x = parse_floats(a67, 3, "a67")
+    p6 = parse_floats(tool_point_6, 3, "tool-point-6")
+    if normalize:
+        for name, v in (("s6", z), ("a67", x)):
+            if np.linalg.norm(v) == 0.0:
+                raise InputError(f"--{name}: a zero vector has no direction")
+        z = z / np.linalg.norm(z)
+        x = x / np.linalg.norm(x)
+    if current_deg is not None and current_axis_deg is not None:
+        raise InputError("give the current configuration once: --current-deg or "
+                         "--current-axis-deg")
+    current = current_axis = None
+    if current_deg is not None:
+        current = np.radians(parse_floats(current_deg, 6, "current-deg"))
+    elif current_axis_deg is not None:
+        current_axis = np.radians(parse_floats(current_axis_deg, 6, "current-axis-deg"))
+        current = P.from_axis_angles(current_axis)
+
+    res = P.reverse(p, z, x, p6)
+    b = res.batch
+    if current_axis is not None:
+        cand = P.select_batch(b, None, lim, current_axis=current_axis)
+    else:
+        cand = P.select_batch(b, current, lim)
+    out: dict = {
+        "model": "puma762",
+        "method": "closed-form",
+        "tool_point": p,
+        "s6": z,
+        "a67": x,
+        "tool_point_6": p6,
+        "solutions": [],
+        "singular_families": [],
+        "axis_limits_deg": lim,
+    }
+    for qk, k in zip(res.solutions, res.branches, strict=True):
+        out["solutions"].append({
+            "branch": int(k),
+            "q_deg": _deg(qk),
+            "axis_deg": _deg(P.to_axis_angles(qk)),
+            "within_limits": bool(cand.candidates_ok[k]),
+            "position_error": float(b.position_error[k]),
+            "rotation_error": float(b.rotation_error[k]),
+        })
+    for f in res.families:
+        rel = "theta6 - theta4" if f.kind == "difference" else "theta4 + theta6"
+        out["singular_families"].append({
+            "branch": f.branch,
+            "kind": f.kind,
+            "relation": f"{rel} = value_deg (theta4 free)",
+            "value_deg": float(np.degrees(f.value)),
+            "phi1_deg": float(np.degrees(f.phi1)),
+            "theta2_deg": float(np.degrees(f.theta2)),
+            "theta3_deg": float(np.degrees(f.theta3)),
+            "theta5_deg": float(np.degrees(f.theta5)),
+            "representative_q_deg": _deg(f.representative),
+            "within_limits": bool(cand.candidates_ok[f.branch]),
+        })
+    if res.reason:
+        out["reason"] = res.reason
+    if current is not None:
+        out["current_q_deg"] = _deg(current)
+        if current_axis is not None:
+            out["current_axis_deg"] = _deg(current_axis)
+        if bool(cand.ok):
+            k = int(cand.branch)
+            out["selected"] = {
+                "branch": k,
+                "q_deg": _deg(cand.q),
+                "axis_deg": _deg(cand.axis),
+                "singular": bool(b.singular[k]),
+                "motion_deg": float(np.degrees(cand.motion)),
+            }
+        else:
+            out["selected"] = None
+            out["selection_error"] = "no solution lies within the axis limits"
+    if as_json:
+        print_json(out)
+        return
+    console.print(f"[bold]PUMA 762 reverse analysis[/]: {len(res.solutions)} isolated "
+                  f"solution(s), {len(res.families)} wrist-singular family(ies)")
+    cols = ["branch", "φ1", "θ2", "θ3", "θ4", "θ5", "θ6", "limits ok"]
+    rows = [[s["branch"], *s["q_deg"], "yes" if s["within_limits"] else "no"]
+            for s in out["solutions"]]
+    if rows:
+        console.print(table("Solutions (degrees)", cols, rows, fmt="{:.3f}"))
+    for f in out["singular_families"]:
+        console.print(
+            f"family (branch {f['branch']}): φ1={f['phi1_deg']:.4f} θ2={f['theta2_deg']:.4f} "
+            f"θ3={f['theta3_deg']:.4f} θ5={f['theta5_deg']:.4f}, {f['relation']} with value "
+            f"{f['value_deg']:.4f}°" + ("" if f["within_limits"] else "  [outside limits]")
+        )
+    if res.reason:
+        console.print(f"[yellow]note:[/] {res.reason}")
+    if current is not None:
+        sel = out["selected"]
+        if sel is None:
+            console.print("[red]no solution lies within the axis limits[/]")
+        else:
+            console.print(
+                f"selected branch {sel['branch']}: q (deg) = "
+                + ", ".join(f"{v:.4f}" for v in sel["q_deg"])
+                + "; axis (deg) = " + ", ".join(f"{v:.4f}" for v in sel["axis_deg"])
+                + f"; total motion {sel['motion_deg']:.4f}°"
+            )
+
+
+def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits,
+               as_json) -> None:
+    import kinestat
+    from kinestat.serial.ik import ik
+
+    m = kinestat.load(model_name)
+    T = _read_poses(pose)
+    q0 = None
+    if q0_deg is not None:
+        v = parse_floats(q0_deg, m.n, "q0-deg")
+        q0 = np.where(m.prismatic, v, np.radians(v))
+    r = ik(m, T, q0, restarts=restarts, max_iter=max_iter, seed=seed,
+           respect_limits=not ignore_limits)
+    q_deg = np.where(m.prismatic, r.q, np.degrees(r.q))
+    out = {
+        "model": m.name,
+        "method": "numerical",
+        "length_unit": m.length_unit,
+        "q": r.q,
+        "q_deg": q_deg,
+        "success": r.success,
+        "position_error": r.position_error,
+        "rotation_error": r.rotation_error,
+        "iterations": r.iterations,
+        "attempts": r.attempts,
+    }
+    if as_json:
+        print_json(out)
+    else:
+        qs = np.atleast_2d(q_deg)
+        ok = np.atleast_1d(r.success)
+        pe = np.atleast_1d(r.position_error)
+        re = np.atleast_1d(r.rotation_error)
+        cols = ["#"] + [f"q{i + 1}" for i in range(m.n)] + ["ok", "pos err", "rot err"]
+        rows = [[i, *qs[i], "yes" if ok[i] else "NO", f"{pe[i]:.1e}", f"{re[i]:.1e}"]
+                for i in range(qs.shape[0])]
+        console.print(table(f"{m.name}: numerical IK (rotating joints in degrees, lengths in "
+                            f"{m.length_unit})", cols, rows, fmt="{:.3f}"))
+    if not np.all(r.success):
+        n_bad = int(np.sum(~np.atleast_1d(r.success)))
+        raise KinestatError(
+            f"numerical IK did not reach {n_bad} target(s) within tolerance (best configuration "
+            "reported above); try another --q0-deg, more --restarts, or check that the pose "
+            "is reachable within the joint limits"
+        )
