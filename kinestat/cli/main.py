@@ -20,6 +20,7 @@ COMMAND_MODULES: list[str] = [
     "fk",
     "screw",
     "ik",
+    "sim",
     "dh_from_axes",
 ]
 

@@ -1,0 +1,116 @@
+"""``kinestat sim``: stand-ins for the cell's hardware (Galil DMC simulator, encoder emitter)."""
+
+from __future__ import annotations
+
+import signal
+import threading
+import time
+
+import typer
+
+from kinestat.cli._output import console, parse_floats, print_json
+from kinestat.devices.encoder_stream import CHANNELS, THESIS_WIRING, legs_to_channels
+from kinestat.errors import InputError
+
+sim_app = typer.Typer(help="Simulated hardware: the Galil DMC controller and the platform's "
+                           "encoder stream.", no_args_is_help=True)
+
+
+def _run_until_stopped(duration: float | None, stop_event: threading.Event | None = None) -> None:
+    """Block until ``duration`` seconds pass (forever if None) or Ctrl-C."""
+    if duration is not None and (duration < 0 or duration != duration):
+        raise InputError(f"--duration must be >= 0 seconds, got {duration}")
+    ev = stop_event or threading.Event()
+    t_end = None if duration is None else time.monotonic() + duration
+    previous = None
+    if threading.current_thread() is threading.main_thread():
+        # SIGTERM (e.g. from a process manager) stops as cleanly as Ctrl-C
+        previous = signal.signal(signal.SIGTERM, lambda *_: ev.set())
+    try:
+        while not ev.is_set():
+            left = None if t_end is None else t_end - time.monotonic()
+            if left is not None and left <= 0:
+                break
+            ev.wait(0.2 if left is None else min(0.2, left))
+    except KeyboardInterrupt:
+        pass
+    finally:
+        if previous is not None:
+            signal.signal(signal.SIGTERM, previous)
+
+
+@sim_app.command("galil")
+def galil(
+    port: int = typer.Option(0, "--port", help="TCP port (0: any free port; the real "
+                             "controller uses 23)."),
+    host: str = typer.Option("127.0.0.1", "--host", help="Address to bind (loopback only, "
+                             "unless --allow-remote)."),
+    allow_remote: bool = typer.Option(False, "--allow-remote", help="Allow a non-loopback "
+                                      "address: anyone who can reach it can command motion."),
+    initial_counts: str = typer.Option("0,0,0,0,0,0", "--initial-counts",
+                                       help="Encoder counts of axes A..F at start."),
+    no_coupling: bool = typer.Option(False, "--no-coupling", help="Disable the axis 4 -> 5 "
+                                     "coupling of the thesis's PUMA."),
+    duration: float = typer.Option(None, "--duration", help="Stop after this many seconds "
+                                   "(default: run until Ctrl-C)."),
+    as_json: bool = typer.Option(False, "--json", help="Print the address as JSON."),
+) -> None:
+    """Run a simulated Galil DMC (six axes, trapezoidal profiles) until Ctrl-C."""
+    from kinestat.sim.galil_server import DmcSimulator, GalilSimServer
+
+    c0 = parse_floats(initial_counts, 6, "initial-counts")
+    ctrl = DmcSimulator(initial_counts=c0, **({"coupling": 0.0} if no_coupling else {}))
+    server = GalilSimServer(host, port, allow_remote=allow_remote, controller=ctrl)
+    with server:
+        if as_json:
+            print_json({"host": server.host, "port": server.port, "axes": "ABCDEF"})
+        else:
+            console.print(f"Galil DMC simulator listening on {server.host}:{server.port} "
+                          "(axes A-F). Ctrl-C to stop.")
+        _run_until_stopped(duration)
+    if not as_json:
+        console.print("Galil DMC simulator stopped.")
+
+
+@sim_app.command("encoders")
+def encoders(
+    rate: float = typer.Option(100.0, "--rate", help="Packets per second."),
+    counts: str = typer.Option("0,0,0,0,0,0", "--counts",
+                               help="Constant leg counts, legs 1..6 (a,b,c,d,e,f)."),
+    fmt: str = typer.Option("ks", "--format", help="'ks' (framed, checksummed) or 'legacy' "
+                            "(the thesis's 23-byte line)."),
+    duration: float = typer.Option(None, "--duration", help="Stop after this many seconds "
+                                   "(default: run until Ctrl-C)."),
+    as_json: bool = typer.Option(False, "--json", help="Print the pty path as JSON."),
+) -> None:
+    """Stream encoder packets onto a pseudo-terminal and print its path until Ctrl-C."""
+    from kinestat.sim.encoder_emitter import EncoderEmitter, constant_counts
+
+    if fmt not in ("ks", "legacy"):
+        raise InputError(f"--format must be 'ks' or 'legacy', got {fmt!r}")
+    legs = parse_floats(counts, 6, "counts")
+    if any(v != int(v) for v in legs):
+        raise InputError(f"--counts must be integers, got {counts!r}")
+    emitter = EncoderEmitter(constant_counts(legs), rate_hz=rate, fmt=fmt)
+    with emitter:
+        channels = legs_to_channels(legs.astype(int)).tolist()
+        if as_json:
+            print_json({"path": emitter.path, "rate_hz": rate, "format": fmt,
+                        "leg_counts": legs.astype(int).tolist(),
+                        "channel_counts": dict(zip(CHANNELS, channels, strict=True))})
+        else:
+            console.print(f"Encoder stream ({fmt}, {rate:g} Hz) on {emitter.path} — open it "
+                          "at 115200 baud. Ctrl-C to stop.")
+            console.print("channels " + ", ".join(
+                f"{c}=leg {w}: {v}" for c, w, v in zip(CHANNELS, THESIS_WIRING, channels,
+                                                        strict=True)))
+        _run_until_stopped(duration)
+        if emitter.error is not None:
+            raise InputError(f"the encoder emitter stopped: {emitter.error}")
+    if not as_json:
+        console.print(f"Encoder emitter stopped after {emitter.sent} packets.")
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``sim`` command group."""
+    app.add_typer(sim_app, name="sim")

@@ -1,0 +1,624 @@
+"""The platform's encoder stream: packet codec, incremental parser and serial reader.
+
+Two wire formats are understood (see ``docs/devices.md`` for the full specification):
+
+``ks`` — kinestat's framed ASCII line (written and read)::
+
+    $KS,<seq:4 hex>,A<count:8 hex>,B<...>,C<...>,D<...>,E<...>,F<...>*<crc:4 hex>\\r\\n
+
+  ``seq`` is a 16-bit sequence number that wraps 0xFFFF -> 0x0000; each count is a signed
+  32-bit integer in two's complement; the CRC is CRC-16/CCITT-FALSE (polynomial 0x1021,
+  initial value 0xFFFF) over every byte between ``$`` and ``*``. A frame is 75 bytes.
+
+``legacy`` — the thesis's 23-byte line (read; the emitter can also write it)
+  (Vibhute 2011 §3.2.3 and App. D.6 ``serialdaq_plat.m``): bytes 4, 7, 10, 13, 16, 19 (1-based)
+  are the tags ``A``..``F``, each followed by ONE 16-bit count as two raw bytes, high byte
+  first; the line ends with LF (which MATLAB's ``fgetl`` strips). Bytes 1-3 and 22-23 are not
+  interpreted. No sequence number, no checksum.
+
+Packets carry counts in channel order A..F. The thesis's FPGA wiring puts leg 2 on A, leg 1 on
+B, leg 6 on C, leg 5 on D, leg 4 on E and leg 3 on F (:data:`THESIS_WIRING`); the reader maps
+channels to legs 1..6 with that wiring unless told otherwise.
+"""
+
+from __future__ import annotations
+
+import binascii
+import math
+import re
+import time
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any, Literal
+
+import numpy as np
+
+from kinestat.errors import DeviceError, InputError, ProtocolError
+
+CHANNELS = "ABCDEF"
+"""Channel tags in packet order."""
+
+THESIS_WIRING: tuple[int, ...] = (2, 1, 6, 5, 4, 3)
+"""Leg number (1-based) carried by channels A..F (Vibhute App. D.6 ``serialdaq_plat.m``)."""
+
+SEQ_MODULUS = 1 << 16
+"""Sequence numbers are 16-bit and wrap around."""
+
+COUNT_MIN = -(1 << 31)
+COUNT_MAX = (1 << 31) - 1
+"""Range of a count in the ``ks`` format (signed 32-bit)."""
+
+LEGACY_LINE_LENGTH = 23
+"""Bytes in a legacy line without its LF terminator (``serialdaq_plat.m``: ``m==23``)."""
+
+LEGACY_TAG_OFFSETS = (3, 6, 9, 12, 15, 18)
+"""0-based offsets of the tags 'A'..'F' in a legacy line (1-based 4, 7, ..., 19)."""
+
+DEFAULT_BAUDRATE = 115200
+"""The XBee link's rate (Vibhute App. D.6)."""
+
+MAX_FRAME = 128
+"""A ``ks`` frame longer than this without its LF is declared broken (the real one is 75)."""
+
+_KS_BODY = re.compile(
+    rb"KS,([0-9A-F]{4}),A([0-9A-F]{8}),B([0-9A-F]{8}),C([0-9A-F]{8}),"
+    rb"D([0-9A-F]{8}),E([0-9A-F]{8}),F([0-9A-F]{8})"
+)
+
+Format = Literal["ks", "legacy"]
+
+
+@dataclass(frozen=True)
+class Packet:
+    """One decoded packet: ``counts`` in channel order A..F; ``seq`` is None for legacy lines."""
+
+    seq: int | None
+    counts: tuple[int, ...]
+    fmt: Format = "ks"
+
+
+@dataclass(frozen=True)
+class StreamFault:
+    """A problem found in the stream, reported in order with the packets.
+
+    ``kind`` is one of ``"framing"`` (garbage, truncated or over-long frame), ``"checksum"``,
+    ``"gap"`` (``lost`` packets are missing before ``seq``), ``"duplicate"`` (``seq`` repeated:
+    a frozen sensor), ``"out_of_order"`` (``seq`` behind the last accepted one; dropped) or
+    ``"restart"`` (the sender's sequence restarted; accepted).
+    """
+
+    kind: str
+    message: str
+    seq: int | None = None
+    lost: int = 0
+
+
+Event = Packet | StreamFault
+
+
+# --------------------------------------------------------------------------- codec (pure)
+
+
+def crc16_ccitt(data: bytes) -> int:
+    """CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection); check value 0x29B1."""
+    return binascii.crc_hqx(data, 0xFFFF)
+
+
+def _check_counts(counts: Iterable[Any], lo: int, hi: int, what: str) -> tuple[int, ...]:
+    try:
+        vals = list(counts)
+    except TypeError as exc:
+        raise InputError(f"{what}: expected 6 integer counts, got {counts!r}") from exc
+    if len(vals) != 6:
+        raise InputError(f"{what}: expected 6 counts (channels A..F), got {len(vals)}")
+    out = []
+    for ch, v in zip(CHANNELS, vals, strict=True):
+        try:
+            f = float(v)
+        except (TypeError, ValueError) as exc:
+            raise InputError(f"{what}: channel {ch} count {v!r} is not a number") from exc
+        if not math.isfinite(f) or f != math.floor(f):
+            raise InputError(f"{what}: channel {ch} count {v!r} is not a finite integer")
+        i = int(f) if not isinstance(v, (int, np.integer)) else int(v)
+        if not lo <= i <= hi:
+            raise InputError(f"{what}: channel {ch} count {i} is outside [{lo}, {hi}]")
+        out.append(i)
+    return tuple(out)
+
+
+def encode_packet(seq: int, counts: Sequence[int]) -> bytes:
+    """Encode one ``ks`` frame: sequence number 0..65535 and six signed 32-bit counts (A..F)."""
+    if isinstance(seq, bool) or not isinstance(seq, (int, np.integer)):
+        raise InputError(f"encode_packet: sequence number must be an integer, got {seq!r}")
+    if not 0 <= int(seq) < SEQ_MODULUS:
+        raise InputError(f"encode_packet: sequence number {seq} outside 0..65535 (wrap it)")
+    vals = _check_counts(counts, COUNT_MIN, COUNT_MAX, "encode_packet")
+    body = f"KS,{int(seq):04X}," + ",".join(
+        f"{ch}{v & 0xFFFFFFFF:08X}" for ch, v in zip(CHANNELS, vals, strict=True)
+    )
+    raw = body.encode("ascii")
+    return b"$" + raw + b"*" + f"{crc16_ccitt(raw):04X}".encode("ascii") + b"\r\n"
+
+
+def _signed32(u: int) -> int:
+    return u - (1 << 32) if u & 0x80000000 else u
+
+
+def decode_packet(data: bytes) -> Packet:
+    """Decode one ``ks`` frame (with or without its CR LF); raises :class:`ProtocolError`."""
+    if not isinstance(data, (bytes, bytearray, memoryview)):
+        raise InputError(f"decode_packet: expected bytes, got {type(data).__name__}")
+    frame = bytes(data).rstrip(b"\r\n")
+    if not frame.startswith(b"$"):
+        raise ProtocolError(f"encoder packet does not start with '$': {frame[:20]!r}")
+    star = frame.rfind(b"*")
+    if star < 0 or len(frame) - star != 5:
+        raise ProtocolError(f"encoder packet has no '*<crc:4 hex>' trailer: {frame[-12:]!r}")
+    body, crc_txt = frame[1:star], frame[star + 1 :]
+    if not re.fullmatch(rb"[0-9A-F]{4}", crc_txt):
+        raise ProtocolError(f"encoder packet checksum field {crc_txt!r} is not 4 hex digits")
+    want, got = int(crc_txt, 16), crc16_ccitt(body)
+    if want != got:
+        raise ProtocolError(
+            f"encoder packet checksum mismatch (frame says {want:04X}, data gives {got:04X}): "
+            "the packet was corrupted in transit; discard it"
+        )
+    m = _KS_BODY.fullmatch(body)
+    if m is None:
+        raise ProtocolError(
+            f"encoder packet body {body[:40]!r}... does not follow "
+            "'KS,<seq4>,A<hex8>,...,F<hex8>' (upper-case hex)"
+        )
+    seq = int(m.group(1), 16)
+    counts = tuple(_signed32(int(g, 16)) for g in m.groups()[1:])
+    return Packet(seq=seq, counts=counts, fmt="ks")
+
+
+def encode_legacy_line(
+    counts: Sequence[int], header: bytes = b"ENC", trailer: bytes = b" \r"
+) -> bytes:
+    """Encode a thesis-style 23-byte line plus LF: 16-bit unsigned counts, high byte first.
+
+    ``header`` (3 bytes) and ``trailer`` (2 bytes) fill the positions the thesis code does not
+    read; their real content is not recorded in the thesis (our choice, see docs/devices.md).
+    A count whose bytes include 0x0A (LF) produces a line that a reader will split: the legacy
+    format cannot protect against that, which is one reason for the ``ks`` format.
+    """
+    if len(header) != 3 or len(trailer) != 2:
+        raise InputError("encode_legacy_line: header must be 3 bytes and trailer 2 bytes")
+    vals = _check_counts(counts, 0, 0xFFFF, "encode_legacy_line")
+    body = b"".join(ch.encode() + v.to_bytes(2, "big") for ch, v in zip(CHANNELS, vals,
+                                                                          strict=True))
+    return header + body + trailer + b"\n"
+
+
+def decode_legacy_line(line: bytes) -> Packet:
+    """Decode a thesis-style line (23 bytes, LF already stripped or not); :class:`ProtocolError`.
+
+    Counts are returned raw (0..65535); see :func:`unwrap16` for counters that cross zero.
+    """
+    if not isinstance(line, (bytes, bytearray, memoryview)):
+        raise InputError(f"decode_legacy_line: expected bytes, got {type(line).__name__}")
+    b = bytes(line)
+    if b.endswith(b"\n"):
+        b = b[:-1]
+    if len(b) != LEGACY_LINE_LENGTH:
+        raise ProtocolError(
+            f"legacy encoder line has {len(b)} bytes, expected {LEGACY_LINE_LENGTH} "
+            "(a count byte equal to LF splits the line; discard it)"
+        )
+    for ch, off in zip(CHANNELS, LEGACY_TAG_OFFSETS, strict=True):
+        if b[off] != ord(ch):
+            raise ProtocolError(
+                f"legacy encoder line: byte {off + 1} is 0x{b[off]:02X}, expected tag "
+                f"'{ch}' (0x{ord(ch):02X})"
+            )
+    counts = tuple(int.from_bytes(b[off + 1 : off + 3], "big") for off in LEGACY_TAG_OFFSETS)
+    return Packet(seq=None, counts=counts, fmt="legacy")
+
+
+def unwrap16(previous: np.ndarray | Sequence[int] | None, raw: Sequence[int]) -> np.ndarray:
+    """Unwrap 16-bit counter values against the previous unwrapped values.
+
+    Each channel moves to the value congruent to ``raw`` modulo 65536 nearest ``previous``
+    (valid while a leg moves less than 32768 counts between packets: 832 mm at 0.0254
+    mm/count). With no previous value, ``raw`` is read as signed 16-bit (two's complement).
+    """
+    r = np.asarray(raw, dtype=np.int64) & 0xFFFF
+    if previous is None:
+        return np.where(r >= 0x8000, r - 0x10000, r)
+    p = np.asarray(previous, dtype=np.int64)
+    delta = (r - p) & 0xFFFF
+    delta = np.where(delta >= 0x8000, delta - 0x10000, delta)
+    return p + delta
+
+
+def channels_to_legs(channel_counts: Sequence[int], wiring: Sequence[int] = THESIS_WIRING
+                     ) -> np.ndarray:
+    """Reorder counts from channels A..F to legs 1..6 (``wiring[k]`` = leg on channel k)."""
+    w = _check_wiring(wiring)
+    c = np.asarray(channel_counts, dtype=np.int64)
+    out = np.empty(c.shape, dtype=np.int64)
+    out[..., np.asarray(w) - 1] = c
+    return out
+
+
+def legs_to_channels(leg_counts: Sequence[int], wiring: Sequence[int] = THESIS_WIRING
+                     ) -> np.ndarray:
+    """Reorder counts from legs 1..6 to channels A..F (inverse of :func:`channels_to_legs`)."""
+    w = _check_wiring(wiring)
+    c = np.asarray(leg_counts, dtype=np.int64)
+    return c[..., np.asarray(w) - 1]
+
+
+def _check_wiring(wiring: Sequence[int]) -> tuple[int, ...]:
+    w = tuple(int(x) for x in wiring)
+    if sorted(w) != [1, 2, 3, 4, 5, 6]:
+        raise InputError(f"wiring must be a permutation of legs 1..6 for channels A..F, got {w}")
+    return w
+
+
+# --------------------------------------------------------------------------- parser
+
+
+@dataclass
+class StreamStats:
+    """Counters kept by a :class:`StreamParser` over its lifetime."""
+
+    packets: int = 0
+    lost: int = 0
+    checksum: int = 0
+    framing: int = 0
+    duplicates: int = 0
+    out_of_order: int = 0
+    restarts: int = 0
+
+
+class StreamParser:
+    """Incremental parser: feed it byte chunks of any size, get packets and faults in order.
+
+    It never raises on stream content: garbage is skipped up to the next frame start and
+    reported once per run as a ``framing`` fault. In the ``ks`` format it also tracks the
+    sequence: a gap reports the number of lost packets (the packet itself is delivered), a
+    repeated sequence number is a ``duplicate`` (dropped), a sequence number behind the last
+    one is ``out_of_order`` (dropped) unless two consecutive such packets show that the sender
+    restarted, which is reported as ``restart`` and followed.
+    """
+
+    def __init__(self, fmt: Format = "ks") -> None:
+        if fmt not in ("ks", "legacy"):
+            raise InputError(f"unknown encoder stream format {fmt!r}; use 'ks' or 'legacy'")
+        self.fmt: Format = fmt
+        self.stats = StreamStats()
+        self._buf = bytearray()
+        self._last_seq: int | None = None
+        self._behind: int | None = None  # seq of the last out-of-order packet
+
+    def reset(self) -> None:
+        """Forget buffered bytes and the sequence history (counters are kept)."""
+        self._buf.clear()
+        self._last_seq = None
+        self._behind = None
+
+    def feed(self, chunk: bytes) -> list[Event]:
+        """Consume ``chunk``; return the packets and faults completed by it, in stream order."""
+        if not isinstance(chunk, (bytes, bytearray, memoryview)):
+            raise InputError(f"StreamParser.feed expects bytes, got {type(chunk).__name__}")
+        self._buf += chunk
+        return self._drain_ks() if self.fmt == "ks" else self._drain_legacy()
+
+    # -- ks
+    def _framing(self, message: str) -> StreamFault:
+        self.stats.framing += 1
+        return StreamFault("framing", message)
+
+    def _drain_ks(self) -> list[Event]:
+        out: list[Event] = []
+        buf = self._buf
+        while buf:
+            start = buf.find(b"$")
+            if start < 0:
+                junk = bytes(buf).strip(b"\r\n")
+                if len(buf) > MAX_FRAME or b"\n" in buf:
+                    if junk:
+                        out.append(self._framing(f"{len(junk)} bytes of garbage skipped"))
+                    buf.clear()
+                break
+            if start > 0:
+                junk = bytes(buf[:start]).strip(b"\r\n")
+                if junk:
+                    out.append(self._framing(f"{len(junk)} bytes of garbage before '$' skipped"))
+                del buf[:start]
+            nl = buf.find(b"\n")
+            nxt = buf.find(b"$", 1)
+            if nxt >= 0 and (nl < 0 or nxt < nl):
+                out.append(self._framing("truncated frame (a new '$' before its end) dropped"))
+                del buf[:nxt]
+                continue
+            if nl < 0:
+                if len(buf) > MAX_FRAME:
+                    out.append(self._framing(f"no end of frame within {MAX_FRAME} bytes"))
+                    del buf[:1]
+                    continue
+                break
+            frame = bytes(buf[: nl + 1])
+            del buf[: nl + 1]
+            if len(frame) > MAX_FRAME + 1:
+                out.append(self._framing(f"frame of {len(frame)} bytes is too long"))
+                continue
+            try:
+                pkt = decode_packet(frame)
+            except ProtocolError as exc:
+                if "checksum mismatch" in str(exc):
+                    self.stats.checksum += 1
+                    out.append(StreamFault("checksum", str(exc)))
+                else:
+                    out.append(self._framing(str(exc)))
+                continue
+            out.extend(self._sequence(pkt))
+        return out
+
+    def _sequence(self, pkt: Packet) -> list[Event]:
+        seq = pkt.seq
+        assert seq is not None
+        last = self._last_seq
+        if last is None:
+            self._accept(pkt)
+            return [pkt]
+        d = (seq - last) % SEQ_MODULUS
+        if d == 1:
+            self._accept(pkt)
+            return [pkt]
+        if d == 0:
+            self.stats.duplicates += 1
+            return [StreamFault("duplicate", f"sequence {seq:04X} repeated (frozen sensor?)",
+                                seq=seq)]
+        if d < SEQ_MODULUS // 2:
+            lost = d - 1
+            self.stats.lost += lost
+            self._accept(pkt)
+            return [StreamFault("gap", f"{lost} packet(s) lost before sequence {seq:04X}",
+                                seq=seq, lost=lost), pkt]
+        # behind the last accepted packet
+        if self._behind is not None and (seq - self._behind) % SEQ_MODULUS == 1:
+            self.stats.restarts += 1
+            self._accept(pkt)
+            return [StreamFault("restart", f"sender sequence restarted at {seq:04X}", seq=seq),
+                    pkt]
+        self._behind = seq
+        self.stats.out_of_order += 1
+        return [StreamFault("out_of_order",
+                            f"sequence {seq:04X} is behind the last one {last:04X}; dropped",
+                            seq=seq)]
+
+    def _accept(self, pkt: Packet) -> None:
+        self._last_seq = pkt.seq
+        self._behind = None
+        self.stats.packets += 1
+
+    # -- legacy
+    def _drain_legacy(self) -> list[Event]:
+        out: list[Event] = []
+        buf = self._buf
+        while True:
+            nl = buf.find(b"\n")
+            if nl < 0:
+                if len(buf) > MAX_FRAME:
+                    out.append(self._framing(f"no LF within {MAX_FRAME} bytes; buffer dropped"))
+                    buf.clear()
+                break
+            line = bytes(buf[:nl])
+            del buf[: nl + 1]
+            if not line:
+                continue
+            try:
+                pkt = decode_legacy_line(line)
+            except ProtocolError as exc:
+                out.append(self._framing(str(exc)))
+                continue
+            self.stats.packets += 1
+            out.append(pkt)
+        return out
+
+
+# --------------------------------------------------------------------------- reader
+
+
+class StaleDataError(ProtocolError):
+    """No fresh valid encoder packet within the allowed time (no packets, or a frozen sequence).
+
+    ``age`` is the time since the last fresh packet (``inf`` if none ever arrived) and
+    ``last_seq`` its sequence number (None if none, or in the legacy format).
+    """
+
+    def __init__(self, message: str, *, age: float, last_seq: int | None) -> None:
+        self.age = age
+        self.last_seq = last_seq
+        super().__init__(message)
+
+
+@dataclass(frozen=True)
+class Reading:
+    """The latest valid counts: ``counts`` per leg 1..6, ``channel_counts`` per channel A..F.
+
+    ``age`` is the time in seconds between its arrival and the call that returned it.
+    """
+
+    seq: int | None
+    counts: np.ndarray
+    channel_counts: tuple[int, ...]
+    received_at: float
+    age: float
+    fmt: Format = "ks"
+    faults: tuple[StreamFault, ...] = field(default=())
+
+
+class EncoderReader:
+    """Read the platform's encoder stream from a serial device or pyserial URL.
+
+    ``port`` is a device path (``/dev/ttyUSB0``, the emitter's pty) or any pyserial URL
+    (``loop://``, ``socket://host:port``, ...). ``stale_after`` (s) is how old the last fresh
+    packet may be before :meth:`latest` / :meth:`read` raise :class:`StaleDataError`. A packet
+    is fresh when its sequence number advances; repeated sequence numbers (a frozen sensor)
+    do not refresh. In the legacy format, without sequence numbers, every valid line is fresh,
+    so a frozen sensor cannot be told from a platform at rest — only silence is detected.
+    Legacy counts are unwrapped from 16 bits (:func:`unwrap16`) unless ``legacy_unwrap=False``.
+    """
+
+    def __init__(
+        self,
+        port: str,
+        *,
+        fmt: Format = "ks",
+        baudrate: int = DEFAULT_BAUDRATE,
+        stale_after: float = 0.25,
+        read_timeout: float = 0.02,
+        wiring: Sequence[int] = THESIS_WIRING,
+        legacy_unwrap: bool = True,
+        clock: Callable[[], float] = time.monotonic,
+        serial_factory: Callable[..., Any] | None = None,
+    ) -> None:
+        if not (isinstance(stale_after, (int, float)) and stale_after > 0
+                and math.isfinite(stale_after)):
+            raise InputError(f"stale_after must be a positive number of seconds, got "
+                             f"{stale_after!r}")
+        if not (isinstance(read_timeout, (int, float)) and read_timeout >= 0):
+            raise InputError(f"read_timeout must be >= 0 seconds, got {read_timeout!r}")
+        self.port = port
+        self.fmt: Format = fmt
+        self.baudrate = baudrate
+        self.stale_after = float(stale_after)
+        self.read_timeout = float(read_timeout)
+        self.wiring = _check_wiring(wiring)
+        self.legacy_unwrap = legacy_unwrap
+        self._clock = clock
+        self._factory = serial_factory
+        self.parser = StreamParser(fmt)
+        self._ser: Any = None
+        self._latest: Packet | None = None
+        self._latest_legs: np.ndarray | None = None
+        self._latest_t: float | None = None
+        self._latest_id = 0
+        self._returned_id = 0
+        self._pending_faults: list[StreamFault] = []
+
+    # -- life cycle
+    def open(self) -> EncoderReader:
+        """Open the serial port (idempotent); raises :class:`DeviceError` if it cannot."""
+        if self._ser is not None:
+            return self
+        import serial
+
+        factory = self._factory or serial.serial_for_url
+        try:
+            self._ser = factory(self.port, baudrate=self.baudrate, timeout=self.read_timeout)
+        except (serial.SerialException, OSError, ValueError) as exc:
+            raise DeviceError(
+                f"cannot open encoder stream {self.port!r}: {exc}. Check the device path or "
+                "URL and that the emitter/receiver is running"
+            ) from exc
+        return self
+
+    def close(self) -> None:
+        """Close the port (idempotent)."""
+        ser, self._ser = self._ser, None
+        if ser is not None:
+            try:
+                ser.close()
+            except Exception:
+                pass
+
+    def __enter__(self) -> EncoderReader:
+        return self.open()
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    @property
+    def stats(self) -> StreamStats:
+        """Stream counters (packets, lost, checksum, framing, duplicates, ...)."""
+        return self.parser.stats
+
+    # -- I/O
+    def poll(self) -> list[Event]:
+        """Read what has arrived (waiting at most ``read_timeout``); return its events."""
+        import serial
+
+        if self._ser is None:
+            self.open()
+        try:
+            waiting = self._ser.in_waiting
+            data = self._ser.read(max(1, waiting))
+        except (serial.SerialException, OSError) as exc:
+            raise DeviceError(f"encoder stream {self.port!r} failed while reading: {exc}. "
+                              "The device was unplugged or the emitter stopped") from exc
+        if not data:
+            return []
+        now = self._clock()
+        events = self.parser.feed(data)
+        for ev in events:
+            if isinstance(ev, Packet):
+                self._take(ev, now)
+            else:
+                self._pending_faults.append(ev)
+        return events
+
+    def _take(self, pkt: Packet, now: float) -> None:
+        legs = channels_to_legs(pkt.counts, self.wiring)
+        if pkt.fmt == "legacy" and self.legacy_unwrap:
+            legs = unwrap16(self._latest_legs, legs)
+        self._latest, self._latest_legs, self._latest_t = pkt, legs, now
+        self._latest_id += 1
+
+    def _reading(self, now: float) -> Reading:
+        assert self._latest is not None and self._latest_t is not None
+        assert self._latest_legs is not None
+        faults, self._pending_faults = tuple(self._pending_faults), []
+        return Reading(seq=self._latest.seq, counts=self._latest_legs.copy(),
+                       channel_counts=self._latest.counts, received_at=self._latest_t,
+                       age=now - self._latest_t, fmt=self._latest.fmt, faults=faults)
+
+    def _stale(self, now: float, why: str) -> StaleDataError:
+        age = math.inf if self._latest_t is None else now - self._latest_t
+        seq = None if self._latest is None else self._latest.seq
+        st = self.parser.stats
+        if self._latest_t is None:
+            what = "no valid encoder packet has arrived"
+        else:
+            what = f"the last fresh encoder packet (seq {seq}) is {age:.3f} s old"
+        return StaleDataError(
+            f"stale encoder data on {self.port!r}: {what} ({why}; {st.duplicates} duplicate, "
+            f"{st.checksum} corrupt, {st.framing} framing faults so far). Check the sensor "
+            "link; do not act on old counts",
+            age=age, last_seq=seq)
+
+    def latest(self, max_age: float | None = None) -> Reading:
+        """The latest valid counts after one :meth:`poll` (at most ``read_timeout``).
+
+        Raises :class:`StaleDataError` if the last fresh packet is older than ``max_age``
+        (default ``stale_after``) or none has arrived.
+        """
+        self.poll()
+        now = self._clock()
+        limit = self.stale_after if max_age is None else float(max_age)
+        if self._latest_t is None or now - self._latest_t > limit:
+            raise self._stale(now, f"limit {limit:.3f} s")
+        self._returned_id = self._latest_id
+        return self._reading(now)
+
+    def read(self, timeout: float | None = None) -> Reading:
+        """Wait for a packet newer than the last one returned (by :meth:`read` or
+        :meth:`latest`); :class:`StaleDataError` if none arrives in time.
+
+        ``timeout`` defaults to ``stale_after``.
+        """
+        limit = self.stale_after if timeout is None else float(timeout)
+        t_end = self._clock() + limit
+        while True:
+            self.poll()
+            now = self._clock()
+            if self._latest_id != self._returned_id:
+                self._returned_id = self._latest_id
+                return self._reading(now)
+            if now >= t_end:
+                raise self._stale(now, f"no new packet within {limit:.3f} s")

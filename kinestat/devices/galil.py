@@ -1,0 +1,480 @@
+"""Galil DMC motion controller: a small TCP client and the thesis's axis conventions.
+
+The PUMA 762 of Vibhute 2011 is driven by a Galil DMC 2160 over Ethernet (App. D.4, D.5, D.9).
+This module holds:
+
+* the thesis's encoder scales (degrees per count per axis A..F), the joint-1 offset
+  (``Pos_A_KCorrection`` = 180°) and conversions between counts, axis degrees and joint
+  angles in radians;
+* the axis 4 -> 5 coupling of that robot and its compensation (``Axis_4_5_Correction.m``);
+* the thesis's move recipe (speeds, accelerations, the +5-count nudge: ``galil_control.m``);
+* :class:`GalilClient`, a pure-Python client for the command subset the thesis uses.
+
+DMC replies: a command is acknowledged by ``:``; a query returns its data then ``\\r\\n:``; a
+rejected command returns ``?`` and the reason is read with ``TC1`` (``"<code> <message>"``).
+A ``?`` is never parsed as a number: it raises :class:`GalilCommandError`.
+"""
+
+from __future__ import annotations
+
+import math
+import socket
+import time
+from typing import Any, NamedTuple
+
+import numpy as np
+
+from kinestat.errors import DeviceError, InputError, ProtocolError
+
+AXES = "ABCDEF"
+"""Galil axis letters; axis A drives joint 1, ..., axis F joint 6."""
+
+AXIS_DEG_PER_COUNT = np.array([0.00125, 0.00086875, 0.001115625, 0.00626, 0.00626, 0.01337])
+"""Degrees of axis motion per encoder count, axes A..F (``ENC_DEG_1..6``, Vibhute App. D.3,
+D.5). Checked: ``startup_initialize.m`` defines joints 2 and 3 at 90° with ``DP 0,103597,80672``
+and 103597 x 0.00086875 = 89.9999°, 80672 x 0.001115625 = 89.9997°."""
+AXIS_DEG_PER_COUNT.setflags(write=False)
+
+JOINT_OFFSET_DEG = np.array([180.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+"""Joint angle minus axis angle, degrees (``Pos_A_KCorrection`` = 180 on joint 1, Vibhute App.
+D.2/D.3): phi1 = axis_A + 180°."""
+JOINT_OFFSET_DEG.setflags(write=False)
+
+JOINT1_OFFSET_DEG = 180.0
+"""``Pos_A_KCorrection``: joint 1 angle phi1 = axis-A angle + 180° (Vibhute App. D.3)."""
+
+AXIS4_TO_5_COUPLING = -11200.0 / 23962.0
+"""Physical axis-5 motion per axis-4 encoder count, in axis-5 counts (Vibhute App. D.9).
+
+The thesis measured 11200 counts of axis 5 (70.1°) for 23962 counts of axis 4 (150.0°) and
+calls the ratio ``Compensation_Factor``. The sign follows from the thesis's correction formula
+with its two OCR-dropped minus signs restored, ``E_cmd - (D_now - D_cmd) * 11200/23962``: that
+formula cancels the coupling only if axis 5 turns by ``-11200/23962`` counts per count of
+axis 4. The axis-5 encoder does not see this motion."""
+
+THESIS_ACCEL = (8000.0, 11511.0, 8964.0, 3194.0, 3194.0, 1496.0)
+"""``AC`` and ``DC`` used by ``galil_control.m`` (counts/s^2), axes A..F."""
+
+THESIS_SPEED_MAX = (8000.0, 11511.0, 8964.0, 3194.0, 0.46 * 3194.0, 1496.0)
+"""Maximum ``SP`` per axis in ``galil_control.m`` (counts/s), axes A..F."""
+
+THESIS_SPEED_MIN = 10.0
+"""Slowest ``SP`` the thesis commands (counts/s)."""
+
+THESIS_NUDGE_COUNTS = 5
+"""``galil_control.m`` adds 5 counts to a target closer than 5 counts to the current position."""
+
+COUNT_LIMIT = 2_147_483_647
+"""Galil position registers are signed 32-bit."""
+
+DEFAULT_PORT = 23
+"""Galil controllers accept commands on TCP port 23."""
+
+
+# --------------------------------------------------------------------------- conversions
+
+
+def _finite(x: Any, name: str) -> np.ndarray:
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"{name}: expected numbers, got {x!r}") from exc
+    if not np.all(np.isfinite(a)):
+        raise InputError(f"{name}: values must be finite, got {x!r}")
+    return a
+
+
+def _six(x: Any, name: str) -> np.ndarray:
+    a = _finite(x, name)
+    if a.ndim == 0 or a.shape[-1] != 6:
+        raise InputError(f"{name}: expected shape (..., 6) for axes A..F, got {a.shape}")
+    return a
+
+
+def round_half_away(x: Any) -> np.ndarray:
+    """Round to the nearest integer, halves away from zero (MATLAB's ``round``), as int64."""
+    a = np.asarray(x, dtype=float)
+    return (np.sign(a) * np.floor(np.abs(a) + 0.5)).astype(np.int64)
+
+
+def counts_to_axis_deg(counts: Any) -> np.ndarray:
+    """Axis angles in degrees from encoder counts, shape (..., 6) (``Pos = PosE * ENC_DEG``)."""
+    return _six(counts, "counts_to_axis_deg") * AXIS_DEG_PER_COUNT
+
+
+def axis_deg_to_counts(axis_deg: Any) -> np.ndarray:
+    """Encoder counts (int64) from axis angles in degrees (``En = round(Deg / ENC_DEG)``)."""
+    c = _six(axis_deg, "axis_deg_to_counts") / AXIS_DEG_PER_COUNT
+    if np.any(np.abs(c) > COUNT_LIMIT):
+        raise InputError("axis_deg_to_counts: a position exceeds the Galil's 32-bit range")
+    return round_half_away(c)
+
+
+def axis_deg_to_joint_rad(axis_deg: Any) -> np.ndarray:
+    """Joint angles q (radians, Crane-Duffy convention) from axis angles: q = axis + offset."""
+    return np.deg2rad(_six(axis_deg, "axis_deg_to_joint_rad") + JOINT_OFFSET_DEG)
+
+
+def joint_rad_to_axis_deg(q: Any) -> np.ndarray:
+    """Axis angles in degrees from joint angles q: axis = q - offset (no wrapping).
+
+    Which multiple of 360° an axis should take (limits, least motion) is the caller's choice;
+    the thesis adds +180° to phi1, which equals -180° modulo 360°.
+    """
+    return np.rad2deg(_six(q, "joint_rad_to_axis_deg")) - JOINT_OFFSET_DEG
+
+
+def counts_to_joint_rad(counts: Any) -> np.ndarray:
+    """Joint angles q (radians) from encoder counts A..F."""
+    return axis_deg_to_joint_rad(counts_to_axis_deg(counts))
+
+
+def joint_rad_to_counts(q: Any) -> np.ndarray:
+    """Encoder counts A..F (int64) for joint angles q (radians), joint 1 offset applied."""
+    return axis_deg_to_counts(joint_rad_to_axis_deg(q))
+
+
+class Axis45Correction(NamedTuple):
+    """Result of :func:`axis45_compensation` (counts, int64 arrays or scalars)."""
+
+    axis5_command: np.ndarray
+    axis5_reset: np.ndarray
+
+
+def axis45_compensation(
+    axis4_target: Any, axis5_target: Any, axis4_now: Any,
+    coupling: float = AXIS4_TO_5_COUPLING,
+) -> Axis45Correction:
+    """Compensate the PUMA's axis 4 -> 5 coupling (Vibhute App. D.9 ``Axis_4_5_Correction.m``).
+
+    Moving axis 4 by ``d4 = axis4_target - axis4_now`` counts turns axis 5 by ``coupling*d4``
+    counts that its encoder does not see. Commanding axis 5 to
+    ``axis5_target - coupling * d4`` (thesis: ``E_cmd + (D_cmd - D_now) * 11200/23962``) makes
+    the true axis-5 position end at ``axis5_target``; afterwards the encoder reads the command,
+    so it is reset with ``DP`` to ``axis5_reset = axis5_target``. All inputs are counts and may
+    carry a leading batch shape; the outputs are rounded (halves away from zero).
+    """
+    d4 = _finite(axis4_target, "axis4_target") - _finite(axis4_now, "axis4_now")
+    e = _finite(axis5_target, "axis5_target")
+    if not math.isfinite(coupling):
+        raise InputError(f"axis45_compensation: coupling must be finite, got {coupling!r}")
+    return Axis45Correction(round_half_away(e - coupling * d4), round_half_away(e))
+
+
+class MovePlan(NamedTuple):
+    """Targets and profile parameters for one ``PA`` move, axes A..F."""
+
+    target: np.ndarray
+    speed: np.ndarray
+    accel: np.ndarray
+    decel: np.ndarray
+
+
+def thesis_move_plan(current: Any, target: Any, *, nudge: bool = True) -> MovePlan:
+    """The move recipe of ``galil_control.m`` (Vibhute App. D.5), for counts A..F.
+
+    Speed per axis ``ceil(|target - current| / 4)`` clamped to [10, max] (so every axis takes
+    about 4 s at cruise), ``AC = DC = THESIS_ACCEL``, and with ``nudge`` a target less than 5
+    counts away is moved 5 counts further (+5) as the thesis does. The thesis sets tiny-move
+    speeds of axes D and E to the maximum instead of 10 (see docs/errata/devices.md); this
+    function uses 10 for every axis.
+    """
+    cur = _six(current, "thesis_move_plan current")
+    tgt = round_half_away(_six(target, "thesis_move_plan target"))
+    dist = np.abs(cur - tgt)
+    speed = np.clip(np.ceil(dist / 4.0), THESIS_SPEED_MIN, np.asarray(THESIS_SPEED_MAX))
+    if nudge:
+        tgt = np.where(dist < THESIS_NUDGE_COUNTS, tgt + THESIS_NUDGE_COUNTS, tgt)
+    acc = np.broadcast_to(np.asarray(THESIS_ACCEL), tgt.shape).copy()
+    return MovePlan(tgt.astype(np.int64), speed, acc, acc.copy())
+
+
+# --------------------------------------------------------------------------- client
+
+
+class GalilCommandError(DeviceError):
+    """The controller answered ``?``: ``code`` and ``message`` come from ``TC1``."""
+
+    def __init__(self, command: str, code: int | None, message: str) -> None:
+        self.command = command
+        self.code = code
+        self.message = message
+        why = f"error {code}: {message}" if code is not None else message
+        super().__init__(f"Galil rejected {command!r} ({why})")
+
+
+def _fmt(x: float) -> str:
+    if float(x).is_integer():
+        return str(int(x))
+    return f"{float(x):.4f}"
+
+
+def _per_axis(value: Any, name: str, *, positive: bool) -> list[float]:
+    a = _finite(value, name)
+    if a.ndim == 0:
+        a = np.full(6, float(a))
+    if a.shape != (6,):
+        raise InputError(f"{name}: expected one value or 6 (axes A..F), got shape {a.shape}")
+    if positive and np.any(a <= 0):
+        raise InputError(f"{name}: values must be > 0, got {a.tolist()}")
+    if np.any(np.abs(a) > COUNT_LIMIT):
+        raise InputError(f"{name}: values exceed the Galil's 32-bit range")
+    return a.tolist()
+
+
+def parse_number(reply: str, command: str = "") -> float:
+    """Read one number from a DMC reply (e.g. ``" 1234.0000"``); :class:`ProtocolError` if not.
+
+    A ``?`` or any non-numeric text is refused, never guessed.
+    """
+    text = reply.strip()
+    if "?" in text or not text:
+        raise ProtocolError(f"Galil reply to {command!r} is not a number: {reply!r}")
+    try:
+        v = float(text)
+    except ValueError as exc:
+        raise ProtocolError(f"Galil reply to {command!r} is not a number: {reply!r}") from exc
+    if not math.isfinite(v):
+        raise ProtocolError(f"Galil reply to {command!r} is not finite: {reply!r}")
+    return v
+
+
+def parse_numbers(reply: str, n: int, command: str = "") -> list[float]:
+    """Read ``n`` comma-separated numbers from a DMC reply (``TP``); :class:`ProtocolError`."""
+    parts = reply.strip().split(",")
+    if len(parts) != n:
+        raise ProtocolError(f"Galil reply to {command!r} has {len(parts)} fields, expected {n}: "
+                            f"{reply!r}")
+    return [parse_number(p, command) for p in parts]
+
+
+class GalilClient:
+    """A TCP client for a Galil DMC controller (or :mod:`kinestat.sim.galil_server`).
+
+    Every method sends one command and waits for its reply up to ``timeout`` seconds. A
+    timeout or a closed link raises :class:`DeviceError` and closes the connection (a late
+    reply would otherwise be taken for the next one); call :meth:`connect` to reconnect.
+    """
+
+    def __init__(self, host: str = "127.0.0.1", port: int = DEFAULT_PORT, *,
+                 timeout: float = 2.0) -> None:
+        if not (isinstance(timeout, (int, float)) and timeout > 0 and math.isfinite(timeout)):
+            raise InputError(f"GalilClient: timeout must be a positive number, got {timeout!r}")
+        self.host = host
+        self.port = int(port)
+        self.timeout = float(timeout)
+        self._sock: socket.socket | None = None
+        self._buf = b""
+
+    # -- connection
+    def connect(self) -> GalilClient:
+        """Open the TCP connection (closing any previous one)."""
+        self.close()
+        try:
+            self._sock = socket.create_connection((self.host, self.port), timeout=self.timeout)
+        except OSError as exc:
+            raise DeviceError(f"cannot connect to the Galil at {self.host}:{self.port}: {exc}. "
+                              "Check the address and that the controller/simulator runs") from exc
+        self._sock.settimeout(self.timeout)
+        self._sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
+        self._buf = b""
+        return self
+
+    def close(self) -> None:
+        """Close the connection (idempotent)."""
+        s, self._sock = self._sock, None
+        if s is not None:
+            try:
+                s.close()
+            except OSError:
+                pass
+
+    @property
+    def connected(self) -> bool:
+        return self._sock is not None
+
+    def __enter__(self) -> GalilClient:
+        return self.connect() if self._sock is None else self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    # -- raw commands
+    def command(self, cmd: str) -> str:
+        """Send one command; return its data (without the ``:``), or raise.
+
+        ``?`` -> :class:`GalilCommandError` with the ``TC1`` code and message; no reply within
+        ``timeout`` or a closed link -> :class:`DeviceError`.
+        """
+        reply = self._exchange(cmd)
+        if reply == "?":
+            code, message = self._tell_error()
+            raise GalilCommandError(cmd, code, message)
+        return reply
+
+    def _exchange(self, cmd: str) -> str:
+        if not isinstance(cmd, str) or not cmd.strip():
+            raise InputError(f"Galil command must be a non-empty string, got {cmd!r}")
+        if any(c in cmd for c in ";\r\n"):
+            raise InputError(f"send one Galil command at a time (no ';' or newline): {cmd!r}")
+        if self._sock is None:
+            raise DeviceError(f"Galil at {self.host}:{self.port} is not connected; call "
+                              "connect() first")
+        try:
+            self._sock.sendall(cmd.encode("ascii") + b"\r")
+        except UnicodeEncodeError as exc:
+            raise InputError(f"Galil commands are ASCII: {cmd!r}") from exc
+        except OSError as exc:
+            self.close()
+            raise DeviceError(f"Galil link to {self.host}:{self.port} failed while sending "
+                              f"{cmd!r}: {exc}") from exc
+        return self._read_reply(cmd)
+
+    def _read_reply(self, cmd: str) -> str:
+        deadline = time.monotonic() + self.timeout
+        buf = self._buf
+        while not (buf.endswith(b":") or buf.endswith(b"?")):
+            remaining = deadline - time.monotonic()
+            if remaining <= 0:
+                self.close()
+                raise DeviceError(f"Galil at {self.host}:{self.port} did not answer {cmd!r} "
+                                  f"within {self.timeout} s; connection closed")
+            assert self._sock is not None
+            self._sock.settimeout(remaining)
+            try:
+                chunk = self._sock.recv(4096)
+            except TimeoutError:
+                continue
+            except OSError as exc:
+                self.close()
+                raise DeviceError(f"Galil link to {self.host}:{self.port} failed while waiting "
+                                  f"for the reply to {cmd!r}: {exc}") from exc
+            if not chunk:
+                self.close()
+                raise DeviceError(f"Galil at {self.host}:{self.port} closed the link while "
+                                  f"answering {cmd!r}")
+            buf += chunk
+        self._buf = b""
+        text = buf.decode("ascii", errors="replace")
+        if text.endswith("?"):
+            return "?"
+        return text[:-1].strip()
+
+    def _tell_error(self) -> tuple[int | None, str]:
+        reply = self._exchange("TC1")
+        if reply == "?":
+            return None, "rejected, and TC1 was rejected too"
+        head, _, rest = reply.strip().partition(" ")
+        try:
+            return int(head), rest.strip()
+        except ValueError:
+            return None, reply.strip()
+
+    def query(self, cmd: str) -> float:
+        """Send a query (``MG _TPA``, ...) and return its single numeric answer."""
+        return parse_number(self.command(cmd), cmd)
+
+    # -- typed helpers
+    def position_counts(self) -> tuple[int, ...]:
+        """Encoder positions of axes A..F (``TP``), in counts."""
+        vals = parse_numbers(self.command("TP"), 6, "TP")
+        return tuple(int(round(v)) for v in vals)
+
+    def axis_position(self, axis: str) -> int:
+        """Encoder position of one axis (``MG _TP<axis>``), in counts."""
+        return int(round(self.query(f"MG _TP{_axis(axis)}")))
+
+    def moving_axes(self) -> tuple[bool, ...]:
+        """Which of axes A..F are profiling a motion (``MG _BGA`` ... ``MG _BGF``)."""
+        return tuple(self.query(f"MG _BG{a}") != 0 for a in AXES)
+
+    def is_moving(self) -> bool:
+        """True while any axis is in motion."""
+        return any(self.moving_axes())
+
+    def move_absolute(self, counts: Any, speed: Any, accel: Any, decel: Any | None = None
+                      ) -> None:
+        """Start a move of axes A..F to absolute ``counts`` (``AC``, ``DC``, ``SP``, ``PA``,
+        ``BG``). ``speed``/``accel``/``decel`` in counts/s and counts/s^2, one value or six;
+        ``decel`` defaults to ``accel``. Returns at once: see :meth:`wait_motion_complete`.
+        """
+        c = _per_axis(counts, "move_absolute counts", positive=False)
+        if any(not float(v).is_integer() for v in c):
+            raise InputError(f"move_absolute: counts must be integers, got {c}")
+        sp = _per_axis(speed, "move_absolute speed", positive=True)
+        ac = _per_axis(accel, "move_absolute accel", positive=True)
+        dc = _per_axis(accel if decel is None else decel, "move_absolute decel", positive=True)
+        self.command("AC " + ",".join(_fmt(v) for v in ac))
+        self.command("DC " + ",".join(_fmt(v) for v in dc))
+        self.command("SP " + ",".join(_fmt(v) for v in sp))
+        self.command("PA " + ",".join(_fmt(v) for v in c))
+        self.command("BG")
+
+    def wait_motion_complete(self, timeout: float = 30.0, poll_interval: float = 0.01
+                             ) -> tuple[int, ...]:
+        """Poll ``MG _BGx`` until no axis moves; return the final positions (``TP``).
+
+        Raises :class:`DeviceError` if the motion is still running after ``timeout`` seconds
+        (the axes are NOT stopped: call :meth:`stop` if that is what you want).
+        """
+        deadline = time.monotonic() + float(timeout)
+        while self.is_moving():
+            if time.monotonic() > deadline:
+                raise DeviceError(f"Galil motion not complete after {timeout} s "
+                                  f"(axes moving: {self.moving_axes()}); stop it or wait longer")
+            if poll_interval > 0:
+                time.sleep(poll_interval)
+        return self.position_counts()
+
+    def move_compensated(self, counts: Any, speed: Any, accel: Any, decel: Any | None = None,
+                         *, timeout: float = 30.0, poll_interval: float = 0.01,
+                         coupling: float = AXIS4_TO_5_COUPLING) -> tuple[int, ...]:
+        """Move to ``counts`` with the axis 4 -> 5 compensation, wait, and reset axis 5 (``DP``).
+
+        The sequence of ``Axis_4_5_Correction.m`` + ``galil_control.m``: read axis 4, command
+        axis 5 to the corrected position, wait for the motion, then ``DP ,,,,<axis5 target>``
+        so the axis-5 encoder reads the true position again. Returns the final ``TP``.
+        """
+        c = _per_axis(counts, "move_compensated counts", positive=False)
+        d_now = self.axis_position("D")
+        corr = axis45_compensation(c[3], c[4], d_now, coupling)
+        c[4] = float(corr.axis5_command)
+        self.move_absolute(c, speed, accel, decel)
+        self.wait_motion_complete(timeout, poll_interval)
+        self.define_position({"E": int(corr.axis5_reset)})
+        return self.position_counts()
+
+    def define_position(self, counts: Any) -> None:
+        """``DP``: redefine encoder positions without motion; six counts, or ``{axis: count}``."""
+        if isinstance(counts, dict):
+            fields = [""] * 6
+            for k, v in counts.items():
+                fields[AXES.index(_axis(k))] = _fmt(_per_axis(v, "DP", positive=False)[0])
+        else:
+            vals = _per_axis(counts, "define_position counts", positive=False)
+            fields = [_fmt(v) for v in vals]
+        self.command("DP " + ",".join(fields))
+
+    def stop(self) -> None:
+        """``ST``: decelerate every axis to a stop."""
+        self.command("ST")
+
+    def motor_off(self) -> None:
+        """``MO``: servo off on every axis."""
+        self.command("MO")
+
+    def servo_here(self) -> None:
+        """``SH``: servo on, holding the current positions."""
+        self.command("SH")
+
+    def error_code(self) -> tuple[int | None, str]:
+        """``TC1``: the last error's code and message."""
+        return self._tell_error()
+
+
+def _axis(axis: str) -> str:
+    a = str(axis).upper()
+    if len(a) != 1 or a not in AXES:
+        raise InputError(f"unknown Galil axis {axis!r}; use one of {', '.join(AXES)}")
+    return a
+
