@@ -22,6 +22,7 @@ COMMAND_MODULES: list[str] = [
     "ik",
     "sim",
     "dh_from_axes",
+    "platform",
 ]
 
 app = typer.Typer(

@@ -1,0 +1,266 @@
+"""``kinestat platform``: the compliant 6-6 platform — geometry, FK, IK, statics, stiffness.
+
+Every command takes ``--platform FILE`` (a TOML platform file; default the embedded 2011
+prototype) and ``--json``. Poses (``--pose``) are ``home``, a file (JSON: a 4x4 list or an
+object with a ``"pose"`` key; TOML: a ``pose`` key) or 16 comma-separated numbers, row-major.
+Wrenches are ``fx,fy,fz,mx,my,mz``: the external wrench on the top, moment about the base
+origin O0, base frame (see docs/platform.md for the sign conventions).
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from kinestat.cli._output import console, parse_floats, print_json, table
+from kinestat.errors import InputError, ParseError
+
+PLATFORM_HELP = "TOML platform file (default: the embedded 2011 prototype)."
+POSE_HELP = "'home', a JSON/TOML file holding a 4x4 pose, or 16 comma-separated numbers."
+WRENCH_HELP = "External wrench on the top fx,fy,fz,mx,my,mz (moment about O0, base frame)."
+
+platform_app = typer.Typer(
+    name="platform",
+    help="The compliant special 6-6 platform: info, fk, ik, statics, stiffness.",
+    no_args_is_help=True,
+)
+
+
+def register(app: typer.Typer) -> None:
+    app.add_typer(platform_app, name="platform")
+
+
+def _load(path: str | None):
+    from kinestat.io.platform_toml import read_platform
+    from kinestat.parallel.platform import prototype
+
+    return prototype() if path is None else read_platform(path)
+
+
+def _pose(text: str, platform) -> np.ndarray:
+    from kinestat.parallel.legs import as_pose
+
+    if text.strip().lower() == "home":
+        return platform.home_pose.copy()
+    p = Path(text)
+    if p.suffix.lower() in (".json", ".toml") or p.exists():
+        try:
+            raw = p.read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ParseError(f"cannot read pose file: {exc.strerror}", file=str(p)) from exc
+        try:
+            doc = tomllib.loads(raw) if p.suffix.lower() == ".toml" else json.loads(raw)
+        except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
+            raise ParseError(f"not valid {p.suffix[1:].upper() or 'JSON'}: {exc}",
+                             file=str(p)) from exc
+        if isinstance(doc, dict):
+            if "pose" not in doc:
+                raise ParseError("expected a 'pose' key holding a 4x4 array", file=str(p),
+                                 field="pose")
+            doc = doc["pose"]
+        try:
+            T = np.array(doc, dtype=float)
+        except (TypeError, ValueError) as exc:
+            raise ParseError("the pose must be a 4x4 array of numbers", file=str(p),
+                             field="pose") from exc
+        if T.shape != (4, 4):
+            raise ParseError(f"the pose must be 4x4, got shape {T.shape}", file=str(p),
+                             field="pose")
+    else:
+        T = parse_floats(text, 16, "pose").reshape(4, 4)
+    return as_pose(T, "--pose")
+
+
+def _pose_rows(T: np.ndarray) -> list[list]:
+    return [[str(i + 1), *T[i]] for i in range(4)]
+
+
+@platform_app.command("info")
+def info_command(
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
+    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+) -> None:
+    """Geometry, springs, free lengths and home pose of the platform.
+
+    JSON: {"name", "length_unit", "force_unit", "leg_names", "base_points", "top_points",
+    "stiffness", "free_lengths", "home_pose", "special", "edge_fractions", "jacobian_det_home",
+    "singularity_measure_home", "design"}.
+    """
+    from kinestat.parallel.singularity import singularity_measure
+    from kinestat.parallel.statics import jacobian_det
+
+    p = _load(platform)
+    d = p.design
+    out = {
+        "name": p.name,
+        "length_unit": p.length_unit,
+        "force_unit": p.force_unit,
+        "leg_names": list(p.leg_names),
+        "base_points": p.base_points,
+        "top_points": p.top_points,
+        "stiffness": p.stiffness,
+        "free_lengths": p.free_lengths,
+        "home_pose": p.home_pose,
+        "special": p.layout is not None,
+        "edge_fractions": None if p.layout is None else dict(
+            zip(("O", "P", "Q", "R", "S", "T"), p.layout.t, strict=True)),
+        "jacobian_det_home": float(jacobian_det(p, p.home_pose)),
+        "singularity_measure_home": float(singularity_measure(p, p.home_pose)),
+        "design": None if d is None else {
+            "base_side": d.base_side, "top_side": d.top_side, "base_offset": d.base_offset,
+            "top_offset": d.top_offset, "home_height": d.height,
+            "home_twist_deg": float(np.degrees(d.twist)), "stiffness": d.stiffness},
+    }
+    if as_json:
+        print_json(out)
+        return
+    console.print(f"[bold]{p.name}[/] (lengths in {p.length_unit}, forces in {p.force_unit}; "
+                  f"{'special 6-6' if p.layout is not None else 'general 6-6'})")
+    console.print(table("Legs", ["leg", "base x", "base y", "base z", "top x", "top y", "top z",
+                                 "k", "free length"],
+                        [[n, *b, *t, k, l0] for n, b, t, k, l0 in zip(
+                            p.leg_names, p.base_points, p.top_points, p.stiffness,
+                            p.free_lengths, strict=True)]))
+    console.print(table("Home pose (top frame in base frame)", ["", "x", "y", "z", "t"],
+                        _pose_rows(p.home_pose)))
+    console.print(f"det j at home = {out['jacobian_det_home']:.6g}, singularity measure = "
+                  f"{out['singularity_measure_home']:.4f}")
+
+
+@platform_app.command("fk")
+def fk_command(
+    legs: str = typer.Option(..., "--legs", help="Six leg lengths in leg order (O,P,Q,R,S,T)."),
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
+    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+) -> None:
+    """Every real assembly mode for six leg lengths, each verified by reverse kinematics.
+
+    JSON: {"count", "method", "solutions": [{"pose", "top_points", "above_base",
+    "max_leg_error"}]}; top_points are O1..T1 (leg order) in base coordinates.
+    """
+    from kinestat.parallel.fk import fk_list, fk_numeric
+    from kinestat.parallel.legs import leg_lengths, top_points_in_base
+
+    p = _load(platform)
+    L = parse_floats(legs, 6, "legs")
+    if p.layout is not None:
+        poses, method = fk_list(p, L), "special 6-6 -> 3-3 closed form, all modes"
+    else:
+        poses, method = [fk_numeric(p, L)], "numerical (Newton from home), one mode"
+    sols = [{"pose": T, "top_points": top_points_in_base(p, T),
+             "above_base": bool(T[2, 3] >= 0),
+             "max_leg_error": float(np.max(np.abs(leg_lengths(p, T) - L)))} for T in poses]
+    out = {"count": len(sols), "method": method, "leg_names": list(p.leg_names),
+           "leg_lengths": L, "solutions": sols}
+    if as_json:
+        print_json(out)
+        return
+    console.print(f"[bold]{len(sols)}[/] assembly mode(s) of {p.name} ({method})")
+    for i, s in enumerate(sols):
+        console.print(table(f"Mode {i + 1}: pose (max leg error {s['max_leg_error']:.2e} "
+                            f"{p.length_unit})", ["", "x", "y", "z", "t"],
+                            _pose_rows(s["pose"])))
+
+
+@platform_app.command("ik")
+def ik_command(
+    pose: str = typer.Option(..., "--pose", help=POSE_HELP),
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
+    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+) -> None:
+    """Leg lengths at a pose (reverse kinematics). JSON: {"leg_lengths", "leg_names"}."""
+    from kinestat.parallel.legs import leg_lengths
+
+    p = _load(platform)
+    T = _pose(pose, p)
+    L = leg_lengths(p, T)
+    out = {"leg_names": list(p.leg_names), "leg_lengths": L,
+           "extension": L - p.free_lengths}
+    if as_json:
+        print_json(out)
+        return
+    console.print(table(f"Leg lengths ({p.length_unit})", ["leg", "length", "l - l0"],
+                        [[n, x, e] for n, x, e in zip(p.leg_names, L, out["extension"],
+                                                      strict=True)]))
+
+
+@platform_app.command("statics")
+def statics_command(
+    pose: str = typer.Option(..., "--pose", help=POSE_HELP),
+    wrench: str = typer.Option(..., "--wrench", help=WRENCH_HELP),
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
+    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+) -> None:
+    """Leg forces balancing an external wrench at a pose, f = j^-1 w (Vibhute eq. 2-8).
+
+    Forces are tensions (positive: the leg pulls). JSON: {"leg_forces", "jacobian_det",
+    "singularity_measure", "leg_names"}.
+    """
+    from kinestat.parallel.singularity import singularity_measure
+    from kinestat.parallel.statics import forces_from_wrench, jacobian_det
+
+    p = _load(platform)
+    T = _pose(pose, p)
+    w = parse_floats(wrench, 6, "wrench")
+    f = forces_from_wrench(p, T, w)
+    out = {"leg_names": list(p.leg_names), "leg_forces": f,
+           "jacobian_det": float(jacobian_det(p, T)),
+           "singularity_measure": float(singularity_measure(p, T)),
+           "convention": "leg force > 0 is tension; wrench = external wrench on the top, "
+                         "moment about O0, base frame"}
+    if as_json:
+        print_json(out)
+        return
+    console.print(table(f"Leg tensions ({p.force_unit})", ["leg", "force"],
+                        [[n, x] for n, x in zip(p.leg_names, f, strict=True)]))
+    console.print(f"det j = {out['jacobian_det']:.6g}, singularity measure = "
+                  f"{out['singularity_measure']:.4f}")
+
+
+@platform_app.command("stiffness")
+def stiffness_command(
+    pose: str = typer.Option("home", "--pose", help=POSE_HELP),
+    wrench: str = typer.Option(None, "--wrench", help=WRENCH_HELP + " The legs carry "
+                               "j^-1 w instead of their spring forces at the pose."),
+    twist_order: str = typer.Option("ray", "--twist-order",
+                                    help="'ray': dD = [dx; dphi] (default); 'axis': [dphi; dx]."),
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
+    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+) -> None:
+    """Spatial stiffness K (dw = K dD, Vibhute eq. 2-17) at a pose, loaded by the springs or w.
+
+    JSON: {"stiffness" (6x6), "twist_order", "leg_forces", "asymmetry" (max |K - K^T|)}.
+    """
+    from kinestat.parallel.statics import forces_from_wrench
+    from kinestat.parallel.stiffness import TWIST_ORDERS, stiffness
+
+    if twist_order not in TWIST_ORDERS:
+        raise InputError(f"--twist-order must be one of {list(TWIST_ORDERS)}, got "
+                         f"{twist_order!r}")
+    p = _load(platform)
+    T = _pose(pose, p)
+    forces = None
+    if wrench is not None:
+        forces = forces_from_wrench(p, T, parse_floats(wrench, 6, "wrench"))
+    K = stiffness(p, T, forces, twist_order=twist_order)
+    if forces is None:
+        from kinestat.parallel.legs import leg_lengths
+
+        forces = p.stiffness * (leg_lengths(p, T) - p.free_lengths)
+    Kr = stiffness(p, T, forces)
+    out = {"stiffness": K, "twist_order": twist_order, "leg_forces": forces,
+           "asymmetry": float(np.max(np.abs(Kr - Kr.T)))}
+    if as_json:
+        print_json(out)
+        return
+    cols = ["dx", "dy", "dz", "dphi_x", "dphi_y", "dphi_z"]
+    if twist_order == "axis":
+        cols = cols[3:] + cols[:3]
+    rows = [[r, *K[i]] for i, r in enumerate(["fx", "fy", "fz", "mx", "my", "mz"])]
+    console.print(table(f"Stiffness ({p.force_unit}, {p.length_unit}; dw = K dD)", ["", *cols],
+                        rows, fmt="{:.4g}"))
+    console.print(f"max |K - K^T| = {out['asymmetry']:.4g} (zero when unloaded)")

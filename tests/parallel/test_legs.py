@@ -1,0 +1,45 @@
+"""Reverse kinematics: leg lengths from a pose."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from kinestat.errors import InputError
+from kinestat.parallel.legs import leg_lengths, leg_vectors, top_points_in_base
+from kinestat.parallel.platform import prototype
+from kinestat.spatial.transforms import make_pose
+
+
+def test_leg_lengths_direct_distance():
+    p = prototype()
+    rng = np.random.default_rng(0)
+    R = Rotation.from_rotvec(rng.normal(size=(5, 3)) * 0.1).as_matrix()
+    t = np.array([30, 52, 60.0]) + rng.normal(size=(5, 3))
+    T = make_pose(R, t)
+    L = leg_lengths(p, T)
+    assert L.shape == (5, 6)
+    for k in range(5):
+        for i in range(6):
+            X = R[k] @ p.top_points[i] + t[k]
+            assert L[k, i] == pytest.approx(np.linalg.norm(X - p.base_points[i]), abs=1e-12)
+    np.testing.assert_allclose(np.linalg.norm(leg_vectors(p, T), axis=-1), L)
+    assert top_points_in_base(p, T).shape == (5, 6, 3)
+
+
+def test_leg_lengths_invariant_under_common_rigid_motion():
+    """Moving base and top together leaves the legs unchanged (distances are preserved)."""
+    p = prototype()
+    G = make_pose(Rotation.from_rotvec([0.3, -0.2, 0.5]).as_matrix(), [5, -7, 11])
+    T = p.home_pose
+    X = top_points_in_base(p, T) @ G[:3, :3].T + G[:3, 3]
+    B = p.base_points @ G[:3, :3].T + G[:3, 3]
+    np.testing.assert_allclose(np.linalg.norm(X - B, axis=-1), leg_lengths(p, T), atol=1e-12)
+
+
+@pytest.mark.parametrize("pose", [np.eye(3), np.full((4, 4), np.nan), 2 * np.eye(4),
+                                  np.r_[np.eye(4)[:3], [[1, 0, 0, 1]]]])
+def test_bad_poses_raise(pose):
+    with pytest.raises(InputError):
+        leg_lengths(prototype(), pose)
