@@ -4,13 +4,15 @@ from __future__ import annotations
 
 import json
 import math
+import sys
 from typing import Any
 
 import numpy as np
 from rich.console import Console
 from rich.table import Table
 
-console = Console()
+# Wide enough for the tables when output goes to a file or pipe (rich assumes 80 columns there).
+console = Console(width=None if sys.stdout.isatty() else 160)
 err_console = Console(stderr=True)
 
 
@@ -45,7 +47,7 @@ def table(title: str, columns: list[str], rows: list[list[Any]], fmt: str = "{:.
     """A rich table; floats formatted with ``fmt``."""
     t = Table(title=title)
     for c in columns:
-        t.add_column(c, justify="right")
+        t.add_column(c, justify="right", no_wrap=True)
     for r in rows:
         t.add_row(*[fmt.format(v) if isinstance(v, (float, np.floating)) else str(v) for v in r])
     return t

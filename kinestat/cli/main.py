@@ -18,6 +18,7 @@ from kinestat.errors import KinestatError
 # Order is the order of the help listing.
 COMMAND_MODULES: list[str] = [
     "fk",
+    "demo",
     "screw",
     "ik",
     "sim",

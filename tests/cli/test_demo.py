@@ -1,0 +1,35 @@
+"""``kinestat demo`` runs end to end and its numbers are consistent."""
+
+import json
+
+import numpy as np
+
+import kinestat
+from kinestat.cli.main import main
+from kinestat.parallel import leg_lengths, prototype
+from kinestat.serial import puma762
+
+
+def test_demo_json(capsys):
+    assert main(["demo", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert len(out["illustration1"]["screws"]) == 2
+    assert len(out["illustration2"]["joints"]) == 7
+    # every PUMA solution reproduces the Appendix C pose
+    for q in np.deg2rad(out["puma762_appendix_c"]["solutions_deg"]):
+        f = puma762.forward(q)
+        np.testing.assert_allclose(f.tool_point, [725, 190, 650], atol=1e-6)
+        np.testing.assert_allclose(f.s6, [1, 0, 0], atol=1e-9)
+    # platform modes come in mirror pairs and reproduce the legs
+    legs = [79.6804, 81.8285, 81.2669, 68.6500, 67.2037, 68.2854]
+    poses = np.array(out["platform_appendix_b"]["poses"])
+    assert out["platform_appendix_b"]["modes"] % 2 == 0
+    expected = np.broadcast_to(legs, (len(poses), 6))
+    np.testing.assert_allclose(leg_lengths(prototype(), poses), expected, atol=1e-9)
+
+
+def test_demo_human(capsys):
+    assert main(["demo"]) == 0
+    text = capsys.readouterr().out
+    assert "Illustration 2" in text and "assembly modes" in text
+    assert kinestat.__version__
