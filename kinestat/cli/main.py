@@ -20,6 +20,8 @@ COMMAND_MODULES: list[str] = [
     "fk",
     "demo",
     "screw",
+    "disp",
+    "guide",
     "ik",
     "sim",
     "dh_from_axes",

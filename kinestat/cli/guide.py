@@ -1,0 +1,272 @@
+"""``kinestat guide``: Nadkarni's guidance analyses on any model (TOML file or embedded name)."""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from kinestat.cli._output import console, parse_floats, print_json, table, to_jsonable
+from kinestat.cli.disp import guidance_options, print_result, progress_reporter
+from kinestat.errors import InputError, ParseError
+
+__all__ = ["register", "parse_command", "parse_move", "read_commands"]
+
+_TYPES = ("screw", "line", "general")
+_SPLIT = re.compile(r",(?=\s*[A-Za-z_]+\s*=)")
+
+
+def _keyvals(text: str, what: str, allowed: dict[str, str]) -> dict[str, str]:
+    out: dict[str, str] = {}
+    for part in _SPLIT.split(text.strip()):
+        if "=" not in part:
+            raise InputError(f"{what} {text!r}: expected key=value items, got {part!r}")
+        k, v = (s.strip() for s in part.split("=", 1))
+        k = allowed.get(k.lower())
+        if k is None:
+            raise InputError(f"{what} {text!r}: unknown key {part.split('=')[0]!r}; "
+                             f"use {', '.join(sorted(set(allowed.values())))}")
+        out[k] = v
+    return out
+
+
+def _num(v: str, what: str) -> float:
+    try:
+        x = float(v)
+    except ValueError:
+        raise InputError(f"{what}: {v!r} is not a number") from None
+    if not math.isfinite(x):
+        raise InputError(f"{what}: must be finite, got {v!r}")
+    return x
+
+
+def parse_command(text: str) -> dict:
+    """``"frame=global,dir=0,0,1,d=4,angle=-30"`` → ``{frame, direction, distance, angle_deg}``
+    (Nadkarni type IV, eqs. 4-21, 4-22; ``frame=hand`` for NTY = 1)."""
+    kv = _keyvals(text, "--command", {"frame": "frame", "dir": "dir", "direction": "dir",
+                                      "d": "d", "distance": "d", "angle": "angle",
+                                      "angle_deg": "angle"})
+    frame = kv.get("frame", "global").lower()
+    if frame not in ("global", "hand"):
+        raise InputError(f"--command {text!r}: frame must be 'global' or 'hand', got {frame!r}")
+    if "dir" not in kv:
+        raise InputError(f"--command {text!r}: give the direction, e.g. dir=0,0,1")
+    direction = parse_floats(kv["dir"], 3, "command dir")
+    if not np.any(direction):
+        raise InputError(f"--command {text!r}: dir is the zero vector")
+    return {"frame": frame, "direction": direction,
+            "distance": _num(kv.get("d", "0"), "--command d"),
+            "angle_deg": _num(kv.get("angle", "0"), "--command angle")}
+
+
+def parse_move(text: str) -> dict:
+    """``"axis=0,0,1,angle=30,dir=1,0,0,d=5"``: type I Examples 1–3 — rotate by ``angle``
+    (deg) about ``axis`` through the hand origin while it moves ``d`` along ``dir``."""
+    kv = _keyvals(text, "--move", {"axis": "axis", "angle": "angle", "dir": "dir",
+                                   "direction": "dir", "d": "d", "distance": "d"})
+    axis = parse_floats(kv.get("axis", "0,0,1"), 3, "move axis")
+    direction = parse_floats(kv.get("dir", "1,0,0"), 3, "move dir")
+    return {"axis": axis, "angle_deg": _num(kv.get("angle", "0"), "--move angle"),
+            "direction": direction, "distance": _num(kv.get("d", "0"), "--move d")}
+
+
+def read_commands(path: Path) -> list[dict]:
+    """Commands from a file: one per line, either ``frame=…,dir=…,d=…,angle=…`` or the six
+    numbers of a DISP SET THREE card ``NTY DCx DCy DCz DD THA``; ``#`` starts a comment."""
+    try:
+        text = path.read_text()
+    except OSError as exc:
+        raise InputError(f"cannot read commands file {str(path)!r}: {exc.strerror}") from exc
+    out = []
+    for lineno, raw in enumerate(text.splitlines(), start=1):
+        line = raw.split("#", 1)[0].strip()
+        if not line:
+            continue
+        try:
+            if "=" in line:
+                out.append(parse_command(line))
+                continue
+            vals = [float(t) for t in line.replace(",", " ").split()]
+            if len(vals) != 6 or vals[0] not in (0.0, 1.0):
+                raise InputError("expected 'NTY DCx DCy DCz DD THA' with NTY 0 or 1, or "
+                                 "key=value items")
+            if not all(math.isfinite(v) for v in vals) or not any(vals[1:4]):
+                raise InputError("numbers must be finite and the direction nonzero")
+            out.append({"frame": "global" if vals[0] == 0 else "hand",
+                        "direction": np.array(vals[1:4]), "distance": vals[4],
+                        "angle_deg": vals[5]})
+        except (InputError, ValueError) as exc:
+            raise ParseError(str(exc), file=str(path), line=lineno) from None
+    if not out:
+        raise ParseError("no commands in the file", file=str(path))
+    return out
+
+
+def _stages(model, q0, targets, kind, commands, moves):
+    from kinestat.mechanism.nadkarni import hand_points
+    from kinestat.serial.fk import fk
+    from kinestat.serial.guidance.planners import (
+        command_path,
+        general_motion,
+        general_path,
+        line_path,
+        screw_path,
+    )
+    from kinestat.spatial.displacement import frame_from_triple
+
+    given = sum(bool(x) for x in (targets, commands, moves))
+    if given == 0:
+        raise InputError("nothing to do: give --to targets, --command(s) or --move(s)")
+    if given > 1:
+        raise InputError("give targets (--to), commands (--command/--commands) or moves "
+                         "(--move), not a mix: run them one after the other instead")
+    if commands:
+        return [(lambda H, c=c: command_path(H, c["direction"], c["distance"],
+                                             math.radians(c["angle_deg"]), c["frame"]))
+                for c in commands]
+    if moves:
+        return [(lambda H, m=m: general_motion(H, m["axis"], math.radians(m["angle_deg"]),
+                                               m["direction"], m["distance"]))
+                for m in moves]
+    if kind == "line":
+        pts = [hand_points(fk(model, q0))] + targets
+        return [(lambda H, a=pts[i - 1], b=pts[i]: line_path(a, b)) for i in range(1, len(pts))]
+    frames = [frame_from_triple(t) for t in targets]
+    if kind == "screw":
+        return [(lambda H, T=T: screw_path(H, T)) for T in frames]
+    return [(lambda H, T=T: general_path(H, T)) for T in frames]
+
+
+def _rates(result, speed: float) -> tuple[np.ndarray, list[int]]:
+    """Joint rates per path step (rad or length per second, eqs. 5-1..5-4) moving along the
+    path at ``speed`` (deg/s of hand rotation; length/s for a purely translating step), and the
+    step numbers (correction steps at the end of a stage are left out)."""
+    from kinestat.serial.guidance.planners import twist_between
+    from kinestat.serial.guidance.velocity import joint_rates
+
+    m = result.model
+    settle = {e["step"] for e in result.events if e["kind"] == "settle"}
+    out, steps = [], []
+    for j in range(1, result.q.shape[0]):
+        if j in settle:
+            continue
+        tw = twist_between(result.poses[j - 1], result.poses[j])
+        steps.append(j)
+        if not np.any(np.abs(tw) > 1e-15):
+            out.append(np.zeros(m.n))
+            continue
+        rot = np.linalg.norm(tw[:3]) > 1e-12 * max(np.linalg.norm(tw[3:]), 1e-300)
+        s = math.radians(speed) if rot else speed
+        out.append(joint_rates(m, result.q[j - 1], tw, s))
+    return np.array(out).reshape(-1, m.n), steps
+
+
+def guide(
+    model: str = typer.Argument(..., help="A TOML model file or an embedded model name "
+                                "(nadkarni-config1, nadkarni-config2, puma762, …)."),
+    to: list[str] = typer.Option(None, "--to", help="Target hand position by three points "
+                                 "x,y,z,x,y,z,x,y,z (origin, a point on +z, a point on the +x "
+                                 "side); repeat for several targets."),
+    kind: str = typer.Option("screw", "--type", help="Path to the targets: screw (type II), "
+                             "line (type III: the hand points move on straight lines) or "
+                             "general (type I, Example 4)."),
+    command: list[str] = typer.Option(None, "--command", help="Operator command (type IV), "
+                                      "e.g. 'frame=global,dir=0,0,1,d=4,angle=-30'; "
+                                      "repeatable, run in order."),
+    commands: Path = typer.Option(None, "--commands", help="File of commands, one per line "
+                                  "(key=value or DISP's 'NTY DCx DCy DCz DD THA')."),
+    move: list[str] = typer.Option(None, "--move", help="Type I Examples 1-3: "
+                                   "'axis=0,0,1,angle=30,dir=1,0,0,d=5' rotates about axis "
+                                   "through the hand origin while it moves d along dir."),
+    q0_deg: str = typer.Option(None, "--q0-deg", help="Initial joint values (degrees for "
+                               "revolute joints, length units for prismatic); default: the "
+                               "model's home."),
+    steps: str = typer.Option(None, "--steps", help="Step count for every stage, or one per "
+                              "stage N1,N2,…; 0 or omitted = automatic."),
+    closed_loop: bool = typer.Option(False, "--closed-loop", help="Newton-correct every step "
+                                     "onto the ideal path."),
+    second_order: bool = typer.Option(False, "--second-order", help="Second-order terms of "
+                                      "Nadkarni eq. 5-5."),
+    damped: bool = typer.Option(False, "--damped", help="Damped least squares at "
+                                "singularities instead of the thesis's perturbation."),
+    no_settle: bool = typer.Option(False, "--no-settle", help="No correction steps at the end "
+                                   "of a stage."),
+    cond_limit: float = typer.Option(1e3, "--cond-limit", help="Dimensionless condition number "
+                                     "above which a configuration counts as singular."),
+    speed: float = typer.Option(None, "--speed", help="Hand speed for the joint rates "
+                                "(Nadkarni suggestion 1): deg/s of rotation, or length/s for a "
+                                "pure translation."),
+    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png here."),
+) -> None:
+    """Guide a manipulator's hand to targets, along commands or moves (Nadkarni ch. IV).
+
+    Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
+    table up to that point is printed first.
+    """
+    from kinestat.mechanism.library import load
+    from kinestat.serial.guidance.disp import parse_steps
+    from kinestat.serial.guidance.run import result_record, run_guidance
+
+    if kind not in _TYPES:
+        raise InputError(f"--type must be one of {', '.join(_TYPES)}, got {kind!r}")
+    m = load(model)
+    if q0_deg is None:
+        q0 = np.array(m.q_home, dtype=float)
+    else:
+        vals = parse_floats(q0_deg, m.n, "q0-deg")
+        q0 = np.where(m.prismatic, vals, np.radians(vals))
+    targets = [parse_floats(t, 9, "to").reshape(3, 3) for t in (to or [])]
+    cmds = [parse_command(c) for c in (command or [])]
+    if commands is not None:
+        cmds += read_commands(commands)
+    moves = [parse_move(s) for s in (move or [])]
+    stages = _stages(m, q0, targets, kind, cmds, moves)
+    opts = guidance_options(closed_loop=closed_loop, second_order=second_order, damped=damped,
+                            settle=not no_settle, cond_limit=cond_limit)
+    with progress_reporter(not as_json) as prog:
+        result = run_guidance(m, q0, stages, steps=parse_steps(steps), options=opts,
+                              progress=prog)
+    rates = None
+    if speed is not None:
+        if not (math.isfinite(speed) and speed > 0):
+            raise InputError(f"--speed must be positive, got {speed}")
+        rates, rate_steps = _rates(result, speed)
+    written = []
+    if plot is not None:
+        from kinestat.viz.guidance_plots import write_guidance_plots
+
+        written = write_guidance_plots(result, plot, title=f"kinestat guide {m.name}")
+    if as_json:
+        rec = {"model": m.name, "type": ("command" if cmds else "general" if moves else kind)}
+        rec.update(result_record(result))
+        if rates is not None:
+            disp_rates = np.where(m.prismatic, rates, np.degrees(rates))
+            rec["joint_rates"] = disp_rates
+            rec["joint_rate_steps"] = rate_steps
+            rec["joint_rate_units"] = [f"{m.length_unit}/s" if p else "deg/s"
+                                       for p in m.prismatic]
+        rec["notes"] = list(result.notes)
+        if written:
+            rec["plots"] = [str(p) for p in written]
+        print_json(to_jsonable(rec))
+    else:
+        print_result(result, result.notes, title=f"Joint variables, {m.name}")
+        if rates is not None and rates.size:
+            peak = np.max(np.abs(rates), axis=0)
+            peak = np.where(m.prismatic, peak, np.degrees(peak))
+            units = [f"{m.length_unit}/s" if p else "deg/s" for p in m.prismatic]
+            console.print(table("Peak joint rates (Nadkarni eqs. 5-1..5-4)", ["joint", "rate"],
+                                [[str(i + 1), f"{peak[i]:.4g} {units[i]}"]
+                                 for i in range(m.n)]))
+        for p in written:
+            console.print(f"wrote {p}")
+    result.raise_if_stopped()
+
+
+def register(app: typer.Typer) -> None:
+    """Add the ``guide`` command to the ``kinestat`` app."""
+    app.command("guide")(guide)

@@ -1,0 +1,254 @@
+"""Running a DISP deck (Nadkarni 1977, Appendix I) for every analysis type MS = 0..6.
+
+============  ==========================================================================
+MS            what runs (DISP subroutine)
+============  ==========================================================================
+1             screw axis between consecutive SET TWO positions (SCREWM)
+2             every SET FOUR joint in the global frame: X*(i), X(i), U(i), ρn(i) (TRANSM)
+3             1 and 2
+0             type II screw path from the hand to each next position (DISPM)
+4             type III straight lines of the hand points (SPLITM → DISPM)
+5             type IV operator commands, each from where the last ended (GUIDM)
+6             type I Example 4 (GENM)
+============  ==========================================================================
+
+The hand (MS = 0, 4, 5, 6): when SET TWO's first three cards are zero (and always for
+MS = 5) it is the seventh joint's frame x*(7), i.e. the chain's forward kinematics at the
+deck's initial configuration. A non-zero first position is the thesis's "inferior" option:
+kinestat then takes the hand to be the body located by those three points, rigidly attached to
+link 6 — the two agree when the points lie on x*(7) (origin, +z, +x side); when they do not,
+the hand is a different body and a note says by how much.
+
+The thesis asks for a7 > 0 because DISP builds the hand from three points, the third being the
+x(7) origin a7 along the seventh normal. kinestat takes the frame x*(7) itself, so a7 only
+matters for that check: a deck with a7 = 0 runs, with a note.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinestat.errors import InputError
+from kinestat.io.disp_deck import DispDeck, deck_warnings
+from kinestat.mechanism.chain import ChainModel, from_nadkarni
+from kinestat.mechanism.nadkarni import hand_points, mechanism_frames
+from kinestat.serial.fk import fk
+from kinestat.serial.guidance.planners import (
+    command_path,
+    general_path,
+    line_path,
+    pose_error,
+    screw_path,
+)
+from kinestat.serial.guidance.run import (
+    GuidanceOptions,
+    GuidanceResult,
+    result_record,
+    run_guidance,
+)
+from kinestat.spatial.displacement import frame_from_triple, screws_between
+from kinestat.spatial.transforms import inv
+
+__all__ = [
+    "DeckRun",
+    "deck_model",
+    "deck_initial_hand",
+    "deck_screws",
+    "deck_joints",
+    "deck_stages",
+    "run_deck",
+    "deck_json",
+    "parse_steps",
+]
+
+_TYPE = {0: "II (screw path)", 4: "III (hand point on a straight line)",
+         5: "IV (operator commands)", 6: "I (general, Example 4)"}
+
+
+@dataclass(frozen=True, eq=False)
+class DeckRun:
+    """Everything a deck produced: ``screws`` (MS 1, 3), ``joints`` (MS 2, 3), ``result``
+    (MS 0, 4, 5, 6) and ``notes`` (deck warnings, hand choice, corrections)."""
+
+    deck: DispDeck
+    screws: list[dict] | None = None
+    joints: list[dict] | None = None
+    model: ChainModel | None = None
+    result: GuidanceResult | None = None
+    notes: tuple[str, ...] = ()
+
+
+def parse_steps(text: str | None) -> list[int] | int | None:
+    """``--steps`` text: ``"40"`` (every stage) or ``"30,12"`` (one per stage); 0 = automatic."""
+    if text is None or text.strip() == "":
+        return None
+    try:
+        vals = [int(v) for v in text.replace(" ", "").split(",")]
+    except ValueError:
+        raise InputError(
+            f"--steps: expected an integer or comma-separated integers (one per stage), "
+            f"got {text!r}") from None
+    if any(v < 0 for v in vals):
+        raise InputError("--steps: step counts must be ≥ 0 (0 = automatic)")
+    return vals[0] if len(vals) == 1 else vals
+
+
+def deck_screws(deck: DispDeck) -> list[dict]:
+    """MS = 1: the screw axis between every pair of consecutive SET TWO positions (SCREWM)."""
+    if deck.positions is None:
+        raise InputError(f"MS = {deck.ms} deck has no SET TWO positions")
+    P = np.asarray(deck.positions, dtype=float)
+    if deck.ms in (0, 4, 6) and deck.hand_from_seventh_joint:
+        raise InputError("the first position is all zero (hand from the seventh joint)")
+    sc = screws_between(frame_from_triple(P))
+    out = []
+    for i in range(P.shape[0] - 1):
+        s = sc[i]
+        out.append({
+            "from_position": i + 1, "to_position": i + 2,
+            "axis": np.asarray(s.axis), "point": np.asarray(s.point),
+            "translation": float(s.d), "angle_deg": float(s.angle_deg),
+            "pitch": float(s.pitch), "pure_translation": bool(s.is_translation),
+        })
+    return out
+
+
+def deck_joints(deck: DispDeck) -> list[dict]:
+    """MS = 2: every SET FOUR joint in the global frame (TRANSM, eqs. 2-10 to 2-18)."""
+    if deck.joints is None or deck.frame_points is None:
+        raise InputError(f"MS = {deck.ms} deck has no SET FOUR / SET FIVE")
+    fr = mechanism_frames(deck.joint_table, deck.frame_points)
+    return [
+        {"joint": i + 1, "origin_star": fr.origin_star[i], "origin": fr.origin[i],
+         "axis": fr.axis[i], "normal": fr.normal[i]}
+        for i in range(len(deck.joints))
+    ]
+
+
+def deck_model(deck: DispDeck) -> ChainModel:
+    """The six-joint chain of a guidance deck (SET FOUR, SET FIVE); its end frame is the
+    seventh joint's x*(7) when N ≥ 7 (later joints are part of the hand, App. I), else x(6)."""
+    if deck.joints is None or deck.frame_points is None:
+        raise InputError(f"MS = {deck.ms} deck has no SET FOUR / SET FIVE")
+    n = len(deck.joints)
+    if n < 6:
+        raise InputError(f"a guidance deck needs at least 6 joints, SET FOUR has {n}")
+    rows = deck.joint_table[: min(n, 7)]
+    name = deck.source.rsplit("/", 1)[-1].removesuffix(".dat") or "deck"
+    return from_nadkarni(rows, deck.frame_points, n_active=6, name=name, length_unit="in",
+                         description=f"DISP deck {deck.source}")
+
+
+def deck_initial_hand(deck: DispDeck, model: ChainModel) -> tuple[ChainModel, np.ndarray,
+                                                                  list[str]]:
+    """The hand: ``(model, initial hand points (3, 3), notes)``.
+
+    Seventh-joint option: the model as is and the unit points of x*(7). Inferior option (a
+    non-zero first SET TWO position): the model's end frame re-attached to link 6 so that the
+    hand at the initial configuration is the frame of those points.
+    """
+    notes: list[str] = []
+    H7 = fk(model, model.q_home)
+    if deck.ms == 5 or deck.hand_from_seventh_joint:
+        if len(deck.joints or ()) < 7:
+            raise InputError("the hand is defined by the seventh joint, but SET FOUR has "
+                             f"{len(deck.joints or ())} joints: give N ≥ 7")
+        a7 = deck.joints[6].a
+        if a7 <= 0.0:
+            notes.append(
+                f"a7 = {a7:g}: DISP needs a7 > 0 to build the hand from three points; kinestat "
+                "takes the seventh joint's frame x*(7) directly, so the run does not depend on "
+                "a7 (Table A2-7 prints a7 = 1.00)")
+        return model, hand_points(H7), notes
+    P0 = np.asarray(deck.positions[0], dtype=float)
+    Hg = frame_from_triple(P0)
+    dp, da = pose_error(Hg, H7)
+    if len(deck.joints) < 7:
+        notes.append("SET FOUR has no seventh joint: the hand is the body located by the first "
+                     "SET TWO position, rigidly attached to link 6")
+    elif dp > 1e-6 * max(1.0, float(np.max(np.abs(P0)))) or da > 1e-6:
+        notes.append(
+            f"the first SET TWO position (the thesis's 'inferior' option) is not the seventh "
+            f"joint's frame: it is {dp:.6g} {model.length_unit} and {math.degrees(da):.6g} deg "
+            "away; kinestat guides the body located by those points, rigidly attached to link 6")
+    else:
+        notes.append("the first SET TWO position agrees with the seventh joint's frame")
+    C = np.array(model.constants)
+    C[-1] = C[-1] @ (inv(H7) @ Hg)
+    return dataclasses.replace(model, constants=C), P0, notes
+
+
+def deck_stages(deck: DispDeck, start_points) -> list[Callable[[np.ndarray], object]]:
+    """One stage per target position (MS 0, 4, 6) or command (MS 5), each a function of the
+    hand pose at its start."""
+    ms = deck.ms
+    if ms == 5:
+        return [
+            (lambda H, c=c: command_path(H, c.direction, c.distance, c.angle, c.frame))
+            for c in deck.commands
+        ]
+    P = [np.asarray(start_points, dtype=float)] + [
+        np.asarray(p, dtype=float) for p in deck.positions[1:]]
+    if ms == 0:
+        return [(lambda H, T=frame_from_triple(P[i]): screw_path(H, T))
+                for i in range(1, len(P))]
+    if ms == 6:
+        return [(lambda H, T=frame_from_triple(P[i]): general_path(H, T))
+                for i in range(1, len(P))]
+    if ms == 4:
+        return [(lambda H, a=P[i - 1], b=P[i]: line_path(a, b)) for i in range(1, len(P))]
+    raise InputError(f"MS = {ms} is not a guidance analysis (0, 4, 5, 6)")
+
+
+def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
+             options: GuidanceOptions | None = None,
+             progress: Callable[[int, int], None] | None = None) -> DeckRun:
+    """Run a deck for its MS. ``steps`` overrides the deck's IT (0/None: IT, or automatic when
+    IT = 0)."""
+    if not isinstance(deck, DispDeck):
+        raise InputError(f"run_deck takes a DispDeck, got {type(deck).__name__}")
+    notes = list(deck_warnings(deck))
+    ms = deck.ms
+    if ms in (1, 2, 3):
+        screws = deck_screws(deck) if ms in (1, 3) else None
+        joints = deck_joints(deck) if ms in (2, 3) else None
+        return DeckRun(deck, screws=screws, joints=joints, notes=tuple(notes))
+    model = deck_model(deck)
+    model, P0, hand_notes = deck_initial_hand(deck, model)
+    notes = [n for n in notes if not n.startswith("a7 =")] + hand_notes
+    stages = deck_stages(deck, P0)
+    if steps is None or steps == 0:
+        steps = deck.it if deck.it > 0 else None
+    result = run_guidance(model, model.q_home, stages, steps=steps, options=options,
+                          progress=progress)
+    return DeckRun(deck, model=model, result=result, notes=tuple(notes) + result.notes)
+
+
+def deck_json(run: DeckRun) -> dict:
+    """The machine-readable record of a deck run (the ``kinestat disp --json`` contract).
+
+    MS 1: ``screws``; MS 2: ``joints``; MS 3: both; MS 0/4/5/6: the keys of
+    :func:`~kinestat.serial.guidance.run.result_record` (``table``, ``final_hand_points``,
+    ``events``, ...; ``hand_points`` of every row when IO = 0), with ``stage_hand_origins``
+    (the hand origin at the end of each command) for MS = 5. Always ``ms``, ``analysis``,
+    ``source`` and ``notes``.
+    """
+    deck = run.deck
+    out: dict = {"ms": deck.ms, "analysis": deck.analysis, "source": deck.source}
+    if run.screws is not None:
+        out["screws"] = run.screws
+    if run.joints is not None:
+        out["joints"] = run.joints
+    if run.result is not None:
+        out["type"] = _TYPE[deck.ms]
+        rec = result_record(run.result, hand_points_every_row=deck.io == 0)
+        if deck.ms != 5:
+            rec.pop("stage_hand_origins")
+        out.update(rec)
+    out["notes"] = list(run.notes)
+    return out

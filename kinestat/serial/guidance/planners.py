@@ -1,0 +1,337 @@
+"""Hand paths of Nadkarni's four analysis types and the twist B of each step (ch. IV).
+
+A path is pure geometry: the ideal hand pose at every fraction ``s ∈ [0, 1]`` of the motion
+(:meth:`pose_at`) plus the rule the thesis uses to build the small hand displacement B of a
+step (:meth:`step_twist`, the right-hand side of eq. 4-11). The runner (:mod:`.run`) chooses
+the step count k and calls them with ``s = j/k``.
+
+=========  ============  =====================================================================
+type       DISP (MS)     path and step twist
+=========  ============  =====================================================================
+II         DISPM (0)     screw path: fixed screw axis through ρn, ``B = [δθU; hδθU − δθU×ρn]``
+                         constant for all k steps (eqs. 4-18, 4-19; Pieper's iterative
+                         velocity method) — :func:`screw_path`
+III        SPLITM (4)    the three hand points move on straight lines split in k equal parts;
+                         each step screws the hand from where it is to the next split position
+                         (eq. 4-20) — :func:`line_path`
+IV         GUIDM (5)     operator command R, d, θ (global frame or hand frame, R = Q'R'):
+                         ``U = R/|R|``, ``δθ = θ/k``, ``h = d/θ``, ``ρn = ρo`` the hand origin
+                         at the start of the command (eqs. 4-21, 4-22) — :func:`command_path`
+I          GENM (6)      rotation δθ about a fixed direction u_ω through the *current* hand
+                         origin O_H plus δr along u_v: ``B = [δθu_ω; δr u_v − δθu_ω×ρo]``
+                         (eq. 4-11a); Ex. 4 (eq. 4-17): u_ω = screw axis U of the whole
+                         displacement, u_v = R/|R| (R = O_H1→O_H2) — :func:`general_path`,
+                         Ex. 1–3 — :func:`general_motion`
+=========  ============  =====================================================================
+
+DISP with MS = 6 plans from the actual hand at every step (ρo = the current O_H), as the thesis
+notes ("DISP uses the actual position of the manipulator hand defined by the seventh joint ...
+for any intermediate stage"); :class:`GeneralPath` does the same.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from kinestat.errors import InputError
+from kinestat.spatial.displacement import (
+    frame_from_triple,
+    pose_from_screw,
+    screw_from_poses,
+)
+from kinestat.spatial.transforms import as_array, make_pose, trans
+
+__all__ = [
+    "twist_exp",
+    "twist_between",
+    "pose_error",
+    "ScrewPath",
+    "LinePath",
+    "GeneralPath",
+    "screw_path",
+    "line_path",
+    "general_path",
+    "general_motion",
+    "command_path",
+    "auto_steps",
+    "path_extent",
+]
+
+
+def _pose(T, name: str) -> np.ndarray:
+    T = as_array(T, shape_tail=(4, 4), name=name)
+    if T.shape != (4, 4):
+        raise InputError(f"{name} must be one 4x4 pose, got shape {T.shape}")
+    return T
+
+
+def twist_exp(V) -> np.ndarray:
+    """Rigid displacement ``(..., 4, 4)`` produced by the twist ``V = [ω; v_O]`` ``(..., 6)``
+    (the matrix exponential of :func:`kinestat.spatial.screws.twist_matrix`), via its screw:
+    θ = |ω|, u = ω/θ, d = u·v, ρn = ω×v/θ² (eqs. 4-19a read backwards)."""
+    V = as_array(V, shape_tail=(6,), name="twist")
+    w, v = V[..., :3], V[..., 3:]
+    th = np.linalg.norm(w, axis=-1)
+    rot = th > 1e-15
+    ths = np.where(rot, th, 1.0)
+    u = np.where(rot[..., None], w / ths[..., None], np.array([0.0, 0.0, 1.0]))
+    d = np.sum(u * v, axis=-1)
+    point = np.where(rot[..., None], np.cross(w, v) / (ths**2)[..., None], 0.0)
+    D = pose_from_screw(u, point, np.where(rot, th, 0.0), np.where(rot, d, 0.0))
+    return np.where(rot[..., None, None], D, trans(v))
+
+
+def twist_between(T1, T2) -> np.ndarray:
+    """Twist ``ξ`` ``(..., 6)`` with ``twist_exp(ξ) @ T1 = T2``: the screw displacement of
+    Nadkarni ch. III as ``[θU; hθU − θU×ρn]`` (eq. 4-19a with k = 1)."""
+    return screw_from_poses(T1, T2).twist
+
+
+def pose_error(T, T_ref) -> tuple[np.ndarray, np.ndarray]:
+    """``(distance between origins, rotation angle in rad)`` between poses, batched."""
+    T = np.asarray(T, dtype=float)
+    T_ref = np.asarray(T_ref, dtype=float)
+    dp = np.linalg.norm(T[..., :3, 3] - T_ref[..., :3, 3], axis=-1)
+    R = np.swapaxes(T_ref[..., :3, :3], -1, -2) @ T[..., :3, :3]
+    c = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
+    # acos is inaccurate near 0: use the skew part for small angles
+    s = 0.5 * np.linalg.norm(
+        np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
+                  R[..., 1, 0] - R[..., 0, 1]], axis=-1), axis=-1)
+    return dp, np.arctan2(s, c)
+
+
+def _rot(axis, angle) -> np.ndarray:
+    rv = np.asarray(axis, dtype=float) * np.asarray(angle, dtype=float)[..., None]
+    flat = rv.reshape(-1, 3)
+    return Rotation.from_rotvec(flat).as_matrix().reshape(rv.shape[:-1] + (3, 3))
+
+
+def _s(s) -> np.ndarray:
+    s = np.asarray(s, dtype=float)
+    if not np.all(np.isfinite(s)):
+        raise InputError("path fraction s must be finite")
+    return s
+
+
+@dataclass(frozen=True, eq=False)
+class ScrewPath:
+    """Screw path (analysis type II; type IV commands): ``pose_at(s) = exp(s ξ) · start``.
+
+    ``twist`` ξ ``(6,)`` is the whole screw displacement ``[θU; hθU − θU×ρn]``; the step twist
+    is the constant ``(s1 − s0) ξ`` whatever the hand's actual pose (eq. 4-19: ρn "constant
+    throughout the analysis").
+    """
+
+    start: np.ndarray
+    twist: np.ndarray
+    kind: str = "screw"
+
+    @property
+    def end(self) -> np.ndarray:
+        return self.pose_at(1.0)
+
+    def pose_at(self, s) -> np.ndarray:
+        s = _s(s)
+        return twist_exp(s[..., None] * self.twist) @ self.start
+
+    def step_twist(self, s0: float, s1: float, hand) -> np.ndarray:
+        return (s1 - s0) * self.twist
+
+    def step_target(self, s0: float, s1: float, hand) -> np.ndarray:
+        return twist_exp((s1 - s0) * self.twist) @ np.asarray(hand, dtype=float)
+
+    def replan(self, hand, s_now: float) -> ScrewPath:
+        """A screw path from ``hand`` to this path's end (after a perturbation)."""
+        hand = _pose(hand, "hand pose")
+        return ScrewPath(hand, twist_between(hand, self.end), self.kind)
+
+
+@dataclass(frozen=True, eq=False)
+class LinePath:
+    """Type III: the three hand points move on straight lines (Nadkarni eq. 4-20, SPLITM).
+
+    ``points0``/``points1`` ``(3, 3)`` are the origin, a point on +z and a point on the +x side
+    at the start and the end; ``pose_at(s)`` is the frame (eqs. 3-1 to 3-3) of the points
+    ``points0 + s (points1 − points0)``. A step screws the hand from its actual pose to the next
+    split position, so the hand origin stays on the straight line.
+    """
+
+    points0: np.ndarray
+    points1: np.ndarray
+    kind: str = "line"
+
+    @property
+    def start(self) -> np.ndarray:
+        return self.pose_at(0.0)
+
+    @property
+    def end(self) -> np.ndarray:
+        return self.pose_at(1.0)
+
+    def points_at(self, s) -> np.ndarray:
+        s = _s(s)[..., None, None]
+        return self.points0 + s * (self.points1 - self.points0)
+
+    def pose_at(self, s) -> np.ndarray:
+        return frame_from_triple(self.points_at(s))
+
+    def step_twist(self, s0: float, s1: float, hand) -> np.ndarray:
+        return twist_between(np.asarray(hand, dtype=float), self.pose_at(s1))
+
+    def step_target(self, s0: float, s1: float, hand) -> np.ndarray:
+        return self.pose_at(s1)
+
+    def replan(self, hand, s_now: float) -> LinePath:
+        """The rest of the same lines, from the split position at ``s_now``."""
+        return LinePath(self.points_at(s_now), self.points1, self.kind)
+
+
+@dataclass(frozen=True, eq=False)
+class GeneralPath:
+    """Type I: rotation θ about the fixed direction ``u_w`` through the moving hand origin and
+    translation r of the origin along ``u_v`` (eqs. 4-9 to 4-17).
+
+    ``pose_at(s) = [Rot(u_w, sθ) R0 , o0 + s r u_v]``. The step twist is eq. 4-11a's
+    ``[δθ u_w; δr u_v − δθ u_w × ρo]`` with ρo the *current* hand origin (DISP, MS = 6).
+    """
+
+    start: np.ndarray
+    u_w: np.ndarray
+    theta: float
+    u_v: np.ndarray
+    r: float
+    kind: str = "general"
+
+    @property
+    def end(self) -> np.ndarray:
+        return self.pose_at(1.0)
+
+    def pose_at(self, s) -> np.ndarray:
+        s = _s(s)
+        R = _rot(self.u_w, s * self.theta) @ self.start[:3, :3]
+        p = self.start[:3, 3] + (s * self.r)[..., None] * self.u_v
+        return make_pose(R, p)
+
+    def step_twist(self, s0: float, s1: float, hand) -> np.ndarray:
+        ds = s1 - s0
+        w = ds * self.theta * self.u_w
+        o = np.asarray(hand, dtype=float)[:3, 3]
+        return np.concatenate([w, ds * self.r * self.u_v - np.cross(w, o)])
+
+    def step_target(self, s0: float, s1: float, hand) -> np.ndarray:
+        ds = s1 - s0
+        hand = np.asarray(hand, dtype=float)
+        R = _rot(self.u_w, ds * self.theta) @ hand[:3, :3]
+        return make_pose(R, hand[:3, 3] + ds * self.r * self.u_v)
+
+    def replan(self, hand, s_now: float) -> GeneralPath:
+        """Example 4 from ``hand`` to this path's end (after a perturbation)."""
+        return general_path(hand, self.end)
+
+
+def screw_path(start, target) -> ScrewPath:
+    """Type II (eqs. 4-18, 4-19): the screw displacement from ``start`` to ``target``."""
+    start = _pose(start, "start pose")
+    target = _pose(target, "target pose")
+    return ScrewPath(start, twist_between(start, target))
+
+
+def line_path(points0, points1) -> LinePath:
+    """Type III (eq. 4-20): straight lines of the three hand points ``(3, 3)`` each (rows:
+    origin, point on +z, point on the +x side). Every split position must fix a frame."""
+    P0 = as_array(points0, shape_tail=(3, 3), name="start points")
+    P1 = as_array(points1, shape_tail=(3, 3), name="target points")
+    if P0.shape != (3, 3) or P1.shape != (3, 3):
+        raise InputError("line_path takes two sets of three points, shape (3, 3) each")
+    path = LinePath(P0, P1)
+    frame_from_triple(path.points_at(np.linspace(0.0, 1.0, 65)))  # raises on degeneracy
+    return path
+
+
+def general_motion(start, axis, angle: float, direction, distance: float) -> GeneralPath:
+    """Type I, Examples 1–3: rotate by ``angle`` (rad) about ``axis`` through the hand origin
+    while the origin moves ``distance`` along ``direction`` (both in the global frame)."""
+    start = _pose(start, "start pose")
+    a = as_array(axis, shape_tail=(3,), name="rotation axis")
+    v = as_array(direction, shape_tail=(3,), name="direction")
+    angle = float(angle)
+    distance = float(distance)
+    na, nv = float(np.linalg.norm(a)), float(np.linalg.norm(v))
+    if angle != 0.0 and na == 0.0:
+        raise InputError("a rotation needs a nonzero axis direction")
+    if distance != 0.0 and nv == 0.0:
+        raise InputError("a translation needs a nonzero direction")
+    u_w = a / na if na > 0 else np.zeros(3)
+    u_v = v / nv if nv > 0 else np.zeros(3)
+    return GeneralPath(start, u_w, angle, u_v, distance)
+
+
+def general_path(start, target) -> GeneralPath:
+    """Type I, Example 4 (eqs. 4-16, 4-17): ``u_ω = U`` the screw axis of start → target,
+    θ its angle, ``u_v = R/|R|`` with R from the start origin to the target origin."""
+    start = _pose(start, "start pose")
+    target = _pose(target, "target pose")
+    sc = screw_from_poses(start, target)
+    R = target[:3, 3] - start[:3, 3]
+    nR = float(np.linalg.norm(R))
+    u_v = R / nR if nR > 0 else np.zeros(3)
+    th = 0.0 if bool(sc.is_translation) else float(sc.theta)
+    return GeneralPath(start, np.asarray(sc.axis, dtype=float), th, u_v, nR)
+
+
+def command_path(start, direction, distance: float, angle: float,
+                 frame: str = "global") -> ScrewPath:
+    """Type IV (eqs. 4-21, 4-22): an operator command from the hand pose ``start``.
+
+    ``direction`` R (global frame, or the hand frame when ``frame="hand"``: R = Q'R'),
+    ``distance`` d along it and ``angle`` θ (rad) about the line through the hand origin
+    parallel to R: ``U = R/|R|``, ``h = d/θ``, ``ρn = ρo``; θ = 0 is a pure translation.
+    """
+    start = _pose(start, "start pose")
+    R = as_array(direction, shape_tail=(3,), name="command direction")
+    if frame not in ("global", "hand"):
+        raise InputError(f"command frame must be 'global' or 'hand', got {frame!r}")
+    nR = float(np.linalg.norm(R))
+    if nR == 0.0:
+        raise InputError("command direction R is the zero vector: give the direction of motion")
+    if not (math.isfinite(distance) and math.isfinite(angle)):
+        raise InputError("command distance and angle must be finite")
+    if frame == "hand":
+        R = start[:3, :3] @ R
+    U = R / nR
+    rho_o = start[:3, 3]
+    twist = np.concatenate([angle * U, angle * np.cross(rho_o, U) + distance * U])
+    return ScrewPath(start, twist, "command")
+
+
+def path_extent(path, samples: int = 256) -> tuple[float, float]:
+    """``(rotation in rad, length)`` travelled by the hand frame / origin along the ideal path,
+    summed over ``samples`` equal parts (exact for screw and general paths in the limit)."""
+    P = path.pose_at(np.linspace(0.0, 1.0, samples + 1))
+    dp, ang = pose_error(P[1:], P[:-1])
+    return float(np.sum(ang)), float(np.sum(dp))
+
+
+def auto_steps(path, length: float, *, max_step_deg: float = 1.0,
+               max_step_fraction: float = 0.01, max_steps: int = 100_000) -> int:
+    """DISP's IT = 0: choose the step count so that no step rotates the hand by more than
+    ``max_step_deg`` nor moves its origin by more than ``max_step_fraction`` × L.
+
+    With these defaults (1°, L/100) the neglected second-order terms of a step are of order
+    ½ δθ² ℓ ≈ 1.5e-4 ℓ (ℓ a lever arm ~ L), see docs/guidance.md.
+    """
+    rot, dist = path_extent(path)
+    k = max(1, math.ceil(math.degrees(rot) / max_step_deg - 1e-9),
+            math.ceil(dist / (max_step_fraction * length) - 1e-9))
+    if k > max_steps:
+        raise InputError(
+            f"the motion needs {k} steps of at most {max_step_deg}° and "
+            f"{max_step_fraction * length:.4g} length units; more than {max_steps}: give the "
+            "step count explicitly or split the motion"
+        )
+    return k
