@@ -26,6 +26,7 @@ COMMAND_MODULES: list[str] = [
     "sim",
     "dh_from_axes",
     "platform",
+    "control",
 ]
 
 app = typer.Typer(

@@ -1,0 +1,287 @@
+"""``kinestat control``: kinestatic force control of the PUMA 762 + compliant platform cell.
+
+With no device arguments the command starts the Galil simulator and the encoder emitter
+itself (loopback TCP and a pty), builds the simulated cell (the thesis's experiment by
+default: Vibhute 2011 §5.1) and drives it through the real client and reader. With
+``--galil HOST:PORT --serial DEVICE`` it drives real hardware.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from kinestat.cli._output import console as out_console
+from kinestat.cli._output import err_console, parse_floats, print_json, table
+from kinestat.errors import InputError, KinestatError
+
+DEFAULT_START = "-400,800,-100"
+DEFAULT_DIRECTION = "0.9713,0,-0.2375"
+DEFAULT_PLANE_DISTANCE = 2.5
+DEFAULT_PLANE_TILT_DEG = 5.0
+
+
+def register(app: typer.Typer) -> None:
+    app.command("control")(control_command)
+
+
+def _host_port(text: str) -> tuple[str, int]:
+    host, sep, port = text.rpartition(":")
+    if not sep or not host:
+        raise InputError(f"--galil: expected HOST:PORT, got {text!r}")
+    try:
+        p = int(port)
+    except ValueError as exc:
+        raise InputError(f"--galil: port {port!r} is not a number") from exc
+    if not 0 < p < 65536:
+        raise InputError(f"--galil: port {p} outside 1..65535")
+    return host, p
+
+
+def default_plane(start_point: np.ndarray, direction: np.ndarray, distance: float,
+                  tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """The default workpiece: a plane ``distance`` mm ahead of the start tool point along the
+    force direction, its normal tilted by ``tilt_deg`` from −direction (towards the fixed +y,
+    or +z when the direction is along y) so that the reorientation (state c) is visible."""
+    d = direction / np.linalg.norm(direction)
+    ref = np.array([0.0, 1.0, 0.0]) if abs(d[1]) < 0.9 else np.array([0.0, 0.0, 1.0])
+    perp = ref - (ref @ d) * d
+    perp /= np.linalg.norm(perp)
+    t = math.radians(tilt_deg)
+    normal = -(math.cos(t) * d + math.sin(t) * perp)
+    return start_point + distance * d, normal
+
+
+def _run_dir(base: Path) -> Path:
+    stamp = time.strftime("%Y%m%d-%H%M%S")
+    d = base / stamp
+    k = 1
+    while d.exists():
+        k += 1
+        d = base / f"{stamp}-{k}"
+    return d
+
+
+def control_command(
+    force: float = typer.Option(4.0, "--force", help="Target force magnitude |F_req| (N)."),
+    direction: str = typer.Option(
+        DEFAULT_DIRECTION, "--direction",
+        help="Direction of F_req x,y,z (fixed frame): the approach direction and the start "
+        "pose's tool axis. Default the thesis's 0.9713 i + 0 j - 0.2375 k."),
+    force_tol: float = typer.Option(0.5, "--force-tol", help="Tolerance on |F| (N)."),
+    align_tol_deg: float = typer.Option(
+        0.5, "--align-tol-deg", help="Tolerance on the angle between S6 and the force (deg)."),
+    start: str = typer.Option(DEFAULT_START, "--start",
+                              help="Start tool point P_tool_F x,y,z (mm, fixed frame)."),
+    plane_point: str = typer.Option(
+        None, "--plane-point",
+        help=f"A point of the workpiece plane x,y,z (mm). Default: {DEFAULT_PLANE_DISTANCE} mm "
+        "ahead of the start tool point along F_req (simulation only)."),
+    plane_normal: str = typer.Option(
+        None, "--plane-normal",
+        help=f"Workpiece normal x,y,z, pointing out of the material towards the tool. Default: "
+        f"-F_req tilted by {DEFAULT_PLANE_TILT_DEG} deg (simulation only)."),
+    method: str = typer.Option(
+        "stiffness", "--method",
+        help="Step along S6: 'stiffness' (Newton step from the platform stiffness) or 'fixed' "
+        "(the thesis's constant step)."),
+    step: float = typer.Option(
+        1.0, "--step", help="Fixed step, and the largest stiffness step (mm)."),
+    approach_step: float = typer.Option(
+        1.0, "--approach-step", help="Step along S6 while no contact is measured (mm)."),
+    estimator: str = typer.Option(
+        "point", "--estimator",
+        help="Force the controller acts on: 'point' (point-contact fit) or 'wrench' (the "
+        "equivalent wrench's force, as the thesis)."),
+    ideal_sensor: bool = typer.Option(
+        False, "--ideal-sensor", help="Simulated leg encoders without quantisation (1 nm)."),
+    noise: float = typer.Option(
+        0.0, "--noise", help="Simulated leg-length noise, standard deviation (mm)."),
+    friction: float = typer.Option(
+        0.0, "--friction", help="Coulomb friction coefficient of the simulated workpiece."),
+    galil: str = typer.Option(None, "--galil", help="Real Galil controller HOST:PORT."),
+    serial: str = typer.Option(None, "--serial",
+                               help="Real encoder stream: serial device or pyserial URL."),
+    serial_format: str = typer.Option(
+        "ks", "--serial-format", help="Encoder packet format: 'ks' or 'legacy' (thesis)."),
+    samples: int = typer.Option(1, "--samples",
+                                help="Sensor packets averaged per measurement."),
+    rate: float = typer.Option(200.0, "--rate", help="Simulated encoder packet rate (Hz)."),
+    seed: int = typer.Option(0, "--seed", help="Seed of the simulated sensor noise."),
+    max_iterations: int = typer.Option(60, "--max-iterations",
+                                       help="Measurement cycles before giving up."),
+    plot: Path = typer.Option(
+        None, "--plot", help="Directory for the wrench-vs-state plot (default: the run "
+        "directory)."),
+    no_plot: bool = typer.Option(False, "--no-plot", help="Do not write the plot."),
+    log: Path = typer.Option(
+        None, "--log", help="Cycle log file, JSON lines (default: "
+        "./kinestat-runs/<timestamp>/log.jsonl)."),
+    as_json: bool = typer.Option(False, "--json", help="Print the final report as JSON."),
+) -> None:
+    """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
+
+    Vibhute 2011 ch. 4-5: move to the start pose, measure the wrench through the compliant
+    platform, turn S6 onto the force about the tool point, then step along S6 until the force
+    is within tolerance. Without --galil/--serial it runs the simulated cell. Every cycle is
+    logged; faults end in a safe stop (ST). Exit status 0 when converged, 2 otherwise.
+
+    JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
+    tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots.
+    """
+    from kinestat.control.controller import ControllerConfig
+    from kinestat.control.envelope import Envelope
+    from kinestat.control.log import CycleLog, read_log
+    from kinestat.control.loop import DeviceIO, run
+    from kinestat.parallel.platform import special_6_6
+    from kinestat.sim.cell import Sensor, centred_mount, ideal_calibration, make_cell
+
+    d = parse_floats(direction, 3, "direction")
+    if np.linalg.norm(d) == 0:
+        raise InputError("--direction must not be the zero vector")
+    d = d / np.linalg.norm(d)
+    if not (math.isfinite(force) and force > 0):
+        raise InputError(f"--force must be a positive number of newtons, got {force}")
+    p0 = parse_floats(start, 3, "start")
+    if (galil is None) != (serial is None):
+        raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
+                         "neither to run the simulated cell")
+    simulated = galil is None
+    if not simulated and (plane_point or plane_normal or ideal_sensor or noise or friction):
+        raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction "
+                         "describe the simulated cell; they cannot be used with real devices")
+    if serial_format not in ("ks", "legacy"):
+        raise InputError(f"--serial-format must be 'ks' or 'legacy', got {serial_format!r}")
+    if ideal_sensor and noise:
+        raise InputError("--ideal-sensor and --noise exclude each other")
+    if not (math.isfinite(noise) and noise >= 0):
+        raise InputError(f"--noise must be >= 0 mm, got {noise}")
+
+    run_dir = None
+    if log is None or (plot is None and not no_plot):
+        run_dir = _run_dir(Path("kinestat-runs"))
+    log_path = log if log is not None else run_dir / "log.jsonl"
+    plot_dir = None if no_plot else (plot if plot is not None else run_dir)
+
+    platform = special_6_6()
+    if simulated:
+        if ideal_sensor:
+            sensor = Sensor(calibration=ideal_calibration())
+        else:
+            sensor = Sensor(noise=noise)
+        pp_default, pn_default = default_plane(p0, d, DEFAULT_PLANE_DISTANCE,
+                                               DEFAULT_PLANE_TILT_DEG)
+        pp = parse_floats(plane_point, 3, "plane-point") if plane_point else pp_default
+        pn = parse_floats(plane_normal, 3, "plane-normal") if plane_normal else pn_default
+        cell = make_cell(platform, plane_point=pp, plane_normal=pn, friction=friction)
+        from kinestat.sim.harness import SimHarness, control_model, start_counts
+
+        model = control_model(cell, sensor)
+    else:
+        from kinestat.control.model import ControlModel
+
+        model = ControlModel(platform=platform, mount=centred_mount(platform),
+                             tool_point_6=(0.0, 0.0, 235.0))
+    config = ControllerConfig(
+        model=model, force=force * d, start_tool_point=p0, force_tol=force_tol,
+        align_tol_deg=align_tol_deg, method=method, step=step, approach_step=approach_step,
+        estimator=estimator,
+        max_iterations=max_iterations, envelope=Envelope())
+
+    header = {"simulated": simulated}
+    if simulated:
+        header.update({"plane_point": cell.workpiece.point, "plane_normal": cell.workpiece.normal,
+                       "friction": friction, "ideal_sensor": ideal_sensor, "noise": noise,
+                       "rate_hz": rate})
+    else:
+        header.update({"galil": galil, "serial": serial, "serial_format": serial_format})
+
+    def progress(rec: dict) -> None:
+        m = rec["measured"]
+        c = rec["commanded"]
+        what = rec["decision"] if c is None else c["action"]
+        extra = ""
+        if c is not None and c["step"]:
+            extra += f" step {c['step']:+.4f} mm"
+        if c is not None and c["rotation_deg"]:
+            extra += f" turn {c['rotation_deg']:.3f}°"
+        fmag = float(np.linalg.norm(m["estimate"]))
+        err_console.print(f"cycle {rec['cycle']:3d}  state {rec['state']}  |F| {fmag:7.4f} N"
+                          f"  -> {what}{extra}")
+
+    err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
+                      f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), method {method}, "
+                      + ("simulated cell" if simulated else f"Galil {galil}, sensor {serial}"))
+    with CycleLog(log_path) as cycle_log:
+        if simulated:
+            sc = start_counts(config)
+            with SimHarness(cell, sensor, start_counts=sc, rate_hz=rate, seed=seed) as h:
+                io = h.device_io(samples=samples)
+                report = run(config, io, cycle_log, progress=progress, extra_header=header)
+        else:
+            report = _run_devices(config, cycle_log, galil, serial, serial_format, samples,
+                                  progress, header, run, DeviceIO)
+    out = report.as_dict()
+    plots: list[str] = []
+    if plot_dir is not None:
+        try:
+            from kinestat.viz.control_plots import write_plots
+
+            plots = [str(p) for p in write_plots(read_log(log_path), plot_dir)]
+        except InputError as exc:
+            err_console.print(f"[yellow]no plot:[/] {exc}")
+    out["plots"] = plots
+    if as_json:
+        print_json(out)
+    else:
+        _print_report(out)
+    if not report.converged:
+        raise KinestatError(f"kinestatic control did not converge: {report.stop_reason}")
+
+
+def _run_devices(config, cycle_log, galil, serial, serial_format, samples, progress, header,
+                 run, DeviceIO):
+    from kinestat.devices.encoder_stream import EncoderReader
+    from kinestat.devices.galil import GalilClient
+
+    host, port = _host_port(galil)
+    client = GalilClient(host, port).connect()
+    try:
+        with EncoderReader(serial, fmt=serial_format) as reader:
+            io = DeviceIO(client, reader, samples=samples, settle=0.1)
+            return run(config, io, cycle_log, progress=progress, extra_header=header)
+    finally:
+        client.close()
+
+
+def _print_report(out: dict) -> None:
+    ok = "[green]converged[/]" if out["converged"] else "[red]not converged[/]"
+    out_console.print(f"Kinestatic control {ok} after {out['iterations']} cycles "
+                      f"({out['moves']} moves, {out['elapsed_s']:.1f} s); states "
+                      f"{out['states']}")
+    out_console.print(f"  {out['stop_reason']}")
+    rows = []
+    for key, label in (("force", "force (N)"), ("torque", "torque about tool point (N·mm)"),
+                       ("true_force", "true force (N)"), ("tool_axis", "tool axis S6"),
+                       ("tool_point", "tool point (mm)")):
+        if out.get(key) is not None:
+            rows.append([label, *out[key]])
+    if rows:
+        out_console.print(table("Final state (fixed frame)", ["", "x", "y", "z"], rows))
+    if out.get("force_magnitude") is not None:
+        line = f"|F| = {out['force_magnitude']:.4f} N (target {out['target_force']:g} N)"
+        if out.get("true_force_magnitude") is not None:
+            line += f", true |F| = {out['true_force_magnitude']:.4f} N"
+        if out.get("axis_error_deg") is not None:
+            line += f", true force vs tool axis {out['axis_error_deg']:.3f}°"
+        out_console.print(line)
+    if out.get("final_axis_deg") is not None:
+        out_console.print("robot axes (deg): " + ", ".join(f"{v:.4f}"
+                                                           for v in out["final_axis_deg"]))
+    out_console.print(f"log: {out['log']}")
+    for p in out.get("plots", []):
+        out_console.print(f"plot: {p}")

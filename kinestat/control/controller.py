@@ -1,0 +1,481 @@
+"""The kinestatic controller: pure decision logic, no I/O (Vibhute 2011 ch. 4, App. D.1).
+
+One call per cycle, :func:`decide`, takes the controller's state and the cycle's
+:class:`~kinestat.control.wrench.Measurement` and returns the next :class:`Command` and the new
+state. The procedure is the thesis's ForceCorrection.m:
+
+1. move to the commanded pose (closed-form reverse analysis of the PUMA 762 and the solution
+   nearest the current configuration within the axis limits) — :func:`start`;
+2. measure the equivalent wrench ``W_eq`` (:mod:`kinestat.control.wrench`);
+3. align S6 with the wrench's force while keeping the tool point ``P_tool_F`` (the unloaded
+   tool point; this cancels the torque about it), then move along S6 until the force
+   magnitude is within ``force_tol`` of ``|F_req|``.
+
+Each cycle is labelled with the states of Vibhute's Figure 5-2:
+
+* ``a`` — platform at rest, unloaded (no contact force measured): approach along S6;
+* ``b`` — the tool has hit the workpiece: first loaded measurement after an approach;
+* ``c`` — measured after the robot reoriented the tool along the equivalent wrench;
+* ``d`` — measured while the force magnitude is being controlled;
+* ``e`` — goal attained: force within tolerance and S6 along the force.
+
+Step along S6 (``method``): ``"fixed"`` is the thesis's 1 mm step with the sign of the force
+error (``step``); ``"stiffness"`` is a Newton step ``δ = (|F_req| − |F|) / k_axial`` with
+``k_axial = s6ᵀ K_tip s6`` the platform's point stiffness at the tip along S6
+(:func:`kinestat.control.envelope.tip_stiffness`), clipped to ``step``.
+
+The commanded axis angles are rounded to whole encoder counts of the robot. With ``vernier``
+the controller picks, among the count vectors next to the ideal one (±4 counts on axes 1..3,
+±1 on axes 4..5), the one whose tool point (forward analysis, including the axis-5 rounding
+left by the axis 4 → 5 compensation) lies nearest the target along S6, with small lateral and
+angular deviations — the robot's counts are ~0.02 mm at the tool, which is 0.2 N of force on
+this platform; the search resolves the target to ~0.1 µm.
+
+When S6 is misaligned AND the force is out of tolerance, the reorientation and the step along
+the new axis are commanded together (at light contact the measured direction is noisy; pushing
+towards the target force makes it precise).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import dataclass, field, replace
+
+import numpy as np
+
+from kinestat.control.envelope import (
+    Envelope,
+    Prediction,
+    check_command,
+    check_measurement,
+    check_target,
+    predict,
+    tip_stiffness,
+)
+from kinestat.control.model import ControlModel
+from kinestat.control.wrench import Measurement
+from kinestat.devices.galil import round_half_away
+from kinestat.errors import InputError, JointLimitError, UnreachableError
+from kinestat.serial import puma762
+
+__all__ = [
+    "THESIS_FORCE_DIRECTION",
+    "STATES",
+    "METHODS",
+    "Target",
+    "ControllerConfig",
+    "ControllerState",
+    "Command",
+    "Controller",
+    "start",
+    "decide",
+    "default_a67",
+    "axis_counts_to_q",
+]
+
+THESIS_FORCE_DIRECTION = np.array([0.9713, 0.0, -0.2375]) / math.hypot(0.9713, 0.2375)
+"""Direction of the thesis's ``F_req = 0.9713 i + 0 j − 0.2375 k`` (Vibhute §5.1; the OCR
+dropped the minus sign — see docs/errata/control.md), normalised (|F_req| printed = 0.99991)."""
+THESIS_FORCE_DIRECTION.setflags(write=False)
+
+STATES = {
+    "a": "platform at rest, unloaded",
+    "b": "tool has hit the workpiece, wrench generated",
+    "c": "robot reoriented the tool along the equivalent wrench",
+    "d": "force in the tool being controlled",
+    "e": "goal force attained, kinestatic control complete",
+}
+"""The states of Vibhute's Figure 5-2."""
+
+METHODS = ("fixed", "stiffness")
+ESTIMATORS = ("point", "wrench")
+
+
+def _unit(v, name: str) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    if a.shape != (3,) or not np.all(np.isfinite(a)):
+        raise InputError(f"{name} must be 3 finite numbers, got {np.asarray(v).tolist()}")
+    n = float(np.linalg.norm(a))
+    if n < 1e-12:
+        raise InputError(f"{name} must be a nonzero vector")
+    return a / n
+
+
+def default_a67(s6) -> np.ndarray:
+    """A link direction a67 ⟂ S6 for a start pose: the fixed z axis projected off S6 (or the
+    x axis if S6 is vertical)."""
+    s = _unit(s6, "s6")
+    for ref in (np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])):
+        a = ref - (ref @ s) * s
+        if np.linalg.norm(a) > 0.1:
+            return a / np.linalg.norm(a)
+    raise InputError("cannot choose a67")  # pragma: no cover - one of the two always works
+
+
+@dataclass(frozen=True, eq=False)
+class Target:
+    """The end effector as the thesis commands it: tool point, S6 and a67 (fixed frame)."""
+
+    tool_point: np.ndarray
+    s6: np.ndarray
+    a67: np.ndarray
+
+    def key(self) -> tuple:
+        """Hashable rounding (1 nm, 1e-9) used to spot a repeated target (a limit cycle)."""
+        return tuple(np.round(np.concatenate([self.tool_point * 1e6, self.s6 * 1e9,
+                                              self.a67 * 1e9])).astype(np.int64).tolist())
+
+
+@dataclass(frozen=True, eq=False)
+class ControllerConfig:
+    """Settings of one kinestatic control run (immutable).
+
+    Attributes:
+        model: the cell as the controller knows it.
+        force: (3,) ``F_req``: its magnitude is the target force (N), its direction the
+            approach direction and the start pose's S6.
+        start_tool_point: (3,) the start pose's tool point ``P_tool_F`` (mm, fixed frame).
+        start_s6, start_a67: the start pose's S6 (default along ``force``) and a67 (default
+            :func:`default_a67`).
+        force_tol: tolerance on the force magnitude (N).
+        align_tol_deg: tolerance on the angle between S6 and the measured force (degrees).
+        method: ``"fixed"`` (thesis) or ``"stiffness"``.
+        step: the fixed step, and the largest step of the stiffness method (mm).
+        approach_step: step along S6 while no contact is measured (mm; the thesis's 1 mm).
+        contact_force: force magnitude above which the tool is in contact (N).
+        max_iterations: measurement cycles before giving up.
+        vernier: choose the count vector that best realises the target along S6.
+        estimator: the force acted on: ``"point"`` (point-contact fit, default) or
+            ``"wrench"`` (the equivalent wrench's force, as the thesis), see
+            :meth:`kinestat.control.wrench.Measurement.estimate`.
+        repeat_limit: a target commanded this many times means a limit cycle → stop.
+        envelope: the safety envelope.
+    """
+
+    model: ControlModel
+    force: np.ndarray
+    start_tool_point: np.ndarray
+    start_s6: np.ndarray | None = None
+    start_a67: np.ndarray | None = None
+    force_tol: float = 0.5
+    align_tol_deg: float = 0.5
+    method: str = "stiffness"
+    step: float = 1.0
+    approach_step: float = 1.0
+    contact_force: float = 0.25
+    max_iterations: int = 60
+    vernier: bool = True
+    estimator: str = "point"
+    repeat_limit: int = 3
+    envelope: Envelope = field(default_factory=Envelope)
+
+    def __post_init__(self) -> None:
+        F = np.asarray(self.force, dtype=float)
+        if F.shape != (3,) or not np.all(np.isfinite(F)) or np.linalg.norm(F) <= 0:
+            raise InputError(f"force (F_req) must be 3 finite numbers, not all zero, got "
+                             f"{np.asarray(self.force).tolist()}")
+        object.__setattr__(self, "force", F.copy())
+        p = np.asarray(self.start_tool_point, dtype=float)
+        if p.shape != (3,) or not np.all(np.isfinite(p)):
+            raise InputError("start_tool_point must be 3 finite numbers (mm)")
+        object.__setattr__(self, "start_tool_point", p.copy())
+        s6 = F / np.linalg.norm(F) if self.start_s6 is None else _unit(self.start_s6, "start_s6")
+        a67 = default_a67(s6) if self.start_a67 is None else _unit(self.start_a67, "start_a67")
+        if abs(float(s6 @ a67)) > 1e-6:
+            raise InputError(f"start_a67 must be perpendicular to start_s6 (dot "
+                             f"{float(s6 @ a67):.3g})")
+        object.__setattr__(self, "start_s6", s6)
+        object.__setattr__(self, "start_a67", a67)
+        if self.estimator not in ESTIMATORS:
+            raise InputError(f"estimator must be one of {ESTIMATORS}, got {self.estimator!r}")
+        if self.method not in METHODS:
+            raise InputError(f"method must be one of {METHODS}, got {self.method!r}")
+        for name in ("force_tol", "align_tol_deg", "step", "contact_force"):
+            v = float(getattr(self, name))
+            if not (math.isfinite(v) and v > 0):
+                raise InputError(f"{name} must be a positive number, got {getattr(self, name)!r}")
+        if not (math.isfinite(self.approach_step) and self.approach_step > 0):
+            raise InputError(f"approach_step must be positive, got {self.approach_step!r}")
+        if int(self.max_iterations) < 1:
+            raise InputError("max_iterations must be at least 1")
+        if self.contact_force >= np.linalg.norm(F):
+            raise InputError(f"the contact threshold {self.contact_force} N must be below the "
+                             f"requested force {np.linalg.norm(F):.3g} N")
+
+    @property
+    def force_target(self) -> float:
+        """|F_req| (N)."""
+        return float(np.linalg.norm(self.force))
+
+    @property
+    def approach(self) -> float:
+        return float(self.approach_step)
+
+
+@dataclass(frozen=True, eq=False)
+class ControllerState:
+    """What the controller remembers between cycles (immutable; :func:`decide` returns a new one).
+
+    Attributes:
+        cycle: measurements processed so far.
+        label: the state (a–e) of the last cycle, "" before the first.
+        last_action: the last command's action ("start", "approach", "align", "force").
+        target: the last commanded end effector.
+        axis_counts: (6,) the last commanded axis counts.
+        top_pose: (4, 4) the last measured top pose (the tracking FK's seed).
+        history: keys of the targets commanded so far (limit-cycle detection).
+        done: the run is over (goal reached or stopped).
+    """
+
+    cycle: int
+    label: str
+    last_action: str
+    target: Target
+    axis_counts: np.ndarray
+    top_pose: np.ndarray
+    history: tuple = ()
+    done: bool = False
+
+
+@dataclass(frozen=True, eq=False)
+class Command:
+    """The controller's decision for one cycle.
+
+    Attributes:
+        kind: "move" (send ``axis_counts``), "done" (goal reached) or "stop" (safe stop).
+        label: the cycle's state a–e ("" for the start move).
+        action: "start", "approach", "align", "force" or "" (done/stop).
+        reason: why (always set for "stop").
+        target: the commanded end effector (moves only).
+        axis_counts: (6,) absolute axis positions in robot encoder counts (moves only).
+        axis_deg: (6,) the same in degrees; q: (6,) joint angles (radians).
+        step: signed step along S6 (mm) for approach/force moves.
+        rotation_deg: reorientation angle for align moves.
+        force_error: |F_req| − |F| (N); misalignment_deg: angle(S6, F).
+        prediction: predicted force and deflections after the move.
+        violations: envelope violations that caused a stop.
+    """
+
+    kind: str
+    label: str
+    action: str = ""
+    reason: str = ""
+    target: Target | None = None
+    axis_counts: np.ndarray | None = None
+    axis_deg: np.ndarray | None = None
+    q: np.ndarray | None = None
+    step: float = 0.0
+    rotation_deg: float = 0.0
+    force_error: float | None = None
+    misalignment_deg: float | None = None
+    prediction: Prediction | None = None
+    violations: tuple[str, ...] = ()
+
+
+# -- joint-space helpers ------------------------------------------------------------------------
+def axis_counts_to_q(model: ControlModel, counts) -> np.ndarray:
+    """Joint angles (radians) from robot axis counts (``axis = counts · resolution``)."""
+    deg = np.asarray(counts, dtype=float) * model.axis_deg_per_count
+    return puma762.from_axis_angles(np.radians(deg))
+
+
+def _q_to_axis_counts(model: ControlModel, axis_rad) -> np.ndarray:
+    return round_half_away(np.degrees(axis_rad) / model.axis_deg_per_count)
+
+
+def _axis5_residual(model: ControlModel, counts: np.ndarray, counts_now: np.ndarray) -> np.ndarray:
+    """Axis-5 counts left over by the 4 → 5 compensation (physical − commanded target)."""
+    kappa = model.coupling * (counts[..., 3] - counts_now[3])
+    return round_half_away(-kappa) + kappa
+
+
+# Vernier candidates: ±4 counts on axes 1-3 (they move the tool point along S6 by ~1-15 µm per
+# count, so their combinations resolve ~0.1 µm), ±1 on the wrist axes 4-5, axis 6 as is (it
+# turns the tool about its own axis).
+_OFFSETS = np.array([(a, b, c, d, e, 0) for a, b, c in itertools.product(range(-4, 5), repeat=3)
+                     for d, e in itertools.product((-1, 0, 1), repeat=2)], dtype=np.int64)
+
+
+def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
+                  vernier: bool) -> tuple[np.ndarray, float]:
+    """Reverse analysis, selection within limits, rounding to counts (with the vernier).
+
+    Returns (counts, residual along S6 in mm of the chosen counts). Raises UnreachableError or
+    JointLimitError."""
+    res = puma762.reverse(target.tool_point, target.s6, target.a67, model.tool_point_6)
+    sel = puma762.select(res, q_now, model.limits_deg)
+    c0 = _q_to_axis_counts(model, sel.axis)
+    cand = c0 + _OFFSETS if vernier else c0[None, :]
+    phys = cand.astype(float)
+    phys[:, 4] += _axis5_residual(model, cand, counts_now)
+    fwd = puma762.forward(axis_counts_to_q(model, phys), model.tool_point_6)
+    d = fwd.tool_point - target.tool_point
+    along = d @ target.s6
+    lateral = np.linalg.norm(d - along[:, None] * target.s6, axis=1)
+    tilt = np.arccos(np.clip(fwd.s6 @ target.s6, -1.0, 1.0))
+    cost = (along / 1e-3) ** 2 + (lateral / 0.05) ** 2 + (tilt / math.radians(0.01)) ** 2
+    k = int(np.argmin(cost))
+    return cand[k], float(along[k])
+
+
+def _rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotate ``v`` by the smallest rotation taking unit ``a`` onto unit ``b``."""
+    axis = np.cross(a, b)
+    s = float(np.linalg.norm(axis))
+    c = float(a @ b)
+    if s < 1e-15:
+        return v.copy()
+    k = axis / s
+    ang = math.atan2(s, c)
+    return (v * math.cos(ang) + np.cross(k, v) * math.sin(ang)
+            + k * (k @ v) * (1.0 - math.cos(ang)))
+
+
+# -- the procedure ---------------------------------------------------------------------------------
+def start(config: ControllerConfig, q_now, *, counts_now=None) -> tuple[Command, ControllerState]:
+    """Step 1: the command that takes the robot to the start pose, and the initial state.
+
+    ``q_now`` are the robot's current joint angles (radians); ``counts_now`` its current axis
+    counts (default: computed from ``q_now``). The target force is checked against the envelope
+    first; a violation yields a "stop" command and nothing moves.
+    """
+    model = config.model
+    q_now = np.asarray(q_now, dtype=float)
+    if counts_now is None:
+        counts_now = _q_to_axis_counts(model, puma762.to_axis_angles(q_now))
+    counts_now = np.asarray(counts_now, dtype=np.int64)
+    target = Target(config.start_tool_point, config.start_s6, config.start_a67)
+    state = ControllerState(cycle=0, label="", last_action="start", target=target,
+                            axis_counts=counts_now, top_pose=model.platform.home_pose.copy())
+    bad = check_target(config.envelope, config.force)
+    if bad:
+        return (Command(kind="stop", label="", reason="; ".join(bad), violations=tuple(bad)),
+                replace(state, done=True))
+    try:
+        counts, _ = _solve_counts(model, target, q_now, counts_now, config.vernier)
+    except (UnreachableError, JointLimitError) as exc:
+        msg = f"the start pose cannot be commanded: {exc}"
+        return Command(kind="stop", label="", reason=msg), replace(state, done=True)
+    axis_deg = counts * model.axis_deg_per_count
+    now_deg = counts_now * model.axis_deg_per_count
+    bad = check_command(config.envelope, model, axis_deg, now_deg, None)
+    if bad:
+        return (Command(kind="stop", label="", reason="start move: " + "; ".join(bad),
+                        violations=tuple(bad)), replace(state, done=True))
+    cmd = Command(kind="move", label="", action="start", target=target, axis_counts=counts,
+                  axis_deg=axis_deg, q=axis_counts_to_q(model, counts))
+    return cmd, replace(state, axis_counts=counts, history=(target.key(),))
+
+
+def _stop(state: ControllerState, label: str, reason: str, **kw) -> tuple[Command, ControllerState]:
+    return Command(kind="stop", label=label, reason=reason, **kw), replace(state, done=True)
+
+
+def decide(config: ControllerConfig, state: ControllerState,
+           meas: Measurement) -> tuple[Command, ControllerState]:
+    """One cycle of the kinestatic procedure: the next command and the new state.
+
+    Pure: the same inputs give the same outputs. Envelope violations (measured or predicted),
+    an unreachable target, a limit cycle or too many cycles give a "stop" command.
+    """
+    if state.done:
+        raise InputError("decide: the run is over (state.done); start a new one")
+    model = config.model
+    env = config.envelope
+    cycle = state.cycle + 1
+    st = replace(state, cycle=cycle, top_pose=meas.top_pose)
+    F = meas.estimate(config.estimator)
+    Fmag = float(np.linalg.norm(F))
+    contact = Fmag >= config.contact_force
+    err = config.force_target - Fmag
+    s6 = state.target.s6
+    mis = math.degrees(math.acos(max(-1.0, min(1.0, float(F @ s6) / Fmag)))) if contact else None
+    if not contact:
+        label = "a"
+    elif state.last_action in ("start", "approach"):
+        label = "b"
+    elif state.last_action == "align":
+        label = "c"
+    else:
+        label = "d"
+    info = {"force_error": err, "misalignment_deg": mis}
+    bad = check_measurement(env, model, meas)
+    if bad:
+        return _stop(replace(st, label=label), label, "measurement outside the envelope: "
+                     + "; ".join(bad), violations=tuple(bad), **info)
+    if contact and abs(err) <= config.force_tol and mis <= config.align_tol_deg:
+        return (Command(kind="done", label="e", reason="goal attained", **info),
+                replace(st, label="e", done=True))
+    if cycle >= config.max_iterations:
+        return _stop(replace(st, label=label), label,
+                     f"not converged after {cycle} cycles (|F| = {Fmag:.4g} N, error "
+                     f"{err:+.4g} N" + (f", misalignment {mis:.3g}°)" if mis is not None else ")"),
+                     **info)
+    tgt = state.target
+    rotation = 0.0
+    step = 0.0
+    if not contact:
+        action = "approach"
+        step = config.approach
+        new = Target(tgt.tool_point + step * tgt.s6, tgt.s6, tgt.a67)
+    else:
+        if mis > config.align_tol_deg:
+            # reorient S6 along the force about the tool point (the torque about it vanishes)
+            action = "align"
+            axis = F / Fmag
+            a67 = _rotate_onto(tgt.a67, tgt.s6, axis)
+            a67 = a67 - (a67 @ axis) * axis
+            a67 /= np.linalg.norm(a67)
+            rotation = mis
+        else:
+            action = "force"
+            axis, a67 = s6, tgt.a67
+        if abs(err) > config.force_tol:
+            if config.method == "fixed":
+                step = math.copysign(config.step, err)
+            else:
+                k_axial = float(axis @ tip_stiffness(model, meas) @ axis)
+                step = float(np.clip(err / k_axial, -config.step, config.step))
+        new = Target(tgt.tool_point + step * axis, axis, a67)
+    key = new.key()
+    if state.history.count(key) + 1 >= config.repeat_limit:
+        return _stop(replace(st, label=label), label,
+                     f"limit cycle: the same target has now been commanded {config.repeat_limit} "
+                     f"times without reaching the goal (|F| = {Fmag:.4g} N, error {err:+.4g} N)"
+                     + (f"; the fixed {config.step:g} mm step is too coarse for this stiffness "
+                        "— use method 'stiffness' or a smaller step"
+                        if config.method == "fixed" else ""), **info)
+    try:
+        counts, _ = _solve_counts(model, new, meas.q, state.axis_counts, config.vernier)
+    except (UnreachableError, JointLimitError) as exc:
+        return _stop(replace(st, label=label), label, f"{action} target not reachable: {exc}",
+                     **info)
+    axis_deg = counts * model.axis_deg_per_count
+    q_new = axis_counts_to_q(model, counts)
+    pred = predict(model, meas, puma762.forward(q_new).pose)
+    bad = check_command(env, model, axis_deg, state.axis_counts * model.axis_deg_per_count, pred)
+    if bad:
+        return _stop(replace(st, label=label), label, f"{action} command refused by the "
+                     "envelope: " + "; ".join(bad), violations=tuple(bad), prediction=pred,
+                     **info)
+    cmd = Command(kind="move", label=label, action=action, target=new, axis_counts=counts,
+                  axis_deg=axis_deg, q=q_new, step=step, rotation_deg=rotation, prediction=pred,
+                  **info)
+    new_state = replace(st, label=label, last_action=action, target=new, axis_counts=counts,
+                        history=state.history + (key,))
+    return cmd, new_state
+
+
+@dataclass(frozen=True)
+class Controller:
+    """The controller as an object: ``decide(state, measurement) -> (command, new_state)``."""
+
+    config: ControllerConfig
+
+    def start(self, q_now, *, counts_now=None) -> tuple[Command, ControllerState]:
+        return start(self.config, q_now, counts_now=counts_now)
+
+    def decide(self, state: ControllerState, meas: Measurement
+               ) -> tuple[Command, ControllerState]:
+        return decide(self.config, state, meas)

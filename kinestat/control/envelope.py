@@ -1,0 +1,232 @@
+"""The safety envelope of the kinestatic controller: limits, predictions, verdicts.
+
+What the cell must never do (Vibhute 2011 Table 3-1 and the PUMA 762's axis limits):
+
+* command an axis outside its limits (every commanded configuration is checked as the absolute
+  axis angles actually sent, after wrapping and rounding), or move an axis by more than
+  ``max_joint_step_deg`` in one command;
+* deflect a leg by more than ``max_deflection`` (5 mm, Table 3-1 "Individual Connector
+  Deflection");
+* load the platform beyond ``max_load`` (50 N, Table 3-1 "Maximum perpendicular load").
+
+Loads and deflections are checked on every measurement AND predicted before a command is sent:
+:func:`predict` assumes the worst case for a step — the tip pinned where it is (a sticking
+contact; a sliding one loads the platform less) — and maps the flange's displacement at the tip
+through the platform's point stiffness at the tip, ``K_tip``, the inverse of the tip's
+translational compliance computed from the spatial stiffness at the measured pose
+(:func:`kinestat.parallel.stiffness.stiffness`, which includes the load terms), plus the
+moment of the present load about the moved point of application. Out of contact the same
+prediction is the load if the workpiece were met at the very start of the step.
+
+Every check returns a list of violations (empty: safe); :func:`require` turns them into a
+:class:`~kinestat.errors.SafetyStop`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinestat.control.model import ControlModel
+from kinestat.control.wrench import Measurement
+from kinestat.errors import InputError, SafetyStop
+from kinestat.parallel.statics import leg_directions
+from kinestat.parallel.stiffness import stiffness
+from kinestat.spatial.transforms import apply, inv, skew
+
+__all__ = [
+    "MAX_DEFLECTION",
+    "MAX_LOAD",
+    "Envelope",
+    "Prediction",
+    "tip_compliance",
+    "tip_stiffness",
+    "predict",
+    "check_target",
+    "check_measurement",
+    "check_command",
+    "require",
+]
+
+MAX_DEFLECTION = 5.0
+"""Largest leg deflection |l − l0|, mm (Vibhute Table 3-1)."""
+MAX_LOAD = 50.0
+"""Largest load on the platform, N (Vibhute Table 3-1)."""
+
+
+@dataclass(frozen=True)
+class Envelope:
+    """Limits the controller enforces (joint limits come from the :class:`ControlModel`).
+
+    Attributes:
+        max_deflection: mm, per leg.
+        max_load: N, magnitude of the force on the platform.
+        max_joint_step_deg: largest axis motion in one command, degrees.
+        max_stream_faults: sensor-stream faults (lost, corrupt, garbled packets) tolerated while
+            acquiring one measurement; more means the link is unreliable → stop.
+    """
+
+    max_deflection: float = MAX_DEFLECTION
+    max_load: float = MAX_LOAD
+    max_joint_step_deg: float = 30.0
+    max_stream_faults: int = 5
+
+    def __post_init__(self) -> None:
+        for name in ("max_deflection", "max_load", "max_joint_step_deg"):
+            v = float(getattr(self, name))
+            if not (math.isfinite(v) and v > 0):
+                raise InputError(f"envelope {name} must be a positive number, got {v!r}")
+        if int(self.max_stream_faults) < 0:
+            raise InputError("envelope max_stream_faults must be >= 0")
+
+
+@dataclass(frozen=True, eq=False)
+class Prediction:
+    """Predicted state after a command (worst case: the tip pinned where it is).
+
+    Attributes:
+        force: (3,) force the tool would apply to the workpiece, fixed frame (N).
+        deflections: (6,) leg deflections ``l − l0`` (mm).
+        tip_motion: (3,) displacement of the flange-carried point at the tip (mm, fixed frame).
+    """
+
+    force: np.ndarray
+    deflections: np.ndarray
+    tip_motion: np.ndarray
+
+    @property
+    def force_magnitude(self) -> float:
+        return float(np.linalg.norm(self.force))
+
+
+def _tip_base(model: ControlModel, meas: Measurement) -> np.ndarray:
+    return apply(meas.top_pose, model.tool_tip_top)
+
+
+def tip_compliance(model: ControlModel, meas: Measurement) -> np.ndarray:
+    """Translational compliance of the tool tip (3, 3), base frame, mm/N.
+
+    A force ``δF`` applied at the tip (the top free to rotate) moves the tip by
+    ``C_tip δF``: ``C_tip = [−[p]×, I] K⁻¹ [I; [p]×]`` with ``K`` the platform's stiffness
+    (axis order ``[δφ; δx_O]``) at the measured pose and ``p`` the tip in base coordinates.
+    """
+    K = stiffness(model.platform, meas.top_pose, twist_order="axis")
+    p = _tip_base(model, meas)
+    A = np.vstack([np.eye(3), skew(p)])
+    B = np.hstack([-skew(p), np.eye(3)])
+    return B @ np.linalg.solve(K, A)
+
+
+def tip_stiffness(model: ControlModel, meas: Measurement) -> np.ndarray:
+    """Point stiffness of the platform at the tool tip (3, 3), FIXED frame, N/mm.
+
+    The inverse of :func:`tip_compliance` rotated into the fixed frame: moving the flange by
+    ``δ`` (at the tip) with the tip held changes the tool's force by ``K_tip δ``.
+    """
+    Kb = np.linalg.inv(tip_compliance(model, meas))
+    R = meas.base_pose[:3, :3]
+    return R @ Kb @ R.T
+
+
+def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Prediction:
+    """Predict force and leg deflections after moving the flange to ``flange_pose_new``.
+
+    Worst case for the load: the tip stays where it is in the fixed frame (pinned, as by a
+    sticking contact) while the top may turn about it. In the new base frame the tip sits at
+    ``p' = p + u``; the springs must then carry ``[F + δF; p' × (F + δF)]`` with the top's tip at
+    ``p'``. To first order, with ``K`` the platform stiffness at the measured pose and ``D`` the
+    top's small twist: ``K D = [δF; p × δF + u × F]`` and ``[−[p]×, I] D = u``, so
+    ``δF = C_tip⁻¹ (u − [−[p]×, I] K⁻¹ [0; u × F])`` and the legs change by ``jᵀ D``. The
+    force on the workpiece, fixed frame, is ``−R' (F + δF)``.
+    """
+    Tn = np.asarray(flange_pose_new, dtype=float)
+    TB_new = Tn @ model.mount
+    tip_F = meas.tip(model)
+    p = _tip_base(model, meas)
+    u = apply(inv(TB_new), tip_F) - p
+    R = meas.base_pose[:3, :3]
+    F = -(R.T @ meas.estimate("point"))  # external force on the tip, base frame
+    K = stiffness(model.platform, meas.top_pose, twist_order="axis")
+    A = np.vstack([np.eye(3), skew(p)])
+    B = np.hstack([-skew(p), np.eye(3)])
+    C_tip = B @ np.linalg.solve(K, A)
+    b = np.concatenate([np.zeros(3), np.cross(u, F)])
+    dF = np.linalg.solve(C_tip, u - B @ np.linalg.solve(K, b))
+    D = np.linalg.solve(K, A @ dF + b)  # top twist [δφ; δx_O] relative to the base
+    S, _ = leg_directions(model.platform, meas.top_pose)
+    Bp = model.platform.base_points
+    dl = np.cross(Bp, S) @ D[:3] + S @ D[3:]
+    force = -(TB_new[:3, :3] @ (F + dF))
+    defl = meas.deflections(model) + dl
+    return Prediction(force=force, deflections=defl, tip_motion=apply(Tn @ inv(meas.flange_pose),
+                                                                      tip_F) - tip_F)
+
+
+def check_target(envelope: Envelope, force_target) -> list[str]:
+    """Violations of the requested force itself (before anything moves)."""
+    F = float(np.linalg.norm(np.asarray(force_target, dtype=float)))
+    if not math.isfinite(F):
+        return ["the requested force is not finite"]
+    if F > envelope.max_load:
+        return [f"the requested force {F:.3g} N exceeds the platform's load limit "
+                f"{envelope.max_load:g} N (Vibhute Table 3-1)"]
+    return []
+
+
+def check_measurement(envelope: Envelope, model: ControlModel, meas: Measurement) -> list[str]:
+    """Violations in a measurement: load and leg deflections beyond the envelope."""
+    out = []
+    if not (np.all(np.isfinite(meas.wrench)) and np.all(np.isfinite(meas.leg_lengths))):
+        return ["the measurement contains NaN or infinity"]
+    F = meas.force_magnitude
+    if F > envelope.max_load:
+        out.append(f"measured load {F:.3g} N exceeds the limit {envelope.max_load:g} N")
+    defl = meas.deflections(model)
+    k = int(np.argmax(np.abs(defl)))
+    if abs(defl[k]) > envelope.max_deflection:
+        out.append(f"leg {model.platform.leg_names[k]} is deflected {defl[k]:+.3f} mm, beyond "
+                   f"±{envelope.max_deflection:g} mm")
+    return out
+
+
+def check_command(envelope: Envelope, model: ControlModel, axis_deg_new, axis_deg_now,
+                  prediction: Prediction | None) -> list[str]:
+    """Violations of a command: axis limits, axis step, predicted load and deflections.
+
+    ``axis_deg_new`` are the absolute axis angles that will be commanded (degrees, after
+    rounding to counts); ``axis_deg_now`` the current ones.
+    """
+    out = []
+    a = np.asarray(axis_deg_new, dtype=float)
+    if a.shape != (6,) or not np.all(np.isfinite(a)):
+        return [f"commanded axis angles are not 6 finite numbers: {a.tolist()}"]
+    lo, hi = model.limits_deg[:, 0], model.limits_deg[:, 1]
+    for j in range(6):
+        if not lo[j] <= a[j] <= hi[j]:
+            out.append(f"axis {j + 1} command {a[j]:.4f}° is outside its limits "
+                       f"[{lo[j]:g}°, {hi[j]:g}°]")
+    if axis_deg_now is not None:
+        step = np.abs(a - np.asarray(axis_deg_now, dtype=float))
+        j = int(np.argmax(step))
+        if step[j] > envelope.max_joint_step_deg:
+            out.append(f"axis {j + 1} would move {step[j]:.3f}° in one command, more than "
+                       f"{envelope.max_joint_step_deg:g}°")
+    if prediction is not None:
+        F = prediction.force_magnitude
+        if F > envelope.max_load:
+            out.append(f"predicted load {F:.3g} N after the move exceeds the limit "
+                       f"{envelope.max_load:g} N")
+        k = int(np.argmax(np.abs(prediction.deflections)))
+        dk = prediction.deflections[k]
+        if abs(dk) > envelope.max_deflection:
+            out.append(f"leg {model.platform.leg_names[k]} would deflect {dk:+.3f} mm after the "
+                       f"move, beyond ±{envelope.max_deflection:g} mm")
+    return out
+
+
+def require(violations: list[str], what: str = "safety envelope") -> None:
+    """Raise :class:`SafetyStop` listing ``violations`` (no-op when empty)."""
+    if violations:
+        raise SafetyStop(f"{what}: " + "; ".join(violations))

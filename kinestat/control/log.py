@@ -1,0 +1,102 @@
+"""The cycle log: one JSON object per line, flushed (and fsync'ed) as each line is written.
+
+A run's log holds, in order: a ``start`` record (settings), one ``cycle`` record per
+measurement (measured and commanded state, the decision, the true state when simulated),
+``fault`` records for anything that went wrong, and an ``end`` record with the final report.
+Because every line reaches the disk before the next command is sent, a safe stop (or a crash)
+never loses the cycles that led to it. Read it back with :func:`read_log`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from kinestat.errors import InputError
+
+__all__ = ["CycleLog", "read_log", "jsonable"]
+
+
+def jsonable(obj: Any) -> Any:
+    """Plain-Python copy of ``obj`` (numpy arrays and scalars; inf/nan as strings)."""
+    if isinstance(obj, dict):
+        return {str(k): jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [jsonable(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return jsonable(obj.tolist())
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        x = float(obj)
+        if math.isnan(x):
+            return "nan"
+        if math.isinf(x):
+            return "inf" if x > 0 else "-inf"
+        return x
+    return obj
+
+
+class CycleLog:
+    """Append JSON-lines records to ``path`` (created with its directories; truncated).
+
+    ``fsync`` (default True) forces each line to the disk, not just to the OS.
+    """
+
+    def __init__(self, path: str | os.PathLike, *, fsync: bool = True) -> None:
+        self.path = Path(path)
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            self._f = open(self.path, "w", encoding="utf-8")  # noqa: SIM115
+        except OSError as exc:
+            raise InputError(f"cannot write the cycle log {str(self.path)!r}: {exc}") from exc
+        self.fsync = fsync
+        self.records = 0
+
+    def write(self, record: dict) -> None:
+        """Write one record as a line, then flush it to the disk."""
+        if self._f.closed:
+            raise InputError(f"cycle log {str(self.path)!r} is closed")
+        self._f.write(json.dumps(jsonable(record), separators=(",", ":")) + "\n")
+        self._f.flush()
+        if self.fsync:
+            try:
+                os.fsync(self._f.fileno())
+            except OSError:  # pragma: no cover - e.g. a pipe
+                pass
+        self.records += 1
+
+    def close(self) -> None:
+        if not self._f.closed:
+            self._f.close()
+
+    def __enter__(self) -> CycleLog:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def read_log(path: str | os.PathLike) -> list[dict]:
+    """All records of a cycle log; raises :class:`InputError` on an unreadable line."""
+    out = []
+    p = Path(path)
+    try:
+        lines = p.read_text(encoding="utf-8").splitlines()
+    except OSError as exc:
+        raise InputError(f"cannot read the cycle log {str(p)!r}: {exc}") from exc
+    for i, line in enumerate(lines, 1):
+        if not line.strip():
+            continue
+        try:
+            out.append(json.loads(line))
+        except json.JSONDecodeError as exc:
+            raise InputError(f"{p}: line {i} is not JSON: {exc}") from exc
+    return out

@@ -1,0 +1,431 @@
+"""The I/O driver of the kinestatic controller: devices in, pure decisions, devices out.
+
+:func:`run` repeats one cycle — read the robot's axis counts and a fresh packet of leg
+counts, run the measurement chain, call the pure :func:`~kinestat.control.controller.decide`,
+log the cycle, send the command — until the goal is reached or something stops it. It talks to
+the cell through a small :class:`CellIO` interface; :class:`DeviceIO` implements it with the
+real Galil client and encoder reader (:mod:`kinestat.devices`), and the simulated cell offers an
+in-process one (:mod:`kinestat.sim.harness`).
+
+Safe stop: any device fault (a ``?`` from the Galil, a dropped link, a timeout), stale or
+unreliable sensor data (no fresh packet in time, a frozen sequence, more stream faults than
+the envelope tolerates), an envelope violation, a measurement the platform's kinematics cannot
+explain, or Ctrl-C ends the run with ``ST`` sent to the motion controller when the link is up,
+a ``fault`` record in the log and a report saying why (:class:`RunReport`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+import numpy as np
+
+from kinestat.control.controller import (
+    STATES,
+    Command,
+    ControllerConfig,
+    ControllerState,
+    axis_counts_to_q,
+    decide,
+    start,
+)
+from kinestat.control.envelope import require
+from kinestat.control.log import CycleLog
+from kinestat.control.wrench import Measurement, measure
+from kinestat.devices.galil import (
+    AXIS4_TO_5_COUPLING,
+    THESIS_ACCEL,
+    THESIS_SPEED_MAX,
+    GalilClient,
+    axis45_compensation,
+)
+from kinestat.errors import DeviceError, InputError, KinestatError, SafetyStop
+
+__all__ = ["SensorSample", "CellIO", "DeviceIO", "RunReport", "run", "MotionProfile"]
+
+
+@dataclass(frozen=True)
+class SensorSample:
+    """Leg counts for one measurement (sensor legs 1..6), with the stream's bookkeeping."""
+
+    counts: np.ndarray
+    seq: int | None = None
+    age: float | None = None
+    faults: tuple[str, ...] = ()
+
+
+class CellIO(Protocol):
+    """What the loop needs from the cell."""
+
+    def robot_counts(self) -> np.ndarray:
+        """The robot's axis positions, encoder counts A..F."""
+
+    def move(self, axis_counts: np.ndarray) -> None:
+        """Move to absolute axis counts and return when the motion is complete."""
+
+    def sensor(self) -> SensorSample:
+        """Leg counts measured after the last motion completed."""
+
+    def stop(self) -> str:
+        """Stop the robot now (best effort); say what was done."""
+
+    def truth(self) -> dict | None:
+        """The true state when simulated (for the log and report), else None."""
+
+
+@dataclass(frozen=True)
+class MotionProfile:
+    """Speeds (counts/s) and accelerations (counts/s²) per axis A..F for each move: by default
+    the thesis's maxima (galil_control.m)."""
+
+    speed: tuple[float, ...] = THESIS_SPEED_MAX
+    accel: tuple[float, ...] = THESIS_ACCEL
+
+
+class DeviceIO:
+    """:class:`CellIO` over a :class:`~kinestat.devices.galil.GalilClient` and an
+    :class:`~kinestat.devices.encoder_stream.EncoderReader` (both opened by the caller).
+
+    Moves compensate the axis 4 -> 5 coupling (``coupling``, as the model's). After each move it
+    waits ``settle`` seconds past the end of the motion and averages ``samples`` fresh packets
+    received after that. ``truth`` is an optional callable returning the true state
+    (simulation only).
+    """
+
+    def __init__(self, client: GalilClient, reader: Any, *, profile: MotionProfile | None = None,
+                 settle: float = 0.03, samples: int = 1, motion_timeout: float = 30.0,
+                 coupling: float = AXIS4_TO_5_COUPLING,
+                 truth: Callable[[], dict] | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        if not (math.isfinite(settle) and settle >= 0):
+            raise InputError(f"settle must be >= 0 seconds, got {settle!r}")
+        if int(samples) < 1:
+            raise InputError(f"samples must be at least 1, got {samples!r}")
+        self.client = client
+        self.reader = reader
+        self.profile = profile or MotionProfile()
+        self.settle = float(settle)
+        self.samples = int(samples)
+        self.motion_timeout = float(motion_timeout)
+        self.coupling = float(coupling)
+        self._truth = truth
+        self._clock = clock
+        self._t_ready = clock()
+
+    def robot_counts(self) -> np.ndarray:
+        return np.asarray(self.client.position_counts(), dtype=np.int64)
+
+    def move(self, axis_counts: np.ndarray) -> None:
+        """Move with the axis 4 -> 5 compensation (Vibhute App. D.9), keep reading the sensor
+        stream while the axes move (so that the serial buffer never overflows), then reset the
+        axis-5 encoder (``DP``) as :meth:`GalilClient.move_compensated` does."""
+        c = np.asarray(axis_counts, dtype=np.int64)
+        corr = axis45_compensation(c[3], c[4], self.client.axis_position("D"),
+                                   self.coupling)
+        cmd = c.copy()
+        cmd[4] = int(corr.axis5_command)
+        self.client.move_absolute(cmd, self.profile.speed, self.profile.accel)
+        deadline = self._clock() + self.motion_timeout
+        while self.client.is_moving():
+            if self._clock() > deadline:
+                raise DeviceError(f"motion not complete after {self.motion_timeout} s")
+            self.reader.poll()
+        self.client.define_position({"E": int(corr.axis5_reset)})
+        self._t_ready = self._clock() + self.settle
+
+    def sensor(self) -> SensorSample:
+        got: list[np.ndarray] = []
+        faults: list[str] = []
+        last = None
+        while len(got) < self.samples:
+            r = self.reader.read()
+            faults.extend(f"{f.kind}: {f.message}" for f in r.faults)
+            if r.received_at >= self._t_ready:
+                got.append(np.asarray(r.counts, dtype=float))
+                last = r
+        assert last is not None
+        return SensorSample(counts=np.mean(got, axis=0), seq=last.seq, age=last.age,
+                            faults=tuple(faults))
+
+    def stop(self) -> str:
+        if not self.client.connected:
+            return "the Galil link is down: ST could not be sent"
+        try:
+            self.client.stop()
+        except KinestatError as exc:
+            return f"ST failed: {exc}"
+        return "ST sent to the Galil"
+
+    def truth(self) -> dict | None:
+        return None if self._truth is None else self._truth()
+
+
+@dataclass
+class RunReport:
+    """The outcome of a run (also the ``end`` record of the log and the CLI's ``--json``)."""
+
+    converged: bool
+    iterations: int
+    moves: int
+    stop_reason: str
+    method: str
+    states: list[str]
+    force: np.ndarray | None = None
+    torque: np.ndarray | None = None
+    force_magnitude: float | None = None
+    tool_axis: np.ndarray | None = None
+    tool_point: np.ndarray | None = None
+    final_joints_deg: np.ndarray | None = None
+    final_axis_deg: np.ndarray | None = None
+    final_leg_lengths: np.ndarray | None = None
+    true_force: np.ndarray | None = None
+    true_force_magnitude: float | None = None
+    axis_error_deg: float | None = None
+    log: str | None = None
+    elapsed_s: float = 0.0
+    target_force: float = 0.0
+    faults: list[str] = field(default_factory=list)
+    estimator: str = "point"
+    equivalent_wrench: np.ndarray | None = None
+
+    def as_dict(self) -> dict:
+        """The report as plain JSON-ready values (the issue's keys first)."""
+        def arr(v):
+            return None if v is None else np.asarray(v, dtype=float).tolist()
+
+        return {
+            "converged": self.converged,
+            "iterations": self.iterations,
+            "force": arr(self.force),
+            "torque": arr(self.torque),
+            "force_magnitude": self.force_magnitude,
+            "true_force": arr(self.true_force),
+            "tool_axis": arr(self.tool_axis),
+            "tool_point": arr(self.tool_point),
+            "final_joints_deg": arr(self.final_joints_deg),
+            "final_leg_lengths": arr(self.final_leg_lengths),
+            "log": self.log,
+            "final_axis_deg": arr(self.final_axis_deg),
+            "states": "".join(self.states),
+            "stop_reason": self.stop_reason,
+            "method": self.method,
+            "moves": self.moves,
+            "target_force": self.target_force,
+            "true_force_magnitude": self.true_force_magnitude,
+            "axis_error_deg": self.axis_error_deg,
+            "elapsed_s": self.elapsed_s,
+            "faults": list(self.faults),
+            "estimator": self.estimator,
+            "equivalent_wrench": arr(self.equivalent_wrench),
+        }
+
+
+def _meas_record(config: ControllerConfig, m: Measurement) -> dict:
+    model = config.model
+    return {
+        "joints_deg": np.degrees(m.q),
+        "counts": m.counts,
+        "leg_lengths": m.leg_lengths,
+        "deflections": m.deflections(model),
+        "force": m.force,
+        "force_magnitude": m.force_magnitude,
+        "point_force": m.point_force,
+        "point_residual": m.point_residual,
+        "estimate": m.estimate(config.estimator),
+        "torque": m.torque,
+        "moment_origin": m.wrench[3:],
+        "tool_point": m.tool_point,
+        "tool_axis": m.s6,
+        "a67": m.a67,
+        "tip": m.tip(model),
+        "top_pose": m.top_pose,
+        "seq": m.seq,
+        "age": m.age,
+    }
+
+
+def _cmd_record(cmd: Command) -> dict | None:
+    if cmd.kind != "move":
+        return None
+    t = cmd.target
+    p = cmd.prediction
+    return {
+        "action": cmd.action,
+        "tool_point": t.tool_point,
+        "tool_axis": t.s6,
+        "a67": t.a67,
+        "axis_counts": cmd.axis_counts,
+        "axis_deg": cmd.axis_deg,
+        "joints_deg": np.degrees(cmd.q),
+        "step": cmd.step,
+        "rotation_deg": cmd.rotation_deg,
+        "predicted_force": None if p is None else p.force,
+        "predicted_force_magnitude": None if p is None else p.force_magnitude,
+        "predicted_deflections": None if p is None else p.deflections,
+    }
+
+
+def _config_record(config: ControllerConfig) -> dict:
+    env = config.envelope
+    return {
+        "force": config.force,
+        "force_target": config.force_target,
+        "force_tol": config.force_tol,
+        "align_tol_deg": config.align_tol_deg,
+        "method": config.method,
+        "step": config.step,
+        "approach_step": config.approach,
+        "contact_force": config.contact_force,
+        "max_iterations": config.max_iterations,
+        "vernier": config.vernier,
+        "estimator": config.estimator,
+        "start_tool_point": config.start_tool_point,
+        "start_s6": config.start_s6,
+        "start_a67": config.start_a67,
+        "tool_point_6": config.model.tool_point_6,
+        "mount": config.model.mount,
+        "envelope": {"max_deflection": env.max_deflection, "max_load": env.max_load,
+                     "max_joint_step_deg": env.max_joint_step_deg,
+                     "max_stream_faults": env.max_stream_faults},
+        "states": STATES,
+    }
+
+
+def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
+        progress: Callable[[dict], None] | None = None,
+        extra_header: dict | None = None) -> RunReport:
+    """Run the kinestatic procedure on ``io`` until the goal, a stop or ``max_iterations``.
+
+    Never raises for a fault of the cell: the run ends with a safe stop and the report says
+    why. Every cycle is written to ``log`` before its command is sent.
+    """
+    t0 = time.monotonic()
+    header = {"type": "start", "time": time.strftime("%Y-%m-%dT%H:%M:%S"),
+              "config": _config_record(config)}
+    if extra_header:
+        header.update(extra_header)
+    log.write(header)
+    model = config.model
+    states: list[str] = []
+    faults: list[str] = []
+    last_meas: Measurement | None = None
+    last_truth: dict | None = None
+    last_counts: np.ndarray | None = None
+    moves = 0
+    converged = False
+    reason = ""
+    state: ControllerState | None = None
+    try:
+        counts_now = io.robot_counts()
+        q_now = axis_counts_to_q(model, counts_now)
+        cmd, state = start(config, q_now, counts_now=counts_now)
+        log.write({"type": "command", "cycle": 0, "t": time.monotonic() - t0,
+                   "decision": cmd.kind, "reason": cmd.reason, "commanded": _cmd_record(cmd)})
+        if cmd.kind == "stop":
+            raise SafetyStop(cmd.reason)
+        io.move(cmd.axis_counts)
+        moves += 1
+        while True:
+            sample = io.sensor()
+            if sample.faults:
+                faults.extend(sample.faults)
+                log.write({"type": "stream_faults", "cycle": state.cycle + 1,
+                           "faults": list(sample.faults)})
+            if len(sample.faults) > config.envelope.max_stream_faults:
+                raise SafetyStop(f"sensor link unreliable: {len(sample.faults)} stream faults "
+                                 f"while acquiring one measurement (limit "
+                                 f"{config.envelope.max_stream_faults}); first: "
+                                 f"{sample.faults[0]}")
+            counts_r = io.robot_counts()
+            last_counts = np.asarray(counts_r)
+            q = axis_counts_to_q(model, counts_r)
+            meas = measure(model, q, sample.counts, state.top_pose, seq=sample.seq,
+                           age=sample.age)
+            last_meas = meas
+            cmd, state = decide(config, state, meas)
+            states.append(cmd.label)
+            last_truth = io.truth()
+            rec = {"type": "cycle", "cycle": state.cycle, "t": time.monotonic() - t0,
+                   "state": cmd.label, "decision": cmd.kind, "action": cmd.action,
+                   "reason": cmd.reason, "force_error": cmd.force_error,
+                   "misalignment_deg": cmd.misalignment_deg,
+                   "measured": _meas_record(config, meas), "commanded": _cmd_record(cmd),
+                   "true": last_truth, "violations": list(cmd.violations)}
+            log.write(rec)
+            if progress is not None:
+                progress(rec)
+            if cmd.kind == "done":
+                converged = True
+                reason = cmd.reason
+                break
+            if cmd.kind == "stop":
+                raise SafetyStop(cmd.reason)
+            require([] if cmd.axis_counts is not None else ["a move without axis counts"])
+            io.move(cmd.axis_counts)
+            moves += 1
+    except (KinestatError, KeyboardInterrupt) as exc:
+        if isinstance(exc, KeyboardInterrupt):
+            reason = "interrupted by the user"
+        elif isinstance(exc, SafetyStop):
+            reason = str(exc)
+        else:
+            kind = "device fault" if isinstance(exc, DeviceError) else type(exc).__name__
+            reason = f"{kind}: {exc}"
+        reason = _safe_stop(io, log, reason, faults, t0)
+    except Exception as exc:  # a bug: stop the robot first, keep the log, then let it show
+        reason = _safe_stop(io, log, f"internal error {type(exc).__name__}: {exc}", faults, t0)
+        report = _report(config, False, state, states, moves, reason, last_meas, last_truth,
+                         log, faults, time.monotonic() - t0, last_counts)
+        log.write({"type": "end", "report": report.as_dict()})
+        raise
+    report = _report(config, converged, state, states, moves, reason, last_meas, last_truth,
+                     log, faults, time.monotonic() - t0, last_counts)
+    log.write({"type": "end", "report": report.as_dict()})
+    return report
+
+
+def _safe_stop(io: CellIO, log: CycleLog, reason: str, faults: list[str], t0: float) -> str:
+    """Stop the robot (best effort), log the fault; return the reason with what was done."""
+    try:
+        stopped = io.stop()
+    except Exception as exc:  # noqa: BLE001 - a failing stop must not hide the fault
+        stopped = f"stopping failed: {exc}"
+    faults.append(reason)
+    log.write({"type": "fault", "t": time.monotonic() - t0, "reason": reason,
+               "action": stopped})
+    return f"{reason} ({stopped})"
+
+
+def _report(config, converged, state, states, moves, reason, m, truth, log, faults, elapsed,
+            counts=None) -> RunReport:
+    rep = RunReport(converged=converged, iterations=0 if state is None else state.cycle,
+                    moves=moves, stop_reason=reason, method=config.method, states=states,
+                    log=str(log.path), elapsed_s=elapsed, target_force=config.force_target,
+                    faults=faults, estimator=config.estimator)
+    if m is not None:
+        f = m.estimate(config.estimator)
+        rep.force = np.array(f, dtype=float)
+        rep.torque = m.torque
+        rep.force_magnitude = float(np.linalg.norm(f))
+        rep.equivalent_wrench = m.wrench.copy()
+        rep.tool_axis = m.s6.copy()
+        rep.tool_point = m.tool_point.copy()
+        rep.final_joints_deg = np.degrees(m.q)
+        if counts is not None:
+            rep.final_axis_deg = counts * config.model.axis_deg_per_count
+        rep.final_leg_lengths = m.leg_lengths.copy()
+    if truth is not None and truth.get("tool_force") is not None:
+        tf = np.asarray(truth["tool_force"], dtype=float)
+        rep.true_force = tf
+        rep.true_force_magnitude = float(np.linalg.norm(tf))
+        axis = truth.get("tool_axis")
+        axis = m.s6 if axis is None and m is not None else axis
+        if axis is not None and rep.true_force_magnitude > 0:
+            c = float(np.clip(tf @ np.asarray(axis, dtype=float) / rep.true_force_magnitude,
+                              -1.0, 1.0))
+            rep.axis_error_deg = math.degrees(math.acos(c))
+    return rep

@@ -1,0 +1,90 @@
+"""What the kinestatic controller knows about the cell (immutable).
+
+The robot (the PUMA 762 in closed form, its axis limits, its encoder resolution and the axis
+4 → 5 coupling its motion controller compensates), the compliant platform, how the platform is
+mounted on the flange, where the unloaded tool tip is (``P_tool_6``, Vibhute App. D.1) and how
+the leg encoders are calibrated. Nothing here changes while the controller runs; per-cycle
+values live in :class:`kinestat.control.controller.ControllerState`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from kinestat.devices.calibration import THESIS_CALIBRATION, LegCalibration
+from kinestat.devices.galil import AXIS4_TO_5_COUPLING, AXIS_DEG_PER_COUNT
+from kinestat.errors import ModelError
+from kinestat.parallel.platform import Platform
+from kinestat.serial import puma762
+from kinestat.spatial.transforms import apply, as_array, inv
+
+__all__ = ["ControlModel"]
+
+
+def _ro(a) -> np.ndarray:
+    out = np.array(a, dtype=float)
+    out.setflags(write=False)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class ControlModel:
+    """The cell as the controller sees it.
+
+    Attributes:
+        platform: the compliant platform (springs, free lengths, home pose).
+        mount: (4, 4) the platform's base frame in frame 6 (``6_BT``).
+        tool_point_6: (3,) the unloaded tool tip in frame 6, mm (``P_tool_6``).
+        calibration: encoder counts → leg lengths (sensor legs 1..6).
+        limits_deg: (6, 2) robot axis limits, degrees (default the MATLAB code's).
+        axis_deg_per_count: (6,) robot encoder resolution, degrees per count.
+        coupling: axis-5 counts turned per axis-4 count, compensated by the motion controller
+            (:func:`kinestat.devices.galil.axis45_compensation`); 0 when there is none.
+    """
+
+    platform: Platform
+    mount: np.ndarray
+    tool_point_6: np.ndarray
+    calibration: LegCalibration = THESIS_CALIBRATION
+    limits_deg: np.ndarray = field(default_factory=lambda: puma762.AXIS_LIMITS_DEG)
+    axis_deg_per_count: np.ndarray = field(default_factory=lambda: AXIS_DEG_PER_COUNT)
+    coupling: float = AXIS4_TO_5_COUPLING
+
+    def __post_init__(self) -> None:
+        M = as_array(self.mount, shape_tail=(4, 4), name="mount")
+        if M.shape != (4, 4):
+            raise ModelError(f"mount must be one 4x4 transform, got shape {M.shape}")
+        object.__setattr__(self, "mount", _ro(M))
+        p6 = as_array(self.tool_point_6, shape_tail=(3,), name="tool_point_6")
+        if p6.shape != (3,):
+            raise ModelError(f"tool_point_6 must be 3 numbers, got shape {p6.shape}")
+        object.__setattr__(self, "tool_point_6", _ro(p6))
+        L = as_array(self.limits_deg, shape_tail=(2,), name="axis limits")
+        if L.shape != (6, 2) or np.any(L[:, 0] >= L[:, 1]):
+            raise ModelError(f"axis limits must be 6 (lower, upper) pairs in degrees with "
+                             f"lower < upper, got {L.tolist()}")
+        object.__setattr__(self, "limits_deg", _ro(L))
+        r = as_array(self.axis_deg_per_count, name="axis resolution")
+        if r.shape != (6,) or np.any(r <= 0):
+            raise ModelError(f"axis resolution must be 6 positive degrees-per-count values, "
+                             f"got {r.tolist()}")
+        object.__setattr__(self, "axis_deg_per_count", _ro(r))
+        if not math.isfinite(float(self.coupling)):
+            raise ModelError("axis 4 -> 5 coupling must be finite")
+        object.__setattr__(self, "coupling", float(self.coupling))
+        # the platform's legs must match the calibration's
+        self.calibration.platform_order(self.platform.leg_names)
+
+    @property
+    def tool_tip_top(self) -> np.ndarray:
+        """The tool tip in the top frame (where ``P_tool_6`` sits when the platform is at home)."""
+        return apply(inv(self.mount @ self.platform.home_pose), self.tool_point_6)
+
+    @property
+    def limits_rad(self) -> np.ndarray:
+        """Axis limits in radians, (6, 2)."""
+        return np.radians(self.limits_deg)
+

@@ -1,0 +1,157 @@
+"""The measurement chain: encoder counts → leg lengths → top pose → the contact wrench.
+
+Vibhute 2011 ch. 4 step 2 (serialdaq_plat.m → leg_to_T10.m → eq_wrench.m): the leg counts
+become leg lengths through the calibration, the platform's forward kinematics (tracking mode,
+from the previous pose) gives the top's pose, the spring forces ``k (l − l0)`` along the legs
+give the wrench, and the flange pose ``F_6T`` (from the robot's encoders) carries it into the
+fixed frame.
+
+Two estimates of the contact force come out of each measurement:
+
+* the **equivalent wrench** ``W_eq = −j k (l − l0)`` (the thesis's eq_wrench.m): all six
+  components, straight from the six leg forces;
+* the **point-contact force**: a tool tip touching a workpiece at a point transmits a pure
+  force through the tip, ``w = [F; p × F]``, so the three components of F are fitted to the six
+  leg forces by least squares, ``F = argmin |k (l − l0) − j⁻¹ [I; [p]×] F|`` (the legs'
+  encoder errors are independent and alike, so this is the maximum-likelihood estimate). With
+  the thesis's 0.0254 mm counts it halves the direction error of ``W_eq`` (mean 0.37° → 0.14°
+  at 4 N); the magnitude is no better (both ±0.03 N typical, 0.1 N worst). Its leg-force
+  residual tells whether the contact really is a point.
+
+Sign: the measured wrench is the one the **tool applies to the workpiece** — the thesis's
+``W_eq`` (the legs' compressive forces along the leg lines), the sense of ``F_req``. It is the
+negative of :func:`kinestat.parallel.statics.spring_wrench`, the external wrench on the top.
+Moments are about the fixed origin (ray coordinates ``[f; m_O]``); :attr:`Measurement.torque`
+is the moment about the tool point ``P_tool_F``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinestat.control.model import ControlModel
+from kinestat.devices.calibration import counts_to_lengths
+from kinestat.errors import InputError
+from kinestat.parallel.statics import line_jacobian, spring_forces, wrench_from_leg_lengths
+from kinestat.serial import puma762
+from kinestat.spatial.screws import transform_wrench
+from kinestat.spatial.transforms import apply, skew
+
+__all__ = ["Measurement", "measure", "tool_frame"]
+
+
+@dataclass(frozen=True, eq=False)
+class Measurement:
+    """One cycle's measured state of the cell (fixed frame unless said otherwise).
+
+    Attributes:
+        q: (6,) joint angles from the robot's encoders (radians, Crane–Duffy).
+        counts: (6,) leg encoder counts, sensor legs 1..6.
+        leg_lengths: (6,) leg lengths, platform leg order (mm).
+        top_pose: (4, 4) the top frame in the base frame (tracking forward kinematics).
+        flange_pose: (4, 4) ``F_6T``.
+        base_pose: (4, 4) the platform base in the fixed frame.
+        wrench: (6,) ``[f; m_O]`` the tool applies to the workpiece, fixed frame, moment about
+            the fixed origin (N, N·mm).
+        tool_point: (3,) ``P_tool_F``: the unloaded tool point carried by the flange.
+        s6, a67: (3,) the tool axis ``S6_F`` and ``a67_F``.
+        point_force: (3,) the point-contact estimate of the force the tool applies (fixed
+            frame, N).
+        point_residual: RMS leg-force residual of the point-contact fit (N).
+        seq, age: sequence number and age (s) of the sensor packet, if known.
+    """
+
+    q: np.ndarray
+    counts: np.ndarray
+    leg_lengths: np.ndarray
+    top_pose: np.ndarray
+    flange_pose: np.ndarray
+    base_pose: np.ndarray
+    wrench: np.ndarray
+    tool_point: np.ndarray
+    s6: np.ndarray
+    a67: np.ndarray
+    point_force: np.ndarray | None = None
+    point_residual: float = 0.0
+    seq: int | None = None
+    age: float | None = None
+
+    @property
+    def force(self) -> np.ndarray:
+        """Force the tool applies to the workpiece (N)."""
+        return self.wrench[:3]
+
+    @property
+    def force_magnitude(self) -> float:
+        return float(np.linalg.norm(self.wrench[:3]))
+
+    @property
+    def torque(self) -> np.ndarray:
+        """Moment of the measured wrench about the tool point ``P_tool_F`` (N·mm)."""
+        return self.wrench[3:] - np.cross(self.tool_point, self.wrench[:3])
+
+    def estimate(self, estimator: str = "point") -> np.ndarray:
+        """The force the controller acts on: ``"point"`` (point-contact fit, default) or
+        ``"wrench"`` (the equivalent wrench's force, as the thesis)."""
+        if estimator == "point" and self.point_force is not None:
+            return self.point_force
+        if estimator in ("point", "wrench"):
+            return self.wrench[:3]
+        raise InputError(f"unknown force estimator {estimator!r}; use 'point' or 'wrench'")
+
+    def deflections(self, model: ControlModel) -> np.ndarray:
+        """Leg deflections ``l − l0`` (mm), platform leg order."""
+        return self.leg_lengths - model.platform.free_lengths
+
+    def tip(self, model: ControlModel) -> np.ndarray:
+        """The measured (deflected) tool tip, fixed frame."""
+        return apply(self.base_pose @ self.top_pose, model.tool_tip_top)
+
+
+def tool_frame(q, model: ControlModel):
+    """Forward analysis of the robot with the model's tool: ``(P_tool_F, S6_F, a67_F, F_6T)``."""
+    r = puma762.forward(q, model.tool_point_6)
+    return r.tool_point, r.s6, r.a67, r.pose
+
+
+def measure(model: ControlModel, q, counts, previous_top_pose, *, seq: int | None = None,
+            age: float | None = None) -> Measurement:
+    """Run the measurement chain for one cycle (Vibhute ch. 4 step 2).
+
+    Args:
+        q: (6,) the robot's joint angles (radians) read from its encoders.
+        counts: (6,) leg encoder counts, sensor legs 1..6 (as the reader returns them).
+        previous_top_pose: (4, 4) the last measured top pose (start: the platform's home).
+
+    Raises:
+        InputError: bad shapes or values; the platform's FK errors (no assembly, a crossed
+            singularity) propagate as their own :class:`~kinestat.errors.KinestatError`.
+    """
+    q = np.asarray(q, dtype=float)
+    c = np.asarray(counts, dtype=float)
+    if q.shape != (6,) or c.shape != (6,):
+        raise InputError(f"measure: expected 6 joint angles and 6 leg counts, got shapes "
+                         f"{q.shape} and {c.shape}")
+    if not (np.all(np.isfinite(q)) and np.all(np.isfinite(c))):
+        raise InputError("measure: joint angles or leg counts contain NaN or infinity")
+    plat = model.platform
+    lengths = counts_to_lengths(c, model.calibration, plat.leg_names)
+    # tracking FK from the previous pose (checked: no singularity crossed, nearest mode), then
+    # w = j k (l - l0), the external wrench on the top (base frame, about O0)
+    top, w_ext = wrench_from_leg_lengths(plat, lengths, previous_top_pose)
+    tension = spring_forces(plat, lengths)
+    j = line_jacobian(plat, top)
+    tool, s6, a67, T6 = tool_frame(q, model)
+    TB = T6 @ model.mount
+    w_fixed = transform_wrench(TB, -w_ext)
+    # point contact at the tip: tensions = j^-1 [I; [p]x] F_ext, least squares in F_ext
+    p = apply(top, model.tool_tip_top)
+    M = np.linalg.solve(j, np.vstack([np.eye(3), skew(p)]))
+    F_ext, *_ = np.linalg.lstsq(M, tension, rcond=None)
+    resid = float(np.sqrt(np.mean((M @ F_ext - tension) ** 2)))
+    point = -(TB[:3, :3] @ F_ext)
+    return Measurement(q=q.copy(), counts=c.copy(), leg_lengths=lengths, top_pose=top,
+                       flange_pose=T6, base_pose=TB, wrench=w_fixed, tool_point=tool, s6=s6,
+                       a67=a67, point_force=point, point_residual=resid, seq=seq, age=age)

@@ -1,0 +1,606 @@
+"""The simulated cell: PUMA 762 + compliant platform + tool + rigid planar workpiece.
+
+The cell of Vibhute 2011 ch. 4-5: the special 6-6 platform's base is bolted to the robot's
+flange (frame 6), a tool tip is fixed to its top, and the tip presses on a workpiece. For each
+flange pose this module solves the **contact equilibrium** of the top platform and returns the
+true leg lengths and the true contact force; :class:`Sensor` turns leg lengths into encoder
+counts as the platform's encoders would.
+
+Frames and conventions (all lengths in mm, forces in N):
+
+* ``flange_pose`` is ``F_6T``, frame 6 in the fixed frame (:func:`kinestat.serial.puma762.forward`).
+* ``Cell.mount`` is ``6_BT``, the platform's base frame (O0 at the origin, P0 on +x) in frame 6.
+  The default, :func:`centred_mount`, puts the base triangle's centroid on frame 6's z axis
+  (S6), the base plane in frame 6's x-y plane and the base x axis along a67 — so the top's
+  axis (the top triangle's centroid normal) is S6 when the platform is unloaded. (The thesis's
+  eq_wrench.m makes the base frame coincide with frame 6 instead: ``mount = I``.)
+* ``Cell.tool_tip`` is the tip in the top frame. By default it is the point that sits at the
+  thesis's unloaded tool point ``P_tool_6 = (0, 0, 235)`` mm (App. D.1) when the platform is at
+  home; with the centred mount that point is on the top's axis, 175 mm above the top plane.
+* The workpiece is the half-space behind a plane through ``point`` with unit ``normal``
+  pointing OUT of the material, towards the tool. The gap of the tip is ``n·(tip − point)``.
+* Forces: ``contact_force`` is what the workpiece exerts on the tool; ``tool_force`` (its
+  negative) is what the tool exerts on the workpiece — the sense of the thesis's ``W_eq``
+  and of ``F_req``.
+
+Equilibrium (all in base coordinates, unknown top pose X):
+
+* out of contact (the unloaded tip is not behind the plane): the top rests at home;
+* frictionless contact: ``w(X) = λ [n; p × n]`` and ``n·(p(X) − c) = 0`` with ``λ ≥ 0``, where
+  ``w`` is the external wrench the springs balance (:func:`kinestat.parallel.statics.spring_wrench`)
+  and ``p`` the tip. 7 equations in (X, λ), solved by Newton with the platform stiffness
+  ``K = ∂w/∂D`` (:func:`kinestat.parallel.stiffness.stiffness`) plus the contact's geometric
+  term;
+* Coulomb friction ``μ``: the tip sticks at its first contact point ``a`` (``w(X) = [f; p × f]``,
+  ``p(X) = a``, 9 equations) while ``|f_t| ≤ μ f_n``; beyond that it slides quasi-statically
+  to the anchor ``a'`` where ``|f_t| = μ f_n`` with the friction opposing the slip
+  ``a' − a`` (maximum dissipation), found by Newton over the 2-D slip.
+
+Each solution is checked: wrench residual ≤ ``tol`` (1e-9 N and N·mm by default), tip on the
+plane, ``f_n ≥ 0`` (unilateral), and every leg deflection within the legs' stroke.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from kinestat.devices.calibration import THESIS_CALIBRATION, LegCalibration, lengths_to_counts
+from kinestat.errors import InputError, ModelError, UnreachableError
+from kinestat.parallel.legs import leg_lengths
+from kinestat.parallel.platform import Platform
+from kinestat.parallel.statics import spring_wrench
+from kinestat.parallel.stiffness import stiffness
+from kinestat.spatial.transforms import apply, apply_vector, as_array, inv, make_pose, skew
+
+__all__ = [
+    "DEFAULT_TOOL_POINT_6",
+    "DEFAULT_STROKE",
+    "Workpiece",
+    "Cell",
+    "Equilibrium",
+    "centred_mount",
+    "make_cell",
+    "equilibrium",
+    "unloaded_tip",
+    "IDEAL_RESOLUTION",
+    "ideal_calibration",
+    "Sensor",
+    "ideal_sensor",
+]
+
+DEFAULT_TOOL_POINT_6 = np.array([0.0, 0.0, 235.0])
+"""The unloaded tool tip in frame 6, mm (Vibhute App. D.1 ForceCorrection.m ``P_tool_6``)."""
+DEFAULT_TOOL_POINT_6.setflags(write=False)
+
+DEFAULT_STROKE = 8.0
+"""Largest leg deflection |l − l0| the simulated legs can take (mm) before bottoming out.
+
+The design range is 5 mm (Vibhute Table 3-1); the controller's safety envelope stops there.
+The simulated hardware tolerates a little more so that the envelope, not the simulator, is
+what stops an excessive command."""
+
+
+def _unit(v, name: str) -> np.ndarray:
+    a = as_array(v, shape_tail=(3,), name=name)
+    if a.shape != (3,):
+        raise InputError(f"{name} must be 3 numbers, got shape {a.shape}")
+    n = float(np.linalg.norm(a))
+    if n < 1e-12:
+        raise InputError(f"{name} must be a nonzero vector, got {a.tolist()}")
+    return a / n
+
+
+def _frozen(a) -> np.ndarray:
+    out = np.array(a, dtype=float)
+    out.setflags(write=False)
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class Workpiece:
+    """A rigid planar workpiece: a plane through ``point`` with unit ``normal`` pointing out of
+    the material (towards the tool), fixed frame; Coulomb ``friction`` coefficient μ ≥ 0
+    (0: frictionless)."""
+
+    point: np.ndarray
+    normal: np.ndarray
+    friction: float = 0.0
+
+    def __post_init__(self) -> None:
+        p = as_array(self.point, shape_tail=(3,), name="workpiece point")
+        if p.shape != (3,):
+            raise InputError(f"workpiece point must be 3 numbers, got shape {p.shape}")
+        object.__setattr__(self, "point", _frozen(p))
+        object.__setattr__(self, "normal", _frozen(_unit(self.normal, "workpiece normal")))
+        mu = float(self.friction)
+        if not (math.isfinite(mu) and mu >= 0.0):
+            raise InputError(f"friction coefficient must be a finite number >= 0, got "
+                             f"{self.friction!r}")
+        object.__setattr__(self, "friction", mu)
+
+    def gap(self, points) -> np.ndarray:
+        """Signed distance of points (..., 3) from the plane; negative means behind it."""
+        return np.einsum("...i,i->...", np.asarray(points, dtype=float) - self.point,
+                         self.normal)
+
+
+@dataclass(frozen=True, eq=False)
+class Cell:
+    """The simulated cell's geometry (immutable).
+
+    Attributes:
+        platform: the compliant platform.
+        mount: (4, 4) the platform's base frame in frame 6.
+        tool_tip: (3,) the tool tip in the top frame.
+        workpiece: the planar workpiece.
+        stroke: largest leg deflection the legs take (mm), see :data:`DEFAULT_STROKE`.
+    """
+
+    platform: Platform
+    mount: np.ndarray
+    tool_tip: np.ndarray
+    workpiece: Workpiece
+    stroke: float = DEFAULT_STROKE
+
+    def __post_init__(self) -> None:
+        M = as_array(self.mount, shape_tail=(4, 4), name="mount")
+        if M.shape != (4, 4):
+            raise ModelError(f"mount must be one 4x4 transform, got shape {M.shape}")
+        R = M[:3, :3]
+        if (np.max(np.abs(R @ R.T - np.eye(3))) > 1e-9 or abs(np.linalg.det(R) - 1.0) > 1e-9
+                or np.any(M[3] != [0.0, 0.0, 0.0, 1.0])):
+            raise ModelError("mount must be a rigid transform (orthonormal rotation, last row "
+                             "0 0 0 1)")
+        object.__setattr__(self, "mount", _frozen(M))
+        tip = as_array(self.tool_tip, shape_tail=(3,), name="tool tip")
+        if tip.shape != (3,):
+            raise ModelError(f"tool tip must be 3 numbers, got shape {tip.shape}")
+        object.__setattr__(self, "tool_tip", _frozen(tip))
+        s = float(self.stroke)
+        if not (math.isfinite(s) and s > 0):
+            raise ModelError(f"leg stroke must be a positive number of mm, got {self.stroke!r}")
+        object.__setattr__(self, "stroke", s)
+
+    @property
+    def tool_point_6(self) -> np.ndarray:
+        """The unloaded tool tip in frame 6 (the thesis's ``P_tool_6``)."""
+        return apply(self.mount @ self.platform.home_pose, self.tool_tip)
+
+
+def _base_corner_centroid(platform: Platform) -> np.ndarray:
+    layout = platform.layout
+    if layout is not None:
+        corners = platform.base_points[list(layout.order[:3])]
+        return corners.mean(axis=0)
+    return platform.base_points.mean(axis=0)
+
+
+def centred_mount(platform: Platform, *, offset: float = 0.0, turn: float = 0.0) -> np.ndarray:
+    """``6_BT`` with the base triangle's centroid on frame 6's z axis (S6).
+
+    The base plane is frame 6's x-y plane shifted by ``offset`` mm along S6; the base x axis is
+    a67 (frame 6's x axis) turned by ``turn`` radians about S6. For the special 6-6 prototype
+    the top's unloaded axis is then S6 itself.
+    """
+    for v, nm in ((offset, "offset"), (turn, "turn")):
+        if not math.isfinite(float(v)):
+            raise InputError(f"mount {nm} must be finite, got {v!r}")
+    c = _base_corner_centroid(platform)
+    R = Rotation.from_rotvec([0.0, 0.0, float(turn)]).as_matrix()
+    # 6_B T maps base coordinates to frame 6: the centroid c goes to (0, 0, offset).
+    return make_pose(R, np.array([0.0, 0.0, float(offset)]) - R @ c)
+
+
+def make_cell(
+    platform: Platform,
+    *,
+    plane_point,
+    plane_normal,
+    friction: float = 0.0,
+    mount=None,
+    tool_point_6=DEFAULT_TOOL_POINT_6,
+    tool_tip=None,
+    stroke: float = DEFAULT_STROKE,
+) -> Cell:
+    """Assemble a :class:`Cell`.
+
+    ``mount`` defaults to :func:`centred_mount`. The tool tip is ``tool_tip`` (top frame) if
+    given, else the point of the top that sits at ``tool_point_6`` (frame 6) when the platform
+    is unloaded — by default the thesis's (0, 0, 235) mm.
+    """
+    M = centred_mount(platform) if mount is None else as_array(mount, shape_tail=(4, 4),
+                                                                  name="mount")
+    if tool_tip is None:
+        p6 = as_array(tool_point_6, shape_tail=(3,), name="tool_point_6")
+        tip = apply(inv(M @ platform.home_pose), p6)
+    else:
+        tip = tool_tip
+    return Cell(platform=platform, mount=M, tool_tip=tip,
+                workpiece=Workpiece(plane_point, plane_normal, friction), stroke=stroke)
+
+
+@dataclass(frozen=True, eq=False)
+class Equilibrium:
+    """The solved state of the cell at one flange pose.
+
+    Attributes:
+        flange_pose: (4, 4) ``F_6T``.
+        top_pose: (4, 4) the top frame in the base frame.
+        leg_lengths: (6,) true leg lengths (mm), the platform's leg order.
+        in_contact: the tip touches the workpiece.
+        sticking: with friction, the tip is stuck at ``anchor``; False when frictionless or
+            sliding.
+        contact_force: (3,) force of the workpiece on the tool, fixed frame (N).
+        tool_force: (3,) force of the tool on the workpiece (= −contact_force), fixed frame.
+        tip: (3,) the tool tip, fixed frame.
+        anchor: (3,) | None the friction anchor (fixed frame) to pass to the next solve.
+        residual: largest wrench residual of the equilibrium (N, N·mm).
+        iterations: Newton iterations used (summed over the slip search).
+    """
+
+    flange_pose: np.ndarray
+    top_pose: np.ndarray
+    leg_lengths: np.ndarray
+    in_contact: bool
+    sticking: bool
+    contact_force: np.ndarray
+    tool_force: np.ndarray
+    tip: np.ndarray
+    anchor: np.ndarray | None
+    residual: float
+    iterations: int
+    normal_force: float = 0.0
+    extra: dict = field(default_factory=dict, repr=False)
+
+    @property
+    def base_pose(self) -> np.ndarray:
+        """The platform's base frame in the fixed frame."""
+        return self.extra["base_pose"]
+
+
+def _displace(X: np.ndarray, d: np.ndarray) -> np.ndarray:
+    """Move a pose by the small twist ``d = [δφ; δx_O]`` (base frame): Rot(δφ)·X + δx_O."""
+    R = Rotation.from_rotvec(d[:3]).as_matrix()
+    out = np.empty((4, 4))
+    out[:3, :3] = R @ X[:3, :3]
+    out[:3, 3] = R @ X[:3, 3] + d[3:]
+    out[3] = (0.0, 0.0, 0.0, 1.0)
+    return out
+
+
+def _check_flange(flange_pose) -> np.ndarray:
+    T = as_array(flange_pose, shape_tail=(4, 4), name="flange pose")
+    if T.shape != (4, 4):
+        raise InputError(f"flange pose must be one 4x4 transform, got shape {T.shape}")
+    R = T[:3, :3]
+    if np.max(np.abs(R @ R.T - np.eye(3))) > 1e-6 or abs(np.linalg.det(R) - 1.0) > 1e-6:
+        raise InputError("flange pose must be a rigid transform (orthonormal rotation)")
+    return T
+
+
+def unloaded_tip(cell: Cell, flange_pose) -> np.ndarray:
+    """Where the tip would be with the platform unloaded (fixed frame)."""
+    T = _check_flange(flange_pose)
+    return apply(T @ cell.mount @ cell.platform.home_pose, cell.tool_tip)
+
+
+def _solve_frictionless(cell: Cell, n: np.ndarray, c: np.ndarray, X0: np.ndarray,
+                        tol: float, max_iter: int):
+    """Newton on (X, λ): w(X) − λ [n; p×n] = 0, n·(p − c) = 0 (base coordinates)."""
+    plat = cell.platform
+    X, lam = X0.copy(), 0.0
+    it = 0
+    while it < max_iter:
+        it += 1
+        p = apply(X, cell.tool_tip)
+        wc = np.concatenate([n, np.cross(p, n)])
+        r = np.concatenate([spring_wrench(plat, X) - lam * wc, [n @ (p - c)]])
+        K = stiffness(plat, X, twist_order="axis")
+        G = np.zeros((6, 6))
+        G[3:, :3] = skew(n) @ skew(p)
+        G[3:, 3:] = -skew(n)
+        A = np.zeros((7, 7))
+        A[:6, :6] = K - lam * G
+        A[:6, 6] = -wc
+        A[6, :3] = np.cross(p, n)
+        A[6, 3:6] = n
+        d = np.linalg.solve(A, -r)
+        d = _limit_step(d, plat.scale)
+        X = _displace(X, d[:6])
+        lam += d[6]
+        if np.max(np.abs(d[:6])) < 1e-13 * max(1.0, plat.scale):
+            break
+    p = apply(X, cell.tool_tip)
+    wc = np.concatenate([n, np.cross(p, n)])
+    res = float(np.max(np.abs(spring_wrench(plat, X) - lam * wc)))
+    return X, lam, res, abs(float(n @ (p - c))), it
+
+
+def _solve_stick(cell: Cell, a: np.ndarray, X0: np.ndarray, tol: float, max_iter: int):
+    """Newton on (X, f): w(X) − [f; p×f] = 0, p(X) − a = 0 (base coordinates)."""
+    plat = cell.platform
+    X, f = X0.copy(), np.zeros(3)
+    it = 0
+    while it < max_iter:
+        it += 1
+        p = apply(X, cell.tool_tip)
+        r = np.concatenate([spring_wrench(plat, X) - np.concatenate([f, np.cross(p, f)]),
+                            p - a])
+        K = stiffness(plat, X, twist_order="axis")
+        A = np.zeros((9, 9))
+        A[:6, :6] = K
+        A[3:6, :3] -= skew(f) @ skew(p)
+        A[3:6, 3:6] += skew(f)
+        A[:3, 6:] = -np.eye(3)
+        A[3:6, 6:] = -skew(p)
+        A[6:, :3] = -skew(p)
+        A[6:, 3:6] = np.eye(3)
+        d = np.linalg.solve(A, -r)
+        d[:6] = _limit_step(d[:6], plat.scale)
+        X = _displace(X, d[:6])
+        f = f + d[6:]
+        if np.max(np.abs(d[:6])) < 1e-13 * max(1.0, plat.scale):
+            break
+    p = apply(X, cell.tool_tip)
+    res = float(np.max(np.abs(spring_wrench(plat, X) - np.concatenate([f, np.cross(p, f)]))))
+    return X, f, res, float(np.max(np.abs(p - a))), it
+
+
+def _limit_step(d: np.ndarray, scale: float) -> np.ndarray:
+    """Damp a Newton step to at most 0.1 rad and 0.2·scale of translation."""
+    k = max(1.0, float(np.linalg.norm(d[:3])) / 0.1, float(np.linalg.norm(d[3:6])) / (0.2 * scale))
+    out = d.copy()
+    out[:6] = d[:6] / k
+    if d.shape[0] > 6:
+        out[6:] = d[6:] / k
+    return out
+
+
+def equilibrium(
+    cell: Cell,
+    flange_pose,
+    *,
+    anchor=None,
+    approach_from=None,
+    tol: float = 1e-9,
+    max_iter: int = 30,
+) -> Equilibrium:
+    """Solve the contact equilibrium of the top platform at ``flange_pose`` (``F_6T``).
+
+    ``anchor`` is the friction anchor returned by the previous solve (None: not in sticking
+    contact before). ``approach_from`` is the previous unloaded tip position (fixed frame):
+    when the tip first touches, the anchor is where the segment from it to the current
+    unloaded tip crosses the plane (else the projection of the unloaded tip onto the plane).
+
+    Raises:
+        UnreachableError: no equilibrium (Newton failed), or one that needs a leg deflection
+            beyond :attr:`Cell.stroke` — the platform would bottom out.
+    """
+    T = _check_flange(flange_pose)
+    plat = cell.platform
+    wp = cell.workpiece
+    TB = T @ cell.mount
+    TBinv = inv(TB)
+    home = plat.home_pose
+    tip0 = apply(TB @ home, cell.tool_tip)
+    g0 = float(wp.gap(tip0))
+    extra = {"base_pose": TB}
+    if g0 >= 0.0:
+        return Equilibrium(flange_pose=T, top_pose=home.copy(), leg_lengths=leg_lengths(plat, home),
+                           in_contact=False, sticking=False, contact_force=np.zeros(3),
+                           tool_force=np.zeros(3), tip=tip0, anchor=None, residual=0.0,
+                           iterations=0, normal_force=0.0, extra=extra)
+    nB = apply_vector(TBinv, wp.normal)
+    cB = apply(TBinv, wp.point)
+    mu = wp.friction
+    iters = 0
+    if mu > 0.0:
+        if anchor is None:
+            if approach_from is not None:
+                prev = as_array(approach_from, shape_tail=(3,), name="approach_from")
+                gp = float(wp.gap(prev))
+                s = gp / (gp - g0) if gp > 0.0 else 1.0
+                a = prev + s * (tip0 - prev)
+            else:
+                a = tip0
+            a = a - float(wp.gap(a)) * wp.normal  # exactly on the plane
+        else:
+            a = as_array(anchor, shape_tail=(3,), name="anchor")
+            a = a - float(wp.gap(a)) * wp.normal
+        sol = _stick_or_slip(cell, TB, TBinv, nB, a, home, tol, max_iter)
+        if sol is not None:
+            X, f_B, a_new, sticking, res, iters = sol
+            fF = apply_vector(TB, f_B)
+            return _finish(cell, T, X, fF, a_new, sticking, res, iters, extra)
+        # the sticking solution would pull: contact released, fall back to frictionless
+    X, lam, res, gap, it = _solve_frictionless(cell, nB, cB, home, tol, max_iter)
+    iters += it
+    if not (res <= tol and gap <= tol):
+        raise UnreachableError(
+            f"simulated cell: no frictionless contact equilibrium found (wrench residual "
+            f"{res:.3g}, gap {gap:.3g} mm after {it} Newton steps); the tool is pushed too far "
+            "into the workpiece")
+    if lam < 0.0:
+        raise UnreachableError(f"simulated cell: contact equilibrium needs a pulling contact "
+                               f"force ({lam:.6g} N); not a valid unilateral contact")
+    fF = lam * wp.normal
+    a_new = apply(TB, apply(X, cell.tool_tip)) if mu > 0.0 else None
+    return _finish(cell, T, X, fF, a_new, False, res, iters, extra)
+
+
+def _finish(cell: Cell, T, X, contact_force_F, anchor, sticking, res, iters, extra
+            ) -> Equilibrium:
+    plat = cell.platform
+    L = leg_lengths(plat, X)
+    defl = L - plat.free_lengths
+    worst = int(np.argmax(np.abs(defl)))
+    if abs(defl[worst]) > cell.stroke:
+        raise UnreachableError(
+            f"simulated cell: leg {plat.leg_names[worst]} would deflect {defl[worst]:+.3f} mm, "
+            f"beyond the legs' stroke of ±{cell.stroke:g} mm: the platform bottoms out (contact "
+            f"force {np.linalg.norm(contact_force_F):.3f} N); the tool was pushed too far")
+    TB = extra["base_pose"]
+    tip = apply(TB @ X, cell.tool_tip)
+    fn = float(contact_force_F @ cell.workpiece.normal)
+    return Equilibrium(flange_pose=T, top_pose=X, leg_lengths=L, in_contact=True,
+                       sticking=bool(sticking), contact_force=np.asarray(contact_force_F),
+                       tool_force=-np.asarray(contact_force_F), tip=tip, anchor=anchor,
+                       residual=float(res), iterations=int(iters), normal_force=fn, extra=extra)
+
+
+def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
+    """Sticking at ``a_F`` if friction allows, else quasi-static slip; None if it would pull.
+
+    Returns (X, f_B, anchor_F, sticking, residual, iterations)."""
+    mu = cell.workpiece.friction
+    nF = cell.workpiece.normal
+    # tangent basis of the plane (fixed frame)
+    e1 = np.cross(nF, [1.0, 0.0, 0.0])
+    if np.linalg.norm(e1) < 0.5:
+        e1 = np.cross(nF, [0.0, 1.0, 0.0])
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(nF, e1)
+    iters = 0
+
+    def stick(aF, X0):
+        nonlocal iters
+        X, f, res, perr, it = _solve_stick(cell, apply(TBinv, aF), X0, tol, max_iter)
+        iters += it
+        if not (res <= tol and perr <= tol):
+            raise UnreachableError(
+                f"simulated cell: no sticking contact equilibrium found (wrench residual "
+                f"{res:.3g}, tip error {perr:.3g} mm after {it} Newton steps)")
+        fF = apply_vector(TB, f)
+        return X, f, fF, res
+
+    X, f, fF, res = stick(a_F, home)
+    fn = float(fF @ nF)
+    if fn < 0.0:
+        return None
+    ft = fF - fn * nF
+    if np.linalg.norm(ft) <= mu * fn * (1.0 + 1e-12):
+        return X, f, a_F, True, res, iters
+
+    # Slip: find d (in the plane) with f_t(a + d) = −μ f_n d/|d|, starting along −f_t.
+    def resid(d2, Xg):
+        aF = a_F + d2[0] * e1 + d2[1] * e2
+        Xs, fs, fFs, rs = stick(aF, Xg)
+        fns = float(fFs @ nF)
+        fts = np.array([fFs @ e1, fFs @ e2])
+        nd = float(np.hypot(*d2))
+        return fts + mu * fns * d2 / nd, Xs, fs, fFs, rs, fns
+
+    u = -np.array([ft @ e1, ft @ e2])
+    u /= np.linalg.norm(u)
+    # 1-D secant along u for |f_t| = μ f_n, starting from the stiffness-based guess
+    def g1(s, Xg):
+        r, Xs, fs, fFs, rs, fns = resid(s * u, Xg)
+        return float(r @ u), Xs
+
+    s0 = (np.linalg.norm(ft) - mu * fn) / 2.0  # ~N per (N/mm): a first guess in mm
+    s0 = max(min(s0, 5.0), 1e-3)
+    ga, Xa = g1(s0, X)
+    s1 = s0 * 1.5
+    gb, Xb = g1(s1, Xa)
+    for _ in range(60):
+        if abs(gb - ga) < 1e-300:
+            break
+        s2 = s1 - gb * (s1 - s0) / (gb - ga)
+        s2 = max(s2, 1e-9)
+        s0, ga, Xa = s1, gb, Xb
+        s1 = s2
+        gb, Xb = g1(s1, Xa)
+        if abs(gb) < 1e-11 or abs(s1 - s0) < 1e-13:
+            break
+    d2 = s1 * u
+    Xg = Xb
+    # 2-D Newton with a finite-difference Jacobian
+    for _ in range(30):
+        r, Xs, fs, fFs, rs, fns = resid(d2, Xg)
+        if np.max(np.abs(r)) <= 1e-10:
+            break
+        h = 1e-7
+        J = np.zeros((2, 2))
+        for k in range(2):
+            dk = d2.copy()
+            dk[k] += h
+            J[:, k] = (resid(dk, Xs)[0] - r) / h
+        d2 = d2 - np.linalg.solve(J, r)
+        Xg = Xs
+    r, Xs, fs, fFs, rs, fns = resid(d2, Xg)
+    if fns < 0.0:
+        return None
+    ft_s = fFs - fns * nF
+    if not (np.max(np.abs(r)) <= 1e-8 and np.linalg.norm(ft_s) <= mu * fns * (1.0 + 1e-6)):
+        raise UnreachableError(
+            f"simulated cell: the sliding contact did not settle (friction residual "
+            f"{np.max(np.abs(r)):.3g} N)")
+    aF = a_F + d2[0] * e1 + d2[1] * e2
+    return Xs, fs, aF, False, rs, iters
+
+
+# -- the leg sensors -----------------------------------------------------------------------------
+IDEAL_RESOLUTION = 1e-6
+"""Length per count of the "ideal" sensor (mm): 1 nm, far below anything that matters here
+(2.6e-6 N of spring force), yet still whole counts on the wire."""
+
+
+def ideal_calibration(reference: LegCalibration = THESIS_CALIBRATION,
+                      resolution: float = IDEAL_RESOLUTION) -> LegCalibration:
+    """A linear length calibration with ``resolution`` mm per count and the same zero-count
+    lengths (and sense) as ``reference``: an encoder without practical quantisation.
+
+    The force maps are scaled to the same counts (force per count × resolution / slope).
+    """
+    if not (math.isfinite(resolution) and resolution > 0):
+        raise InputError(f"sensor resolution must be a positive number of mm, got {resolution!r}")
+    a = reference.length_coeffs
+    if a.shape[1] != 2:
+        raise InputError("ideal_calibration needs a linear reference calibration")
+    sign = np.sign(a[:, 1])
+    length = np.stack([a[:, 0], sign * resolution], axis=1)
+    fc = reference.force_coeffs
+    force = fc.copy()
+    if fc.shape[1] == 2:
+        force[:, 1] = fc[:, 1] * resolution / np.abs(a[:, 1])
+    return LegCalibration(length_coeffs=length, force_coeffs=force,
+                          leg_names=reference.leg_names)
+
+
+@dataclass(frozen=True, eq=False)
+class Sensor:
+    """The platform's leg encoders: true leg lengths → counts (sensor legs 1..6).
+
+    ``calibration`` maps counts to lengths (its inverse gives the counts a length produces);
+    by default the thesis's maps (leg_to_T10.m: 0.0255–0.0271 mm per count). ``noise`` is
+    the standard deviation of Gaussian noise added to each length before quantisation (mm).
+    ``quantize=False`` returns fractional counts (the emitter rounds them on the wire; use
+    :func:`ideal_calibration` for a sensor without practical quantisation).
+    """
+
+    calibration: LegCalibration = THESIS_CALIBRATION
+    noise: float = 0.0
+    quantize: bool = True
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(float(self.noise)) and self.noise >= 0):
+            raise InputError(f"sensor noise must be a number of mm >= 0, got {self.noise!r}")
+
+    def counts(self, platform: Platform, lengths, rng: np.random.Generator | None = None
+               ) -> np.ndarray:
+        """Counts (6,) in sensor order for leg ``lengths`` in the platform's leg order."""
+        L = np.asarray(lengths, dtype=float)
+        if self.noise > 0:
+            gen = rng if rng is not None else np.random.default_rng()
+            L = L + gen.normal(0.0, self.noise, size=L.shape)
+        c = lengths_to_counts(L, self.calibration, platform.leg_names)
+        return np.rint(c) if self.quantize else c
+
+
+def ideal_sensor() -> Sensor:
+    """A sensor with 1 nm counts and no noise (see :func:`ideal_calibration`)."""
+    return Sensor(calibration=ideal_calibration())

@@ -1,0 +1,278 @@
+"""Wiring the simulated cell to the simulated devices, for ``kinestat control`` without hardware.
+
+:class:`SimHarness` starts the Galil simulator (:mod:`kinestat.sim.galil_server`, loopback
+only) and the encoder emitter (:mod:`kinestat.sim.encoder_emitter`, on a pty) and connects
+them through the cell: at every packet the emitter asks :meth:`SimHarness.counts_now`, which
+reads the simulator's TRUE axis positions (including the axis 4 → 5 coupling the encoders do
+not see), solves the contact equilibrium of the platform at that flange pose
+(:func:`kinestat.sim.cell.equilibrium`, quasi-statically along the robot's motion so that a
+friction anchor follows the path) and turns the true leg lengths into encoder counts
+(:class:`kinestat.sim.cell.Sensor`). The controller then drives the cell through the real
+client and reader (:class:`kinestat.control.loop.DeviceIO`), over TCP loopback and the pty.
+
+:class:`InProcessIO` is the same cell without devices (an exact robot, counts straight from the
+sensor model): fast, deterministic, for tests of the control law.
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+import numpy as np
+
+from kinestat.control.controller import ControllerConfig, axis_counts_to_q
+from kinestat.control.loop import DeviceIO, SensorSample
+from kinestat.control.model import ControlModel
+from kinestat.devices.encoder_stream import EncoderReader
+from kinestat.devices.galil import (
+    AXIS4_TO_5_COUPLING,
+    GalilClient,
+    axis_deg_to_counts,
+    counts_to_joint_rad,
+)
+from kinestat.errors import DeviceError, KinestatError
+from kinestat.serial import puma762
+from kinestat.sim.cell import Cell, Equilibrium, Sensor, equilibrium, unloaded_tip
+from kinestat.sim.encoder_emitter import EncoderEmitter
+from kinestat.sim.galil_server import DmcSimulator, GalilSimServer, SimClock
+
+__all__ = ["CellState", "SimHarness", "InProcessIO", "control_model", "start_counts"]
+
+
+def control_model(cell: Cell, sensor: Sensor, *, coupling: float = AXIS4_TO_5_COUPLING,
+                  **kw: Any) -> ControlModel:
+    """The controller's model of a simulated cell: same platform, mount, tool and calibration."""
+    return ControlModel(platform=cell.platform, mount=cell.mount, tool_point_6=cell.tool_point_6,
+                        calibration=sensor.calibration, coupling=coupling, **kw)
+
+
+def start_counts(config: ControllerConfig, current_counts=(0, 0, 0, 0, 0, 0)) -> np.ndarray:
+    """Axis counts of the start pose (the solution nearest ``current_counts``), where a
+    simulated robot is placed before the run so that the first move is short."""
+    model = config.model
+    c = np.asarray(current_counts, dtype=np.int64)
+    res = puma762.reverse(config.start_tool_point, config.start_s6, config.start_a67,
+                          model.tool_point_6)
+    sel = puma762.select(res, axis_counts_to_q(model, c), model.limits_deg)
+    return axis_deg_to_counts(np.degrees(sel.axis))
+
+
+class CellState:
+    """The evolving state of a simulated cell (thread-safe): friction anchor, last solution.
+
+    :meth:`solve` is quasi-static: call it along the robot's motion (the emitter does, at its
+    rate) so that a sticking contact's anchor and the first-contact point follow the path.
+    """
+
+    def __init__(self, cell: Cell, sensor: Sensor | None = None, *, seed: int | None = 0) -> None:
+        self.cell = cell
+        self.sensor = sensor if sensor is not None else Sensor()
+        self._rng = np.random.default_rng(seed)
+        self._lock = threading.Lock()
+        self._anchor: np.ndarray | None = None
+        self._free_tip: np.ndarray | None = None
+        self._key: bytes | None = None
+        self._eq: Equilibrium | None = None
+        self.error: KinestatError | None = None
+
+    def solve(self, q) -> Equilibrium:
+        """Equilibrium at joint angles ``q`` (radians), updating the contact history."""
+        q = np.asarray(q, dtype=float)
+        key = q.tobytes()
+        with self._lock:
+            if key == self._key and self._eq is not None:
+                return self._eq
+            T = puma762.forward(q).pose
+            try:
+                eq = equilibrium(self.cell, T, anchor=self._anchor, approach_from=self._free_tip)
+            except KinestatError as exc:
+                self.error = exc
+                raise
+            if eq.in_contact:
+                self._anchor = eq.anchor
+            else:
+                self._anchor = None
+                self._free_tip = unloaded_tip(self.cell, T)
+            self._key, self._eq = key, eq
+            return eq
+
+    def counts(self, q) -> np.ndarray:
+        """Sensor counts (legs 1..6) at joint angles ``q``."""
+        eq = self.solve(q)
+        with self._lock:
+            return self.sensor.counts(self.cell.platform, eq.leg_lengths, self._rng)
+
+    def truth(self, q, tool_point_6) -> dict:
+        """The true state at ``q`` for logs and reports (fixed frame)."""
+        eq = self.solve(q)
+        fwd = puma762.forward(np.asarray(q, dtype=float), tool_point_6)
+        return {
+            "tool_force": eq.tool_force,
+            "tool_force_magnitude": float(np.linalg.norm(eq.tool_force)),
+            "in_contact": eq.in_contact,
+            "sticking": eq.sticking,
+            "tip": eq.tip,
+            "leg_lengths": eq.leg_lengths,
+            "tool_axis": fwd.s6,
+            "tool_point": fwd.tool_point,
+            "joints_deg": np.degrees(q),
+            "residual": eq.residual,
+        }
+
+
+class SimHarness:
+    """The simulated cell behind real device protocols (context manager).
+
+    Args:
+        cell: the simulated cell; ``sensor`` its leg encoders (default thesis resolution).
+        start_counts: the robot's axis counts at start (see :func:`start_counts`).
+        rate_hz: encoder packet rate; ``fmt``: "ks" or "legacy" packets.
+        clock: None for real time, or a :class:`~kinestat.sim.galil_server.SimClock`.
+        coupling: the simulated robot's axis 4 → 5 coupling.
+        seed: noise seed. ``emitter_options``: passed to the emitter (fault rates...).
+        record: keep every command the simulated Galil received (``controller.commands``).
+    """
+
+    def __init__(self, cell: Cell, sensor: Sensor | None = None, *, start_counts=(0,) * 6,
+                 rate_hz: float = 200.0, fmt: str = "ks", clock: SimClock | None = None,
+                 coupling: float = AXIS4_TO_5_COUPLING, seed: int | None = 0,
+                 emitter_options: dict | None = None, record: bool = False) -> None:
+        self.state = CellState(cell, sensor, seed=seed)
+        self.cell = cell
+        self.fmt = fmt
+        self.controller = DmcSimulator(clock=clock, initial_counts=start_counts,
+                                       coupling=coupling, record=record)
+        self.server = GalilSimServer(controller=self.controller)
+        self.emitter = EncoderEmitter(self.counts_now, rate_hz=rate_hz, fmt=fmt,  # type: ignore[arg-type]
+                                      **(emitter_options or {}))
+        self._opened: list[Any] = []
+
+    # -- life cycle
+    def start(self) -> SimHarness:
+        self.server.start()
+        try:
+            self.emitter.start()
+        except BaseException:
+            self.server.stop()
+            raise
+        return self
+
+    def stop(self) -> None:
+        for obj in reversed(self._opened):
+            try:
+                obj.close()
+            except Exception:  # noqa: BLE001 - closing must not fail
+                pass
+        self._opened.clear()
+        self.emitter.stop()
+        self.server.stop()
+
+    def __enter__(self) -> SimHarness:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    # -- wiring
+    @property
+    def galil_address(self) -> tuple[str, int]:
+        return self.server.address
+
+    @property
+    def serial_path(self) -> str:
+        return self.emitter.path
+
+    def true_q(self) -> np.ndarray:
+        """The robot's true joint angles (radians)."""
+        return counts_to_joint_rad(self.server.true_axis_counts())
+
+    def counts_now(self) -> np.ndarray:
+        """Leg counts for the emitter: the cell at the robot's true pose, through the sensor."""
+        return self.state.counts(self.true_q())
+
+    def truth(self) -> dict:
+        """The true state now (what the controller cannot see)."""
+        if self.emitter.error is not None:
+            return {"error": str(self.emitter.error)}
+        try:
+            return self.state.truth(self.true_q(), self.cell.tool_point_6)
+        except KinestatError as exc:
+            return {"error": str(exc)}
+
+    def client(self, timeout: float = 2.0) -> GalilClient:
+        """A connected Galil client (closed with the harness)."""
+        host, port = self.galil_address
+        c = GalilClient(host, port, timeout=timeout).connect()
+        self._opened.append(c)
+        return c
+
+    def reader(self, **kw: Any) -> EncoderReader:
+        """An open encoder reader on the emitter's pty (closed with the harness)."""
+        kw.setdefault("fmt", self.fmt)
+        kw.setdefault("stale_after", 0.5)
+        r = EncoderReader(self.serial_path, **kw).open()
+        self._opened.append(r)
+        return r
+
+    def device_io(self, *, reader_options: dict | None = None, client_timeout: float = 2.0,
+                  **kw: Any) -> DeviceIO:
+        """A :class:`DeviceIO` through the real client and reader, with the truth attached."""
+        kw.setdefault("truth", self.truth)
+        kw.setdefault("settle", 2.5 / self.emitter.rate_hz)
+        return DeviceIO(self.client(client_timeout), self.reader(**(reader_options or {})),
+                        **kw)
+
+
+class InProcessIO:
+    """The simulated cell as a :class:`~kinestat.control.loop.CellIO` without devices.
+
+    The robot reaches every commanded count exactly (no coupling, no motion time); the sensor
+    counts come straight from the cell. Moves are evaluated quasi-statically at ``substeps``
+    points along the straight joint-space path (for friction's history).
+    """
+
+    def __init__(self, cell: Cell, sensor: Sensor | None = None, *, start_counts,
+                 axis_deg_per_count=None, seed: int | None = 0, substeps: int = 4) -> None:
+        from kinestat.devices.galil import AXIS_DEG_PER_COUNT
+
+        self.state = CellState(cell, sensor, seed=seed)
+        self.cell = cell
+        self._res = np.asarray(AXIS_DEG_PER_COUNT if axis_deg_per_count is None
+                               else axis_deg_per_count, dtype=float)
+        self._counts = np.asarray(start_counts, dtype=np.int64).copy()
+        self.substeps = int(substeps)
+        self.stopped = False
+        self.moves: list[np.ndarray] = []
+
+    def _q(self, counts) -> np.ndarray:
+        return puma762.from_axis_angles(np.radians(np.asarray(counts, dtype=float) * self._res))
+
+    def robot_counts(self) -> np.ndarray:
+        return self._counts.copy()
+
+    def move(self, axis_counts) -> None:
+        new = np.asarray(axis_counts, dtype=np.int64)
+        old = self._counts.astype(float)
+        for s in np.linspace(0.0, 1.0, self.substeps + 1)[1:]:
+            self.state.solve(self._q(old + s * (new - old)))
+        self._counts = new.copy()
+        self.moves.append(new.copy())
+
+    def sensor(self) -> SensorSample:
+        try:
+            return SensorSample(counts=self.state.counts(self._q(self._counts)))
+        except KinestatError as exc:
+            raise DeviceError(f"simulated sensor failed: {exc}") from exc
+
+    def stop(self) -> str:
+        self.stopped = True
+        return "stopped (in-process)"
+
+    def truth(self) -> dict:
+        try:
+            return self.state.truth(self._q(self._counts), self.cell.tool_point_6)
+        except KinestatError as exc:
+            return {"error": str(exc)}
+
+

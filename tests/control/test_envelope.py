@@ -1,0 +1,123 @@
+"""The safety envelope: limits, the worst-case prediction, verdicts."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kinestat.control.controller import axis_counts_to_q
+from kinestat.control.envelope import (
+    Envelope,
+    check_command,
+    check_measurement,
+    check_target,
+    predict,
+    require,
+    tip_compliance,
+    tip_stiffness,
+)
+from kinestat.control.wrench import measure
+from kinestat.errors import InputError, SafetyStop
+from kinestat.serial import puma762
+from kinestat.sim.cell import Sensor, equilibrium
+from kinestat.sim.harness import start_counts
+from kinestat.spatial.transforms import trans
+
+from .conftest import F_HAT, PLATFORM, scenario
+
+ENV = Envelope()
+
+
+def _loaded(scn, push=0.4):
+    """Flange at a pose pushing ``push`` mm into the plane; its exact measurement."""
+    cfg = scn.config(start_tool_point=scn.cell.workpiece.point + push * F_HAT)
+    q = axis_counts_to_q(scn.model, start_counts(cfg))
+    T = puma762.forward(q).pose
+    eq = equilibrium(scn.cell, T)
+    exact = Sensor(calibration=scn.sensor.calibration, quantize=False)
+    m = measure(scn.model, q, exact.counts(PLATFORM, eq.leg_lengths), PLATFORM.home_pose)
+    return T, eq, m
+
+
+def test_target_beyond_the_load_limit_is_refused():
+    assert check_target(ENV, [0, 0, 4]) == []
+    bad = check_target(ENV, [0, 0, 60])
+    assert bad and "50" in bad[0]
+    with pytest.raises(SafetyStop, match="load limit"):
+        require(bad)
+
+
+def test_tip_compliance_is_symmetric_unloaded_and_positive():
+    scn = scenario(distance=50.0, ideal=True)  # far away: no load
+    q = axis_counts_to_q(scn.model, start_counts(scn.config()))
+    m = measure(scn.model, q, scn.sensor.counts(PLATFORM, PLATFORM.free_lengths),
+                PLATFORM.home_pose)
+    C = tip_compliance(scn.model, m)
+    np.testing.assert_allclose(C, C.T, atol=1e-8 * np.abs(C).max())
+    assert np.all(np.linalg.eigvalsh(C) > 0)
+    K = tip_stiffness(scn.model, m)
+    # axially the platform is far stiffer than sideways at the end of a 175 mm tool
+    s6 = m.s6
+    lateral = np.cross(s6, [0, 0, 1.0])
+    lateral /= np.linalg.norm(lateral)
+    assert s6 @ K @ s6 > 5 * (lateral @ K @ lateral)
+
+
+@pytest.mark.parametrize("move", ["push", "pull", "sideways", "turn"])
+def test_prediction_matches_a_sticking_contact(move):
+    """Worst case = the tip pinned: compare with the cell solved with a sticking contact."""
+    scn = scenario(tilt_deg=4.0, friction=5.0)
+    T, eq, m = _loaded(scn)
+    d = {"push": 0.02 * m.s6, "pull": -0.02 * m.s6,
+         "sideways": 0.02 * np.cross(m.s6, [0, 1.0, 0])}.get(move)
+    if d is not None:
+        Tn = trans(d) @ T
+    else:  # turn 0.05° about an axis through the tool point
+        from scipy.spatial.transform import Rotation
+
+        R = np.eye(4)
+        R[:3, :3] = Rotation.from_rotvec(np.radians(0.05) * np.array([0, 1.0, 0])).as_matrix()
+        Tn = trans(m.tool_point) @ R @ trans(-m.tool_point) @ T
+    pred = predict(scn.model, m, Tn)
+    after = equilibrium(scn.cell, Tn, anchor=eq.anchor)
+    assert after.sticking
+    dF_true = after.tool_force - eq.tool_force
+    dF_pred = pred.force - m.force
+    assert np.linalg.norm(dF_pred - dF_true) <= 0.03 * np.linalg.norm(dF_true) + 1e-6
+    dl_true = after.leg_lengths - eq.leg_lengths
+    dl_pred = pred.deflections - m.deflections(scn.model)
+    assert np.max(np.abs(dl_pred - dl_true)) <= 0.03 * np.max(np.abs(dl_true)) + 1e-7
+
+
+def test_command_checks():
+    scn = scenario()
+    model = scn.model
+    now = np.zeros(6)
+    assert check_command(ENV, model, np.full(6, 1.0), now, None) == []
+    bad = check_command(ENV, model, [0, 0, 0, 0, 101.0, 0], now, None)
+    assert any("axis 5" in b and "limits" in b for b in bad)
+    bad = check_command(Envelope(max_joint_step_deg=5), model, [0, 6.0, 0, 0, 0, 0], now, None)
+    assert any("axis 2 would move" in b for b in bad)
+    _, _, m = _loaded(scn)
+    heavy = predict(model, m, trans(6.0 * m.s6) @ m.flange_pose)  # 6 mm further in
+    bad = check_command(ENV, model, np.zeros(6), now, heavy)
+    assert any("predicted load" in b for b in bad) and any("deflect" in b for b in bad)
+    assert check_command(ENV, model, [np.nan] * 6, now, None)
+
+
+def test_measurement_checks():
+    scn = scenario()
+    _, _, m = _loaded(scn)
+    assert check_measurement(ENV, scn.model, m) == []
+    crushed = PLATFORM.free_lengths - 5.5
+    c = scn.sensor.counts(PLATFORM, crushed)
+    mc = measure(scn.model, np.zeros(6), c, PLATFORM.home_pose)
+    bad = check_measurement(ENV, scn.model, mc)
+    assert any("deflected" in b for b in bad) and any("load" in b for b in bad)
+
+
+def test_envelope_values_are_checked():
+    with pytest.raises(InputError):
+        Envelope(max_load=0)
+    with pytest.raises(InputError):
+        Envelope(max_stream_faults=-1)
