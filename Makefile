@@ -24,7 +24,7 @@ $(DEV_STAMP): $(RUN_STAMP) requirements/dev.txt
 
 # The main job, on the embedded defaults.
 run: $(RUN_STAMP)
-	$(BIN)/kinestat demo
+	$(BIN)/kinestat control
 
 # The whole test suite (lint first, then pytest; pytest fails when no test runs).
 test: $(DEV_STAMP)
