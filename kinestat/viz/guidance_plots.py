@@ -76,8 +76,17 @@ def hand_path_figure(result: GuidanceResult, title: str | None = None):
     # hand z axes at a few rows
     k = max(1, len(o) // 12)
     z = result.poses[::k, :3, 2]
-    scale = 0.06 * max(float(np.ptp(o, axis=0).max()), 1e-9)
+    scale = 0.15 * max(float(np.ptp(o, axis=0).max()), 1e-9)
     ax.quiver(*o[::k].T, *(scale * z).T, color="#ff7f0e", lw=0.8, label="hand z")
+    # equal scales on the three axes, so a straight path looks straight and deviations are
+    # seen at their true size
+    pts = np.vstack([o, ideal])
+    centre = (pts.max(axis=0) + pts.min(axis=0)) / 2
+    half = max(float(np.ptp(pts, axis=0).max()) / 2 * 1.1, 1e-9)
+    ax.set_xlim(centre[0] - half, centre[0] + half)
+    ax.set_ylim(centre[1] - half, centre[1] + half)
+    ax.set_zlim(centre[2] - half, centre[2] + half)
+    ax.set_box_aspect((1, 1, 1))
     u = result.model.length_unit
     ax.set_xlabel(f"x ({u})")
     ax.set_ylabel(f"y ({u})")
