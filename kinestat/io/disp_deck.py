@@ -1021,6 +1021,7 @@ _EMBEDDED: dict[str, str] = {
     "illustration4": "MS = 0: screw-path guidance of configuration #1 (Table A2-5, expanded)",
     "illustration5": "MS = 4: straight-line guidance of configuration #2 (Table A2-8, as printed)",
     "illustration5-corrected": "Illustration 5 with a7 = 1.00 (Table A2-7) for the printed 0.00",
+    "illustration5-published": "Illustration 5 as Table A2-9 implies: b2 = (15, -10, 20), IT = 27",
     "illustration6": "MS = 5: two operator commands (Table A2-10, expanded, as printed)",
     "illustration6-corrected": "Illustration 6 with a7 = 1.00 (Table A2-7) for the printed 0.00",
     "illustration7": "MS = 6: general guidance to a target (Table A2-12, expanded; NP = 2)",
@@ -1059,6 +1060,6 @@ def embedded_deck_text(name: str) -> str:
 
 def embedded_deck(name: str) -> DispDeck:
     """Load an embedded thesis deck: ``"illustration1"`` … ``"illustration7"`` (Nadkarni
-    App. II) or a ``"-corrected"`` variant (see :func:`list_embedded_decks`)."""
+    App. II) or a ``"-corrected"``/``"-published"`` variant (see :func:`list_embedded_decks`)."""
     key = _embedded_name(name)
     return parse_deck(embedded_deck_text(key), source=f"kinestat/data/decks/{key}.dat")
