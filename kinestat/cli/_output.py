@@ -57,8 +57,13 @@ def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.nda
     """Parse ``"1,2,3"`` into floats, checking the count; raises InputError."""
     from kinestat.errors import InputError
 
+    items = [v.strip() for v in text.split(",")] if text.strip() else []
+    if "" in items:
+        raise InputError(f"--{name}: empty value at position {items.index('') + 1} in "
+                         f"{text!r}; give the numbers separated by single commas")
     try:
-        vals = [float(v) for v in text.replace(" ", "").split(",") if v != ""]
+        # float() accepts blanks around a number but not inside one: '1 2' is an error, not 12
+        vals = [float(v) for v in items]
     except ValueError as exc:
         raise InputError(f"--{name}: cannot read {text!r} as comma-separated numbers") from exc
     if n is not None and len(vals) != n:

@@ -58,8 +58,10 @@ def _puma() -> dict:
                         [[int(b), *q] for b, q in zip(res.branches, sols, strict=True)],
                         fmt="{:.3f}"))
     for fam in res.families:
-        console.print(f"  wrist-singular family: θ4 {'+' if fam.kind == 'sum' else '−'} θ6 = "
-                      f"{np.rad2deg(fam.value):.3f}° (θ5 = {np.rad2deg(fam.theta5):.1f}°)")
+        # WristFamily: "sum" fixes θ4 + θ6 (θ5 = 180°), "difference" fixes θ6 − θ4 (θ5 = 0)
+        rel = "θ4 + θ6" if fam.kind == "sum" else "θ6 − θ4"
+        console.print(f"  wrist-singular family: {rel} = {np.rad2deg(fam.value):.3f}° "
+                      f"(θ5 = {np.rad2deg(fam.theta5):.1f}°)")
     return {"solutions_deg": sols, "singular_families": len(res.families)}
 
 

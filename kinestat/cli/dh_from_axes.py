@@ -30,7 +30,7 @@ import numpy as np
 import typer
 
 from kinestat.cli._output import console, print_json, table
-from kinestat.errors import ParseError
+from kinestat.errors import InputError, ParseError
 
 __all__ = ["register", "read_axes_file", "loads_axes"]
 
@@ -90,7 +90,19 @@ def loads_axes(doc: dict, source: str = "<string>") -> dict:
             if "point" in ax or "direction" in ax:
                 raise ParseError("give either plucker or point and direction, not both",
                                  file=source, field=where)
-            lines.append(_vector(ax["plucker"], 6, source, f"{where}.plucker"))
+            pl = _vector(ax["plucker"], 6, source, f"{where}.plucker")
+            S, S0 = np.array(pl[:3]), np.array(pl[3:])
+            nS = float(np.linalg.norm(S))
+            if nS == 0.0:
+                raise ParseError("the direction S (first three numbers) is the zero vector; "
+                                 "give the axis direction", file=source,
+                                 field=f"{where}.plucker")
+            # the same test as kinestat.mechanism.dh_from_axes applies
+            if abs(float(S @ S0)) > 1e-6 * nS * max(float(np.linalg.norm(S0)), nS):
+                raise ParseError("not a line: Plücker coordinates [S; S0] need S . S0 = 0 "
+                                 "(S0 = r x S for a point r on the line)", file=source,
+                                 field=f"{where}.plucker")
+            lines.append(pl)
             forms.add("plucker")
         else:
             for k in ("point", "direction"):
@@ -144,6 +156,10 @@ def read_axes_file(path: str | Path) -> dict:
         text = p.read_text(encoding="utf-8")
     except OSError as exc:
         raise ParseError(f"cannot read the axes file: {exc.strerror}", file=str(p)) from exc
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
+                         f"{exc.start} is not UTF-8); an axes file is TOML or JSON text",
+                         file=str(p)) from exc
     if p.suffix.lower() == ".json":
         try:
             doc = json.loads(text)
@@ -178,12 +194,20 @@ def dh_from_axes_command(
 
     spec = read_axes_file(file)
     if tol is not None:
+        if not (math.isfinite(tol) and tol >= 0):
+            raise InputError(f"--tol must be a finite non-negative number, got {tol}")
         spec["tol"] = tol
-    res = dh_from_axes(
-        spec["axes"], spec["kinds"], pitches=spec["pitches"], names=spec["names"],
-        base=spec.get("base"), tool=spec.get("tool"), tol=spec.get("tol", 1e-9),
-        name=spec["name"], length_unit=spec["length_unit"], description=spec["description"],
-    )
+    try:
+        res = dh_from_axes(
+            spec["axes"], spec["kinds"], pitches=spec["pitches"], names=spec["names"],
+            base=spec.get("base"), tool=spec.get("tool"), tol=spec.get("tol", 1e-9),
+            name=spec["name"], length_unit=spec["length_unit"],
+            description=spec["description"],
+        )
+    except ParseError:
+        raise
+    except InputError as exc:  # a base off axis 1, a bad tool...: say which file
+        raise ParseError(str(exc), file=str(file)) from exc
     if write_model is not None:
         save_model(res.model, write_model)
     ang = (lambda x: math.degrees(x) + 0.0) if deg else (lambda x: float(x) + 0.0)

@@ -20,7 +20,8 @@ def fk_command(
         None, "--q-deg", help="Joint values with rotating joints in degrees (prismatic: length)."
     ),
     tool_point_6: str = typer.Option(
-        "0,0,0", "--tool-point-6", help="Tool point in the end (6th) frame, x,y,z."
+        "0,0,0", "--tool-point-6", help="Tool point in the end frame (frame n: the PUMA's "
+        "frame 6), x,y,z."
     ),
     euler: str = typer.Option(
         "ZYX", "--euler", help="Euler sequence for the orientation (SciPy style: ZYX intrinsic, "

@@ -253,6 +253,10 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
     import kinestat
     from kinestat.serial.ik import ik
 
+    if restarts < 0:
+        raise InputError(f"--restarts must be 0 or more, got {restarts}")
+    if max_iter < 1:
+        raise InputError(f"--max-iter must be at least 1, got {max_iter}")
     m = kinestat.load(model_name)
     T = _read_poses(pose)
     q0 = None

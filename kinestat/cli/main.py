@@ -51,7 +51,8 @@ def main(argv: list[str] | None = None) -> int:
     """Console-script entry point; returns the exit status.
 
     Usage errors and ``--help`` are handled by Typer (usage errors exit with status 2); a
-    :class:`KinestatError` is printed as one line on stderr and exits with status 2.
+    :class:`KinestatError`, or an ``OSError`` from the file system or network, is printed as
+    one line on stderr and exits with status 2.
     """
     try:
         app(args=argv, standalone_mode=True)
@@ -60,6 +61,10 @@ def main(argv: list[str] | None = None) -> int:
         return code if isinstance(code, int) else (0 if code is None else 1)
     except KinestatError as exc:
         typer.echo(f"kinestat: error: {exc}", err=True)
+        return 2
+    except OSError as exc:  # the file system or the network said no: not a kinestat bug
+        where = f": {exc.filename}" if exc.filename is not None else ""
+        typer.echo(f"kinestat: error: {exc.strerror or exc}{where}", err=True)
         return 2
     except KeyboardInterrupt:
         typer.echo("kinestat: interrupted", err=True)

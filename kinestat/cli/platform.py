@@ -17,7 +17,7 @@ import numpy as np
 import typer
 
 from kinestat.cli._output import console, parse_floats, print_json, table
-from kinestat.errors import InputError, ParseError
+from kinestat.errors import InputError, ParseError, UnreachableError
 
 PLATFORM_HELP = "TOML platform file (default: the embedded 2011 prototype)."
 POSE_HELP = "'home', a JSON/TOML file holding a 4x4 pose, or 16 comma-separated numbers."
@@ -52,6 +52,10 @@ def _pose(text: str, platform) -> np.ndarray:
             raw = p.read_text(encoding="utf-8")
         except OSError as exc:
             raise ParseError(f"cannot read pose file: {exc.strerror}", file=str(p)) from exc
+        except UnicodeDecodeError as exc:
+            raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
+                             f"{exc.start} is not UTF-8); a pose file is JSON or TOML",
+                             file=str(p)) from exc
         try:
             doc = tomllib.loads(raw) if p.suffix.lower() == ".toml" else json.loads(raw)
         except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
@@ -147,10 +151,21 @@ def fk_command(
 
     p = _load(platform)
     L = parse_floats(legs, 6, "legs")
+    for name, x in zip(p.leg_names, L, strict=True):
+        if x <= 0:
+            raise InputError(f"--legs: leg {name} has length {x:g}; leg lengths must be positive "
+                             f"(order {', '.join(p.leg_names)})")
     if p.layout is not None:
         poses, method = fk_list(p, L), "special 6-6 -> 3-3 closed form, all modes"
     else:
-        poses, method = [fk_numeric(p, L)], "numerical (Newton from home), one mode"
+        try:
+            poses, method = [fk_numeric(p, L)], "numerical (Newton from home), one mode"
+        except UnreachableError as exc:
+            raise UnreachableError(
+                f"no assembly of {p.name!r} found near its home pose: it is a general 6-6 "
+                "platform, which platform fk solves by Newton from home only (one mode); check "
+                f"the leg lengths (order {', '.join(p.leg_names)}; at home "
+                f"{', '.join(f'{x:.4g}' for x in leg_lengths(p, p.home_pose))})") from exc
     sols = [{"pose": T, "top_points": top_points_in_base(p, T),
              "above_base": bool(T[2, 3] >= 0),
              "max_leg_error": float(np.max(np.abs(leg_lengths(p, T) - L)))} for T in poses]

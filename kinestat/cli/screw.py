@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 
 import numpy as np
@@ -9,22 +10,57 @@ import typer
 
 from kinestat.cli._output import console, parse_floats, print_json, table
 from kinestat.errors import InputError, ParseError
-from kinestat.spatial.displacement import ScrewDisplacement, screw_from_points, screw_from_poses
+from kinestat.spatial.displacement import (
+    ScrewDisplacement,
+    frame_from_triple,
+    screw_from_points,
+    screw_from_poses,
+)
+
+
+def _read_json_pose(text: str, path: Path) -> list[float]:
+    """A JSON pose: a 4x4 (or 3x4) array, 16 (or 12) numbers, or ``{"pose": ...}`` (as written
+    by ``kinestat fk --json``)."""
+    try:
+        doc = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise ParseError(f"not valid JSON: {exc.msg}", file=str(path), line=exc.lineno) from exc
+    if isinstance(doc, dict):
+        if "pose" not in doc:
+            raise ParseError("a JSON object must hold the pose under a \"pose\" key",
+                             file=str(path))
+        doc = doc["pose"]
+    try:
+        arr = np.asarray(doc, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ParseError("the pose must be a 4x4 array of numbers", file=str(path)) from exc
+    if arr.shape not in ((4, 4), (3, 4), (16,), (12,)):
+        raise ParseError(f"the pose must be 4x4 (or its top three rows), got shape {arr.shape}",
+                         file=str(path))
+    return arr.ravel().tolist()
 
 
 def _read_pose_file(path: Path) -> np.ndarray:
-    """Numbers separated by spaces/commas, ``#`` comments; 16 (4x4) or 12 (top 3x4 rows)."""
+    """Numbers separated by spaces/commas, ``#`` comments; 16 (4x4) or 12 (top 3x4 rows); or
+    JSON (see :func:`_read_json_pose`)."""
     try:
-        text = path.read_text()
+        text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise InputError(f"cannot read pose file {str(path)!r}: {exc.strerror}") from exc
-    vals: list[float] = []
-    for lineno, line in enumerate(text.splitlines(), start=1):
-        for tok in line.split("#", 1)[0].replace(",", " ").split():
-            try:
-                vals.append(float(tok))
-            except ValueError as exc:
-                raise ParseError(f"{tok!r} is not a number", file=str(path), line=lineno) from exc
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
+                         f"{exc.start} is not UTF-8)", file=str(path)) from exc
+    if text.lstrip()[:1] in ("{", "["):
+        vals = _read_json_pose(text, path)
+    else:
+        vals = []
+        for lineno, line in enumerate(text.splitlines(), start=1):
+            for tok in line.split("#", 1)[0].replace(",", " ").split():
+                try:
+                    vals.append(float(tok))
+                except ValueError as exc:
+                    raise ParseError(f"{tok!r} is not a number", file=str(path),
+                                     line=lineno) from exc
     if len(vals) not in (12, 16):
         raise ParseError(
             f"expected 16 numbers (a 4x4 pose, row by row) or 12 (its top three rows), "
@@ -50,7 +86,12 @@ def _pose(value: str, name: str) -> np.ndarray:
 
 
 def _points(value: str, name: str) -> np.ndarray:
-    return parse_floats(value, 9, name).reshape(3, 3)
+    pts = parse_floats(value, 9, name).reshape(3, 3)
+    try:
+        frame_from_triple(pts)
+    except InputError as exc:  # coincident or collinear points: say which option
+        raise InputError(f"--{name}: {exc}") from exc
+    return pts
 
 
 def screw_json(sc: ScrewDisplacement) -> dict:
@@ -66,8 +107,9 @@ def screw_json(sc: ScrewDisplacement) -> dict:
 
 
 def screw(
-    pose1: str = typer.Option(None, "--pose1", help="First pose: a file (4x4 or 3x4 numbers) "
-                              "or 16 comma-separated numbers, row by row."),
+    pose1: str = typer.Option(None, "--pose1", help="First pose: a file (4x4 or 3x4 numbers, or "
+                              "JSON such as kinestat fk --json writes) or 16 comma-separated "
+                              "numbers, row by row."),
     pose2: str = typer.Option(None, "--pose2", help="Second pose, as --pose1."),
     points1: str = typer.Option(None, "--points1", help="First position by three body points "
                                 "x,y,z,x,y,z,x,y,z: origin, a point on +z, a point in the z-x "

@@ -6,20 +6,42 @@ import signal
 import threading
 import time
 
+import numpy as np
 import typer
 
 from kinestat.cli._output import console, parse_floats, print_json
-from kinestat.devices.encoder_stream import CHANNELS, THESIS_WIRING, legs_to_channels
+from kinestat.devices.encoder_stream import (
+    CHANNELS,
+    COUNT_MAX,
+    COUNT_MIN,
+    THESIS_WIRING,
+    legs_to_channels,
+)
 from kinestat.errors import InputError
 
 sim_app = typer.Typer(help="Simulated hardware: the Galil DMC controller and the platform's "
                            "encoder stream.", no_args_is_help=True)
 
 
-def _run_until_stopped(duration: float | None, stop_event: threading.Event | None = None) -> None:
-    """Block until ``duration`` seconds pass (forever if None) or Ctrl-C."""
+def _check_duration(duration: float | None) -> None:
     if duration is not None and (duration < 0 or duration != duration):
         raise InputError(f"--duration must be >= 0 seconds, got {duration}")
+
+
+def _int_counts(text: str, option: str) -> np.ndarray:
+    """Six whole encoder counts within the signed 32-bit range both protocols carry."""
+    vals = parse_floats(text, 6, option)
+    if any(v != int(v) for v in vals):
+        raise InputError(f"--{option} must be integers, got {text!r}")
+    if np.any(vals < COUNT_MIN) or np.any(vals > COUNT_MAX):
+        raise InputError(f"--{option} must lie in [{COUNT_MIN}, {COUNT_MAX}] (signed 32-bit), "
+                         f"got {text!r}")
+    return vals
+
+
+def _run_until_stopped(duration: float | None, stop_event: threading.Event | None = None) -> None:
+    """Block until ``duration`` seconds pass (forever if None) or Ctrl-C."""
+    _check_duration(duration)
     ev = stop_event or threading.Event()
     t_end = None if duration is None else time.monotonic() + duration
     previous = None
@@ -58,7 +80,8 @@ def galil(
     """Run a simulated Galil DMC (six axes, trapezoidal profiles) until Ctrl-C."""
     from kinestat.sim.galil_server import DmcSimulator, GalilSimServer
 
-    c0 = parse_floats(initial_counts, 6, "initial-counts")
+    _check_duration(duration)
+    c0 = _int_counts(initial_counts, "initial-counts")
     ctrl = DmcSimulator(initial_counts=c0, **({"coupling": 0.0} if no_coupling else {}))
     server = GalilSimServer(host, port, allow_remote=allow_remote, controller=ctrl)
     with server:
@@ -86,11 +109,13 @@ def encoders(
     """Stream encoder packets onto a pseudo-terminal and print its path until Ctrl-C."""
     from kinestat.sim.encoder_emitter import EncoderEmitter, constant_counts
 
+    _check_duration(duration)
     if fmt not in ("ks", "legacy"):
         raise InputError(f"--format must be 'ks' or 'legacy', got {fmt!r}")
-    legs = parse_floats(counts, 6, "counts")
-    if any(v != int(v) for v in legs):
-        raise InputError(f"--counts must be integers, got {counts!r}")
+    if not 0 < rate <= 5000:  # also refuses NaN
+        raise InputError(f"--rate must be in (0, 5000] packets per second, got {rate}")
+    # legacy lines carry 16 bits and wrap, as the thesis's counters did
+    legs = _int_counts(counts, "counts")
     emitter = EncoderEmitter(constant_counts(legs), rate_hz=rate, fmt=fmt)
     with emitter:
         channels = legs_to_channels(legs.astype(int)).tolist()

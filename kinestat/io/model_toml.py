@@ -45,7 +45,7 @@ from pathlib import Path
 import numpy as np
 import tomli_w
 
-from kinestat.errors import ModelError, ParseError
+from kinestat.errors import InputError, ModelError, ParseError
 from kinestat.mechanism.chain import (
     ChainModel,
     from_modified_dh,
@@ -104,6 +104,10 @@ def read_model(path: str | os.PathLike) -> ChainModel:
         text = p.read_text(encoding="utf-8")
     except OSError as exc:
         raise ParseError(f"cannot read model file: {exc.strerror}", file=str(p)) from exc
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
+                         f"{exc.start} is not UTF-8); a model file is TOML text",
+                         file=str(p)) from exc
     return loads_model(text, source=str(p))
 
 
@@ -122,6 +126,13 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
     if angle_unit not in ("deg", "rad"):
         raise _err(f"angle_unit must be 'deg' or 'rad', got {angle_unit!r}", source, "angle_unit")
     to_rad = math.pi / 180.0 if angle_unit == "deg" else 1.0
+    # keys of the other notations: refused rather than silently ignored
+    unused = ["q_home"] if notation == "nadkarni" else ["frame_points", "hand"]
+    for k in unused:
+        if k in doc:
+            hint = ("the joint values of a nadkarni file are the initial configuration"
+                    if k == "q_home" else "it belongs to the nadkarni notation")
+            raise _err(f"'{k}' is not used with the {notation} notation ({hint})", source, k)
     name = str(doc.get("name", Path(source).stem))
     length_unit = str(doc.get("length_unit", "mm"))
     joints = doc.get("joints")
@@ -149,6 +160,9 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
         pitch = _num(j.get("pitch", 0.0), source, f"{where}.pitch")
         if kind == "screw" and pitch == 0.0:
             raise _err("a screw joint needs a non-zero pitch", source, f"{where}.pitch")
+        if kind != "screw" and pitch != 0.0:
+            raise _err(f"pitch is only for screw joints, not {kind} (write type = \"screw\")",
+                       source, f"{where}.pitch")
         pitches.append(pitch)
         lim = j.get("limits", [-math.inf, math.inf])
         if not isinstance(lim, list) or len(lim) != 2:
@@ -191,6 +205,9 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
             build = from_standard_dh if notation == "standard_dh" else from_modified_dh
             q_home = None
             if "q_home" in doc:
+                if not isinstance(doc["q_home"], list):
+                    raise _err(f"q_home must be a list of {len(rows)} numbers, got "
+                               f"{doc['q_home']!r}", source, "q_home")
                 qh = np.array([_num(v, source, "q_home") for v in doc["q_home"]])
                 if qh.shape != (len(rows),):
                     raise _err(f"q_home must have {len(rows)} values", source, "q_home")
@@ -198,9 +215,9 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
             model = build(rows, kinds, pitches=pitches, limits=limits, names=names, base=base,
                           tool=tool, name=name, length_unit=length_unit, q_home=q_home,
                           description=description)
-    except ModelError as exc:
-        if isinstance(exc, ParseError):
-            raise
+    except ParseError:
+        raise
+    except InputError as exc:  # ModelError, and InputError from the frame points
         raise _err(str(exc), source) from exc
     return model
 
@@ -260,12 +277,18 @@ def write_model(model: ChainModel, path: str | os.PathLike, angle_unit: str = "d
     """Write a model as TOML, atomically (a temporary file renamed into place)."""
     text = dumps_model(model, angle_unit=angle_unit)
     p = Path(path)
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", dir=p.parent or ".")
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", dir=p.parent or ".")
+    except OSError as exc:
+        raise InputError(f"cannot write model file {str(p)!r}: {exc.strerror}; check the "
+                         "directory") from exc
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
         os.replace(tmp, p)
-    except BaseException:
+    except BaseException as exc:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise InputError(f"cannot write model file {str(p)!r}: {exc.strerror}") from exc
         raise

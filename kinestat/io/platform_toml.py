@@ -120,6 +120,10 @@ def read_platform(path: str | os.PathLike) -> Platform:
         text = p.read_text(encoding="utf-8")
     except OSError as exc:
         raise ParseError(f"cannot read platform file: {exc.strerror}", file=str(p)) from exc
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
+                         f"{exc.start} is not UTF-8); a platform file is TOML text",
+                         file=str(p)) from exc
     return loads_platform(text, source=str(p))
 
 
@@ -276,11 +280,17 @@ def write_platform(platform: Platform, path: str | os.PathLike,
     """Write a platform to a TOML file (atomically: a temporary file renamed into place)."""
     p = Path(path)
     text = dumps_platform(platform, description)
-    fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=".tmp")
+    try:
+        fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=".tmp")
+    except OSError as exc:
+        raise InputError(f"cannot write platform file {str(p)!r}: {exc.strerror}; check the "
+                         "directory") from exc
     try:
         with os.fdopen(fd, "w", encoding="utf-8") as fh:
             fh.write(text)
         os.replace(tmp, p)
-    except BaseException:
+    except BaseException as exc:
         Path(tmp).unlink(missing_ok=True)
+        if isinstance(exc, OSError):
+            raise InputError(f"cannot write platform file {str(p)!r}: {exc.strerror}") from exc
         raise

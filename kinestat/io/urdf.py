@@ -188,4 +188,7 @@ def read_urdf(path: str | os.PathLike, **kwargs) -> ChainModel:
         text = p.read_text(encoding="utf-8")
     except OSError as exc:
         raise ParseError(f"cannot read URDF: {exc.strerror}", file=str(p)) from exc
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"cannot read URDF: byte {exc.object[exc.start]:#04x} at offset "
+                         f"{exc.start} is not UTF-8 text", file=str(p)) from exc
     return from_urdf(text, source=str(p), **kwargs)

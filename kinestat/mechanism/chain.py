@@ -205,8 +205,15 @@ def _joints(kinds: Sequence[str] | None, n: int, pitches, limits, names) -> tupl
     )
 
 
+def _numbers(x, what: str) -> np.ndarray:
+    try:
+        return np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:  # strings, ragged rows
+        raise ModelError(f"{what}: expected an array of numbers ({exc})") from exc
+
+
 def _rows(rows, name: str) -> np.ndarray:
-    P = np.asarray(rows, dtype=float)
+    P = _numbers(rows, name)
     if P.ndim != 2 or P.shape[1] != 4 or P.shape[0] == 0:
         raise ModelError(f"{name}: expected rows of 4 parameters, got shape {P.shape}")
     if not np.all(np.isfinite(P)):
@@ -330,7 +337,7 @@ def from_nadkarni(
     """
     from kinestat.mechanism.joints import kind_from_pitch
 
-    R = np.asarray(joints_rows, dtype=float)
+    R = _numbers(joints_rows, "Nadkarni joint rows")
     if R.ndim != 2 or R.shape[1] != 5 or R.shape[0] == 0:
         raise ModelError(
             f"Nadkarni joints must be rows of (r, alpha, a, theta, pitch), got {R.shape}")

@@ -82,6 +82,13 @@ def _unit(v, n) -> np.ndarray:
     return v / np.where(n > 0, n, 1.0)[..., None]
 
 
+def _axes_array(axes) -> np.ndarray:
+    try:
+        return np.asarray(axes, dtype=float)
+    except (TypeError, ValueError) as exc:  # strings, ragged lists
+        raise InputError(f"joint axes must be an array of numbers ({exc})") from exc
+
+
 def _where_first(mask: np.ndarray) -> str:
     idx = np.argwhere(mask)[0]
     return ", ".join(str(int(i)) for i in idx)
@@ -95,7 +102,7 @@ def axis_lines(axes) -> tuple[np.ndarray, np.ndarray]:
     eq. A-7). The returned point is the foot of the perpendicular from the origin, so the result
     depends only on the lines, not on the points chosen on them.
     """
-    A = np.asarray(axes, dtype=float)
+    A = _axes_array(axes)
     if A.ndim >= 3 and A.shape[-2:] == (2, 3):
         point, S = A[..., 0, :], A[..., 1, :]
         what = "direction"
@@ -422,7 +429,7 @@ def dh_from_axes(
     its end pose on ``tool`` (lecture notes, steps 1 and 2). For a batch of axis sets use
     :func:`assign_dh_frames`.
     """
-    A = np.asarray(axes, dtype=float)
+    A = _axes_array(axes)
     if not ((A.ndim == 3 and A.shape[1:] == (2, 3)) or (A.ndim == 2 and A.shape[1] == 6)):
         raise InputError(
             f"dh_from_axes takes one chain: axes of shape (n, 2, 3) or (n, 6), got {A.shape} "

@@ -127,7 +127,9 @@ def _reduction(platform: Platform) -> tuple[list[int], np.ndarray, np.ndarray]:
 
 def _reduce_sq(platform: Platform, L: np.ndarray) -> np.ndarray:
     order, MinvT, c = _reduction(platform)
-    return (L[..., order] ** 2 + c) @ MinvT
+    # absurd lengths (1e300) overflow to inf/nan here; callers report them as unreachable
+    with np.errstate(over="ignore", invalid="ignore"):
+        return (L[..., order] ** 2 + c) @ MinvT
 
 
 def reduce_to_33(platform: Platform, lengths) -> np.ndarray:
@@ -271,7 +273,8 @@ def fk_numeric(platform: Platform, lengths, guess=None, *, tol: float = 1e-9,
         raise UnreachableError(
             f"numerical forward kinematics did not converge{'' if L.ndim == 1 else f' at {idx}'}"
             f" (leg error {worst:.3g} {platform.length_unit} after {max_iter} iterations): the "
-            "lengths may admit no assembly near the guess; try another guess or fk_all")
+            "lengths may admit no assembly near the guess; try another guess (or fk_all, for a "
+            "special 6-6 platform)")
     return pose
 
 

@@ -16,13 +16,25 @@ def as_pose(pose, name: str = "pose") -> np.ndarray:
     T = as_array(pose, shape_tail=(4, 4), name=name)
     R = T[..., :3, :3]
     err = np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)).max(axis=(-1, -2), initial=0.0)
-    bad = (err > 1e-6) | (np.abs(np.linalg.det(R) - 1.0) > 1e-6)
-    bad |= np.abs(T[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(axis=-1) > 1e-12
-    if np.any(bad):
-        where = "" if T.ndim == 2 else (
-            f" at batch index {tuple(int(i) for i in np.argwhere(bad)[0])}")
-        raise InputError(f"{name} is not a rigid transform (rotation not orthonormal, det != 1 "
-                         f"or last row != 0 0 0 1){where}")
+    det = np.linalg.det(R)
+    bad_rot = (err > 1e-6) | (np.abs(det - 1.0) > 1e-6)
+    bad_row = np.abs(T[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(axis=-1) > 1e-12
+
+    def first(bad: np.ndarray) -> tuple[tuple[int, ...], str]:
+        if T.ndim == 2:
+            return (), ""
+        i = tuple(int(k) for k in np.argwhere(bad)[0])
+        return i, f" at batch index {i}"
+
+    if np.any(bad_row):
+        _, where = first(bad_row)
+        raise InputError(f"{name} is not a rigid transform{where}: its last row must be 0 0 0 1")
+    if np.any(bad_rot):
+        i, where = first(bad_rot)
+        raise InputError(
+            f"{name} is not a rigid transform{where}: its rotation part has max|R R^T - I| = "
+            f"{float(err[i]):.2g} and det = {float(det[i]):.6g}; it must be orthonormal with "
+            "det +1 (tolerance 1e-06: give the rotation to enough digits)")
     return T
 
 

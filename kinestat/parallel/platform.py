@@ -193,8 +193,8 @@ class Platform:
 
 def triangle_points(sides) -> np.ndarray:
     """Corners (3, 3) of a triangle from its sides (|AB|, |BC|, |CA|): A at 0, B on +x, C at y>0."""
-    ab, bc, ca = _vec(sides, 3, "triangle sides")
-    if np.any(np.array([ab, bc, ca]) <= 0):
+    ab, bc, ca = (float(x) for x in _vec(sides, 3, "triangle sides"))
+    if min(ab, bc, ca) <= 0:
         raise InputError(f"triangle sides must be positive, got {[ab, bc, ca]}")
     cx = (ab * ab + ca * ca - bc * bc) / (2 * ab)
     cy2 = ca * ca - cx * cx
@@ -239,8 +239,13 @@ def special_6_6(
         InputError: impossible dimensions (offsets outside their edge, bad triangles).
         ModelError: an architecturally singular layout (see :mod:`kinestat.parallel.singularity`).
     """
-    base = triangle_points(base_side)
-    top = triangle_points(top_side)
+    triangles = []
+    for sides, what in ((base_side, "base_side"), (top_side, "top_side")):
+        try:
+            triangles.append(triangle_points(sides))
+        except InputError as exc:
+            raise InputError(f"{what}: {exc}") from exc
+    base, top = triangles
     bside = np.array([np.linalg.norm(base[(i + 1) % 3] - base[i]) for i in range(3)])
     tside = np.array([np.linalg.norm(top[(i + 1) % 3] - top[i]) for i in range(3)])
     boff = _vec(base_offset, 3, "base_offset")

@@ -32,7 +32,10 @@ __all__ = [
 
 def as_array(x, *, shape_tail: tuple[int, ...] = (), name: str = "value") -> np.ndarray:
     """Convert to a float64 array, checking the trailing shape and finiteness."""
-    a = np.asarray(x, dtype=float)
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError) as exc:  # strings, ragged lists, None in a list...
+        raise InputError(f"{name} must be an array of numbers: {exc}") from exc
     if shape_tail and a.shape[a.ndim - len(shape_tail):] != shape_tail:
         raise InputError(f"{name} must have trailing shape {shape_tail}, got {a.shape}")
     if not np.all(np.isfinite(a)):

@@ -3,6 +3,7 @@
 import json
 
 import numpy as np
+import pytest
 
 import kinestat
 from kinestat.cli.main import main
@@ -33,3 +34,23 @@ def test_demo_human(capsys):
     text = capsys.readouterr().out
     assert "Illustration 2" in text and "assembly modes" in text
     assert kinestat.__version__
+
+
+def test_demo_states_each_wrist_family_relation_correctly(capsys, monkeypatch):
+    # A "difference" family (θ5 = 0) fixes θ6 − θ4; the demo used to print it as θ4 − θ6.
+    # Feed the demo a pose at θ5 = 0 and check the printed value against the generating q.
+    import re
+
+    q_deg = np.array([150.0, 30.0, 40.0, 20.0, 0.0, 50.0])
+    f = puma762.forward(np.radians(q_deg))
+    real = puma762.reverse
+    monkeypatch.setattr(puma762, "reverse",
+                        lambda *a, **k: real(f.tool_point, f.s6, f.a67))
+    assert main(["demo"]) == 0
+    text = capsys.readouterr().out
+    m = re.search(r"wrist-singular family: (θ\d [+−] θ\d) = (-?[\d.]+)°", text)
+    assert m is not None
+    a, op, b = m.group(1).split()
+    val = {"θ4": q_deg[3], "θ6": q_deg[5]}
+    expected = val[a] + val[b] if op == "+" else val[a] - val[b]
+    assert (float(m.group(2)) - expected + 180) % 360 - 180 == pytest.approx(0, abs=1e-3)

@@ -140,3 +140,43 @@ def test_missing_file_and_bad_json(capsys, tmp_path):
     p.write_text('{"axes": [\n  {"point": [0, 0, 0],}\n]}')
     assert main(["dh-from-axes", str(p)]) == 2
     assert "line 2" in capsys.readouterr().err
+
+
+_AXIS = '[[axes]]\npoint = [0, 0, 0]\ndirection = [0, 0, 1]\n'
+
+
+@pytest.mark.parametrize("body, where", [
+    # Plücker problems used to be reported as "joint axis [1]" (0-based) with no file or field
+    (_AXIS + '[[axes]]\nplucker = [0, 0, 0, 0, 1, 0]\n', ", field axes[2].plucker"),
+    (_AXIS + '[[axes]]\nplucker = [0, 0, 1, 0, 0, 1]\n', ", field axes[2].plucker"),
+    # errors found by the algorithm (base off axis 1, non-rigid tool) used to lack the file
+    ('base = [[1,0,0,5],[0,1,0,0],[0,0,1,0],[0,0,0,1]]\n' + _AXIS, ": base"),
+    ('tool = [[2,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]\n' + _AXIS, ": tool"),
+])
+def test_errors_name_file_and_field(capsys, tmp_path, body, where):
+    p = tmp_path / "bad.toml"
+    p.write_text(body)
+    assert main(["dh-from-axes", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(f"kinestat: error: {p}{where}") and len(err.splitlines()) == 1
+
+
+def test_binary_file_and_unwritable_model_are_clean(capsys, tmp_path):
+    # both used to end in a Python traceback (UnicodeDecodeError, FileNotFoundError)
+    p = tmp_path / "bin.toml"
+    p.write_bytes(b"\xff\xfe\x00")
+    assert main(["dh-from-axes", str(p)]) == 2
+    assert "not a text file" in capsys.readouterr().err
+    good = tmp_path / "arm.toml"
+    good.write_text(_AXIS)
+    out = tmp_path / "no" / "dir" / "m.toml"
+    assert main(["dh-from-axes", str(good), "--write-model", str(out)]) == 2
+    assert "cannot write model file" in capsys.readouterr().err
+    assert not out.parent.exists()
+
+
+def test_bad_tol_option_names_the_option(capsys, tmp_path):
+    p = tmp_path / "arm.toml"
+    p.write_text(_AXIS)
+    assert main(["dh-from-axes", str(p), "--tol", "-1"]) == 2
+    assert "--tol must be" in capsys.readouterr().err

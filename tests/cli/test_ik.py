@@ -156,3 +156,30 @@ def test_pose_json_file_errors(capsys, tmp_path):
     assert "pose" in capsys.readouterr().err
     assert main(["ik", "puma762", "--pose", str(tmp_path / "missing.json")]) == 2
     assert "does not exist" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--restarts", "-1"], "--restarts must be 0 or more"),
+    (["--max-iter", "0"], "--max-iter must be at least 1"),
+])
+def test_numerical_budget_options_are_named(capsys, args, words):
+    # the message used to come from the library: "max_iter must be at least 1 and restarts ..."
+    assert main(["ik", "puma762", "--pose", csv(np.eye(4)), *args]) == 2
+    assert words in capsys.readouterr().err
+
+
+def test_fk_then_closed_form_ik_round_trip_through_the_cli(capsys):
+    q_deg = np.array([150.0, 30.0, 40.0, 20.0, 60.0, 30.0])
+    p6 = "10,-20,235"
+    fk = run_json(capsys, ["fk", "puma762", "--q-deg", csv(q_deg), "--tool-point-6", p6,
+                           "--json"])
+    out = run_json(capsys, ["ik", "puma762", "--tool-point", csv(fk["tool_point"]),
+                            "--s6", csv(fk["s6"]), "--a67", csv(fk["a67"]),
+                            "--tool-point-6", p6, "--json"])
+    diffs = [np.abs((np.array(s["q_deg"]) - q_deg + 180.0) % 360.0 - 180.0).max()
+             for s in out["solutions"]]
+    assert min(diffs) < 1e-7
+    m = kinestat.load("puma762")
+    for s in out["solutions"]:  # every solution reproduces the fk pose (generic chain)
+        np.testing.assert_allclose(kinestat.fk(m, np.radians(s["q_deg"])), fk["pose"],
+                                   atol=1e-8)

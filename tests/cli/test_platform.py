@@ -129,3 +129,67 @@ def test_singular_pose_statics_error(capsys, tmp_path):
     f = tmp_path / "singular.json"
     f.write_text(json.dumps(T.tolist()))
     assert "singular" in run_err(capsys, "statics", "--pose", str(f), "--wrench", "0,0,-1,0,0,0")
+
+
+def test_nonpositive_leg_is_named(capsys):
+    # used to say "at index (5,)"
+    err = run_err(capsys, "fk", "--legs", "79,81,81,68,67,-68")
+    assert "--legs: leg T has length -68" in err
+
+
+def test_binary_pose_file_is_clean(capsys, tmp_path):
+    # used to end in a UnicodeDecodeError traceback
+    f = tmp_path / "pose.json"
+    f.write_bytes(b"\xff\xfe\x00")
+    err = run_err(capsys, "ik", "--pose", str(f))
+    assert err.startswith(f"kinestat: error: {f}: not a text file") and len(err.splitlines()) == 1
+
+
+def test_ik_fk_round_trip_through_the_cli(capsys, tmp_path, rng):
+    # platform ik at a pose near home, then platform fk on those legs: one mode is that pose
+    p = prototype()
+    from kinestat.parallel._refine import apply_twist
+
+    T = apply_twist(p.home_pose, rng.normal(size=6) * np.r_[[0.05] * 3, [2.0] * 3])
+    f = tmp_path / "pose.json"
+    f.write_text(json.dumps({"pose": T.tolist()}))
+    legs = run_json(capsys, "ik", "--pose", str(f))["leg_lengths"]
+    out = run_json(capsys, "fk", "--legs", ",".join(repr(x) for x in legs))
+    err = [np.abs(np.array(s["pose"]) - T).max() for s in out["solutions"]]
+    assert min(err) < 1e-9
+    best = out["solutions"][int(np.argmin(err))]
+    np.testing.assert_allclose(best["top_points"], (T[:3, :3] @ p.top_points.T).T + T[:3, 3],
+                               atol=1e-9)
+
+
+def _general_platform_file(tmp_path):
+    from kinestat.parallel.platform import Platform
+
+    base = np.array([[100, 0, 0], [90, 40, 0], [-30, 95, 0], [-70, 60, 0], [-60, -80, 0],
+                     [-10, -100, 0]], dtype=float)
+    top = np.array([[40, 10, 0], [20, 40, 0], [-15, 45, 0], [-45, 5, 0], [-30, -35, 0],
+                    [30, -30, 0]], dtype=float)
+    home = np.eye(4)
+    home[2, 3] = 60.0
+    plat = Platform(base_points=base, top_points=top, stiffness=np.full(6, 2.0),
+                    free_lengths=np.linalg.norm(top + [0, 0, 60] - base, axis=1), home_pose=home,
+                    leg_names=tuple("abcdef"), name="general")
+    f = tmp_path / "general.toml"
+    write_platform(plat, f)
+    return plat, f
+
+
+def test_general_platform_fk_and_its_failure_message(capsys, tmp_path, rng):
+    from kinestat.parallel._refine import apply_twist
+
+    plat, f = _general_platform_file(tmp_path)
+    T = apply_twist(plat.home_pose, rng.normal(size=6) * np.r_[[0.02] * 3, [1.0] * 3])
+    legs = ",".join(repr(float(x)) for x in leg_lengths(plat, T))
+    out = run_json(capsys, "fk", "--legs", legs, "--platform", str(f))
+    assert out["count"] == 1
+    np.testing.assert_allclose(out["solutions"][0]["pose"], T, atol=1e-8)
+    # far from home: the message used to advise "another guess or fk_all", neither of which
+    # the command offers (and fk_all refuses a general platform)
+    err = run_err(capsys, "fk", "--legs", "10,10,10,10,10,500", "--platform", str(f))
+    assert "general 6-6 platform" in err and "fk_all" not in err
+    assert len(err.splitlines()) == 1

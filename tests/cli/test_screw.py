@@ -97,3 +97,53 @@ def test_bad_pose_file(tmp_path, capsys):
     f.write_text("1 0 0\n")
     assert main(["screw", "--pose1", str(f), "--pose2", str(f)]) == 2
     assert "got 3" in capsys.readouterr().err
+
+
+def test_screw_of_two_fk_json_poses(tmp_path, capsys):
+    # `kinestat fk --json` output used to be refused ("'{' is not a number"); the screw found
+    # from it must carry the first pose onto the second (checked with SciPy's rotation vector)
+    from scipy.spatial.transform import Rotation
+
+    from kinestat.spatial.displacement import pose_from_screw
+
+    files = []
+    for i, q in enumerate(["180,10,20,30,40,50", "170,15,25,35,45,55"]):
+        assert main(["fk", "puma762", "--q-deg", q, "--json"]) == 0
+        f = tmp_path / f"fk{i}.json"
+        f.write_text(capsys.readouterr().out)
+        files.append(f)
+    out = _run_json(capsys, ["--pose1", str(files[0]), "--pose2", str(files[1])])
+    T1, T2 = (np.array(json.loads(f.read_text())["pose"]) for f in files)
+    D = pose_from_screw(out["axis"], out["point"], np.radians(out["angle_deg"]),
+                        out["translation"])
+    np.testing.assert_allclose(D @ T1, T2, atol=1e-9)
+    rotvec = Rotation.from_matrix(T2[:3, :3] @ T1[:3, :3].T).as_rotvec(degrees=True)
+    np.testing.assert_allclose(np.array(out["axis"]) * out["angle_deg"], rotvec, atol=1e-9)
+
+
+def test_json_pose_file_forms(tmp_path, capsys):
+    T = _known_pose()
+    for i, doc in enumerate([T.tolist(), T[:3].ravel().tolist()]):
+        f = tmp_path / f"p{i}.json"
+        f.write_text(json.dumps(doc))
+        out = _run_json(capsys, ["--pose1", _csv(np.eye(4)), "--pose2", str(f)])
+        assert out["angle_deg"] == pytest.approx(90.0)
+    f = tmp_path / "bad.json"
+    for text, msg in [('{"x": 1}', '"pose" key'), ("[[1, 2], [3, 4]]", "shape (2, 2)"),
+                      ('{"pose": [1,', "not valid JSON")]:
+        f.write_text(text)
+        assert main(["screw", "--pose1", str(f), "--pose2", str(f)]) == 2
+        err = capsys.readouterr().err
+        assert msg in err and "bad.json" in err
+
+
+def test_binary_pose_file_and_degenerate_second_points(tmp_path, capsys):
+    # a binary file used to end in a UnicodeDecodeError traceback
+    f = tmp_path / "bin.txt"
+    f.write_bytes(b"\xff\xfe\x00")
+    assert main(["screw", "--pose1", str(f), "--pose2", str(f)]) == 2
+    assert "not a text file" in capsys.readouterr().err
+    # degenerate points now say which option holds them
+    assert main(["screw", "--points1", "0,0,0,0,0,1,1,0,0",
+                 "--points2", "0,0,0,0,0,0,1,0,0"]) == 2
+    assert capsys.readouterr().err.startswith("kinestat: error: --points2: points 1 and 2")

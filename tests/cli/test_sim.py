@@ -77,9 +77,27 @@ def test_sim_encoders_streams_counts(capsys):
     (["sim", "encoders", "--format", "xml", "--duration", "0"], "--format"),
     (["sim", "encoders", "--counts", "1,2,3", "--duration", "0"], "--counts"),
     (["sim", "encoders", "--counts", "1.5,2,3,4,5,6", "--duration", "0"], "integers"),
-    (["sim", "encoders", "--rate", "0", "--duration", "0"], "rate_hz"),
+    (["sim", "encoders", "--rate", "0", "--duration", "0"], "--rate"),
     (["sim", "galil", "--initial-counts", "1,2", "--duration", "0"], "--initial-counts"),
 ])
 def test_sim_bad_options(capsys, argv, msg):
     assert main(argv) == 2
     assert msg in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("argv, msg", [
+    # a bad --duration used to be noticed only after the server/emitter had started and
+    # printed its address
+    (["sim", "galil", "--duration", "-1"], "--duration"),
+    (["sim", "encoders", "--duration", "-1"], "--duration"),
+    # counts beyond 32 bits used to start the emitter, warn from NumPy, then fail late
+    (["sim", "encoders", "--counts", "1e30,0,0,0,0,0", "--duration", "0"], "signed 32-bit"),
+    # the Galil simulator took fractional or out-of-range encoder counts
+    (["sim", "galil", "--initial-counts", "1.5,0,0,0,0,0", "--duration", "0"], "integers"),
+    (["sim", "galil", "--initial-counts", "3e9,0,0,0,0,0", "--duration", "0"], "signed 32-bit"),
+])
+def test_sim_options_checked_before_starting(capsys, argv, msg):
+    assert main(argv) == 2
+    out = capsys.readouterr()
+    assert msg in out.err and len(out.err.splitlines()) == 1
+    assert out.out == ""  # nothing was started

@@ -67,3 +67,59 @@ def test_write_is_atomic(tmp_path):
     with pytest.raises(kinestat.KinestatError):
         write_model(Bad(), p)  # type: ignore[arg-type]
     assert p.read_text() == "old"
+
+
+_NAD = ("notation = 'nadkarni'\nframe_points = [[0,0,0],[0,0,1],[1,0,0]]\n"
+        "[[joints]]\nr = 0\nalpha = 0\na = 1\ntheta = 0\n")
+
+
+@pytest.mark.parametrize("text,where", [
+    # pitch on a revolute joint used to turn it silently into a screw (DH notations) or be
+    # dropped (nadkarni); on a prismatic joint it was dropped
+    ("notation = 'standard_dh'\n[[joints]]\npitch = 2.0\n", "joints[1].pitch"),
+    ("notation = 'modified_dh'\n[[joints]]\ntype = 'prismatic'\npitch = 2.0\n",
+     "joints[1].pitch"),
+    (_NAD + "pitch = 2.0\n", "joints[1].pitch"),
+    # keys of another notation used to be ignored without a word
+    ("notation = 'standard_dh'\nframe_points = [[0,0,0],[0,0,1],[1,0,0]]\n[[joints]]\n",
+     "frame_points"),
+    ("notation = 'standard_dh'\n[hand]\nr = 1\n[[joints]]\n", "hand"),
+    ("notation = 'nadkarni'\nq_home = [1.0]\n" + _NAD.split("\n", 1)[1], "q_home"),
+    # a scalar q_home used to escape as a TypeError traceback
+    ("notation = 'standard_dh'\nq_home = 5\n[[joints]]\n", "q_home"),
+    # degenerate frame points: the message lacked the file
+    ("notation = 'nadkarni'\nframe_points = [[0,0,0],[0,0,1],[0,0,2]]\n"
+     "[[joints]]\nr = 0\nalpha = 0\na = 1\ntheta = 0\n", None),
+])
+def test_misplaced_or_malformed_keys_are_refused(text, where):
+    with pytest.raises(ParseError) as exc:
+        loads_model(text, source="bad.toml")
+    assert "bad.toml" in str(exc.value)
+    if where:
+        assert where in str(exc.value)
+
+
+def test_screw_joint_with_pitch_still_reads():
+    m = loads_model("notation = 'standard_dh'\n[[joints]]\ntype = 'screw'\npitch = 2.0\n")
+    T = kinestat.fk(m, [np.pi / 2])
+    np.testing.assert_allclose(T[:3, 3], [0, 0, np.pi], atol=1e-12)  # h q along z
+
+
+def test_binary_file_is_a_parse_error(tmp_path):
+    p = tmp_path / "bin.toml"
+    p.write_bytes(b"\xff\xfe\x00")
+    with pytest.raises(ParseError, match="not a text file"):
+        read_model(p)
+
+
+def test_unwritable_destination_is_an_input_error(tmp_path):
+    from kinestat.errors import InputError
+
+    m = kinestat.load("puma560")
+    with pytest.raises(InputError, match="cannot write model file"):
+        write_model(m, tmp_path / "no" / "such" / "dir" / "m.toml")
+    target = tmp_path / "d"
+    target.mkdir()
+    with pytest.raises(InputError, match="cannot write model file"):
+        write_model(m, target)  # a directory: the temporary file is made beside it
+    assert list(tmp_path.iterdir()) == [target]  # and removed again

@@ -104,3 +104,23 @@ def test_both_forms_or_neither_is_an_error(tmp_path):
         loads_platform("name = ")
     with pytest.raises(ParseError, match="cannot read"):
         read_platform(tmp_path / "missing.toml")
+
+
+def test_binary_file_is_a_parse_error(tmp_path):
+    # used to escape as a UnicodeDecodeError traceback
+    p = tmp_path / "bin.toml"
+    p.write_bytes(b"\xff\xfe\x00")
+    with pytest.raises(ParseError, match="not a text file"):
+        read_platform(p)
+
+
+def test_unwritable_destination_is_an_input_error(tmp_path):
+    from kinestat.errors import InputError
+
+    with pytest.raises(InputError, match="cannot write platform file"):
+        write_platform(prototype(), tmp_path / "missing" / "p.toml")
+    target = tmp_path / "d"
+    target.mkdir()
+    with pytest.raises(InputError, match="cannot write platform file"):
+        write_platform(prototype(), target)  # a directory
+    assert list(tmp_path.iterdir()) == [target]  # the temporary file was removed

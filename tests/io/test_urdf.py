@@ -73,3 +73,14 @@ def test_screw_joint_refused():
     m = from_standard_dh([[0, 0, 0, 0]], ["screw"], pitches=[1.0])
     with pytest.raises(KinestatError, match="screw"):
         to_urdf(m)
+
+
+def test_binary_file_is_a_parse_error(tmp_path):
+    # used to escape as a UnicodeDecodeError traceback
+    from kinestat.errors import ParseError
+    from kinestat.io.urdf import read_urdf
+
+    p = tmp_path / "bin.urdf"
+    p.write_bytes(b"\xff\xfe<robot/>")
+    with pytest.raises(ParseError, match="not UTF-8"):
+        read_urdf(p)

@@ -346,6 +346,9 @@ def test_result_is_read_only():
         ([[0, 0, 1, 1, 0, 1]], "Plücker"),
         ([[0, 0, 0, 1, 0, 0]], "zero Plücker direction"),
         (np.zeros((2, 2, 2, 3)) + [0, 0, 1], "one chain"),
+        # non-numbers used to raise NumPy's bare ValueError
+        ("abc", "array of numbers"),
+        ([[[0, 0, 0], [0, 0, 1]], [[0, 0], [0, 1, 0]]], "array of numbers"),
     ],
 )
 def test_bad_axes_raise_input_error(axes, match):

@@ -232,3 +232,14 @@ def test_thesis_printed_coordinates_still_solve_all_modes():
     assert sol.count == 8
     np.testing.assert_allclose(leg_lengths(q, sol.poses[sol.valid]),
                                np.tile(THESIS_LEGS, (8, 1)), atol=1e-9)
+
+
+def test_absurd_lengths_are_unreachable_without_numpy_warnings():
+    # 1e300 overflowed in the 3-3 reduction and printed a RuntimeWarning before the error
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(UnreachableError, match="no real assembly"):
+            fk_list(prototype(), [1e300] * 6)
+        assert fk_all(prototype(), [1e300] * 6).count == 0

@@ -43,3 +43,21 @@ def test_leg_lengths_invariant_under_common_rigid_motion():
 def test_bad_poses_raise(pose):
     with pytest.raises(InputError):
         leg_lengths(prototype(), pose)
+
+
+def test_non_rigid_pose_messages_say_what_is_wrong():
+    # the message used to list every possible fault at once, with no size and no batch index
+    from kinestat.parallel.legs import as_pose
+
+    p = prototype()
+    T = np.broadcast_to(p.home_pose, (3, 4, 4)).copy()
+    T[1, 0, 1] += 4.4e-5                           # a rotation typed to four digits
+    with pytest.raises(InputError, match=r"at batch index \(1,\): its rotation part") as exc:
+        as_pose(T)
+    R = T[1, :3, :3]
+    reported = float(str(exc.value).split("= ")[1].split()[0])
+    assert reported == pytest.approx(np.abs(R @ R.T - np.eye(3)).max(), rel=0.05)
+    T = p.home_pose.copy()
+    T[3, 2] = 1.0
+    with pytest.raises(InputError, match="its last row must be 0 0 0 1"):
+        leg_lengths(p, T)

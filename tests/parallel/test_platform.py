@@ -122,3 +122,15 @@ def test_platform_validation():
             Platform(**{**good, key: bad})
     with pytest.raises(ModelError):
         Platform(**good, leg_names=("a", "a", "b", "c", "d", "e"))
+
+
+@pytest.mark.parametrize("kwargs, which", [
+    ({"base_side": (1, 1, 3)}, "base_side"),
+    ({"top_side": -60}, "top_side"),
+])
+def test_bad_triangle_names_the_triangle_with_plain_numbers(kwargs, which):
+    # the message used to show "[np.float64(-60.0), ...]" and not say which triangle
+    with pytest.raises(InputError) as exc:
+        special_6_6(**kwargs)
+    msg = str(exc.value)
+    assert msg.startswith(f"{which}: ") and "np.float64" not in msg
