@@ -10,38 +10,17 @@ never loses the cycles that led to it. Read it back with :func:`read_log`.
 from __future__ import annotations
 
 import json
-import math
 import os
 from pathlib import Path
-from typing import Any
-
-import numpy as np
 
 from kinestat.errors import InputError
+from kinestat.io.jsonable import to_jsonable
 
 __all__ = ["CycleLog", "read_log", "jsonable"]
 
 
-def jsonable(obj: Any) -> Any:
-    """Plain-Python copy of ``obj`` (numpy arrays and scalars; inf/nan as strings)."""
-    if isinstance(obj, dict):
-        return {str(k): jsonable(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [jsonable(v) for v in obj]
-    if isinstance(obj, np.ndarray):
-        return jsonable(obj.tolist())
-    if isinstance(obj, np.bool_):
-        return bool(obj)
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, (float, np.floating)):
-        x = float(obj)
-        if math.isnan(x):
-            return "nan"
-        if math.isinf(x):
-            return "inf" if x > 0 else "-inf"
-        return x
-    return obj
+#: kept under its earlier name for the control package
+jsonable = to_jsonable
 
 
 class CycleLog:
