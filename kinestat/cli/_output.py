@@ -51,3 +51,22 @@ def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.nda
     if not np.all(np.isfinite(arr)):
         raise InputError(f"--{name}: values must be finite, got {text!r}")
     return arr
+
+
+def parse_pose(value: str, option: str = "pose", *, allow_batch: bool = False) -> np.ndarray:
+    """A pose option's value: a pose file (JSON, TOML or numbers; :mod:`kinestat.io.posefile`)
+    or 16 comma-separated numbers (a 4x4 matrix, row by row)."""
+    from pathlib import Path
+
+    from kinestat.errors import InputError
+    from kinestat.io.posefile import read_pose_file
+
+    p = Path(value)
+    if p.is_file() or p.suffix.lower() in (".json", ".toml"):
+        if not p.exists():
+            raise InputError(f"--{option}: file {value!r} does not exist")
+        return read_pose_file(p, allow_batch=allow_batch)
+    if "," not in value:
+        raise InputError(f"--{option}: {value!r} is neither a file nor 16 comma-separated "
+                         "numbers (a 4x4 pose, row by row)")
+    return parse_floats(value, 16, option).reshape(4, 4)

@@ -31,6 +31,7 @@ import typer
 
 from kinestat.cli._output import console, print_json, table
 from kinestat.errors import InputError, ParseError
+from kinestat.io.posefile import read_text_file
 
 __all__ = ["register", "read_axes_file", "loads_axes"]
 
@@ -152,14 +153,7 @@ def loads_axes(doc: dict, source: str = "<string>") -> dict:
 def read_axes_file(path: str | Path) -> dict:
     """Read an axes file (``.json`` as JSON, anything else as TOML); see the module docstring."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ParseError(f"cannot read the axes file: {exc.strerror}", file=str(p)) from exc
-    except UnicodeDecodeError as exc:
-        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
-                         f"{exc.start} is not UTF-8); an axes file is TOML or JSON text",
-                         file=str(p)) from exc
+    text = read_text_file(p, "axes file")
     if p.suffix.lower() == ".json":
         try:
             doc = json.loads(text)

@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, parse_floats, print_json, table
+from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, KinestatError
 
 
@@ -17,36 +14,10 @@ def register(app: typer.Typer) -> None:
 
 
 def _read_poses(text: str) -> np.ndarray:
-    """``--pose``: 16 comma-separated numbers (row-major 4x4) or a JSON file holding a 4x4
-    matrix, 16 numbers, a list of 4x4 matrices, or an object with a "pose" key (as written by
-    ``kinestat fk --json``)."""
-    p = Path(text)
-    if text.strip().endswith(".json") or (p.exists() and p.is_file()):
-        if not p.exists():
-            raise InputError(f"--pose: file {text!r} does not exist")
-        try:
-            data = json.loads(p.read_text(encoding="utf-8"))
-        except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-            raise InputError(f"--pose: cannot read {text!r} as JSON: {exc}") from exc
-        if isinstance(data, dict):
-            if "pose" not in data:
-                raise InputError(f"--pose: {text!r} is a JSON object without a \"pose\" key")
-            data = data["pose"]
-        try:
-            arr = np.asarray(data, dtype=float)
-        except (TypeError, ValueError) as exc:
-            raise InputError(f"--pose: {text!r} does not hold numbers in a 4x4 layout") from exc
-        if arr.shape == (16,):
-            arr = arr.reshape(4, 4)
-        if arr.ndim < 2 or arr.shape[-2:] != (4, 4):
-            raise InputError(
-                f"--pose: {text!r} must hold a 4x4 matrix (or a list of them), got shape "
-                f"{arr.shape}"
-            )
-        if not np.all(np.isfinite(arr)):
-            raise InputError(f"--pose: {text!r} contains NaN or infinity")
-        return arr
-    return parse_floats(text, 16, "pose").reshape(4, 4)
+    """``--pose``: 16 comma-separated numbers (row-major 4x4) or a pose file (JSON — a 4x4
+    matrix, 16 numbers, a list of 4x4 matrices, or an object with a "pose" key as written by
+    ``kinestat fk --json`` — TOML, or plain numbers)."""
+    return parse_pose(text, "pose", allow_batch=True)
 
 
 def _deg(x) -> list[float]:

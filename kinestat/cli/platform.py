@@ -9,15 +9,11 @@ origin O0, base frame (see docs/platform.md for the sign conventions).
 
 from __future__ import annotations
 
-import json
-import tomllib
-from pathlib import Path
-
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, parse_floats, print_json, table
-from kinestat.errors import InputError, ParseError, UnreachableError
+from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
+from kinestat.errors import InputError, UnreachableError
 
 PLATFORM_HELP = "TOML platform file (default: the embedded 2011 prototype)."
 POSE_HELP = "'home', a JSON/TOML file holding a 4x4 pose, or 16 comma-separated numbers."
@@ -46,36 +42,7 @@ def _pose(text: str, platform) -> np.ndarray:
 
     if text.strip().lower() == "home":
         return platform.home_pose.copy()
-    p = Path(text)
-    if p.suffix.lower() in (".json", ".toml") or p.exists():
-        try:
-            raw = p.read_text(encoding="utf-8")
-        except OSError as exc:
-            raise ParseError(f"cannot read pose file: {exc.strerror}", file=str(p)) from exc
-        except UnicodeDecodeError as exc:
-            raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
-                             f"{exc.start} is not UTF-8); a pose file is JSON or TOML",
-                             file=str(p)) from exc
-        try:
-            doc = tomllib.loads(raw) if p.suffix.lower() == ".toml" else json.loads(raw)
-        except (tomllib.TOMLDecodeError, json.JSONDecodeError) as exc:
-            raise ParseError(f"not valid {p.suffix[1:].upper() or 'JSON'}: {exc}",
-                             file=str(p)) from exc
-        if isinstance(doc, dict):
-            if "pose" not in doc:
-                raise ParseError("expected a 'pose' key holding a 4x4 array", file=str(p),
-                                 field="pose")
-            doc = doc["pose"]
-        try:
-            T = np.array(doc, dtype=float)
-        except (TypeError, ValueError) as exc:
-            raise ParseError("the pose must be a 4x4 array of numbers", file=str(p),
-                             field="pose") from exc
-        if T.shape != (4, 4):
-            raise ParseError(f"the pose must be 4x4, got shape {T.shape}", file=str(p),
-                             field="pose")
-    else:
-        T = parse_floats(text, 16, "pose").reshape(4, 4)
+    T = parse_pose(text, "pose")
     return as_pose(T, "--pose")
 
 

@@ -2,14 +2,11 @@
 
 from __future__ import annotations
 
-import json
-from pathlib import Path
-
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, parse_floats, print_json, table
-from kinestat.errors import InputError, ParseError
+from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
+from kinestat.errors import InputError
 from kinestat.spatial.displacement import (
     ScrewDisplacement,
     frame_from_triple,
@@ -18,71 +15,8 @@ from kinestat.spatial.displacement import (
 )
 
 
-def _read_json_pose(text: str, path: Path) -> list[float]:
-    """A JSON pose: a 4x4 (or 3x4) array, 16 (or 12) numbers, or ``{"pose": ...}`` (as written
-    by ``kinestat fk --json``)."""
-    try:
-        doc = json.loads(text)
-    except json.JSONDecodeError as exc:
-        raise ParseError(f"not valid JSON: {exc.msg}", file=str(path), line=exc.lineno) from exc
-    if isinstance(doc, dict):
-        if "pose" not in doc:
-            raise ParseError("a JSON object must hold the pose under a \"pose\" key",
-                             file=str(path))
-        doc = doc["pose"]
-    try:
-        arr = np.asarray(doc, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ParseError("the pose must be a 4x4 array of numbers", file=str(path)) from exc
-    if arr.shape not in ((4, 4), (3, 4), (16,), (12,)):
-        raise ParseError(f"the pose must be 4x4 (or its top three rows), got shape {arr.shape}",
-                         file=str(path))
-    return arr.ravel().tolist()
-
-
-def _read_pose_file(path: Path) -> np.ndarray:
-    """Numbers separated by spaces/commas, ``#`` comments; 16 (4x4) or 12 (top 3x4 rows); or
-    JSON (see :func:`_read_json_pose`)."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise InputError(f"cannot read pose file {str(path)!r}: {exc.strerror}") from exc
-    except UnicodeDecodeError as exc:
-        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
-                         f"{exc.start} is not UTF-8)", file=str(path)) from exc
-    if text.lstrip()[:1] in ("{", "["):
-        vals = _read_json_pose(text, path)
-    else:
-        vals = []
-        for lineno, line in enumerate(text.splitlines(), start=1):
-            for tok in line.split("#", 1)[0].replace(",", " ").split():
-                try:
-                    vals.append(float(tok))
-                except ValueError as exc:
-                    raise ParseError(f"{tok!r} is not a number", file=str(path),
-                                     line=lineno) from exc
-    if len(vals) not in (12, 16):
-        raise ParseError(
-            f"expected 16 numbers (a 4x4 pose, row by row) or 12 (its top three rows), "
-            f"got {len(vals)}", file=str(path),
-        )
-    T = np.eye(4)
-    T[: len(vals) // 4] = np.reshape(vals, (-1, 4))
-    if not np.all(np.isfinite(T)):
-        raise ParseError("pose contains NaN or infinity", file=str(path))
-    return T
-
-
 def _pose(value: str, name: str) -> np.ndarray:
-    path = Path(value)
-    if path.is_file():
-        return _read_pose_file(path)
-    if "," not in value:
-        raise InputError(
-            f"--{name}: {value!r} is neither a file nor 16 comma-separated numbers "
-            "(a 4x4 pose, row by row)"
-        )
-    return parse_floats(value, 16, name).reshape(4, 4)
+    return parse_pose(value, name)
 
 
 def _points(value: str, name: str) -> np.ndarray:

@@ -46,6 +46,7 @@ import numpy as np
 import tomli_w
 
 from kinestat.errors import InputError, ModelError, ParseError
+from kinestat.io.posefile import read_text_file
 from kinestat.mechanism.chain import (
     ChainModel,
     from_modified_dh,
@@ -99,16 +100,7 @@ def loads_model(text: str, source: str = "<string>") -> ChainModel:
 
 def read_model(path: str | os.PathLike) -> ChainModel:
     """Read a TOML model file."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ParseError(f"cannot read model file: {exc.strerror}", file=str(p)) from exc
-    except UnicodeDecodeError as exc:
-        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
-                         f"{exc.start} is not UTF-8); a model file is TOML text",
-                         file=str(p)) from exc
-    return loads_model(text, source=str(p))
+    return loads_model(read_text_file(path, "model file"), source=str(Path(path)))
 
 
 def _from_doc(doc: dict, source: str) -> ChainModel:

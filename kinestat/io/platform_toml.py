@@ -53,6 +53,7 @@ import numpy as np
 import tomli_w
 
 from kinestat.errors import InputError, ModelError, ParseError
+from kinestat.io.posefile import read_text_file
 from kinestat.parallel.platform import LEG_NAMES, Platform, special_6_6
 from kinestat.spatial.transforms import apply
 
@@ -115,16 +116,7 @@ def loads_platform(text: str, source: str = "<string>") -> Platform:
 
 def read_platform(path: str | os.PathLike) -> Platform:
     """Read a TOML platform file."""
-    p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ParseError(f"cannot read platform file: {exc.strerror}", file=str(p)) from exc
-    except UnicodeDecodeError as exc:
-        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
-                         f"{exc.start} is not UTF-8); a platform file is TOML text",
-                         file=str(p)) from exc
-    return loads_platform(text, source=str(p))
+    return loads_platform(read_text_file(path, "platform file"), source=str(Path(path)))
 
 
 def _from_doc(doc: dict, source: str) -> Platform:

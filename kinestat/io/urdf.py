@@ -20,6 +20,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from kinestat.errors import ModelError, ParseError
+from kinestat.io.posefile import read_text_file
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import Joint
 
@@ -184,11 +185,5 @@ def from_urdf(
 def read_urdf(path: str | os.PathLike, **kwargs) -> ChainModel:
     """Read a URDF file (see :func:`from_urdf`)."""
     p = Path(path)
-    try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ParseError(f"cannot read URDF: {exc.strerror}", file=str(p)) from exc
-    except UnicodeDecodeError as exc:
-        raise ParseError(f"cannot read URDF: byte {exc.object[exc.start]:#04x} at offset "
-                         f"{exc.start} is not UTF-8 text", file=str(p)) from exc
+    text = read_text_file(p, "URDF file")
     return from_urdf(text, source=str(p), **kwargs)

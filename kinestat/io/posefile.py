@@ -1,0 +1,94 @@
+"""Reading poses given on the command line or in files, the same way for every command.
+
+A pose argument is one of:
+
+- 16 comma-separated numbers: a 4x4 homogeneous matrix, row by row;
+- a file of numbers (spaces or commas, ``#`` comments): 16 (4x4) or 12 (its top three rows);
+- a JSON file: a 4x4 array, 16 or 12 numbers, an object with a ``"pose"`` key (what
+  ``kinestat fk --json`` writes), or — where a command takes several — a list of 4x4 arrays;
+- a TOML file with ``pose = [[…], […], […], […]]``.
+
+Content errors raise :class:`~kinestat.errors.ParseError` naming the file (and line where
+known); :func:`kinestat.cli._output.parse_pose` handles a command-line value (a file or 16
+numbers). Rigidity is checked by the caller (each command knows its tolerance).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tomllib
+from pathlib import Path
+
+import numpy as np
+
+from kinestat.errors import ParseError
+
+__all__ = ["read_text_file", "pose_from_document", "read_pose_file"]
+
+
+def read_text_file(path: str | os.PathLike, what: str = "file") -> str:
+    """The UTF-8 text of ``path``; unreadable or binary files raise a ParseError naming it."""
+    p = Path(path)
+    try:
+        return p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ParseError(f"cannot read the {what}: {exc.strerror}", file=str(p)) from exc
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
+                         f"{exc.start} is not UTF-8); a {what} is text", file=str(p)) from exc
+
+
+def pose_from_document(doc, source: str, *, allow_batch: bool = False) -> np.ndarray:
+    """A pose ``(4, 4)`` (or ``(N, 4, 4)`` with ``allow_batch``) from parsed JSON/TOML data."""
+    if isinstance(doc, dict):
+        if "pose" not in doc:
+            raise ParseError('expected a "pose" key holding a 4x4 array', file=source,
+                             field="pose")
+        doc = doc["pose"]
+    try:
+        arr = np.asarray(doc, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise ParseError("the pose must be a 4x4 array of numbers", file=source) from exc
+    if arr.shape in ((16,), (12,)):
+        arr = arr.reshape(-1, 4)
+    if arr.shape == (3, 4):
+        arr = np.vstack([arr, [0.0, 0.0, 0.0, 1.0]])
+    ok = arr.shape == (4, 4) or (allow_batch and arr.ndim == 3 and arr.shape[1:] == (4, 4))
+    if not ok:
+        many = " (or a list of them)" if allow_batch else ""
+        raise ParseError(f"the pose must be a 4x4 array{many}, got shape {arr.shape}",
+                         file=source)
+    if not np.all(np.isfinite(arr)):
+        raise ParseError("the pose contains NaN or infinity", file=source)
+    return arr
+
+
+def read_pose_file(path: str | os.PathLike, *, allow_batch: bool = False) -> np.ndarray:
+    """Read a pose file (JSON, TOML or plain numbers; see the module docstring)."""
+    p = Path(path)
+    text = read_text_file(p, "pose file")
+    suffix = p.suffix.lower()
+    if suffix == ".toml":
+        try:
+            doc = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            raise ParseError(f"not valid TOML: {exc}", file=str(p)) from exc
+        return pose_from_document(doc, str(p), allow_batch=allow_batch)
+    if suffix == ".json" or text.lstrip()[:1] in ("{", "["):
+        try:
+            doc = json.loads(text)
+        except json.JSONDecodeError as exc:
+            raise ParseError(f"not valid JSON: {exc.msg}", file=str(p), line=exc.lineno) from exc
+        return pose_from_document(doc, str(p), allow_batch=allow_batch)
+    vals = []
+    for lineno, line in enumerate(text.splitlines(), start=1):
+        for tok in line.split("#", 1)[0].replace(",", " ").split():
+            try:
+                vals.append(float(tok))
+            except ValueError as exc:
+                raise ParseError(f"{tok!r} is not a number", file=str(p), line=lineno) from exc
+    if len(vals) not in (12, 16):
+        raise ParseError(f"expected 16 numbers (a 4x4 pose, row by row) or 12 (its top three "
+                         f"rows), got {len(vals)}", file=str(p))
+    return pose_from_document(vals, str(p))
