@@ -150,7 +150,8 @@ def _pose_distance(a: np.ndarray, b: np.ndarray, scale: float) -> np.ndarray:
     return np.maximum(dr, dp)
 
 
-def fk_all(platform: Platform, lengths, *, tol: float = 1e-9, polish: int = 4) -> FKSolutions:
+def fk_all(platform: Platform, lengths, *, tol: float = 1e-9, polish: int = 4,
+           backend: str = "numba") -> FKSolutions:
     """Every real assembly mode of a special 6-6 platform, batched over leg-length sets.
 
     Args:
@@ -161,9 +162,19 @@ def fk_all(platform: Platform, lengths, *, tol: float = 1e-9, polish: int = 4) -
         polish: at most this many Newton steps on the six real legs, for closed-form poses
             whose legs are off by more than ``tol / 10``.
 
+        backend: ``"numba"`` (default) runs the compiled kernel of
+            :mod:`kinestat.parallel._fk_kernels`; ``"numpy"`` this reference implementation.
+            Both find the same modes (the order of the pairs may differ).
+
     Returns:
         :class:`FKSolutions` with up to 16 modes per set (mirror pairs in slots 2i, 2i+1).
     """
+    if backend == "numba":
+        from kinestat.parallel._fk_kernels import fk_all_fast
+
+        return fk_all_fast(platform, lengths, tol=tol, polish=polish)
+    if backend != "numpy":
+        raise InputError(f"backend must be 'numba' or 'numpy', got {backend!r}")
     L = check_lengths(lengths)
     lay = _layout(platform)
     sq = _reduce_sq(platform, L)

@@ -16,15 +16,19 @@ turns into its limits; a prismatic joint is only clipped). A start that stalls �
 falling, or the iteration budget of one attempt is spent — is restarted from a random
 configuration within the limits.
 
-All targets iterate together (vectorised over the batch; converged ones drop out). Success is
-decided from the final forward kinematics only: the position error is at most ``pos_tol``, the
-rotation error at most ``rot_tol`` and the configuration is within the limits. There are no
-false successes.
+By default each target iterates in compiled code (:mod:`kinestat.serial._ik_kernels`), all
+targets in parallel; ``backend="numpy"`` runs the plain array reference, where all targets
+iterate together (vectorised over the batch; converged ones drop out). Success is decided from
+the final forward kinematics only: the position error is at most ``pos_tol``, the rotation
+error at most ``rot_tol`` and the configuration is within the limits. There are no false
+successes.
 """
 
 from __future__ import annotations
 
 import math
+import weakref
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
@@ -32,12 +36,15 @@ from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.fk import fk, fk_frames
+from kinestat.serial import _ik_kernels as _K
+from kinestat.serial.fk import CHUNK_ROWS, fk, fk_frames
 from kinestat.serial.jacobian import jacobian_from_frames
 
 __all__ = [
     "IKResult",
     "ik",
+    "iter_ik",
+    "BACKENDS",
     "pose_error",
     "rotation_log",
     "model_scale",
@@ -207,6 +214,64 @@ def damped_step(model: ChainModel, frames: np.ndarray, e: np.ndarray, mu: np.nda
     return np.linalg.solve(A, g[..., None])[..., 0] * D
 
 
+BACKENDS = ("numba", "numpy")
+"""Implementations of :func:`ik`: ``"numba"`` (compiled, every target in parallel,
+:mod:`kinestat.serial._ik_kernels`; the default) and ``"numpy"`` (the plain array reference,
+all targets iterating together)."""
+
+_PARALLEL_MIN = 8  # fewer targets run on one thread (starting the workers costs more)
+
+# per-model constants of the compiled path: (L, lower, upper), computed once per model
+_MODEL_ARGS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _model_args(model: ChainModel) -> tuple[float, np.ndarray, np.ndarray]:
+    args = _MODEL_ARGS.get(model)
+    if args is None:
+        args = (model_scale(model), np.ascontiguousarray(model.lower, dtype=float),
+                np.ascontiguousarray(model.upper, dtype=float))
+        _MODEL_ARGS[model] = args
+    return args
+
+
+def _poses_compiled(poses) -> np.ndarray:
+    """:func:`_check_poses`' checks by the compiled validator; the poses as ``(*B, 4, 4)``
+    (the projection onto the nearest rotation happens per target inside the solver)."""
+    try:
+        T = np.asarray(poses, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"target poses must be numbers of shape (..., 4, 4): {exc}") from exc
+    if T.ndim < 2 or T.shape[-2:] != (4, 4):
+        raise InputError(f"target poses must have shape (..., 4, 4), got {T.shape}")
+    code, k = _K.validate_poses(np.ascontiguousarray(T.reshape(-1, 4, 4)))
+    if code == _K.POSE_NONFINITE:
+        raise InputError("target poses contain NaN or infinity")
+    if code == _K.POSE_NOT_RIGID:
+        shape = T.shape[:-2]
+        where = f" (pose {tuple(int(i) for i in np.unravel_index(k, shape))})" if shape else ""
+        raise InputError(
+            f"target pose{where} is not a rigid transform: its rotation part is not orthonormal "
+            "with determinant +1"
+        )
+    if code == _K.POSE_LAST_ROW:
+        raise InputError("target poses must have last row [0, 0, 0, 1]")
+    return T
+
+
+def _seed_key(seed) -> np.uint64:
+    """The 64-bit key of the compiled path's random streams."""
+    if seed is None:
+        return np.uint64(np.random.SeedSequence().entropy % (1 << 64))
+    if isinstance(seed, (int, np.integer)) and not isinstance(seed, bool):
+        if seed < 0:
+            raise InputError(f"seed must be a non-negative integer or None, got {seed}")
+        return np.uint64(int(seed) % (1 << 64))
+    try:
+        return np.random.default_rng(seed).integers(0, 1 << 64, dtype=np.uint64)
+    except (TypeError, ValueError) as exc:
+        raise InputError(f"seed must be a non-negative integer or None, got {seed!r}") from exc
+
+
 def ik(
     model: ChainModel,
     poses,
@@ -218,6 +283,7 @@ def ik(
     restarts: int = 20,
     seed: int | None = 0,
     respect_limits: bool = True,
+    backend: str = "numba",
 ) -> IKResult:
     """Inverse kinematics of ``model`` for target end poses ``(*B, 4, 4)`` (or one ``(4, 4)``).
 
@@ -235,17 +301,27 @@ def ik(
         seed: seed of the random restarts (deterministic by default).
         respect_limits: keep every iterate within the joint limits (and judge success with
             them); False ignores the limits.
+        backend: ``"numba"`` (compiled; each target iterates on its own, all in parallel, and
+            draws its restarts from a random stream keyed by ``seed`` and its index) or
+            ``"numpy"`` (the plain array reference, one shared random generator). The same
+            algorithm; answers can differ only where restarts were needed.
 
-    Returns an :class:`IKResult`.
+    Returns an :class:`IKResult`. The compiled path needs no memory beyond its inputs and
+    outputs; :func:`iter_ik` streams the results of very large batches chunk by chunk.
     """
     if not isinstance(model, ChainModel):
         raise InputError(f"model must be a ChainModel (use kinestat.load), got {type(model)!r}")
-    Tt = _check_poses(poses)
+    if backend not in BACKENDS:
+        raise InputError(f"backend must be one of {BACKENDS}, got {backend!r}")
+    Tt = _check_poses(poses) if backend == "numpy" else _poses_compiled(poses)
     shape = Tt.shape[:-2]
     n = model.n
     if max_iter < 1 or restarts < 0:
         raise InputError("max_iter must be at least 1 and restarts non-negative")
-    L = model_scale(model)
+    if backend == "numpy":
+        L = model_scale(model)
+    else:
+        L, lo, hi = _model_args(model)
     if pos_tol is None:
         pos_tol = 1e-9 * L
     if not (pos_tol > 0 and rot_tol > 0):
@@ -254,14 +330,127 @@ def ik(
         q0 = model.q_home
     q0 = model.check_q(q0, "q0")
     try:
-        qs = np.broadcast_to(q0, shape + (n,)).reshape(-1, n).astype(float)
+        qs = np.broadcast_to(q0, shape + (n,))
     except ValueError as exc:
         raise InputError(
             f"q0 of shape {q0.shape} does not match {int(np.prod(shape))} poses of shape {shape}"
         ) from exc
+    if backend == "numpy":
+        return _ik_numpy(model, Tt, qs, shape, L, pos_tol, rot_tol, max_iter, restarts, seed,
+                         respect_limits)
+    Q0 = np.ascontiguousarray(q0[None] if q0.ndim == 1 else qs.reshape(-1, n))
+    Tf = np.ascontiguousarray(Tt.reshape(-1, 4, 4))
+    return _ik_compiled(model, Tf, Q0, shape, L, lo, hi, float(pos_tol), float(rot_tol),
+                        int(max_iter), int(restarts), _seed_key(seed), bool(respect_limits), 0)
+
+
+def _ik_compiled(model: ChainModel, Tf: np.ndarray, Q0: np.ndarray, shape: tuple, L: float,
+                 lo: np.ndarray, hi: np.ndarray, pos_tol: float, rot_tol: float, max_iter: int,
+                 restarts: int, key: np.uint64, limits: bool, offset: int) -> IKResult:
+    N = Tf.shape[0]
+    n = model.n
+    q = np.empty((N, n))
+    ok = np.empty(N, dtype=bool)
+    pos = np.empty(N)
+    rot = np.empty(N)
+    its = np.empty(N, dtype=np.int64)
+    att = np.empty(N, dtype=np.int64)
+    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
+    kernel = _K.ik_batch if N >= _PARALLEL_MIN else _K.ik_serial
+    kernel(C, kinds, pitch, lo, hi, Q0, Tf, L, pos_tol, rot_tol, max_iter, restarts, limits,
+           key, offset, q, ok, pos, rot, its, att)
+    return IKResult(q=q.reshape(shape + (n,)), success=ok.reshape(shape),
+                    position_error=pos.reshape(shape), rotation_error=rot.reshape(shape),
+                    iterations=its.reshape(shape), attempts=att.reshape(shape))
+
+
+def iter_ik(model: ChainModel, poses, q0=None, *, chunk_rows: int = CHUNK_ROWS,
+            **options) -> Iterator[tuple[slice, IKResult]]:
+    """Stream :func:`ik` over a large batch of targets ``(N, 4, 4)`` chunk by chunk: yields
+    ``(rows, result)`` so that 10^7 targets need only one chunk of results at a time.
+
+    ``q0`` is ``(n,)`` or ``(N, n)``; ``options`` are :func:`ik`'s keywords. With the compiled
+    backend each target keeps its own random stream, so the chunks give exactly the answers of
+    one call on the whole batch.
+    """
+    if chunk_rows < 1:
+        raise InputError(f"chunk_rows must be at least 1, got {chunk_rows}")
+    if not isinstance(model, ChainModel):
+        raise InputError(f"model must be a ChainModel (use kinestat.load), got {type(model)!r}")
+    T = np.asarray(poses, dtype=float)
+    if T.ndim < 2 or T.shape[-2:] != (4, 4):
+        raise InputError(f"target poses must have shape (..., 4, 4), got {T.shape}")
+    Tf = T.reshape(-1, 4, 4)
+    N = Tf.shape[0]
+    q0a = None if q0 is None else model.check_q(q0, "q0")
+    if q0a is not None and q0a.ndim > 1:
+        try:
+            q0a = np.broadcast_to(q0a, T.shape[:-2] + (model.n,)).reshape(-1, model.n)
+        except ValueError as exc:
+            raise InputError(f"q0 of shape {q0a.shape} does not match {N} poses of shape "
+                             f"{T.shape[:-2]}") from exc
+    backend = options.get("backend", "numba")
+    seed = options.pop("seed", 0)
+    key = _seed_key(seed) if backend == "numba" else None
+    for start in range(0, N, chunk_rows):
+        rows = slice(start, min(start + chunk_rows, N))
+        q0c = q0a if q0a is None or q0a.ndim == 1 else q0a[rows]
+        if backend == "numba":
+            yield rows, _ik_chunk(model, Tf[rows], q0c, key, start, **options)
+        else:
+            yield rows, ik(model, Tf[rows], q0c, seed=seed, **options)
+
+
+def _ik_chunk(model: ChainModel, T: np.ndarray, q0, key: np.uint64, offset: int, *,
+              pos_tol: float | None = None, rot_tol: float = 1e-9, max_iter: int = 100,
+              restarts: int = 20, respect_limits: bool = True,
+              backend: str = "numba") -> IKResult:
+    """One chunk of :func:`iter_ik` (compiled path, random streams offset by ``offset``)."""
+    Tt = _poses_compiled(T)
+    if max_iter < 1 or restarts < 0:
+        raise InputError("max_iter must be at least 1 and restarts non-negative")
+    L, lo, hi = _model_args(model)
+    if pos_tol is None:
+        pos_tol = 1e-9 * L
+    if not (pos_tol > 0 and rot_tol > 0):
+        raise InputError("pos_tol and rot_tol must be positive")
+    q0 = model.check_q(model.q_home if q0 is None else q0, "q0")
+    Q0 = np.ascontiguousarray(q0[None] if q0.ndim == 1 else q0)
+    return _ik_compiled(model, np.ascontiguousarray(Tt), Q0, Tt.shape[:-2], L, lo, hi,
+                        float(pos_tol), float(rot_tol), int(max_iter), int(restarts), key,
+                        bool(respect_limits), offset)
+
+
+def _ik_numpy(model: ChainModel, Tt: np.ndarray, qs: np.ndarray, shape: tuple, L: float,
+              pos_tol: float, rot_tol: float, max_iter: int, restarts: int, seed,
+              respect_limits: bool) -> IKResult:
+    """The plain NumPy reference: all targets iterate together, in chunks of
+    :data:`~kinestat.serial.fk.CHUNK_ROWS` targets (bounded temporaries)."""
+    n = model.n
+    qs = qs.reshape(-1, n).astype(float)
     Tt = Tt.reshape(-1, 4, 4)
     N = Tt.shape[0]
     rng = np.random.default_rng(seed)
+    parts = [_lm_numpy(model, Tt[s:s + CHUNK_ROWS], qs[s:s + CHUNK_ROWS], L, pos_tol, rot_tol,
+                       max_iter, restarts, rng, respect_limits)
+             for s in range(0, max(N, 1), CHUNK_ROWS)]
+    q_out, ok, pos, rot, it_total, attempts = (np.concatenate(a) for a in zip(*parts,
+                                                                               strict=True))
+    return IKResult(
+        q=q_out.reshape(shape + (n,)),
+        success=ok.reshape(shape),
+        position_error=pos.reshape(shape),
+        rotation_error=rot.reshape(shape),
+        iterations=it_total.reshape(shape),
+        attempts=attempts.reshape(shape),
+    )
+
+
+def _lm_numpy(model: ChainModel, Tt: np.ndarray, qs: np.ndarray, L: float, pos_tol: float,
+              rot_tol: float, max_iter: int, restarts: int, rng: np.random.Generator,
+              respect_limits: bool):
+    """Levenberg–Marquardt with restarts, vectorised over the targets ``Tt (N, 4, 4)``."""
+    N = Tt.shape[0]
     if respect_limits:
         project = lambda q, ref: wrap_joints(model, q, ref)  # noqa: E731
     else:
@@ -334,11 +523,4 @@ def ik(
     ok = (pos <= pos_tol) & (rot <= rot_tol)
     if respect_limits:
         ok &= model.within_limits(q_out)
-    return IKResult(
-        q=q_out.reshape(shape + (n,)),
-        success=ok.reshape(shape),
-        position_error=pos.reshape(shape),
-        rotation_error=rot.reshape(shape),
-        iterations=it_total.reshape(shape),
-        attempts=attempts.reshape(shape),
-    )
+    return q_out, ok, pos, rot, it_total, attempts

@@ -29,11 +29,13 @@ axis angles (:data:`AXIS_LIMITS_DEG`).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import numpy as np
 
 from kinestat.errors import InputError, JointLimitError, UnreachableError
+from kinestat.serial import _puma762_kernels as _pk
 
 __all__ = [
     "A23",
@@ -64,6 +66,9 @@ __all__ = [
     "reverse",
     "reverse_pose",
     "reverse_batch_pose",
+    "iter_reverse_batch_pose",
+    "BACKENDS",
+    "CHUNK_ROWS",
     "pose_residuals",
     "to_axis_angles",
     "from_axis_angles",
@@ -117,6 +122,16 @@ AXIS_LIMITS_DEG = AXIS_LIMITS_MATLAB_DEG
 Table 2-1's ±110°) and the ones the thesis's controller actually enforced."""
 
 N_BRANCHES = 8
+
+BACKENDS = ("numba", "numpy")
+"""Implementations of the reverse analysis: ``"numba"`` (compiled kernels,
+:mod:`kinestat.serial._puma762_kernels`, the default) and ``"numpy"`` (the plain array reference
+they are tested against)."""
+
+CHUNK_ROWS = 1 << 15
+"""Poses per chunk of the NumPy reference and of :func:`iter_reverse_batch_pose`."""
+
+_PARALLEL_MIN = 64  # smaller batches run on one thread (starting the workers costs more)
 
 STATUS_OK = 0
 STATUS_INSIDE_CYLINDER = 1
@@ -246,50 +261,55 @@ def forward(q, tool_point_6=(0.0, 0.0, 0.0)) -> ForwardResult:
 
 
 # -- the end effector as a frame ----------------------------------------------------------------
+def _frame6_message(code: int, bad: float, tol: float) -> str:
+    """The words of :func:`frame6`'s input errors (codes of :mod:`._puma762_kernels`)."""
+    if code == _pk.ERR_NONFINITE_P:
+        return "tool_point (P_tool_F) contains NaN or infinity"
+    if code == _pk.ERR_NONFINITE_Z:
+        return "s6 (S6_F) contains NaN or infinity"
+    if code == _pk.ERR_NONFINITE_X:
+        return "a67 (a67_F) contains NaN or infinity"
+    if code == _pk.ERR_NONFINITE_P6:
+        return "tool_point_6 (P_tool_6) contains NaN or infinity"
+    if code == _pk.ERR_Z_NOT_UNIT:
+        return (f"s6 (S6_F) must be a unit vector: |S6_F| differs from 1 by {bad:.3g} "
+                f"(tolerance {tol:g}); normalise it first")
+    if code == _pk.ERR_X_NOT_UNIT:
+        return (f"a67 (a67_F) must be a unit vector: |a67_F| differs from 1 by {bad:.3g} "
+                f"(tolerance {tol:g}); normalise it first")
+    if code == _pk.ERR_NOT_PERPENDICULAR:
+        return (f"s6 (S6_F) and a67 (a67_F) must be perpendicular: S6_F·a67_F = {bad:.3g} "
+                f"(tolerance {tol:g})")
+    return "pose must be a finite rigid transform (orthonormal rotation, det +1)"
+
+
 def frame6(tool_point, s6, a67, tool_point_6=(0.0, 0.0, 0.0), *, tol: float = 1e-6) -> np.ndarray:
     """Pose of frame 6 ``(..., 4, 4)`` from the thesis's description of the end effector.
 
     ``S6_F`` and ``a67_F`` must be unit vectors and perpendicular to within ``tol``; they are
     then re-orthonormalised (Gram–Schmidt) so that the frame is exactly a rotation. The origin is
-    ``P_tool_F − R · P_tool_6``.
+    ``P_tool_F − R · P_tool_6``. The inputs broadcast against each other.
     """
     p = _check_vec3(tool_point, "tool_point (P_tool_F)")
     z = _check_vec3(s6, "s6 (S6_F)")
     x = _check_vec3(a67, "a67 (a67_F)")
     p6 = _check_vec3(tool_point_6, "tool_point_6 (P_tool_6)")
-    nz = np.linalg.norm(z, axis=-1)
-    nx = np.linalg.norm(x, axis=-1)
-    if np.any(np.abs(nz - 1.0) > tol):
-        bad = np.max(np.abs(nz - 1.0))
+    try:
+        shape = np.broadcast_shapes(p.shape, z.shape, x.shape, p6.shape)[:-1]
+    except ValueError as exc:
         raise InputError(
-            f"s6 (S6_F) must be a unit vector: |S6_F| differs from 1 by {bad:.3g} "
-            f"(tolerance {tol:g}); normalise it first"
-        )
-    if np.any(np.abs(nx - 1.0) > tol):
-        bad = np.max(np.abs(nx - 1.0))
-        raise InputError(
-            f"a67 (a67_F) must be a unit vector: |a67_F| differs from 1 by {bad:.3g} "
-            f"(tolerance {tol:g}); normalise it first"
-        )
-    dot = np.sum(z * x, axis=-1)
-    if np.any(np.abs(dot) > tol):
-        bad = np.max(np.abs(dot))
-        raise InputError(
-            f"s6 (S6_F) and a67 (a67_F) must be perpendicular: S6_F·a67_F = {bad:.3g} "
-            f"(tolerance {tol:g})"
-        )
-    z = z / nz[..., None]
-    x = x - np.sum(z * x, axis=-1)[..., None] * z
-    x = x / np.linalg.norm(x, axis=-1)[..., None]
-    y = np.cross(z, x)
-    shape = np.broadcast_shapes(p.shape, z.shape, x.shape, p6.shape)[:-1]
-    T = np.zeros(shape + (4, 4))
-    T[..., :3, 0] = x
-    T[..., :3, 1] = y
-    T[..., :3, 2] = z
-    T[..., :3, 3] = p - np.einsum("...ij,...j->...i", T[..., :3, :3], p6)
-    T[..., 3, 3] = 1.0
-    return T
+            f"tool_point {p.shape}, s6 {z.shape}, a67 {x.shape} and tool_point_6 {p6.shape} "
+            "do not broadcast to one batch of poses"
+        ) from exc
+    rows = [np.ascontiguousarray(np.broadcast_to(v, shape + (3,)).reshape(-1, 3))
+            for v in (p, z, x, p6)]
+    T = np.empty((rows[0].shape[0], 4, 4))
+    dz, dx, dd = _pk.frame6_rows(*rows, T)
+    for code, dev in ((_pk.ERR_Z_NOT_UNIT, dz), (_pk.ERR_X_NOT_UNIT, dx),
+                      (_pk.ERR_NOT_PERPENDICULAR, dd)):
+        if dev > tol:
+            raise InputError(_frame6_message(code, dev, tol))
+    return T.reshape(shape + (4, 4))
 
 
 def wrist_center(pose6) -> np.ndarray:
@@ -534,6 +554,11 @@ def _reverse_kernel(T: np.ndarray, tol: float, s5_tol: float):
     return q, sing, fam_sum, fam_val, status
 
 
+def _check_backend(backend: str) -> None:
+    if backend not in BACKENDS:
+        raise InputError(f"backend must be one of {BACKENDS}, got {backend!r}")
+
+
 def reverse_batch(
     tool_point,
     s6,
@@ -544,6 +569,7 @@ def reverse_batch(
     tol: float = 1e-9,
     unit_tol: float = 1e-6,
     s5_tol: float = 1e-10,
+    backend: str = "numba",
 ) -> ReverseBatch:
     """Reverse analysis of a batch of end-effector descriptions, all eight branches.
 
@@ -556,25 +582,18 @@ def reverse_batch(
         tol: reach tolerance (a wrist centre up to ``tol`` mm outside the workspace is clamped onto
             its boundary) and verification tolerance.
         s5_tol: |sin θ5| below which a branch is reported as a wrist-singular family.
+        backend: ``"numba"`` (compiled, parallel over the poses) or ``"numpy"`` (the plain
+            array reference); both give the same results.
 
-    Pure array arithmetic over the batch (no Python loop over poses). See :class:`ReverseBatch`.
+    No Python loop over poses. See :class:`ReverseBatch`.
     """
+    _check_backend(backend)
     T = frame6(tool_point, s6, a67, tool_point_6, tol=unit_tol)
-    return reverse_batch_pose(T, verify=verify, tol=tol, s5_tol=s5_tol)
+    return reverse_batch_pose(T, verify=verify, tol=tol, s5_tol=s5_tol, backend=backend)
 
 
-def reverse_batch_pose(pose6, *, verify: bool = True, tol: float = 1e-9,
-                       s5_tol: float = 1e-10) -> ReverseBatch:
-    """:func:`reverse_batch` for poses of frame 6 ``(*B, 4, 4)`` given directly.
-
-    The poses must be rigid transforms; only their finiteness is checked here (this is the
-    fast path). A rotation part that is not orthonormal fails the verification.
-    """
-    T = np.asarray(pose6, dtype=float)
-    if T.ndim < 2 or T.shape[-2:] != (4, 4):
-        raise InputError(f"poses must have shape (..., 4, 4), got {T.shape}")
-    if not np.all(np.isfinite(T)):
-        raise InputError("poses contain NaN or infinity")
+def _reverse_numpy(T: np.ndarray, verify: bool, tol: float, s5_tol: float):
+    """The plain array reference: :func:`_reverse_kernel` and :func:`pose_residuals`."""
     q, sing, fam_sum, fam_val, status = _reverse_kernel(T, tol, s5_tol)
     valid = np.broadcast_to((status == STATUS_OK)[..., None], sing.shape).copy()
     if verify:
@@ -586,9 +605,72 @@ def reverse_batch_pose(pose6, *, verify: bool = True, tol: float = 1e-9,
     q = np.where(valid[..., None], q, np.nan)
     sing = sing & valid
     fam_val = np.where(sing, fam_val, np.nan)
-    return ReverseBatch(q=q, valid=valid, singular=sing, family_sum=fam_sum & sing,
-                        family_value=fam_val, status=status, position_error=pe,
-                        rotation_error=re, verified=verify)
+    return q, valid, sing, fam_sum & sing, fam_val, status, pe, re
+
+
+def reverse_batch_pose(pose6, *, verify: bool = True, tol: float = 1e-9,
+                       s5_tol: float = 1e-10, backend: str = "numba") -> ReverseBatch:
+    """:func:`reverse_batch` for poses of frame 6 ``(*B, 4, 4)`` given directly.
+
+    The poses must be rigid transforms; only their finiteness is checked here (this is the
+    fast path). A rotation part that is not orthonormal fails the verification. Memory: the
+    compiled path needs nothing beyond its outputs (about 0.5 kB per pose); the NumPy reference
+    works in chunks of :data:`CHUNK_ROWS` poses. :func:`iter_reverse_batch_pose` streams the
+    results of very large batches chunk by chunk.
+    """
+    _check_backend(backend)
+    T = np.asarray(pose6, dtype=float)
+    if T.ndim < 2 or T.shape[-2:] != (4, 4):
+        raise InputError(f"poses must have shape (..., 4, 4), got {T.shape}")
+    shape = T.shape[:-2]
+    Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
+    N = Tf.shape[0]
+    q = np.empty((N, N_BRANCHES, 6))
+    valid = np.empty((N, N_BRANCHES), dtype=bool)
+    sing = np.empty((N, N_BRANCHES), dtype=bool)
+    fsum = np.empty((N, N_BRANCHES), dtype=bool)
+    fval = np.empty((N, N_BRANCHES))
+    status = np.empty(N, dtype=np.int8)
+    pe = np.empty((N, N_BRANCHES))
+    re = np.empty((N, N_BRANCHES))
+    outs = (q, valid, sing, fsum, fval, status, pe, re)
+    if backend == "numba":
+        kernel = _pk.reverse_batch if N >= _PARALLEL_MIN else _pk.reverse_serial
+        if kernel(Tf, float(tol), float(s5_tol), bool(verify), *outs):
+            raise InputError("poses contain NaN or infinity")
+    else:
+        if not np.all(np.isfinite(Tf)):
+            raise InputError("poses contain NaN or infinity")
+        for start in range(0, N, CHUNK_ROWS):
+            rows = slice(start, start + CHUNK_ROWS)
+            for out, part in zip(outs, _reverse_numpy(Tf[rows], verify, tol, s5_tol),
+                                 strict=True):
+                out[rows] = part
+    return ReverseBatch(q=q.reshape(shape + (N_BRANCHES, 6)),
+                        valid=valid.reshape(shape + (N_BRANCHES,)),
+                        singular=sing.reshape(shape + (N_BRANCHES,)),
+                        family_sum=fsum.reshape(shape + (N_BRANCHES,)),
+                        family_value=fval.reshape(shape + (N_BRANCHES,)),
+                        status=status.reshape(shape),
+                        position_error=pe.reshape(shape + (N_BRANCHES,)),
+                        rotation_error=re.reshape(shape + (N_BRANCHES,)), verified=bool(verify))
+
+
+def iter_reverse_batch_pose(pose6, *, chunk_rows: int = CHUNK_ROWS, verify: bool = True,
+                            tol: float = 1e-9, s5_tol: float = 1e-10,
+                            backend: str = "numba") -> Iterator[tuple[slice, ReverseBatch]]:
+    """Stream :func:`reverse_batch_pose` over a large batch ``(N, 4, 4)`` chunk by chunk:
+    yields ``(rows, batch)`` so that 10^7 poses need only one chunk of results at a time."""
+    T = np.asarray(pose6, dtype=float)
+    if T.ndim < 2 or T.shape[-2:] != (4, 4):
+        raise InputError(f"poses must have shape (..., 4, 4), got {T.shape}")
+    if chunk_rows < 1:
+        raise InputError(f"chunk_rows must be at least 1, got {chunk_rows}")
+    Tf = T.reshape(-1, 4, 4)
+    for start in range(0, Tf.shape[0], chunk_rows):
+        rows = slice(start, min(start + chunk_rows, Tf.shape[0]))
+        yield rows, reverse_batch_pose(Tf[rows], verify=verify, tol=tol, s5_tol=s5_tol,
+                                       backend=backend)
 
 
 # -- reverse analysis for one pose: solutions, families, reasons ----------------------------------
@@ -638,6 +720,17 @@ def _same_angles(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
     return bool(np.all(np.abs(_wrap(a - b)) <= tol))
 
 
+def _single_vec3(v, name: str) -> np.ndarray:
+    try:
+        a = np.asarray(v, dtype=np.float64)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or a.shape != (3,):
+        raise InputError(f"{name} must be 3 numbers for a single pose, got shape "
+                         f"{np.shape(v)}; use reverse_batch for many poses")
+    return a
+
+
 def reverse(
     tool_point,
     s6,
@@ -647,44 +740,117 @@ def reverse(
     tol: float = 1e-9,
     unit_tol: float = 1e-6,
     s5_tol: float = 1e-10,
+    backend: str = "numba",
 ) -> ReverseResult:
     """Closed-form reverse analysis of one pose: every isolated solution and singular family.
 
     Each returned solution reproduces the pose under :func:`forward` within ``tol``. Raises
     :class:`UnreachableError` (saying which step has no real solution) when there is none.
+    ``backend="numpy"`` runs the plain array reference instead of the compiled kernel.
     """
-    for name, v in (("tool_point", tool_point), ("s6", s6), ("a67", a67),
-                    ("tool_point_6", tool_point_6)):
-        if np.shape(v) != (3,):
-            raise InputError(f"{name} must be 3 numbers for a single pose, got shape "
-                             f"{np.shape(v)}; use reverse_batch for many poses")
-    T = frame6(tool_point, s6, a67, tool_point_6, tol=unit_tol)
-    return _reverse_one(T, tol=tol, s5_tol=s5_tol)
+    p = _single_vec3(tool_point, "tool_point")
+    z = _single_vec3(s6, "s6")
+    x = _single_vec3(a67, "a67")
+    p6 = _single_vec3(tool_point_6, "tool_point_6")
+    if backend == "numba":
+        return _result_one(_pk.reverse_vectors_one(p, z, x, p6, float(unit_tol), float(tol),
+                                                   float(s5_tol)), tol, unit_tol)
+    _check_backend(backend)
+    T = frame6(p, z, x, p6, tol=unit_tol)
+    return _reverse_one(T, tol=tol, s5_tol=s5_tol, backend=backend)
 
 
-def reverse_pose(pose6, *, tol: float = 1e-9, s5_tol: float = 1e-10) -> ReverseResult:
+def reverse_pose(pose6, *, tol: float = 1e-9, s5_tol: float = 1e-10,
+                 backend: str = "numba") -> ReverseResult:
     """:func:`reverse` for the pose of frame 6 given as a 4x4 matrix."""
     T = np.asarray(pose6, dtype=float)
     if T.shape != (4, 4):
         raise InputError(f"pose must be a 4x4 matrix, got shape {T.shape}")
+    if backend == "numba":
+        return _result_one(_pk.reverse_pose_one(T, float(tol), float(s5_tol)), tol, 1e-6)
+    _check_backend(backend)
     R = T[:3, :3]
     if not np.all(np.isfinite(T)) or np.max(np.abs(R @ R.T - np.eye(3))) > 1e-6 \
             or np.linalg.det(R) < 0:
-        raise InputError("pose must be a finite rigid transform (orthonormal rotation, det +1)")
-    return _reverse_one(frame6(T[:3, 3], T[:3, 2], T[:3, 0]), tol=tol, s5_tol=s5_tol)
+        raise InputError(_frame6_message(_pk.ERR_NOT_RIGID, 0.0, 0.0))
+    return _reverse_one(frame6(T[:3, 3], T[:3, 2], T[:3, 0]), tol=tol, s5_tol=s5_tol,
+                        backend=backend)
 
 
-def _reverse_one(T: np.ndarray, *, tol: float, s5_tol: float) -> ReverseResult:
-    b = reverse_batch_pose(T, verify=True, tol=tol, s5_tol=s5_tol)
+def _unreachable(T: np.ndarray, status: int) -> UnreachableError:
+    W = wrist_center(T)
+    r = float(np.hypot(W[0], W[1]))
+    ux = math.sqrt(max(r * r - S2 * S2, 0.0))
+    return UnreachableError(
+        "PUMA 762 pose out of reach: "
+        + status_message(status, wrist_radius=r, reach=math.hypot(ux, W[2]))
+    )
+
+
+def _failed_reason(n_bad: int, tol: float) -> str:
+    return (f"{n_bad} of 8 branches failed verification (forward residual above "
+            f"{tol:g}); numerically ill-conditioned pose")
+
+
+def _family(b: ReverseBatch, k: int) -> WristFamily:
+    qk = b.q[k]
+    return WristFamily(phi1=float(qk[0]), theta2=float(qk[1]), theta3=float(qk[2]),
+                       theta5=float(qk[4]), kind="sum" if b.family_sum[k] else "difference",
+                       value=float(b.family_value[k]), representative=qk.copy(), branch=k)
+
+
+_STATUS_0D = {s: np.array(s, dtype=np.int8) for s in range(4)}
+
+
+def _result_one(out, tol: float, unit_tol: float) -> ReverseResult:
+    """A :class:`ReverseResult` from the single-pose kernel's output."""
+    err, bad, status, T, q, valid, sing, fsum, fval, pe, re, sols, branches, n_fam, n_bad = out
+    if err:
+        raise InputError(_frame6_message(err, bad, unit_tol))
+    if status:
+        raise _unreachable(T, status)
+    b = ReverseBatch(q=q, valid=valid, singular=sing, family_sum=fsum, family_value=fval,
+                     status=_STATUS_0D[status].copy(), position_error=pe, rotation_error=re,
+                     verified=True)
+    fams: tuple[WristFamily, ...] = ()
+    if n_fam:
+        fams = _distinct_families(b, tol)
+    reason = None
+    if n_bad:
+        reason = _failed_reason(n_bad, tol)
+        if branches.size == 0 and not fams:
+            raise UnreachableError("PUMA 762 reverse analysis: " + reason)
+    return ReverseResult(solutions=sols, branches=branches, families=fams, reason=reason,
+                         batch=b)
+
+
+def _distinct_families(b: ReverseBatch, tol: float) -> tuple[WristFamily, ...]:
+    """The distinct wrist-singular families among the valid branches, in branch order."""
+    fams: list[WristFamily] = []
+    dup_tol = max(1e3 * tol, 1e-9)
+    for k in range(N_BRANCHES):
+        if not (b.valid[k] and b.singular[k]):
+            continue
+        qk = b.q[k]
+        kind = "sum" if b.family_sum[k] else "difference"
+        val = float(b.family_value[k])
+        if not any(
+            f.kind == kind
+            and _same_angles(np.array([f.phi1, f.theta2, f.theta3, f.value]),
+                             np.array([qk[0], qk[1], qk[2], val]), dup_tol)
+            for f in fams
+        ):
+            fams.append(_family(b, k))
+    return tuple(fams)
+
+
+def _reverse_one(T: np.ndarray, *, tol: float, s5_tol: float,
+                 backend: str = "numpy") -> ReverseResult:
+    """The reference single-pose analysis: a batch of one, then duplicates removed in Python."""
+    b = reverse_batch_pose(T, verify=True, tol=tol, s5_tol=s5_tol, backend=backend)
     status = int(b.status)
     if status != STATUS_OK:
-        W = wrist_center(T)
-        r = float(np.hypot(W[0], W[1]))
-        ux = math.sqrt(max(r * r - S2 * S2, 0.0))
-        raise UnreachableError(
-            "PUMA 762 pose out of reach: "
-            + status_message(status, wrist_radius=r, reach=math.hypot(ux, W[2]))
-        )
+        raise _unreachable(T, status)
     sols: list[np.ndarray] = []
     branches: list[int] = []
     fams: list[WristFamily] = []
@@ -703,9 +869,7 @@ def _reverse_one(T: np.ndarray, *, tol: float, s5_tol: float) -> ReverseResult:
                 for f in fams
             ):
                 continue
-            fams.append(WristFamily(phi1=float(qk[0]), theta2=float(qk[1]), theta3=float(qk[2]),
-                                    theta5=float(qk[4]), kind=kind, value=val,
-                                    representative=qk.copy(), branch=k))
+            fams.append(_family(b, k))
             continue
         if any(_same_angles(s, qk, dup_tol) for s in sols):
             continue
@@ -714,8 +878,7 @@ def _reverse_one(T: np.ndarray, *, tol: float, s5_tol: float) -> ReverseResult:
     n_bad = int(np.sum(~b.valid))
     reason = None
     if n_bad:
-        reason = (f"{n_bad} of 8 branches failed verification (forward residual above "
-                  f"{tol:g}); numerically ill-conditioned pose")
+        reason = _failed_reason(n_bad, tol)
         if not sols and not fams:
             raise UnreachableError("PUMA 762 reverse analysis: " + reason)
     out = np.array(sols).reshape(-1, 6)
