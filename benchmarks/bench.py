@@ -350,19 +350,20 @@ class Bench:
         L = p.free_lengths * (1 + RNG.uniform(-0.1, 0.1, (N, 6)))
         one = L[0]
         fast = _fk_kernels.fk_all_fast(p, one)
-        assert fast.count == fk_all(p, one).count
+        assert fast.count == fk_all(p, one, backend="numpy").count
         n = 200 if self.quick else 2000
         self.add("platform fk all-mode single", "kinestat",
                  median_time(lambda: _fk_kernels.fk_all_fast(p, one), number=n),
                  note=f"compiled; {int(fast.count)} modes")
         self.add("platform fk all-mode single", "fk_all (NumPy reference)",
-                 median_time(lambda: fk_all(p, one), number=max(n // 20, 5)))
+                 median_time(lambda: fk_all(p, one, backend="numpy"), number=max(n // 20, 5)))
         self.add("platform fk all-mode batch", "kinestat",
                  median_time(lambda: _fk_kernels.fk_all_fast(p, L), repeat=5), items=N,
                  note="compiled, 16 slots per set")
         k = N // 10
         self.add("platform fk all-mode batch", "fk_all (NumPy reference)",
-                 median_time(lambda: fk_all(p, L[:k]), repeat=3), items=k, note="on N/10")
+                 median_time(lambda: fk_all(p, L[:k], backend="numpy"), repeat=3), items=k,
+                 note="on N/10")
 
     def run(self, only: list[str] | None) -> None:
         for name in TASKS:
