@@ -221,6 +221,15 @@ def _rows(rows, name: str) -> np.ndarray:
     return P
 
 
+def _prepare(rows, label, kinds, pitches, limits, names, base, tool):
+    """The checked table, joints, base and tool shared by the DH constructors."""
+    P = _rows(rows, label)
+    joints = _joints(kinds, P.shape[0], pitches, limits, names)
+    base = np.eye(4) if base is None else _check_pose(base, "base")
+    tool = np.eye(4) if tool is None else _check_pose(tool, "tool")
+    return P, joints, base, tool
+
+
 def from_standard_dh(
     rows,
     kinds: Sequence[str] | None = None,
@@ -242,11 +251,9 @@ def from_standard_dh(
     (lecture notes' H_i^{i-1}; Nadkarni eq. 2-7). Rz and Tz commute, so each link is
     ``Z(qi) · Ci`` with ``Ci = Rz(θi) Tz(di) Tx(ai) Rx(αi)``.
     """
-    P = _rows(rows, "standard DH table")
+    P, joints, base, tool = _prepare(rows, "standard DH table", kinds, pitches, limits, names,
+                                     base, tool)
     n = P.shape[0]
-    joints = _joints(kinds, n, pitches, limits, names)
-    base = np.eye(4) if base is None else _check_pose(base, "base")
-    tool = np.eye(4) if tool is None else _check_pose(tool, "tool")
     th, d, a, al = P.T
     links = rot_z(th) @ trans_z(d) @ trans_x(a) @ rot_x(al)
     C = np.empty((n + 1, 4, 4))
@@ -278,11 +285,9 @@ def from_modified_dh(
     Link j is ``Rx(α_ij) · Tx(a_ij) · Rz(θj + qj) · Tz(Sj)`` (Craig; Crane & Duffy, Vibhute
     eq. 2-26), i.e. ``Pj · Z(qj)`` with ``Pj = Rx(α) Tx(a) Rz(θ) Tz(d)``.
     """
-    P = _rows(rows, "modified DH table")
+    P, joints, base, tool = _prepare(rows, "modified DH table", kinds, pitches, limits, names,
+                                     base, tool)
     n = P.shape[0]
-    joints = _joints(kinds, n, pitches, limits, names)
-    base = np.eye(4) if base is None else _check_pose(base, "base")
-    tool = np.eye(4) if tool is None else _check_pose(tool, "tool")
     al, a, th, d = P.T
     pre = rot_x(al) @ trans_x(a) @ rot_z(th) @ trans_z(d)
     C = np.empty((n + 1, 4, 4))
