@@ -32,12 +32,12 @@ def load_deck(spec: str):
 
 
 def guidance_options(*, closed_loop: bool, second_order: bool, damped: bool, settle: bool,
-                     cond_limit: float):
+                     cond_limit: float, disp_1977: bool = False):
     from kinestat.serial.guidance.run import GuidanceOptions
 
-    return GuidanceOptions(closed_loop=closed_loop, second_order=second_order,
-                           singular="damped" if damped else "perturb", settle=settle,
-                           cond_limit=cond_limit)
+    kw = dict(closed_loop=closed_loop, second_order=second_order,
+              singular="damped" if damped else "perturb", settle=settle, cond_limit=cond_limit)
+    return GuidanceOptions.disp_1977(**kw) if disp_1977 else GuidanceOptions(**kw)
 
 
 @contextlib.contextmanager
@@ -153,6 +153,10 @@ def disp(
                                    "at the end of a stage to reach its target exactly."),
     cond_limit: float = typer.Option(1e3, "--cond-limit", help="Dimensionless condition "
                                      "number above which a configuration counts as singular."),
+    disp_1977: bool = typer.Option(False, "--disp-1977", help="The 1977 program's step rule "
+                                   "(B from the hand origin's second-order displacement, "
+                                   "ceil(dθ°²/40) sub-steps), which reproduces Table A2-9 with "
+                                   "the illustration5-published deck."),
 ) -> None:
     """Run a DISP deck (Nadkarni 1977): MS 1 screw axes, 2 mechanism data, 3 both, 0/4/5/6
     guidance of types II/III/IV/I.
@@ -164,7 +168,7 @@ def disp(
 
     d = load_deck(deck)
     opts = guidance_options(closed_loop=closed_loop, second_order=second_order, damped=damped,
-                            settle=not no_settle, cond_limit=cond_limit)
+                            settle=not no_settle, cond_limit=cond_limit, disp_1977=disp_1977)
     with progress_reporter(not as_json) as prog:
         run = run_deck(d, steps=parse_steps(steps), options=opts, progress=prog)
     written = []

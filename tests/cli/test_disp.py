@@ -118,3 +118,24 @@ def test_progress_bar_on_a_terminal(capsys, monkeypatch):
         assert prog is None
     assert main(["disp", "illustration6", "--steps", "4"]) == 0
     assert "Joint variables" in capsys.readouterr().out
+
+
+# Nadkarni 1977, Table A2-9 (published), rows 2-9 and the final row; row 1's θ4 is a misprint
+# (10.000 for 10.886: docs/seed-errata.md, G1).
+TABLE_A2_9 = {
+    2: [-0.948, 27.775, 7.407, 21.801], 3: [-1.960, 28.790, 7.111, 32.005],
+    4: [-3.108, 29.464, 6.815, 41.009], 5: [-4.229, 29.864, 6.519, 48.652],
+    6: [-5.317, 29.953, 6.222, 55.008], 7: [-6.254, 29.919, 5.926, 60.255],
+    8: [-7.138, 29.674, 5.630, 64.592], 9: [-7.918, 29.343, 5.333, 68.199],
+}
+
+
+def test_disp_1977_flag_reproduces_table_a2_9(capsys):
+    assert main(["disp", "illustration5-published", "--disp-1977", "--json"]) == 0
+    table = json.loads(capsys.readouterr().out)["table"]
+    for row, values in TABLE_A2_9.items():
+        np.testing.assert_allclose(table[row][:4], values, atol=6e-4, err_msg=f"row {row}")
+        np.testing.assert_allclose(table[row][4:], [90.0, 0.0], atol=6e-4)
+    np.testing.assert_allclose(table[-1], [-15.0, 20.0, 0.0, 90.0, 90.0, 0.0], atol=6e-4)
+    assert main(["disp", "illustration5-published", "--disp-1977", "--closed-loop"]) == 2
+    assert "cannot be combined" in capsys.readouterr().err

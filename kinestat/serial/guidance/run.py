@@ -42,9 +42,11 @@ from kinestat.serial.guidance.step import (
     conditioning,
     escape_singularity,
     limit_violation,
+    origin_displacement_twist,
     scaled_jacobian,
     solve_second_order,
     solve_step,
+    split_substep_count,
 )
 from kinestat.serial.jacobian import jacobian
 
@@ -80,6 +82,14 @@ class GuidanceOptions:
       it is reached to ``settle_tol`` (angle in rad; origin in length × max(1, L)); each is a
       table row and a ``settle`` event. A target still missed after ``max_settle`` of them
       stops the run (``target_not_reached``).
+    - ``origin_step`` (DISP 1977, Table A2-9): B's translation is the second-order displacement
+      of the body point at the global origin, ``v + ½ ω×v``
+      (:func:`~kinestat.serial.guidance.step.origin_displacement_twist`), solved to first
+      order; ``split_substep_deg2``: every step is done as
+      :func:`~kinestat.serial.guidance.step.split_substep_count` equal sub-steps with the
+      same twist (the Jacobian recomputed for each). :meth:`disp_1977` sets both; with them
+      Illustration 5 reproduces Table A2-9 (docs/errata/guidance.md G1). Not combinable with
+      ``second_order`` or ``closed_loop``.
     """
 
     closed_loop: bool = False
@@ -99,8 +109,24 @@ class GuidanceOptions:
     settle_tol: float = 1e-9
     max_settle: int = 10
     check_limits: bool = True
+    origin_step: bool = False
+    split_substep_deg2: float | None = None
+
+    @classmethod
+    def disp_1977(cls, **changes) -> GuidanceOptions:
+        """The step rule that reproduces Nadkarni's Table A2-9 (Illustration 5): B from the
+        origin point's second-order displacement, ⌈(δθ°)²/40⌉ sub-steps per step."""
+        return cls(**{"origin_step": True, "split_substep_deg2": 40.0, **changes})
 
     def __post_init__(self) -> None:
+        if (self.origin_step or self.split_substep_deg2 is not None) and (
+                self.second_order or self.closed_loop):
+            raise InputError("origin_step / split_substep_deg2 (the DISP 1977 step) cannot be "
+                             "combined with second_order or closed_loop")
+        if self.split_substep_deg2 is not None:
+            v = self.split_substep_deg2
+            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+                raise InputError(f"split_substep_deg2 must be a positive number, got {v!r}")
         if self.singular not in SINGULAR_MODES:
             raise InputError(
                 f"singular must be one of {', '.join(SINGULAR_MODES)}, got {self.singular!r}")
@@ -381,14 +407,21 @@ def run_guidance(
                     damping = "auto"
                     ev["action"] = "damped"
                     events.append(ev)
-            dq, sol = _increment(model, q, H, J, path, s0, s1, L, damping, opt)
+            if opt.origin_step or opt.split_substep_deg2 is not None:
+                dq, sol, m_disp = _disp_1977_increment(model, q, H, J, path, s0, s1, L,
+                                                       damping, opt)
+                substeps += m_disp - 1
+                refine_now = None
+            else:
+                dq, sol = _increment(model, q, H, J, path, s0, s1, L, damping, opt)
+                refine_now = refine
             if damping is not None:
                 events[-1]["damping"] = float(sol.damping)
             if model.n != 6 and sol.residual > 1e-9:
                 events.append({"step": gstep, "stage": si + 1, "kind": "least_squares",
                                "residual": float(sol.residual)})
             q_new = q + dq
-            m_sub = _substeps(model, dq, L, refine)
+            m_sub = _substeps(model, dq, L, refine_now)
             if m_sub > 1:  # refine: the same hand motion in m_sub smaller first-order steps
                 q_new = q
                 H_sub = H
@@ -496,6 +529,26 @@ def _increment(model, q, H, J, path, s0, s1, L, damping, opt: GuidanceOptions):
         dq, _, _ = solve_second_order(model, q, B, target[:3, 3] - H[:3, 3], length=L,
                                       dq0=dq)
     return dq, sol
+
+
+def _disp_1977_increment(model, q, H, J, path, s0, s1, L, damping, opt: GuidanceOptions):
+    """The step of DISP's Illustration 5 run (docs/errata/guidance.md G1): the path's step
+    twist B split into m equal parts (``split_substep_deg2``), each solved to first order at
+    the current joints with, for ``origin_step``, the origin point's second-order
+    displacement as its translation. Returns ``(dq, last solution, m)``."""
+    B = path.step_twist(s0, s1, H)
+    m = 1 if opt.split_substep_deg2 is None else split_substep_count(B, opt.split_substep_deg2)
+    Bi = B / m
+    if opt.origin_step:
+        Bi = origin_displacement_twist(Bi)
+    q_i = np.array(q, dtype=float)
+    sol = None
+    for i in range(m):
+        J_i = J if i == 0 else jacobian(model, q_i)
+        sol = solve_step(J_i, Bi, prismatic=model.prismatic, length=L, damping=damping,
+                         cond_limit=opt.cond_limit, max_damping=opt.max_damping)
+        q_i = q_i + sol.dq
+    return q_i - q, sol, m
 
 
 def _substeps(model: ChainModel, dq, L: float, max_joint_step_deg: float | None) -> int:

@@ -16,6 +16,8 @@ least-squares weights and damping no longer change when inches become millimetre
   increments until the singularity disappears.
 - :func:`solve_second_order`: Nadkarni eq. 5-5 (suggestion 2), the δθ²/2 terms.
 - :func:`limit_violation`: ch. IV "Singularities" 2), a joint at its limit.
+- :func:`origin_displacement_twist`, :func:`split_substep_count`: the step as DISP (1977)
+  computed it in Illustration 5 (docs/errata/guidance.md G1).
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.fk import fk_frames
 from kinestat.serial.jacobian import jacobian
+from kinestat.spatial.transforms import as_array
 
 __all__ = [
     "StepSolution",
@@ -42,6 +45,8 @@ __all__ = [
     "solve_second_order",
     "escape_singularity",
     "limit_violation",
+    "origin_displacement_twist",
+    "split_substep_count",
     "DEFAULT_COND_LIMIT",
 ]
 
@@ -303,3 +308,34 @@ def limit_violation(model: ChainModel, q, tol: float = 1e-12):
         if q[i] > hi[i] + tol:
             return i, "upper", float(hi[i]), float(q[i])
     return None
+
+
+def origin_displacement_twist(B) -> np.ndarray:
+    """``[ω; v + ½ ω×v]`` ``(..., 6)`` for a step twist ``B = [ω; v]`` ``(..., 6)``.
+
+    ``v + ½ ω×v`` is the displacement, to second order, of the body point at the global
+    origin; for a screw step ``[δθU; hδθU − δθU×ρn]`` it is ``hδθU − δθU×ρn + ½δθ²ρn``
+    (ρn ⊥ U). Used as the translational part of B (with the first-order solve of eq. 4-11)
+    it leaves every step off by ``½δθ² W`` (W the point of the turning axis nearest the
+    origin): the error pattern of Nadkarni's Table A2-9 (docs/errata/guidance.md G1).
+    """
+    B = as_array(B, shape_tail=(6,), name="step twist")
+    w, v = B[..., :3], B[..., 3:]
+    return np.concatenate([w, v + 0.5 * np.cross(w, v)], axis=-1)
+
+
+def split_substep_count(B, deg2: float) -> int:
+    """Equal sub-steps for one step twist ``B`` ``(6,)``: ``max(1, ⌈(δθ°)² / deg2⌉)`` with δθ°
+    its rotation in degrees.
+
+    With ``deg2`` in [39.72, 40.40) it gives the counts Table A2-9 implies (3, 3, 3, 3, 2, 2,
+    then 1; 37 steps for 27 splits, 38 with the final correction: the caption's "Total 38
+    steps"). The rule is fitted to those counts, not taken from the thesis.
+    """
+    B = as_array(B, shape_tail=(6,), name="step twist")
+    if B.shape != (6,):
+        raise InputError(f"split_substep_count takes one twist of shape (6,), got {B.shape}")
+    if not (math.isfinite(deg2) and deg2 > 0):
+        raise InputError(f"deg2 must be a positive number of square degrees, got {deg2!r}")
+    d = math.degrees(float(np.linalg.norm(B[:3])))
+    return max(1, math.ceil(d * d / deg2 - 1e-9))

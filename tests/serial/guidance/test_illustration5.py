@@ -11,10 +11,12 @@ import numpy as np
 import pytest
 
 import kinestat
+from kinestat.errors import InputError
 from kinestat.io.disp_deck import embedded_deck
 from kinestat.serial.guidance.disp import deck_initial_hand, deck_model, run_deck
-from kinestat.serial.guidance.planners import line_path, twist_between
-from kinestat.serial.guidance.run import joint_display
+from kinestat.serial.guidance.planners import line_path, twist_between, twist_exp
+from kinestat.serial.guidance.run import GuidanceOptions, joint_display
+from kinestat.serial.guidance.step import origin_displacement_twist, split_substep_count
 
 # Table A2-9: r1, r2, r3 (in), θ4, θ5, θ6 (deg) — the initial position and the nine printed
 # intermediate rows ("Total 38 steps"); then the final position.
@@ -102,3 +104,95 @@ def test_printed_rows_are_farther_from_the_split_positions_than_one_first_order_
         assert gap_printed > gap_step + 0.02, j
         # and the printed height is the split position's (r3 is exact)
         assert kinestat.fk(model, q_rows[j])[2, 3] == pytest.approx(target[2, 3], abs=1e-3)
+
+
+def _disp_step(model, q, target, m):
+    """One DISP 1977 step, written out independently of run.py: the screw from the hand to
+    ``target`` in m equal parts, each B = [ω; v + ½ω×v] solved to first order."""
+    B = twist_between(kinestat.fk(model, q), target) / m
+    w, v = B[:3], B[3:]
+    B2 = np.concatenate([w, v + 0.5 * np.cross(w, v)])
+    for _ in range(m):
+        q = q + np.linalg.solve(kinestat.jacobian(model, q), B2)
+    return q
+
+
+def test_disp_1977_step_reproduces_every_printed_value_of_table_a2_9():
+    """G1: with B's translation the origin point's second-order displacement and ⌈(δθ°)²/40⌉
+    sub-steps, the run gives every printed number of Table A2-9 to the printed decimals —
+    except θ4 of row 1 (printed 10.000; the run 10.886 = atan(5/26)) — and the caption's
+    38 steps: 27 splits + 10 sub-steps + 1 correction."""
+    run = run_deck(embedded_deck("illustration5-published"), options=GuidanceOptions.disp_1977())
+    res = run.result
+    table = joint_display(res.model, res.q)
+    expected = TABLE_A2_9.copy()
+    expected[1, 3] = math.degrees(math.atan2(5, 26))  # the misprint, see the next test
+    np.testing.assert_allclose(table[:10], expected, atol=HALF_UNIT)
+    np.testing.assert_allclose(table[-1], TABLE_A2_9_FINAL, atol=5e-4)
+    settles = [e for e in res.events if e["kind"] == "settle"]
+    assert res.steps == (K,) and res.substeps == 10 and len(settles) == 1
+    assert K + res.substeps + len(settles) == 38 and len(table) == K + 2
+
+
+def test_row_1_theta4_of_table_a2_9_is_a_misprint_for_10_886():
+    """From the printed row 1, one DISP step (3 sub-steps, the count of rows 1-4) reaches the
+    printed row 2 only if row 1's θ4 was 10.886 deg (the first split position), not 10.000."""
+    deck = embedded_deck("illustration5-published")
+    model, P0, _ = deck_initial_hand(deck, deck_model(deck))
+    path = line_path(P0, np.array(deck.positions)[1])
+    for th4, ok in ((math.degrees(math.atan2(5, 26)), True), (10.0, False)):
+        row1 = TABLE_A2_9[1].copy()
+        row1[3] = th4
+        q = _disp_step(model, np.where(model.prismatic, row1, np.radians(row1)),
+                       path.pose_at(2 / K), 3)
+        dev = np.abs(joint_display(model, q) - TABLE_A2_9[2]).max()
+        assert (dev < 2 * HALF_UNIT) == ok, (th4, dev)
+
+
+def test_table_a2_9_fixes_the_sub_step_counts_and_the_second_order_origin_term():
+    """Each printed row from the printed previous one (row 1's θ4 corrected): the sub-step
+    count 3, 3, 3, 3, 2, 2, 1, 1, 1 is the only one within 0.002 in; with the *exact* finite
+    displacement of the origin point instead of its second-order form the rows miss by more
+    than 0.003 in (the table resolves the third-order term)."""
+    deck = embedded_deck("illustration5-published")
+    model, P0, _ = deck_initial_hand(deck, deck_model(deck))
+    path = line_path(P0, np.array(deck.positions)[1])
+    rows = TABLE_A2_9.copy()
+    rows[1, 3] = math.degrees(math.atan2(5, 26))
+    q_rows = np.where(model.prismatic, rows, np.radians(rows))
+    counts = []
+    worst_exact = 0.0
+    for j in range(1, 10):
+        target = path.pose_at(j / K)
+        devs = [np.abs(joint_display(model, _disp_step(model, q_rows[j - 1], target, m))
+                       - rows[j])[:2].max() for m in range(1, 5)]
+        good = [m for m, d in zip(range(1, 5), devs, strict=True) if d < 2e-3]
+        assert len(good) == 1, (j, devs)
+        counts.append(good[0])
+        B = twist_between(kinestat.fk(model, q_rows[j - 1]), target)
+        assert split_substep_count(B, 40.0) == good[0]
+        m = good[0]
+        Bx = B / m  # the exact displacement of the origin point for 1/m of the screw
+        Bx = np.concatenate([Bx[:3], twist_exp(Bx)[:3, 3]])
+        q = q_rows[j - 1]
+        for _ in range(m):
+            q = q + np.linalg.solve(kinestat.jacobian(model, q), Bx)
+        worst_exact = max(worst_exact, np.abs(joint_display(model, q) - rows[j])[:2].max())
+    assert counts == [3, 3, 3, 3, 2, 2, 1, 1, 1]
+    assert worst_exact > 3e-3
+
+
+def test_origin_displacement_twist_is_the_second_order_motion_of_the_origin_point():
+    rng = np.random.default_rng(5)
+    B = rng.normal(size=6)
+    for eps in (1e-2, 5e-3):
+        exact = twist_exp(eps * B)[:3, 3]  # where the body point at the origin goes
+        approx = origin_displacement_twist(eps * B)[3:]
+        assert np.linalg.norm(exact - approx) < 2 * eps**3 * np.linalg.norm(B) ** 3
+    np.testing.assert_array_equal(origin_displacement_twist(B)[:3], B[:3])
+    assert split_substep_count(np.r_[0, 0, math.radians(10.9), 0, 0, 0], 40.0) == 3
+    assert split_substep_count(np.zeros(6), 40.0) == 1
+    with pytest.raises(InputError):
+        GuidanceOptions.disp_1977(second_order=True)
+    with pytest.raises(InputError):
+        GuidanceOptions(split_substep_deg2=-1.0)
