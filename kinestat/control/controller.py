@@ -76,7 +76,7 @@ __all__ = [
 
 THESIS_FORCE_DIRECTION = np.array([0.9713, 0.0, -0.2375]) / math.hypot(0.9713, 0.2375)
 """Direction of the thesis's ``F_req = 0.9713 i + 0 j − 0.2375 k`` (Vibhute §5.1; the OCR
-dropped the minus sign — see docs/errata/control.md), normalised (|F_req| printed = 0.99991)."""
+dropped the minus sign — see docs/seed-errata.md), normalised (|F_req| printed = 0.99991)."""
 THESIS_FORCE_DIRECTION.setflags(write=False)
 
 STATES = {

@@ -176,7 +176,7 @@ def thesis_move_plan(current: Any, target: Any, *, nudge: bool = True) -> MovePl
     Speed per axis ``ceil(|target - current| / 4)`` clamped to [10, max] (so every axis takes
     about 4 s at cruise), ``AC = DC = THESIS_ACCEL``, and with ``nudge`` a target less than 5
     counts away is moved 5 counts further (+5) as the thesis does. The thesis sets tiny-move
-    speeds of axes D and E to the maximum instead of 10 (see docs/errata/devices.md); this
+    speeds of axes D and E to the maximum instead of 10 (see docs/seed-errata.md); this
     function uses 10 for every axis.
     """
     cur = _six(current, "thesis_move_plan current")

@@ -351,7 +351,7 @@ def close_loop(tool_point, s6, a67, tool_point_6=(0.0, 0.0, 0.0), *,
     ``S7 = a67 × S6``; ``c71 = S7·S1`` (2-35); ``a71 = S7 × S1 / s71`` (2-36); ``c7 = a67·a71``,
     ``s7 = (a67 × a71)·S7`` (2-37, 2-38); ``cγ1 = a71·i``, ``sγ1 = (a71 × i)·S1`` (2-39, 2-40);
     ``S7 = (S1 × P6)·a71 / s71``, ``a71 = (P6 × S1)·S7 / s71``, ``S1 = (P6 × S7)·a71 / s71``
-    (2-41..2-43, P6 the origin of frame 6) — signs restored, see docs/errata/puma762.md.
+    (2-41..2-43, P6 the origin of frame 6) — signs restored, see docs/seed-errata.md.
     When S7 is parallel to S1 (s71 = 0) the common normal is not unique: a71 is taken along the
     perpendicular from S7 to S1 (or along a67 if the lines coincide) and S7 = 0.
     """

@@ -88,7 +88,7 @@ class GuidanceOptions:
       order; ``split_substep_deg2``: every step is done as
       :func:`~kinestat.serial.guidance.step.split_substep_count` equal sub-steps with the
       same twist (the Jacobian recomputed for each). :meth:`disp_1977` sets both; with them
-      Illustration 5 reproduces Table A2-9 (docs/errata/guidance.md G1). Not combinable with
+      Illustration 5 reproduces Table A2-9 (docs/seed-errata.md G1). Not combinable with
       ``second_order`` or ``closed_loop``.
     """
 
@@ -532,7 +532,7 @@ def _increment(model, q, H, J, path, s0, s1, L, damping, opt: GuidanceOptions):
 
 
 def _disp_1977_increment(model, q, H, J, path, s0, s1, L, damping, opt: GuidanceOptions):
-    """The step of DISP's Illustration 5 run (docs/errata/guidance.md G1): the path's step
+    """The step of DISP's Illustration 5 run (docs/seed-errata.md G1): the path's step
     twist B split into m equal parts (``split_substep_deg2``), each solved to first order at
     the current joints with, for ``origin_step``, the origin point's second-order
     displacement as its translation. Returns ``(dq, last solution, m)``."""

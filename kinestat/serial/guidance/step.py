@@ -17,7 +17,7 @@ least-squares weights and damping no longer change when inches become millimetre
 - :func:`solve_second_order`: Nadkarni eq. 5-5 (suggestion 2), the δθ²/2 terms.
 - :func:`limit_violation`: ch. IV "Singularities" 2), a joint at its limit.
 - :func:`origin_displacement_twist`, :func:`split_substep_count`: the step as DISP (1977)
-  computed it in Illustration 5 (docs/errata/guidance.md G1).
+  computed it in Illustration 5 (docs/seed-errata.md G1).
 """
 
 from __future__ import annotations
@@ -317,7 +317,7 @@ def origin_displacement_twist(B) -> np.ndarray:
     origin; for a screw step ``[δθU; hδθU − δθU×ρn]`` it is ``hδθU − δθU×ρn + ½δθ²ρn``
     (ρn ⊥ U). Used as the translational part of B (with the first-order solve of eq. 4-11)
     it leaves every step off by ``½δθ² W`` (W the point of the turning axis nearest the
-    origin): the error pattern of Nadkarni's Table A2-9 (docs/errata/guidance.md G1).
+    origin): the error pattern of Nadkarni's Table A2-9 (docs/seed-errata.md G1).
     """
     B = as_array(B, shape_tail=(6,), name="step twist")
     w, v = B[..., :3], B[..., 3:]

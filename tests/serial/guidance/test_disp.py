@@ -40,7 +40,7 @@ TABLE_A2_9_FINAL = np.array([-15.000, 20.000, 0.000, 90.000, 90.000, 0.000])
 
 
 def _illustration5_as_run():
-    """Table A2-8 with the input the published table implies (docs/errata/guidance.md G1):
+    """Table A2-8 with the input the published table implies (docs/seed-errata.md G1):
     the target's +z point 5 units from its origin, b2 = (15, -10, 20)."""
     deck = embedded_deck("illustration5")
     P = np.array(deck.positions)

@@ -1,6 +1,6 @@
 """Illustration 5 (Nadkarni 1977, App. II): the embedded ``illustration5-published`` deck against
 the published Table A2-9, and what the published table itself implies about the input
-(docs/errata/guidance.md G1)."""
+(docs/seed-errata.md G1)."""
 
 from __future__ import annotations
 

@@ -107,7 +107,7 @@ def test_general_path_example_4_reaches_target_on_a_straight_line(rng):
 def test_general_motion_examples_1_to_3():
     """Ex. 3: rotation about z through O_H plus translation along x. Eq. 4-11a gives
     B = [0 0 δθ  ρ2δθ+δr  −ρ1δθ  0]; the thesis prints −ρ2δθ, ρ1δθ (a sign slip, see
-    docs/errata/guidance.md G2): with it the hand origin would not stay on its path."""
+    docs/seed-errata.md G2): with it the hand origin would not stay on its path."""
     H = _pose([0.1, 0.2, 0.3], [1.0, 2.0, 3.0])
     path = general_motion(H, [0, 0, 2.0], math.radians(30), [3.0, 0, 0], 2.0)
     k = 10
