@@ -131,6 +131,7 @@ class ChainModel:
         object.__setattr__(self, "kernel_args", (self.constants, kinds, pitches))
         packed = np.concatenate([self.constants.ravel(), kinds.astype(float), pitches])
         object.__setattr__(self, "kernel_packed", _readonly(packed))
+        object.__setattr__(self, "n_joints", n)  # a plain attribute (the fast paths read it)
 
     # -- derived, cheap views ------------------------------------------------------------------
     @property

@@ -190,3 +190,22 @@ def fk_jacobian_batch(C, kinds, pitch, Q, T_out, J_out):
             t = _step(C[i + 1], kinds[i], pitch[i], Q[k, i], t)
         _store(t, T_out[k])
     return bad
+
+
+_ENTRY: dict[str, object] = {}
+
+
+def single_entry(name: str):
+    """The compiled entry point of ``fk_one`` or ``jacobian_one`` for (packed chain: read-only
+    C-contiguous float64, q: C-contiguous float64), bypassing Numba's per-call type dispatch.
+
+    Callers must pass exactly those types (a 1-D float64 ndarray with strides (8,)); anything
+    else goes through the dispatcher.
+    """
+    ep = _ENTRY.get(name)
+    if ep is None:
+        ro = nb.types.Array(nb.float64, 1, "C", readonly=True)
+        rw = nb.types.Array(nb.float64, 1, "C")
+        ep = _ENTRY[name] = globals()[name].compile((ro, rw))
+    return ep
+

@@ -58,17 +58,36 @@ def _as_q(model: ChainModel, q) -> np.ndarray:
     return q
 
 
+_FK_ONE = None
+_JAC_ONE = None
+
+
+def _entry(name: str):
+    """Fetch (and remember) a compiled single-configuration entry point."""
+    global _FK_ONE, _JAC_ONE
+    ep = _kernels.single_entry(name)
+    if name == "fk_one":
+        _FK_ONE = ep
+    else:
+        _JAC_ONE = ep
+    return ep
+
+
 def _nonfinite() -> InputError:
     return InputError("q contains NaN or infinity")
 
 
 _F64 = np.dtype(np.float64)
+_ND = np.ndarray
+_S8 = (8,)
 
 
 def fk(model: ChainModel, q) -> np.ndarray:
     """End pose(s) ``(..., 4, 4)`` for joint values ``q`` of shape ``(..., n)``."""
-    if type(q) is np.ndarray and q.dtype is _F64 and q.shape == model.q_home.shape:
-        out = _kernels.fk_one(model.kernel_packed, q)  # type: ignore[attr-defined]
+    # fast path for one configuration: a contiguous float64 vector of the right length goes
+    # straight to the compiled entry point (no per-call type dispatch)
+    if type(q) is _ND and q.strides == _S8 and q.dtype is _F64 and len(q) == model.n_joints:
+        out = (_FK_ONE or _entry("fk_one"))(model.kernel_packed, q)  # type: ignore[attr-defined]
         if out is None:
             raise _nonfinite()
         return out

@@ -13,7 +13,8 @@ import numpy as np
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import _kernels
-from kinestat.serial.fk import _F64, _as_q, fk_frames
+from kinestat.serial import fk as _fkmod
+from kinestat.serial.fk import _F64, _ND, _S8, _as_q, fk_frames
 
 __all__ = ["jacobian", "jacobian_reference", "jacobian_from_frames", "fk_and_jacobian"]
 
@@ -37,8 +38,9 @@ def jacobian_reference(model: ChainModel, q) -> np.ndarray:
 
 def jacobian(model: ChainModel, q) -> np.ndarray:
     """Space Jacobian ``(..., 6, n)`` mapping joint rates to the end twist ``[ω; v_O]``."""
-    if type(q) is np.ndarray and q.dtype is _F64 and q.shape == model.q_home.shape:
-        J = _kernels.jacobian_one(model.kernel_packed, q)  # type: ignore[attr-defined]
+    if type(q) is _ND and q.strides == _S8 and q.dtype is _F64 and len(q) == model.n_joints:
+        J = (_fkmod._JAC_ONE or _fkmod._entry("jacobian_one"))(
+            model.kernel_packed, q)  # type: ignore[attr-defined]
         if J is None:
             raise InputError("q contains NaN or infinity")
         return J

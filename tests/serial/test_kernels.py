@@ -71,3 +71,28 @@ def test_wrong_shape_and_type():
         kinestat.fk(m, np.zeros((3, 5)))
     with pytest.raises(InputError):
         kinestat.fk(m, "abc")
+
+
+def test_single_configuration_fast_path_edge_cases(rng):
+    """The direct entry point only takes contiguous float64 vectors; every other layout goes
+    through the checked path, and all give the reference result."""
+    m = kinestat.load("puma762")
+    q = rng.uniform(-3, 3, 6)
+    ro = q.copy()
+    ro.setflags(write=False)
+    raw = bytearray(6 * 8 + 1)
+    unaligned = np.frombuffer(raw, dtype=np.float64, count=6, offset=1)
+    strided = np.zeros(12)
+    strided[::2] = q
+    for variant in (q, ro, strided[::2], q.astype(np.float32).astype(np.float64), list(q)):
+        v = np.array(variant, dtype=float)
+        np.testing.assert_allclose(kinestat.fk(m, variant), fk_reference(m, v), atol=1e-12)
+        np.testing.assert_allclose(kinestat.jacobian(m, variant), jacobian_reference(m, v),
+                                   atol=1e-12)
+    np.testing.assert_allclose(kinestat.fk(m, unaligned), fk_reference(m, np.zeros(6)), atol=1e-12)
+    with pytest.raises(InputError):
+        kinestat.fk(m, q[:5].copy())
+    with pytest.raises(InputError, match="NaN"):
+        kinestat.fk(m, np.r_[q[:5], np.nan])
+    with pytest.raises(InputError, match="NaN"):
+        kinestat.jacobian(m, np.r_[q[:5], np.inf])
