@@ -31,7 +31,7 @@ import typer
 
 from kinestat.cli._output import console, print_json, table
 from kinestat.errors import InputError, ParseError
-from kinestat.io.posefile import read_text_file
+from kinestat.io.textfile import read_text_file
 
 __all__ = ["register", "read_axes_file", "loads_axes"]
 

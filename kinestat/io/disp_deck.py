@@ -42,12 +42,10 @@ unit in data.
 
 from __future__ import annotations
 
-import contextlib
 import math
 import operator
 import os
 import re
-import tempfile
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass, field
 from importlib import resources
@@ -56,6 +54,7 @@ from pathlib import Path
 import numpy as np
 
 from kinestat.errors import InputError, KinestatError, ParseError
+from kinestat.io.textfile import write_text_atomic
 from kinestat.mechanism.joints import PRISMATIC_PITCH_THRESHOLD
 
 __all__ = [
@@ -983,30 +982,7 @@ def write_deck(
     text = format_deck(deck, exact=exact)
     if path is None:
         return text
-    target = Path(path)
-    directory = target.parent
-    try:
-        mode = target.stat().st_mode & 0o777 if target.exists() else 0o644
-        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=directory)
-    except OSError as exc:
-        raise InputError(
-            f"cannot write DISP deck {str(target)!r}: {exc.strerror or exc}; check the directory"
-        ) from None
-    try:
-        with os.fdopen(fd, "w", encoding="ascii", newline="\n") as fh:
-            fh.write(text)
-            fh.flush()
-            os.fsync(fh.fileno())
-        os.chmod(tmp, mode)
-        os.replace(tmp, target)
-    except BaseException as exc:
-        with contextlib.suppress(OSError):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise InputError(
-                f"cannot write DISP deck {str(target)!r}: {exc.strerror or exc}"
-            ) from None
-        raise
+    write_text_atomic(path, text, "DISP deck", encoding="ascii")
     return text
 
 

@@ -38,7 +38,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 import tomllib
 from pathlib import Path
 
@@ -46,7 +45,7 @@ import numpy as np
 import tomli_w
 
 from kinestat.errors import InputError, ModelError, ParseError
-from kinestat.io.posefile import read_text_file
+from kinestat.io.textfile import read_text_file, write_text_atomic
 from kinestat.mechanism.chain import (
     ChainModel,
     from_modified_dh,
@@ -267,20 +266,4 @@ def dumps_model(model: ChainModel, angle_unit: str = "deg") -> str:
 
 def write_model(model: ChainModel, path: str | os.PathLike, angle_unit: str = "deg") -> None:
     """Write a model as TOML, atomically (a temporary file renamed into place)."""
-    text = dumps_model(model, angle_unit=angle_unit)
-    p = Path(path)
-    try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", dir=p.parent or ".")
-    except OSError as exc:
-        raise InputError(f"cannot write model file {str(p)!r}: {exc.strerror}; check the "
-                         "directory") from exc
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, p)
-    except BaseException as exc:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        if isinstance(exc, OSError):
-            raise InputError(f"cannot write model file {str(p)!r}: {exc.strerror}") from exc
-        raise
+    write_text_atomic(path, dumps_model(model, angle_unit=angle_unit), "model file")

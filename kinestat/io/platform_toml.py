@@ -45,7 +45,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 import tomllib
 from pathlib import Path
 
@@ -53,7 +52,7 @@ import numpy as np
 import tomli_w
 
 from kinestat.errors import InputError, ModelError, ParseError
-from kinestat.io.posefile import read_text_file
+from kinestat.io.textfile import read_text_file, write_text_atomic
 from kinestat.parallel.platform import LEG_NAMES, Platform, special_6_6
 from kinestat.spatial.transforms import apply
 
@@ -270,19 +269,4 @@ def dumps_platform(platform: Platform, description: str | None = None) -> str:
 def write_platform(platform: Platform, path: str | os.PathLike,
                    description: str | None = None) -> None:
     """Write a platform to a TOML file (atomically: a temporary file renamed into place)."""
-    p = Path(path)
-    text = dumps_platform(platform, description)
-    try:
-        fd, tmp = tempfile.mkstemp(dir=p.parent, prefix=f".{p.name}.", suffix=".tmp")
-    except OSError as exc:
-        raise InputError(f"cannot write platform file {str(p)!r}: {exc.strerror}; check the "
-                         "directory") from exc
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as fh:
-            fh.write(text)
-        os.replace(tmp, p)
-    except BaseException as exc:
-        Path(tmp).unlink(missing_ok=True)
-        if isinstance(exc, OSError):
-            raise InputError(f"cannot write platform file {str(p)!r}: {exc.strerror}") from exc
-        raise
+    write_text_atomic(path, dumps_platform(platform, description), "platform file")

@@ -23,20 +23,9 @@ from pathlib import Path
 import numpy as np
 
 from kinestat.errors import ParseError
+from kinestat.io.textfile import read_text_file
 
 __all__ = ["read_text_file", "pose_from_document", "read_pose_file"]
-
-
-def read_text_file(path: str | os.PathLike, what: str = "file") -> str:
-    """The UTF-8 text of ``path``; unreadable or binary files raise a ParseError naming it."""
-    p = Path(path)
-    try:
-        return p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise ParseError(f"cannot read the {what}: {exc.strerror}", file=str(p)) from exc
-    except UnicodeDecodeError as exc:
-        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
-                         f"{exc.start} is not UTF-8); a {what} is text", file=str(p)) from exc
 
 
 def pose_from_document(doc, source: str, *, allow_batch: bool = False) -> np.ndarray:

@@ -20,7 +20,7 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from kinestat.errors import ModelError, ParseError
-from kinestat.io.posefile import read_text_file
+from kinestat.io.textfile import read_text_file
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import Joint
 

@@ -71,6 +71,15 @@ def _store(t, out):
     out[3, 0], out[3, 1], out[3, 2], out[3, 3] = 0.0, 0.0, 0.0, 1.0
 
 
+@nb.njit(inline="always", **_OPTS)
+def _row_finite(Q, k, n):
+    """True when row ``k`` of ``Q`` holds only finite values."""
+    for i in range(n):
+        if not math.isfinite(Q[k, i]):
+            return False
+    return True
+
+
 @nb.njit(**_OPTS)
 def fk_one(P, q):
     """End pose of one configuration of the packed chain ``P``; None if q is not finite."""
@@ -95,11 +104,7 @@ def fk_batch(C, kinds, pitch, Q, out):
     n = kinds.shape[0]
     bad = 0
     for k in nb.prange(N):
-        ok = True
-        for i in range(n):
-            if not math.isfinite(Q[k, i]):
-                ok = False
-        if not ok:
+        if not _row_finite(Q, k, n):
             bad += 1
             continue
         t = _start(C[0])
@@ -156,11 +161,7 @@ def jacobian_batch(C, kinds, pitch, Q, out):
     n = kinds.shape[0]
     bad = 0
     for k in nb.prange(N):
-        ok = True
-        for i in range(n):
-            if not math.isfinite(Q[k, i]):
-                ok = False
-        if not ok:
+        if not _row_finite(Q, k, n):
             bad += 1
             continue
         t = _start(C[0])
@@ -177,11 +178,7 @@ def fk_jacobian_batch(C, kinds, pitch, Q, T_out, J_out):
     n = kinds.shape[0]
     bad = 0
     for k in nb.prange(N):
-        ok = True
-        for i in range(n):
-            if not math.isfinite(Q[k, i]):
-                ok = False
-        if not ok:
+        if not _row_finite(Q, k, n):
             bad += 1
             continue
         t = _start(C[0])

@@ -1,0 +1,58 @@
+"""Reading and writing text files with clear errors; writes are atomic.
+
+Every kinestat file format (TOML models and platforms, DISP decks, pose and axes files, URDF)
+goes through these two functions, so a missing directory, a binary file or a full disk gives the
+same one-line error naming the file, and an interrupted write never leaves a half-written file.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+
+from kinestat.errors import InputError, ParseError
+
+__all__ = ["read_text_file", "write_text_atomic"]
+
+
+def read_text_file(path: str | os.PathLike, what: str = "file") -> str:
+    """The UTF-8 text of ``path``; unreadable or binary files raise a ParseError naming it."""
+    p = Path(path)
+    try:
+        return p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ParseError(f"cannot read the {what}: {exc.strerror}", file=str(p)) from exc
+    except UnicodeDecodeError as exc:
+        raise ParseError(f"not a text file (byte {exc.object[exc.start]:#04x} at offset "
+                         f"{exc.start} is not UTF-8); a {what} is text", file=str(p)) from exc
+
+
+def write_text_atomic(path: str | os.PathLike, text: str, what: str = "file", *,
+                      encoding: str = "utf-8") -> None:
+    """Write ``text`` to ``path`` atomically: a temporary file in the same directory, flushed to
+    the disk and renamed over ``path`` (keeping an existing file's permissions). Any failure
+    raises an InputError naming the file and leaves ``path`` as it was."""
+    target = Path(path)
+    try:
+        mode = target.stat().st_mode & 0o777 if target.exists() else 0o644
+        fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp",
+                                   dir=target.parent)
+    except OSError as exc:
+        raise InputError(f"cannot write {what} {str(target)!r}: {exc.strerror or exc}; check "
+                         "the directory") from None
+    try:
+        with os.fdopen(fd, "w", encoding=encoding, newline="\n") as fh:
+            fh.write(text)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, mode)
+        os.replace(tmp, target)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if isinstance(exc, OSError):
+            raise InputError(f"cannot write {what} {str(target)!r}: {exc.strerror or exc}"
+                             ) from None
+        raise
