@@ -339,9 +339,9 @@ class Bench:
         """All-mode forward kinematics of the 2011 prototype platform (no peer library solves
         it): the compiled path against kinestat's NumPy reference ``fk_all``."""
         try:
+            from kinestat.io.library import prototype
             from kinestat.parallel import _fk_kernels
             from kinestat.parallel.fk import fk_all
-            from kinestat.parallel.platform import prototype
         except ImportError as exc:  # pragma: no cover - platform package absent
             print(f"  platform FK not available: {exc}", file=sys.stderr)
             return

@@ -10,8 +10,8 @@ The stable top-level API::
 """
 
 from kinestat.errors import KinestatError
+from kinestat.io.library import list_models, load
 from kinestat.mechanism.chain import ChainModel
-from kinestat.mechanism.library import list_models, load
 from kinestat.serial.fk import fk
 from kinestat.serial.ik import ik
 from kinestat.serial.jacobian import jacobian

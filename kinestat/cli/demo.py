@@ -67,7 +67,8 @@ def _puma() -> dict:
 
 def _platform() -> dict:
     """Vibhute Appendix B: every assembly mode of the prototype for main.cpp's leg lengths."""
-    from kinestat.parallel import fk_list, leg_lengths, prototype
+    from kinestat.io.library import prototype
+    from kinestat.parallel import fk_list, leg_lengths
 
     p = prototype()
     legs = np.array([79.6804, 81.8285, 81.2669, 68.6500, 67.2037, 68.2854])

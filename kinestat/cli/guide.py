@@ -207,7 +207,7 @@ def guide(
     Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
     table up to that point is printed first.
     """
-    from kinestat.mechanism.library import load
+    from kinestat.io.library import load
     from kinestat.serial.guidance.disp import parse_steps
     from kinestat.serial.guidance.run import result_record, run_guidance
 

@@ -31,8 +31,8 @@ def register(app: typer.Typer) -> None:
 
 
 def _load(path: str | None):
+    from kinestat.io.library import prototype
     from kinestat.io.platform_toml import read_platform
-    from kinestat.parallel.platform import prototype
 
     return prototype() if path is None else read_platform(path)
 

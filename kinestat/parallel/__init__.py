@@ -1,7 +1,8 @@
 """The compliant 6-6 parallel platform: model, reverse and forward kinematics, statics, stiffness.
 
 - :mod:`~kinestat.parallel.platform` — the immutable :class:`Platform`, the special 6-6 builder
-  :func:`special_6_6` and the embedded 2011 :func:`prototype`.
+  :func:`special_6_6` (the embedded 2011 prototype is loaded by
+  :func:`kinestat.io.library.prototype`: models never read files).
 - :mod:`~kinestat.parallel.legs` — leg lengths from a pose (reverse kinematics).
 - :mod:`~kinestat.parallel.fk33` — closed-form 3-3 forward kinematics (all modes).
 - :mod:`~kinestat.parallel.fk` — special 6-6 → 3-3, all modes; tracking mode; general 6-6.
@@ -35,7 +36,6 @@ from kinestat.parallel.platform import (
     Platform,
     SpecialDesign,
     SpecialLayout,
-    prototype,
     special_6_6,
     special_layout,
 )
@@ -82,7 +82,6 @@ __all__ = [
     "leg_vectors",
     "line_jacobian",
     "load_asymmetry",
-    "prototype",
     "reduce_to_33",
     "singularity_measure",
     "special_6_6",

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from functools import cached_property, lru_cache
+from functools import cached_property
 from itertools import permutations
 
 import numpy as np
@@ -31,7 +31,6 @@ from kinestat.spatial.transforms import apply, make_pose, rot_z
 
 __all__ = [
     "LEG_NAMES",
-    "prototype",
     "Platform",
     "SpecialDesign",
     "SpecialLayout",
@@ -357,18 +356,3 @@ def special_layout(base_points, top_points, tol: float | None = None) -> Special
         if t is not None:
             return SpecialLayout(order=tuple(int(i) for i in order), t=t)
     return None
-
-
-@lru_cache(maxsize=1)
-def prototype() -> Platform:
-    """The embedded 2011 prototype (``kinestat/data/platforms/prototype-2011.toml``).
-
-    Base side 120 mm, top side 60 mm, offsets 28 mm and 14 mm, home height 60 mm, top turned
-    −60° at home, k = 2.627 N/mm; legs O, P, Q, R, S, T as in the thesis's code.
-    """
-    from importlib import resources
-
-    from kinestat.io.platform_toml import loads_platform
-
-    res = resources.files("kinestat.data") / "platforms" / "prototype-2011.toml"
-    return loads_platform(res.read_text(encoding="utf-8"), source=str(res))

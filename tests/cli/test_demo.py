@@ -7,7 +7,8 @@ import pytest
 
 import kinestat
 from kinestat.cli.main import main
-from kinestat.parallel import leg_lengths, prototype
+from kinestat.io.library import prototype
+from kinestat.parallel import leg_lengths
 from kinestat.serial import puma762
 
 

@@ -60,7 +60,7 @@ def test_q0_and_moves_and_joint_rates(capsys):
 
 
 def test_joint_limit_stop_prints_the_table_and_exits_2(capsys, tmp_path):
-    from kinestat.mechanism.library import _models_dir
+    from kinestat.io.library import _models_dir
 
     text = (_models_dir() / "nadkarni-config2.toml").read_text()
     text = text.replace('name = "4"\ntype = "revolute"', 'name = "4"\ntype = "revolute"\n'

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from kinestat.cli.main import main
+from kinestat.io.library import prototype
 from kinestat.io.platform_toml import write_platform
 from kinestat.parallel.legs import leg_lengths
-from kinestat.parallel.platform import prototype, special_6_6
+from kinestat.parallel.platform import special_6_6
 from kinestat.parallel.statics import line_jacobian
 
 THESIS = "79.6804,81.8285,81.2669,68.6500,67.2037,68.2854"

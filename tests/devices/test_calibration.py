@@ -17,7 +17,7 @@ from kinestat.devices.calibration import (
     lengths_to_counts,
 )
 from kinestat.errors import InputError
-from kinestat.parallel.platform import prototype
+from kinestat.io.library import prototype
 
 THESIS_LEGS = np.array([79.6804, 81.8285, 81.2669, 68.6500, 67.2037, 68.2854])  # main.cpp
 

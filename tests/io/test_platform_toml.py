@@ -6,8 +6,9 @@ import numpy as np
 import pytest
 
 from kinestat.errors import ParseError
+from kinestat.io.library import prototype
 from kinestat.io.platform_toml import dumps_platform, loads_platform, read_platform, write_platform
-from kinestat.parallel.platform import Platform, prototype, special_6_6
+from kinestat.parallel.platform import Platform, special_6_6
 
 DESIGN = """
 name = "t"

@@ -10,10 +10,11 @@ from scipy.optimize import least_squares
 from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError, ModelError, SingularityError, UnreachableError
+from kinestat.io.library import prototype
 from kinestat.parallel._refine import apply_twist, refine
 from kinestat.parallel.fk import fk_all, fk_list, fk_numeric, fk_tracking, reduce_to_33
 from kinestat.parallel.legs import leg_lengths, top_points_in_base
-from kinestat.parallel.platform import Platform, prototype, special_6_6
+from kinestat.parallel.platform import Platform, special_6_6
 from kinestat.parallel.singularity import singularity_measure
 from kinestat.spatial.transforms import make_pose
 

@@ -7,10 +7,11 @@ import numpy as np
 import pytest
 
 from kinestat.errors import InputError, ModelError
+from kinestat.io.library import prototype
 from kinestat.parallel import _fk_kernels as F
 from kinestat.parallel.fk import fk_all
 from kinestat.parallel.legs import leg_lengths
-from kinestat.parallel.platform import Platform, prototype, special_6_6
+from kinestat.parallel.platform import Platform, special_6_6
 
 # Appendix B, main.cpp: the prototype's example leg lengths.
 THESIS_LEGS = np.array([79.6804, 81.8285, 81.2669, 68.6500, 67.2037, 68.2854])

@@ -7,8 +7,8 @@ import pytest
 from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError
+from kinestat.io.library import prototype
 from kinestat.parallel.legs import leg_lengths, leg_vectors, top_points_in_base
-from kinestat.parallel.platform import prototype
 from kinestat.spatial.transforms import make_pose
 
 

@@ -8,11 +8,11 @@ import numpy as np
 import pytest
 
 from kinestat.errors import InputError, ModelError
+from kinestat.io.library import prototype
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.platform import (
     LEG_NAMES,
     Platform,
-    prototype,
     special_6_6,
     special_layout,
 )

@@ -8,9 +8,10 @@ import numpy as np
 import pytest
 
 from kinestat.errors import ModelError
+from kinestat.io.library import prototype
 from kinestat.parallel._refine import apply_twist, refine
 from kinestat.parallel.legs import leg_lengths
-from kinestat.parallel.platform import Platform, prototype, special_6_6, triangle_points
+from kinestat.parallel.platform import Platform, special_6_6, triangle_points
 from kinestat.parallel.singularity import (
     check_design,
     is_architecturally_singular,

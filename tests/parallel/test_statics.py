@@ -8,9 +8,9 @@ import numpy as np
 import pytest
 
 from kinestat.errors import InputError, SingularityError
+from kinestat.io.library import prototype
 from kinestat.parallel._refine import apply_twist
 from kinestat.parallel.legs import leg_lengths, top_points_in_base
-from kinestat.parallel.platform import prototype
 from kinestat.parallel.singularity import singularity_measure
 from kinestat.parallel.statics import (
     forces_from_wrench,

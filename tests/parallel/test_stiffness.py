@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 
 from kinestat.errors import InputError, UnreachableError
+from kinestat.io.library import prototype
 from kinestat.parallel._refine import apply_twist
-from kinestat.parallel.platform import prototype
 from kinestat.parallel.statics import forces_from_wrench, line_jacobian, spring_wrench
 from kinestat.parallel.stiffness import (
     equilibrium_pose,

@@ -1,0 +1,83 @@
+"""Model loading: the embedded models and platform, and ``load(name_or_path)``.
+
+The embedded data stays in :mod:`kinestat.data` (``models/*.toml``, ``platforms/*.toml``); this
+module is the one place that reads it, so the model layers (:mod:`kinestat.mechanism`,
+:mod:`kinestat.parallel`) never read files.
+
+>>> from kinestat.io.library import list_models, load, prototype
+>>> "puma762" in list_models()
+True
+>>> load("puma762").n
+6
+>>> prototype().leg_names
+('O', 'P', 'Q', 'R', 'S', 'T')
+"""
+
+from __future__ import annotations
+
+import os
+from functools import lru_cache
+from importlib import resources
+from pathlib import Path
+
+from kinestat.errors import InputError
+from kinestat.io.model_toml import loads_model, read_model
+from kinestat.io.platform_toml import loads_platform
+from kinestat.mechanism.chain import ChainModel
+from kinestat.parallel.platform import Platform
+
+__all__ = ["load", "list_models", "prototype"]
+
+
+def _models_dir():
+    return resources.files("kinestat.data") / "models"
+
+
+def list_models() -> list[str]:
+    """Names of the embedded models, sorted.
+
+    >>> list_models()[:2]
+    ['nadkarni-config1', 'nadkarni-config2']
+    """
+    return sorted(p.name[:-5] for p in _models_dir().iterdir() if p.name.endswith(".toml"))
+
+
+def load(name_or_path: str | os.PathLike | ChainModel) -> ChainModel:
+    """An embedded model by name (``"puma762"``, ``"puma560"``, ``"nadkarni-config1"``, ...)
+    or a TOML model file by path; a :class:`ChainModel` is returned as it is.
+
+    >>> m = load("puma560")
+    >>> m.n, m.length_unit
+    (6, 'm')
+    """
+    if isinstance(name_or_path, ChainModel):
+        return name_or_path
+    s = os.fspath(name_or_path)
+    if s in list_models():
+        res = _models_dir() / f"{s}.toml"
+        return loads_model(res.read_text(encoding="utf-8"), source=f"<embedded {s}>")
+    p = Path(s)
+    if p.suffix == ".toml" or p.exists():
+        if not p.exists():
+            raise InputError(f"model file {s!r} does not exist")
+        return read_model(p)
+    raise InputError(
+        f"unknown model {s!r}: not an embedded model ({', '.join(list_models())}) "
+        "and not a TOML file path"
+    )
+
+
+@lru_cache(maxsize=1)
+def prototype() -> Platform:
+    """The embedded 2011 prototype platform (``kinestat/data/platforms/prototype-2011.toml``).
+
+    Base side 120 mm, top side 60 mm, offsets 28 mm and 14 mm, home height 60 mm, top turned
+    −60° at home, k = 2.627 N/mm; legs O, P, Q, R, S, T as in the thesis's code (Vibhute 2011,
+    Appendix B).
+
+    >>> p = prototype()
+    >>> p.name, p.length_unit, round(float(p.home_pose[2, 3]), 6)
+    ('vibhute-2011-prototype', 'mm', 60.0)
+    """
+    res = resources.files("kinestat.data") / "platforms" / "prototype-2011.toml"
+    return loads_platform(res.read_text(encoding="utf-8"), source=str(res))
