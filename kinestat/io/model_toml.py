@@ -45,6 +45,7 @@ import numpy as np
 import tomli_w
 
 from kinestat.errors import InputError, ModelError, ParseError
+from kinestat.io._fields import joint_type_and_pitch, matrix, number, refuse_unknown
 from kinestat.io.textfile import read_text_file, write_text_atomic
 from kinestat.mechanism.chain import (
     ChainModel,
@@ -62,30 +63,12 @@ _FIELDS = {
     "nadkarni": ("r", "alpha", "a", "theta"),
 }
 _ANGLES = {"theta", "alpha"}
+_TOP_KEYS = {"name", "notation", "length_unit", "angle_unit", "description", "base", "tool",
+             "q_home", "frame_points", "hand", "joints", "source"}
 
 
 def _err(msg: str, source: str, field: str | None = None) -> ParseError:
     return ParseError(msg, file=source, field=field)
-
-
-def _num(v, source: str, field: str) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise _err(f"expected a number, got {v!r}", source, field)
-    x = float(v)
-    if not math.isfinite(x):
-        raise _err(f"expected a finite number, got {v!r}", source, field)
-    return x
-
-
-def _matrix(v, source: str, field: str, shape: tuple[int, int]) -> np.ndarray:
-    try:
-        a = np.array(v, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise _err(f"expected a {shape[0]}x{shape[1]} array of numbers", source, field) from exc
-    if a.shape != shape or not np.all(np.isfinite(a)):
-        raise _err(f"expected a finite {shape[0]}x{shape[1]} array, got shape {a.shape}",
-                   source, field)
-    return a
 
 
 def loads_model(text: str, source: str = "<string>") -> ChainModel:
@@ -103,12 +86,7 @@ def read_model(path: str | os.PathLike) -> ChainModel:
 
 
 def _from_doc(doc: dict, source: str) -> ChainModel:
-    known = {"name", "notation", "length_unit", "angle_unit", "description", "base", "tool",
-             "q_home", "frame_points", "hand", "joints", "source"}
-    unknown = set(doc) - known
-    if unknown:
-        raise _err(f"unknown top-level keys {sorted(unknown)}; expected some of {sorted(known)}",
-                   source)
+    refuse_unknown(doc, _TOP_KEYS, source, "top-level keys")
     notation = doc.get("notation")
     if notation not in _FIELDS:
         raise _err(f"notation must be one of {sorted(_FIELDS)}, got {notation!r}", source,
@@ -135,25 +113,14 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
         where = f"joints[{i}]"
         if not isinstance(j, dict):
             raise _err("each joint must be a table", source, where)
-        extra = set(j) - set(fields) - {"name", "type", "pitch", "limits"}
-        if extra:
-            raise _err(f"unknown keys {sorted(extra)}", source, where)
-        kind = j.get("type", "revolute")
-        if kind not in ("revolute", "prismatic", "screw"):
-            raise _err(f"unknown joint type {kind!r}; expected revolute, prismatic or screw",
-                       source, f"{where}.type")
+        refuse_unknown(j, {*fields, "name", "type", "pitch", "limits"}, source, field=where)
+        kind, pitch = joint_type_and_pitch(j, source, where)
         row = []
         for f in fields:
-            v = _num(j.get(f, 0.0), source, f"{where}.{f}")
+            v = number(j.get(f, 0.0), source, f"{where}.{f}")
             row.append(v * to_rad if f in _ANGLES else v)
         rows.append(row)
         kinds.append(kind)
-        pitch = _num(j.get("pitch", 0.0), source, f"{where}.pitch")
-        if kind == "screw" and pitch == 0.0:
-            raise _err("a screw joint needs a non-zero pitch", source, f"{where}.pitch")
-        if kind != "screw" and pitch != 0.0:
-            raise _err(f"pitch is only for screw joints, not {kind} (write type = \"screw\")",
-                       source, f"{where}.pitch")
         pitches.append(pitch)
         lim = j.get("limits", [-math.inf, math.inf])
         if not isinstance(lim, list) or len(lim) != 2:
@@ -171,7 +138,7 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
                 if k in doc:
                     raise _err(f"'{k}' is not used with the nadkarni notation "
                                "(use frame_points and [hand])", source, k)
-            fp = _matrix(doc.get("frame_points"), source, "frame_points", (3, 3))
+            fp = matrix(doc.get("frame_points"), source, "frame_points", (3, 3))
             full = []
             for row, kind, pitch in zip(rows, kinds, pitches, strict=True):
                 ph = {"prismatic": 2 * PRISMATIC_PITCH_THRESHOLD, "revolute": 0.0}.get(kind, pitch)
@@ -181,7 +148,7 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
                 h = doc["hand"]
                 if not isinstance(h, dict):
                     raise _err("[hand] must be a table of r, alpha, a, theta", source, "hand")
-                hr = [_num(h.get(f, 0.0), source, f"hand.{f}") * (to_rad if f in _ANGLES else 1)
+                hr = [number(h.get(f, 0.0), source, f"hand.{f}") * (to_rad if f in _ANGLES else 1)
                       for f in fields]
                 full.append(hr + [0.0])
                 n_active = len(rows)
@@ -191,15 +158,15 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
                 type(jt)(kind=jt.kind, pitch=jt.pitch, lower=jt.lower, upper=jt.upper, name=nm)
                 for jt, nm in zip(model.joints, names, strict=True)))
         else:
-            base = _matrix(doc["base"], source, "base", (4, 4)) if "base" in doc else None
-            tool = _matrix(doc["tool"], source, "tool", (4, 4)) if "tool" in doc else None
+            base = matrix(doc["base"], source, "base", (4, 4)) if "base" in doc else None
+            tool = matrix(doc["tool"], source, "tool", (4, 4)) if "tool" in doc else None
             build = from_standard_dh if notation == "standard_dh" else from_modified_dh
             q_home = None
             if "q_home" in doc:
                 if not isinstance(doc["q_home"], list):
                     raise _err(f"q_home must be a list of {len(rows)} numbers, got "
                                f"{doc['q_home']!r}", source, "q_home")
-                qh = np.array([_num(v, source, "q_home") for v in doc["q_home"]])
+                qh = np.array([number(v, source, "q_home") for v in doc["q_home"]])
                 if qh.shape != (len(rows),):
                     raise _err(f"q_home must have {len(rows)} values", source, "q_home")
                 q_home = np.where(np.array(kinds) == "prismatic", qh, qh * to_rad)

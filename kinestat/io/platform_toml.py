@@ -52,8 +52,10 @@ import numpy as np
 import tomli_w
 
 from kinestat.errors import InputError, ModelError, ParseError
+from kinestat.io._fields import matrix, number, numbers, refuse_unknown, string
 from kinestat.io.textfile import read_text_file, write_text_atomic
 from kinestat.parallel.platform import LEG_NAMES, Platform, special_6_6
+from kinestat.parallel.singularity import check_design
 from kinestat.spatial.transforms import apply
 
 __all__ = ["LENGTH_UNITS", "FORCE_UNITS", "loads_platform", "read_platform", "dumps_platform",
@@ -69,35 +71,11 @@ _DESIGN_KEYS = {"kind", "base_side", "top_side", "base_offset", "top_offset", "h
 _LEG_KEYS = {"name", "base", "top", "stiffness", "free_length"}
 
 
-def _num(v, source: str, field: str) -> float:
-    if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise ParseError(f"expected a number, got {v!r}", file=source, field=field)
-    x = float(v)
-    if not math.isfinite(x):
-        raise ParseError(f"expected a finite number, got {v!r}", file=source, field=field)
-    return x
-
-
-def _nums(v, n: int, source: str, field: str, scalar_ok: bool = True):
-    if scalar_ok and not isinstance(v, list):
-        return _num(v, source, field)
-    if not isinstance(v, list) or len(v) != n:
-        what = f"a number or a list of {n} numbers" if scalar_ok else f"a list of {n} numbers"
-        raise ParseError(f"expected {what}, got {v!r}", file=source, field=field)
-    return [_num(x, source, f"{field}[{i}]") for i, x in enumerate(v)]
-
-
-def _str(v, source: str, field: str) -> str:
-    if not isinstance(v, str):
-        raise ParseError(f"expected a string, got {v!r}", file=source, field=field)
-    return v
-
-
 def _unit(doc: dict, key: str, allowed: tuple[str, ...], source: str) -> str:
     if key not in doc:
         raise ParseError(f"missing required {key!r} (one of {list(allowed)}): units must be "
                          "explicit", file=source, field=key)
-    u = _str(doc[key], source, key)
+    u = string(doc[key], source, key)
     if u not in allowed:
         raise ParseError(f"unknown unit {u!r}; expected one of {list(allowed)}", file=source,
                          field=key)
@@ -119,11 +97,8 @@ def read_platform(path: str | os.PathLike) -> Platform:
 
 
 def _from_doc(doc: dict, source: str) -> Platform:
-    unknown = set(doc) - _TOP_KEYS
-    if unknown:
-        raise ParseError(f"unknown top-level keys {sorted(unknown)}; expected some of "
-                         f"{sorted(_TOP_KEYS)}", file=source)
-    name = _str(doc.get("name", Path(source).stem), source, "name")
+    refuse_unknown(doc, _TOP_KEYS, source, "top-level keys")
+    name = string(doc.get("name", Path(source).stem), source, "name")
     lu = _unit(doc, "length_unit", LENGTH_UNITS, source)
     fu = _unit(doc, "force_unit", FORCE_UNITS, source)
     has_design, has_legs = "design" in doc, "legs" in doc
@@ -144,10 +119,7 @@ def _design(doc: dict, source: str, name: str, lu: str, fu: str) -> Platform:
     d = doc["design"]
     if not isinstance(d, dict):
         raise ParseError("[design] must be a table", file=source, card="design")
-    unknown = set(d) - _DESIGN_KEYS
-    if unknown:
-        raise ParseError(f"unknown keys {sorted(unknown)} in [design]; expected some of "
-                         f"{sorted(_DESIGN_KEYS)}", file=source, card="design")
+    refuse_unknown(d, _DESIGN_KEYS, source, "keys in [design]", card="design")
     kind = d.get("kind", "special-6-6")
     if kind != "special-6-6":
         raise ParseError(f"unknown design kind {kind!r}; only 'special-6-6' is known",
@@ -159,7 +131,7 @@ def _design(doc: dict, source: str, name: str, lu: str, fu: str) -> Platform:
             raise ParseError(f"missing {key!r}", file=source, card="design", field=key)
 
     def f(key, n):
-        return _nums(d[key], n, source, f"design.{key}")
+        return numbers(d[key], n, source, f"design.{key}")
 
     names = doc.get("leg_names", list(LEG_NAMES))
     if (not isinstance(names, list) or len(names) != 6
@@ -168,12 +140,12 @@ def _design(doc: dict, source: str, name: str, lu: str, fu: str) -> Platform:
                          field="leg_names")
     free = None
     if "free_lengths" in d:
-        free = _nums(d["free_lengths"], 6, source, "design.free_lengths", scalar_ok=False)
-    twist = _num(d.get("home_twist_deg", -60.0), source, "design.home_twist_deg")
+        free = numbers(d["free_lengths"], 6, source, "design.free_lengths", scalar_ok=False)
+    twist = number(d.get("home_twist_deg", -60.0), source, "design.home_twist_deg")
     return special_6_6(
         base_side=f("base_side", 3), top_side=f("top_side", 3),
         base_offset=f("base_offset", 3), top_offset=f("top_offset", 3),
-        height=_num(d["home_height"], source, "design.home_height"),
+        height=number(d["home_height"], source, "design.home_height"),
         twist=math.radians(twist), stiffness=f("stiffness", 6), free_lengths=free,
         name=name, length_unit=lu, force_unit=fu, leg_names=tuple(names))
 
@@ -187,31 +159,21 @@ def _explicit(doc: dict, source: str, name: str, lu: str, fu: str) -> Platform:
     if "home_pose" not in doc:
         raise ParseError("missing 'home_pose' (4x4) for an explicit platform", file=source,
                          field="home_pose")
-    try:
-        home = np.array(doc["home_pose"], dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ParseError("home_pose must be a 4x4 array of numbers", file=source,
-                         field="home_pose") from exc
-    if home.shape != (4, 4) or not np.all(np.isfinite(home)):
-        raise ParseError(f"home_pose must be a finite 4x4 array, got shape {home.shape}",
-                         file=source, field="home_pose")
+    home = matrix(doc["home_pose"], source, "home_pose", (4, 4))
     names, base, top, k, l0 = [], [], [], [], []
     for i, leg in enumerate(legs):
         card = f"legs[{i}]"
         if not isinstance(leg, dict):
             raise ParseError("each [[legs]] entry must be a table", file=source, card=card)
-        unknown = set(leg) - _LEG_KEYS
-        if unknown:
-            raise ParseError(f"unknown keys {sorted(unknown)}; expected some of "
-                             f"{sorted(_LEG_KEYS)}", file=source, card=card)
+        refuse_unknown(leg, _LEG_KEYS, source, card=card)
         for key in ("name", "base", "top", "stiffness"):
             if key not in leg:
                 raise ParseError(f"missing {key!r}", file=source, card=card, field=key)
-        names.append(_str(leg["name"], source, f"{card}.name"))
-        base.append(_nums(leg["base"], 3, source, f"{card}.base", scalar_ok=False))
-        top.append(_nums(leg["top"], 3, source, f"{card}.top", scalar_ok=False))
-        k.append(_num(leg["stiffness"], source, f"{card}.stiffness"))
-        l0.append(_num(leg["free_length"], source, f"{card}.free_length")
+        names.append(string(leg["name"], source, f"{card}.name"))
+        base.append(numbers(leg["base"], 3, source, f"{card}.base", scalar_ok=False))
+        top.append(numbers(leg["top"], 3, source, f"{card}.top", scalar_ok=False))
+        k.append(number(leg["stiffness"], source, f"{card}.stiffness"))
+        l0.append(number(leg["free_length"], source, f"{card}.free_length")
                   if "free_length" in leg else None)
     base_a, top_a = np.array(base), np.array(top)
     home_l = np.linalg.norm(apply(home, top_a) - base_a, axis=-1)
@@ -219,8 +181,6 @@ def _explicit(doc: dict, source: str, name: str, lu: str, fu: str) -> Platform:
     plat = Platform(base_points=base_a, top_points=top_a, stiffness=np.array(k),
                     free_lengths=free, home_pose=home, leg_names=tuple(names), name=name,
                     length_unit=lu, force_unit=fu)
-    from kinestat.parallel.singularity import check_design
-
     check_design(plat)
     return plat
 
