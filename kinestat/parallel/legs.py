@@ -1,14 +1,25 @@
-"""Reverse kinematics of the platform: leg vectors and leg lengths from a pose, batched."""
+"""Reverse kinematics of the platform: leg vectors, lengths and lines from a pose, batched.
+
+Leg ``i`` lies on the line ``{S_i; B_i × S_i}`` (Vibhute 2011 eq. A-7), ``S_i`` the unit vector
+from the base point ``B_i`` to the top point, base frame; the line Jacobian ``j`` has these
+lines as columns (eq. 2-6). They live here, below :mod:`~kinestat.parallel.statics` and
+:mod:`~kinestat.parallel.singularity`, because the platform builder's design check needs them.
+"""
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from kinestat.errors import InputError
-from kinestat.parallel.platform import Platform
+from kinestat.errors import InputError, SingularityError
 from kinestat.spatial.transforms import apply, as_array
 
-__all__ = ["as_pose", "top_points_in_base", "leg_vectors", "leg_lengths"]
+if TYPE_CHECKING:  # the platform module imports this one (its design check)
+    from kinestat.parallel.platform import Platform
+
+__all__ = ["as_pose", "top_points_in_base", "leg_vectors", "leg_lengths", "leg_directions",
+           "leg_lines", "line_jacobian"]
 
 
 def as_pose(pose, name: str = "pose") -> np.ndarray:
@@ -52,3 +63,23 @@ def leg_vectors(platform: Platform, pose) -> np.ndarray:
 def leg_lengths(platform: Platform, pose) -> np.ndarray:
     """Leg lengths ``(..., 6)`` of the platform at ``pose`` (the reverse kinematic analysis)."""
     return np.linalg.norm(leg_vectors(platform, pose), axis=-1)
+
+
+def leg_directions(platform: Platform, pose) -> tuple[np.ndarray, np.ndarray]:
+    """Unit leg directions S_i (base → top) (..., 6, 3) and leg lengths (..., 6)."""
+    d = leg_vectors(platform, pose)
+    l = np.linalg.norm(d, axis=-1)
+    if np.any(l <= 0):
+        raise SingularityError("a leg has zero length at this pose: its line is undefined")
+    return d / l[..., None], l
+
+
+def leg_lines(platform: Platform, pose) -> np.ndarray:
+    """Plücker coordinates ``{S_i; B_i × S_i}`` of the six legs, (..., 6 legs, 6) (eq. A-7)."""
+    S, _ = leg_directions(platform, pose)
+    return np.concatenate([S, np.cross(platform.base_points, S)], axis=-1)
+
+
+def line_jacobian(platform: Platform, pose) -> np.ndarray:
+    """The line Jacobian ``j`` (..., 6, 6), columns ``[S_i; B_i × S_i]`` (Vibhute eq. 2-6)."""
+    return np.swapaxes(leg_lines(platform, pose), -1, -2)

@@ -27,6 +27,7 @@ from itertools import permutations
 import numpy as np
 
 from kinestat.errors import InputError, ModelError
+from kinestat.parallel.singularity import check_design, reduction_products
 from kinestat.spatial.transforms import apply, make_pose, rot_z
 
 __all__ = [
@@ -102,8 +103,8 @@ class SpecialLayout:
     @property
     def reduction_det(self) -> float:
         """Determinant of the special 6-6 → 3-3 reduction, Π(1 − t) − Π t (zero: singular)."""
-        t = np.asarray(self.t)
-        return float(np.prod(1.0 - t) - np.prod(t))
+        a, b = reduction_products(self.t)
+        return a - b
 
 
 @dataclass(frozen=True, eq=False)
@@ -298,8 +299,6 @@ def special_6_6(
     plat = Platform(base_points=base_pts, top_points=top_pts, stiffness=k, free_lengths=l0,
                     home_pose=home, leg_names=leg_names, name=name, length_unit=length_unit,
                     force_unit=force_unit, design=design)
-    from kinestat.parallel.singularity import check_design
-
     check_design(plat)
     return plat
 

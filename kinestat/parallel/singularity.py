@@ -16,13 +16,19 @@ Karger) is the best known case.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from kinestat.errors import ModelError
-from kinestat.parallel.platform import Platform
+from kinestat.parallel._refine import apply_twist
+from kinestat.parallel.legs import line_jacobian
 
-__all__ = ["singularity_measure", "reduction_conditioning", "is_architecturally_singular",
-           "check_design"]
+if TYPE_CHECKING:  # the platform builder calls check_design
+    from kinestat.parallel.platform import Platform
+
+__all__ = ["singularity_measure", "reduction_products", "reduction_conditioning",
+           "is_architecturally_singular", "check_design"]
 
 #: Below this, a dimensionless measure counts as singular.
 SINGULAR_TOL = 1e-9
@@ -34,24 +40,30 @@ def singularity_measure(platform: Platform, pose) -> np.ndarray:
     0 at a singular pose; of order 1 for a well-conditioned one (columns are unit lines).
     Batched over poses (...,4,4) → (...).
     """
-    from kinestat.parallel.statics import line_jacobian
-
     j = line_jacobian(platform, pose).copy()
     j[..., 3:, :] /= platform.scale
     return np.abs(np.linalg.det(j))
 
 
+def reduction_products(t) -> tuple[float, float]:
+    """(Π(1 − t), Π t) of the six edge fractions: equal when the special 6-6 → 3-3 reduction is
+    singular (its determinant is their difference).
+
+    >>> reduction_products([0.5] * 6)
+    (0.015625, 0.015625)
+    """
+    t = np.asarray(t, dtype=float)
+    return float(np.prod(1.0 - t)), float(np.prod(t))
+
+
 def reduction_conditioning(t) -> float:
     """|Π(1 − t) − Π t| / max(Π(1 − t), Π t): 0 when the special 6-6 → 3-3 reduction is singular."""
-    t = np.asarray(t, dtype=float)
-    a, b = float(np.prod(1.0 - t)), float(np.prod(t))
+    a, b = reduction_products(t)
     den = max(abs(a), abs(b), 1e-300)
     return abs(a - b) / den
 
 
 def _sample_poses(platform: Platform, n: int, seed: int) -> np.ndarray:
-    from kinestat.parallel._refine import apply_twist
-
     rng = np.random.default_rng(seed)
     tw = rng.normal(size=(n, 6)) * np.r_[0.15, 0.15, 0.15, [0.1 * platform.scale] * 3]
     return apply_twist(np.broadcast_to(platform.home_pose, (n, 4, 4)), tw)

@@ -28,10 +28,12 @@ import numpy as np
 
 from kinestat.errors import SingularityError
 from kinestat.parallel.fk import check_lengths, fk_tracking
-from kinestat.parallel.legs import leg_vectors
+from kinestat.parallel.legs import leg_directions, leg_lines, line_jacobian
 from kinestat.parallel.platform import Platform
+from kinestat.parallel.singularity import singularity_measure
 from kinestat.spatial.transforms import as_array
 
+# leg_directions, leg_lines and line_jacobian are defined in kinestat.parallel.legs
 __all__ = [
     "leg_directions",
     "leg_lines",
@@ -43,26 +45,6 @@ __all__ = [
     "spring_wrench",
     "wrench_from_leg_lengths",
 ]
-
-
-def leg_directions(platform: Platform, pose) -> tuple[np.ndarray, np.ndarray]:
-    """Unit leg directions S_i (base → top) (..., 6, 3) and leg lengths (..., 6)."""
-    d = leg_vectors(platform, pose)
-    l = np.linalg.norm(d, axis=-1)
-    if np.any(l <= 0):
-        raise SingularityError("a leg has zero length at this pose: its line is undefined")
-    return d / l[..., None], l
-
-
-def leg_lines(platform: Platform, pose) -> np.ndarray:
-    """Plücker coordinates ``{S_i; B_i × S_i}`` of the six legs, (..., 6 legs, 6) (eq. A-7)."""
-    S, _ = leg_directions(platform, pose)
-    return np.concatenate([S, np.cross(platform.base_points, S)], axis=-1)
-
-
-def line_jacobian(platform: Platform, pose) -> np.ndarray:
-    """The line Jacobian ``j`` (..., 6, 6), columns ``[S_i; B_i × S_i]`` (Vibhute eq. 2-6)."""
-    return np.swapaxes(leg_lines(platform, pose), -1, -2)
 
 
 def jacobian_det(platform: Platform, pose) -> np.ndarray:
@@ -88,8 +70,6 @@ def forces_from_wrench(platform: Platform, pose, wrench, *, tol: float = 1e-9) -
     Raises:
         SingularityError: the pose is singular (dimensionless |det j| below ``tol``).
     """
-    from kinestat.parallel.singularity import singularity_measure
-
     w = as_array(wrench, shape_tail=(6,), name="wrench")
     j = line_jacobian(platform, pose)
     m = singularity_measure(platform, pose)
