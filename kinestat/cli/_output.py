@@ -4,13 +4,16 @@ from __future__ import annotations
 
 import json
 import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 from rich.console import Console
 from rich.table import Table
 
+from kinestat.errors import InputError
 from kinestat.io.jsonable import to_jsonable
+from kinestat.io.posefile import read_pose_file
 
 # Wide enough for the tables when output goes to a file or pipe (rich assumes 80 columns there).
 console = Console(width=None if sys.stdout.isatty() else 160)
@@ -34,8 +37,6 @@ def table(title: str, columns: list[str], rows: list[list[Any]], fmt: str = "{:.
 
 def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.ndarray:
     """Parse ``"1,2,3"`` into floats, checking the count; raises InputError."""
-    from kinestat.errors import InputError
-
     items = [v.strip() for v in text.split(",")] if text.strip() else []
     if "" in items:
         raise InputError(f"--{name}: empty value at position {items.index('') + 1} in "
@@ -56,11 +57,6 @@ def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.nda
 def parse_pose(value: str, option: str = "pose", *, allow_batch: bool = False) -> np.ndarray:
     """A pose option's value: a pose file (JSON, TOML or numbers; :mod:`kinestat.io.posefile`)
     or 16 comma-separated numbers (a 4x4 matrix, row by row)."""
-    from pathlib import Path
-
-    from kinestat.errors import InputError
-    from kinestat.io.posefile import read_pose_file
-
     p = Path(value)
     if p.is_file() or p.suffix.lower() in (".json", ".toml"):
         if not p.exists():

@@ -10,6 +10,11 @@ import numpy as np
 import typer
 
 from kinestat.cli._output import console, print_json, table
+from kinestat.io.disp_deck import embedded_deck
+from kinestat.io.library import prototype
+from kinestat.mechanism.nadkarni import mechanism_frames
+from kinestat.parallel import fk_list, leg_lengths
+from kinestat.spatial.displacement import frame_from_triple, screws_between
 
 
 def register(app: typer.Typer) -> None:
@@ -18,8 +23,6 @@ def register(app: typer.Typer) -> None:
 
 def _screws() -> dict:
     """Nadkarni Illustration 1 (MS = 1): the screw between consecutive body positions."""
-    from kinestat.io.disp_deck import embedded_deck
-    from kinestat.spatial.displacement import frame_from_triple, screws_between
 
     deck = embedded_deck("illustration1")
     s = screws_between(frame_from_triple(deck.positions))
@@ -34,8 +37,6 @@ def _screws() -> dict:
 
 def _transm() -> dict:
     """Nadkarni Illustration 2 (MS = 2): the mechanism in the global frame."""
-    from kinestat.io.disp_deck import embedded_deck
-    from kinestat.mechanism.nadkarni import mechanism_frames
 
     deck = embedded_deck("illustration2")
     f = mechanism_frames(deck.joint_table, deck.frame_points)
@@ -49,7 +50,7 @@ def _transm() -> dict:
 
 def _puma() -> dict:
     """Vibhute Appendix C: reverse analysis of the PUMA 762 example pose."""
-    from kinestat.serial import puma762
+    from kinestat.serial import puma762  # lazy: PUMA closed-form kernels, ~13 ms at start-up
 
     res = puma762.reverse([725.0, 190.0, 650.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
     sols = np.rad2deg(res.solutions)
@@ -67,8 +68,6 @@ def _puma() -> dict:
 
 def _platform() -> dict:
     """Vibhute Appendix B: every assembly mode of the prototype for main.cpp's leg lengths."""
-    from kinestat.io.library import prototype
-    from kinestat.parallel import fk_list, leg_lengths
 
     p = prototype()
     legs = np.array([79.6804, 81.8285, 81.2669, 68.6500, 67.2037, 68.2854])

@@ -14,6 +14,13 @@ import typer
 
 from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, UnreachableError
+from kinestat.io.library import prototype
+from kinestat.io.platform_toml import read_platform
+from kinestat.parallel.fk import fk_list, fk_numeric
+from kinestat.parallel.legs import as_pose, leg_lengths, top_points_in_base
+from kinestat.parallel.singularity import singularity_measure
+from kinestat.parallel.statics import forces_from_wrench, jacobian_det
+from kinestat.parallel.stiffness import TWIST_ORDERS, stiffness
 
 PLATFORM_HELP = "TOML platform file (default: the embedded 2011 prototype)."
 POSE_HELP = "'home', a JSON/TOML file holding a 4x4 pose, or 16 comma-separated numbers."
@@ -31,15 +38,10 @@ def register(app: typer.Typer) -> None:
 
 
 def _load(path: str | None):
-    from kinestat.io.library import prototype
-    from kinestat.io.platform_toml import read_platform
-
     return prototype() if path is None else read_platform(path)
 
 
 def _pose(text: str, platform) -> np.ndarray:
-    from kinestat.parallel.legs import as_pose
-
     if text.strip().lower() == "home":
         return platform.home_pose.copy()
     T = parse_pose(text, "pose")
@@ -61,8 +63,6 @@ def info_command(
     "stiffness", "free_lengths", "home_pose", "special", "edge_fractions", "jacobian_det_home",
     "singularity_measure_home", "design"}.
     """
-    from kinestat.parallel.singularity import singularity_measure
-    from kinestat.parallel.statics import jacobian_det
 
     p = _load(platform)
     d = p.design
@@ -113,8 +113,6 @@ def fk_command(
     JSON: {"count", "method", "solutions": [{"pose", "top_points", "above_base",
     "max_leg_error"}]}; top_points are O1..T1 (leg order) in base coordinates.
     """
-    from kinestat.parallel.fk import fk_list, fk_numeric
-    from kinestat.parallel.legs import leg_lengths, top_points_in_base
 
     p = _load(platform)
     L = parse_floats(legs, 6, "legs")
@@ -155,7 +153,6 @@ def ik_command(
     as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
 ) -> None:
     """Leg lengths at a pose (reverse kinematics). JSON: {"leg_lengths", "leg_names"}."""
-    from kinestat.parallel.legs import leg_lengths
 
     p = _load(platform)
     T = _pose(pose, p)
@@ -182,8 +179,6 @@ def statics_command(
     Forces are tensions (positive: the leg pulls). JSON: {"leg_forces", "jacobian_det",
     "singularity_measure", "leg_names"}.
     """
-    from kinestat.parallel.singularity import singularity_measure
-    from kinestat.parallel.statics import forces_from_wrench, jacobian_det
 
     p = _load(platform)
     T = _pose(pose, p)
@@ -217,8 +212,6 @@ def stiffness_command(
 
     JSON: {"stiffness" (6x6), "twist_order", "leg_forces", "asymmetry" (max |K - K^T|)}.
     """
-    from kinestat.parallel.statics import forces_from_wrench
-    from kinestat.parallel.stiffness import TWIST_ORDERS, stiffness
 
     if twist_order not in TWIST_ORDERS:
         raise InputError(f"--twist-order must be one of {list(TWIST_ORDERS)}, got "
@@ -230,7 +223,6 @@ def stiffness_command(
         forces = forces_from_wrench(p, T, parse_floats(wrench, 6, "wrench"))
     K = stiffness(p, T, forces, twist_order=twist_order)
     if forces is None:
-        from kinestat.parallel.legs import leg_lengths
 
         forces = p.stiffness * (leg_lengths(p, T) - p.free_lengths)
     Kr = stiffness(p, T, forces)
