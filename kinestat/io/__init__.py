@@ -1,10 +1,21 @@
-"""Files at the edges: DISP card decks (:mod:`kinestat.io.disp_deck`), model and platform files.
+"""Files at the edges, and model loading. The model layers below never read files.
 
-The DISP deck API is re-exported here; the other formats are imported from their modules.
+- :mod:`~kinestat.io.library` — ``load``/``list_models`` (embedded models or TOML files) and the
+  embedded 2011 prototype platform (:func:`~kinestat.io.library.prototype`).
+- :mod:`~kinestat.io.model_toml` — TOML model files (read, write, round trip).
+- :mod:`~kinestat.io.platform_toml` — TOML platform files.
+- :mod:`~kinestat.io.axes_file` — axes files (joint axes in the world frame, for dh-from-axes).
+- :mod:`~kinestat.io.urdf` — URDF export and import of serial chains.
+- :mod:`~kinestat.io.posefile` — pose files (JSON, TOML or plain numbers).
+- :mod:`~kinestat.io.disp_deck` — DISP card decks (Nadkarni 1977).
+- :mod:`~kinestat.io.textfile` — the text reader and atomic writer every format uses.
+- :mod:`~kinestat.io.jsonable` — numpy results to JSON-ready values.
+- ``kinestat.io._fields`` — checked fields of parsed TOML/JSON documents (private).
 """
 
 from __future__ import annotations
 
+from kinestat.io.axes_file import loads_axes, read_axes_file
 from kinestat.io.disp_deck import (
     DeckJoint,
     DispDeck,
@@ -16,15 +27,37 @@ from kinestat.io.disp_deck import (
     read_deck,
     write_deck,
 )
+from kinestat.io.library import list_models, load, prototype
+from kinestat.io.model_toml import dumps_model, loads_model, read_model, write_model
+from kinestat.io.platform_toml import dumps_platform, loads_platform, read_platform, write_platform
+from kinestat.io.posefile import read_pose_file
+from kinestat.io.urdf import from_urdf, read_urdf, to_urdf
 
 __all__ = [
     "DeckJoint",
     "DispDeck",
     "OperatorCommand",
     "deck_warnings",
+    "dumps_model",
+    "dumps_platform",
     "embedded_deck",
+    "from_urdf",
     "list_embedded_decks",
+    "list_models",
+    "load",
+    "loads_axes",
+    "loads_model",
+    "loads_platform",
     "parse_deck",
+    "prototype",
+    "read_axes_file",
     "read_deck",
+    "read_model",
+    "read_platform",
+    "read_pose_file",
+    "read_urdf",
+    "to_urdf",
     "write_deck",
+    "write_model",
+    "write_platform",
 ]

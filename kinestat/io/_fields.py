@@ -12,13 +12,10 @@ import math
 import numpy as np
 
 from kinestat.errors import ParseError
+from kinestat.mechanism.joints import JOINT_KINDS
 
-__all__ = ["JOINT_TYPES", "number", "numbers", "string", "matrix", "refuse_unknown",
+__all__ = ["number", "numbers", "string", "matrix", "refuse_unknown",
            "joint_type_and_pitch"]
-
-#: The joint types a file may name (``type = ...``).
-JOINT_TYPES = ("revolute", "prismatic", "screw")
-
 
 def number(v, source: str, field: str, **where) -> float:
     """A finite number (not a bool)."""
@@ -75,7 +72,7 @@ def joint_type_and_pitch(entry: dict, source: str, where: str) -> tuple[str, flo
     A screw joint needs a non-zero pitch (length per radian); the others take none.
     """
     kind = entry.get("type", "revolute")
-    if kind not in JOINT_TYPES:
+    if kind not in JOINT_KINDS:
         raise ParseError(f"unknown joint type {kind!r}; expected revolute, prismatic or screw",
                          file=source, field=f"{where}.type")
     pitch = number(entry.get("pitch", 0.0), source, f"{where}.pitch")

@@ -61,7 +61,16 @@ def leg_vectors(platform: Platform, pose) -> np.ndarray:
 
 
 def leg_lengths(platform: Platform, pose) -> np.ndarray:
-    """Leg lengths ``(..., 6)`` of the platform at ``pose`` (the reverse kinematic analysis)."""
+    """Leg lengths ``(..., 6)`` of the platform at ``pose`` (the reverse kinematic analysis).
+
+    At home they are the free lengths (the default of :func:`~kinestat.parallel.special_6_6`):
+
+    >>> import numpy as np
+    >>> from kinestat.parallel.platform import special_6_6
+    >>> p = special_6_6()
+    >>> bool(np.allclose(leg_lengths(p, p.home_pose), p.free_lengths))
+    True
+    """
     return np.linalg.norm(leg_vectors(platform, pose), axis=-1)
 
 
@@ -81,5 +90,11 @@ def leg_lines(platform: Platform, pose) -> np.ndarray:
 
 
 def line_jacobian(platform: Platform, pose) -> np.ndarray:
-    """The line Jacobian ``j`` (..., 6, 6), columns ``[S_i; B_i × S_i]`` (Vibhute eq. 2-6)."""
+    """The line Jacobian ``j`` (..., 6, 6), columns ``[S_i; B_i × S_i]`` (Vibhute eq. 2-6).
+
+    >>> from kinestat.parallel.platform import special_6_6
+    >>> p = special_6_6()
+    >>> line_jacobian(p, p.home_pose).shape
+    (6, 6)
+    """
     return np.swapaxes(leg_lines(platform, pose), -1, -2)

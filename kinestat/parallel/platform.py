@@ -238,6 +238,10 @@ def special_6_6(
     Raises:
         InputError: impossible dimensions (offsets outside their edge, bad triangles).
         ModelError: an architecturally singular layout (see :mod:`kinestat.parallel.singularity`).
+
+    >>> p = special_6_6()                      # the 2011 prototype's design
+    >>> p.leg_names, round(p.layout.t[0], 6)   # edge points 14 mm along 60 mm top sides
+    (('O', 'P', 'Q', 'R', 'S', 'T'), 0.233333)
     """
     triangles = []
     for sides, what in ((base_side, "base_side"), (top_side, "top_side")):

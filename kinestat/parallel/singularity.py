@@ -80,6 +80,13 @@ def check_design(platform: Platform) -> None:
 
     Raises:
         ModelError: the design has a self-motion, or its home pose is singular.
+
+    >>> from kinestat.parallel.platform import special_6_6
+    >>> check_design(special_6_6())   # the 2011 prototype: accepted; all edge midpoints: refused
+    >>> special_6_6(base_offset=60.0, top_offset=30.0)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    kinestat.errors.ModelError: platform 'special-6-6' is architecturally singular: ...
     """
     lay = platform.layout
     if lay is not None and reduction_conditioning(lay.t) < SINGULAR_TOL:
