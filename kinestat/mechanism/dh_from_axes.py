@@ -46,6 +46,7 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel, from_standard_dh
+from kinestat.spatial.plucker import COINCIDENT, INTERSECTING, LINE_KINDS, PARALLEL, SKEW
 from kinestat.spatial.transforms import inv, rot_x, rot_z, trans_x, trans_z
 
 __all__ = [
@@ -65,10 +66,9 @@ __all__ = [
     "dh_from_axes",
 ]
 
-#: Relation of neighbouring z axes, indexed by the integer codes (same order as
-#: :data:`kinestat.spatial.plucker.LINE_KINDS`).
-RELATIONS: tuple[str, ...] = ("skew", "parallel", "intersecting", "coincident")
-SKEW, PARALLEL, INTERSECTING, COINCIDENT = range(4)
+#: Relation of neighbouring z axes, indexed by the integer codes SKEW, PARALLEL, INTERSECTING,
+#: COINCIDENT: the line relations of :mod:`kinestat.spatial.plucker` (one definition).
+RELATIONS: tuple[str, ...] = LINE_KINDS
 
 # Below this |x_tool × z| the tool's x axis is taken as along z and its y axis used instead.
 _TOOL_X_ALONG_Z = 1e-6
