@@ -428,6 +428,13 @@ def dh_from_axes(
     kinematics at q = 0 puts joint i's axis on the i-th given line with the given direction, and
     its end pose on ``tool`` (lecture notes, steps 1 and 2). For a batch of axis sets use
     :func:`assign_dh_frames`.
+
+    A vertical waist axis, then two parallel horizontal axes 400 mm apart:
+
+    >>> res = dh_from_axes([[[0, 0, 0], [0, 0, 1]], [[0, 0, 300], [0, -1, 0]],
+    ...                     [[0, 0, 700], [0, -1, 0]]])
+    >>> res.n, res.relations[:2], round(float(res.table[1, 2]), 6)
+    (3, ('intersecting', 'parallel'), 400.0)
     """
     A = _axes_array(axes)
     if not ((A.ndim == 3 and A.shape[1:] == (2, 3)) or (A.ndim == 2 and A.shape[1] == 6)):
