@@ -85,29 +85,8 @@ def read_model(path: str | os.PathLike) -> ChainModel:
     return loads_model(read_text_file(path, "model file"), source=str(Path(path)))
 
 
-def _from_doc(doc: dict, source: str) -> ChainModel:
-    refuse_unknown(doc, _TOP_KEYS, source, "top-level keys")
-    notation = doc.get("notation")
-    if notation not in _FIELDS:
-        raise _err(f"notation must be one of {sorted(_FIELDS)}, got {notation!r}", source,
-                   "notation")
-    angle_unit = doc.get("angle_unit", "deg")
-    if angle_unit not in ("deg", "rad"):
-        raise _err(f"angle_unit must be 'deg' or 'rad', got {angle_unit!r}", source, "angle_unit")
-    to_rad = math.pi / 180.0 if angle_unit == "deg" else 1.0
-    # keys of the other notations: refused rather than silently ignored
-    unused = ["q_home"] if notation == "nadkarni" else ["frame_points", "hand"]
-    for k in unused:
-        if k in doc:
-            hint = ("the joint values of a nadkarni file are the initial configuration"
-                    if k == "q_home" else "it belongs to the nadkarni notation")
-            raise _err(f"'{k}' is not used with the {notation} notation ({hint})", source, k)
-    name = str(doc.get("name", Path(source).stem))
-    length_unit = str(doc.get("length_unit", "mm"))
-    joints = doc.get("joints")
-    if not isinstance(joints, list) or not joints:
-        raise _err("expected at least one [[joints]] table", source, "joints")
-    fields = _FIELDS[notation]
+def _joint_tables(joints: list, fields: tuple[str, ...], to_rad: float, source: str):
+    """Rows (radians), kinds, pitches, limits (radians or length) and names of [[joints]]."""
     rows, kinds, pitches, limits, names = [], [], [], [], []
     for i, j in enumerate(joints, start=1):
         where = f"joints[{i}]"
@@ -131,6 +110,33 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
         scale = 1.0 if kind == "prismatic" else to_rad
         limits.append((lo * scale, hi * scale))
         names.append(str(j.get("name", i)))
+    return rows, kinds, pitches, limits, names
+
+
+def _from_doc(doc: dict, source: str) -> ChainModel:
+    refuse_unknown(doc, _TOP_KEYS, source, "top-level keys")
+    notation = doc.get("notation")
+    if notation not in _FIELDS:
+        raise _err(f"notation must be one of {sorted(_FIELDS)}, got {notation!r}", source,
+                   "notation")
+    angle_unit = doc.get("angle_unit", "deg")
+    if angle_unit not in ("deg", "rad"):
+        raise _err(f"angle_unit must be 'deg' or 'rad', got {angle_unit!r}", source, "angle_unit")
+    to_rad = math.pi / 180.0 if angle_unit == "deg" else 1.0
+    # keys of the other notations: refused rather than silently ignored
+    unused = ["q_home"] if notation == "nadkarni" else ["frame_points", "hand"]
+    for k in unused:
+        if k in doc:
+            hint = ("the joint values of a nadkarni file are the initial configuration"
+                    if k == "q_home" else "it belongs to the nadkarni notation")
+            raise _err(f"'{k}' is not used with the {notation} notation ({hint})", source, k)
+    name = str(doc.get("name", Path(source).stem))
+    length_unit = str(doc.get("length_unit", "mm"))
+    joints = doc.get("joints")
+    if not isinstance(joints, list) or not joints:
+        raise _err("expected at least one [[joints]] table", source, "joints")
+    fields = _FIELDS[notation]
+    rows, kinds, pitches, limits, names = _joint_tables(joints, fields, to_rad, source)
     description = str(doc.get("description", ""))
     try:
         if notation == "nadkarni":
