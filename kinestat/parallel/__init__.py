@@ -3,10 +3,11 @@
 - :mod:`~kinestat.parallel.platform` — the immutable :class:`Platform`, the special 6-6 builder
   :func:`special_6_6` (the embedded 2011 prototype is loaded by
   :func:`kinestat.io.library.prototype`: models never read files).
-- :mod:`~kinestat.parallel.legs` — leg lengths from a pose (reverse kinematics).
+- :mod:`~kinestat.parallel.legs` — leg lengths from a pose (reverse kinematics), leg lines and
+  the line Jacobian.
 - :mod:`~kinestat.parallel.fk33` — closed-form 3-3 forward kinematics (all modes).
 - :mod:`~kinestat.parallel.fk` — special 6-6 → 3-3, all modes; tracking mode; general 6-6.
-- :mod:`~kinestat.parallel.statics` — leg lines, line Jacobian, leg forces ↔ wrench.
+- :mod:`~kinestat.parallel.statics` — leg forces ↔ wrench (re-exports the leg lines).
 - :mod:`~kinestat.parallel.stiffness` — spatial stiffness under load, equilibrium poses.
 - :mod:`~kinestat.parallel.planar_springs` — the thesis's planar spring examples.
 - :mod:`~kinestat.parallel.singularity` — singular poses and architecturally singular designs.
