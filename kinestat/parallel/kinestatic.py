@@ -133,9 +133,11 @@ def contact_basis(W) -> np.ndarray:
     s = np.linalg.svd(W / norms[..., None, :], compute_uv=False)
     dep = s[..., -1] <= _W_TOL * s[..., 0]
     if np.any(dep):
+        sv = s[tuple(np.argwhere(dep)[0])] if dep.ndim else s
+        rank = int(np.sum(sv > _W_TOL * sv[0]))
         raise InputError(f"the {m} contact wrenches are linearly dependent{_where(dep)} "
-                         f"(rank {int(np.sum(s[np.argwhere(dep)[0]] > _W_TOL * s[..., 0].max()))}"
-                         f" < {m}); give a basis of the wrenches the contact can exert")
+                         f"(rank {rank} < {m}); give a basis of the wrenches the contact can "
+                         "exert")
     return W
 
 
