@@ -28,6 +28,13 @@ Conventions (every function here):
   :func:`~kinestat.parallel.stiffness.stiffness` defaults to the ray twist order
   ``δD = [δx_O; δφ] = Δ T``; :func:`axis_stiffness` converts, ``K_axis = K_ray Δ``.
 
+Which twist, which sign. K is the platform's: ``T`` the twist of the top relative to the base,
+``δw`` the change of the external wrench on the top. Decomposing that relative twist, the wrench
+on the top changes by ``+W λ``. In kinestatic control the decomposed twist is usually the
+robot's motion ``T_robot`` of the base while the tool (top) touches a rigid environment: the top
+then moves by ``T_f`` and deflects by ``T_f − T_robot = −T_c``, so the external wrench on the top
+changes by ``−W λ`` (the planar example, :mod:`kinestat.parallel.planar_wheel`, has ``λ = −δN``).
+
 The elliptic metric (Griffis & Duffy). ``K T_c = W λ`` and ``Wᵀ Δ T_f = 0`` give
 ``T_fᵀ Δ K T_c = λᵀ Wᵀ Δ T_f = 0``: the wrench that the twist of compliance produces does no
 work on the twist of freedom. ``Δ K_axis = Δ K_ray Δ`` is symmetric, and then

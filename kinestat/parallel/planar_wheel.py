@@ -4,7 +4,7 @@ A body carried by two actuated prismatic joints (pure translation along i and j,
 coordinates ``d = (d1, d2)``) holds a wheel through two springs B1C and B2C (constants k1, k2,
 free lengths L01, L02). The wheel (centre C, radius ρ_w) rolls without friction on a rigid wall,
 the line through ``wall_point`` with unit normal ``n`` (pointing out of the wall, toward the
-wheel) and tangent ``t = (−n_y, n_x)``. With the wheel at arc position ``s`` along the wall,
+wheel) and tangent ``t = (n_y, −n_x)`` (n is t turned +90°). With the wheel at arc position ``s`` along the wall,
 ``C = wall_point + s t + ρ_w n``. The wall can only push along n: the contact force on the wheel
 is ``N n``, N ≥ 0.
 
@@ -84,8 +84,8 @@ class WheelOnWall:
 
     @property
     def wall_tangent(self) -> np.ndarray:
-        """t = (−n_y, n_x): the direction of increasing s along the wall."""
-        return np.array([-self.wall_normal[1], self.wall_normal[0]])
+        """t = (n_y, −n_x): the direction of increasing s along the wall (n is t turned +90°)."""
+        return np.array([self.wall_normal[1], -self.wall_normal[0]])
 
 
 def figure_2_10_example() -> WheelOnWall:

@@ -42,7 +42,7 @@ def force_on_wheel(model, C, d):
 def solve_wheel(model, d, guess):
     """Independent forward problem: the wheel's (s, N) for actuators at d (scipy root)."""
     n = model.wall_normal
-    t = np.array([-n[1], n[0]])
+    t = np.array([n[1], -n[0]])  # n is t turned +90°
 
     def balance(x):
         C = model.wall_point + x[0] * t + model.wheel_radius * n
