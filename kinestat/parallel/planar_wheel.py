@@ -4,9 +4,9 @@ A body carried by two actuated prismatic joints (pure translation along i and j,
 coordinates ``d = (d1, d2)``) holds a wheel through two springs B1C and B2C (constants k1, k2,
 free lengths L01, L02). The wheel (centre C, radius ρ_w) rolls without friction on a rigid wall,
 the line through ``wall_point`` with unit normal ``n`` (pointing out of the wall, toward the
-wheel) and tangent ``t = (n_y, −n_x)`` (n is t turned +90°). With the wheel at arc position ``s`` along the wall,
-``C = wall_point + s t + ρ_w n``. The wall can only push along n: the contact force on the wheel
-is ``N n``, N ≥ 0.
+wheel) and tangent ``t = (n_y, −n_x)`` (n is t turned +90°). With the wheel at arc position
+``s`` along the wall, ``C = wall_point + s t + ρ_w n``. The wall can only push along n: the
+contact force on the wheel is ``N n``, N ≥ 0.
 
 Spring pivots ``B_i = d + b_i`` (``b_i`` fixed in the body), so the springs see only
 ``r = C − d``. With :func:`~kinestat.parallel.planar_springs.two_spring_force`
