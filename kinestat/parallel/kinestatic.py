@@ -58,6 +58,8 @@ from typing import NamedTuple
 import numpy as np
 
 from kinestat.errors import InputError, SingularityError
+from kinestat.parallel.statics import forces_from_wrench
+from kinestat.parallel.stiffness import stiffness
 from kinestat.spatial.transforms import as_array
 
 __all__ = [
@@ -169,7 +171,8 @@ def elliptic_product(K, T1, T2) -> np.ndarray:
     return np.einsum("...i,...i->...", _twist(T1, "twist T1") @ DELTA, w2)
 
 
-def _check_stiffness(K) -> np.ndarray:
+def _check_stiffness(K) -> tuple[np.ndarray, np.ndarray]:
+    """K as an array and its smallest singular value; SingularityError when K is singular."""
     K = as_array(K, shape_tail=(6, 6), name="stiffness K")
     s = np.linalg.svd(K, compute_uv=False)
     bad = s[..., -1] <= _K_TOL * s[..., 0]
@@ -177,24 +180,27 @@ def _check_stiffness(K) -> np.ndarray:
         raise SingularityError(f"the stiffness K is singular{_where(bad)} (s_min/s_max = "
                                f"{float(np.min(s[..., -1] / s[..., 0])):.3g}): some twist "
                                "costs no wrench, so the twist of compliance is not determined")
-    return K
+    return K, s[..., -1]
 
 
-def compliance_twists(K, W) -> np.ndarray:
-    """``K⁻¹ W`` (..., 6, m): the twists of compliance of the contact wrenches (axis order)."""
-    K = _check_stiffness(K)
-    W = contact_basis(W)
+def _solve(K: np.ndarray, W: np.ndarray) -> np.ndarray:
     batch = np.broadcast_shapes(K.shape[:-2], W.shape[:-2])
     return np.linalg.solve(np.broadcast_to(K, batch + (6, 6)),
                            np.broadcast_to(W, batch + W.shape[-2:]))
 
 
-def _gram(W: np.ndarray, X: np.ndarray, K: np.ndarray) -> np.ndarray:
+def compliance_twists(K, W) -> np.ndarray:
+    """``K⁻¹ W`` (..., 6, m): the twists of compliance of the contact wrenches (axis order)."""
+    K, _ = _check_stiffness(K)
+    return _solve(K, contact_basis(W))
+
+
+def _gram(W: np.ndarray, X: np.ndarray, k_min: np.ndarray) -> np.ndarray:
     """``G = Wᵀ Δ K⁻¹ W`` with ``X = K⁻¹ W``, checked for singularity."""
     G = np.einsum("...im,...in->...mn", DELTA @ W, X)
     n = np.linalg.norm(W, axis=-2)
     Gn = G / (n[..., :, None] * n[..., None, :])
-    cinv = 1.0 / np.linalg.svd(K, compute_uv=False)[..., -1]  # |K⁻¹|₂
+    cinv = 1.0 / k_min  # |K⁻¹|₂
     s = np.linalg.svd(Gn, compute_uv=False)
     bad = s[..., -1] <= _G_TOL * cinv
     if np.any(bad):
@@ -218,11 +224,11 @@ def decompose_twist(K, W, T) -> TwistSplit:
     >>> s.freedom, s.compliance, s.lam
     (array([0., 0., 0., 1., 0., 0.]), array([0., 0., 0., 0., 0., 2.]), array([20.]))
     """
-    K = _check_stiffness(K)
+    K, k_min = _check_stiffness(K)
     W = contact_basis(W)
     T = _twist(T)
-    X = compliance_twists(K, W)
-    G = _gram(W, X, K)
+    X = _solve(K, W)
+    G = _gram(W, X, k_min)
     b = np.einsum("...im,...i->...m", W, T @ DELTA)
     lam = np.linalg.solve(G, b[..., None])[..., 0]
     Tc = np.einsum("...im,...m->...i", X, lam)
@@ -260,7 +266,7 @@ def compose_twist(K, W, freedom, delta_wrench) -> np.ndarray:
     >>> compose_twist(K, [0, 0, 1, 0, 0, 0], [0, 0, 0, 1.0, 0, 0], [0, 0, 20.0, 0, 0, 0])
     array([0., 0., 0., 1., 0., 2.])
     """
-    K = _check_stiffness(K)
+    K, _ = _check_stiffness(K)
     W = contact_basis(W)
     Tf = _twist(freedom, "twist of freedom")
     wrench_coordinates(W, delta_wrench)
@@ -294,8 +300,5 @@ def platform_stiffness_axis(platform, pose, wrench=None) -> np.ndarray:
     The same K as ``kinestat platform stiffness --pose P [--wrench W0] --twist-order axis``:
     with ``wrench`` the legs carry ``j⁻¹ w`` (Vibhute eq. 2-8), otherwise their spring forces.
     """
-    from kinestat.parallel.statics import forces_from_wrench  # lazy: same layer, saves import
-    from kinestat.parallel.stiffness import stiffness  # lazy: same layer, saves import
-
     forces = None if wrench is None else forces_from_wrench(platform, pose, wrench)
     return axis_stiffness(stiffness(platform, pose, forces), "ray")
