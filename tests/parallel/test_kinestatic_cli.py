@@ -17,10 +17,12 @@ from kinestat.parallel.platform import prototype
 
 @pytest.fixture(autouse=True)
 def wired(monkeypatch):
-    """Register the command on a copy of the group's command list (undone after the test)."""
-    monkeypatch.setattr(platform_cli.platform_app, "registered_commands",
-                        list(platform_cli.platform_app.registered_commands))
-    register(platform_cli.platform_app)
+    """Register the command on a copy of the group's command list (undone after the test),
+    unless cli/platform.py already wires it in."""
+    commands = list(platform_cli.platform_app.registered_commands)
+    monkeypatch.setattr(platform_cli.platform_app, "registered_commands", commands)
+    if not any(c.name == "decompose" for c in commands):
+        register(platform_cli.platform_app)
 
 
 def csv(x):
