@@ -17,6 +17,7 @@ from kinestat.errors import InputError, UnreachableError
 from kinestat.io.library import prototype
 from kinestat.io.platform_toml import read_platform
 from kinestat.parallel.fk import fk_list, fk_numeric
+from kinestat.parallel.kinestatic import decompose_twist, platform_stiffness_axis
 from kinestat.parallel.legs import as_pose, leg_lengths, top_points_in_base
 from kinestat.parallel.singularity import singularity_measure
 from kinestat.parallel.statics import forces_from_wrench, jacobian_det
@@ -238,3 +239,49 @@ def stiffness_command(
     console.print(table(f"Stiffness ({p.force_unit}, {p.length_unit}; dw = K dD)", ["", *cols],
                         rows, fmt="{:.4g}"))
     console.print(f"max |K - K^T| = {out['asymmetry']:.4g} (zero when unloaded)")
+
+
+CONTACT_HELP = ("A wrench the contact can exert, fx,fy,fz,mx,my,mz (moment about O0, base "
+                "frame); repeat for 1 to 5 independent wrenches.")
+DECOMPOSE_TWIST_HELP = "Twist wx,wy,wz,vx,vy,vz: [omega; v_O] (rad, length unit), base frame."
+
+
+@platform_app.command("decompose")
+def decompose_command(
+    twist: str = typer.Option(..., "--twist", help=DECOMPOSE_TWIST_HELP),
+    contact: list[str] = typer.Option(..., "--contact", help=CONTACT_HELP),
+    pose: str = typer.Option("home", "--pose", help=POSE_HELP),
+    wrench: str = typer.Option(None, "--wrench", help=WRENCH_HELP),
+    platform: str = typer.Option(None, "--platform",
+                                 help="TOML platform file (default: the embedded 2011 prototype)."),
+    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+) -> None:
+    """Twist of freedom and twist of compliance of a twist against contact wrenches.
+
+    T = T_f + T_c, T_c = K^-1 W lambda, W^T Delta T_f = 0 (Griffis & Duffy; Vibhute 2.1.3.3).
+    Twists in axis order [omega; v_O]. JSON: {"freedom" (6), "compliance" (6), "lambda" (m),
+    "wrench_change" (6, = W lambda = K T_c), "twist_order": "axis"}.
+    """
+    if not 1 <= len(contact) <= 5:
+        raise InputError(f"--contact: give 1 to 5 contact wrenches, got {len(contact)}")
+    W = np.stack([parse_floats(c, 6, "contact") for c in contact], axis=1)
+    T_axis = parse_floats(twist, 6, "twist")
+    p = _load(platform)
+    T_base_top = _pose(pose, p)
+    w0 = None if wrench is None else parse_floats(wrench, 6, "wrench")
+    K = platform_stiffness_axis(p, T_base_top, w0)
+    s = decompose_twist(K, W, T_axis)
+    out = {"freedom": s.freedom, "compliance": s.compliance, "lambda": s.lam,
+           "wrench_change": W @ s.lam, "twist_order": "axis"}
+    if as_json:
+        print_json(out)
+        return
+    u = p.length_unit
+    cols = ["wx (rad)", "wy (rad)", "wz (rad)", f"vx ({u})", f"vy ({u})", f"vz ({u})"]
+    title = "Kinestatic decomposition T = T_f + T_c (axis order \\[w; v_O], base frame)"
+    console.print(table(title, ["", *cols], [["twist T", *T_axis], ["freedom T_f", *s.freedom],
+                                      ["compliance T_c", *s.compliance]], fmt="{:.6g}"))
+    console.print(table(f"Wrench change W lambda ({p.force_unit}, {p.force_unit}·{u})",
+                        ["", "fx", "fy", "fz", "mx", "my", "mz"],
+                        [["dw", *out["wrench_change"]]], fmt="{:.6g}"))
+    console.print("lambda = " + ", ".join(f"{x:.6g}" for x in s.lam))

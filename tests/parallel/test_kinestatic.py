@@ -11,6 +11,7 @@ import scipy.linalg
 
 import kinestat.parallel.kinestatic as kmod
 from kinestat.errors import InputError, SingularityError
+from kinestat.io.library import prototype
 from kinestat.parallel._refine import apply_twist
 from kinestat.parallel.kinestatic import (
     DELTA,
@@ -25,7 +26,6 @@ from kinestat.parallel.kinestatic import (
     reciprocal_products,
     wrench_coordinates,
 )
-from kinestat.parallel.platform import prototype
 from kinestat.parallel.statics import forces_from_wrench, spring_wrench
 from kinestat.parallel.stiffness import stiffness
 

@@ -1,4 +1,4 @@
-"""``kinestat platform decompose`` end to end (wired into the platform group for the test)."""
+"""``kinestat platform decompose`` end to end."""
 
 from __future__ import annotations
 
@@ -7,22 +7,10 @@ import json
 import numpy as np
 import pytest
 
-import kinestat.cli.platform as platform_cli
-from kinestat.cli.decompose import register
 from kinestat.cli.main import main
+from kinestat.io.library import prototype
 from kinestat.parallel._refine import apply_twist
 from kinestat.parallel.kinestatic import DELTA, decompose_twist
-from kinestat.parallel.platform import prototype
-
-
-@pytest.fixture(autouse=True)
-def wired(monkeypatch):
-    """Register the command on a copy of the group's command list (undone after the test),
-    unless cli/platform.py already wires it in."""
-    commands = list(platform_cli.platform_app.registered_commands)
-    monkeypatch.setattr(platform_cli.platform_app, "registered_commands", commands)
-    if not any(c.name == "decompose" for c in commands):
-        register(platform_cli.platform_app)
 
 
 def csv(x):
