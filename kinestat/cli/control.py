@@ -3,7 +3,8 @@
 With no device arguments the command starts the Galil simulator and the encoder emitter
 itself (loopback TCP and a pty), builds the simulated cell (the thesis's experiment by
 default: Vibhute 2011 §5.1) and drives it through the real client and reader. With
-``--galil HOST:PORT --serial DEVICE`` it drives real hardware.
+``--galil HOST:PORT --serial DEVICE`` it drives real hardware. This module only parses and
+prints; the assembly is :mod:`kinestat.app.control_run`.
 """
 
 from __future__ import annotations
@@ -15,14 +16,21 @@ from pathlib import Path
 import numpy as np
 import typer
 
+from kinestat.app.control_run import (
+    DEFAULT_DIRECTION,
+    DEFAULT_PLANE_DISTANCE,
+    DEFAULT_PLANE_TILT_DEG,
+    DEFAULT_START,
+    ControlRequest,
+    RealDevices,
+    SimulatedCell,
+    plot_run,
+    prepare_control,
+    run_control,
+)
 from kinestat.cli._output import console as out_console
 from kinestat.cli._output import err_console, parse_floats, print_json, table
 from kinestat.errors import InputError, KinestatError
-
-DEFAULT_START = "-400,800,-100"
-DEFAULT_DIRECTION = "0.9713,0,-0.2375"
-DEFAULT_PLANE_DISTANCE = 2.5
-DEFAULT_PLANE_TILT_DEG = 5.0
 
 
 def register(app: typer.Typer) -> None:
@@ -40,20 +48,6 @@ def _host_port(text: str) -> tuple[str, int]:
     if not 0 < p < 65536:
         raise InputError(f"--galil: port {p} outside 1..65535")
     return host, p
-
-
-def default_plane(start_point: np.ndarray, direction: np.ndarray, distance: float,
-                  tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
-    """The default workpiece: a plane ``distance`` mm ahead of the start tool point along the
-    force direction, its normal tilted by ``tilt_deg`` from −direction (towards the fixed +y,
-    or +z when the direction is along y) so that the reorientation (state c) is visible."""
-    d = direction / np.linalg.norm(direction)
-    ref = np.array([0.0, 1.0, 0.0]) if abs(d[1]) < 0.9 else np.array([0.0, 0.0, 1.0])
-    perp = ref - (ref @ d) * d
-    perp /= np.linalg.norm(perp)
-    t = math.radians(tilt_deg)
-    normal = -(math.cos(t) * d + math.sin(t) * perp)
-    return start_point + distance * d, normal
 
 
 def _run_dir(base: Path) -> Path:
@@ -133,13 +127,6 @@ def control_command(
     JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
     tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots.
     """
-    from kinestat.control.controller import ControllerConfig
-    from kinestat.control.envelope import Envelope
-    from kinestat.control.log import CycleLog, read_log
-    from kinestat.control.loop import DeviceIO, run
-    from kinestat.parallel.platform import special_6_6
-    from kinestat.sim.cell import Sensor, centred_mount, ideal_calibration, make_cell
-
     d = parse_floats(direction, 3, "direction")
     if np.linalg.norm(d) == 0:
         raise InputError("--direction must not be the zero vector")
@@ -167,38 +154,19 @@ def control_command(
     log_path = log if log is not None else run_dir / "log.jsonl"
     plot_dir = None if no_plot else (plot if plot is not None else run_dir)
 
-    platform = special_6_6()
     if simulated:
-        if ideal_sensor:
-            sensor = Sensor(calibration=ideal_calibration())
-        else:
-            sensor = Sensor(noise=noise)
-        pp_default, pn_default = default_plane(p0, d, DEFAULT_PLANE_DISTANCE,
-                                               DEFAULT_PLANE_TILT_DEG)
-        pp = parse_floats(plane_point, 3, "plane-point") if plane_point else pp_default
-        pn = parse_floats(plane_normal, 3, "plane-normal") if plane_normal else pn_default
-        cell = make_cell(platform, plane_point=pp, plane_normal=pn, friction=friction)
-        from kinestat.sim.harness import SimHarness, control_model, start_counts
-
-        model = control_model(cell, sensor)
+        cell = SimulatedCell(
+            plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
+            plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
+            friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed)
     else:
-        from kinestat.control.model import ControlModel
-
-        model = ControlModel(platform=platform, mount=centred_mount(platform),
-                             tool_point_6=(0.0, 0.0, 235.0))
-    config = ControllerConfig(
-        model=model, force=force * d, start_tool_point=p0, force_tol=force_tol,
-        align_tol_deg=align_tol_deg, method=method, step=step, approach_step=approach_step,
-        estimator=estimator,
-        max_iterations=max_iterations, envelope=Envelope())
-
-    header = {"simulated": simulated}
-    if simulated:
-        header.update({"plane_point": cell.workpiece.point, "plane_normal": cell.workpiece.normal,
-                       "friction": friction, "ideal_sensor": ideal_sensor, "noise": noise,
-                       "rate_hz": rate})
-    else:
-        header.update({"galil": galil, "serial": serial, "serial_format": serial_format})
+        host, port = _host_port(galil)
+        cell = RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
+    req = ControlRequest(force=force * d, start_tool_point=p0, cell=cell, force_tol=force_tol,
+                         align_tol_deg=align_tol_deg, method=method, step=step,
+                         approach_step=approach_step, estimator=estimator, samples=samples,
+                         max_iterations=max_iterations)
+    prepared = prepare_control(req)
 
     def progress(rec: dict) -> None:
         m = rec["measured"]
@@ -216,22 +184,12 @@ def control_command(
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), method {method}, "
                       + ("simulated cell" if simulated else f"Galil {galil}, sensor {serial}"))
-    with CycleLog(log_path) as cycle_log:
-        if simulated:
-            sc = start_counts(config)
-            with SimHarness(cell, sensor, start_counts=sc, rate_hz=rate, seed=seed) as h:
-                io = h.device_io(samples=samples)
-                report = run(config, io, cycle_log, progress=progress, extra_header=header)
-        else:
-            report = _run_devices(config, cycle_log, galil, serial, serial_format, samples,
-                                  progress, header, run, DeviceIO)
+    report = run_control(prepared, log_path, progress=progress)
     out = report.as_dict()
     plots: list[str] = []
     if plot_dir is not None:
         try:
-            from kinestat.viz.control_plots import write_plots
-
-            plots = [str(p) for p in write_plots(read_log(log_path), plot_dir)]
+            plots = plot_run(log_path, plot_dir)
         except InputError as exc:
             err_console.print(f"[yellow]no plot:[/] {exc}")
     out["plots"] = plots
@@ -241,21 +199,6 @@ def control_command(
         _print_report(out)
     if not report.converged:
         raise KinestatError(f"kinestatic control did not converge: {report.stop_reason}")
-
-
-def _run_devices(config, cycle_log, galil, serial, serial_format, samples, progress, header,
-                 run, DeviceIO):
-    from kinestat.devices.encoder_stream import EncoderReader
-    from kinestat.devices.galil import GalilClient
-
-    host, port = _host_port(galil)
-    client = GalilClient(host, port).connect()
-    try:
-        with EncoderReader(serial, fmt=serial_format) as reader:
-            io = DeviceIO(client, reader, samples=samples, settle=0.1)
-            return run(config, io, cycle_log, progress=progress, extra_header=header)
-    finally:
-        client.close()
 
 
 def _print_report(out: dict) -> None:

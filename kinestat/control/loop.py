@@ -3,9 +3,9 @@
 :func:`run` repeats one cycle — read the robot's axis counts and a fresh packet of leg
 counts, run the measurement chain, call the pure :func:`~kinestat.control.controller.decide`,
 log the cycle, send the command — until the goal is reached or something stops it. It talks to
-the cell through a small :class:`CellIO` interface; :class:`DeviceIO` implements it with the
-real Galil client and encoder reader (:mod:`kinestat.devices`), and the simulated cell offers an
-in-process one (:mod:`kinestat.sim.harness`).
+the cell through a small :class:`CellIO` protocol and imports no driver:
+:class:`kinestat.devices.cell_io.DeviceIO` implements it with the real Galil client and encoder
+reader, and :class:`kinestat.app.sim_cell.InProcessIO` with the simulated cell in-process.
 
 Safe stop: any device fault (a ``?`` from the Galil, a dropped link, a timeout), stale or
 unreliable sensor data (no fresh packet in time, a frozen sequence, more stream faults than
@@ -20,7 +20,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -36,26 +36,26 @@ from kinestat.control.controller import (
 from kinestat.control.envelope import require
 from kinestat.control.log import CycleLog
 from kinestat.control.wrench import Measurement, measure
-from kinestat.devices.galil import (
-    AXIS4_TO_5_COUPLING,
-    THESIS_ACCEL,
-    THESIS_SPEED_MAX,
-    GalilClient,
-    axis45_compensation,
-)
-from kinestat.errors import DeviceError, InputError, KinestatError, SafetyStop
+from kinestat.errors import DeviceError, KinestatError, SafetyStop
 
-__all__ = ["SensorSample", "CellIO", "DeviceIO", "RunReport", "run", "MotionProfile"]
+__all__ = ["SensorReading", "CellIO", "RunReport", "run"]
 
 
-@dataclass(frozen=True)
-class SensorSample:
-    """Leg counts for one measurement (sensor legs 1..6), with the stream's bookkeeping."""
+class SensorReading(Protocol):
+    """One measurement of the leg counts as the loop reads it (sensor legs 1..6), with the
+    stream's bookkeeping (:class:`kinestat.devices.cell_io.SensorSample` is one)."""
 
-    counts: np.ndarray
-    seq: int | None = None
-    age: float | None = None
-    faults: tuple[str, ...] = ()
+    @property
+    def counts(self) -> np.ndarray: ...
+
+    @property
+    def seq(self) -> int | None: ...
+
+    @property
+    def age(self) -> float | None: ...
+
+    @property
+    def faults(self) -> tuple[str, ...]: ...
 
 
 class CellIO(Protocol):
@@ -67,7 +67,7 @@ class CellIO(Protocol):
     def move(self, axis_counts: np.ndarray) -> None:
         """Move to absolute axis counts and return when the motion is complete."""
 
-    def sensor(self) -> SensorSample:
+    def sensor(self) -> SensorReading:
         """Leg counts measured after the last motion completed."""
 
     def stop(self) -> str:
@@ -75,93 +75,6 @@ class CellIO(Protocol):
 
     def truth(self) -> dict | None:
         """The true state when simulated (for the log and report), else None."""
-
-
-@dataclass(frozen=True)
-class MotionProfile:
-    """Speeds (counts/s) and accelerations (counts/s²) per axis A..F for each move: by default
-    the thesis's maxima (galil_control.m)."""
-
-    speed: tuple[float, ...] = THESIS_SPEED_MAX
-    accel: tuple[float, ...] = THESIS_ACCEL
-
-
-class DeviceIO:
-    """:class:`CellIO` over a :class:`~kinestat.devices.galil.GalilClient` and an
-    :class:`~kinestat.devices.encoder_stream.EncoderReader` (both opened by the caller).
-
-    Moves compensate the axis 4 -> 5 coupling (``coupling``, as the model's). After each move it
-    waits ``settle`` seconds past the end of the motion and averages ``samples`` fresh packets
-    received after that. ``truth`` is an optional callable returning the true state
-    (simulation only).
-    """
-
-    def __init__(self, client: GalilClient, reader: Any, *, profile: MotionProfile | None = None,
-                 settle: float = 0.03, samples: int = 1, motion_timeout: float = 30.0,
-                 coupling: float = AXIS4_TO_5_COUPLING,
-                 truth: Callable[[], dict] | None = None,
-                 clock: Callable[[], float] = time.monotonic) -> None:
-        if not (math.isfinite(settle) and settle >= 0):
-            raise InputError(f"settle must be >= 0 seconds, got {settle!r}")
-        if int(samples) < 1:
-            raise InputError(f"samples must be at least 1, got {samples!r}")
-        self.client = client
-        self.reader = reader
-        self.profile = profile or MotionProfile()
-        self.settle = float(settle)
-        self.samples = int(samples)
-        self.motion_timeout = float(motion_timeout)
-        self.coupling = float(coupling)
-        self._truth = truth
-        self._clock = clock
-        self._t_ready = clock()
-
-    def robot_counts(self) -> np.ndarray:
-        return np.asarray(self.client.position_counts(), dtype=np.int64)
-
-    def move(self, axis_counts: np.ndarray) -> None:
-        """Move with the axis 4 -> 5 compensation (Vibhute App. D.9), keep reading the sensor
-        stream while the axes move (so that the serial buffer never overflows), then reset the
-        axis-5 encoder (``DP``) as :meth:`GalilClient.move_compensated` does."""
-        c = np.asarray(axis_counts, dtype=np.int64)
-        corr = axis45_compensation(c[3], c[4], self.client.axis_position("D"),
-                                   self.coupling)
-        cmd = c.copy()
-        cmd[4] = int(corr.axis5_command)
-        self.client.move_absolute(cmd, self.profile.speed, self.profile.accel)
-        deadline = self._clock() + self.motion_timeout
-        while self.client.is_moving():
-            if self._clock() > deadline:
-                raise DeviceError(f"motion not complete after {self.motion_timeout} s")
-            self.reader.poll()
-        self.client.define_position({"E": int(corr.axis5_reset)})
-        self._t_ready = self._clock() + self.settle
-
-    def sensor(self) -> SensorSample:
-        got: list[np.ndarray] = []
-        faults: list[str] = []
-        last = None
-        while len(got) < self.samples:
-            r = self.reader.read()
-            faults.extend(f"{f.kind}: {f.message}" for f in r.faults)
-            if r.received_at >= self._t_ready:
-                got.append(np.asarray(r.counts, dtype=float))
-                last = r
-        assert last is not None
-        return SensorSample(counts=np.mean(got, axis=0), seq=last.seq, age=last.age,
-                            faults=tuple(faults))
-
-    def stop(self) -> str:
-        if not self.client.connected:
-            return "the Galil link is down: ST could not be sent"
-        try:
-            self.client.stop()
-        except KinestatError as exc:
-            return f"ST failed: {exc}"
-        return "ST sent to the Galil"
-
-    def truth(self) -> dict | None:
-        return None if self._truth is None else self._truth()
 
 
 @dataclass

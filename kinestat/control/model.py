@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kinestat.devices.calibration import THESIS_CALIBRATION, LegCalibration
-from kinestat.devices.galil import AXIS4_TO_5_COUPLING, AXIS_DEG_PER_COUNT
 from kinestat.errors import ModelError
+from kinestat.hardware.leg_calibration import THESIS_CALIBRATION, LegCalibration
+from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, AXIS_DEG_PER_COUNT
 from kinestat.parallel.platform import Platform
 from kinestat.serial import puma762
 from kinestat.spatial.transforms import apply, as_array, inv

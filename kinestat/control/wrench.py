@@ -32,8 +32,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinestat.control.model import ControlModel
-from kinestat.devices.calibration import counts_to_lengths
 from kinestat.errors import InputError
+from kinestat.hardware.leg_calibration import counts_to_lengths
 from kinestat.parallel.statics import line_jacobian, spring_forces, wrench_from_leg_lengths
 from kinestat.serial import puma762
 from kinestat.spatial.screws import transform_wrench

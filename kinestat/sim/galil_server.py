@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kinestat.devices.galil import AXES, AXIS4_TO_5_COUPLING, COUNT_LIMIT
 from kinestat.errors import DeviceError, InputError
+from kinestat.hardware.puma762_axes import AXES, AXIS4_TO_5_COUPLING, COUNT_LIMIT
 
 TC_MESSAGES: dict[int, str] = {
     0: "No error",

@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from kinestat.app.sim_cell import start_counts
 from kinestat.control.controller import axis_counts_to_q
 from kinestat.control.envelope import (
     Envelope,
@@ -19,8 +20,8 @@ from kinestat.control.envelope import (
 from kinestat.control.wrench import measure
 from kinestat.errors import InputError, SafetyStop
 from kinestat.serial import puma762
-from kinestat.sim.cell import Sensor, equilibrium
-from kinestat.sim.harness import start_counts
+from kinestat.sim.contact import equilibrium
+from kinestat.sim.sensor import Sensor
 from kinestat.spatial.transforms import trans
 
 from .conftest import F_HAT, PLATFORM, scenario

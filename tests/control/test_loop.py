@@ -7,10 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from kinestat.app.sim_cell import SimHarness, start_counts
 from kinestat.control.log import CycleLog, read_log
-from kinestat.control.loop import MotionProfile, run
+from kinestat.control.loop import run
+from kinestat.devices.cell_io import MotionProfile
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
-from kinestat.sim.harness import SimHarness, start_counts
 
 from .conftest import F_HAT, scenario
 

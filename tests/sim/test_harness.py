@@ -7,14 +7,15 @@ import time
 import numpy as np
 import pytest
 
+from kinestat.app.sim_cell import InProcessIO, SimHarness, control_model, start_counts
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
-from kinestat.devices.calibration import counts_to_lengths
-from kinestat.devices.galil import counts_to_joint_rad
 from kinestat.errors import DeviceError
+from kinestat.hardware.leg_calibration import counts_to_lengths
+from kinestat.hardware.puma762_axes import counts_to_joint_rad
 from kinestat.parallel.platform import special_6_6
 from kinestat.serial import puma762
-from kinestat.sim.cell import Sensor, equilibrium, make_cell
-from kinestat.sim.harness import InProcessIO, SimHarness, control_model, start_counts
+from kinestat.sim.contact import equilibrium, make_cell
+from kinestat.sim.sensor import Sensor
 
 PLAT = special_6_6()
 F = np.asarray(THESIS_FORCE_DIRECTION)

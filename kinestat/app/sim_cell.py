@@ -1,4 +1,5 @@
-"""Wiring the simulated cell to the simulated devices, for ``kinestat control`` without hardware.
+"""Composition root: the simulated cell wired to the simulated devices (``kinestat control``
+without hardware).
 
 :class:`SimHarness` starts the Galil simulator (:mod:`kinestat.sim.galil_server`, loopback
 only) and the encoder emitter (:mod:`kinestat.sim.encoder_emitter`, on a pty) and connects
@@ -8,7 +9,7 @@ not see), solves the contact equilibrium of the platform at that flange pose
 (:func:`kinestat.sim.cell.equilibrium`, quasi-statically along the robot's motion so that a
 friction anchor follows the path) and turns the true leg lengths into encoder counts
 (:class:`kinestat.sim.cell.Sensor`). The controller then drives the cell through the real
-client and reader (:class:`kinestat.control.loop.DeviceIO`), over TCP loopback and the pty.
+client and reader (:class:`kinestat.devices.cell_io.DeviceIO`), over TCP loopback and the pty.
 
 :class:`InProcessIO` is the same cell without devices (an exact robot, counts straight from the
 sensor model): fast, deterministic, for tests of the control law.
@@ -22,20 +23,22 @@ from typing import Any
 import numpy as np
 
 from kinestat.control.controller import ControllerConfig, axis_counts_to_q
-from kinestat.control.loop import DeviceIO, SensorSample
 from kinestat.control.model import ControlModel
+from kinestat.devices.cell_io import DeviceIO, SensorSample
 from kinestat.devices.encoder_stream import EncoderReader
-from kinestat.devices.galil import (
+from kinestat.devices.galil import GalilClient
+from kinestat.errors import DeviceError, KinestatError
+from kinestat.hardware.puma762_axes import (
     AXIS4_TO_5_COUPLING,
-    GalilClient,
+    AXIS_DEG_PER_COUNT,
     axis_deg_to_counts,
     counts_to_joint_rad,
 )
-from kinestat.errors import DeviceError, KinestatError
 from kinestat.serial import puma762
-from kinestat.sim.cell import Cell, Equilibrium, Sensor, equilibrium, unloaded_tip
+from kinestat.sim.contact import Cell, Equilibrium, equilibrium, unloaded_tip
 from kinestat.sim.encoder_emitter import EncoderEmitter
 from kinestat.sim.galil_server import DmcSimulator, GalilSimServer, SimClock
+from kinestat.sim.sensor import Sensor
 
 __all__ = ["CellState", "SimHarness", "InProcessIO", "control_model", "start_counts"]
 
@@ -234,8 +237,6 @@ class InProcessIO:
 
     def __init__(self, cell: Cell, sensor: Sensor | None = None, *, start_counts,
                  axis_deg_per_count=None, seed: int | None = 0, substeps: int = 4) -> None:
-        from kinestat.devices.galil import AXIS_DEG_PER_COUNT
-
         self.state = CellState(cell, sensor, seed=seed)
         self.cell = cell
         self._res = np.asarray(AXIS_DEG_PER_COUNT if axis_deg_per_count is None
