@@ -4,6 +4,9 @@ sensors that decisions, drivers and simulators share. No I/O, no decisions.
 - :mod:`kinestat.hardware.puma762_axes` — the PUMA 762's encoder scales, joint-1 offset,
   axis 4 -> 5 coupling and its compensation, rounding to counts, the thesis tool point
   ``P_tool_6``.
+- :mod:`kinestat.hardware.encoder_packets` — the encoder box's wire formats (``ks`` and the
+  thesis's legacy line) and its channel -> leg wiring: the codec shared by the reader
+  (:mod:`kinestat.devices`) and the emitter (:mod:`kinestat.sim`).
 - :mod:`kinestat.hardware.leg_calibration` — the platform's leg encoders: counts -> leg length
   and counts -> leg force maps, and calibration fitting.
 
