@@ -36,8 +36,9 @@ from kinestat.hardware.puma762_axes import (
 )
 from kinestat.serial import puma762
 from kinestat.sim.contact import Cell, Equilibrium, equilibrium, unloaded_tip
+from kinestat.sim.dmc import DmcSimulator, SimClock
 from kinestat.sim.encoder_emitter import EncoderEmitter
-from kinestat.sim.galil_server import DmcSimulator, GalilSimServer, SimClock
+from kinestat.sim.galil_server import GalilSimServer
 from kinestat.sim.sensor import Sensor
 
 __all__ = ["CellState", "SimHarness", "InProcessIO", "control_model", "start_counts"]

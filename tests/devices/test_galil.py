@@ -34,7 +34,8 @@ from kinestat.hardware.puma762_axes import (
     joint_rad_to_counts,
     round_half_away,
 )
-from kinestat.sim.galil_server import DmcSimulator, GalilSimServer, SimClock
+from kinestat.sim.dmc import DmcSimulator, SimClock
+from kinestat.sim.galil_server import GalilSimServer
 
 counts6 = st.lists(st.integers(-10_000_000, 10_000_000), min_size=6, max_size=6)
 
