@@ -14,18 +14,18 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Literal
 
 import numpy as np
 
 from kinestat.app.sim_cell import SimHarness, control_model, start_counts
-from kinestat.control.controller import ControllerConfig, Estimator, StepMethod
+from kinestat.control.controller import ControllerConfig, StepMethod
 from kinestat.control.envelope import Envelope
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, run
 from kinestat.control.model import ControlModel
+from kinestat.control.wrench import Estimator
 from kinestat.devices.cell_io import DeviceIO
-from kinestat.devices.encoder_stream import EncoderReader
+from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import GalilClient
 from kinestat.hardware.puma762_axes import THESIS_TOOL_POINT_6
 from kinestat.parallel.platform import special_6_6
@@ -57,9 +57,6 @@ DEFAULT_PLANE_DISTANCE = 2.5
 """The default workpiece plane's distance ahead of the start tool point (mm)."""
 DEFAULT_PLANE_TILT_DEG = 5.0
 """The default workpiece normal's tilt from −F_req (degrees)."""
-
-SerialFormat = Literal["ks", "legacy"]
-
 
 def default_plane(start_point: np.ndarray, direction: np.ndarray, distance: float,
                   tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
@@ -100,7 +97,7 @@ class RealDevices:
     host: str
     port: int
     serial: str
-    serial_format: SerialFormat = "ks"
+    serial_format: Format = "ks"
 
 
 @dataclass(frozen=True)

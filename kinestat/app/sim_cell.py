@@ -25,7 +25,7 @@ import numpy as np
 from kinestat.control.controller import ControllerConfig, axis_counts_to_q
 from kinestat.control.model import ControlModel
 from kinestat.devices.cell_io import DeviceIO, SensorSample
-from kinestat.devices.encoder_stream import EncoderReader
+from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import GalilClient
 from kinestat.errors import DeviceError, KinestatError
 from kinestat.hardware.puma762_axes import (
@@ -139,7 +139,7 @@ class SimHarness:
     """
 
     def __init__(self, cell: Cell, sensor: Sensor | None = None, *, start_counts=(0,) * 6,
-                 rate_hz: float = 200.0, fmt: str = "ks", clock: SimClock | None = None,
+                 rate_hz: float = 200.0, fmt: Format = "ks", clock: SimClock | None = None,
                  coupling: float = AXIS4_TO_5_COUPLING, seed: int | None = 0,
                  emitter_options: dict | None = None, record: bool = False) -> None:
         self.state = CellState(cell, sensor, seed=seed)

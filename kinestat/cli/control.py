@@ -60,6 +60,46 @@ def _run_dir(base: Path) -> Path:
     return d
 
 
+def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise, friction,
+          rate, seed) -> SimulatedCell | RealDevices:
+    """The cell the options describe: simulated (no device options) or the real devices."""
+    if (galil is None) != (serial is None):
+        raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
+                         "neither to run the simulated cell")
+    if galil is not None and (plane_point or plane_normal or ideal_sensor or noise or friction):
+        raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction "
+                         "describe the simulated cell; they cannot be used with real devices")
+    if serial_format not in ("ks", "legacy"):
+        raise InputError(f"--serial-format must be 'ks' or 'legacy', got {serial_format!r}")
+    if ideal_sensor and noise:
+        raise InputError("--ideal-sensor and --noise exclude each other")
+    if not (math.isfinite(noise) and noise >= 0):
+        raise InputError(f"--noise must be >= 0 mm, got {noise}")
+
+    if galil is None:
+        return SimulatedCell(
+            plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
+            plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
+            friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed)
+    host, port = _host_port(galil)
+    return RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
+
+
+def _print_progress(rec: dict) -> None:
+    """One line per cycle on stderr."""
+    m = rec["measured"]
+    c = rec["commanded"]
+    what = rec["decision"] if c is None else c["action"]
+    extra = ""
+    if c is not None and c["step"]:
+        extra += f" step {c['step']:+.4f} mm"
+    if c is not None and c["rotation_deg"]:
+        extra += f" turn {c['rotation_deg']:.3f}°"
+    fmag = float(np.linalg.norm(m["estimate"]))
+    err_console.print(f"cycle {rec['cycle']:3d}  state {rec['state']}  |F| {fmag:7.4f} N"
+                      f"  -> {what}{extra}")
+
+
 def control_command(
     force: float = typer.Option(4.0, "--force", help="Target force magnitude |F_req| (N)."),
     direction: str = typer.Option(
@@ -134,57 +174,25 @@ def control_command(
     if not (math.isfinite(force) and force > 0):
         raise InputError(f"--force must be a positive number of newtons, got {force}")
     p0 = parse_floats(start, 3, "start")
-    if (galil is None) != (serial is None):
-        raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
-                         "neither to run the simulated cell")
-    simulated = galil is None
-    if not simulated and (plane_point or plane_normal or ideal_sensor or noise or friction):
-        raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction "
-                         "describe the simulated cell; they cannot be used with real devices")
-    if serial_format not in ("ks", "legacy"):
-        raise InputError(f"--serial-format must be 'ks' or 'legacy', got {serial_format!r}")
-    if ideal_sensor and noise:
-        raise InputError("--ideal-sensor and --noise exclude each other")
-    if not (math.isfinite(noise) and noise >= 0):
-        raise InputError(f"--noise must be >= 0 mm, got {noise}")
-
     run_dir = None
     if log is None or (plot is None and not no_plot):
         run_dir = _run_dir(Path("kinestat-runs"))
     log_path = log if log is not None else run_dir / "log.jsonl"
     plot_dir = None if no_plot else (plot if plot is not None else run_dir)
 
-    if simulated:
-        cell = SimulatedCell(
-            plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
-            plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
-            friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed)
-    else:
-        host, port = _host_port(galil)
-        cell = RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
+    cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
+                 friction, rate, seed)
+    simulated = isinstance(cell, SimulatedCell)
     req = ControlRequest(force=force * d, start_tool_point=p0, cell=cell, force_tol=force_tol,
                          align_tol_deg=align_tol_deg, method=method, step=step,
                          approach_step=approach_step, estimator=estimator, samples=samples,
                          max_iterations=max_iterations)
     prepared = prepare_control(req)
 
-    def progress(rec: dict) -> None:
-        m = rec["measured"]
-        c = rec["commanded"]
-        what = rec["decision"] if c is None else c["action"]
-        extra = ""
-        if c is not None and c["step"]:
-            extra += f" step {c['step']:+.4f} mm"
-        if c is not None and c["rotation_deg"]:
-            extra += f" turn {c['rotation_deg']:.3f}°"
-        fmag = float(np.linalg.norm(m["estimate"]))
-        err_console.print(f"cycle {rec['cycle']:3d}  state {rec['state']}  |F| {fmag:7.4f} N"
-                          f"  -> {what}{extra}")
-
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), method {method}, "
                       + ("simulated cell" if simulated else f"Galil {galil}, sensor {serial}"))
-    report = run_control(prepared, log_path, progress=progress)
+    report = run_control(prepared, log_path, progress=_print_progress)
     out = report.as_dict()
     plots: list[str] = []
     if plot_dir is not None:

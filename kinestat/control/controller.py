@@ -55,7 +55,7 @@ from kinestat.control.envelope import (
     tip_stiffness,
 )
 from kinestat.control.model import ControlModel
-from kinestat.control.wrench import Measurement
+from kinestat.control.wrench import Estimator, Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
 from kinestat.hardware.puma762_axes import round_half_away
 from kinestat.serial import puma762
@@ -69,7 +69,6 @@ __all__ = [
     "ControllerState",
     "Command",
     "StepMethod",
-    "Estimator",
     "start",
     "decide",
     "default_a67",
@@ -93,8 +92,6 @@ STATES = {
 StepMethod = Literal["fixed", "stiffness"]
 """How the step along S6 is chosen: the thesis's fixed step or a Newton step from the
 platform stiffness (see the module docstring)."""
-Estimator = Literal["point", "wrench"]
-"""The force the controller acts on (:meth:`kinestat.control.wrench.Measurement.estimate`)."""
 METHODS: tuple[str, ...] = get_args(StepMethod)
 ESTIMATORS: tuple[str, ...] = get_args(Estimator)
 

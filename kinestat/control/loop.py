@@ -29,13 +29,14 @@ from kinestat.control.controller import (
     Command,
     ControllerConfig,
     ControllerState,
+    StepMethod,
     axis_counts_to_q,
     decide,
     start,
 )
 from kinestat.control.envelope import require
 from kinestat.control.log import CycleLog
-from kinestat.control.wrench import Measurement, measure
+from kinestat.control.wrench import Estimator, Measurement, measure
 from kinestat.errors import DeviceError, KinestatError, SafetyStop
 
 __all__ = ["SensorReading", "CellIO", "RunReport", "run"]
@@ -85,7 +86,7 @@ class RunReport:
     iterations: int
     moves: int
     stop_reason: str
-    method: str
+    method: StepMethod
     states: list[str]
     force: np.ndarray | None = None
     torque: np.ndarray | None = None
@@ -102,7 +103,7 @@ class RunReport:
     elapsed_s: float = 0.0
     target_force: float = 0.0
     faults: list[str] = field(default_factory=list)
-    estimator: str = "point"
+    estimator: Estimator = "point"
     equivalent_wrench: np.ndarray | None = None
 
     def as_dict(self) -> dict:

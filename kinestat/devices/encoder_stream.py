@@ -29,7 +29,7 @@ import math
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -73,6 +73,7 @@ __all__ = [
     # the stream
     "DEFAULT_BAUDRATE",
     "MAX_FRAME",
+    "FaultKind",
     "StreamFault",
     "Event",
     "StreamStats",
@@ -88,6 +89,10 @@ DEFAULT_BAUDRATE = 115200
 MAX_FRAME = 128
 """A ``ks`` frame longer than this without its LF is declared broken (the real one is 75)."""
 
+FaultKind = Literal["framing", "checksum", "gap", "duplicate", "out_of_order", "restart"]
+"""What a :class:`StreamFault` is about."""
+
+
 @dataclass(frozen=True)
 class StreamFault:
     """A problem found in the stream, reported in order with the packets.
@@ -98,7 +103,7 @@ class StreamFault:
     ``"restart"`` (the sender's sequence restarted; accepted).
     """
 
-    kind: str
+    kind: FaultKind
     message: str
     seq: int | None = None
     lost: int = 0
@@ -357,7 +362,7 @@ class EncoderReader:
         """Open the serial port (idempotent); raises :class:`DeviceError` if it cannot."""
         if self._ser is not None:
             return self
-        import serial
+        import serial  # lazy: pyserial is loaded only when a port is used
 
         factory = self._factory or serial.serial_for_url
         try:
@@ -392,7 +397,7 @@ class EncoderReader:
     # -- I/O
     def poll(self) -> list[Event]:
         """Read what has arrived (waiting at most ``read_timeout``); return its events."""
-        import serial
+        import serial  # lazy: pyserial is loaded only when a port is used
 
         if self._ser is None:
             self.open()

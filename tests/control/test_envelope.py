@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
 from kinestat.app.sim_cell import start_counts
 from kinestat.control.controller import axis_counts_to_q
@@ -74,7 +75,6 @@ def test_prediction_matches_a_sticking_contact(move):
     if d is not None:
         Tn = trans(d) @ T
     else:  # turn 0.05° about an axis through the tool point
-        from scipy.spatial.transform import Rotation
 
         R = np.eye(4)
         R[:3, :3] = Rotation.from_rotvec(np.radians(0.05) * np.array([0, 1.0, 0])).as_matrix()

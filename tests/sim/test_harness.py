@@ -9,6 +9,7 @@ import pytest
 
 from kinestat.app.sim_cell import InProcessIO, SimHarness, control_model, start_counts
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
+from kinestat.devices.encoder_stream import StaleDataError
 from kinestat.errors import DeviceError
 from kinestat.hardware.leg_calibration import counts_to_lengths
 from kinestat.hardware.puma762_axes import counts_to_joint_rad
@@ -64,7 +65,6 @@ def test_a_bottomed_out_cell_silences_the_sensor():
             time.sleep(0.01)
         assert h.emitter.error is not None and "stroke" in str(h.emitter.error)
         assert "error" in h.truth()
-        from kinestat.devices.encoder_stream import StaleDataError
 
         with pytest.raises(StaleDataError):
             h.reader(stale_after=0.1).read()
