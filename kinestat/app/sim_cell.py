@@ -6,9 +6,9 @@ only) and the encoder emitter (:mod:`kinestat.sim.encoder_emitter`, on a pty) an
 them through the cell: at every packet the emitter asks :meth:`SimHarness.counts_now`, which
 reads the simulator's TRUE axis positions (including the axis 4 → 5 coupling the encoders do
 not see), solves the contact equilibrium of the platform at that flange pose
-(:func:`kinestat.sim.cell.equilibrium`, quasi-statically along the robot's motion so that a
+(:func:`kinestat.sim.contact.equilibrium`, quasi-statically along the robot's motion so that a
 friction anchor follows the path) and turns the true leg lengths into encoder counts
-(:class:`kinestat.sim.cell.Sensor`). The controller then drives the cell through the real
+(:class:`kinestat.sim.sensor.Sensor`). The controller then drives the cell through the real
 client and reader (:class:`kinestat.devices.cell_io.DeviceIO`), over TCP loopback and the pty.
 
 :class:`InProcessIO` is the same cell without devices (an exact robot, counts straight from the
