@@ -209,95 +209,123 @@ def _config_record(config: ControllerConfig) -> dict:
     }
 
 
+@dataclass
+class _Run:
+    """What a run has accumulated so far (mutable, private to :func:`run`)."""
+
+    t0: float
+    state: ControllerState | None = None
+    states: list[str] = field(default_factory=list)
+    faults: list[str] = field(default_factory=list)
+    last_meas: Measurement | None = None
+    last_truth: dict | None = None
+    last_counts: np.ndarray | None = None
+    moves: int = 0
+    converged: bool = False
+    reason: str = ""
+
+    def t(self) -> float:
+        return time.monotonic() - self.t0
+
+
 def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
         progress: Callable[[dict], None] | None = None,
         extra_header: dict | None = None) -> RunReport:
-    """Run the kinestatic procedure on ``io`` until the goal, a stop or ``max_iterations``.
+    """Run the kinestatic procedure (Vibhute 2011 ch. 5, Fig. 5-2) on ``io`` until the goal, a
+    stop or ``max_iterations``.
 
     Never raises for a fault of the cell: the run ends with a safe stop and the report says
     why. Every cycle is written to ``log`` before its command is sent.
     """
-    t0 = time.monotonic()
+    r = _Run(t0=time.monotonic())
     header = {"type": "start", "time": time.strftime("%Y-%m-%dT%H:%M:%S"),
               "config": _config_record(config)}
     if extra_header:
         header.update(extra_header)
     log.write(header)
-    model = config.model
-    states: list[str] = []
-    faults: list[str] = []
-    last_meas: Measurement | None = None
-    last_truth: dict | None = None
-    last_counts: np.ndarray | None = None
-    moves = 0
-    converged = False
-    reason = ""
-    state: ControllerState | None = None
     try:
-        counts_now = io.robot_counts()
-        q_now = axis_counts_to_q(model, counts_now)
-        cmd, state = start(config, q_now, counts_now=counts_now)
-        log.write({"type": "command", "cycle": 0, "t": time.monotonic() - t0,
-                   "decision": cmd.kind, "reason": cmd.reason, "commanded": _cmd_record(cmd)})
-        if cmd.kind == "stop":
-            raise SafetyStop(cmd.reason)
-        io.move(cmd.axis_counts)
-        moves += 1
-        while True:
-            sample = io.sensor()
-            if sample.faults:
-                faults.extend(sample.faults)
-                log.write({"type": "stream_faults", "cycle": state.cycle + 1,
-                           "faults": list(sample.faults)})
-            if len(sample.faults) > config.envelope.max_stream_faults:
-                raise SafetyStop(f"sensor link unreliable: {len(sample.faults)} stream faults "
-                                 f"while acquiring one measurement (limit "
-                                 f"{config.envelope.max_stream_faults}); first: "
-                                 f"{sample.faults[0]}")
-            counts_r = io.robot_counts()
-            last_counts = np.asarray(counts_r)
-            q = axis_counts_to_q(model, counts_r)
-            meas = measure(model, q, sample.counts, state.top_pose, seq=sample.seq,
-                           age=sample.age)
-            last_meas = meas
-            cmd, state = decide(config, state, meas)
-            states.append(cmd.label)
-            last_truth = io.truth()
-            rec = {"type": "cycle", "cycle": state.cycle, "t": time.monotonic() - t0,
-                   "state": cmd.label, "decision": cmd.kind, "action": cmd.action,
-                   "reason": cmd.reason, "force_error": cmd.force_error,
-                   "misalignment_deg": cmd.misalignment_deg,
-                   "measured": _meas_record(config, meas), "commanded": _cmd_record(cmd),
-                   "true": last_truth, "violations": list(cmd.violations)}
-            log.write(rec)
-            if progress is not None:
-                progress(rec)
-            if cmd.kind == "done":
-                converged = True
-                reason = cmd.reason
-                break
-            if cmd.kind == "stop":
-                raise SafetyStop(cmd.reason)
-            require([] if cmd.axis_counts is not None else ["a move without axis counts"])
-            io.move(cmd.axis_counts)
-            moves += 1
+        _start_move(config, io, log, r)
+        while not _cycle(config, io, log, r, progress):
+            pass
     except (KinestatError, KeyboardInterrupt) as exc:
-        if isinstance(exc, KeyboardInterrupt):
-            reason = "interrupted by the user"
-        elif isinstance(exc, SafetyStop):
-            reason = str(exc)
-        else:
-            kind = "device fault" if isinstance(exc, DeviceError) else type(exc).__name__
-            reason = f"{kind}: {exc}"
-        reason = _safe_stop(io, log, reason, faults, t0)
+        r.reason = _safe_stop(io, log, _fault_reason(exc), r.faults, r.t0)
     except Exception as exc:  # a bug: stop the robot first, keep the log, then let it show
-        reason = _safe_stop(io, log, f"internal error {type(exc).__name__}: {exc}", faults, t0)
-        report = _report(config, False, state, states, moves, reason, last_meas, last_truth,
-                         log, faults, time.monotonic() - t0, last_counts)
-        log.write({"type": "end", "report": report.as_dict()})
+        r.reason = _safe_stop(io, log, f"internal error {type(exc).__name__}: {exc}", r.faults,
+                              r.t0)
+        _finish(config, r, log)
         raise
-    report = _report(config, converged, state, states, moves, reason, last_meas, last_truth,
-                     log, faults, time.monotonic() - t0, last_counts)
+    return _finish(config, r, log)
+
+
+def _start_move(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run) -> None:
+    """Step 1: command the start pose (:func:`~kinestat.control.controller.start`)."""
+    counts_now = io.robot_counts()
+    q_now = axis_counts_to_q(config.model, counts_now)
+    cmd, r.state = start(config, q_now, counts_now=counts_now)
+    log.write({"type": "command", "cycle": 0, "t": r.t(), "decision": cmd.kind,
+               "reason": cmd.reason, "commanded": _cmd_record(cmd)})
+    if cmd.kind == "stop":
+        raise SafetyStop(cmd.reason)
+    io.move(cmd.axis_counts)
+    r.moves += 1
+
+
+def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
+           progress: Callable[[dict], None] | None) -> bool:
+    """One cycle: sense, measure, decide, log, act. True when the goal is attained."""
+    sample = io.sensor()
+    if sample.faults:
+        r.faults.extend(sample.faults)
+        log.write({"type": "stream_faults", "cycle": r.state.cycle + 1,
+                   "faults": list(sample.faults)})
+    if len(sample.faults) > config.envelope.max_stream_faults:
+        raise SafetyStop(f"sensor link unreliable: {len(sample.faults)} stream faults "
+                         f"while acquiring one measurement (limit "
+                         f"{config.envelope.max_stream_faults}); first: {sample.faults[0]}")
+    counts_r = io.robot_counts()
+    r.last_counts = np.asarray(counts_r)
+    q = axis_counts_to_q(config.model, counts_r)
+    meas = measure(config.model, q, sample.counts, r.state.top_pose, seq=sample.seq,
+                   age=sample.age)
+    r.last_meas = meas
+    cmd, r.state = decide(config, r.state, meas)
+    r.states.append(cmd.label)
+    r.last_truth = io.truth()
+    rec = {"type": "cycle", "cycle": r.state.cycle, "t": r.t(),
+           "state": cmd.label, "decision": cmd.kind, "action": cmd.action,
+           "reason": cmd.reason, "force_error": cmd.force_error,
+           "misalignment_deg": cmd.misalignment_deg,
+           "measured": _meas_record(config, meas), "commanded": _cmd_record(cmd),
+           "true": r.last_truth, "violations": list(cmd.violations)}
+    log.write(rec)
+    if progress is not None:
+        progress(rec)
+    if cmd.kind == "done":
+        r.converged = True
+        r.reason = cmd.reason
+        return True
+    if cmd.kind == "stop":
+        raise SafetyStop(cmd.reason)
+    require([] if cmd.axis_counts is not None else ["a move without axis counts"])
+    io.move(cmd.axis_counts)
+    r.moves += 1
+    return False
+
+
+def _fault_reason(exc: BaseException) -> str:
+    """The report's reason for a fault that ends the run."""
+    if isinstance(exc, KeyboardInterrupt):
+        return "interrupted by the user"
+    if isinstance(exc, SafetyStop):
+        return str(exc)
+    kind = "device fault" if isinstance(exc, DeviceError) else type(exc).__name__
+    return f"{kind}: {exc}"
+
+
+def _finish(config: ControllerConfig, r: _Run, log: CycleLog) -> RunReport:
+    """The report of the run, also written as the log's ``end`` record."""
+    report = _report(config, r.converged, r.state, r.states, r.moves, r.reason, r.last_meas,
+                     r.last_truth, log, r.faults, r.t(), r.last_counts)
     log.write({"type": "end", "report": report.as_dict()})
     return report
 
