@@ -154,6 +154,7 @@ class SimHarness:
 
     # -- life cycle
     def start(self) -> SimHarness:
+        """Start the Galil simulator's server and the encoder emitter."""
         self.server.start()
         try:
             self.emitter.start()
@@ -163,6 +164,7 @@ class SimHarness:
         return self
 
     def stop(self) -> None:
+        """Close the clients and readers it opened, stop the emitter and the server."""
         for obj in reversed(self._opened):
             try:
                 obj.close()
@@ -251,9 +253,11 @@ class InProcessIO:
         return puma762.from_axis_angles(np.radians(np.asarray(counts, dtype=float) * self._res))
 
     def robot_counts(self) -> np.ndarray:
+        """The exact robot's axis counts A..F."""
         return self._counts.copy()
 
     def move(self, axis_counts) -> None:
+        """Reach ``axis_counts`` exactly, solving the cell at ``substeps`` points on the way."""
         new = np.asarray(axis_counts, dtype=np.int64)
         old = self._counts.astype(float)
         for s in np.linspace(0.0, 1.0, self.substeps + 1)[1:]:
@@ -262,16 +266,19 @@ class InProcessIO:
         self.moves.append(new.copy())
 
     def sensor(self) -> SensorSample:
+        """Leg counts of the cell at the present pose, through the sensor model."""
         try:
             return SensorSample(counts=self.state.counts(self._q(self._counts)))
         except KinestatError as exc:
             raise DeviceError(f"simulated sensor failed: {exc}") from exc
 
     def stop(self) -> str:
+        """Record that a stop was requested."""
         self.stopped = True
         return "stopped (in-process)"
 
     def truth(self) -> dict:
+        """The true state at the present pose (or the simulator's error)."""
         try:
             return self.state.truth(self._q(self._counts), self.cell.tool_point_6)
         except KinestatError as exc:

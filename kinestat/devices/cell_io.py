@@ -76,6 +76,7 @@ class DeviceIO:
         self._t_ready = clock()
 
     def robot_counts(self) -> np.ndarray:
+        """The robot's axis positions A..F, encoder counts (``TP``)."""
         return np.asarray(self.client.position_counts(), dtype=np.int64)
 
     def move(self, axis_counts: np.ndarray) -> None:
@@ -97,6 +98,8 @@ class DeviceIO:
         self._t_ready = self._clock() + self.settle
 
     def sensor(self) -> SensorSample:
+        """The mean of ``samples`` fresh packets received after the motion settled, with the
+        stream faults seen while waiting for them."""
         got: list[np.ndarray] = []
         faults: list[str] = []
         last = None
@@ -111,6 +114,7 @@ class DeviceIO:
                             faults=tuple(faults))
 
     def stop(self) -> str:
+        """Send ``ST`` when the link is up (best effort); say what was done."""
         if not self.client.connected:
             return "the Galil link is down: ST could not be sent"
         try:
@@ -120,4 +124,5 @@ class DeviceIO:
         return "ST sent to the Galil"
 
     def truth(self) -> dict | None:
+        """The true state when simulated (the ``truth`` callable), else None."""
         return None if self._truth is None else self._truth()
