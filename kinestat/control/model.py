@@ -42,7 +42,7 @@ class ControlModel:
         limits_deg: (6, 2) robot axis limits, degrees (default the MATLAB code's).
         axis_deg_per_count: (6,) robot encoder resolution, degrees per count.
         coupling: axis-5 counts turned per axis-4 count, compensated by the motion controller
-            (:func:`kinestat.devices.galil.axis45_compensation`); 0 when there is none.
+            (:func:`kinestat.hardware.puma762_axes.axis45_compensation`); 0 when there is none.
     """
 
     platform: Platform
