@@ -69,6 +69,8 @@ __all__ = [
     "ControllerState",
     "Command",
     "StepMethod",
+    "CommandKind",
+    "Action",
     "start",
     "decide",
     "default_a67",
@@ -93,6 +95,10 @@ StepMethod = Literal["fixed", "stiffness"]
 """How the step along S6 is chosen: the thesis's fixed step or a Newton step from the
 platform stiffness (see the module docstring)."""
 METHODS: tuple[str, ...] = get_args(StepMethod)
+CommandKind = Literal["move", "done", "stop"]
+"""What a :class:`Command` asks for: send axis counts, report the goal, or stop safely."""
+Action = Literal["start", "approach", "align", "force", ""]
+"""Why a move is made (Vibhute Fig. 5-2 steps); "" for done/stop."""
 ESTIMATORS: tuple[str, ...] = get_args(Estimator)
 
 
@@ -234,7 +240,7 @@ class ControllerState:
 
     cycle: int
     label: str
-    last_action: str
+    last_action: Action
     target: Target
     axis_counts: np.ndarray
     top_pose: np.ndarray
@@ -261,9 +267,9 @@ class Command:
         violations: envelope violations that caused a stop.
     """
 
-    kind: str
+    kind: CommandKind
     label: str
-    action: str = ""
+    action: Action = ""
     reason: str = ""
     target: Target | None = None
     axis_counts: np.ndarray | None = None
