@@ -136,7 +136,6 @@ def test_averaging_noisy_samples(tmp_path, samples):
 
 def test_an_internal_error_still_stops_the_robot_and_keeps_the_log(tmp_path, monkeypatch):
     """A bug (any exception) stops the robot and is logged before it propagates."""
-
     class Broken(Exception):
         pass
 
