@@ -3,7 +3,8 @@
 With no device arguments the command starts the Galil simulator and the encoder emitter
 itself (loopback TCP and a pty), builds the simulated cell (the thesis's experiment by
 default: Vibhute 2011 §5.1) and drives it through the real client and reader. With
-``--galil HOST:PORT --serial DEVICE`` it drives real hardware.
+``--galil HOST:PORT --serial DEVICE`` it drives real hardware. This module only parses and
+prints; the assembly is :mod:`kinestat.app.control_run`.
 """
 
 from __future__ import annotations
@@ -15,14 +16,21 @@ from pathlib import Path
 import numpy as np
 import typer
 
+from kinestat.app.control_run import (
+    DEFAULT_DIRECTION,
+    DEFAULT_PLANE_DISTANCE,
+    DEFAULT_PLANE_TILT_DEG,
+    DEFAULT_START,
+    ControlRequest,
+    RealDevices,
+    SimulatedCell,
+    plot_run,
+    prepare_control,
+    run_control,
+)
 from kinestat.cli._output import console as out_console
 from kinestat.cli._output import err_console, parse_floats, print_json, table
 from kinestat.errors import InputError, KinestatError
-
-DEFAULT_START = "-400,800,-100"
-DEFAULT_DIRECTION = "0.9713,0,-0.2375"
-DEFAULT_PLANE_DISTANCE = 2.5
-DEFAULT_PLANE_TILT_DEG = 5.0
 
 
 def register(app: typer.Typer) -> None:
@@ -42,20 +50,6 @@ def _host_port(text: str) -> tuple[str, int]:
     return host, p
 
 
-def default_plane(start_point: np.ndarray, direction: np.ndarray, distance: float,
-                  tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
-    """The default workpiece: a plane ``distance`` mm ahead of the start tool point along the
-    force direction, its normal tilted by ``tilt_deg`` from −direction (towards the fixed +y,
-    or +z when the direction is along y) so that the reorientation (state c) is visible."""
-    d = direction / np.linalg.norm(direction)
-    ref = np.array([0.0, 1.0, 0.0]) if abs(d[1]) < 0.9 else np.array([0.0, 0.0, 1.0])
-    perp = ref - (ref @ d) * d
-    perp /= np.linalg.norm(perp)
-    t = math.radians(tilt_deg)
-    normal = -(math.cos(t) * d + math.sin(t) * perp)
-    return start_point + distance * d, normal
-
-
 def _run_dir(base: Path) -> Path:
     stamp = time.strftime("%Y%m%d-%H%M%S")
     d = base / stamp
@@ -64,6 +58,46 @@ def _run_dir(base: Path) -> Path:
         k += 1
         d = base / f"{stamp}-{k}"
     return d
+
+
+def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise, friction,
+          rate, seed) -> SimulatedCell | RealDevices:
+    """The cell the options describe: simulated (no device options) or the real devices."""
+    if (galil is None) != (serial is None):
+        raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
+                         "neither to run the simulated cell")
+    if galil is not None and (plane_point or plane_normal or ideal_sensor or noise or friction):
+        raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction "
+                         "describe the simulated cell; they cannot be used with real devices")
+    if serial_format not in ("ks", "legacy"):
+        raise InputError(f"--serial-format must be 'ks' or 'legacy', got {serial_format!r}")
+    if ideal_sensor and noise:
+        raise InputError("--ideal-sensor and --noise exclude each other")
+    if not (math.isfinite(noise) and noise >= 0):
+        raise InputError(f"--noise must be >= 0 mm, got {noise}")
+
+    if galil is None:
+        return SimulatedCell(
+            plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
+            plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
+            friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed)
+    host, port = _host_port(galil)
+    return RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
+
+
+def _print_progress(rec: dict) -> None:
+    """One line per cycle on stderr."""
+    m = rec["measured"]
+    c = rec["commanded"]
+    what = rec["decision"] if c is None else c["action"]
+    extra = ""
+    if c is not None and c["step"]:
+        extra += f" step {c['step']:+.4f} mm"
+    if c is not None and c["rotation_deg"]:
+        extra += f" turn {c['rotation_deg']:.3f}°"
+    fmag = float(np.linalg.norm(m["estimate"]))
+    err_console.print(f"cycle {rec['cycle']:3d}  state {rec['state']}  |F| {fmag:7.4f} N"
+                      f"  -> {what}{extra}")
 
 
 def control_command(
@@ -133,13 +167,6 @@ def control_command(
     JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
     tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots.
     """
-    from kinestat.control.controller import ControllerConfig
-    from kinestat.control.envelope import Envelope
-    from kinestat.control.log import CycleLog, read_log
-    from kinestat.control.loop import DeviceIO, run
-    from kinestat.parallel.platform import special_6_6
-    from kinestat.sim.cell import Sensor, centred_mount, ideal_calibration, make_cell
-
     d = parse_floats(direction, 3, "direction")
     if np.linalg.norm(d) == 0:
         raise InputError("--direction must not be the zero vector")
@@ -147,91 +174,30 @@ def control_command(
     if not (math.isfinite(force) and force > 0):
         raise InputError(f"--force must be a positive number of newtons, got {force}")
     p0 = parse_floats(start, 3, "start")
-    if (galil is None) != (serial is None):
-        raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
-                         "neither to run the simulated cell")
-    simulated = galil is None
-    if not simulated and (plane_point or plane_normal or ideal_sensor or noise or friction):
-        raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction "
-                         "describe the simulated cell; they cannot be used with real devices")
-    if serial_format not in ("ks", "legacy"):
-        raise InputError(f"--serial-format must be 'ks' or 'legacy', got {serial_format!r}")
-    if ideal_sensor and noise:
-        raise InputError("--ideal-sensor and --noise exclude each other")
-    if not (math.isfinite(noise) and noise >= 0):
-        raise InputError(f"--noise must be >= 0 mm, got {noise}")
-
     run_dir = None
     if log is None or (plot is None and not no_plot):
         run_dir = _run_dir(Path("kinestat-runs"))
     log_path = log if log is not None else run_dir / "log.jsonl"
     plot_dir = None if no_plot else (plot if plot is not None else run_dir)
 
-    platform = special_6_6()
-    if simulated:
-        if ideal_sensor:
-            sensor = Sensor(calibration=ideal_calibration())
-        else:
-            sensor = Sensor(noise=noise)
-        pp_default, pn_default = default_plane(p0, d, DEFAULT_PLANE_DISTANCE,
-                                               DEFAULT_PLANE_TILT_DEG)
-        pp = parse_floats(plane_point, 3, "plane-point") if plane_point else pp_default
-        pn = parse_floats(plane_normal, 3, "plane-normal") if plane_normal else pn_default
-        cell = make_cell(platform, plane_point=pp, plane_normal=pn, friction=friction)
-        from kinestat.sim.harness import SimHarness, control_model, start_counts
-
-        model = control_model(cell, sensor)
-    else:
-        from kinestat.control.model import ControlModel
-
-        model = ControlModel(platform=platform, mount=centred_mount(platform),
-                             tool_point_6=(0.0, 0.0, 235.0))
-    config = ControllerConfig(
-        model=model, force=force * d, start_tool_point=p0, force_tol=force_tol,
-        align_tol_deg=align_tol_deg, method=method, step=step, approach_step=approach_step,
-        estimator=estimator,
-        max_iterations=max_iterations, envelope=Envelope())
-
-    header = {"simulated": simulated}
-    if simulated:
-        header.update({"plane_point": cell.workpiece.point, "plane_normal": cell.workpiece.normal,
-                       "friction": friction, "ideal_sensor": ideal_sensor, "noise": noise,
-                       "rate_hz": rate})
-    else:
-        header.update({"galil": galil, "serial": serial, "serial_format": serial_format})
-
-    def progress(rec: dict) -> None:
-        m = rec["measured"]
-        c = rec["commanded"]
-        what = rec["decision"] if c is None else c["action"]
-        extra = ""
-        if c is not None and c["step"]:
-            extra += f" step {c['step']:+.4f} mm"
-        if c is not None and c["rotation_deg"]:
-            extra += f" turn {c['rotation_deg']:.3f}°"
-        fmag = float(np.linalg.norm(m["estimate"]))
-        err_console.print(f"cycle {rec['cycle']:3d}  state {rec['state']}  |F| {fmag:7.4f} N"
-                          f"  -> {what}{extra}")
+    cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
+                 friction, rate, seed)
+    simulated = isinstance(cell, SimulatedCell)
+    req = ControlRequest(force=force * d, start_tool_point=p0, cell=cell, force_tol=force_tol,
+                         align_tol_deg=align_tol_deg, method=method, step=step,
+                         approach_step=approach_step, estimator=estimator, samples=samples,
+                         max_iterations=max_iterations)
+    prepared = prepare_control(req)
 
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), method {method}, "
                       + ("simulated cell" if simulated else f"Galil {galil}, sensor {serial}"))
-    with CycleLog(log_path) as cycle_log:
-        if simulated:
-            sc = start_counts(config)
-            with SimHarness(cell, sensor, start_counts=sc, rate_hz=rate, seed=seed) as h:
-                io = h.device_io(samples=samples)
-                report = run(config, io, cycle_log, progress=progress, extra_header=header)
-        else:
-            report = _run_devices(config, cycle_log, galil, serial, serial_format, samples,
-                                  progress, header, run, DeviceIO)
+    report = run_control(prepared, log_path, progress=_print_progress)
     out = report.as_dict()
     plots: list[str] = []
     if plot_dir is not None:
         try:
-            from kinestat.viz.control_plots import write_plots
-
-            plots = [str(p) for p in write_plots(read_log(log_path), plot_dir)]
+            plots = plot_run(log_path, plot_dir)
         except InputError as exc:
             err_console.print(f"[yellow]no plot:[/] {exc}")
     out["plots"] = plots
@@ -241,21 +207,6 @@ def control_command(
         _print_report(out)
     if not report.converged:
         raise KinestatError(f"kinestatic control did not converge: {report.stop_reason}")
-
-
-def _run_devices(config, cycle_log, galil, serial, serial_format, samples, progress, header,
-                 run, DeviceIO):
-    from kinestat.devices.encoder_stream import EncoderReader
-    from kinestat.devices.galil import GalilClient
-
-    host, port = _host_port(galil)
-    client = GalilClient(host, port).connect()
-    try:
-        with EncoderReader(serial, fmt=serial_format) as reader:
-            io = DeviceIO(client, reader, samples=samples, settle=0.1)
-            return run(config, io, cycle_log, progress=progress, extra_header=header)
-    finally:
-        client.close()
 
 
 def _print_report(out: dict) -> None:

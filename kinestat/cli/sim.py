@@ -10,14 +10,17 @@ import numpy as np
 import typer
 
 from kinestat.cli._output import console, parse_floats, print_json
-from kinestat.devices.encoder_stream import (
+from kinestat.errors import InputError
+from kinestat.hardware.encoder_packets import (
     CHANNELS,
     COUNT_MAX,
     COUNT_MIN,
     THESIS_WIRING,
     legs_to_channels,
 )
-from kinestat.errors import InputError
+from kinestat.sim.dmc import DmcSimulator
+from kinestat.sim.encoder_emitter import EncoderEmitter, constant_counts
+from kinestat.sim.galil_server import GalilSimServer
 
 sim_app = typer.Typer(help="Simulated hardware: the Galil DMC controller and the platform's "
                            "encoder stream.", no_args_is_help=True)
@@ -78,8 +81,6 @@ def galil(
     as_json: bool = typer.Option(False, "--json", help="Print the address as JSON."),
 ) -> None:
     """Run a simulated Galil DMC (six axes, trapezoidal profiles) until Ctrl-C."""
-    from kinestat.sim.galil_server import DmcSimulator, GalilSimServer
-
     _check_duration(duration)
     c0 = _int_counts(initial_counts, "initial-counts")
     ctrl = DmcSimulator(initial_counts=c0, **({"coupling": 0.0} if no_coupling else {}))
@@ -107,8 +108,6 @@ def encoders(
     as_json: bool = typer.Option(False, "--json", help="Print the pty path as JSON."),
 ) -> None:
     """Stream encoder packets onto a pseudo-terminal and print its path until Ctrl-C."""
-    from kinestat.sim.encoder_emitter import EncoderEmitter, constant_counts
-
     _check_duration(duration)
     if fmt not in ("ks", "legacy"):
         raise InputError(f"--format must be 'ks' or 'legacy', got {fmt!r}")

@@ -6,14 +6,16 @@ safety envelope, log every cycle.
 - :mod:`kinestat.control.controller` — pure decision logic, ``decide(config, state, meas)``.
 - :mod:`kinestat.control.envelope` — limits, worst-case predictions, verdicts.
 - :mod:`kinestat.control.log` — the JSON-lines cycle log.
-- :mod:`kinestat.control.loop` — the I/O driver (devices in, decisions, devices out).
+- :mod:`kinestat.control.loop` — the loop over the :class:`~kinestat.control.loop.CellIO`
+  protocol (cell in, decisions, cell out); it imports no driver and no simulator.
+
+The robot's axis conventions and the leg calibration come from :mod:`kinestat.hardware`.
 """
 
 from kinestat.control.controller import (
     STATES,
     THESIS_FORCE_DIRECTION,
     Command,
-    Controller,
     ControllerConfig,
     ControllerState,
     Target,
@@ -22,7 +24,7 @@ from kinestat.control.controller import (
 )
 from kinestat.control.envelope import Envelope, predict
 from kinestat.control.log import CycleLog, read_log
-from kinestat.control.loop import DeviceIO, MotionProfile, RunReport, run
+from kinestat.control.loop import CellIO, RunReport, SensorReading, run
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement, measure
 
@@ -31,15 +33,14 @@ __all__ = [
     "THESIS_FORCE_DIRECTION",
     "Command",
     "ControlModel",
-    "Controller",
     "ControllerConfig",
     "ControllerState",
     "CycleLog",
-    "DeviceIO",
+    "CellIO",
     "Envelope",
     "Measurement",
-    "MotionProfile",
     "RunReport",
+    "SensorReading",
     "Target",
     "decide",
     "measure",

@@ -41,6 +41,7 @@ from __future__ import annotations
 import itertools
 import math
 from dataclasses import dataclass, field, replace
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -54,9 +55,9 @@ from kinestat.control.envelope import (
     tip_stiffness,
 )
 from kinestat.control.model import ControlModel
-from kinestat.control.wrench import Measurement
-from kinestat.devices.galil import round_half_away
+from kinestat.control.wrench import Estimator, Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
+from kinestat.hardware.puma762_axes import round_half_away
 from kinestat.serial import puma762
 
 __all__ = [
@@ -67,7 +68,9 @@ __all__ = [
     "ControllerConfig",
     "ControllerState",
     "Command",
-    "Controller",
+    "StepMethod",
+    "CommandKind",
+    "Action",
     "start",
     "decide",
     "default_a67",
@@ -88,8 +91,15 @@ STATES = {
 }
 """The states of Vibhute's Figure 5-2."""
 
-METHODS = ("fixed", "stiffness")
-ESTIMATORS = ("point", "wrench")
+StepMethod = Literal["fixed", "stiffness"]
+"""How the step along S6 is chosen: the thesis's fixed step or a Newton step from the
+platform stiffness (see the module docstring)."""
+METHODS: tuple[str, ...] = get_args(StepMethod)
+CommandKind = Literal["move", "done", "stop"]
+"""What a :class:`Command` asks for: send axis counts, report the goal, or stop safely."""
+Action = Literal["start", "approach", "align", "force", ""]
+"""Why a move is made (Vibhute Fig. 5-2 steps); "" for done/stop."""
+ESTIMATORS: tuple[str, ...] = get_args(Estimator)
 
 
 def _unit(v, name: str) -> np.ndarray:
@@ -160,13 +170,13 @@ class ControllerConfig:
     start_a67: np.ndarray | None = None
     force_tol: float = 0.5
     align_tol_deg: float = 0.5
-    method: str = "stiffness"
+    method: StepMethod = "stiffness"
     step: float = 1.0
     approach_step: float = 1.0
     contact_force: float = 0.25
     max_iterations: int = 60
     vernier: bool = True
-    estimator: str = "point"
+    estimator: Estimator = "point"
     repeat_limit: int = 3
     envelope: Envelope = field(default_factory=Envelope)
 
@@ -230,7 +240,7 @@ class ControllerState:
 
     cycle: int
     label: str
-    last_action: str
+    last_action: Action
     target: Target
     axis_counts: np.ndarray
     top_pose: np.ndarray
@@ -257,9 +267,9 @@ class Command:
         violations: envelope violations that caused a stop.
     """
 
-    kind: str
+    kind: CommandKind
     label: str
-    action: str = ""
+    action: Action = ""
     reason: str = ""
     target: Target | None = None
     axis_counts: np.ndarray | None = None
@@ -465,17 +475,3 @@ def decide(config: ControllerConfig, state: ControllerState,
     new_state = replace(st, label=label, last_action=action, target=new, axis_counts=counts,
                         history=state.history + (key,))
     return cmd, new_state
-
-
-@dataclass(frozen=True)
-class Controller:
-    """The controller as an object: ``decide(state, measurement) -> (command, new_state)``."""
-
-    config: ControllerConfig
-
-    def start(self, q_now, *, counts_now=None) -> tuple[Command, ControllerState]:
-        return start(self.config, q_now, counts_now=counts_now)
-
-    def decide(self, state: ControllerState, meas: Measurement
-               ) -> tuple[Command, ControllerState]:
-        return decide(self.config, state, meas)

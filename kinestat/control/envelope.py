@@ -34,6 +34,8 @@ from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
 from kinestat.parallel.statics import leg_directions
 from kinestat.parallel.stiffness import stiffness
+from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
+from kinestat.parallel.stiffness import tip_stiffness as platform_tip_stiffness
 from kinestat.spatial.transforms import apply, inv, skew
 
 __all__ = [
@@ -106,28 +108,20 @@ def _tip_base(model: ControlModel, meas: Measurement) -> np.ndarray:
 
 
 def tip_compliance(model: ControlModel, meas: Measurement) -> np.ndarray:
-    """Translational compliance of the tool tip (3, 3), base frame, mm/N.
-
-    A force ``δF`` applied at the tip (the top free to rotate) moves the tip by
-    ``C_tip δF``: ``C_tip = [−[p]×, I] K⁻¹ [I; [p]×]`` with ``K`` the platform's stiffness
-    (axis order ``[δφ; δx_O]``) at the measured pose and ``p`` the tip in base coordinates.
-    """
-    K = stiffness(model.platform, meas.top_pose, twist_order="axis")
-    p = _tip_base(model, meas)
-    A = np.vstack([np.eye(3), skew(p)])
-    B = np.hstack([-skew(p), np.eye(3)])
-    return B @ np.linalg.solve(K, A)
+    """Translational compliance of the tool tip (3, 3), base frame, mm/N, at the measured pose:
+    :func:`kinestat.parallel.stiffness.tip_compliance` (Vibhute eq. 2-16/2-17)."""
+    return platform_tip_compliance(model.platform, meas.top_pose, _tip_base(model, meas))
 
 
 def tip_stiffness(model: ControlModel, meas: Measurement) -> np.ndarray:
     """Point stiffness of the platform at the tool tip (3, 3), FIXED frame, N/mm.
 
-    The inverse of :func:`tip_compliance` rotated into the fixed frame: moving the flange by
-    ``δ`` (at the tip) with the tip held changes the tool's force by ``K_tip δ``.
+    The inverse of :func:`tip_compliance` rotated into the fixed frame
+    (:func:`kinestat.parallel.stiffness.tip_stiffness`): moving the flange by ``δ`` (at the
+    tip) with the tip held changes the tool's force by ``K_tip δ``.
     """
-    Kb = np.linalg.inv(tip_compliance(model, meas))
-    R = meas.base_pose[:3, :3]
-    return R @ Kb @ R.T
+    return platform_tip_stiffness(model.platform, meas.top_pose, _tip_base(model, meas),
+                                  meas.base_pose[:3, :3])
 
 
 def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Prediction:
@@ -151,7 +145,7 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     K = stiffness(model.platform, meas.top_pose, twist_order="axis")
     A = np.vstack([np.eye(3), skew(p)])
     B = np.hstack([-skew(p), np.eye(3)])
-    C_tip = B @ np.linalg.solve(K, A)
+    C_tip = platform_tip_compliance(model.platform, meas.top_pose, p)
     b = np.concatenate([np.zeros(3), np.cross(u, F)])
     dF = np.linalg.solve(C_tip, u - B @ np.linalg.solve(K, b))
     D = np.linalg.solve(K, A @ dF + b)  # top twist [δφ; δx_O] relative to the base

@@ -3,9 +3,9 @@
 :func:`run` repeats one cycle — read the robot's axis counts and a fresh packet of leg
 counts, run the measurement chain, call the pure :func:`~kinestat.control.controller.decide`,
 log the cycle, send the command — until the goal is reached or something stops it. It talks to
-the cell through a small :class:`CellIO` interface; :class:`DeviceIO` implements it with the
-real Galil client and encoder reader (:mod:`kinestat.devices`), and the simulated cell offers an
-in-process one (:mod:`kinestat.sim.harness`).
+the cell through a small :class:`CellIO` protocol and imports no driver:
+:class:`kinestat.devices.cell_io.DeviceIO` implements it with the real Galil client and encoder
+reader, and :class:`kinestat.app.sim_cell.InProcessIO` with the simulated cell in-process.
 
 Safe stop: any device fault (a ``?`` from the Galil, a dropped link, a timeout), stale or
 unreliable sensor data (no fresh packet in time, a frozen sequence, more stream faults than
@@ -20,7 +20,7 @@ import math
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Protocol
 
 import numpy as np
 
@@ -29,33 +29,34 @@ from kinestat.control.controller import (
     Command,
     ControllerConfig,
     ControllerState,
+    StepMethod,
     axis_counts_to_q,
     decide,
     start,
 )
 from kinestat.control.envelope import require
 from kinestat.control.log import CycleLog
-from kinestat.control.wrench import Measurement, measure
-from kinestat.devices.galil import (
-    AXIS4_TO_5_COUPLING,
-    THESIS_ACCEL,
-    THESIS_SPEED_MAX,
-    GalilClient,
-    axis45_compensation,
-)
-from kinestat.errors import DeviceError, InputError, KinestatError, SafetyStop
+from kinestat.control.wrench import Estimator, Measurement, measure
+from kinestat.errors import DeviceError, KinestatError, SafetyStop
 
-__all__ = ["SensorSample", "CellIO", "DeviceIO", "RunReport", "run", "MotionProfile"]
+__all__ = ["SensorReading", "CellIO", "RunReport", "run"]
 
 
-@dataclass(frozen=True)
-class SensorSample:
-    """Leg counts for one measurement (sensor legs 1..6), with the stream's bookkeeping."""
+class SensorReading(Protocol):
+    """One measurement of the leg counts as the loop reads it (sensor legs 1..6), with the
+    stream's bookkeeping (:class:`kinestat.devices.cell_io.SensorSample` is one)."""
 
-    counts: np.ndarray
-    seq: int | None = None
-    age: float | None = None
-    faults: tuple[str, ...] = ()
+    @property
+    def counts(self) -> np.ndarray: ...
+
+    @property
+    def seq(self) -> int | None: ...
+
+    @property
+    def age(self) -> float | None: ...
+
+    @property
+    def faults(self) -> tuple[str, ...]: ...
 
 
 class CellIO(Protocol):
@@ -67,7 +68,7 @@ class CellIO(Protocol):
     def move(self, axis_counts: np.ndarray) -> None:
         """Move to absolute axis counts and return when the motion is complete."""
 
-    def sensor(self) -> SensorSample:
+    def sensor(self) -> SensorReading:
         """Leg counts measured after the last motion completed."""
 
     def stop(self) -> str:
@@ -75,93 +76,6 @@ class CellIO(Protocol):
 
     def truth(self) -> dict | None:
         """The true state when simulated (for the log and report), else None."""
-
-
-@dataclass(frozen=True)
-class MotionProfile:
-    """Speeds (counts/s) and accelerations (counts/s²) per axis A..F for each move: by default
-    the thesis's maxima (galil_control.m)."""
-
-    speed: tuple[float, ...] = THESIS_SPEED_MAX
-    accel: tuple[float, ...] = THESIS_ACCEL
-
-
-class DeviceIO:
-    """:class:`CellIO` over a :class:`~kinestat.devices.galil.GalilClient` and an
-    :class:`~kinestat.devices.encoder_stream.EncoderReader` (both opened by the caller).
-
-    Moves compensate the axis 4 -> 5 coupling (``coupling``, as the model's). After each move it
-    waits ``settle`` seconds past the end of the motion and averages ``samples`` fresh packets
-    received after that. ``truth`` is an optional callable returning the true state
-    (simulation only).
-    """
-
-    def __init__(self, client: GalilClient, reader: Any, *, profile: MotionProfile | None = None,
-                 settle: float = 0.03, samples: int = 1, motion_timeout: float = 30.0,
-                 coupling: float = AXIS4_TO_5_COUPLING,
-                 truth: Callable[[], dict] | None = None,
-                 clock: Callable[[], float] = time.monotonic) -> None:
-        if not (math.isfinite(settle) and settle >= 0):
-            raise InputError(f"settle must be >= 0 seconds, got {settle!r}")
-        if int(samples) < 1:
-            raise InputError(f"samples must be at least 1, got {samples!r}")
-        self.client = client
-        self.reader = reader
-        self.profile = profile or MotionProfile()
-        self.settle = float(settle)
-        self.samples = int(samples)
-        self.motion_timeout = float(motion_timeout)
-        self.coupling = float(coupling)
-        self._truth = truth
-        self._clock = clock
-        self._t_ready = clock()
-
-    def robot_counts(self) -> np.ndarray:
-        return np.asarray(self.client.position_counts(), dtype=np.int64)
-
-    def move(self, axis_counts: np.ndarray) -> None:
-        """Move with the axis 4 -> 5 compensation (Vibhute App. D.9), keep reading the sensor
-        stream while the axes move (so that the serial buffer never overflows), then reset the
-        axis-5 encoder (``DP``) as :meth:`GalilClient.move_compensated` does."""
-        c = np.asarray(axis_counts, dtype=np.int64)
-        corr = axis45_compensation(c[3], c[4], self.client.axis_position("D"),
-                                   self.coupling)
-        cmd = c.copy()
-        cmd[4] = int(corr.axis5_command)
-        self.client.move_absolute(cmd, self.profile.speed, self.profile.accel)
-        deadline = self._clock() + self.motion_timeout
-        while self.client.is_moving():
-            if self._clock() > deadline:
-                raise DeviceError(f"motion not complete after {self.motion_timeout} s")
-            self.reader.poll()
-        self.client.define_position({"E": int(corr.axis5_reset)})
-        self._t_ready = self._clock() + self.settle
-
-    def sensor(self) -> SensorSample:
-        got: list[np.ndarray] = []
-        faults: list[str] = []
-        last = None
-        while len(got) < self.samples:
-            r = self.reader.read()
-            faults.extend(f"{f.kind}: {f.message}" for f in r.faults)
-            if r.received_at >= self._t_ready:
-                got.append(np.asarray(r.counts, dtype=float))
-                last = r
-        assert last is not None
-        return SensorSample(counts=np.mean(got, axis=0), seq=last.seq, age=last.age,
-                            faults=tuple(faults))
-
-    def stop(self) -> str:
-        if not self.client.connected:
-            return "the Galil link is down: ST could not be sent"
-        try:
-            self.client.stop()
-        except KinestatError as exc:
-            return f"ST failed: {exc}"
-        return "ST sent to the Galil"
-
-    def truth(self) -> dict | None:
-        return None if self._truth is None else self._truth()
 
 
 @dataclass
@@ -172,7 +86,7 @@ class RunReport:
     iterations: int
     moves: int
     stop_reason: str
-    method: str
+    method: StepMethod
     states: list[str]
     force: np.ndarray | None = None
     torque: np.ndarray | None = None
@@ -189,7 +103,7 @@ class RunReport:
     elapsed_s: float = 0.0
     target_force: float = 0.0
     faults: list[str] = field(default_factory=list)
-    estimator: str = "point"
+    estimator: Estimator = "point"
     equivalent_wrench: np.ndarray | None = None
 
     def as_dict(self) -> dict:
@@ -295,95 +209,123 @@ def _config_record(config: ControllerConfig) -> dict:
     }
 
 
+@dataclass
+class _Run:
+    """What a run has accumulated so far (mutable, private to :func:`run`)."""
+
+    t0: float
+    state: ControllerState | None = None
+    states: list[str] = field(default_factory=list)
+    faults: list[str] = field(default_factory=list)
+    last_meas: Measurement | None = None
+    last_truth: dict | None = None
+    last_counts: np.ndarray | None = None
+    moves: int = 0
+    converged: bool = False
+    reason: str = ""
+
+    def t(self) -> float:
+        return time.monotonic() - self.t0
+
+
 def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
         progress: Callable[[dict], None] | None = None,
         extra_header: dict | None = None) -> RunReport:
-    """Run the kinestatic procedure on ``io`` until the goal, a stop or ``max_iterations``.
+    """Run the kinestatic procedure (Vibhute 2011 ch. 5, Fig. 5-2) on ``io`` until the goal, a
+    stop or ``max_iterations``.
 
     Never raises for a fault of the cell: the run ends with a safe stop and the report says
     why. Every cycle is written to ``log`` before its command is sent.
     """
-    t0 = time.monotonic()
+    r = _Run(t0=time.monotonic())
     header = {"type": "start", "time": time.strftime("%Y-%m-%dT%H:%M:%S"),
               "config": _config_record(config)}
     if extra_header:
         header.update(extra_header)
     log.write(header)
-    model = config.model
-    states: list[str] = []
-    faults: list[str] = []
-    last_meas: Measurement | None = None
-    last_truth: dict | None = None
-    last_counts: np.ndarray | None = None
-    moves = 0
-    converged = False
-    reason = ""
-    state: ControllerState | None = None
     try:
-        counts_now = io.robot_counts()
-        q_now = axis_counts_to_q(model, counts_now)
-        cmd, state = start(config, q_now, counts_now=counts_now)
-        log.write({"type": "command", "cycle": 0, "t": time.monotonic() - t0,
-                   "decision": cmd.kind, "reason": cmd.reason, "commanded": _cmd_record(cmd)})
-        if cmd.kind == "stop":
-            raise SafetyStop(cmd.reason)
-        io.move(cmd.axis_counts)
-        moves += 1
-        while True:
-            sample = io.sensor()
-            if sample.faults:
-                faults.extend(sample.faults)
-                log.write({"type": "stream_faults", "cycle": state.cycle + 1,
-                           "faults": list(sample.faults)})
-            if len(sample.faults) > config.envelope.max_stream_faults:
-                raise SafetyStop(f"sensor link unreliable: {len(sample.faults)} stream faults "
-                                 f"while acquiring one measurement (limit "
-                                 f"{config.envelope.max_stream_faults}); first: "
-                                 f"{sample.faults[0]}")
-            counts_r = io.robot_counts()
-            last_counts = np.asarray(counts_r)
-            q = axis_counts_to_q(model, counts_r)
-            meas = measure(model, q, sample.counts, state.top_pose, seq=sample.seq,
-                           age=sample.age)
-            last_meas = meas
-            cmd, state = decide(config, state, meas)
-            states.append(cmd.label)
-            last_truth = io.truth()
-            rec = {"type": "cycle", "cycle": state.cycle, "t": time.monotonic() - t0,
-                   "state": cmd.label, "decision": cmd.kind, "action": cmd.action,
-                   "reason": cmd.reason, "force_error": cmd.force_error,
-                   "misalignment_deg": cmd.misalignment_deg,
-                   "measured": _meas_record(config, meas), "commanded": _cmd_record(cmd),
-                   "true": last_truth, "violations": list(cmd.violations)}
-            log.write(rec)
-            if progress is not None:
-                progress(rec)
-            if cmd.kind == "done":
-                converged = True
-                reason = cmd.reason
-                break
-            if cmd.kind == "stop":
-                raise SafetyStop(cmd.reason)
-            require([] if cmd.axis_counts is not None else ["a move without axis counts"])
-            io.move(cmd.axis_counts)
-            moves += 1
+        _start_move(config, io, log, r)
+        while not _cycle(config, io, log, r, progress):
+            pass
     except (KinestatError, KeyboardInterrupt) as exc:
-        if isinstance(exc, KeyboardInterrupt):
-            reason = "interrupted by the user"
-        elif isinstance(exc, SafetyStop):
-            reason = str(exc)
-        else:
-            kind = "device fault" if isinstance(exc, DeviceError) else type(exc).__name__
-            reason = f"{kind}: {exc}"
-        reason = _safe_stop(io, log, reason, faults, t0)
+        r.reason = _safe_stop(io, log, _fault_reason(exc), r.faults, r.t0)
     except Exception as exc:  # a bug: stop the robot first, keep the log, then let it show
-        reason = _safe_stop(io, log, f"internal error {type(exc).__name__}: {exc}", faults, t0)
-        report = _report(config, False, state, states, moves, reason, last_meas, last_truth,
-                         log, faults, time.monotonic() - t0, last_counts)
-        log.write({"type": "end", "report": report.as_dict()})
+        r.reason = _safe_stop(io, log, f"internal error {type(exc).__name__}: {exc}", r.faults,
+                              r.t0)
+        _finish(config, r, log)
         raise
-    report = _report(config, converged, state, states, moves, reason, last_meas, last_truth,
-                     log, faults, time.monotonic() - t0, last_counts)
+    return _finish(config, r, log)
+
+
+def _start_move(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run) -> None:
+    """Step 1: command the start pose (:func:`~kinestat.control.controller.start`)."""
+    counts_now = io.robot_counts()
+    q_now = axis_counts_to_q(config.model, counts_now)
+    cmd, r.state = start(config, q_now, counts_now=counts_now)
+    log.write({"type": "command", "cycle": 0, "t": r.t(), "decision": cmd.kind,
+               "reason": cmd.reason, "commanded": _cmd_record(cmd)})
+    if cmd.kind == "stop":
+        raise SafetyStop(cmd.reason)
+    io.move(cmd.axis_counts)
+    r.moves += 1
+
+
+def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
+           progress: Callable[[dict], None] | None) -> bool:
+    """One cycle: sense, measure, decide, log, act. True when the goal is attained."""
+    sample = io.sensor()
+    if sample.faults:
+        r.faults.extend(sample.faults)
+        log.write({"type": "stream_faults", "cycle": r.state.cycle + 1,
+                   "faults": list(sample.faults)})
+    if len(sample.faults) > config.envelope.max_stream_faults:
+        raise SafetyStop(f"sensor link unreliable: {len(sample.faults)} stream faults "
+                         f"while acquiring one measurement (limit "
+                         f"{config.envelope.max_stream_faults}); first: {sample.faults[0]}")
+    counts_r = io.robot_counts()
+    r.last_counts = np.asarray(counts_r)
+    q = axis_counts_to_q(config.model, counts_r)
+    meas = measure(config.model, q, sample.counts, r.state.top_pose, seq=sample.seq,
+                   age=sample.age)
+    r.last_meas = meas
+    cmd, r.state = decide(config, r.state, meas)
+    r.states.append(cmd.label)
+    r.last_truth = io.truth()
+    rec = {"type": "cycle", "cycle": r.state.cycle, "t": r.t(),
+           "state": cmd.label, "decision": cmd.kind, "action": cmd.action,
+           "reason": cmd.reason, "force_error": cmd.force_error,
+           "misalignment_deg": cmd.misalignment_deg,
+           "measured": _meas_record(config, meas), "commanded": _cmd_record(cmd),
+           "true": r.last_truth, "violations": list(cmd.violations)}
+    log.write(rec)
+    if progress is not None:
+        progress(rec)
+    if cmd.kind == "done":
+        r.converged = True
+        r.reason = cmd.reason
+        return True
+    if cmd.kind == "stop":
+        raise SafetyStop(cmd.reason)
+    require([] if cmd.axis_counts is not None else ["a move without axis counts"])
+    io.move(cmd.axis_counts)
+    r.moves += 1
+    return False
+
+
+def _fault_reason(exc: BaseException) -> str:
+    """The report's reason for a fault that ends the run."""
+    if isinstance(exc, KeyboardInterrupt):
+        return "interrupted by the user"
+    if isinstance(exc, SafetyStop):
+        return str(exc)
+    kind = "device fault" if isinstance(exc, DeviceError) else type(exc).__name__
+    return f"{kind}: {exc}"
+
+
+def _finish(config: ControllerConfig, r: _Run, log: CycleLog) -> RunReport:
+    """The report of the run, also written as the log's ``end`` record."""
+    report = _report(config, r.converged, r.state, r.states, r.moves, r.reason, r.last_meas,
+                     r.last_truth, log, r.faults, r.t(), r.last_counts)
     log.write({"type": "end", "report": report.as_dict()})
     return report
 

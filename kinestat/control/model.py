@@ -14,9 +14,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from kinestat.devices.calibration import THESIS_CALIBRATION, LegCalibration
-from kinestat.devices.galil import AXIS4_TO_5_COUPLING, AXIS_DEG_PER_COUNT
 from kinestat.errors import ModelError
+from kinestat.hardware.leg_calibration import THESIS_CALIBRATION, LegCalibration
+from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, AXIS_DEG_PER_COUNT
 from kinestat.parallel.platform import Platform
 from kinestat.serial import puma762
 from kinestat.spatial.transforms import apply, as_array, inv
@@ -42,7 +42,7 @@ class ControlModel:
         limits_deg: (6, 2) robot axis limits, degrees (default the MATLAB code's).
         axis_deg_per_count: (6,) robot encoder resolution, degrees per count.
         coupling: axis-5 counts turned per axis-4 count, compensated by the motion controller
-            (:func:`kinestat.devices.galil.axis45_compensation`); 0 when there is none.
+            (:func:`kinestat.hardware.puma762_axes.axis45_compensation`); 0 when there is none.
     """
 
     platform: Platform

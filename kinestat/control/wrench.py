@@ -28,18 +28,23 @@ is the moment about the tool point ``P_tool_F``.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
 from kinestat.control.model import ControlModel
-from kinestat.devices.calibration import counts_to_lengths
 from kinestat.errors import InputError
+from kinestat.hardware.leg_calibration import counts_to_lengths
 from kinestat.parallel.statics import line_jacobian, spring_forces, wrench_from_leg_lengths
 from kinestat.serial import puma762
 from kinestat.spatial.screws import transform_wrench
 from kinestat.spatial.transforms import apply, skew
 
-__all__ = ["Measurement", "measure", "tool_frame"]
+__all__ = ["Estimator", "Measurement", "measure", "tool_frame"]
+
+Estimator = Literal["point", "wrench"]
+"""The force a measurement offers the controller (:meth:`Measurement.estimate`): the
+point-contact fit or the equivalent wrench's force (as the thesis)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,7 +97,7 @@ class Measurement:
         """Moment of the measured wrench about the tool point ``P_tool_F`` (N·mm)."""
         return self.wrench[3:] - np.cross(self.tool_point, self.wrench[:3])
 
-    def estimate(self, estimator: str = "point") -> np.ndarray:
+    def estimate(self, estimator: Estimator = "point") -> np.ndarray:
         """The force the controller acts on: ``"point"`` (point-contact fit, default) or
         ``"wrench"`` (the equivalent wrench's force, as the thesis)."""
         if estimator == "point" and self.point_force is not None:

@@ -1,14 +1,19 @@
-"""Talking to the cell's hardware: the I/O edge between the controller and the world.
+"""Talking to the cell's hardware: the drivers between the controller's loop and the world.
 
 - :mod:`kinestat.devices.encoder_stream` — the platform's encoder packets (codec, incremental
   parser, serial reader with stale-data detection).
-- :mod:`kinestat.devices.galil` — the Galil DMC TCP client, the thesis's axis scales and
-  offsets, and the PUMA's axis 4 -> 5 coupling compensation.
-- :mod:`kinestat.devices.calibration` — encoder counts to leg lengths and forces.
+- :mod:`kinestat.devices.galil` — the Galil DMC TCP client and the thesis's move recipe.
+- :mod:`kinestat.devices.cell_io` — :class:`DeviceIO` and :class:`MotionProfile`: the device-side
+  implementation of the loop's :class:`kinestat.control.loop.CellIO` protocol.
+- :mod:`kinestat.devices.calibration` — old path of :mod:`kinestat.hardware.leg_calibration`
+  (kept: documented in docs/platform.md).
 
-Nothing here decides what to do; :mod:`kinestat.control` does.
+The robot's axis conventions and the leg calibration are in :mod:`kinestat.hardware`. Nothing
+here decides what to do (:mod:`kinestat.control` does) and nothing here imports
+:mod:`kinestat.control` or :mod:`kinestat.sim`.
 """
 
+from kinestat.devices.cell_io import DeviceIO, MotionProfile, SensorSample
 from kinestat.devices.encoder_stream import (
     EncoderReader,
     Packet,
@@ -21,28 +26,23 @@ from kinestat.devices.encoder_stream import (
     encode_legacy_line,
     encode_packet,
 )
-from kinestat.devices.galil import (
-    GalilClient,
-    GalilCommandError,
-    axis45_compensation,
-    axis_deg_to_counts,
-    counts_to_axis_deg,
-)
+from kinestat.devices.galil import GalilClient, GalilCommandError, thesis_move_plan
 
 __all__ = [
+    "DeviceIO",
     "EncoderReader",
     "GalilClient",
     "GalilCommandError",
+    "MotionProfile",
     "Packet",
     "Reading",
+    "SensorSample",
     "StaleDataError",
     "StreamFault",
     "StreamParser",
-    "axis45_compensation",
-    "axis_deg_to_counts",
-    "counts_to_axis_deg",
     "decode_legacy_line",
     "decode_packet",
     "encode_legacy_line",
     "encode_packet",
+    "thesis_move_plan",
 ]

@@ -1,4 +1,6 @@
-"""The platform's encoder stream: packet codec, incremental parser and serial reader.
+"""The platform's encoder stream: incremental parser and serial reader.
+
+The packet codec and the channel wiring are :mod:`kinestat.hardware.encoder_packets`.
 
 Two wire formats are understood (see ``docs/devices.md`` for the full specification):
 
@@ -23,36 +25,63 @@ channels to legs 1..6 with that wiring unless told otherwise.
 
 from __future__ import annotations
 
-import binascii
 import math
-import re
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 
 from kinestat.errors import DeviceError, InputError, ProtocolError
+from kinestat.hardware.encoder_packets import (
+    CHANNELS,
+    COUNT_MAX,
+    COUNT_MIN,
+    SEQ_MODULUS,
+    THESIS_WIRING,
+    Format,
+    Packet,
+    channels_to_legs,
+    check_wiring,
+    crc16_ccitt,
+    decode_legacy_line,
+    decode_packet,
+    encode_legacy_line,
+    encode_packet,
+    legs_to_channels,
+    unwrap16,
+)
 
-CHANNELS = "ABCDEF"
-"""Channel tags in packet order."""
-
-THESIS_WIRING: tuple[int, ...] = (2, 1, 6, 5, 4, 3)
-"""Leg number (1-based) carried by channels A..F (Vibhute App. D.6 ``serialdaq_plat.m``)."""
-
-SEQ_MODULUS = 1 << 16
-"""Sequence numbers are 16-bit and wrap around."""
-
-COUNT_MIN = -(1 << 31)
-COUNT_MAX = (1 << 31) - 1
-"""Range of a count in the ``ks`` format (signed 32-bit)."""
-
-LEGACY_LINE_LENGTH = 23
-"""Bytes in a legacy line without its LF terminator (``serialdaq_plat.m``: ``m==23``)."""
-
-LEGACY_TAG_OFFSETS = (3, 6, 9, 12, 15, 18)
-"""0-based offsets of the tags 'A'..'F' in a legacy line (1-based 4, 7, ..., 19)."""
+__all__ = [
+    # re-exported from kinestat.hardware.encoder_packets (documented in docs/devices.md)
+    "CHANNELS",
+    "COUNT_MAX",
+    "COUNT_MIN",
+    "SEQ_MODULUS",
+    "THESIS_WIRING",
+    "Format",
+    "Packet",
+    "channels_to_legs",
+    "crc16_ccitt",
+    "decode_legacy_line",
+    "decode_packet",
+    "encode_legacy_line",
+    "encode_packet",
+    "legs_to_channels",
+    "unwrap16",
+    # the stream
+    "DEFAULT_BAUDRATE",
+    "MAX_FRAME",
+    "FaultKind",
+    "StreamFault",
+    "Event",
+    "StreamStats",
+    "StreamParser",
+    "StaleDataError",
+    "Reading",
+    "EncoderReader",
+]
 
 DEFAULT_BAUDRATE = 115200
 """The XBee link's rate (Vibhute App. D.6)."""
@@ -60,21 +89,8 @@ DEFAULT_BAUDRATE = 115200
 MAX_FRAME = 128
 """A ``ks`` frame longer than this without its LF is declared broken (the real one is 75)."""
 
-_KS_BODY = re.compile(
-    rb"KS,([0-9A-F]{4}),A([0-9A-F]{8}),B([0-9A-F]{8}),C([0-9A-F]{8}),"
-    rb"D([0-9A-F]{8}),E([0-9A-F]{8}),F([0-9A-F]{8})"
-)
-
-Format = Literal["ks", "legacy"]
-
-
-@dataclass(frozen=True)
-class Packet:
-    """One decoded packet: ``counts`` in channel order A..F; ``seq`` is None for legacy lines."""
-
-    seq: int | None
-    counts: tuple[int, ...]
-    fmt: Format = "ks"
+FaultKind = Literal["framing", "checksum", "gap", "duplicate", "out_of_order", "restart"]
+"""What a :class:`StreamFault` is about."""
 
 
 @dataclass(frozen=True)
@@ -87,7 +103,7 @@ class StreamFault:
     ``"restart"`` (the sender's sequence restarted; accepted).
     """
 
-    kind: str
+    kind: FaultKind
     message: str
     seq: int | None = None
     lost: int = 0
@@ -95,167 +111,6 @@ class StreamFault:
 
 Event = Packet | StreamFault
 
-
-# --------------------------------------------------------------------------- codec (pure)
-
-
-def crc16_ccitt(data: bytes) -> int:
-    """CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, no reflection); check value 0x29B1."""
-    return binascii.crc_hqx(data, 0xFFFF)
-
-
-def _check_counts(counts: Iterable[Any], lo: int, hi: int, what: str) -> tuple[int, ...]:
-    try:
-        vals = list(counts)
-    except TypeError as exc:
-        raise InputError(f"{what}: expected 6 integer counts, got {counts!r}") from exc
-    if len(vals) != 6:
-        raise InputError(f"{what}: expected 6 counts (channels A..F), got {len(vals)}")
-    out = []
-    for ch, v in zip(CHANNELS, vals, strict=True):
-        try:
-            f = float(v)
-        except (TypeError, ValueError) as exc:
-            raise InputError(f"{what}: channel {ch} count {v!r} is not a number") from exc
-        if not math.isfinite(f) or f != math.floor(f):
-            raise InputError(f"{what}: channel {ch} count {v!r} is not a finite integer")
-        i = int(f) if not isinstance(v, (int, np.integer)) else int(v)
-        if not lo <= i <= hi:
-            raise InputError(f"{what}: channel {ch} count {i} is outside [{lo}, {hi}]")
-        out.append(i)
-    return tuple(out)
-
-
-def encode_packet(seq: int, counts: Sequence[int]) -> bytes:
-    """Encode one ``ks`` frame: sequence number 0..65535 and six signed 32-bit counts (A..F)."""
-    if isinstance(seq, bool) or not isinstance(seq, (int, np.integer)):
-        raise InputError(f"encode_packet: sequence number must be an integer, got {seq!r}")
-    if not 0 <= int(seq) < SEQ_MODULUS:
-        raise InputError(f"encode_packet: sequence number {seq} outside 0..65535 (wrap it)")
-    vals = _check_counts(counts, COUNT_MIN, COUNT_MAX, "encode_packet")
-    body = f"KS,{int(seq):04X}," + ",".join(
-        f"{ch}{v & 0xFFFFFFFF:08X}" for ch, v in zip(CHANNELS, vals, strict=True)
-    )
-    raw = body.encode("ascii")
-    return b"$" + raw + b"*" + f"{crc16_ccitt(raw):04X}".encode("ascii") + b"\r\n"
-
-
-def _signed32(u: int) -> int:
-    return u - (1 << 32) if u & 0x80000000 else u
-
-
-def decode_packet(data: bytes) -> Packet:
-    """Decode one ``ks`` frame (with or without its CR LF); raises :class:`ProtocolError`."""
-    if not isinstance(data, (bytes, bytearray, memoryview)):
-        raise InputError(f"decode_packet: expected bytes, got {type(data).__name__}")
-    frame = bytes(data).rstrip(b"\r\n")
-    if not frame.startswith(b"$"):
-        raise ProtocolError(f"encoder packet does not start with '$': {frame[:20]!r}")
-    star = frame.rfind(b"*")
-    if star < 0 or len(frame) - star != 5:
-        raise ProtocolError(f"encoder packet has no '*<crc:4 hex>' trailer: {frame[-12:]!r}")
-    body, crc_txt = frame[1:star], frame[star + 1 :]
-    if not re.fullmatch(rb"[0-9A-F]{4}", crc_txt):
-        raise ProtocolError(f"encoder packet checksum field {crc_txt!r} is not 4 hex digits")
-    want, got = int(crc_txt, 16), crc16_ccitt(body)
-    if want != got:
-        raise ProtocolError(
-            f"encoder packet checksum mismatch (frame says {want:04X}, data gives {got:04X}): "
-            "the packet was corrupted in transit; discard it"
-        )
-    m = _KS_BODY.fullmatch(body)
-    if m is None:
-        raise ProtocolError(
-            f"encoder packet body {body[:40]!r}... does not follow "
-            "'KS,<seq4>,A<hex8>,...,F<hex8>' (upper-case hex)"
-        )
-    seq = int(m.group(1), 16)
-    counts = tuple(_signed32(int(g, 16)) for g in m.groups()[1:])
-    return Packet(seq=seq, counts=counts, fmt="ks")
-
-
-def encode_legacy_line(
-    counts: Sequence[int], header: bytes = b"ENC", trailer: bytes = b" \r"
-) -> bytes:
-    """Encode a thesis-style 23-byte line plus LF: 16-bit unsigned counts, high byte first.
-
-    ``header`` (3 bytes) and ``trailer`` (2 bytes) fill the positions the thesis code does not
-    read; their real content is not recorded in the thesis (our choice, see docs/devices.md).
-    A count whose bytes include 0x0A (LF) produces a line that a reader will split: the legacy
-    format cannot protect against that, which is one reason for the ``ks`` format.
-    """
-    if len(header) != 3 or len(trailer) != 2:
-        raise InputError("encode_legacy_line: header must be 3 bytes and trailer 2 bytes")
-    vals = _check_counts(counts, 0, 0xFFFF, "encode_legacy_line")
-    body = b"".join(ch.encode() + v.to_bytes(2, "big") for ch, v in zip(CHANNELS, vals,
-                                                                          strict=True))
-    return header + body + trailer + b"\n"
-
-
-def decode_legacy_line(line: bytes) -> Packet:
-    """Decode a thesis-style line (23 bytes, LF already stripped or not); :class:`ProtocolError`.
-
-    Counts are returned raw (0..65535); see :func:`unwrap16` for counters that cross zero.
-    """
-    if not isinstance(line, (bytes, bytearray, memoryview)):
-        raise InputError(f"decode_legacy_line: expected bytes, got {type(line).__name__}")
-    b = bytes(line)
-    if b.endswith(b"\n"):
-        b = b[:-1]
-    if len(b) != LEGACY_LINE_LENGTH:
-        raise ProtocolError(
-            f"legacy encoder line has {len(b)} bytes, expected {LEGACY_LINE_LENGTH} "
-            "(a count byte equal to LF splits the line; discard it)"
-        )
-    for ch, off in zip(CHANNELS, LEGACY_TAG_OFFSETS, strict=True):
-        if b[off] != ord(ch):
-            raise ProtocolError(
-                f"legacy encoder line: byte {off + 1} is 0x{b[off]:02X}, expected tag "
-                f"'{ch}' (0x{ord(ch):02X})"
-            )
-    counts = tuple(int.from_bytes(b[off + 1 : off + 3], "big") for off in LEGACY_TAG_OFFSETS)
-    return Packet(seq=None, counts=counts, fmt="legacy")
-
-
-def unwrap16(previous: np.ndarray | Sequence[int] | None, raw: Sequence[int]) -> np.ndarray:
-    """Unwrap 16-bit counter values against the previous unwrapped values.
-
-    Each channel moves to the value congruent to ``raw`` modulo 65536 nearest ``previous``
-    (valid while a leg moves less than 32768 counts between packets: 832 mm at 0.0254
-    mm/count). With no previous value, ``raw`` is read as signed 16-bit (two's complement).
-    """
-    r = np.asarray(raw, dtype=np.int64) & 0xFFFF
-    if previous is None:
-        return np.where(r >= 0x8000, r - 0x10000, r)
-    p = np.asarray(previous, dtype=np.int64)
-    delta = (r - p) & 0xFFFF
-    delta = np.where(delta >= 0x8000, delta - 0x10000, delta)
-    return p + delta
-
-
-def channels_to_legs(channel_counts: Sequence[int], wiring: Sequence[int] = THESIS_WIRING
-                     ) -> np.ndarray:
-    """Reorder counts from channels A..F to legs 1..6 (``wiring[k]`` = leg on channel k)."""
-    w = _check_wiring(wiring)
-    c = np.asarray(channel_counts, dtype=np.int64)
-    out = np.empty(c.shape, dtype=np.int64)
-    out[..., np.asarray(w) - 1] = c
-    return out
-
-
-def legs_to_channels(leg_counts: Sequence[int], wiring: Sequence[int] = THESIS_WIRING
-                     ) -> np.ndarray:
-    """Reorder counts from legs 1..6 to channels A..F (inverse of :func:`channels_to_legs`)."""
-    w = _check_wiring(wiring)
-    c = np.asarray(leg_counts, dtype=np.int64)
-    return c[..., np.asarray(w) - 1]
-
-
-def _check_wiring(wiring: Sequence[int]) -> tuple[int, ...]:
-    w = tuple(int(x) for x in wiring)
-    if sorted(w) != [1, 2, 3, 4, 5, 6]:
-        raise InputError(f"wiring must be a permutation of legs 1..6 for channels A..F, got {w}")
-    return w
 
 
 # --------------------------------------------------------------------------- parser
@@ -489,7 +344,7 @@ class EncoderReader:
         self.baudrate = baudrate
         self.stale_after = float(stale_after)
         self.read_timeout = float(read_timeout)
-        self.wiring = _check_wiring(wiring)
+        self.wiring = check_wiring(wiring)
         self.legacy_unwrap = legacy_unwrap
         self._clock = clock
         self._factory = serial_factory
@@ -507,7 +362,7 @@ class EncoderReader:
         """Open the serial port (idempotent); raises :class:`DeviceError` if it cannot."""
         if self._ser is not None:
             return self
-        import serial
+        import serial  # lazy: pyserial is loaded only when a port is used
 
         factory = self._factory or serial.serial_for_url
         try:
@@ -542,7 +397,7 @@ class EncoderReader:
     # -- I/O
     def poll(self) -> list[Event]:
         """Read what has arrived (waiting at most ``read_timeout``); return its events."""
-        import serial
+        import serial  # lazy: pyserial is loaded only when a port is used
 
         if self._ser is None:
             self.open()

@@ -1,12 +1,10 @@
-"""Galil DMC motion controller: a small TCP client and the thesis's axis conventions.
+"""Galil DMC motion controller: a small TCP client and the thesis's move recipe.
 
 The PUMA 762 of Vibhute 2011 is driven by a Galil DMC 2160 over Ethernet (App. D.4, D.5, D.9).
-This module holds:
+The robot's axis conventions (encoder scales, joint-1 offset, axis 4 -> 5 coupling and its
+compensation, rounding to counts) live in :mod:`kinestat.hardware.puma762_axes`. This module
+holds:
 
-* the thesis's encoder scales (degrees per count per axis A..F), the joint-1 offset
-  (``Pos_A_KCorrection`` = 180°) and conversions between counts, axis degrees and joint
-  angles in radians;
-* the axis 4 -> 5 coupling of that robot and its compensation (``Axis_4_5_Correction.m``);
 * the thesis's move recipe (speeds, accelerations, the +5-count nudge: ``galil_control.m``);
 * :class:`GalilClient`, a pure-Python client for the command subset the thesis uses.
 
@@ -25,32 +23,15 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from kinestat.errors import DeviceError, InputError, ProtocolError
-
-AXES = "ABCDEF"
-"""Galil axis letters; axis A drives joint 1, ..., axis F joint 6."""
-
-AXIS_DEG_PER_COUNT = np.array([0.00125, 0.00086875, 0.001115625, 0.00626, 0.00626, 0.01337])
-"""Degrees of axis motion per encoder count, axes A..F (``ENC_DEG_1..6``, Vibhute App. D.3,
-D.5). Checked: ``startup_initialize.m`` defines joints 2 and 3 at 90° with ``DP 0,103597,80672``
-and 103597 x 0.00086875 = 89.9999°, 80672 x 0.001115625 = 89.9997°."""
-AXIS_DEG_PER_COUNT.setflags(write=False)
-
-JOINT_OFFSET_DEG = np.array([180.0, 0.0, 0.0, 0.0, 0.0, 0.0])
-"""Joint angle minus axis angle, degrees (``Pos_A_KCorrection`` = 180 on joint 1, Vibhute App.
-D.2/D.3): phi1 = axis_A + 180°."""
-JOINT_OFFSET_DEG.setflags(write=False)
-
-JOINT1_OFFSET_DEG = 180.0
-"""``Pos_A_KCorrection``: joint 1 angle phi1 = axis-A angle + 180° (Vibhute App. D.3)."""
-
-AXIS4_TO_5_COUPLING = -11200.0 / 23962.0
-"""Physical axis-5 motion per axis-4 encoder count, in axis-5 counts (Vibhute App. D.9).
-
-The thesis measured 11200 counts of axis 5 (70.1°) for 23962 counts of axis 4 (150.0°) and
-calls the ratio ``Compensation_Factor``. The sign follows from the thesis's correction formula
-with its two OCR-dropped minus signs restored, ``E_cmd - (D_now - D_cmd) * 11200/23962``: that
-formula cancels the coupling only if axis 5 turns by ``-11200/23962`` counts per count of
-axis 4. The axis-5 encoder does not see this motion."""
+from kinestat.hardware.puma762_axes import (
+    AXES,
+    AXIS4_TO_5_COUPLING,
+    COUNT_LIMIT,
+    as_axes6,
+    as_finite,
+    axis45_compensation,
+    round_half_away,
+)
 
 THESIS_ACCEL = (8000.0, 11511.0, 8964.0, 3194.0, 3194.0, 1496.0)
 """``AC`` and ``DC`` used by ``galil_control.m`` (counts/s^2), axes A..F."""
@@ -64,101 +45,11 @@ THESIS_SPEED_MIN = 10.0
 THESIS_NUDGE_COUNTS = 5
 """``galil_control.m`` adds 5 counts to a target closer than 5 counts to the current position."""
 
-COUNT_LIMIT = 2_147_483_647
-"""Galil position registers are signed 32-bit."""
-
 DEFAULT_PORT = 23
 """Galil controllers accept commands on TCP port 23."""
 
 
-# --------------------------------------------------------------------------- conversions
-
-
-def _finite(x: Any, name: str) -> np.ndarray:
-    try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"{name}: expected numbers, got {x!r}") from exc
-    if not np.all(np.isfinite(a)):
-        raise InputError(f"{name}: values must be finite, got {x!r}")
-    return a
-
-
-def _six(x: Any, name: str) -> np.ndarray:
-    a = _finite(x, name)
-    if a.ndim == 0 or a.shape[-1] != 6:
-        raise InputError(f"{name}: expected shape (..., 6) for axes A..F, got {a.shape}")
-    return a
-
-
-def round_half_away(x: Any) -> np.ndarray:
-    """Round to the nearest integer, halves away from zero (MATLAB's ``round``), as int64."""
-    a = np.asarray(x, dtype=float)
-    return (np.sign(a) * np.floor(np.abs(a) + 0.5)).astype(np.int64)
-
-
-def counts_to_axis_deg(counts: Any) -> np.ndarray:
-    """Axis angles in degrees from encoder counts, shape (..., 6) (``Pos = PosE * ENC_DEG``)."""
-    return _six(counts, "counts_to_axis_deg") * AXIS_DEG_PER_COUNT
-
-
-def axis_deg_to_counts(axis_deg: Any) -> np.ndarray:
-    """Encoder counts (int64) from axis angles in degrees (``En = round(Deg / ENC_DEG)``)."""
-    c = _six(axis_deg, "axis_deg_to_counts") / AXIS_DEG_PER_COUNT
-    if np.any(np.abs(c) > COUNT_LIMIT):
-        raise InputError("axis_deg_to_counts: a position exceeds the Galil's 32-bit range")
-    return round_half_away(c)
-
-
-def axis_deg_to_joint_rad(axis_deg: Any) -> np.ndarray:
-    """Joint angles q (radians, Crane-Duffy convention) from axis angles: q = axis + offset."""
-    return np.deg2rad(_six(axis_deg, "axis_deg_to_joint_rad") + JOINT_OFFSET_DEG)
-
-
-def joint_rad_to_axis_deg(q: Any) -> np.ndarray:
-    """Axis angles in degrees from joint angles q: axis = q - offset (no wrapping).
-
-    Which multiple of 360° an axis should take (limits, least motion) is the caller's choice;
-    the thesis adds +180° to phi1, which equals -180° modulo 360°.
-    """
-    return np.rad2deg(_six(q, "joint_rad_to_axis_deg")) - JOINT_OFFSET_DEG
-
-
-def counts_to_joint_rad(counts: Any) -> np.ndarray:
-    """Joint angles q (radians) from encoder counts A..F."""
-    return axis_deg_to_joint_rad(counts_to_axis_deg(counts))
-
-
-def joint_rad_to_counts(q: Any) -> np.ndarray:
-    """Encoder counts A..F (int64) for joint angles q (radians), joint 1 offset applied."""
-    return axis_deg_to_counts(joint_rad_to_axis_deg(q))
-
-
-class Axis45Correction(NamedTuple):
-    """Result of :func:`axis45_compensation` (counts, int64 arrays or scalars)."""
-
-    axis5_command: np.ndarray
-    axis5_reset: np.ndarray
-
-
-def axis45_compensation(
-    axis4_target: Any, axis5_target: Any, axis4_now: Any,
-    coupling: float = AXIS4_TO_5_COUPLING,
-) -> Axis45Correction:
-    """Compensate the PUMA's axis 4 -> 5 coupling (Vibhute App. D.9 ``Axis_4_5_Correction.m``).
-
-    Moving axis 4 by ``d4 = axis4_target - axis4_now`` counts turns axis 5 by ``coupling*d4``
-    counts that its encoder does not see. Commanding axis 5 to
-    ``axis5_target - coupling * d4`` (thesis: ``E_cmd + (D_cmd - D_now) * 11200/23962``) makes
-    the true axis-5 position end at ``axis5_target``; afterwards the encoder reads the command,
-    so it is reset with ``DP`` to ``axis5_reset = axis5_target``. All inputs are counts and may
-    carry a leading batch shape; the outputs are rounded (halves away from zero).
-    """
-    d4 = _finite(axis4_target, "axis4_target") - _finite(axis4_now, "axis4_now")
-    e = _finite(axis5_target, "axis5_target")
-    if not math.isfinite(coupling):
-        raise InputError(f"axis45_compensation: coupling must be finite, got {coupling!r}")
-    return Axis45Correction(round_half_away(e - coupling * d4), round_half_away(e))
+# --------------------------------------------------------------------------- move recipe
 
 
 class MovePlan(NamedTuple):
@@ -179,8 +70,8 @@ def thesis_move_plan(current: Any, target: Any, *, nudge: bool = True) -> MovePl
     speeds of axes D and E to the maximum instead of 10 (see docs/seed-errata.md); this
     function uses 10 for every axis.
     """
-    cur = _six(current, "thesis_move_plan current")
-    tgt = round_half_away(_six(target, "thesis_move_plan target"))
+    cur = as_axes6(current, "thesis_move_plan current")
+    tgt = round_half_away(as_axes6(target, "thesis_move_plan target"))
     dist = np.abs(cur - tgt)
     speed = np.clip(np.ceil(dist / 4.0), THESIS_SPEED_MIN, np.asarray(THESIS_SPEED_MAX))
     if nudge:
@@ -210,7 +101,7 @@ def _fmt(x: float) -> str:
 
 
 def _per_axis(value: Any, name: str, *, positive: bool) -> list[float]:
-    a = _finite(value, name)
+    a = as_finite(value, name)
     if a.ndim == 0:
         a = np.full(6, float(a))
     if a.shape != (6,):

@@ -42,7 +42,7 @@ from kinestat.parallel.statics import leg_directions, spring_wrench
 from kinestat.spatial.transforms import as_array, skew
 
 __all__ = ["stiffness", "stiffness_terms", "load_asymmetry", "equilibrium_pose",
-           "TWIST_ORDERS"]
+           "tip_compliance", "tip_stiffness", "TWIST_ORDERS"]
 
 TWIST_ORDERS = ("ray", "axis")
 
@@ -93,6 +93,44 @@ def stiffness(platform: Platform, pose, forces=None, *, twist_order: str = "ray"
     parts = stiffness_terms(platform, pose, forces)
     K = parts["elastic"] + parts["geometric"] + parts["load"]
     return K if twist_order == "ray" else _swap(K)
+
+
+def tip_compliance(platform: Platform, pose, tip) -> np.ndarray:
+    """Translational compliance (..., 3, 3) of a point ``tip`` of the top, base frame, mm/N.
+
+    A force ``δF`` applied at the tip (the top free to rotate) moves the tip by ``C_tip δF``:
+    ``C_tip = [−[p]×, I] K⁻¹ [I; [p]×]``, K the platform's stiffness at ``pose`` (Vibhute
+    eq. 2-16/2-17, axis order ``[δφ; δx_O]``) and ``p`` (..., 3) the tip in base coordinates.
+    Batched over a leading shape shared by ``pose`` and ``tip``.
+
+    >>> from kinestat.parallel.platform import special_6_6
+    >>> pf = special_6_6()
+    >>> C = tip_compliance(pf, pf.home_pose, [0.0, 0.0, 100.0])
+    >>> bool(np.allclose(C, C.T)) and bool(np.all(np.linalg.eigvalsh(C) > 0))
+    True
+    """
+    K = stiffness(platform, pose, twist_order="axis")
+    p = as_array(tip, shape_tail=(3,), name="tip")
+    P = skew(p)
+    eye = np.broadcast_to(np.eye(3), P.shape)
+    A = np.concatenate([eye, P], axis=-2)
+    B = np.concatenate([-P, eye], axis=-1)
+    return B @ np.linalg.solve(K, A)
+
+
+def tip_stiffness(platform: Platform, pose, tip, rotation=None) -> np.ndarray:
+    """Point stiffness (..., 3, 3) of the platform at ``tip``, N/mm: ``C_tip⁻¹``
+    (:func:`tip_compliance`), in the base frame, or rotated by ``rotation`` (..., 3, 3, the
+    base frame's orientation in another frame) into that frame: ``R C_tip⁻¹ Rᵀ``.
+
+    Moving the base by ``δ`` at the tip with the tip held changes the tip force by
+    ``K_tip δ`` (Vibhute eq. 2-16 reduced to the tip's translation).
+    """
+    Kb = np.linalg.inv(tip_compliance(platform, pose, tip))
+    if rotation is None:
+        return Kb
+    R = np.asarray(rotation, dtype=float)
+    return R @ Kb @ np.swapaxes(R, -1, -2)
 
 
 def load_asymmetry(wrench) -> np.ndarray:

@@ -1,13 +1,38 @@
 """Stand-ins for the cell's hardware, for tests, demos and development without the robot.
 
-- :mod:`kinestat.sim.galil_server` — a simulated Galil DMC controller served over TCP
-  (loopback only unless told otherwise), with trapezoidal profiles, the PUMA's axis 4 -> 5
-  coupling, simulated or real time and fault injection.
+Only hardware: no decisions (:mod:`kinestat.control`) and no drivers (:mod:`kinestat.devices`)
+are imported here; the wiring of a simulated cell to the controller is
+:mod:`kinestat.app.sim_cell`.
+
+- :mod:`kinestat.sim.contact` — the cell's mechanics: platform + tool + planar workpiece, the
+  contact equilibrium (frictionless or Coulomb) at a flange pose.
+- :mod:`kinestat.sim.sensor` — the leg encoders: true leg lengths -> quantised counts, noise.
+- :mod:`kinestat.sim.dmc` — a simulated Galil DMC controller: command interpreter,
+  trapezoidal profiles, the PUMA's axis 4 -> 5 coupling, simulated or real time, fault
+  injection.
+- :mod:`kinestat.sim.galil_server` — that controller served over TCP (loopback only unless
+  told otherwise).
 - :mod:`kinestat.sim.encoder_emitter` — a simulated encoder box streaming packets onto a
   pseudo-terminal, with fault injection.
 """
 
+from kinestat.sim.contact import Cell, Equilibrium, Workpiece, equilibrium, make_cell
+from kinestat.sim.dmc import DmcSimulator, SimClock
 from kinestat.sim.encoder_emitter import EncoderEmitter, constant_counts
-from kinestat.sim.galil_server import DmcSimulator, GalilSimServer, SimClock
+from kinestat.sim.galil_server import GalilSimServer
+from kinestat.sim.sensor import Sensor, ideal_sensor
 
-__all__ = ["DmcSimulator", "EncoderEmitter", "GalilSimServer", "SimClock", "constant_counts"]
+__all__ = [
+    "Cell",
+    "DmcSimulator",
+    "EncoderEmitter",
+    "Equilibrium",
+    "GalilSimServer",
+    "Sensor",
+    "SimClock",
+    "Workpiece",
+    "constant_counts",
+    "equilibrium",
+    "ideal_sensor",
+    "make_cell",
+]

@@ -25,7 +25,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from kinestat.devices.encoder_stream import (
+from kinestat.errors import DeviceError, InputError, KinestatError
+from kinestat.hardware.encoder_packets import (
     SEQ_MODULUS,
     THESIS_WIRING,
     Format,
@@ -33,7 +34,6 @@ from kinestat.devices.encoder_stream import (
     encode_packet,
     legs_to_channels,
 )
-from kinestat.errors import DeviceError, InputError, KinestatError
 
 
 def constant_counts(counts: Sequence[float]) -> Callable[[], np.ndarray]:

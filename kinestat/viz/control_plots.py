@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from kinestat.control.controller import STATES
 from kinestat.errors import InputError
 
 __all__ = ["STATE_COLOURS", "cycle_series", "wrench_figure", "write_plots"]
@@ -59,11 +60,11 @@ def cycle_series(records: list[dict]) -> dict:
 
 def wrench_figure(records: list[dict], title: str | None = None):
     """The seven-panel figure (matplotlib ``Figure``) of Vibhute's Figure 5-2 for a run."""
-    import matplotlib
+    import matplotlib  # lazy: matplotlib costs start-up time and is needed only to plot
 
     matplotlib.use("Agg", force=False)
-    from matplotlib.figure import Figure
-    from matplotlib.lines import Line2D
+    from matplotlib.figure import Figure  # lazy: as above
+    from matplotlib.lines import Line2D  # lazy: as above
 
     s = cycle_series(records)
     x = s["cycle"]
@@ -94,8 +95,6 @@ def wrench_figure(records: list[dict], title: str | None = None):
     ax.axis("off")
     handles = [Line2D([], [], marker="o", ls="", color=c, label=f"{k}") for k, c in
                STATE_COLOURS.items()]
-    from kinestat.control.controller import STATES
-
     labels = [f"{k}: {STATES[k]}" for k in STATE_COLOURS]
     if np.any(np.isfinite(s["true_fmag"])):
         handles.append(Line2D([], [], ls="--", color="black"))

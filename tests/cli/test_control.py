@@ -7,10 +7,15 @@ import json
 import numpy as np
 import pytest
 
+from kinestat.app import sim_cell as harness_mod
+from kinestat.app.control_run import DEFAULT_START, default_plane
 from kinestat.cli.main import main
-from kinestat.control.loop import MotionProfile
+from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
+from kinestat.devices.cell_io import MotionProfile
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
-from kinestat.sim import harness as harness_mod
+from kinestat.parallel.platform import special_6_6
+from kinestat.sim.contact import make_cell
+from kinestat.sim.sensor import Sensor
 
 FAST = MotionProfile(speed=tuple(20 * np.asarray(THESIS_SPEED_MAX)),
                      accel=tuple(400 * np.asarray(THESIS_ACCEL)))
@@ -98,10 +103,6 @@ def test_bad_input_is_reported(tmp_path, capsys, args, message):
 
 def test_real_device_options_drive_external_devices(tmp_path, capsys):
     """--galil/--serial: the CLI talks to devices it did not start (here: a harness)."""
-    from kinestat.cli.control import DEFAULT_START, default_plane
-    from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
-    from kinestat.parallel.platform import special_6_6
-    from kinestat.sim.cell import Sensor, make_cell
 
     plat = special_6_6()
     p0 = np.array([float(v) for v in DEFAULT_START.split(",")])

@@ -8,11 +8,14 @@ from dataclasses import dataclass
 import numpy as np
 import pytest
 
+from kinestat.app.sim_cell import InProcessIO, control_model, start_counts
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
+from kinestat.control.log import CycleLog, read_log
+from kinestat.control.loop import run
 from kinestat.control.model import ControlModel
 from kinestat.parallel.platform import special_6_6
-from kinestat.sim.cell import Cell, Sensor, ideal_sensor, make_cell
-from kinestat.sim.harness import control_model
+from kinestat.sim.contact import Cell, make_cell
+from kinestat.sim.sensor import Sensor, ideal_sensor
 
 PLATFORM = special_6_6()
 START = np.array([-400.0, 800.0, -100.0])
@@ -56,9 +59,6 @@ def default_scenario() -> Scenario:
 
 def run_in_process(scn: Scenario, config: ControllerConfig, log_path, **io_kw):
     """Run the controller on the in-process cell; return (report, log records, io)."""
-    from kinestat.control.log import CycleLog, read_log
-    from kinestat.control.loop import run
-    from kinestat.sim.harness import InProcessIO, start_counts
 
     io = InProcessIO(scn.cell, scn.sensor, start_counts=start_counts(config), **io_kw)
     with CycleLog(log_path) as log:

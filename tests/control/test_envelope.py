@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.spatial.transform import Rotation
 
+from kinestat.app.sim_cell import start_counts
 from kinestat.control.controller import axis_counts_to_q
 from kinestat.control.envelope import (
     Envelope,
@@ -18,10 +20,13 @@ from kinestat.control.envelope import (
 )
 from kinestat.control.wrench import measure
 from kinestat.errors import InputError, SafetyStop
+from kinestat.parallel.stiffness import equilibrium_pose
+from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
+from kinestat.parallel.stiffness import tip_stiffness as platform_tip_stiffness
 from kinestat.serial import puma762
-from kinestat.sim.cell import Sensor, equilibrium
-from kinestat.sim.harness import start_counts
-from kinestat.spatial.transforms import trans
+from kinestat.sim.contact import equilibrium
+from kinestat.sim.sensor import Sensor
+from kinestat.spatial.transforms import apply, trans
 
 from .conftest import F_HAT, PLATFORM, scenario
 
@@ -73,7 +78,6 @@ def test_prediction_matches_a_sticking_contact(move):
     if d is not None:
         Tn = trans(d) @ T
     else:  # turn 0.05° about an axis through the tool point
-        from scipy.spatial.transform import Rotation
 
         R = np.eye(4)
         R[:3, :3] = Rotation.from_rotvec(np.radians(0.05) * np.array([0, 1.0, 0])).as_matrix()
@@ -121,3 +125,25 @@ def test_envelope_values_are_checked():
         Envelope(max_load=0)
     with pytest.raises(InputError):
         Envelope(max_stream_faults=-1)
+
+
+def test_platform_tip_compliance_matches_the_springs_and_batches():
+    """parallel.stiffness.tip_compliance: a small force at the tip, solved by the springs'
+    equilibrium, moves the tip by C δF; a batch equals its items; tip_stiffness inverts it."""
+    pf = PLATFORM
+    tip_top = np.array([3.0, -2.0, 120.0])
+    home = pf.home_pose
+    p = apply(home, tip_top)
+    C = platform_tip_compliance(pf, home, p)
+    dF = np.array([0.3, -0.2, 0.5]) * 1e-2  # small: the tip moves ~10 µm
+    T = equilibrium_pose(pf, np.concatenate([dF, np.cross(p, dF)]))
+    moved = apply(T, tip_top) - p
+    np.testing.assert_allclose(moved, C @ dF, rtol=1e-3, atol=1e-3 * np.abs(moved).max())
+    poses = np.stack([home, T])
+    tips = np.stack([p, apply(T, tip_top)])
+    Cb = platform_tip_compliance(pf, poses, tips)
+    assert Cb.shape == (2, 3, 3)
+    np.testing.assert_allclose(Cb[1], platform_tip_compliance(pf, T, tips[1]), rtol=1e-12)
+    R = Rotation.from_rotvec([0.1, 0.2, -0.3]).as_matrix()
+    K = platform_tip_stiffness(pf, home, p, R)
+    np.testing.assert_allclose(R.T @ K @ R @ C, np.eye(3), atol=1e-9)

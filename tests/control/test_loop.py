@@ -7,12 +7,14 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+import kinestat.control.loop as loop_mod
+from kinestat.app.sim_cell import SimHarness, start_counts
 from kinestat.control.log import CycleLog, read_log
-from kinestat.control.loop import MotionProfile, run
+from kinestat.control.loop import run
+from kinestat.devices.cell_io import MotionProfile
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
-from kinestat.sim.harness import SimHarness, start_counts
 
-from .conftest import F_HAT, scenario
+from .conftest import F_HAT, run_in_process, scenario
 
 # a fast robot: moves of a few ms keep the tests short
 FAST = MotionProfile(speed=tuple(20 * np.asarray(THESIS_SPEED_MAX)),
@@ -134,10 +136,6 @@ def test_averaging_noisy_samples(tmp_path, samples):
 
 def test_an_internal_error_still_stops_the_robot_and_keeps_the_log(tmp_path, monkeypatch):
     """A bug (any exception) stops the robot and is logged before it propagates."""
-    import kinestat.control.loop as loop_mod
-
-    from .conftest import run_in_process
-
     class Broken(Exception):
         pass
 

@@ -5,14 +5,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from kinestat.app.sim_cell import start_counts
 from kinestat.control.controller import axis_counts_to_q
 from kinestat.control.wrench import measure
 from kinestat.errors import InputError
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.stiffness import equilibrium_pose
 from kinestat.serial import puma762
-from kinestat.sim.cell import Sensor, equilibrium
-from kinestat.sim.harness import start_counts
+from kinestat.sim.contact import equilibrium
+from kinestat.sim.sensor import Sensor
 
 from .conftest import F_HAT, PLATFORM, scenario
 

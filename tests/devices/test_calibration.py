@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from kinestat.devices.calibration import (
+from kinestat.errors import InputError
+from kinestat.hardware.leg_calibration import (
     COUNTS_PER_INCH,
     MM_PER_COUNT,
     THESIS_CALIBRATION,
@@ -16,7 +17,6 @@ from kinestat.devices.calibration import (
     fit_polynomial,
     lengths_to_counts,
 )
-from kinestat.errors import InputError
 from kinestat.io.library import prototype
 
 THESIS_LEGS = np.array([79.6804, 81.8285, 81.2669, 68.6500, 67.2037, 68.2854])  # main.cpp

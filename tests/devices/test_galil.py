@@ -12,13 +12,19 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from kinestat.devices.galil import (
-    AXIS4_TO_5_COUPLING,
-    AXIS_DEG_PER_COUNT,
-    JOINT1_OFFSET_DEG,
     THESIS_ACCEL,
     THESIS_SPEED_MAX,
     GalilClient,
     GalilCommandError,
+    parse_number,
+    parse_numbers,
+    thesis_move_plan,
+)
+from kinestat.errors import DeviceError, InputError, ProtocolError
+from kinestat.hardware.puma762_axes import (
+    AXIS4_TO_5_COUPLING,
+    AXIS_DEG_PER_COUNT,
+    JOINT1_OFFSET_DEG,
     axis45_compensation,
     axis_deg_to_counts,
     axis_deg_to_joint_rad,
@@ -26,13 +32,10 @@ from kinestat.devices.galil import (
     counts_to_joint_rad,
     joint_rad_to_axis_deg,
     joint_rad_to_counts,
-    parse_number,
-    parse_numbers,
     round_half_away,
-    thesis_move_plan,
 )
-from kinestat.errors import DeviceError, InputError, ProtocolError
-from kinestat.sim.galil_server import DmcSimulator, GalilSimServer, SimClock
+from kinestat.sim.dmc import DmcSimulator, SimClock
+from kinestat.sim.galil_server import GalilSimServer
 
 counts6 = st.lists(st.integers(-10_000_000, 10_000_000), min_size=6, max_size=6)
 

@@ -11,21 +11,20 @@ from hypothesis import strategies as st
 from scipy.optimize import minimize
 from scipy.spatial.transform import Rotation
 
-from kinestat.devices.calibration import MM_PER_COUNT, counts_to_lengths
 from kinestat.errors import InputError, ModelError, UnreachableError
+from kinestat.hardware.leg_calibration import MM_PER_COUNT, counts_to_lengths
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.platform import special_6_6
 from kinestat.parallel.statics import spring_wrench
-from kinestat.sim.cell import (
+from kinestat.sim.contact import (
     DEFAULT_TOOL_POINT_6,
-    Sensor,
     Workpiece,
     centred_mount,
     equilibrium,
-    ideal_sensor,
     make_cell,
     unloaded_tip,
 )
+from kinestat.sim.sensor import Sensor, ideal_sensor
 from kinestat.spatial.transforms import apply
 
 PLAT = special_6_6()

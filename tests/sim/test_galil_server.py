@@ -12,13 +12,8 @@ from hypothesis import strategies as st
 
 from kinestat.devices.galil import GalilClient
 from kinestat.errors import InputError
-from kinestat.sim.galil_server import (
-    DmcSimulator,
-    GalilSimServer,
-    SimClock,
-    check_bind_address,
-    trapezoid,
-)
+from kinestat.sim.dmc import DmcSimulator, SimClock, trapezoid
+from kinestat.sim.galil_server import GalilSimServer, check_bind_address
 
 
 @pytest.mark.parametrize("host", ["0.0.0.0", "", "::", "8.8.8.8", "192.168.0.84"])

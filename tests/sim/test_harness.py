@@ -7,14 +7,16 @@ import time
 import numpy as np
 import pytest
 
+from kinestat.app.sim_cell import InProcessIO, SimHarness, control_model, start_counts
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
-from kinestat.devices.calibration import counts_to_lengths
-from kinestat.devices.galil import counts_to_joint_rad
+from kinestat.devices.encoder_stream import StaleDataError
 from kinestat.errors import DeviceError
+from kinestat.hardware.leg_calibration import counts_to_lengths
+from kinestat.hardware.puma762_axes import counts_to_joint_rad
 from kinestat.parallel.platform import special_6_6
 from kinestat.serial import puma762
-from kinestat.sim.cell import Sensor, equilibrium, make_cell
-from kinestat.sim.harness import InProcessIO, SimHarness, control_model, start_counts
+from kinestat.sim.contact import equilibrium, make_cell
+from kinestat.sim.sensor import Sensor
 
 PLAT = special_6_6()
 F = np.asarray(THESIS_FORCE_DIRECTION)
@@ -63,7 +65,6 @@ def test_a_bottomed_out_cell_silences_the_sensor():
             time.sleep(0.01)
         assert h.emitter.error is not None and "stroke" in str(h.emitter.error)
         assert "error" in h.truth()
-        from kinestat.devices.encoder_stream import StaleDataError
 
         with pytest.raises(StaleDataError):
             h.reader(stale_after=0.1).read()

@@ -1,14 +1,15 @@
-"""Wiring the simulated cell to the simulated devices, for ``kinestat control`` without hardware.
+"""Composition root: the simulated cell wired to the simulated devices (``kinestat control``
+without hardware).
 
 :class:`SimHarness` starts the Galil simulator (:mod:`kinestat.sim.galil_server`, loopback
 only) and the encoder emitter (:mod:`kinestat.sim.encoder_emitter`, on a pty) and connects
 them through the cell: at every packet the emitter asks :meth:`SimHarness.counts_now`, which
 reads the simulator's TRUE axis positions (including the axis 4 → 5 coupling the encoders do
 not see), solves the contact equilibrium of the platform at that flange pose
-(:func:`kinestat.sim.cell.equilibrium`, quasi-statically along the robot's motion so that a
+(:func:`kinestat.sim.contact.equilibrium`, quasi-statically along the robot's motion so that a
 friction anchor follows the path) and turns the true leg lengths into encoder counts
-(:class:`kinestat.sim.cell.Sensor`). The controller then drives the cell through the real
-client and reader (:class:`kinestat.control.loop.DeviceIO`), over TCP loopback and the pty.
+(:class:`kinestat.sim.sensor.Sensor`). The controller then drives the cell through the real
+client and reader (:class:`kinestat.devices.cell_io.DeviceIO`), over TCP loopback and the pty.
 
 :class:`InProcessIO` is the same cell without devices (an exact robot, counts straight from the
 sensor model): fast, deterministic, for tests of the control law.
@@ -22,20 +23,23 @@ from typing import Any
 import numpy as np
 
 from kinestat.control.controller import ControllerConfig, axis_counts_to_q
-from kinestat.control.loop import DeviceIO, SensorSample
 from kinestat.control.model import ControlModel
-from kinestat.devices.encoder_stream import EncoderReader
-from kinestat.devices.galil import (
+from kinestat.devices.cell_io import DeviceIO, SensorSample
+from kinestat.devices.encoder_stream import EncoderReader, Format
+from kinestat.devices.galil import GalilClient
+from kinestat.errors import DeviceError, KinestatError
+from kinestat.hardware.puma762_axes import (
     AXIS4_TO_5_COUPLING,
-    GalilClient,
+    AXIS_DEG_PER_COUNT,
     axis_deg_to_counts,
     counts_to_joint_rad,
 )
-from kinestat.errors import DeviceError, KinestatError
 from kinestat.serial import puma762
-from kinestat.sim.cell import Cell, Equilibrium, Sensor, equilibrium, unloaded_tip
+from kinestat.sim.contact import Cell, Equilibrium, equilibrium, unloaded_tip
+from kinestat.sim.dmc import DmcSimulator, SimClock
 from kinestat.sim.encoder_emitter import EncoderEmitter
-from kinestat.sim.galil_server import DmcSimulator, GalilSimServer, SimClock
+from kinestat.sim.galil_server import GalilSimServer
+from kinestat.sim.sensor import Sensor
 
 __all__ = ["CellState", "SimHarness", "InProcessIO", "control_model", "start_counts"]
 
@@ -135,7 +139,7 @@ class SimHarness:
     """
 
     def __init__(self, cell: Cell, sensor: Sensor | None = None, *, start_counts=(0,) * 6,
-                 rate_hz: float = 200.0, fmt: str = "ks", clock: SimClock | None = None,
+                 rate_hz: float = 200.0, fmt: Format = "ks", clock: SimClock | None = None,
                  coupling: float = AXIS4_TO_5_COUPLING, seed: int | None = 0,
                  emitter_options: dict | None = None, record: bool = False) -> None:
         self.state = CellState(cell, sensor, seed=seed)
@@ -150,6 +154,7 @@ class SimHarness:
 
     # -- life cycle
     def start(self) -> SimHarness:
+        """Start the Galil simulator's server and the encoder emitter."""
         self.server.start()
         try:
             self.emitter.start()
@@ -159,6 +164,7 @@ class SimHarness:
         return self
 
     def stop(self) -> None:
+        """Close the clients and readers it opened, stop the emitter and the server."""
         for obj in reversed(self._opened):
             try:
                 obj.close()
@@ -234,8 +240,6 @@ class InProcessIO:
 
     def __init__(self, cell: Cell, sensor: Sensor | None = None, *, start_counts,
                  axis_deg_per_count=None, seed: int | None = 0, substeps: int = 4) -> None:
-        from kinestat.devices.galil import AXIS_DEG_PER_COUNT
-
         self.state = CellState(cell, sensor, seed=seed)
         self.cell = cell
         self._res = np.asarray(AXIS_DEG_PER_COUNT if axis_deg_per_count is None
@@ -249,9 +253,11 @@ class InProcessIO:
         return puma762.from_axis_angles(np.radians(np.asarray(counts, dtype=float) * self._res))
 
     def robot_counts(self) -> np.ndarray:
+        """The exact robot's axis counts A..F."""
         return self._counts.copy()
 
     def move(self, axis_counts) -> None:
+        """Reach ``axis_counts`` exactly, solving the cell at ``substeps`` points on the way."""
         new = np.asarray(axis_counts, dtype=np.int64)
         old = self._counts.astype(float)
         for s in np.linspace(0.0, 1.0, self.substeps + 1)[1:]:
@@ -260,16 +266,19 @@ class InProcessIO:
         self.moves.append(new.copy())
 
     def sensor(self) -> SensorSample:
+        """Leg counts of the cell at the present pose, through the sensor model."""
         try:
             return SensorSample(counts=self.state.counts(self._q(self._counts)))
         except KinestatError as exc:
             raise DeviceError(f"simulated sensor failed: {exc}") from exc
 
     def stop(self) -> str:
+        """Record that a stop was requested."""
         self.stopped = True
         return "stopped (in-process)"
 
     def truth(self) -> dict:
+        """The true state at the present pose (or the simulator's error)."""
         try:
             return self.state.truth(self._q(self._counts), self.cell.tool_point_6)
         except KinestatError as exc:

@@ -1,10 +1,10 @@
-"""The simulated cell: PUMA 762 + compliant platform + tool + rigid planar workpiece.
+"""The simulated cell's mechanics: PUMA 762 + compliant platform + tool + rigid planar workpiece.
 
 The cell of Vibhute 2011 ch. 4-5: the special 6-6 platform's base is bolted to the robot's
 flange (frame 6), a tool tip is fixed to its top, and the tip presses on a workpiece. For each
 flange pose this module solves the **contact equilibrium** of the top platform and returns the
-true leg lengths and the true contact force; :class:`Sensor` turns leg lengths into encoder
-counts as the platform's encoders would.
+true leg lengths and the true contact force; :class:`kinestat.sim.sensor.Sensor` turns leg
+lengths into encoder counts as the platform's encoders would.
 
 Frames and conventions (all lengths in mm, forces in N):
 
@@ -48,8 +48,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from kinestat.devices.calibration import THESIS_CALIBRATION, LegCalibration, lengths_to_counts
 from kinestat.errors import InputError, ModelError, UnreachableError
+from kinestat.hardware.puma762_axes import THESIS_TOOL_POINT_6
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.platform import Platform
 from kinestat.parallel.statics import spring_wrench
@@ -66,15 +66,11 @@ __all__ = [
     "make_cell",
     "equilibrium",
     "unloaded_tip",
-    "IDEAL_RESOLUTION",
-    "ideal_calibration",
-    "Sensor",
-    "ideal_sensor",
 ]
 
-DEFAULT_TOOL_POINT_6 = np.array([0.0, 0.0, 235.0])
-"""The unloaded tool tip in frame 6, mm (Vibhute App. D.1 ForceCorrection.m ``P_tool_6``)."""
-DEFAULT_TOOL_POINT_6.setflags(write=False)
+DEFAULT_TOOL_POINT_6 = THESIS_TOOL_POINT_6
+"""The unloaded tool tip in frame 6, mm: the thesis's ``P_tool_6`` (Vibhute App. D.1,
+:data:`kinestat.hardware.puma762_axes.THESIS_TOOL_POINT_6`)."""
 
 DEFAULT_STROKE = 8.0
 """Largest leg deflection |l − l0| the simulated legs can take (mm) before bottoming out.
@@ -541,66 +537,3 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
             f"{np.max(np.abs(r)):.3g} N)")
     aF = a_F + d2[0] * e1 + d2[1] * e2
     return Xs, fs, aF, False, rs, iters
-
-
-# -- the leg sensors -----------------------------------------------------------------------------
-IDEAL_RESOLUTION = 1e-6
-"""Length per count of the "ideal" sensor (mm): 1 nm, far below anything that matters here
-(2.6e-6 N of spring force), yet still whole counts on the wire."""
-
-
-def ideal_calibration(reference: LegCalibration = THESIS_CALIBRATION,
-                      resolution: float = IDEAL_RESOLUTION) -> LegCalibration:
-    """A linear length calibration with ``resolution`` mm per count and the same zero-count
-    lengths (and sense) as ``reference``: an encoder without practical quantisation.
-
-    The force maps are scaled to the same counts (force per count × resolution / slope).
-    """
-    if not (math.isfinite(resolution) and resolution > 0):
-        raise InputError(f"sensor resolution must be a positive number of mm, got {resolution!r}")
-    a = reference.length_coeffs
-    if a.shape[1] != 2:
-        raise InputError("ideal_calibration needs a linear reference calibration")
-    sign = np.sign(a[:, 1])
-    length = np.stack([a[:, 0], sign * resolution], axis=1)
-    fc = reference.force_coeffs
-    force = fc.copy()
-    if fc.shape[1] == 2:
-        force[:, 1] = fc[:, 1] * resolution / np.abs(a[:, 1])
-    return LegCalibration(length_coeffs=length, force_coeffs=force,
-                          leg_names=reference.leg_names)
-
-
-@dataclass(frozen=True, eq=False)
-class Sensor:
-    """The platform's leg encoders: true leg lengths → counts (sensor legs 1..6).
-
-    ``calibration`` maps counts to lengths (its inverse gives the counts a length produces);
-    by default the thesis's maps (leg_to_T10.m: 0.0255–0.0271 mm per count). ``noise`` is
-    the standard deviation of Gaussian noise added to each length before quantisation (mm).
-    ``quantize=False`` returns fractional counts (the emitter rounds them on the wire; use
-    :func:`ideal_calibration` for a sensor without practical quantisation).
-    """
-
-    calibration: LegCalibration = THESIS_CALIBRATION
-    noise: float = 0.0
-    quantize: bool = True
-
-    def __post_init__(self) -> None:
-        if not (math.isfinite(float(self.noise)) and self.noise >= 0):
-            raise InputError(f"sensor noise must be a number of mm >= 0, got {self.noise!r}")
-
-    def counts(self, platform: Platform, lengths, rng: np.random.Generator | None = None
-               ) -> np.ndarray:
-        """Counts (6,) in sensor order for leg ``lengths`` in the platform's leg order."""
-        L = np.asarray(lengths, dtype=float)
-        if self.noise > 0:
-            gen = rng if rng is not None else np.random.default_rng()
-            L = L + gen.normal(0.0, self.noise, size=L.shape)
-        c = lengths_to_counts(L, self.calibration, platform.leg_names)
-        return np.rint(c) if self.quantize else c
-
-
-def ideal_sensor() -> Sensor:
-    """A sensor with 1 nm counts and no noise (see :func:`ideal_calibration`)."""
-    return Sensor(calibration=ideal_calibration())

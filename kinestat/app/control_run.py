@@ -1,0 +1,207 @@
+"""Composition root of ``kinestat control``: assemble the cell, the controller and its devices.
+
+The CLI (:mod:`kinestat.cli.control`) parses options into a :class:`ControlRequest` and prints
+the report; this module builds what the run needs — the thesis's experiment as a simulated
+cell (Vibhute 2011 §5.1: the special 6-6 platform centred on the flange, the tool at
+``P_tool_6``, a tilted plane ahead of the start tool point) behind the simulated Galil and
+encoder box (:mod:`kinestat.app.sim_cell`), or the real Galil and encoder stream — and runs
+the kinestatic loop (:func:`kinestat.control.loop.run`) on it.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from kinestat.app.sim_cell import SimHarness, control_model, start_counts
+from kinestat.control.controller import ControllerConfig, StepMethod
+from kinestat.control.envelope import Envelope
+from kinestat.control.log import CycleLog, read_log
+from kinestat.control.loop import RunReport, run
+from kinestat.control.model import ControlModel
+from kinestat.control.wrench import Estimator
+from kinestat.devices.cell_io import DeviceIO
+from kinestat.devices.encoder_stream import EncoderReader, Format
+from kinestat.devices.galil import GalilClient
+from kinestat.hardware.puma762_axes import THESIS_TOOL_POINT_6
+from kinestat.parallel.platform import special_6_6
+from kinestat.sim.contact import Cell, centred_mount, make_cell
+from kinestat.sim.sensor import Sensor, ideal_calibration
+
+__all__ = [
+    "DEFAULT_START",
+    "DEFAULT_DIRECTION",
+    "DEFAULT_PLANE_DISTANCE",
+    "DEFAULT_PLANE_TILT_DEG",
+    "SimulatedCell",
+    "RealDevices",
+    "ControlRequest",
+    "PreparedRun",
+    "prepare_control",
+    "default_plane",
+    "simulated_cell",
+    "device_model",
+    "run_control",
+    "plot_run",
+]
+
+DEFAULT_START = "-400,800,-100"
+"""The start tool point ``P_tool_F`` (mm, fixed frame) of the default run."""
+DEFAULT_DIRECTION = "0.9713,0,-0.2375"
+"""The thesis's force direction ``F_req`` (Vibhute §5.1, sign restored)."""
+DEFAULT_PLANE_DISTANCE = 2.5
+"""The default workpiece plane's distance ahead of the start tool point (mm)."""
+DEFAULT_PLANE_TILT_DEG = 5.0
+"""The default workpiece normal's tilt from −F_req (degrees)."""
+
+def default_plane(start_point: np.ndarray, direction: np.ndarray, distance: float,
+                  tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
+    """The default workpiece: a plane ``distance`` mm ahead of the start tool point along the
+    force direction, its normal tilted by ``tilt_deg`` from −direction (towards the fixed +y,
+    or +z when the direction is along y) so that the reorientation (state c, Vibhute Fig. 5-2)
+    is visible."""
+    d = direction / np.linalg.norm(direction)
+    ref = np.array([0.0, 1.0, 0.0]) if abs(d[1]) < 0.9 else np.array([0.0, 0.0, 1.0])
+    perp = ref - (ref @ d) * d
+    perp /= np.linalg.norm(perp)
+    t = math.radians(tilt_deg)
+    normal = -(math.cos(t) * d + math.sin(t) * perp)
+    return start_point + distance * d, normal
+
+
+@dataclass(frozen=True)
+class SimulatedCell:
+    """Settings of the simulated cell (``kinestat control`` without devices).
+
+    ``plane_point``/``plane_normal`` None: :func:`default_plane`. ``noise``: leg-length noise
+    (mm, standard deviation); ``ideal_sensor``: 1 nm leg encoders; ``rate_hz``: packet rate.
+    """
+
+    plane_point: np.ndarray | None = None
+    plane_normal: np.ndarray | None = None
+    friction: float = 0.0
+    ideal_sensor: bool = False
+    noise: float = 0.0
+    rate_hz: float = 200.0
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class RealDevices:
+    """The real cell: the Galil at ``host``:``port``, the encoder stream on ``serial``."""
+
+    host: str
+    port: int
+    serial: str
+    serial_format: Format = "ks"
+
+
+@dataclass(frozen=True)
+class ControlRequest:
+    """One ``kinestat control`` run: the goal, the controller's settings and the cell."""
+
+    force: np.ndarray
+    start_tool_point: np.ndarray
+    cell: SimulatedCell | RealDevices
+    force_tol: float = 0.5
+    align_tol_deg: float = 0.5
+    method: StepMethod = "stiffness"
+    step: float = 1.0
+    approach_step: float = 1.0
+    estimator: Estimator = "point"
+    samples: int = 1
+    max_iterations: int = 60
+
+
+def simulated_cell(settings: SimulatedCell, start_point: np.ndarray,
+                   direction: np.ndarray) -> tuple[Cell, Sensor]:
+    """The thesis's experiment as a simulated cell and its leg sensor (Vibhute §5.1)."""
+    sensor = (Sensor(calibration=ideal_calibration()) if settings.ideal_sensor
+              else Sensor(noise=settings.noise))
+    pp, pn = default_plane(start_point, direction, DEFAULT_PLANE_DISTANCE,
+                           DEFAULT_PLANE_TILT_DEG)
+    if settings.plane_point is not None:
+        pp = settings.plane_point
+    if settings.plane_normal is not None:
+        pn = settings.plane_normal
+    cell = make_cell(special_6_6(), plane_point=pp, plane_normal=pn,
+                     friction=settings.friction)
+    return cell, sensor
+
+
+def device_model() -> ControlModel:
+    """The controller's model of the real cell: the special 6-6 platform centred on the flange,
+    the thesis's tool point ``P_tool_6`` (App. D.1) and leg calibration."""
+    platform = special_6_6()
+    return ControlModel(platform=platform, mount=centred_mount(platform),
+                        tool_point_6=THESIS_TOOL_POINT_6)
+
+
+def _config(req: ControlRequest, model: ControlModel) -> ControllerConfig:
+    return ControllerConfig(
+        model=model, force=req.force, start_tool_point=req.start_tool_point,
+        force_tol=req.force_tol, align_tol_deg=req.align_tol_deg, method=req.method,
+        step=req.step, approach_step=req.approach_step, estimator=req.estimator,
+        max_iterations=req.max_iterations, envelope=Envelope())
+
+
+@dataclass(frozen=True, eq=False)
+class PreparedRun:
+    """A run assembled but not started: the controller's settings, the simulated cell and its
+    sensor (None with real devices) and the log header describing the cell."""
+
+    request: ControlRequest
+    config: ControllerConfig
+    header: dict
+    cell: Cell | None = None
+    sensor: Sensor | None = None
+
+
+def prepare_control(req: ControlRequest) -> PreparedRun:
+    """Assemble the cell and the controller of ``req`` (checks every setting; nothing starts)."""
+    direction = req.force / np.linalg.norm(req.force)
+    header: dict = {"simulated": isinstance(req.cell, SimulatedCell)}
+    if isinstance(req.cell, SimulatedCell):
+        s = req.cell
+        cell, sensor = simulated_cell(s, req.start_tool_point, direction)
+        config = _config(req, control_model(cell, sensor))
+        header.update({"plane_point": cell.workpiece.point, "plane_normal": cell.workpiece.normal,
+                       "friction": s.friction, "ideal_sensor": s.ideal_sensor, "noise": s.noise,
+                       "rate_hz": s.rate_hz})
+        return PreparedRun(req, config, header, cell, sensor)
+    d = req.cell
+    header.update({"galil": f"{d.host}:{d.port}", "serial": d.serial,
+                   "serial_format": d.serial_format})
+    return PreparedRun(req, _config(req, device_model()), header)
+
+
+def run_control(prepared: PreparedRun, log_path: Path, *,
+                progress: Callable[[dict], None] | None = None) -> RunReport:
+    """Start the devices (simulated or real) and run the kinestatic procedure (Vibhute ch. 5)
+    on the prepared cell, logging every cycle to ``log_path``."""
+    req, config, header = prepared.request, prepared.config, prepared.header
+    with CycleLog(log_path) as cycle_log:
+        if isinstance(req.cell, SimulatedCell):
+            with SimHarness(prepared.cell, prepared.sensor, start_counts=start_counts(config),
+                            rate_hz=req.cell.rate_hz, seed=req.cell.seed) as h:
+                io = h.device_io(samples=req.samples)
+                return run(config, io, cycle_log, progress=progress, extra_header=header)
+        d = req.cell
+        client = GalilClient(d.host, d.port).connect()
+        try:
+            with EncoderReader(d.serial, fmt=d.serial_format) as reader:
+                io = DeviceIO(client, reader, samples=req.samples, settle=0.1)
+                return run(config, io, cycle_log, progress=progress, extra_header=header)
+        finally:
+            client.close()
+
+
+def plot_run(log_path: Path, plot_dir: Path) -> list[str]:
+    """Write the wrench-vs-state plot of a run's log (Vibhute Fig. 5-2's states)."""
+    from kinestat.viz.control_plots import write_plots  # lazy: matplotlib only when plotting
+
+    return [str(p) for p in write_plots(read_log(log_path), plot_dir)]

@@ -1,0 +1,128 @@
+"""The cell's device side of the kinestatic loop: :class:`DeviceIO` over the real drivers.
+
+:class:`DeviceIO` implements the loop's :class:`kinestat.control.loop.CellIO` protocol with a
+:class:`~kinestat.devices.galil.GalilClient` and an
+:class:`~kinestat.devices.encoder_stream.EncoderReader`: moves with the PUMA's axis 4 -> 5
+compensation (Vibhute App. D.9), the thesis's motion profile (:class:`MotionProfile`,
+``galil_control.m``, App. D.5) and sensor samples taken after the motion settled
+(:class:`SensorSample`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
+from kinestat.errors import DeviceError, InputError, KinestatError
+from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, axis45_compensation
+
+__all__ = ["SensorSample", "MotionProfile", "DeviceIO"]
+
+
+@dataclass(frozen=True)
+class SensorSample:
+    """Leg counts for one measurement (sensor legs 1..6), with the stream's bookkeeping."""
+
+    counts: np.ndarray
+    seq: int | None = None
+    age: float | None = None
+    faults: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class MotionProfile:
+    """Speeds (counts/s) and accelerations (counts/s²) per axis A..F for each move: by default
+    the thesis's maxima (galil_control.m)."""
+
+    speed: tuple[float, ...] = THESIS_SPEED_MAX
+    accel: tuple[float, ...] = THESIS_ACCEL
+
+
+class DeviceIO:
+    """The loop's :class:`~kinestat.control.loop.CellIO` over a
+    :class:`~kinestat.devices.galil.GalilClient` and an
+    :class:`~kinestat.devices.encoder_stream.EncoderReader` (both opened by the caller).
+
+    Moves compensate the axis 4 -> 5 coupling (``coupling``, as the model's). After each move it
+    waits ``settle`` seconds past the end of the motion and averages ``samples`` fresh packets
+    received after that. ``truth`` is an optional callable returning the true state
+    (simulation only).
+    """
+
+    def __init__(self, client: GalilClient, reader: Any, *, profile: MotionProfile | None = None,
+                 settle: float = 0.03, samples: int = 1, motion_timeout: float = 30.0,
+                 coupling: float = AXIS4_TO_5_COUPLING,
+                 truth: Callable[[], dict] | None = None,
+                 clock: Callable[[], float] = time.monotonic) -> None:
+        if not (math.isfinite(settle) and settle >= 0):
+            raise InputError(f"settle must be >= 0 seconds, got {settle!r}")
+        if int(samples) < 1:
+            raise InputError(f"samples must be at least 1, got {samples!r}")
+        self.client = client
+        self.reader = reader
+        self.profile = profile or MotionProfile()
+        self.settle = float(settle)
+        self.samples = int(samples)
+        self.motion_timeout = float(motion_timeout)
+        self.coupling = float(coupling)
+        self._truth = truth
+        self._clock = clock
+        self._t_ready = clock()
+
+    def robot_counts(self) -> np.ndarray:
+        """The robot's axis positions A..F, encoder counts (``TP``)."""
+        return np.asarray(self.client.position_counts(), dtype=np.int64)
+
+    def move(self, axis_counts: np.ndarray) -> None:
+        """Move with the axis 4 -> 5 compensation (Vibhute App. D.9), keep reading the sensor
+        stream while the axes move (so that the serial buffer never overflows), then reset the
+        axis-5 encoder (``DP``) as :meth:`GalilClient.move_compensated` does."""
+        c = np.asarray(axis_counts, dtype=np.int64)
+        corr = axis45_compensation(c[3], c[4], self.client.axis_position("D"),
+                                   self.coupling)
+        cmd = c.copy()
+        cmd[4] = int(corr.axis5_command)
+        self.client.move_absolute(cmd, self.profile.speed, self.profile.accel)
+        deadline = self._clock() + self.motion_timeout
+        while self.client.is_moving():
+            if self._clock() > deadline:
+                raise DeviceError(f"motion not complete after {self.motion_timeout} s")
+            self.reader.poll()
+        self.client.define_position({"E": int(corr.axis5_reset)})
+        self._t_ready = self._clock() + self.settle
+
+    def sensor(self) -> SensorSample:
+        """The mean of ``samples`` fresh packets received after the motion settled, with the
+        stream faults seen while waiting for them."""
+        got: list[np.ndarray] = []
+        faults: list[str] = []
+        last = None
+        while len(got) < self.samples:
+            r = self.reader.read()
+            faults.extend(f"{f.kind}: {f.message}" for f in r.faults)
+            if r.received_at >= self._t_ready:
+                got.append(np.asarray(r.counts, dtype=float))
+                last = r
+        assert last is not None
+        return SensorSample(counts=np.mean(got, axis=0), seq=last.seq, age=last.age,
+                            faults=tuple(faults))
+
+    def stop(self) -> str:
+        """Send ``ST`` when the link is up (best effort); say what was done."""
+        if not self.client.connected:
+            return "the Galil link is down: ST could not be sent"
+        try:
+            self.client.stop()
+        except KinestatError as exc:
+            return f"ST failed: {exc}"
+        return "ST sent to the Galil"
+
+    def truth(self) -> dict | None:
+        """The true state when simulated (the ``truth`` callable), else None."""
+        return None if self._truth is None else self._truth()

@@ -1,0 +1,50 @@
+"""The cell's hardware conventions (Vibhute 2011): facts about the robot and the platform's
+sensors that decisions, drivers and simulators share. No I/O, no decisions.
+
+- :mod:`kinestat.hardware.puma762_axes` — the PUMA 762's encoder scales, joint-1 offset,
+  axis 4 -> 5 coupling and its compensation, rounding to counts, the thesis tool point
+  ``P_tool_6``.
+- :mod:`kinestat.hardware.encoder_packets` — the encoder box's wire formats (``ks`` and the
+  thesis's legacy line) and its channel -> leg wiring: the codec shared by the reader
+  (:mod:`kinestat.devices`) and the emitter (:mod:`kinestat.sim`).
+- :mod:`kinestat.hardware.leg_calibration` — the platform's leg encoders: counts -> leg length
+  and counts -> leg force maps, and calibration fitting.
+
+Imported by :mod:`kinestat.control`, :mod:`kinestat.devices` and :mod:`kinestat.sim` alike.
+"""
+
+from kinestat.hardware.leg_calibration import (
+    MM_PER_COUNT,
+    THESIS_CALIBRATION,
+    LegCalibration,
+    counts_to_forces,
+    counts_to_lengths,
+    lengths_to_counts,
+)
+from kinestat.hardware.puma762_axes import (
+    AXIS4_TO_5_COUPLING,
+    AXIS_DEG_PER_COUNT,
+    THESIS_TOOL_POINT_6,
+    axis45_compensation,
+    axis_deg_to_counts,
+    counts_to_joint_rad,
+    joint_rad_to_counts,
+    round_half_away,
+)
+
+__all__ = [
+    "AXIS4_TO_5_COUPLING",
+    "AXIS_DEG_PER_COUNT",
+    "MM_PER_COUNT",
+    "THESIS_CALIBRATION",
+    "THESIS_TOOL_POINT_6",
+    "LegCalibration",
+    "axis45_compensation",
+    "axis_deg_to_counts",
+    "counts_to_forces",
+    "counts_to_joint_rad",
+    "counts_to_lengths",
+    "joint_rad_to_counts",
+    "lengths_to_counts",
+    "round_half_away",
+]
