@@ -9,16 +9,16 @@ import math
 import numpy as np
 import pytest
 
+from kinestat.cli._guidance import parse_steps
+from kinestat.disp import (
+    deck_json,
+    deck_model,
+    run_deck,
+)
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import embedded_deck
 from kinestat.mechanism.nadkarni import hand_points
 from kinestat.serial.fk import fk
-from kinestat.serial.guidance.disp import (
-    deck_json,
-    deck_model,
-    parse_steps,
-    run_deck,
-)
 from kinestat.serial.guidance.run import GuidanceOptions
 from kinestat.spatial.displacement import frame_from_triple, pose_from_screw
 

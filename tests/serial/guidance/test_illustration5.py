@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import kinestat
+from kinestat.disp import deck_initial_hand, deck_model, run_deck
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import embedded_deck
-from kinestat.serial.guidance.disp import deck_initial_hand, deck_model, run_deck
 from kinestat.serial.guidance.planners import line_path, twist_between, twist_exp
 from kinestat.serial.guidance.run import GuidanceOptions, joint_display
 from kinestat.serial.guidance.step import origin_displacement_twist, split_substep_count
