@@ -220,4 +220,10 @@ def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
         steps = deck.it if deck.it > 0 else None
     result = run_guidance(model, model.q_home, stages, steps=steps, options=options,
                           progress=progress)
+    if not result.stopped and not options.settle:
+        dp, da = result.final_pose_error()
+        if dp > 1e-9 * max(1.0, result.length) or da > 1e-9:
+            notes.append(f"the last step left the hand {dp:.4g} {model.length_unit} and "
+                         f"{math.degrees(da):.3g} deg from the target (the first-order "
+                         "residual; --settle adds correction steps)")
     return DeckRun(deck, model=model, result=result, notes=tuple(notes) + result.notes)
