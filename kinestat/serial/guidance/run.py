@@ -196,9 +196,10 @@ class _Run:
     """The mutable state of one run: current joints and hand, rows, events, the stop."""
 
     def __init__(self, model: ChainModel, q: np.ndarray, opt: GuidanceOptions, L: float,
-                 progress: Callable[[int, int], None] | None) -> None:
+                 progress: Callable[[int, int], None] | None,
+                 rule: StepRule | None = None) -> None:
         self.model, self.opt, self.L, self.progress = model, opt, L, progress
-        self.rule: StepRule = opt.rule()
+        self.rule: StepRule = opt.rule() if rule is None else rule
         self.q = q
         self.H = fk(model, q)
         self.rows_q = [q.copy()]
@@ -448,6 +449,7 @@ def run_guidance(
     options: GuidanceOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
     length: float | None = None,
+    rule: StepRule | None = None,
 ) -> GuidanceResult:
     """Guide the hand of ``model`` from joint values ``q0`` through ``stages`` (Nadkarni
     ch. IV: eq. 4-11 per step, the singularity and joint-limit rules of "Singularities").
@@ -460,6 +462,8 @@ def run_guidance(
             (:func:`~kinestat.serial.guidance.planners.auto_steps`).
         length: the characteristic length L (default: from ``q0``).
         progress: called as ``progress(steps_done, steps_planned_so_far)``.
+        rule: a step rule (:class:`~kinestat.serial.guidance.rules.StepRule`) to use instead
+            of the one ``options.step_rule`` names.
 
     >>> from kinestat.mechanism.library import load
     >>> from kinestat.serial.guidance.planners import command_path
@@ -484,7 +488,7 @@ def run_guidance(
             f"the chain has {model.n} joints, not 6: each step solves J δq = B in the "
             "least-squares sense" + (" (minimum-norm increments)" if model.n > 6 else
                                      " (the residual is reported in the events)"))
-    run = _Run(model, q, opt, L, progress)
+    run = _Run(model, q, opt, L, progress, rule)
     if run.limit_stop(q, None):
         return run.result(notes)
     for si, spec in enumerate(stages):
