@@ -298,7 +298,12 @@ class GeneralPath:
 
 
 def screw_path(start, target) -> ScrewPath:
-    """Type II (eqs. 4-18, 4-19): the screw displacement from ``start`` to ``target``."""
+    """Type II (eqs. 4-18, 4-19): the screw displacement from ``start`` to ``target``.
+
+    >>> p = screw_path(np.eye(4), trans([0.0, 0.0, 4.0]))
+    >>> p.step_twist(0.0, 0.25, np.eye(4)).tolist()      # constant B = ξ/k (eq. 4-19)
+    [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    """
     start = _pose(start, "start pose")
     target = _pose(target, "target pose")
     return ScrewPath(start, twist_between(start, target))
@@ -306,7 +311,12 @@ def screw_path(start, target) -> ScrewPath:
 
 def line_path(points0, points1) -> LinePath:
     """Type III (eq. 4-20): straight lines of the three hand points ``(3, 3)`` each (rows:
-    origin, point on +z, point on the +x side). Every split position must fix a frame."""
+    origin, point on +z, point on the +x side). Every split position must fix a frame.
+
+    >>> P0 = np.array([[0.0, 0, 0], [0, 0, 1], [1, 0, 0]])
+    >>> line_path(P0, P0 + [2.0, 0, 0]).pose_at(0.5)[:3, 3].tolist()
+    [1.0, 0.0, 0.0]
+    """
     P0 = as_array(points0, shape_tail=(3, 3), name="start points")
     P1 = as_array(points1, shape_tail=(3, 3), name="target points")
     if P0.shape != (3, 3) or P1.shape != (3, 3):
@@ -361,6 +371,10 @@ def command_path(start, direction, distance: float, angle: float,
     ``direction`` R (global frame, or the hand frame when ``frame="hand"``: R = Q'R'),
     ``distance`` d along it and ``angle`` θ (rad) about the line through the hand origin
     parallel to R: ``U = R/|R|``, ``h = d/θ``, ``ρn = ρo``; θ = 0 is a pure translation.
+
+    >>> c = command_path(trans([15.0, -25.0, 12.0]), [0, 0, 1], 4.0, 0.0)
+    >>> c.end[:3, 3].tolist()                              # Illustration 6, command 1's d
+    [15.0, -25.0, 16.0]
     """
     start = _pose(start, "start pose")
     R = as_array(direction, shape_tail=(3,), name="command direction")
@@ -394,6 +408,9 @@ def auto_steps(path, length: float, *, max_step_deg: float = 1.0,
 
     With these defaults (1°, L/100) the neglected second-order terms of a step are of order
     ½ δθ² ℓ ≈ 1.5e-4 ℓ (ℓ a lever arm ~ L), see docs/guidance.md.
+
+    >>> auto_steps(screw_path(np.eye(4), trans([3.0, 0.0, 0.0])), length=10.0)
+    30
     """
     rot, dist = path_extent(path)
     k = max(1, math.ceil(math.degrees(rot) / max_step_deg - 1e-9),

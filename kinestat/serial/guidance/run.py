@@ -470,8 +470,8 @@ def run_guidance(
     >>> m = load("nadkarni-config2")
     >>> r = run_guidance(m, m.q_home, [lambda H: command_path(H, [0, 0, 1], 4.0, 0.0)],
     ...                  steps=8)
-    >>> len(r.q), r.final_pose_error()[0] < 1e-9
-    (10, True)
+    >>> len(r.q), r.final_pose_error()[0] < 1e-9          # 8 steps + the initial row
+    (9, True)
     """
     opt = options or GuidanceOptions()
     q = model.check_q(q0).astype(float)
