@@ -1,4 +1,8 @@
-"""``kinestat guide``: Nadkarni's guidance analyses on any model (TOML file or embedded name)."""
+"""``kinestat guide``: Nadkarni's guidance analyses on any model (TOML file or embedded name).
+
+Not an emulator of DISP: by default each stage ends with correction steps straight at its
+target (``--no-settle`` turns them off); ``kinestat disp`` behaves as DISP did.
+"""
 
 from __future__ import annotations
 
@@ -9,13 +13,33 @@ from pathlib import Path
 import numpy as np
 import typer
 
+from kinestat.cli._guidance import (
+    SINGULAR_HELP,
+    parse_steps,
+    print_result,
+    progress_reporter,
+    singular_mode,
+)
 from kinestat.cli._output import console, parse_floats, print_json, table, to_jsonable
-from kinestat.cli.disp import guidance_options, print_result, progress_reporter
+from kinestat.disp import result_record
 from kinestat.errors import InputError, ParseError
+from kinestat.io.disp_deck import OperatorCommand, parse_operator_command
+from kinestat.io.library import load
+from kinestat.mechanism.nadkarni import hand_points
+from kinestat.serial.fk import fk
+from kinestat.serial.guidance.planners import twist_between
+from kinestat.serial.guidance.rules import GuidanceOptions
+from kinestat.serial.guidance.run import run_guidance
+from kinestat.serial.guidance.stages import (
+    PATH_TYPES,
+    command_stages,
+    move_stages,
+    target_stages,
+)
+from kinestat.serial.guidance.velocity import joint_rates
 
 __all__ = ["register", "parse_command", "parse_move", "read_commands"]
 
-_TYPES = ("screw", "line", "general")
 _SPLIT = re.compile(r",(?=\s*[A-Za-z_]+\s*=)")
 
 
@@ -43,23 +67,16 @@ def _num(v: str, what: str) -> float:
     return x
 
 
+def _command_dict(c: OperatorCommand) -> dict:
+    return {"frame": c.frame, "direction": np.array(c.direction), "distance": c.distance,
+            "angle_deg": c.angle_deg}
+
+
 def parse_command(text: str) -> dict:
     """``"frame=global,dir=0,0,1,d=4,angle=-30"`` → ``{frame, direction, distance, angle_deg}``
-    (Nadkarni type IV, eqs. 4-21, 4-22; ``frame=hand`` for NTY = 1)."""
-    kv = _keyvals(text, "--command", {"frame": "frame", "dir": "dir", "direction": "dir",
-                                      "d": "d", "distance": "d", "angle": "angle",
-                                      "angle_deg": "angle"})
-    frame = kv.get("frame", "global").lower()
-    if frame not in ("global", "hand"):
-        raise InputError(f"--command {text!r}: frame must be 'global' or 'hand', got {frame!r}")
-    if "dir" not in kv:
-        raise InputError(f"--command {text!r}: give the direction, e.g. dir=0,0,1")
-    direction = parse_floats(kv["dir"], 3, "command dir")
-    if not np.any(direction):
-        raise InputError(f"--command {text!r}: dir is the zero vector")
-    return {"frame": frame, "direction": direction,
-            "distance": _num(kv.get("d", "0"), "--command d"),
-            "angle_deg": _num(kv.get("angle", "0"), "--command angle")}
+    (Nadkarni type IV, eqs. 4-21, 4-22; ``frame=hand`` for NTY = 1), parsed and validated by
+    :func:`kinestat.io.disp_deck.parse_operator_command` (the SET THREE rules)."""
+    return _command_dict(parse_operator_command(text, "--command"))
 
 
 def parse_move(text: str) -> dict:
@@ -86,37 +103,23 @@ def read_commands(path: Path) -> list[dict]:
         if not line:
             continue
         try:
-            if "=" in line:
-                out.append(parse_command(line))
-                continue
-            vals = [float(t) for t in line.replace(",", " ").split()]
-            if len(vals) != 6 or vals[0] not in (0.0, 1.0):
-                raise InputError("expected 'NTY DCx DCy DCz DD THA' with NTY 0 or 1, or "
-                                 "key=value items")
-            if not all(math.isfinite(v) for v in vals) or not any(vals[1:4]):
-                raise InputError("numbers must be finite and the direction nonzero")
-            out.append({"frame": "global" if vals[0] == 0 else "hand",
-                        "direction": np.array(vals[1:4]), "distance": vals[4],
-                        "angle_deg": vals[5]})
-        except (InputError, ValueError) as exc:
+            out.append(_command_dict(parse_operator_command(line, "command")))
+        except InputError as exc:
             raise ParseError(str(exc), file=str(path), line=lineno) from None
     if not out:
         raise ParseError("no commands in the file", file=str(path))
     return out
 
 
-def _stages(model, q0, targets, kind, commands, moves):
-    from kinestat.mechanism.nadkarni import hand_points
-    from kinestat.serial.fk import fk
-    from kinestat.serial.guidance.planners import (
-        command_path,
-        general_motion,
-        general_path,
-        line_path,
-        screw_path,
-    )
-    from kinestat.spatial.displacement import frame_from_triple
+class _Cmd:
+    """A parsed command dict seen as a :class:`~kinestat.serial.guidance.stages.Command`."""
 
+    def __init__(self, c: dict) -> None:
+        self.direction, self.distance = c["direction"], c["distance"]
+        self.angle, self.frame = math.radians(c["angle_deg"]), c["frame"]
+
+
+def _stages(model, q0, targets, kind, commands, moves):
     given = sum(bool(x) for x in (targets, commands, moves))
     if given == 0:
         raise InputError("nothing to do: give --to targets, --command(s) or --move(s)")
@@ -124,31 +127,18 @@ def _stages(model, q0, targets, kind, commands, moves):
         raise InputError("give targets (--to), commands (--command/--commands) or moves "
                          "(--move), not a mix: run them one after the other instead")
     if commands:
-        return [(lambda H, c=c: command_path(H, c["direction"], c["distance"],
-                                             math.radians(c["angle_deg"]), c["frame"]))
-                for c in commands]
+        return command_stages([_Cmd(c) for c in commands])
     if moves:
-        return [(lambda H, m=m: general_motion(H, m["axis"], math.radians(m["angle_deg"]),
-                                               m["direction"], m["distance"]))
-                for m in moves]
-    if kind == "line":
-        pts = [hand_points(fk(model, q0))] + targets
-        return [(lambda H, a=pts[i - 1], b=pts[i]: line_path(a, b)) for i in range(1, len(pts))]
-    frames = [frame_from_triple(t) for t in targets]
-    if kind == "screw":
-        return [(lambda H, T=T: screw_path(H, T)) for T in frames]
-    return [(lambda H, T=T: general_path(H, T)) for T in frames]
+        return move_stages(moves)
+    return target_stages(kind, hand_points(fk(model, q0)), targets)
 
 
 def _rates(result, speed: float) -> tuple[np.ndarray, list[int]]:
     """Joint rates per path step (rad or length per second, eqs. 5-1..5-4) moving along the
     path at ``speed`` (deg/s of hand rotation; length/s for a purely translating step), and the
     step numbers (correction steps at the end of a stage are left out)."""
-    from kinestat.serial.guidance.planners import twist_between
-    from kinestat.serial.guidance.velocity import joint_rates
-
     m = result.model
-    settle = {e["step"] for e in result.events if e["kind"] == "settle"}
+    settle = result.settle_rows()
     out, steps = [], []
     for j in range(1, result.q.shape[0]):
         if j in settle:
@@ -190,10 +180,10 @@ def guide(
                                      "onto the ideal path."),
     second_order: bool = typer.Option(False, "--second-order", help="Second-order terms of "
                                       "Nadkarni eq. 5-5."),
-    damped: bool = typer.Option(False, "--damped", help="Damped least squares at "
-                                "singularities instead of the thesis's perturbation."),
+    singular: str = typer.Option("perturb", "--singular", help=SINGULAR_HELP),
+    damped: bool = typer.Option(False, "--damped", help="Short for --singular damped."),
     no_settle: bool = typer.Option(False, "--no-settle", help="No correction steps at the end "
-                                   "of a stage."),
+                                   "of a stage (kinestat's default adds them; DISP did not)."),
     cond_limit: float = typer.Option(1e3, "--cond-limit", help="Dimensionless condition number "
                                      "above which a configuration counts as singular."),
     speed: float = typer.Option(None, "--speed", help="Hand speed for the joint rates "
@@ -204,15 +194,14 @@ def guide(
 ) -> None:
     """Guide a manipulator's hand to targets, along commands or moves (Nadkarni ch. IV).
 
+    kinestat's defaults, not an emulator of DISP: each stage ends with correction steps
+    straight at its target (--no-settle: off). `kinestat disp` runs decks as DISP did.
+
     Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
     table up to that point is printed first.
     """
-    from kinestat.io.library import load
-    from kinestat.serial.guidance.disp import parse_steps
-    from kinestat.serial.guidance.run import result_record, run_guidance
-
-    if kind not in _TYPES:
-        raise InputError(f"--type must be one of {', '.join(_TYPES)}, got {kind!r}")
+    if kind not in PATH_TYPES:
+        raise InputError(f"--type must be one of {', '.join(PATH_TYPES)}, got {kind!r}")
     m = load(model)
     if q0_deg is None:
         q0 = np.array(m.q_home, dtype=float)
@@ -225,8 +214,9 @@ def guide(
         cmds += read_commands(commands)
     moves = [parse_move(s) for s in (move or [])]
     stages = _stages(m, q0, targets, kind, cmds, moves)
-    opts = guidance_options(closed_loop=closed_loop, second_order=second_order, damped=damped,
-                            settle=not no_settle, cond_limit=cond_limit)
+    opts = GuidanceOptions(step_rule="second_order" if second_order else "first_order",
+                           closed_loop=closed_loop, singular=singular_mode(singular, damped),
+                           settle=not no_settle, cond_limit=cond_limit)
     with progress_reporter(not as_json) as prog:
         result = run_guidance(m, q0, stages, steps=parse_steps(steps), options=opts,
                               progress=prog)
@@ -237,7 +227,7 @@ def guide(
         rates, rate_steps = _rates(result, speed)
     written = []
     if plot is not None:
-        from kinestat.viz.guidance_plots import write_guidance_plots
+        from kinestat.viz.guidance_plots import write_guidance_plots  # lazy: matplotlib
 
         written = write_guidance_plots(result, plot, title=f"kinestat guide {m.name}")
     if as_json:

@@ -12,16 +12,17 @@ from pathlib import Path
 import numpy as np
 
 from kinestat.errors import InputError
+from kinestat.serial.guidance.events import JointLimitStop, NotConverged, Singularity
 from kinestat.serial.guidance.run import GuidanceResult, joint_display
 
 __all__ = ["joints_figure", "hand_path_figure", "write_guidance_plots"]
 
 
 def _figure(**kw):
-    import matplotlib
+    import matplotlib  # lazy: matplotlib takes ~0.5 s to import, only plots need it
 
     matplotlib.use("Agg", force=False)
-    from matplotlib.figure import Figure
+    from matplotlib.figure import Figure  # lazy: as above
 
     return Figure(**kw)
 
@@ -47,8 +48,8 @@ def joints_figure(result: GuidanceResult, title: str | None = None):
         for e in ends[:-1]:
             ax.axvline(e, color="grey", lw=0.6, ls=":")
         for ev in result.events:
-            if ev["kind"] in ("singular", "joint_limit", "not_converged"):
-                ax.axvline(ev["step"], color="red", lw=0.8, ls="--")
+            if isinstance(ev, (Singularity, JointLimitStop, NotConverged)):
+                ax.axvline(ev.step, color="red", lw=0.8, ls="--")
         unit = m.length_unit if m.prismatic[i] else "deg"
         name = f"r{i + 1}" if m.prismatic[i] else f"θ{i + 1}"
         ax.set_ylabel(f"{name} ({unit})")

@@ -35,7 +35,12 @@ def test_ms2_and_ms3_contract(capsys):
 @pytest.mark.parametrize("name,ms", [("illustration4", 0), ("illustration5", 4),
                                      ("illustration6", 5), ("illustration7", 6)])
 def test_guidance_contract(capsys, name, ms):
-    out = _json(capsys, [name, "--steps", "12"])
+    # issue 14: the default is DISP (one row per step, no correction rows)
+    bare = _json(capsys, [name, "--steps", "12"])
+    assert len(bare["table"]) == 1 + sum(bare["steps"])
+    assert not any(e["kind"] == "settle" for e in bare["events"])
+    assert any("first-order residual" in n for n in bare["notes"])  # 12 steps leave one
+    out = _json(capsys, [name, "--steps", "12", "--settle"])
     assert out["ms"] == ms
     table = np.array(out["table"])
     assert table.shape[1] == 6 and table.shape[0] >= 13
@@ -97,7 +102,9 @@ def test_unreachable_target_deck_stops_with_status_2(capsys, tmp_path):
         "    201.00      0.00      0.00")
     deck = tmp_path / "far.dat"
     deck.write_text(text)
-    assert main(["disp", str(deck), "--steps", "30", "--json"]) == 2
+    assert main(["disp", str(deck), "--steps", "30", "--json"]) == 0  # DISP: no check
+    assert "from the target" in " ".join(json.loads(capsys.readouterr().out)["notes"])
+    assert main(["disp", str(deck), "--steps", "30", "--settle", "--json"]) == 2
     captured = capsys.readouterr()
     out = json.loads(captured.out)
     assert out["stopped"] is True and out["stop_reason"]

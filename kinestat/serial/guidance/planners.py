@@ -32,7 +32,9 @@ for any intermediate stage"); :class:`GeneralPath` does the same.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol, runtime_checkable
 
 import numpy as np
 from scipy.spatial.transform import Rotation
@@ -46,6 +48,9 @@ from kinestat.spatial.displacement import (
 from kinestat.spatial.transforms import as_array, make_pose, trans
 
 __all__ = [
+    "Path",
+    "StageSpec",
+    "resolve_stage",
     "twist_exp",
     "twist_between",
     "pose_error",
@@ -60,6 +65,44 @@ __all__ = [
     "auto_steps",
     "path_extent",
 ]
+
+
+@runtime_checkable
+class Path(Protocol):
+    """A hand path of analysis types I–IV: the ideal pose at every fraction ``s`` and the
+    step twist B of eq. 4-11 from the actual hand pose."""
+
+    kind: str
+
+    @property
+    def end(self) -> np.ndarray:
+        """The ideal end pose ``(4, 4)``."""
+        ...
+
+    def pose_at(self, s) -> np.ndarray:
+        """Ideal hand poses ``(..., 4, 4)`` at fractions ``s`` ``(...)``."""
+        ...
+
+    def step_twist(self, s0: float, s1: float, hand) -> np.ndarray:
+        """B ``(6,)`` of the step from ``s0`` to ``s1`` with the hand at ``hand``."""
+        ...
+
+    def step_target(self, s0: float, s1: float, hand) -> np.ndarray:
+        """The pose ``(4, 4)`` the step is meant to reach (for eq. 5-5's chord)."""
+        ...
+
+    def replan(self, hand, s_now: float) -> Path:
+        """The rest of the path from ``hand`` (after a perturbation at ``s_now``)."""
+        ...
+
+
+#: A stage of a run: a path, or a function of the hand pose at the stage start returning one.
+StageSpec = Path | Callable[[np.ndarray], Path]
+
+
+def resolve_stage(spec: StageSpec, hand: np.ndarray) -> Path:
+    """The path of a stage starting with the hand at ``hand`` ``(4, 4)``."""
+    return spec if isinstance(spec, Path) else spec(hand)
 
 
 def _pose(T, name: str) -> np.ndarray:
@@ -197,7 +240,12 @@ class GeneralPath:
     translation r of the origin along ``u_v`` (eqs. 4-9 to 4-17).
 
     ``pose_at(s) = [Rot(u_w, sθ) R0 , o0 + s r u_v]``. The step twist is eq. 4-11a's
-    ``[δθ u_w; δr u_v − δθ u_w × ρo]`` with ρo the *current* hand origin (DISP, MS = 6).
+    ``[δθ u_w; δr u_v − δθ u_w × ρo]`` with ρo the *current* hand origin.
+
+    ``replan_each_step`` (Example 4, DISP's GENM, MS = 6): every step re-plans eqs. 4-16 and
+    4-17 from the *actual* hand to the end pose — u_v from the actual hand origin to the
+    target origin, u_w the axis of the remaining rotation — and takes 1/(steps left) of the
+    remaining length and angle, so first-order errors do not accumulate.
     """
 
     start: np.ndarray
@@ -206,6 +254,7 @@ class GeneralPath:
     u_v: np.ndarray
     r: float
     kind: str = "general"
+    replan_each_step: bool = False
 
     @property
     def end(self) -> np.ndarray:
@@ -217,17 +266,31 @@ class GeneralPath:
         p = self.start[:3, 3] + (s * self.r)[..., None] * self.u_v
         return make_pose(R, p)
 
+    def _step_parts(self, s0: float, s1: float, hand) -> tuple[np.ndarray, np.ndarray]:
+        """(rotation vector δθ u_w, displacement δr u_v of the hand origin) of the step."""
+        hand = np.asarray(hand, dtype=float)
+        if not self.replan_each_step:
+            ds = s1 - s0
+            return ds * self.theta * self.u_w, ds * self.r * self.u_v
+        left = 1.0 - s0
+        frac = (s1 - s0) / left if left > 1e-15 else 1.0  # 1 / (steps left)
+        end = self.end
+        sc = screw_from_poses(hand, end)
+        th = 0.0 if bool(sc.is_translation) else float(sc.theta)
+        return frac * th * np.asarray(sc.axis, dtype=float), frac * (end[:3, 3] - hand[:3, 3])
+
     def step_twist(self, s0: float, s1: float, hand) -> np.ndarray:
-        ds = s1 - s0
-        w = ds * self.theta * self.u_w
+        """Eq. 4-11a: ``[δθ u_w; δr u_v − δθ u_w × ρo]`` with ρo the actual hand origin."""
+        w, dr = self._step_parts(s0, s1, hand)
         o = np.asarray(hand, dtype=float)[:3, 3]
-        return np.concatenate([w, ds * self.r * self.u_v - np.cross(w, o)])
+        return np.concatenate([w, dr - np.cross(w, o)])
 
     def step_target(self, s0: float, s1: float, hand) -> np.ndarray:
-        ds = s1 - s0
+        w, dr = self._step_parts(s0, s1, hand)
         hand = np.asarray(hand, dtype=float)
-        R = _rot(self.u_w, ds * self.theta) @ hand[:3, :3]
-        return make_pose(R, hand[:3, 3] + ds * self.r * self.u_v)
+        th = float(np.linalg.norm(w))
+        R = _rot(w / th, th) @ hand[:3, :3] if th > 0 else hand[:3, :3]
+        return make_pose(R, hand[:3, 3] + dr)
 
     def replan(self, hand, s_now: float) -> GeneralPath:
         """Example 4 from ``hand`` to this path's end (after a perturbation)."""
@@ -235,7 +298,12 @@ class GeneralPath:
 
 
 def screw_path(start, target) -> ScrewPath:
-    """Type II (eqs. 4-18, 4-19): the screw displacement from ``start`` to ``target``."""
+    """Type II (eqs. 4-18, 4-19): the screw displacement from ``start`` to ``target``.
+
+    >>> p = screw_path(np.eye(4), trans([0.0, 0.0, 4.0]))
+    >>> p.step_twist(0.0, 0.25, np.eye(4)).tolist()      # constant B = ξ/k (eq. 4-19)
+    [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    """
     start = _pose(start, "start pose")
     target = _pose(target, "target pose")
     return ScrewPath(start, twist_between(start, target))
@@ -243,7 +311,12 @@ def screw_path(start, target) -> ScrewPath:
 
 def line_path(points0, points1) -> LinePath:
     """Type III (eq. 4-20): straight lines of the three hand points ``(3, 3)`` each (rows:
-    origin, point on +z, point on the +x side). Every split position must fix a frame."""
+    origin, point on +z, point on the +x side). Every split position must fix a frame.
+
+    >>> P0 = np.array([[0.0, 0, 0], [0, 0, 1], [1, 0, 0]])
+    >>> line_path(P0, P0 + [2.0, 0, 0]).pose_at(0.5)[:3, 3].tolist()
+    [1.0, 0.0, 0.0]
+    """
     P0 = as_array(points0, shape_tail=(3, 3), name="start points")
     P1 = as_array(points1, shape_tail=(3, 3), name="target points")
     if P0.shape != (3, 3) or P1.shape != (3, 3):
@@ -273,7 +346,13 @@ def general_motion(start, axis, angle: float, direction, distance: float) -> Gen
 
 def general_path(start, target) -> GeneralPath:
     """Type I, Example 4 (eqs. 4-16, 4-17): ``u_ω = U`` the screw axis of start → target,
-    θ its angle, ``u_v = R/|R|`` with R from the start origin to the target origin."""
+    θ its angle, ``u_v = R/|R|`` with R from the start origin to the target origin; re-planned
+    from the actual hand at every step as DISP's GENM does (``replan_each_step``).
+
+    >>> p = general_path(np.eye(4), trans([3.0, 0.0, 0.0]))
+    >>> (p.step_twist(0.5, 0.75, trans([1.0, 1.0, 0.0])).round(3) + 0.0).tolist()
+    [0.0, 0.0, 0.0, 1.0, -0.5, 0.0]
+    """
     start = _pose(start, "start pose")
     target = _pose(target, "target pose")
     sc = screw_from_poses(start, target)
@@ -281,7 +360,8 @@ def general_path(start, target) -> GeneralPath:
     nR = float(np.linalg.norm(R))
     u_v = R / nR if nR > 0 else np.zeros(3)
     th = 0.0 if bool(sc.is_translation) else float(sc.theta)
-    return GeneralPath(start, np.asarray(sc.axis, dtype=float), th, u_v, nR)
+    return GeneralPath(start, np.asarray(sc.axis, dtype=float), th, u_v, nR,
+                       replan_each_step=True)
 
 
 def command_path(start, direction, distance: float, angle: float,
@@ -291,6 +371,10 @@ def command_path(start, direction, distance: float, angle: float,
     ``direction`` R (global frame, or the hand frame when ``frame="hand"``: R = Q'R'),
     ``distance`` d along it and ``angle`` θ (rad) about the line through the hand origin
     parallel to R: ``U = R/|R|``, ``h = d/θ``, ``ρn = ρo``; θ = 0 is a pure translation.
+
+    >>> c = command_path(trans([15.0, -25.0, 12.0]), [0, 0, 1], 4.0, 0.0)
+    >>> c.end[:3, 3].tolist()                              # Illustration 6, command 1's d
+    [15.0, -25.0, 16.0]
     """
     start = _pose(start, "start pose")
     R = as_array(direction, shape_tail=(3,), name="command direction")
@@ -324,6 +408,9 @@ def auto_steps(path, length: float, *, max_step_deg: float = 1.0,
 
     With these defaults (1°, L/100) the neglected second-order terms of a step are of order
     ½ δθ² ℓ ≈ 1.5e-4 ℓ (ℓ a lever arm ~ L), see docs/guidance.md.
+
+    >>> auto_steps(screw_path(np.eye(4), trans([3.0, 0.0, 0.0])), length=10.0)
+    30
     """
     rot, dist = path_extent(path)
     k = max(1, math.ceil(math.degrees(rot) / max_step_deg - 1e-9),

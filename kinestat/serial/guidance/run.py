@@ -1,52 +1,67 @@
 """Running a guidance analysis: the step loop, events, step counts, corrections.
 
-For each stage (a path, or a function of the hand pose returning one) and each step j of k:
+For each stage (a :class:`~.planners.Path`, or a function of the hand pose returning one) and
+each step j of k (:class:`_Run`, one small method per part):
 
-1. compute the Jacobian at the current joints; if it is (near) singular, handle it —
-   ``"perturb"``: Nadkarni's remedy (small joint increments until regular, report the new
-   configuration, replan the rest of the stage from the actual hand, continue),
-   ``"damped"``: damped least squares for the step, ``"stop"``: stop;
-2. B = the path's step twist (eq. 4-11's right-hand side); solve ``J δq = B``
-   (:func:`~kinestat.serial.guidance.step.solve_step`); optionally refine with the second-order
-   terms of eq. 5-5;
-3. optionally (``closed_loop``) Newton-correct onto the ideal path pose of this step until the
-   error twist is below ``tol``;
-4. check the joint limits: a violation ends the run cleanly with a ``joint_limit`` event.
+1. compute the Jacobian at the current joints; if it is (near) singular, handle it
+   (:attr:`GuidanceOptions.singular`) — ``"perturb"``/``"perturb_all"``: Nadkarni's remedy
+   (small joint increments until regular, report the new configuration, replan the rest of the
+   stage from the actual hand, continue), ``"damped"``: damped least squares for the step,
+   ``"stop"``: stop;
+2. B = the path's step twist (eq. 4-11's right-hand side); the step rule
+   (:mod:`~kinestat.serial.guidance.rules`: first order, second order eq. 5-5, the inferred
+   1977 rule) turns it into joint increments;
+3. optionally (``closed_loop``) Newton-correct onto the ideal path pose of this step;
+4. check the joint limits: a violation ends the run cleanly with a :class:`JointLimitStop`.
 
 Nothing here raises for a motion that cannot be completed: the result carries the rows so far,
-``stopped`` and the event that stopped it; :meth:`GuidanceResult.raise_if_stopped` turns that
-into the matching :class:`~kinestat.errors.KinestatError` when the caller wants an exception.
+``stopped`` and the event that stopped it; :meth:`GuidanceResult.raise_if_stopped` raises
+that event's :class:`~kinestat.errors.KinestatError`.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from kinestat.errors import (
-    InputError,
-    JointLimitError,
-    KinestatError,
-    SingularityError,
-    UnreachableError,
-)
+from kinestat.errors import InputError, KinestatError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.fk import fk
-from kinestat.serial.guidance.planners import auto_steps, pose_error, twist_between
+from kinestat.serial.guidance.events import (
+    GuidanceEvent,
+    JointLimitStop,
+    LeastSquaresStep,
+    NotConverged,
+    SettleStep,
+    Singularity,
+    TargetNotReached,
+)
+from kinestat.serial.guidance.planners import (
+    Path,
+    StageSpec,
+    auto_steps,
+    pose_error,
+    resolve_stage,
+    twist_between,
+)
+from kinestat.serial.guidance.rules import (
+    SINGULAR_MODES,
+    GuidanceOptions,
+    StepInput,
+    StepRule,
+)
 from kinestat.serial.guidance.step import (
-    DEFAULT_COND_LIMIT,
     characteristic_length,
     conditioning,
     escape_singularity,
     limit_violation,
-    origin_displacement_twist,
+    perturb_all_joints,
     scaled_jacobian,
-    solve_second_order,
     solve_step,
-    split_substep_count,
 )
 from kinestat.serial.jacobian import jacobian
 
@@ -55,85 +70,8 @@ __all__ = [
     "GuidanceResult",
     "run_guidance",
     "joint_display",
-    "result_record",
     "SINGULAR_MODES",
 ]
-
-SINGULAR_MODES = ("perturb", "damped", "stop")
-
-
-@dataclass(frozen=True)
-class GuidanceOptions:
-    """How to run an analysis.
-
-    - ``closed_loop``: after each first-order step, Newton iterations ``J δq = ε`` with ε the
-      error twist from the actual to the ideal hand pose of the step, until
-      ``|ε_ω| ≤ tol`` and ``|ε_p| ≤ tol·max(1, L)`` (beyond the thesis).
-    - ``second_order``: solve eqs. 4-9 and 5-5 (Nadkarni suggestion 2) instead of 4-11.
-    - ``singular``: ``"perturb"`` (the thesis), ``"damped"`` or ``"stop"``; a configuration is
-      singular when the dimensionless condition number exceeds ``cond_limit``.
-    - ``max_step_deg``, ``max_step_fraction``: the automatic step count (IT = 0): no step
-      rotates the hand by more than ``max_step_deg`` or moves its origin by more than
-      ``max_step_fraction`` × L; and, for automatically counted stages only, a step whose joint
-      increments exceed ``max_joint_step_deg`` (prismatic: that angle in radians × L) is done
-      as equal sub-steps (``None`` disables it). Explicit step counts are never refined.
-    - ``settle``: after the last step of a stage, take first-order steps straight at the stage's
-      target (the screw from the actual hand to it, eq. 4-19 with k = 1: Newton's method) until
-      it is reached to ``settle_tol`` (angle in rad; origin in length × max(1, L)); each is a
-      table row and a ``settle`` event. A target still missed after ``max_settle`` of them
-      stops the run (``target_not_reached``).
-    - ``origin_step`` (DISP 1977, Table A2-9): B's translation is the second-order displacement
-      of the body point at the global origin, ``v + ½ ω×v``
-      (:func:`~kinestat.serial.guidance.step.origin_displacement_twist`), solved to first
-      order; ``split_substep_deg2``: every step is done as
-      :func:`~kinestat.serial.guidance.step.split_substep_count` equal sub-steps with the
-      same twist (the Jacobian recomputed for each). :meth:`disp_1977` sets both; with them
-      Illustration 5 reproduces Table A2-9 (docs/seed-errata.md G1). Not combinable with
-      ``second_order`` or ``closed_loop``.
-    """
-
-    closed_loop: bool = False
-    second_order: bool = False
-    singular: str = "perturb"
-    cond_limit: float = DEFAULT_COND_LIMIT
-    tol: float = 1e-12
-    max_newton: int = 30
-    perturb_deg: float = 1.0
-    max_perturb_tries: int = 30
-    max_perturbations: int = 25
-    max_damping: float = 0.1
-    max_step_deg: float = 1.0
-    max_step_fraction: float = 0.01
-    max_joint_step_deg: float | None = 2.0
-    settle: bool = True
-    settle_tol: float = 1e-9
-    max_settle: int = 10
-    check_limits: bool = True
-    origin_step: bool = False
-    split_substep_deg2: float | None = None
-
-    @classmethod
-    def disp_1977(cls, **changes) -> GuidanceOptions:
-        """The step rule that reproduces Nadkarni's Table A2-9 (Illustration 5): B from the
-        origin point's second-order displacement, ⌈(δθ°)²/40⌉ sub-steps per step."""
-        return cls(**{"origin_step": True, "split_substep_deg2": 40.0, **changes})
-
-    def __post_init__(self) -> None:
-        if (self.origin_step or self.split_substep_deg2 is not None) and (
-                self.second_order or self.closed_loop):
-            raise InputError("origin_step / split_substep_deg2 (the DISP 1977 step) cannot be "
-                             "combined with second_order or closed_loop")
-        if self.split_substep_deg2 is not None:
-            v = self.split_substep_deg2
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise InputError(f"split_substep_deg2 must be a positive number, got {v!r}")
-        if self.singular not in SINGULAR_MODES:
-            raise InputError(
-                f"singular must be one of {', '.join(SINGULAR_MODES)}, got {self.singular!r}")
-        for name in ("cond_limit", "tol", "perturb_deg", "max_step_deg", "max_step_fraction"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise InputError(f"{name} must be a positive number, got {v!r}")
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,8 +81,9 @@ class GuidanceResult:
     ``q`` ``(R, n)`` joint values (radians / length), ``poses`` ``(R, 4, 4)`` actual hand
     poses, ``ideal`` ``(R, 4, 4)`` the ideal path pose of each row, ``stage`` ``(R,)`` the stage
     of each row (-1 for row 0), ``stage_targets`` the ideal end pose of each stage started,
-    ``steps`` the planned step count per stage, ``events`` dicts with at least ``step`` (global,
-    1-based) and ``kind``, ``stopped``/``stop_kind``/``stop_message`` when the run ended early.
+    ``steps`` the planned step count per stage, ``events`` typed events
+    (:mod:`~kinestat.serial.guidance.events`), ``stopped``/``stop_kind``/``stop_message``/
+    ``stop_event`` when the run ended early.
     """
 
     model: ChainModel
@@ -154,13 +93,14 @@ class GuidanceResult:
     stage: np.ndarray
     stage_targets: tuple[np.ndarray, ...]
     steps: tuple[int, ...]
-    events: tuple[dict, ...]
+    events: tuple[GuidanceEvent, ...]
     length: float
     stopped: bool = False
     stop_kind: str | None = None
     stop_message: str | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
     substeps: int = 0
+    stop_event: GuidanceEvent | None = None
 
     @property
     def final_q(self) -> np.ndarray:
@@ -169,6 +109,10 @@ class GuidanceResult:
     @property
     def final_pose(self) -> np.ndarray:
         return self.poses[-1]
+
+    def settle_rows(self) -> set[int]:
+        """Rows that are correction (settle) steps, not path steps."""
+        return {e.step for e in self.events if isinstance(e, SettleStep)}
 
     def stage_end_rows(self) -> list[int]:
         """Index of the last row of each stage that ran (its end, or where it stopped)."""
@@ -194,87 +138,321 @@ class GuidanceResult:
         return float(np.max(dp)), float(np.max(da))
 
     def raise_if_stopped(self) -> None:
-        """Raise the error matching the stop (JointLimitError, SingularityError, ...)."""
+        """Raise the error of the stopping event (JointLimitError, SingularityError, ...)."""
         if not self.stopped:
             return
         msg = self.stop_message or "the guidance run stopped"
-        if self.stop_kind == "joint_limit":
-            ev = next(e for e in self.events if e["kind"] == "joint_limit")
-            raise JointLimitError(msg, joint=ev["joint"], step=ev["step"],
-                                  limit=ev["limit_value"], value=ev["value"])
-        if self.stop_kind == "singular":
-            raise SingularityError(msg)
-        if self.stop_kind in ("not_converged", "target_not_reached"):
-            raise UnreachableError(msg)
-        raise KinestatError(msg)
+        if self.stop_event is None:
+            raise KinestatError(msg)
+        raise self.stop_event.error(msg)
 
 
 def joint_display(model: ChainModel, q) -> np.ndarray:
     """Joint values as the thesis prints them: degrees for revolute and screw joints, length
-    units for prismatic joints (batched)."""
+    units for prismatic joints (batched).
+
+    >>> from kinestat.io.library import load
+    >>> joint_display(load("puma762"), [math.pi / 2, 0, 0, 0, 0, 0]).tolist()
+    [90.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    """
     q = np.asarray(q, dtype=float)
     return np.where(model.prismatic, q, np.degrees(q))
-
-
-def result_record(result: GuidanceResult, *, hand_points_every_row: bool = False) -> dict:
-    """A plain record of a run (arrays stay numpy; ``to_jsonable`` them for JSON).
-
-    Keys: ``columns``, ``units``, ``table`` (joint values per row, initial first, degrees for
-    revolute joints), ``hand_origins``, ``final_hand_points`` (origin, unit point on +z, unit
-    point on +x), ``target_hand_points``, ``events``, ``steps``, ``substeps``,
-    ``final_pose_error`` and ``max_path_deviation`` (``position``, ``angle_deg``), ``stopped``,
-    ``stop_reason`` (``stop_message``), ``stage_hand_origins`` (the hand origin at the end of
-    each stage) and, when asked, ``hand_points`` of every row.
-    """
-    from kinestat.mechanism.nadkarni import hand_points
-
-    m = result.model
-    rec: dict = {
-        "columns": [(f"r{i + 1}" if m.prismatic[i] else f"theta{i + 1}") for i in range(m.n)],
-        "units": [m.length_unit if p else "deg" for p in m.prismatic],
-        "table": joint_display(m, result.q),
-        "hand_origins": result.poses[:, :3, 3],
-    }
-    if hand_points_every_row:
-        rec["hand_points"] = hand_points(result.poses)
-    rec["final_hand_points"] = hand_points(result.final_pose)
-    rec["target_hand_points"] = [hand_points(T) for T in result.stage_targets]
-    rec["stage_hand_origins"] = [result.poses[i, :3, 3] for i in result.stage_end_rows()]
-    rec["events"] = list(result.events)
-    rec["steps"] = list(result.steps)
-    rec["substeps"] = result.substeps
-    dp, da = result.final_pose_error()
-    rec["final_pose_error"] = {"position": dp, "angle_deg": math.degrees(da)}
-    mp, ma = result.max_path_deviation()
-    rec["max_path_deviation"] = {"position": mp, "angle_deg": math.degrees(ma)}
-    rec["stopped"] = result.stopped
-    rec["stop_reason"] = result.stop_kind
-    if result.stop_message:
-        rec["stop_message"] = result.stop_message
-    rec["length_scale"] = result.length
-    return rec
 
 
 def _unit(model: ChainModel, i: int) -> str:
     return model.length_unit if model.prismatic[i] else "deg"
 
 
-def _error_small(T, T_ref, tol: float, length: float) -> tuple[bool, float, float]:
-    dp, da = pose_error(T, T_ref)
-    return bool(da <= tol and dp <= tol * max(1.0, length)), float(dp), float(da)
+def _per_stage_steps(steps, n_stages: int) -> list[int | None]:
+    if steps is None or isinstance(steps, (int, np.integer)):
+        per_stage: list[int | None] = [None if not steps else int(steps)] * n_stages
+    else:
+        per_stage = [None if not s else int(s) for s in steps]
+        if len(per_stage) != n_stages:
+            raise InputError(
+                f"{len(per_stage)} step counts given for {n_stages} stages; give one count "
+                "for all or one per stage")
+    if any(s is not None and s < 1 for s in per_stage):
+        raise InputError("step counts must be positive integers (0 means automatic)")
+    return per_stage
+
+
+@dataclass
+class _Stage:
+    """The stage being run: its path (replaced after a perturbation), step count k, the step
+    j0 at which the current path object starts, and the sub-step limit (auto counts only)."""
+
+    index: int
+    path: Path
+    k: int
+    refine: float | None
+    j0: int = 0
+
+    def fractions(self, j: int) -> tuple[float, float]:
+        return (j - 1 - self.j0) / (self.k - self.j0), (j - self.j0) / (self.k - self.j0)
+
+
+class _Run:
+    """The mutable state of one run: current joints and hand, rows, events, the stop."""
+
+    def __init__(self, model: ChainModel, q: np.ndarray, opt: GuidanceOptions, L: float,
+                 progress: Callable[[int, int], None] | None,
+                 rule: StepRule | None = None) -> None:
+        self.model, self.opt, self.L, self.progress = model, opt, L, progress
+        self.rule: StepRule = opt.rule() if rule is None else rule
+        self.q = q
+        self.H = fk(model, q)
+        self.rows_q = [q.copy()]
+        self.rows_T = [self.H]
+        self.rows_ideal = [self.H]
+        self.rows_stage = [-1]
+        self.events: list[GuidanceEvent] = []
+        self.targets: list[np.ndarray] = []
+        self.planned: list[int] = []
+        self.stop_event: GuidanceEvent | None = None
+        self.stop_msg: str | None = None
+        self.gstep = 0
+        self.perturbations = 0
+        self.total_planned = 0
+        self.substeps = 0
+
+    # -- bookkeeping -------------------------------------------------------------------------
+    def stop(self, event: GuidanceEvent, message: str) -> None:
+        self.events.append(event)
+        self.stop_event, self.stop_msg = event, message
+
+    def accept(self, q_new: np.ndarray, ideal, stage: int) -> None:
+        self.q = q_new
+        self.H = fk(self.model, q_new)
+        self.rows_q.append(q_new.copy())
+        self.rows_T.append(self.H)
+        self.rows_ideal.append(np.asarray(ideal, dtype=float))
+        self.rows_stage.append(stage)
+
+    def limit_stop(self, q_new, stage: int | None) -> bool:
+        """Stop with a :class:`JointLimitStop` if ``q_new`` leaves the limits (ch. IV, 2))."""
+        if not self.opt.check_limits or (v := limit_violation(self.model, q_new)) is None:
+            return False
+        m = self.model
+        i, side, lim, _ = v
+        dv = float(joint_display(m, np.where(np.arange(m.n) == i, lim, 0.0))[i])
+        val = float(joint_display(m, q_new)[i])
+        ev = JointLimitStop(self.gstep, stage, joint=i + 1, limit=side, limit_value=dv,
+                            value=val, unit=_unit(m, i))
+        if stage is None:
+            msg = f"joint {i + 1} starts outside its {side} limit ({val:.6g} {_unit(m, i)})"
+        else:
+            msg = (f"joint {i + 1} would pass its {side} limit ({dv:.6g} {_unit(m, i)}) at step "
+                   f"{self.gstep}: stopped with the configuration of step {self.gstep - 1}")
+        self.stop(ev, msg)
+        return True
+
+    def _error_small(self, T, T_ref, tol: float) -> tuple[bool, float, float]:
+        dp, da = pose_error(T, T_ref)
+        return bool(da <= tol and dp <= tol * max(1.0, self.L)), float(dp), float(da)
+
+    def _solve(self, J, B, damping):
+        o = self.opt
+        return solve_step(J, B, prismatic=self.model.prismatic, length=self.L, damping=damping,
+                          cond_limit=o.cond_limit, max_damping=o.max_damping)
+
+    # -- a stage -----------------------------------------------------------------------------
+    def run_stage(self, si: int, spec: StageSpec, k_given: int | None) -> None:
+        path = resolve_stage(spec, self.H)
+        refine = None
+        k = k_given
+        if k is None:
+            refine = self.opt.max_joint_step_deg
+            k = auto_steps(path, self.L, max_step_deg=self.opt.max_step_deg,
+                           max_step_fraction=self.opt.max_step_fraction)
+        self.planned.append(k)
+        self.total_planned += k
+        self.targets.append(np.asarray(path.end, dtype=float))
+        stage = _Stage(si, path, k, refine)
+        for j in range(1, k + 1):
+            self.gstep += 1
+            if not self.step(stage, j):
+                break
+            if self.progress is not None:
+                self.progress(self.gstep, self.total_planned)
+        if self.stop_event is None and self.opt.settle:
+            self.settle(si)
+        if isinstance(self.stop_event, (Singularity, NotConverged)):
+            dp, _ = pose_error(self.H, self.targets[-1])
+            if dp > 1e-6 * max(1.0, self.L):
+                self.stop_msg += (f"; the hand is still {float(dp):.4g} "
+                                  f"{self.model.length_unit} from the target of stage "
+                                  f"{si + 1}, which may be out of reach")
+
+    def step(self, st: _Stage, j: int) -> bool:
+        """Step j of the stage; False when the run stopped."""
+        J = jacobian(self.model, self.q)
+        damping = None
+        smin, cond = conditioning(scaled_jacobian(J, self.model.prismatic, self.L))
+        if cond > self.opt.cond_limit:
+            handled = self.singular(st, j, J, float(smin), float(cond))
+            if handled is None:
+                return False
+            J, damping = handled
+        s0, s1 = st.fractions(j)
+        inc = self.increment(st, s0, s1, J, damping)
+        q_new = self.q + inc
+        ideal = st.path.pose_at(s1)
+        if self.opt.closed_loop:
+            q_new = self.newton(st, ideal, q_new)
+            if q_new is None:
+                return False
+        if self.limit_stop(q_new, st.index + 1):
+            return False
+        self.accept(q_new, ideal, st.index)
+        return True
+
+    def increment(self, st: _Stage, s0: float, s1: float, J, damping) -> np.ndarray:
+        """Joint increments of the step from the step rule; for automatic step counts a step
+        whose increments exceed ``max_joint_step_deg`` is redone as equal sub-steps."""
+        o = self.opt
+        inp = StepInput(self.model, self.q, self.H, J, self.L, damping, o.cond_limit,
+                        o.max_damping)
+        res = self.rule.increment(st.path, s0, s1, inp)
+        self.substeps += res.substeps - 1
+        if damping is not None:
+            ev = self.events[-1]
+            self.events[-1] = dataclasses.replace(ev, damping=float(res.solution.damping))
+        if self.model.n != 6 and res.solution.residual > 1e-9:
+            self.events.append(LeastSquaresStep(self.gstep, st.index + 1,
+                                                residual=float(res.solution.residual)))
+        m_sub = _substeps(self.model, res.dq, self.L, st.refine if self.rule.refinable else None)
+        if m_sub <= 1:
+            return res.dq
+        q_i, H_i = self.q, self.H  # the same hand motion in m_sub smaller steps
+        for i in range(m_sub):
+            a = s0 + (s1 - s0) * i / m_sub
+            b = s0 + (s1 - s0) * (i + 1) / m_sub
+            J_i = J if i == 0 else jacobian(self.model, q_i)
+            sub = StepInput(self.model, q_i, H_i, J_i, self.L, damping, o.cond_limit,
+                            o.max_damping)
+            q_i = q_i + self.rule.increment(st.path, a, b, sub).dq
+            H_i = fk(self.model, q_i)
+        self.substeps += m_sub - 1
+        return q_i - self.q
+
+    # -- singularities (ch. IV, "Singularities" 1)) ------------------------------------------
+    def singular(self, st: _Stage, j: int, J, smin: float, cond: float):
+        """Handle a singular [A]: ``(J, damping)`` to go on with, or None when stopped."""
+        o = self.opt
+        base = dict(sigma_min=smin, cond=cond)
+        where = (self.gstep, st.index + 1)
+        if o.singular == "stop" or (o.singular.startswith("perturb")
+                                    and self.perturbations >= o.max_perturbations):
+            self.stop(Singularity(*where, **base),
+                      f"singular configuration at step {self.gstep} (condition number "
+                      f"{cond:.3g} > {o.cond_limit:g})")
+            return None
+        if o.singular == "damped":
+            self.events.append(Singularity(*where, **base, action="damped"))
+            return J, "auto"
+        escape = perturb_all_joints if o.singular == "perturb_all" else escape_singularity
+        q_new, cond_new, tries = escape(self.model, self.q, length=self.L,
+                                        cond_limit=o.cond_limit, increment_deg=o.perturb_deg,
+                                        max_tries=o.max_perturb_tries)
+        self.perturbations += 1
+        base.update(joint_increments=joint_display(self.model, q_new - self.q), tries=tries,
+                    cond_after=cond_new, method=o.singular)
+        if cond_new >= o.cond_limit:
+            self.stop(Singularity(*where, **base),
+                      f"singular at step {self.gstep}: {tries} small joint increments did not "
+                      f"bring the condition number below {o.cond_limit:g} (best "
+                      f"{cond_new:.3g}); the motion cannot continue")
+            return None
+        if o.check_limits and limit_violation(self.model, q_new) is not None:
+            self.stop(Singularity(*where, **base),
+                      f"singular at step {self.gstep} and no perturbation within limits")
+            return None
+        H_new = fk(self.model, q_new)
+        dp, da = pose_error(H_new, self.H)
+        self.events.append(Singularity(
+            *where, **base, action="perturbed", q=joint_display(self.model, q_new),
+            hand_shift=float(dp), hand_rotation_deg=math.degrees(float(da))))
+        s0, _ = st.fractions(j)
+        self.q, self.H = q_new, H_new
+        st.path = st.path.replan(H_new, s0)
+        st.j0 = j - 1
+        return jacobian(self.model, self.q), None
+
+    # -- corrections -------------------------------------------------------------------------
+    def newton(self, st: _Stage, target, q) -> np.ndarray | None:
+        """Closed loop: Newton iterations ``J δq = twist(actual → target)`` until the pose
+        error ≤ tol; the corrected joints, or None (stopped) when they do not converge."""
+        o = self.opt
+        damping = "auto" if o.singular == "damped" else None
+        dp = da = math.inf
+        for it in range(o.max_newton + 1):
+            T = fk(self.model, q)
+            ok, dp, da = self._error_small(T, target, o.tol)
+            if ok:
+                return q
+            if it == o.max_newton:
+                break
+            q = q + self._solve(jacobian(self.model, q), twist_between(T, target), damping).dq
+        self.stop(NotConverged(self.gstep, st.index + 1, position_error=dp,
+                               angle_error_deg=math.degrees(da), iterations=o.max_newton),
+                  f"step {self.gstep}: the closed-loop correction did not reach the path "
+                  f"(error {dp:.3g} {self.model.length_unit}, {math.degrees(da):.3g} deg after "
+                  f"{o.max_newton} iterations): the path leaves the workspace or crosses a "
+                  "singularity")
+        return None
+
+    def settle(self, si: int) -> None:
+        """Correction steps straight at the stage target (eq. 4-19 with k = 1)."""
+        o = self.opt
+        target = self.targets[-1]
+        for it in range(o.max_settle + 1):
+            ok, dp, da = self._error_small(self.H, target, o.settle_tol)
+            if ok:
+                return
+            if it == o.max_settle:
+                self.stop(TargetNotReached(self.gstep, si + 1, position_error=dp,
+                                           angle_error_deg=math.degrees(da)),
+                          f"stage {si + 1}: the target was not reached (error {dp:.3g} "
+                          f"{self.model.length_unit}, {math.degrees(da):.3g} deg after "
+                          f"{o.max_settle} correction steps): it is out of reach or beyond a "
+                          "singularity")
+                return
+            self.gstep += 1
+            damping = "auto" if o.singular == "damped" else None
+            sol = self._solve(jacobian(self.model, self.q), twist_between(self.H, target),
+                              damping)
+            q_new = self.q + sol.dq
+            self.events.append(SettleStep(self.gstep, si + 1, position_error=dp,
+                                          angle_error_deg=math.degrees(da)))
+            if self.limit_stop(q_new, si + 1):
+                return
+            self.accept(q_new, target, si)
+
+    def result(self, notes: list[str]) -> GuidanceResult:
+        ev = self.stop_event
+        return GuidanceResult(
+            model=self.model, q=np.array(self.rows_q), poses=np.array(self.rows_T),
+            ideal=np.array(self.rows_ideal), stage=np.array(self.rows_stage),
+            stage_targets=tuple(self.targets), steps=tuple(self.planned),
+            events=tuple(self.events), length=self.L, stopped=ev is not None,
+            stop_kind=None if ev is None else ev.kind, stop_message=self.stop_msg,
+            notes=tuple(notes), substeps=self.substeps, stop_event=ev)
 
 
 def run_guidance(
     model: ChainModel,
     q0,
-    stages: Sequence[object],
+    stages: Sequence[StageSpec],
     *,
     steps: Sequence[int | None] | int | None = None,
     options: GuidanceOptions | None = None,
     progress: Callable[[int, int], None] | None = None,
     length: float | None = None,
+    rule: StepRule | None = None,
 ) -> GuidanceResult:
-    """Guide the hand of ``model`` from joint values ``q0`` through ``stages``.
+    """Guide the hand of ``model`` from joint values ``q0`` through ``stages`` (Nadkarni
+    ch. IV: eq. 4-11 per step, the singularity and joint-limit rules of "Singularities").
 
     Args:
         stages: paths (:mod:`~kinestat.serial.guidance.planners`) or functions
@@ -284,6 +462,16 @@ def run_guidance(
             (:func:`~kinestat.serial.guidance.planners.auto_steps`).
         length: the characteristic length L (default: from ``q0``).
         progress: called as ``progress(steps_done, steps_planned_so_far)``.
+        rule: a step rule (:class:`~kinestat.serial.guidance.rules.StepRule`) to use instead
+            of the one ``options.step_rule`` names.
+
+    >>> from kinestat.io.library import load
+    >>> from kinestat.serial.guidance.planners import command_path
+    >>> m = load("nadkarni-config2")
+    >>> r = run_guidance(m, m.q_home, [lambda H: command_path(H, [0, 0, 1], 4.0, 0.0)],
+    ...                  steps=8)
+    >>> len(r.q), r.final_pose_error()[0] < 1e-9          # 8 steps + the initial row
+    (9, True)
     """
     opt = options or GuidanceOptions()
     q = model.check_q(q0).astype(float)
@@ -292,263 +480,22 @@ def run_guidance(
     stages = list(stages)
     if not stages:
         raise InputError("no stages to run: give at least one target or command")
-    if steps is None or isinstance(steps, (int, np.integer)):
-        per_stage: list[int | None] = [None if not steps else int(steps)] * len(stages)
-    else:
-        per_stage = [None if not s else int(s) for s in steps]
-        if len(per_stage) != len(stages):
-            raise InputError(
-                f"{len(per_stage)} step counts given for {len(stages)} stages; give one count "
-                "for all or one per stage")
-    if any(s is not None and s < 1 for s in per_stage):
-        raise InputError("step counts must be positive integers (0 means automatic)")
+    per_stage = _per_stage_steps(steps, len(stages))
     L = characteristic_length(model, q) if length is None else float(length)
-    pris = model.prismatic
     notes: list[str] = []
     if model.n != 6:
         notes.append(
             f"the chain has {model.n} joints, not 6: each step solves J δq = B in the "
             "least-squares sense" + (" (minimum-norm increments)" if model.n > 6 else
                                      " (the residual is reported in the events)"))
-
-    H = fk(model, q)
-    rows_q = [q.copy()]
-    rows_T = [H]
-    rows_ideal = [H]
-    rows_stage = [-1]
-    events: list[dict] = []
-    targets: list[np.ndarray] = []
-    planned: list[int] = []
-    stop_kind = None
-    stop_msg = None
-    gstep = 0
-    perturbations = 0
-    total_planned = 0
-    substeps = 0
-
-    if opt.check_limits and (v := limit_violation(model, q)) is not None:
-        i, side, lim, val = v
-        disp = joint_display(model, np.array([lim if j == i else 0.0 for j in range(model.n)]))
-        events.append({"step": 0, "kind": "joint_limit", "joint": i + 1, "limit": side,
-                       "limit_value": float(disp[i]),
-                       "value": float(joint_display(model, q)[i]), "unit": _unit(model, i),
-                       "action": "stopped"})
-        stop_kind = "joint_limit"
-        stop_msg = (f"joint {i + 1} starts outside its {side} limit "
-                    f"({float(joint_display(model, q)[i]):.6g} {_unit(model, i)})")
-        return GuidanceResult(model, np.array(rows_q), np.array(rows_T), np.array(rows_ideal),
-                              np.array(rows_stage), (), (), tuple(events), L, True, stop_kind,
-                              stop_msg, tuple(notes))
-
+    run = _Run(model, q, opt, L, progress, rule)
+    if run.limit_stop(q, None):
+        return run.result(notes)
     for si, spec in enumerate(stages):
-        path = spec(H) if callable(spec) and not hasattr(spec, "pose_at") else spec
-        k = per_stage[si]
-        refine = None
-        if k is None:
-            refine = opt.max_joint_step_deg
-            k = auto_steps(path, L, max_step_deg=opt.max_step_deg,
-                           max_step_fraction=opt.max_step_fraction)
-        planned.append(k)
-        total_planned += k
-        targets.append(np.asarray(path.end, dtype=float))
-        j0 = 0  # step index at which the current path object starts (replanning)
-        for j in range(1, k + 1):
-            gstep += 1
-            s0 = (j - 1 - j0) / (k - j0)
-            s1 = (j - j0) / (k - j0)
-            J = jacobian(model, q)
-            smin, cond = conditioning(scaled_jacobian(J, pris, L))
-            damping = None
-            if cond > opt.cond_limit:
-                ev = {"step": gstep, "stage": si + 1, "kind": "singular",
-                      "sigma_min": float(smin), "cond": float(cond)}
-                if opt.singular == "stop" or (opt.singular == "perturb"
-                                              and perturbations >= opt.max_perturbations):
-                    ev["action"] = "stopped"
-                    events.append(ev)
-                    stop_kind = "singular"
-                    stop_msg = (f"singular configuration at step {gstep} (condition number "
-                                f"{float(cond):.3g} > {opt.cond_limit:g})")
-                    break
-                if opt.singular == "perturb":
-                    q_new, cond_new, tries = escape_singularity(
-                        model, q, length=L, cond_limit=opt.cond_limit,
-                        increment_deg=opt.perturb_deg, max_tries=opt.max_perturb_tries)
-                    perturbations += 1
-                    ev["joint_increments"] = joint_display(model, q_new - q)
-                    ev["tries"] = tries
-                    ev["cond_after"] = cond_new
-                    if cond_new >= opt.cond_limit:
-                        ev["action"] = "stopped"
-                        events.append(ev)
-                        stop_kind = "singular"
-                        stop_msg = (
-                            f"singular at step {gstep}: {tries} small joint increments did not "
-                            f"bring the condition number below {opt.cond_limit:g} "
-                            f"(best {cond_new:.3g}); the motion cannot continue")
-                        break
-                    if opt.check_limits and limit_violation(model, q_new) is not None:
-                        ev["action"] = "stopped"
-                        events.append(ev)
-                        stop_kind = "singular"
-                        stop_msg = f"singular at step {gstep} and no perturbation within limits"
-                        break
-                    H_new = fk(model, q_new)
-                    dp, da = pose_error(H_new, H)
-                    ev.update(action="perturbed", q=joint_display(model, q_new),
-                              hand_shift=float(dp), hand_rotation_deg=math.degrees(float(da)))
-                    events.append(ev)
-                    q, H = q_new, H_new
-                    path = path.replan(H, s0)
-                    j0 = j - 1
-                    s0, s1 = 0.0, 1.0 / (k - j0)
-                    J = jacobian(model, q)
-                else:  # damped
-                    damping = "auto"
-                    ev["action"] = "damped"
-                    events.append(ev)
-            if opt.origin_step or opt.split_substep_deg2 is not None:
-                dq, sol, m_disp = _disp_1977_increment(model, q, H, J, path, s0, s1, L,
-                                                       damping, opt)
-                substeps += m_disp - 1
-                refine_now = None
-            else:
-                dq, sol = _increment(model, q, H, J, path, s0, s1, L, damping, opt)
-                refine_now = refine
-            if damping is not None:
-                events[-1]["damping"] = float(sol.damping)
-            if model.n != 6 and sol.residual > 1e-9:
-                events.append({"step": gstep, "stage": si + 1, "kind": "least_squares",
-                               "residual": float(sol.residual)})
-            q_new = q + dq
-            m_sub = _substeps(model, dq, L, refine_now)
-            if m_sub > 1:  # refine: the same hand motion in m_sub smaller first-order steps
-                q_new = q
-                H_sub = H
-                for i in range(m_sub):
-                    a = s0 + (s1 - s0) * i / m_sub
-                    b = s0 + (s1 - s0) * (i + 1) / m_sub
-                    J_sub = J if i == 0 else jacobian(model, q_new)
-                    dq_i, _ = _increment(model, q_new, H_sub, J_sub, path, a, b, L, damping,
-                                         opt)
-                    q_new = q_new + dq_i
-                    H_sub = fk(model, q_new)
-                substeps += m_sub - 1
-            ideal = path.pose_at(s1)
-            if opt.closed_loop:
-                q_new, ok, dp, da, iters = _newton(model, q_new, ideal, L, opt, pris)
-                if not ok:
-                    events.append({"step": gstep, "stage": si + 1, "kind": "not_converged",
-                                   "position_error": dp, "angle_error_deg": math.degrees(da),
-                                   "iterations": iters, "action": "stopped"})
-                    stop_kind = "not_converged"
-                    stop_msg = (f"step {gstep}: the closed-loop correction did not reach the "
-                                f"path (error {dp:.3g} {model.length_unit}, "
-                                f"{math.degrees(da):.3g} deg after {iters} iterations): "
-                                "the path leaves the workspace or crosses a singularity")
-                    break
-            if opt.check_limits and (v := limit_violation(model, q_new)) is not None:
-                stop_kind, stop_msg = _limit_event(model, v, q_new, gstep, si, events)
-                break
-            q = q_new
-            H = fk(model, q)
-            rows_q.append(q.copy())
-            rows_T.append(H)
-            rows_ideal.append(np.asarray(ideal, dtype=float))
-            rows_stage.append(si)
-            if progress is not None:
-                progress(gstep, total_planned)
-        if stop_kind is None and opt.settle:
-            target = targets[-1]
-            for it in range(opt.max_settle + 1):
-                ok, dp, da = _error_small(H, target, opt.settle_tol, L)
-                if ok:
-                    break
-                if it == opt.max_settle:
-                    events.append({"step": gstep, "stage": si + 1, "kind": "target_not_reached",
-                                   "position_error": dp, "angle_error_deg": math.degrees(da),
-                                   "action": "stopped"})
-                    stop_kind = "target_not_reached"
-                    stop_msg = (f"stage {si + 1}: the target was not reached (error {dp:.3g} "
-                                f"{model.length_unit}, {math.degrees(da):.3g} deg after "
-                                f"{opt.max_settle} correction steps): it is out of reach or "
-                                "beyond a singularity")
-                    break
-                gstep += 1
-                damping = "auto" if opt.singular == "damped" else None
-                sol = solve_step(jacobian(model, q), twist_between(H, target), prismatic=pris,
-                                 length=L, damping=damping, cond_limit=opt.cond_limit,
-                                 max_damping=opt.max_damping)
-                q_new = q + sol.dq
-                events.append({"step": gstep, "stage": si + 1, "kind": "settle",
-                               "position_error": dp, "angle_error_deg": math.degrees(da)})
-                if opt.check_limits and (v := limit_violation(model, q_new)) is not None:
-                    stop_kind, stop_msg = _limit_event(model, v, q_new, gstep, si, events)
-                    break
-                q = q_new
-                H = fk(model, q)
-                rows_q.append(q.copy())
-                rows_T.append(H)
-                rows_ideal.append(target)
-                rows_stage.append(si)
-        if stop_kind in ("singular", "not_converged"):
-            dp, _ = pose_error(H, targets[-1])
-            if dp > 1e-6 * max(1.0, L):
-                stop_msg += (f"; the hand is still {float(dp):.4g} {model.length_unit} from "
-                             f"the target of stage {si + 1}, which may be out of reach")
-        if stop_kind is not None:
+        run.run_stage(si, spec, per_stage[si])
+        if run.stop_event is not None:
             break
-
-    return GuidanceResult(
-        model=model, q=np.array(rows_q), poses=np.array(rows_T), ideal=np.array(rows_ideal),
-        stage=np.array(rows_stage), stage_targets=tuple(targets), steps=tuple(planned),
-        events=tuple(events), length=L, stopped=stop_kind is not None, stop_kind=stop_kind,
-        stop_message=stop_msg, notes=tuple(notes), substeps=substeps)
-
-
-def _limit_event(model, v, q_new, gstep: int, si: int, events: list) -> tuple[str, str]:
-    i, side, lim, _ = v
-    dv = float(joint_display(model, np.where(np.arange(model.n) == i, lim, 0.0))[i])
-    events.append({"step": gstep, "stage": si + 1, "kind": "joint_limit", "joint": i + 1,
-                   "limit": side, "limit_value": dv,
-                   "value": float(joint_display(model, q_new)[i]), "unit": _unit(model, i),
-                   "action": "stopped"})
-    return "joint_limit", (f"joint {i + 1} would pass its {side} limit ({dv:.6g} "
-                           f"{_unit(model, i)}) at step {gstep}: stopped with the configuration "
-                           f"of step {gstep - 1}")
-
-
-def _increment(model, q, H, J, path, s0, s1, L, damping, opt: GuidanceOptions):
-    """First-order (or second-order) joint increments for the path from s0 to s1."""
-    B = path.step_twist(s0, s1, H)
-    sol = solve_step(J, B, prismatic=model.prismatic, length=L, damping=damping,
-                     cond_limit=opt.cond_limit, max_damping=opt.max_damping)
-    dq = sol.dq
-    if opt.second_order:
-        target = path.step_target(s0, s1, H)
-        dq, _, _ = solve_second_order(model, q, B, target[:3, 3] - H[:3, 3], length=L,
-                                      dq0=dq)
-    return dq, sol
-
-
-def _disp_1977_increment(model, q, H, J, path, s0, s1, L, damping, opt: GuidanceOptions):
-    """The step of DISP's Illustration 5 run (docs/seed-errata.md G1): the path's step
-    twist B split into m equal parts (``split_substep_deg2``), each solved to first order at
-    the current joints with, for ``origin_step``, the origin point's second-order
-    displacement as its translation. Returns ``(dq, last solution, m)``."""
-    B = path.step_twist(s0, s1, H)
-    m = 1 if opt.split_substep_deg2 is None else split_substep_count(B, opt.split_substep_deg2)
-    Bi = B / m
-    if opt.origin_step:
-        Bi = origin_displacement_twist(Bi)
-    q_i = np.array(q, dtype=float)
-    sol = None
-    for i in range(m):
-        J_i = J if i == 0 else jacobian(model, q_i)
-        sol = solve_step(J_i, Bi, prismatic=model.prismatic, length=L, damping=damping,
-                         cond_limit=opt.cond_limit, max_damping=opt.max_damping)
-        q_i = q_i + sol.dq
-    return q_i - q, sol, m
+    return run.result(notes)
 
 
 def _substeps(model: ChainModel, dq, L: float, max_joint_step_deg: float | None) -> int:
@@ -558,21 +505,3 @@ def _substeps(model: ChainModel, dq, L: float, max_joint_step_deg: float | None)
         return 1
     size = float(np.max(np.abs(np.where(model.prismatic, dq / L, dq))))
     return int(min(1000, max(1, math.ceil(size / math.radians(max_joint_step_deg) - 1e-9))))
-
-
-def _newton(model, q, target, L, opt: GuidanceOptions, pris):
-    """Newton iterations ``J δq = twist(actual → target)`` until the pose error ≤ tol."""
-    damping = "auto" if opt.singular == "damped" else None
-    dp = da = math.inf
-    for it in range(opt.max_newton + 1):
-        T = fk(model, q)
-        ok, dp, da = _error_small(T, target, opt.tol, L)
-        if ok:
-            return q, True, dp, da, it
-        if it == opt.max_newton:
-            break
-        E = twist_between(T, target)
-        sol = solve_step(jacobian(model, q), E, prismatic=pris, length=L, damping=damping,
-                         cond_limit=opt.cond_limit, max_damping=opt.max_damping)
-        q = q + sol.dq
-    return q, False, dp, da, opt.max_newton

@@ -12,8 +12,9 @@ least-squares weights and damping no longer change when inches become millimetre
 
 - :func:`solve_step`: exact solve (n = 6), least squares (n ≠ 6, or a rank-deficient J), or
   damped least squares; reports σ_min and the condition number of J_s.
-- :func:`escape_singularity`: Nadkarni ch. IV "Singularities" 1): give the joints small
-  increments until the singularity disappears.
+- :func:`escape_singularity` (greedy, one joint per try) and :func:`perturb_all_joints`
+  (DISP's way, every joint at once): Nadkarni ch. IV "Singularities" 1), give the joints
+  small increments until the singularity disappears.
 - :func:`solve_second_order`: Nadkarni eq. 5-5 (suggestion 2), the δθ²/2 terms.
 - :func:`limit_violation`: ch. IV "Singularities" 2), a joint at its limit.
 - :func:`origin_displacement_twist`, :func:`split_substep_count`: the step as DISP (1977)
@@ -44,6 +45,7 @@ __all__ = [
     "second_order_residual",
     "solve_second_order",
     "escape_singularity",
+    "perturb_all_joints",
     "limit_violation",
     "origin_displacement_twist",
     "split_substep_count",
@@ -296,6 +298,41 @@ def escape_singularity(model: ChainModel, q, *, length: float,
         if cond < cond_limit:
             return q, cond, tries
     return q, cond, max_tries
+
+
+def perturb_all_joints(model: ChainModel, q, *, length: float,
+                       cond_limit: float = DEFAULT_COND_LIMIT, increment_deg: float = 1.0,
+                       max_tries: int = 30) -> tuple[np.ndarray, float, int]:
+    """Nadkarni ch. IV, "Singularities" 1): "small increments to the joint variables" — all
+    of them at once — until the singularity disappears.
+
+    Deterministic rule: try ``t = 1, 2, …`` moves every joint by ``t·δ`` (δ = ``increment_deg``
+    for revolute and screw joints, L/100 for prismatic ones) towards its farther limit (+ when
+    both are equally far, e.g. unlimited), until the dimensionless condition number is below
+    ``cond_limit``. Returns ``(q_new, cond_new, tries)``; ``cond_new >= cond_limit`` means no
+    try within the joint limits succeeded (``q_new`` is then ``q``).
+
+    >>> from kinestat.io.library import load
+    >>> m = load("puma762")
+    >>> q_wrist_singular = np.radians([90.0, -30.0, 30.0, 0.0, 0.0, 0.0])  # θ5 = 0
+    >>> q, c, t = perturb_all_joints(m, q_wrist_singular, length=400.0)
+    >>> np.degrees(q - q_wrist_singular).round(6).tolist(), bool(c < DEFAULT_COND_LIMIT)
+    ([1.0, 1.0, -1.0, 1.0, 1.0, 1.0], True)
+    """
+    q = model.check_q(q).astype(float)
+    pris = model.prismatic
+    lo, hi = model.lower, model.upper
+    inc = np.where(pris, length / 100.0, math.radians(increment_deg))
+    sign = np.where(hi - q >= q - lo, 1.0, -1.0)
+    _, cond = conditioning(scaled_jacobian(jacobian(model, q), pris, length))
+    for tries in range(1, max_tries + 1):
+        cand = q + tries * sign * inc
+        if not np.all((cand >= lo) & (cand <= hi)):
+            return q, float(cond), tries
+        _, cc = conditioning(scaled_jacobian(jacobian(model, cand), pris, length))
+        if float(cc) < cond_limit:
+            return cand, float(cc), tries
+    return q, float(cond), max_tries
 
 
 def limit_violation(model: ChainModel, q, tol: float = 1e-12):

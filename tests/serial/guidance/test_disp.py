@@ -9,16 +9,17 @@ import math
 import numpy as np
 import pytest
 
+from kinestat.cli._guidance import parse_steps
+from kinestat.disp import (
+    deck_json,
+    deck_model,
+    disp_options,
+    run_deck,
+)
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import embedded_deck
 from kinestat.mechanism.nadkarni import hand_points
 from kinestat.serial.fk import fk
-from kinestat.serial.guidance.disp import (
-    deck_json,
-    deck_model,
-    parse_steps,
-    run_deck,
-)
 from kinestat.serial.guidance.run import GuidanceOptions
 from kinestat.spatial.displacement import frame_from_triple, pose_from_screw
 
@@ -56,7 +57,13 @@ def test_ms3_gives_both():
 
 @pytest.mark.parametrize("name", ["illustration4", "illustration6", "illustration7"])
 def test_guidance_decks_reach_their_targets(name):
-    run = run_deck(embedded_deck(name))
+    # issue 14: run_deck is DISP by default — one row per step, no correction rows, the
+    # first-order residual left (and noted); settle=True adds the correction steps
+    bare = run_deck(embedded_deck(name)).result
+    assert not bare.stopped and not bare.events[1:]
+    assert len(bare.q) == 1 + sum(bare.steps) and not bare.settle_rows()
+    assert bare.final_pose_error()[0] < 0.1
+    run = run_deck(embedded_deck(name), options=disp_options(settle=True))
     r = run.result
     assert not r.stopped
     dp, da = r.final_pose_error()
@@ -89,7 +96,8 @@ def test_seventh_joint_hand_and_the_inferior_option():
     # first position given = the printed a1, b1, c1 (to 3 decimals): agrees with x*(7)
     P = np.array(deck.positions)
     P[0] = [[-24.315, 5.273, 4.059], [-24.144, 5.447, 5.029], [-24.833, 6.126, 3.998]]
-    run = run_deck(dataclasses.replace(deck, positions=P), steps=5)
+    run = run_deck(dataclasses.replace(deck, positions=P), steps=5,
+                   options=disp_options(settle=True))
     assert any("inferior" in n for n in run.notes)  # 3-decimal points are 1e-3 off x*(7)
     np.testing.assert_allclose(run.result.poses[0], frame_from_triple(P[0]), atol=1e-12)
     assert run.result.final_pose_error()[0] < 1e-8

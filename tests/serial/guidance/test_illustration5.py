@@ -11,9 +11,9 @@ import numpy as np
 import pytest
 
 import kinestat
+from kinestat.disp import deck_initial_hand, deck_model, disp_options, run_deck
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import embedded_deck
-from kinestat.serial.guidance.disp import deck_initial_hand, deck_model, run_deck
 from kinestat.serial.guidance.planners import line_path, twist_between, twist_exp
 from kinestat.serial.guidance.run import GuidanceOptions, joint_display
 from kinestat.serial.guidance.step import origin_displacement_twist, split_substep_count
@@ -77,8 +77,15 @@ def test_published_deck_reproduces_table_a2_9():
         np.testing.assert_allclose(table[:10, col], TABLE_A2_9[:, col], atol=HALF_UNIT)
     rows = [0, *range(2, 10)]  # θ4 in every row but the first
     np.testing.assert_allclose(table[rows, 3], TABLE_A2_9[rows, 3], atol=HALF_UNIT)
-    # "coincides with the desired final position with three decimal accuracy"
-    np.testing.assert_allclose(table[-1], TABLE_A2_9_FINAL, atol=5e-4)
+    # issue 14: DISP's default run ends with the bare 27th step, 0.0024 in short; the
+    # "coincides with the desired final position with three decimal accuracy" of the text
+    # needs one correction step (settle)
+    assert len(table) == K + 1
+    np.testing.assert_allclose(table[-1], TABLE_A2_9_FINAL, atol=2.5e-3)
+    settled = run_deck(embedded_deck("illustration5-published"),
+                       options=disp_options(settle=True)).result
+    np.testing.assert_allclose(joint_display(settled.model, settled.q[-1]), TABLE_A2_9_FINAL,
+                               atol=5e-4)
     # the departures G1 leaves unexplained, bounded: θ4 of row 1, r1 and r2
     assert table[1, 3] - TABLE_A2_9[1, 3] == pytest.approx(0.886, abs=1e-3)
     dev = np.abs(table[:10, :2] - TABLE_A2_9[:, :2]).max(axis=0)

@@ -1,4 +1,5 @@
-"""Running a DISP deck (Nadkarni 1977, Appendix I) for every analysis type MS = 0..6.
+"""Running a DISP deck (Nadkarni 1977, Appendix I) for every analysis type MS = 0..6:
+deck -> model -> run (the DISP program; layer 3, an application of io + serial guidance).
 
 ============  ==========================================================================
 MS            what runs (DISP subroutine)
@@ -38,35 +39,26 @@ from kinestat.io.disp_deck import DispDeck, deck_warnings
 from kinestat.mechanism.chain import ChainModel, from_nadkarni
 from kinestat.mechanism.nadkarni import hand_points, mechanism_frames
 from kinestat.serial.fk import fk
-from kinestat.serial.guidance.planners import (
-    command_path,
-    general_path,
-    line_path,
-    pose_error,
-    screw_path,
-)
-from kinestat.serial.guidance.run import (
-    GuidanceOptions,
-    GuidanceResult,
-    result_record,
-    run_guidance,
-)
+from kinestat.serial.guidance.planners import StageSpec, pose_error
+from kinestat.serial.guidance.rules import GuidanceOptions, SingularMode
+from kinestat.serial.guidance.run import GuidanceResult, run_guidance
+from kinestat.serial.guidance.stages import command_stages, target_stages
 from kinestat.spatial.displacement import frame_from_triple, screws_between
 from kinestat.spatial.transforms import inv
 
 __all__ = [
     "DeckRun",
+    "disp_options",
     "deck_model",
     "deck_initial_hand",
     "deck_screws",
     "deck_joints",
     "deck_stages",
     "run_deck",
-    "deck_json",
-    "parse_steps",
+    "TYPE_NAMES",
 ]
 
-_TYPE = {0: "II (screw path)", 4: "III (hand point on a straight line)",
+TYPE_NAMES = {0: "II (screw path)", 4: "III (hand point on a straight line)",
          5: "IV (operator commands)", 6: "I (general, Example 4)"}
 
 
@@ -81,21 +73,6 @@ class DeckRun:
     model: ChainModel | None = None
     result: GuidanceResult | None = None
     notes: tuple[str, ...] = ()
-
-
-def parse_steps(text: str | None) -> list[int] | int | None:
-    """``--steps`` text: ``"40"`` (every stage) or ``"30,12"`` (one per stage); 0 = automatic."""
-    if text is None or text.strip() == "":
-        return None
-    try:
-        vals = [int(v) for v in text.replace(" ", "").split(",")]
-    except ValueError:
-        raise InputError(
-            f"--steps: expected an integer or comma-separated integers (one per stage), "
-            f"got {text!r}") from None
-    if any(v < 0 for v in vals):
-        raise InputError("--steps: step counts must be ≥ 0 (0 = automatic)")
-    return vals[0] if len(vals) == 1 else vals
 
 
 def deck_screws(deck: DispDeck) -> list[dict]:
@@ -183,37 +160,54 @@ def deck_initial_hand(deck: DispDeck, model: ChainModel) -> tuple[ChainModel, np
     return dataclasses.replace(model, constants=C), P0, notes
 
 
-def deck_stages(deck: DispDeck, start_points) -> list[Callable[[np.ndarray], object]]:
+def deck_stages(deck: DispDeck, start_points) -> list[StageSpec]:
     """One stage per target position (MS 0, 4, 6) or command (MS 5), each a function of the
-    hand pose at its start."""
+    hand pose at its start (:mod:`kinestat.serial.guidance.stages`)."""
     ms = deck.ms
     if ms == 5:
-        return [
-            (lambda H, c=c: command_path(H, c.direction, c.distance, c.angle, c.frame))
-            for c in deck.commands
-        ]
-    P = [np.asarray(start_points, dtype=float)] + [
-        np.asarray(p, dtype=float) for p in deck.positions[1:]]
-    if ms == 0:
-        return [(lambda H, T=frame_from_triple(P[i]): screw_path(H, T))
-                for i in range(1, len(P))]
-    if ms == 6:
-        return [(lambda H, T=frame_from_triple(P[i]): general_path(H, T))
-                for i in range(1, len(P))]
-    if ms == 4:
-        return [(lambda H, a=P[i - 1], b=P[i]: line_path(a, b)) for i in range(1, len(P))]
-    raise InputError(f"MS = {ms} is not a guidance analysis (0, 4, 5, 6)")
+        return command_stages(deck.commands)
+    kind = {0: "screw", 4: "line", 6: "general"}.get(ms)
+    if kind is None:
+        raise InputError(f"MS = {ms} is not a guidance analysis (0, 4, 5, 6)")
+    return target_stages(kind, start_points, list(deck.positions[1:]))
+
+
+def disp_options(*, settle: bool = False, closed_loop: bool = False,
+                 second_order: bool = False, singular: SingularMode = "perturb",
+                 cond_limit: float = 1e3, disp_1977: bool = False) -> GuidanceOptions:
+    """Guidance options of DISP (Nadkarni 1977, ch. IV, App. I) by default: first-order
+    steps (eq. 4-11), no correction ("settle") steps, the thesis's perturbation at a
+    singularity; kinestat's refinements are opt-in. ``disp_1977`` selects the inferred type III
+    step rule of Table A2-9, which includes its final correction step.
+
+    >>> o = disp_options()
+    >>> o.step_rule, o.settle, o.closed_loop
+    ('first_order', False, False)
+    """
+    if disp_1977:
+        return GuidanceOptions.disp_1977(closed_loop=closed_loop, second_order=second_order,
+                                         singular=singular, cond_limit=cond_limit)
+    return GuidanceOptions(step_rule="second_order" if second_order else "first_order",
+                           closed_loop=closed_loop, singular=singular, settle=settle,
+                           cond_limit=cond_limit)
 
 
 def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
              options: GuidanceOptions | None = None,
              progress: Callable[[int, int], None] | None = None) -> DeckRun:
-    """Run a deck for its MS. ``steps`` overrides the deck's IT (0/None: IT, or automatic when
-    IT = 0)."""
+    """Run a deck for its MS as DISP does. ``steps`` overrides the deck's IT (0/None: IT, or
+    automatic when IT = 0); ``options`` default to :func:`disp_options` (DISP's behaviour).
+    The inferred 1977 step rule (``step_rule="disp_1977"``) belongs to the type III analysis
+    (MS = 4) it was fitted to and is refused for other MS."""
     if not isinstance(deck, DispDeck):
         raise InputError(f"run_deck takes a DispDeck, got {type(deck).__name__}")
+    options = disp_options() if options is None else options
     notes = list(deck_warnings(deck))
     ms = deck.ms
+    if options.step_rule == "disp_1977" and ms != 4:
+        raise InputError(
+            f"the DISP 1977 step rule (--disp-1977) is inferred from Table A2-9, a type III "
+            f"analysis (MS = 4); it does not apply to MS = {ms}")
     if ms in (1, 2, 3):
         screws = deck_screws(deck) if ms in (1, 3) else None
         joints = deck_joints(deck) if ms in (2, 3) else None
@@ -226,29 +220,10 @@ def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
         steps = deck.it if deck.it > 0 else None
     result = run_guidance(model, model.q_home, stages, steps=steps, options=options,
                           progress=progress)
+    if not result.stopped and not options.settle:
+        dp, da = result.final_pose_error()
+        if dp > 1e-9 * max(1.0, result.length) or da > 1e-9:
+            notes.append(f"the last step left the hand {dp:.4g} {model.length_unit} and "
+                         f"{math.degrees(da):.3g} deg from the target (the first-order "
+                         "residual; --settle adds correction steps)")
     return DeckRun(deck, model=model, result=result, notes=tuple(notes) + result.notes)
-
-
-def deck_json(run: DeckRun) -> dict:
-    """The machine-readable record of a deck run (the ``kinestat disp --json`` contract).
-
-    MS 1: ``screws``; MS 2: ``joints``; MS 3: both; MS 0/4/5/6: the keys of
-    :func:`~kinestat.serial.guidance.run.result_record` (``table``, ``final_hand_points``,
-    ``events``, ...; ``hand_points`` of every row when IO = 0), with ``stage_hand_origins``
-    (the hand origin at the end of each command) for MS = 5. Always ``ms``, ``analysis``,
-    ``source`` and ``notes``.
-    """
-    deck = run.deck
-    out: dict = {"ms": deck.ms, "analysis": deck.analysis, "source": deck.source}
-    if run.screws is not None:
-        out["screws"] = run.screws
-    if run.joints is not None:
-        out["joints"] = run.joints
-    if run.result is not None:
-        out["type"] = _TYPE[deck.ms]
-        rec = result_record(run.result, hand_points_every_row=deck.io == 0)
-        if deck.ms != 5:
-            rec.pop("stage_hand_origins")
-        out.update(rec)
-    out["notes"] = list(run.notes)
-    return out

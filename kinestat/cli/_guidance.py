@@ -1,0 +1,121 @@
+"""Helpers shared by ``kinestat disp`` and ``kinestat guide``: ``--steps`` parsing, the progress
+bar, the human-readable tables of a guidance run."""
+
+from __future__ import annotations
+
+import contextlib
+import math
+
+import numpy as np
+from rich.console import Console
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
+
+from kinestat.cli._output import console, err_console, table
+from kinestat.errors import InputError
+from kinestat.mechanism.nadkarni import hand_points
+from kinestat.serial.guidance.run import GuidanceResult, joint_display
+
+__all__ = ["parse_steps", "progress_reporter", "print_result", "singular_mode", "SINGULAR_HELP"]
+
+SINGULAR_HELP = ("At a singular configuration: perturb (small increments, one joint at a time, "
+                 "greedy), perturb-all (DISP's way: small increments on all joints at once), "
+                 "damped (damped least squares) or stop.")
+
+
+def parse_steps(text: str | None) -> list[int] | int | None:
+    """``--steps`` text: ``"40"`` (every stage) or ``"30,12"`` (one per stage); 0 = automatic.
+
+    >>> parse_steps("30, 12")
+    [30, 12]
+    """
+    if text is None or text.strip() == "":
+        return None
+    try:
+        vals = [int(v) for v in text.replace(" ", "").split(",")]
+    except ValueError:
+        raise InputError(
+            f"--steps: expected an integer or comma-separated integers (one per stage), "
+            f"got {text!r}") from None
+    if any(v < 0 for v in vals):
+        raise InputError("--steps: step counts must be ≥ 0 (0 = automatic)")
+    return vals[0] if len(vals) == 1 else vals
+
+
+def singular_mode(text: str, damped: bool) -> str:
+    """``--singular`` value (``perturb-all`` → ``perturb_all``); ``--damped`` is short for
+    ``--singular damped``."""
+    mode = "damped" if damped else text.strip().lower().replace("-", "_")
+    if mode not in ("perturb", "perturb_all", "damped", "stop"):
+        raise InputError(f"--singular must be perturb, perturb-all, damped or stop, got {text!r}")
+    return mode
+
+
+@contextlib.contextmanager
+def progress_reporter(enabled: bool = True, console_err: Console | None = None):
+    """A ``progress(done, total)`` callback drawing a rich progress bar on stderr when stderr
+    is a terminal (None otherwise)."""
+    con = err_console if console_err is None else console_err
+    if not (enabled and con.is_terminal):
+        yield None
+        return
+    with Progress(TextColumn("guidance"), BarColumn(), MofNCompleteColumn(),
+                  console=con, transient=True) as prog:
+        task = prog.add_task("steps", total=None)
+
+        def update(done: int, total: int) -> None:
+            prog.update(task, completed=done, total=max(total, done))
+
+        yield update
+
+
+def _fmt_event(ev: dict) -> str:
+    skip = {"step", "kind", "stage"}
+    parts = []
+    for k, v in ev.items():
+        if k in skip:
+            continue
+        if isinstance(v, np.ndarray):
+            v = "[" + ", ".join(f"{x:.4g}" for x in v) + "]"
+        elif isinstance(v, float):
+            v = f"{v:.4g}"
+        parts.append(f"{k}={v}")
+    return ", ".join(parts)
+
+
+def print_result(result: GuidanceResult, notes=(), title: str = "Joint variables") -> None:
+    """Human-readable tables of a guidance run (rich)."""
+    m = result.model
+    vals = np.round(joint_display(m, result.q), 3) + 0.0  # no "-0.000"
+    cols = ["step"] + [
+        (f"r{i + 1} {m.length_unit}" if m.prismatic[i] else f"θ{i + 1} deg") for i in range(m.n)]
+    settle = result.settle_rows()
+    rows = []
+    for r in range(vals.shape[0]):
+        label = "initial" if r == 0 else (f"{r}*" if r in settle else str(r))
+        if r == vals.shape[0] - 1 and r > 0:
+            label = "final" + ("*" if r in settle else "")
+        rows.append([label, *[float(v) for v in vals[r]]])
+    console.print(table(title, cols, rows, fmt="{:.3f}"))
+    if result.events:
+        ev_rows = [[str(e.step), e.kind, _fmt_event(e.as_dict())] for e in result.events]
+        console.print(table("Events", ["step", "kind", "details"], ev_rows))
+    hp = hand_points(result.final_pose)
+    dp, da = result.final_pose_error()
+    mp, ma = result.max_path_deviation()
+    summary = [
+        ["steps per stage", ", ".join(str(k) for k in result.steps) +
+         (f" (+{result.substeps} sub-steps)" if result.substeps else "")],
+        ["final hand origin", ", ".join(f"{v:.4f}" for v in hp[0])],
+        ["final hand +z point", ", ".join(f"{v:.4f}" for v in hp[1])],
+        ["final hand +x point", ", ".join(f"{v:.4f}" for v in hp[2])],
+        ["final pose error", f"{dp:.3g} {m.length_unit}, {math.degrees(da):.3g} deg"],
+        ["max deviation from the ideal path", f"{mp:.3g} {m.length_unit}, "
+                                               f"{math.degrees(ma):.3g} deg"],
+    ]
+    if settle:
+        summary.append(["rows marked *", "correction steps straight at the stage target"])
+    if result.stopped:
+        summary.append(["STOPPED", result.stop_message or result.stop_kind or ""])
+    for n in notes:
+        summary.append(["note", n])
+    console.print(table("Summary", ["", ""], summary))

@@ -1,0 +1,178 @@
+"""Typed events of a guidance run (Nadkarni ch. IV, "Singularities" 1) and 2)).
+
+Every event is a frozen dataclass with the global 1-based ``step`` (0 = before the first step)
+and the 1-based ``stage`` (None before the first stage). ``kind`` names it in records; an event
+also reads like the plain record it becomes in JSON (``ev["kind"]``, ``ev["cond"]``, ...,
+:meth:`GuidanceEvent.as_dict`). An event that stops a run knows the error it stands for
+(:meth:`GuidanceEvent.error`), so nothing maps kinds back to exceptions by string.
+
+=====================  ==================================================================
+kind                   event
+=====================  ==================================================================
+``singular``           :class:`Singularity` — [A] singular; ``action`` says what was done
+                       (``perturbed``, ``damped``, ``stopped``)
+``joint_limit``        :class:`JointLimitStop` — a joint would pass a limit: stopped
+``least_squares``      :class:`LeastSquaresStep` — n ≠ 6: the step's residual
+``not_converged``      :class:`NotConverged` — the closed-loop correction failed: stopped
+``settle``             :class:`SettleStep` — a correction step straight at the stage target
+``target_not_reached`` :class:`TargetNotReached` — settling failed: stopped
+=====================  ==================================================================
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from kinestat.errors import (
+    JointLimitError,
+    KinestatError,
+    SingularityError,
+    UnreachableError,
+)
+
+__all__ = [
+    "GuidanceEvent",
+    "Singularity",
+    "JointLimitStop",
+    "LeastSquaresStep",
+    "NotConverged",
+    "SettleStep",
+    "TargetNotReached",
+]
+
+
+@dataclass(frozen=True, eq=False)
+class GuidanceEvent:
+    """Base of all events: ``step`` (global, 1-based) and ``stage`` (1-based or None)."""
+
+    kind: ClassVar[str] = "event"
+    stops: ClassVar[bool] = False
+
+    step: int
+    stage: int | None
+
+    def as_dict(self) -> dict[str, Any]:
+        """The plain record (JSON contract): ``step``, ``stage`` (when set), ``kind``, then the
+        event's own fields; fields that are None are left out."""
+        out: dict[str, Any] = {"step": self.step}
+        if self.stage is not None:
+            out["stage"] = self.stage
+        out["kind"] = self.kind
+        for f in dataclasses.fields(self)[2:]:
+            v = getattr(self, f.name)
+            if v is not None:
+                out[f.name] = v
+        return out
+
+    def __getitem__(self, key: str) -> Any:
+        return self.as_dict()[key]
+
+    def get(self, key: str, default: Any = None) -> Any:
+        return self.as_dict().get(key, default)
+
+    def __contains__(self, key: object) -> bool:
+        return key in self.as_dict()
+
+    def error(self, message: str) -> KinestatError:
+        """The exception this event stands for when it stopped the run."""
+        return KinestatError(message)
+
+
+@dataclass(frozen=True, eq=False)
+class Singularity(GuidanceEvent):
+    """[A] (the Jacobian) is singular at the start of a step: condition number ``cond`` of the
+    dimensionless Jacobian above the limit. ``action``: ``perturbed`` (small joint increments,
+    ``joint_increments``, new configuration ``q``, hand shift), ``damped`` (damped least
+    squares with ``damping``) or ``stopped``."""
+
+    kind: ClassVar[str] = "singular"
+
+    sigma_min: float = 0.0
+    cond: float = 0.0
+    joint_increments: np.ndarray | None = None
+    tries: int | None = None
+    cond_after: float | None = None
+    action: str = "stopped"
+    q: np.ndarray | None = None
+    hand_shift: float | None = None
+    hand_rotation_deg: float | None = None
+    damping: float | None = None
+    method: str | None = None
+
+    def error(self, message: str) -> KinestatError:
+        return SingularityError(message)
+
+
+@dataclass(frozen=True, eq=False)
+class JointLimitStop(GuidanceEvent):
+    """Joint ``joint`` (1-based) would pass its ``limit`` side (``limit_value`` in display
+    units: deg or length) with ``value``: the run stops with the configuration before."""
+
+    kind: ClassVar[str] = "joint_limit"
+    stops: ClassVar[bool] = True
+
+    joint: int = 0
+    limit: str = "upper"
+    limit_value: float = 0.0
+    value: float = 0.0
+    unit: str = "deg"
+    action: str = "stopped"
+
+    def error(self, message: str) -> KinestatError:
+        return JointLimitError(message, joint=self.joint, step=self.step,
+                               limit=self.limit_value, value=self.value)
+
+
+@dataclass(frozen=True, eq=False)
+class LeastSquaresStep(GuidanceEvent):
+    """n ≠ 6: ``J δq = B`` solved in the least-squares sense with a nonzero ``residual``."""
+
+    kind: ClassVar[str] = "least_squares"
+
+    residual: float = 0.0
+
+
+@dataclass(frozen=True, eq=False)
+class NotConverged(GuidanceEvent):
+    """The closed-loop Newton correction did not reach the ideal pose of the step."""
+
+    kind: ClassVar[str] = "not_converged"
+    stops: ClassVar[bool] = True
+
+    position_error: float = 0.0
+    angle_error_deg: float = 0.0
+    iterations: int = 0
+    action: str = "stopped"
+
+    def error(self, message: str) -> KinestatError:
+        return UnreachableError(message)
+
+
+@dataclass(frozen=True, eq=False)
+class SettleStep(GuidanceEvent):
+    """A correction step straight at the stage target (eq. 4-19 with k = 1), taken from a hand
+    that was ``position_error`` / ``angle_error_deg`` away."""
+
+    kind: ClassVar[str] = "settle"
+
+    position_error: float = 0.0
+    angle_error_deg: float = 0.0
+
+
+@dataclass(frozen=True, eq=False)
+class TargetNotReached(GuidanceEvent):
+    """Settling gave up: the stage target is out of reach or beyond a singularity."""
+
+    kind: ClassVar[str] = "target_not_reached"
+    stops: ClassVar[bool] = True
+
+    position_error: float = 0.0
+    angle_error_deg: float = 0.0
+    action: str = "stopped"
+
+    def error(self, message: str) -> KinestatError:
+        return UnreachableError(message)

@@ -1,0 +1,188 @@
+"""Issue 14: ``kinestat disp`` behaves as DISP did — type I re-planned from the actual hand at
+every step (GENM), first-order steps with the deck's counts and no correction rows, the 1977 rule
+only for type III, DISP's all-joint perturbation at singularities."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import kinestat
+from kinestat.cli.main import main
+from kinestat.disp import disp_options, run_deck
+from kinestat.errors import InputError, SingularityError
+from kinestat.io.disp_deck import embedded_deck
+from kinestat.serial.guidance.events import Singularity
+from kinestat.serial.guidance.planners import general_path
+from kinestat.serial.guidance.rules import FirstOrder, GuidanceOptions
+from kinestat.serial.guidance.run import joint_display, run_guidance
+from kinestat.serial.guidance.step import (
+    DEFAULT_COND_LIMIT,
+    characteristic_length,
+    conditioning,
+    perturb_all_joints,
+    scaled_jacobian,
+)
+from kinestat.spatial.displacement import screw_from_poses
+
+TARGET7 = np.array([10.0, -10.0, 20.0])  # Illustration 7's a2
+
+
+def _commanded_twists(model, q_rows):
+    """B of every step, recovered from the rows alone: a first-order step solves J δq = B."""
+    return np.array([kinestat.jacobian(model, q_rows[j]) @ (q_rows[j + 1] - q_rows[j])
+                     for j in range(len(q_rows) - 1)])
+
+
+def test_type_i_replans_from_the_actual_hand_at_every_step():
+    """GENM (MS = 6): at every step the commanded translation of the hand origin points from the
+    actual hand origin to the target origin, with 1/(steps left) of the remaining length, and
+    the rotation is 1/(steps left) of the remaining rotation."""
+    k = 35
+    r = run_deck(embedded_deck("illustration7"), steps=k).result
+    assert len(r.q) == k + 1 and not r.events  # the steps only, no correction row
+    B = _commanded_twists(r.model, r.q)
+    for j in range(k):
+        o = r.poses[j, :3, 3]
+        v_origin = B[j, 3:] + np.cross(B[j, :3], o)  # velocity of the body point at O_H
+        np.testing.assert_allclose(v_origin, (TARGET7 - o) / (k - j), atol=1e-9)
+        sc = screw_from_poses(r.poses[j], r.stage_targets[0])
+        rot_left = 0.0 if bool(sc.is_translation) else float(sc.theta)
+        np.testing.assert_allclose(B[j, :3], rot_left / (k - j) * np.asarray(sc.axis),
+                                   atol=1e-9)
+    # re-planning keeps the first-order error from accumulating: the end is ~0.01 in off
+    dp, da = r.final_pose_error()
+    assert dp < 0.02 and da < 1e-9
+
+
+def test_type_i_without_replanning_drifts_further():
+    """The same 35 steps on the path planned once at the start (ρo updated, u_v, δr, δθ fixed)
+    end ~0.3 in from the target: re-planning is what brings DISP's rows close."""
+    deck = embedded_deck("illustration7")
+    ref = run_deck(deck, steps=35).result
+    fixed = general_path(ref.poses[0], ref.stage_targets[0])
+    fixed = type(fixed)(fixed.start, fixed.u_w, fixed.theta, fixed.u_v, fixed.r)
+    r = run_guidance(ref.model, ref.q[0], [fixed], steps=35, options=disp_options())
+    assert r.final_pose_error()[0] > 0.2 > 10 * ref.final_pose_error()[0]
+    assert np.abs(joint_display(r.model, r.q[-1] - ref.q[-1]))[:2].max() > 0.15
+
+
+def test_disp_default_rows_are_the_steps_and_nothing_else(capsys):
+    """``kinestat disp illustration6 --steps 9,4``: 14 rows, initial first, final last. Each
+    command moves the hand origin d along R and turns it θ about R (eq. 4-21): the prismatic
+    r3 carries the vertical motion and θ4 (axis −z) the turn, in equal steps."""
+    assert main(["disp", "illustration6", "--steps", "9,4", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    t = np.array(out["table"])
+    assert t.shape == (14, 6) and out["steps"] == [9, 4]
+    assert not any(e["kind"] == "settle" for e in out["events"])
+    np.testing.assert_allclose(t[0], [0, 25, 8, 0, 90, 0], atol=1e-12)
+    np.testing.assert_allclose(t[:10, 2], 8 - 4 * np.arange(10) / 9, atol=1e-9)   # d = 4
+    np.testing.assert_allclose(t[9:, 2], 4 - np.arange(5) / 4, atol=1e-9)         # d = -1
+    np.testing.assert_allclose(t[:10, 3], 30 * np.arange(10) / 9, atol=1e-9)      # -30°
+    np.testing.assert_allclose(t[9:, 3], 30 + 15 * np.arange(5) / 4, atol=1e-9)   # 15°
+    np.testing.assert_allclose(t[:, 4:], np.tile([90.0, 0.0], (14, 1)), atol=1e-9)
+    # the first-order residual stays: the hand origin ends near, not on, (15, -25, 17)
+    assert 1e-3 < out["final_pose_error"]["position"] < 0.1
+
+
+def test_disp_illustration7_cli_ends_close_without_a_correction_row(capsys):
+    assert main(["disp", "illustration7", "--steps", "35", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert len(out["table"]) == 36 and out["events"] == []
+    assert out["final_pose_error"]["position"] < 0.02
+    np.testing.assert_allclose(out["table"][-1], [-15, 20, 0, 90, 90, 0], atol=0.02)
+
+
+def test_settle_is_an_option_of_disp_and_the_default_of_guide():
+    deck = embedded_deck("illustration7")
+    settled = run_deck(deck, steps=35, options=disp_options(settle=True)).result
+    assert settled.settle_rows() and settled.final_pose_error()[0] < 1e-8
+    assert GuidanceOptions().settle and not disp_options().settle
+
+
+def test_disp_1977_rule_only_for_type_iii(capsys):
+    with pytest.raises(InputError, match="MS = 4"):
+        run_deck(embedded_deck("illustration7"), options=GuidanceOptions.disp_1977())
+    assert main(["disp", "illustration6", "--disp-1977"]) == 2
+    assert "type III" in capsys.readouterr().err
+
+
+def test_help_texts_say_who_emulates_disp(capsys):
+    for cmd, words in (("disp", "By default this is DISP"), ("guide", "not an emulator")):
+        assert main([cmd, "--help"]) == 0
+        assert words in " ".join(capsys.readouterr().out.split())
+
+
+# -- singularities: DISP's small increments on all joints ----------------------------------
+
+def _wrist_singular():
+    m = kinestat.load("puma762")
+    q = np.radians([90.0, -30.0, 30.0, 0.0, 0.0, 0.0])  # θ5 = 0: axes 4 and 6 line up
+    return m, q, characteristic_length(m, q)
+
+
+def test_perturb_all_moves_every_joint_by_the_same_small_amount():
+    m, q, L = _wrist_singular()
+    _, c0 = conditioning(scaled_jacobian(kinestat.jacobian(m, q), m.prismatic, L))
+    assert c0 > DEFAULT_COND_LIMIT
+    q1, c1, tries = perturb_all_joints(m, q, length=L)
+    d = np.degrees(q1 - q)
+    np.testing.assert_allclose(np.abs(d), tries * 1.0, atol=1e-12)  # all joints, t·1°
+    _, c_check = conditioning(scaled_jacobian(kinestat.jacobian(m, q1), m.prismatic, L))
+    assert c1 == pytest.approx(float(c_check)) and c1 < DEFAULT_COND_LIMIT
+    # towards the farther limit: joint 3 at +30° of ±135° goes down
+    assert d[2] < 0 and np.all(d[[0, 1, 3, 4, 5]] > 0)
+    q2, _, _ = perturb_all_joints(m, q, length=L)
+    np.testing.assert_array_equal(q1, q2)  # deterministic
+
+
+@pytest.mark.parametrize("mode", ["perturb", "perturb_all"])
+def test_illustration4_singular_start_reports_the_new_configuration(mode):
+    r = run_deck(embedded_deck("illustration4"), options=disp_options(singular=mode)).result
+    ev = r.events[0]
+    assert isinstance(ev, Singularity) and ev.action == "perturbed" and ev.method == mode
+    moved = np.count_nonzero(np.abs(ev.joint_increments) > 1e-12)
+    assert moved == (6 if mode == "perturb_all" else 1)
+    np.testing.assert_allclose(ev.q, joint_display(r.model, r.q[0]) + ev.joint_increments,
+                               atol=1e-9)
+    assert ev.cond > DEFAULT_COND_LIMIT > ev.cond_after
+    assert not r.stopped and r.final_pose_error()[0] < 0.2
+
+
+def test_singular_modes_from_the_cli(capsys):
+    assert main(["disp", "illustration4", "--singular", "perturb-all", "--json"]) == 0
+    ev = json.loads(capsys.readouterr().out)["events"][0]
+    assert ev["method"] == "perturb_all" and np.ptp(ev["joint_increments"]) < 1e-9
+    assert main(["disp", "illustration4", "--singular", "stop", "--json"]) == 2
+    out = json.loads(capsys.readouterr().out)
+    assert out["stop_reason"] == "singular" and len(out["table"]) == 1
+    assert main(["disp", "illustration4", "--singular", "sideways"]) == 2
+    assert "--singular" in capsys.readouterr().err
+
+
+def test_stop_event_raises_its_own_error():
+    r = run_deck(embedded_deck("illustration4"), options=disp_options(singular="stop")).result
+    assert r.stop_event is r.events[-1] and r.stop_kind == r.stop_event.kind == "singular"
+    with pytest.raises(SingularityError):
+        r.raise_if_stopped()
+
+
+def test_a_custom_step_rule_plugs_in():
+    calls = []
+
+    class Counting(FirstOrder):
+        def increment(self, path, s0, s1, inp):
+            calls.append((s0, s1))
+            return super().increment(path, s0, s1, inp)
+
+    deck = embedded_deck("illustration7")
+    ref = run_deck(deck, steps=10).result
+    r = run_guidance(ref.model, ref.q[0], [general_path(ref.poses[0], ref.stage_targets[0])],
+                     steps=10, options=disp_options(), rule=Counting())
+    assert len(calls) == 10 and calls[0] == (0.0, 0.1)
+    np.testing.assert_allclose(r.q, ref.q, atol=1e-12)
+    assert math.isclose(calls[-1][1], 1.0)
