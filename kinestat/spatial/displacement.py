@@ -31,7 +31,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError
+from kinestat.spatial.tolerances import ORTHO_TOL as _ORTHO_TOL
 from kinestat.spatial.transforms import as_array, make_pose, skew
+from kinestat.spatial.validate import as_pose, batch_index
 
 __all__ = [
     "ScrewDisplacement",
@@ -47,7 +49,7 @@ __all__ = [
 ]
 
 #: Poses are accepted when their rotation part is orthonormal to this tolerance.
-ORTHO_TOL: float = 1e-6
+ORTHO_TOL: float = _ORTHO_TOL
 #: Rotation angles (rad) at or below this are treated as zero: a pure translation.
 ANGLE_TOL: float = 1e-12
 #: Components of ``u`` within this of zero count as zero for the sign convention.
@@ -58,10 +60,7 @@ def _dot(a, b) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
 
 
-def _where(mask: np.ndarray) -> str:
-    if mask.ndim == 0:
-        return ""
-    return f" at batch index {tuple(int(i) for i in np.argwhere(mask)[0])}"
+_where = batch_index
 
 
 def _frozen(a) -> np.ndarray:
@@ -118,22 +117,7 @@ def frame_from_triple(points, *, tol: float = 1e-9) -> np.ndarray:
 
 
 def _check_pose(T, name: str, tol: float) -> np.ndarray:
-    T = as_array(T, shape_tail=(4, 4), name=name)
-    R = T[..., :3, :3]
-    err = np.max(np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)), axis=(-1, -2))
-    det = np.linalg.det(R)
-    bad = (err > tol) | (np.abs(det - 1.0) > tol)
-    if np.any(bad):
-        raise InputError(
-            f"{name}{_where(bad)} is not a rigid pose: its rotation part has "
-            f"max|R R^T - I| = {err[bad].flat[0]:.3g} and det = {det[bad].flat[0]:.6g}; "
-            f"it must be orthonormal with det +1 (tolerance {tol:g})"
-        )
-    bottom = np.max(np.abs(T[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])), axis=-1)
-    bad = bottom > tol
-    if np.any(bad):
-        raise InputError(f"{name}{_where(bad)}: the last row of a pose must be [0, 0, 0, 1]")
-    return T
+    return as_pose(T, name, tol=tol, last_row_tol=tol)
 
 
 def relative_displacement(T1, T2, *, tol: float = ORTHO_TOL) -> np.ndarray:
