@@ -5,9 +5,10 @@ of the NumPy reference (:mod:`kinestat.serial._reference`): the SE(3) error
 ``[log(R_t Rᵀ)^∨; δp/L]``, the damped least-squares (Levenberg–Marquardt) step on the space
 Jacobian with its velocity rows moved to the end point, projection into the joint limits, the
 stall tests and random restarts, and the final verdict from the forward kinematics of the
-returned configuration. The targets are spread over the cores with ``prange``; each draws its restarts from its own counter-based
-random stream (SplitMix64 keyed by the seed and the target's index), so the result does not
-depend on the number of threads or on how the batch is chunked.
+returned configuration. The targets are spread over the cores with ``prange``; each draws its
+restarts from its own counter-based random stream (SplitMix64 keyed by the seed and the
+target's index), so the result does not depend on the number of threads or on how the batch
+is chunked.
 
 FK and Jacobian come from :mod:`kinestat.serial._kernels` (the same inlined steps). Compiled on
 first use and cached on disk (``cache=True``, in ``__pycache__``).
