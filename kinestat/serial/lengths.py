@@ -37,8 +37,8 @@ def characteristic_length(model: ChainModel, q=None) -> float:
     >>> arm = from_standard_dh([[0.0, 0.0, 3.0, 0.0], [0.0, 0.0, 4.0, 0.0]])
     >>> characteristic_length(arm)
     7.0
-    >>> round(characteristic_length(arm, [0.0, 0.0]), 12)  # distances 7 and 4 to the end
-    5.700877125495
+    >>> round(characteristic_length(arm, [0.0, 0.0]), 9)  # RMS of the distances 7 and 4
+    5.700877125
     """
     if q is None:
         L = float(np.sum(np.linalg.norm(model.constants[:, :3, 3], axis=-1)))

@@ -120,10 +120,10 @@ def forward(q, tool_point_6=(0.0, 0.0, 0.0)) -> ForwardResult:
     ``puma762`` model gives the same pose).
 
     >>> f = forward(np.zeros(6))
-    >>> np.round(f.tool_point, 9) + 0.0  # the wrist stretched along a23 and S4
-    array([ 650., -315.,  600.])
-    >>> f.s6, f.a67
-    (array([0., 1., 0.]), array([1., 0., 0.]))
+    >>> np.round(f.tool_point, 9) + 0.0  # a23 along x, S2 to the side, S4 − S6 up
+    array([ 650., -190.,  475.])
+    >>> f.s6 + 0.0, f.a67 + 0.0
+    (array([ 0.,  0., -1.]), array([1., 0., 0.]))
     """
     q = _check_q(q)
     p6 = _check_vec3(tool_point_6, "tool_point_6")
