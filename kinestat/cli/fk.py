@@ -10,7 +10,6 @@ import typer
 from kinestat.cli._output import console, parse_floats, print_json, table
 from kinestat.errors import InputError
 
-
 #: the model whose end frame is described in the thesis's words (P_tool_F, S6_F, a67_F)
 _PUMA762 = "puma762"
 
