@@ -10,6 +10,14 @@ from __future__ import annotations
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
+from kinestat.serial._lm import (
+    IKResult,
+    _errors,
+    _random_q,
+    damped_step,
+    wrap_joints,
+    wrap_rotating,
+)
 from kinestat.serial._lm_constants import (
     CHECK_EVERY,
     MU_DOWN,
@@ -23,14 +31,6 @@ from kinestat.serial._lm_constants import (
 )
 from kinestat.serial.chunks import chunk_slices
 from kinestat.serial.fk import fk, fk_frames, joint_motion
-from kinestat.serial.ik import (
-    IKResult,
-    _errors,
-    _random_q,
-    damped_step,
-    wrap_joints,
-    wrap_rotating,
-)
 from kinestat.serial.jacobian import jacobian_from_frames
 from kinestat.spatial.se3 import pose_error
 

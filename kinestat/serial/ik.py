@@ -26,9 +26,7 @@ successes.
 
 from __future__ import annotations
 
-import math
 from collections.abc import Iterator
-from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
@@ -37,10 +35,10 @@ from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import _ik_kernels as _K
 from kinestat.serial._kernel_cache import KernelData, kernel_data
+from kinestat.serial._lm import IKResult, damped_step, wrap_joints, wrap_rotating
 from kinestat.serial._lm_constants import TARGET_LAST_ROW_TOL, TARGET_ORTHO_TOL
+from kinestat.serial._reference import ik_reference
 from kinestat.serial.chunks import CHUNK_ROWS, chunk_slices
-from kinestat.serial.fk import fk_frames
-from kinestat.serial.jacobian import jacobian_from_frames
 from kinestat.serial.lengths import characteristic_length
 from kinestat.spatial.se3 import pose_error, so3_log
 from kinestat.spatial.validate import as_pose
@@ -77,56 +75,6 @@ def model_scale(model: ChainModel) -> float:
     return characteristic_length(model)
 
 
-def wrap_joints(model: ChainModel, q, reference=None) -> np.ndarray:
-    """Shift rotating joints by whole turns: into their limits when possible (nearest
-    ``reference``, default 0), else to [-π, π) about the reference. Prismatic joints are only
-    clipped to their limits; rotating joints that cannot be shifted into their limits are
-    clipped too."""
-    q = np.asarray(q, dtype=float)
-    rot = ~model.prismatic
-    lo, hi = model.lower, model.upper
-    ref = np.zeros_like(q) if reference is None else np.broadcast_to(reference, q.shape)
-    base = ref + (q - ref + math.pi) % (2 * math.pi) - math.pi
-    # the whole-turn shift nearest the reference that lies in [lo, hi]
-    ks = np.arange(-3, 4) * (2 * math.pi)
-    cand = base[..., None] + ks
-    inside = (cand >= lo[:, None]) & (cand <= hi[:, None])
-    dist = np.where(inside, np.abs(cand - ref[..., None]), np.inf)
-    idx = np.argmin(dist, axis=-1)
-    best = np.take_along_axis(cand, idx[..., None], axis=-1)[..., 0]
-    has = np.isfinite(np.take_along_axis(dist, idx[..., None], axis=-1)[..., 0])
-    out = np.where(rot, np.where(has, best, base), q)
-    return np.clip(out, lo, hi)
-
-
-def wrap_rotating(model: ChainModel, q) -> np.ndarray:
-    """Rotating joints wrapped to [-π, π); prismatic joints untouched (limits ignored)."""
-    q = np.asarray(q, dtype=float)
-    return np.where(model.prismatic, q, (q + math.pi) % (2 * math.pi) - math.pi)
-
-
-@dataclass(frozen=True, eq=False)
-class IKResult:
-    """Result of :func:`ik`, batched like the poses ``B``.
-
-    Attributes:
-        q: ``(*B, n)`` joint values (radians / length): the solution where ``success``, the best
-            configuration found otherwise.
-        success: ``(*B,)`` the pose is reproduced within the tolerances and q is within limits.
-        position_error: ``(*B,)`` distance between the reached and target positions (length).
-        rotation_error: ``(*B,)`` angle between the reached and target orientations (radians).
-        iterations: ``(*B,)`` total iterations spent (over all attempts).
-        attempts: ``(*B,)`` starts used (1 = converged from the given start).
-    """
-
-    q: np.ndarray
-    success: np.ndarray
-    position_error: np.ndarray
-    rotation_error: np.ndarray
-    iterations: np.ndarray
-    attempts: np.ndarray
-
-
 def _check_poses(poses) -> np.ndarray:
     """Target poses ``(..., 4, 4)`` checked (:func:`kinestat.spatial.validate.as_pose`) and
     projected onto the nearest rotation (polar decomposition): rounded input (e.g. typed with 6
@@ -138,48 +86,6 @@ def _check_poses(poses) -> np.ndarray:
         U, _, Vt = np.linalg.svd(R)
         T[..., :3, :3] = U @ Vt
     return T
-
-
-def _random_q(model: ChainModel, rng: np.random.Generator, k: int, scale: float) -> np.ndarray:
-    lo, hi = model.lower, model.upper
-    rot = ~model.prismatic
-    lo_f = np.where(np.isfinite(lo), lo, np.where(rot, -math.pi, -scale))
-    hi_f = np.where(np.isfinite(hi), hi, np.where(rot, math.pi, scale))
-    # a revolute joint spanning more than a turn: one turn is enough
-    span = np.where(rot, np.minimum(hi_f - lo_f, 2 * math.pi), hi_f - lo_f)
-    return lo_f + rng.random((k, model.n)) * span
-
-
-def _errors(model: ChainModel, q: np.ndarray, Tt: np.ndarray, L: float):
-    """Link frames, scaled error vectors ``[ω; δp/L]`` (k, 6) and squared cost (k,)."""
-    F = fk_frames(model, q)
-    T = F[..., -1, :, :]
-    w = so3_log(Tt[..., :3, :3] @ np.swapaxes(T[..., :3, :3], -1, -2))
-    dp = Tt[..., :3, 3] - T[..., :3, 3]
-    e = np.concatenate([w, dp / L], axis=-1)
-    return F, e, np.sum(e * e, axis=-1)
-
-
-def damped_step(model: ChainModel, frames: np.ndarray, e: np.ndarray, mu: np.ndarray,
-                L: float) -> np.ndarray:
-    """One Levenberg–Marquardt step ``δq (k, n)`` for the scaled errors ``e = [ω; δp/L]``.
-
-    ``(JᵀJ + μ s I) δx = Jᵀ e`` with ``J = [J_ω; (J_v − p × J_ω)/L] · D`` (the space Jacobian's
-    velocity rows moved to the end point p, lengths over L, prismatic columns scaled by
-    ``D = L``), ``s = trace(JᵀJ)/n``, and ``δq = D δx``.
-    """
-    n = model.n
-    D = np.where(model.prismatic, L, 1.0)
-    J = jacobian_from_frames(model, frames)
-    p = frames[..., -1, :3, 3]
-    Jw = J[..., :3, :]
-    Jv = J[..., 3:, :] - np.cross(p[..., None, :], np.swapaxes(Jw, -1, -2)).swapaxes(-1, -2)
-    Js = np.concatenate([Jw, Jv / L], axis=-2) * D
-    JtJ = np.swapaxes(Js, -1, -2) @ Js
-    g = np.einsum("...ji,...j->...i", Js, e)
-    s = np.maximum(np.trace(JtJ, axis1=-2, axis2=-1) / n, 1e-12)
-    A = JtJ + (mu * s)[..., None, None] * np.eye(n)
-    return np.linalg.solve(A, g[..., None])[..., 0] * D
 
 
 Backend = Literal["numba", "numpy"]
@@ -299,8 +205,6 @@ def ik(
             f"q0 of shape {q0.shape} does not match {int(np.prod(shape))} poses of shape {shape}"
         ) from exc
     if backend == "numpy":
-        from kinestat.serial._reference import ik_reference  # lazy: test-only path; avoids a cycle
-
         return ik_reference(model, Tt, qs, shape, L, pos_tol, rot_tol, max_iter, restarts, seed,
                             respect_limits)
     Q0 = np.ascontiguousarray(q0[None] if q0.ndim == 1 else qs.reshape(-1, n))
