@@ -102,6 +102,7 @@ def ik_command(
 def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_axis_deg,
                  limits, normalize, as_json) -> None:
     from kinestat.serial import puma762 as P  # lazy: numba kernels; keeps `kinestat --help` fast
+    from kinestat.spatial.validate import as_unit_vector  # lazy: kinestat.spatial loads scipy
 
     if model != "puma762":
         raise InputError(
@@ -120,11 +121,8 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
     x = parse_floats(a67, 3, "a67")
     p6 = parse_floats(tool_point_6, 3, "tool-point-6")
     if normalize:
-        for name, v in (("s6", z), ("a67", x)):
-            if np.linalg.norm(v) == 0.0:
-                raise InputError(f"--{name}: a zero vector has no direction")
-        z = z / np.linalg.norm(z)
-        x = x / np.linalg.norm(x)
+        z = as_unit_vector(z, "--s6", normalize=True)
+        x = as_unit_vector(x, "--a67", normalize=True)
     if current_deg is not None and current_axis_deg is not None:
         raise InputError("give the current configuration once: --current-deg or "
                          "--current-axis-deg")

@@ -33,7 +33,7 @@ from scipy.spatial.transform import Rotation
 from kinestat.errors import InputError
 from kinestat.spatial.tolerances import ORTHO_TOL as _ORTHO_TOL
 from kinestat.spatial.transforms import as_array, make_pose, skew
-from kinestat.spatial.validate import as_pose, batch_index
+from kinestat.spatial.validate import as_pose, as_unit_vector, batch_index
 
 __all__ = [
     "ScrewDisplacement",
@@ -271,15 +271,10 @@ def pose_from_screw(axis, point, theta, d) -> np.ndarray:
     ``T2 = D @ T1``. ``Q = I + sin(theta) [u]x + 2 sin^2(theta/2) [u]x^2`` (Rodrigues) and
     ``q = (I - Q) point + d u``, the latter as ``2 sin^2(theta/2) c - sin(theta) u x c`` with
     ``c`` the part of ``point`` normal to ``u`` (accurate even for far-away axes)."""
-    u = as_array(axis, shape_tail=(3,), name="axis")
+    u = as_unit_vector(axis, "axis", normalize=True)
     c = as_array(point, shape_tail=(3,), name="point")
     theta = as_array(theta, name="theta")
     d = as_array(d, name="d")
-    nu = np.linalg.norm(u, axis=-1)
-    bad = nu == 0.0
-    if np.any(bad):
-        raise InputError(f"axis is the zero vector{_where(bad)}: give a nonzero axis direction")
-    u = u / nu[..., None]
     s, h2 = np.sin(theta), 2.0 * np.sin(0.5 * theta) ** 2
     K = skew(u)
     Q = np.eye(3) + s[..., None, None] * K + h2[..., None, None] * (K @ K)

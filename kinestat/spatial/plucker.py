@@ -14,6 +14,7 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.spatial.transforms import as_array
+from kinestat.spatial.validate import as_unit_vector
 
 __all__ = [
     "LINE_KINDS",
@@ -75,12 +76,7 @@ def line_from_points(p1, p2) -> np.ndarray:
 def line_from_point_direction(p, s) -> np.ndarray:
     """Line through point ``p`` with direction ``s`` (any nonzero length): ``[S; p x S]``."""
     p = as_array(p, shape_tail=(3,), name="point")
-    s = as_array(s, shape_tail=(3,), name="direction")
-    n = np.linalg.norm(s, axis=-1)
-    bad = n == 0.0
-    if np.any(bad):
-        raise InputError(f"direction is the zero vector{_where(bad)}: give a nonzero direction")
-    S = s / n[..., None]
+    S = as_unit_vector(s, "direction", normalize=True)
     return np.concatenate(np.broadcast_arrays(S, np.cross(p, S)), axis=-1)
 
 

@@ -99,19 +99,23 @@ def as_unit_vector(u, name: str = "direction", *, tol: float = UNIT_TOL,
                    normalize: bool = False, single: bool = False,
                    error: type[Exception] = InputError) -> np.ndarray:
     """Unit vectors ``(..., 3)``: ``||u| − 1| <= tol`` is required; with ``normalize`` any
-    non-zero length is accepted (more than ``tol``) and the vector is scaled to unit length.
+    nonzero vector is accepted and scaled to unit length (``u / |u|``).
 
     >>> as_unit_vector([0.0, 0.0, 1.0], "z_base_tool")
     array([0., 0., 1.])
     >>> as_unit_vector([0.0, 3.0, 4.0], "s", normalize=True)
     array([0. , 0.6, 0.8])
+    >>> as_unit_vector([0.0, 0.0, 0.0], "s", normalize=True)
+    Traceback (most recent call last):
+    ...
+    kinestat.errors.InputError: s is the zero vector: give a nonzero direction
     """
     a = as_vector3(u, name, single=single, error=error)
     norm = np.linalg.norm(a, axis=-1)
     if normalize:
-        bad = norm <= tol
+        bad = norm == 0.0
         if np.any(bad):
-            raise error(f"{name}{batch_index(bad)} has zero length; it must be a direction")
+            raise error(f"{name} is the zero vector{batch_index(bad)}: give a nonzero direction")
         return a / norm[..., None]
     bad = np.abs(norm - 1.0) > tol
     if np.any(bad):
