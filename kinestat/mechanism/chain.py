@@ -74,6 +74,10 @@ class ChainModel:
         q_home: a reference configuration (the initial one for Nadkarni decks).
         extra: notation-specific data kept for write-back (e.g. Nadkarni's frame points and
             seventh joint), as a tuple of ``(key, value)`` pairs.
+
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]], name='rr')
+    >>> arm, arm.n, arm.constants.shape
+    (ChainModel('rr', RR, notation='standard_dh', unit='mm'), 2, (3, 4, 4))
     """
 
     name: str
@@ -240,6 +244,10 @@ def from_standard_dh(
     Tz(di + qi) · …`` for a prismatic one and ``Rz(θi + qi) · Tz(di + h qi) · …`` for a screw
     (lecture notes' H_i^{i-1}; Nadkarni eq. 2-7). Rz and Tz commute, so each link is
     ``Z(qi) · Ci`` with ``Ci = Rz(θi) Tz(di) Tx(ai) Rx(αi)``.
+
+    >>> arm = from_standard_dh([[0.0, 0.5, 1.0, np.pi / 2]], ['prismatic'])
+    >>> arm.joints[0].kind, arm.constants[1][:3, 3]
+    ('prismatic', array([1. , 0. , 0.5]))
     """
     P, joints, base, tool = _prepare(rows, "standard DH table", kinds, pitches, limits, names,
                                      base, tool)
@@ -274,6 +282,10 @@ def from_modified_dh(
 
     Link j is ``Rx(α_ij) · Tx(a_ij) · Rz(θj + qj) · Tz(Sj)`` (Craig; Crane & Duffy, Vibhute
     eq. 2-26), i.e. ``Pj · Z(qj)`` with ``Pj = Rx(α) Tx(a) Rz(θ) Tz(d)``.
+
+    >>> arm = from_modified_dh([[0.0, 1.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
+    >>> arm.constants[0][:3, 3], arm.constants[1][:3, 3]
+    (array([1., 0., 0.]), array([1., 0., 0.]))
     """
     P, joints, base, tool = _prepare(rows, "modified DH table", kinds, pitches, limits, names,
                                      base, tool)
@@ -295,6 +307,9 @@ def frame_from_three_points(p1, p2, p3, *, what: str = "frame points") -> np.nda
 
     :func:`kinestat.spatial.displacement.frame_from_points`, with ``what`` naming the points in
     error messages (e.g. "SET FIVE frame points").
+
+    >>> frame_from_three_points([1.0, 0.0, 0.0], [1.0, 0.0, 1.0], [2.0, 0.0, 0.0])[:3, 3]
+    array([1., 0., 0.])
     """
     try:
         return frame_from_points(p1, p2, p3)
@@ -327,6 +342,11 @@ def from_nadkarni(
     Nadkarni's transformation x(i-1) ← x(i) is ``Rz(θi) Tz(ri) Tx(ai) Rx(αi)`` (eqs. 2-5, 2-7),
     standard DH with d = r, and x*(i) = x(i-1) · Rz(θi) Tz(ri). The base x(0) follows from the
     initial x*(1) = x*(0) given by the three points (eqs. 2-13 to 2-15).
+
+    >>> rows = [[0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0, 0.0]]
+    >>> m = from_nadkarni(rows, [[0, 0, 0], [0, 0, 1], [1, 0, 0]], n_active=None)
+    >>> m.notation, m.n, m.q_home
+    ('nadkarni', 2, array([0., 0.]))
     """
     R = _numbers(joints_rows, "Nadkarni joint rows")
     if R.ndim != 2 or R.shape[1] != 5 or R.shape[0] == 0:

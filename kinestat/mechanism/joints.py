@@ -56,7 +56,11 @@ PRISMATIC_PITCH_THRESHOLD = 1e5
 
 
 def kind_from_pitch(pitch: float) -> str:
-    """Joint kind from a DISP pitch: > 1e5 prismatic, 0 revolute, otherwise screw."""
+    """Joint kind from a DISP pitch: > 1e5 prismatic, 0 revolute, otherwise screw.
+
+    >>> kind_from_pitch(0.0), kind_from_pitch(0.2), kind_from_pitch(1e6)
+    ('revolute', 'screw', 'prismatic')
+    """
     if not math.isfinite(pitch):
         raise ModelError(f"joint pitch must be finite, got {pitch!r}")
     if pitch > PRISMATIC_PITCH_THRESHOLD:
@@ -72,6 +76,9 @@ class Joint:
 
     ``lower``/``upper`` are limits on the joint value q (radians for revolute and screw joints,
     length for prismatic ones); infinite when the joint is unlimited.
+
+    >>> Joint('screw', pitch=0.5, name='lead').rotates, Joint('prismatic', pitch=3.0).pitch
+    (True, 0.0)
     """
 
     kind: JointKindName = "revolute"

@@ -241,6 +241,14 @@ def iter_ik(model: ChainModel, poses, q0=None, *, chunk_rows: int = CHUNK_ROWS,
     ``q0`` is ``(n,)`` or ``(N, n)``; ``options`` are :func:`ik`'s keywords. With the compiled
     backend each target keeps its own random stream, so the chunks give exactly the answers of
     one call on the whole batch.
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> from kinestat.serial.fk import fk
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+    >>> T = fk(arm, np.array([[0.3, 0.4], [0.5, 0.6], [0.7, 0.8]]))
+    >>> parts = iter_ik(arm, T, [0.4, 0.5], chunk_rows=2)
+    >>> [(rows.start, bool(r.success.all())) for rows, r in parts]
+    [(0, True), (2, True)]
     """
     if chunk_rows < 1:
         raise InputError(f"chunk_rows must be at least 1, got {chunk_rows}")

@@ -22,7 +22,15 @@ __all__ = ["jacobian", "jacobian_from_frames", "fk_and_jacobian"]
 
 def jacobian_from_frames(model: ChainModel, frames: np.ndarray) -> np.ndarray:
     """Jacobian ``(..., 6, n)`` from the link frames returned by
-    :func:`~kinestat.serial.fk.fk_frames` (the NumPy form of :func:`jacobian`)."""
+    :func:`~kinestat.serial.fk.fk_frames` (the NumPy form of :func:`jacobian`).
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> from kinestat.serial.fk import fk_frames
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+    >>> J = jacobian_from_frames(arm, fk_frames(arm, [0.3, 0.4]))
+    >>> bool(np.allclose(J, jacobian(arm, [0.3, 0.4])))
+    True
+    """
     F = frames[..., :-1, :, :]
     u = F[..., :3, 2]
     rho = F[..., :3, 3]
@@ -65,7 +73,14 @@ def jacobian(model: ChainModel, q) -> np.ndarray:
 
 
 def fk_and_jacobian(model: ChainModel, q) -> tuple[np.ndarray, np.ndarray]:
-    """End poses ``(..., 4, 4)`` and Jacobians ``(..., 6, n)`` in one pass."""
+    """End poses ``(..., 4, 4)`` and Jacobians ``(..., 6, n)`` in one pass.
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+    >>> T, J = fk_and_jacobian(arm, np.zeros((3, 2)))
+    >>> T.shape, J.shape
+    ((3, 4, 4), (3, 6, 2))
+    """
     q = _as_q(model, q)
     d = kernel_data(model)
     lead = q.shape[:-1]

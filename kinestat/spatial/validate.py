@@ -20,7 +20,11 @@ _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 
 def batch_index(mask: np.ndarray) -> str:
-    """``" at batch index (i, j)"`` for the first True entry of ``mask`` ("" for a scalar)."""
+    """``" at batch index (i, j)"`` for the first True entry of ``mask`` ("" for a scalar).
+
+    >>> batch_index(np.array([False, True])), batch_index(np.array(True))
+    (' at batch index (1,)', '')
+    """
     if mask.ndim == 0:
         return ""
     return f" at batch index {tuple(int(i) for i in np.argwhere(mask)[0])}"

@@ -21,6 +21,12 @@ def link_transform(cos_alpha, sin_alpha, a, theta, s) -> np.ndarray:
     """``iT_j = Rx(α_ij) Tx(a_ij) Rz(θ_j) Tz(S_j)``, batched over ``theta`` (Vibhute eq. 2-26).
 
     Takes cos α and sin α (so that 270° is exact) and θ in radians.
+
+    >>> link_transform(0.0, 1.0, 0.0, 0.0, 190.0) + 0.0  # link 1-2: α12 = 90°, S2 = 190
+    array([[   1.,    0.,    0.,    0.],
+           [   0.,    0.,   -1., -190.],
+           [   0.,    1.,    0.,    0.],
+           [   0.,    0.,    0.,    1.]])
     """
     th = np.asarray(theta, dtype=float)
     c, s_ = np.cos(th), np.sin(th)
@@ -49,6 +55,10 @@ class ForwardResult:
         s6: ``S6_F`` ``(..., 3)``, the sixth joint axis (z of frame 6).
         a67: ``a67_F`` ``(..., 3)``, the link direction a67 (x of frame 6).
         pose: ``F_6T`` ``(..., 4, 4)``, frame 6 in the fixed frame (eq. 2-33).
+
+    >>> f = forward(np.zeros((4, 6)))
+    >>> f.tool_point.shape, f.pose.shape
+    ((4, 3), (4, 4, 4))
     """
 
     tool_point: np.ndarray
@@ -162,6 +172,10 @@ def frame6(tool_point, s6, a67, tool_point_6=(0.0, 0.0, 0.0), *, tol: float = 1e
     ``S6_F`` and ``a67_F`` must be unit vectors and perpendicular to within ``tol``; they are
     then re-orthonormalised (Gram–Schmidt) so that the frame is exactly a rotation. The origin is
     ``P_tool_F − R · P_tool_6``. The inputs broadcast against each other.
+
+    >>> T_F_6 = frame6([650.0, -190.0, 475.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0])
+    >>> bool(np.allclose(T_F_6, forward(np.zeros(6)).pose))
+    True
     """
     p = _check_vec3(tool_point, "tool_point (P_tool_F)")
     z = _check_vec3(s6, "s6 (S6_F)")

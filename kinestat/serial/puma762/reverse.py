@@ -70,6 +70,10 @@ class ClosedLoop:
         theta7: joint angle θ7 (from a67 to a71 about S7).
         gamma1: angle from a71 to the fixed x axis about S1 (eqs. 2-39, 2-40), so φ1 = θ1 − γ1.
         S7, a71_len, S1: the offsets S7, the link length a71 and the offset S1 (eqs. 2-41..2-43).
+
+    >>> c = close_loop([650.0, -190.0, 475.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0])
+    >>> c.s7 + 0.0, round(float(np.degrees(c.alpha71)), 9)
+    (array([0., 1., 0.]), 90.0)
     """
 
     s7: np.ndarray
@@ -92,6 +96,10 @@ def close_loop(tool_point, s6, a67, tool_point_6=(0.0, 0.0, 0.0), *,
     (2-41..2-43, P6 the origin of frame 6) — signs restored, see docs/seed-errata.md.
     When S7 is parallel to S1 (s71 = 0) the common normal is not unique: a71 is taken along the
     perpendicular from S7 to S1 (or along a67 if the lines coincide) and S7 = 0.
+
+    >>> c = close_loop([650.0, -190.0, 475.0], [0.0, 0.0, -1.0], [1.0, 0.0, 0.0])
+    >>> c.a71 + 0.0
+    array([1., 0., 0.])
     """
     T = frame6(tool_point, s6, a67, tool_point_6, tol=tol)
     x6, z6, p6 = T[..., :3, 0], T[..., :3, 2], T[..., :3, 3]
@@ -145,6 +153,11 @@ class ReverseBatch:
         position_error, rotation_error: ``(*B, 8)`` forward-analysis residuals of each branch
             (tool point distance in mm; rotation angle in radians); NaN when not verified.
         verified: whether the residuals were computed (``verify=True``).
+
+    >>> from kinestat.serial.puma762.forward import forward
+    >>> b = reverse_batch_pose(forward(np.full((2, 6), 0.3)).pose)
+    >>> b.q.shape, b.valid.shape, b.status.tolist()
+    ((2, 8, 6), (2, 8), [0, 0])
     """
 
     q: np.ndarray
@@ -160,7 +173,11 @@ class ReverseBatch:
 
 def status_message(status: int, *, wrist_radius: float | None = None,
                    reach: float | None = None) -> str:
-    """Explain a :class:`ReverseBatch` status code (which step has no real solution)."""
+    """Explain a :class:`ReverseBatch` status code (which step has no real solution).
+
+    >>> status_message(STATUS_INSIDE_CYLINDER)[:32]
+    'φ1 has no real solution: the wri'
+    """
     if status == STATUS_INSIDE_CYLINDER:
         extra = ("" if wrist_radius is None
                  else f" (its distance from S1 is {wrist_radius:.6g} mm)")
@@ -238,6 +255,13 @@ def reverse_batch_pose(pose6, *, verify: bool = True, tol: float = 1e-9,
     compiled path needs nothing beyond its outputs (about 0.5 kB per pose); the NumPy reference
     works in chunks of :data:`CHUNK_ROWS` poses. :func:`iter_reverse_batch_pose` streams the
     results of very large batches chunk by chunk.
+
+    >>> from kinestat.serial.puma762.forward import forward
+    >>> q = np.array([[0.1, 0.2, 0.3, 0.4, 0.5, 0.6]])
+    >>> b = reverse_batch_pose(forward(q).pose)
+    >>> found = np.all(np.abs(b.q[0] - q) < 1e-9, axis=-1)  # the branch that is q
+    >>> bool(found.any()), float(b.position_error.max()) < 1e-9
+    (True, True)
     """
     _check_backend(backend)
     T = np.asarray(pose6, dtype=float)
@@ -280,7 +304,13 @@ def iter_reverse_batch_pose(pose6, *, chunk_rows: int = CHUNK_ROWS, verify: bool
                             tol: float = 1e-9, s5_tol: float = 1e-10,
                             backend: Backend = "numba") -> Iterator[tuple[slice, ReverseBatch]]:
     """Stream :func:`reverse_batch_pose` over a large batch ``(N, 4, 4)`` chunk by chunk:
-    yields ``(rows, batch)`` so that 10^7 poses need only one chunk of results at a time."""
+    yields ``(rows, batch)`` so that 10^7 poses need only one chunk of results at a time.
+
+    >>> from kinestat.serial.puma762.forward import forward
+    >>> T = forward(np.full((5, 6), 0.3)).pose
+    >>> [(rows.start, b.q.shape) for rows, b in iter_reverse_batch_pose(T, chunk_rows=2)]
+    [(0, (2, 8, 6)), (2, (2, 8, 6)), (4, (1, 8, 6))]
+    """
     T = np.asarray(pose6, dtype=float)
     if T.ndim < 2 or T.shape[-2:] != (4, 4):
         raise InputError(f"poses must have shape (..., 4, 4), got {T.shape}")
@@ -298,6 +328,11 @@ class WristFamily:
 
     ``kind`` is ``"difference"`` (θ5 = 0: θ6 − θ4 = ``value``) or ``"sum"`` (θ5 = 180°:
     θ4 + θ6 = ``value``); φ1, θ2, θ3, θ5 are fixed. ``representative`` is one member.
+
+    >>> from kinestat.serial.puma762.forward import forward
+    >>> fam = reverse_pose(forward(np.zeros(6)).pose).families[0]
+    >>> fam.kind, bool(np.allclose(forward(fam.member(0.7)).pose, forward(np.zeros(6)).pose))
+    ('difference', True)
     """
 
     phi1: float
@@ -325,6 +360,11 @@ class ReverseResult:
         families: the distinct wrist-singular one-parameter families.
         reason: None when every branch exists; otherwise why some are missing.
         batch: the underlying :class:`ReverseBatch` (batch shape ``()``).
+
+    >>> from kinestat.serial.puma762.forward import forward
+    >>> r = reverse_pose(forward(np.full(6, 0.3)).pose)
+    >>> r.solutions.shape, r.branches.tolist(), r.families, r.reason
+    ((8, 6), [0, 1, 2, 3, 4, 5, 6, 7], (), None)
     """
 
     solutions: np.ndarray

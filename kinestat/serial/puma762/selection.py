@@ -33,6 +33,9 @@ def from_axis_angles(a) -> np.ndarray:
 
     Joint 1's axis range (320°) is less than a turn, so wrapping φ1 loses nothing;
     ``from_axis_angles(to_axis_angles(q)) == q`` for φ1 in [-π, π).
+
+    >>> np.degrees(from_axis_angles(np.radians([180.0, 10.0, 20.0, 30.0, 40.0, 50.0])))
+    array([ 0., 10., 20., 30., 40., 50.])
     """
     q = np.asarray(a, dtype=float) - AXIS_OFFSET
     return np.concatenate([_wrap(q[..., :1]), q[..., 1:]], axis=-1)
@@ -52,6 +55,10 @@ def wrap_into_limits(angles, current, lower, upper) -> tuple[np.ndarray, np.ndar
     All arrays broadcast; the last axis is the joint. Returns ``(wrapped, ok)`` where ``ok`` is
     False for a joint whose every shift is outside its limits (``wrapped`` is then the shift
     nearest ``current``).
+
+    >>> a, ok = wrap_into_limits([3.0], [-3.0], [-4.0], [4.0])
+    >>> np.round(a, 6), ok  # 3 rad is nearer to -3 as 3 - 2π
+    (array([-3.283185]), array([ True]))
     """
     a = np.asarray(angles, dtype=float)
     c = np.asarray(current, dtype=float)
@@ -70,7 +77,12 @@ def wrap_into_limits(angles, current, lower, upper) -> tuple[np.ndarray, np.ndar
 
 
 def within_limits(q, limits_deg=None) -> np.ndarray:
-    """True where some 2π-shift of every axis angle of ``q (..., 6)`` lies inside the limits."""
+    """True where some 2π-shift of every axis angle of ``q (..., 6)`` lies inside the limits.
+
+    >>> home = from_axis_angles(np.zeros(6))  # every axis at 0: φ1 = −180°
+    >>> bool(within_limits(home)), bool(within_limits(home + np.radians([0, 0, 0, 0, 120, 0])))
+    (True, False)
+    """
     q = _check_q(q)
     lo, hi = _limits_rad(limits_deg)
     _, ok = wrap_into_limits(to_axis_angles(q), np.zeros(6), lo, hi)
@@ -91,6 +103,13 @@ class Selection:
         motion: ``(*B,)`` total axis motion Σ|Δaxis| (radians) from the current configuration.
         candidates_axis: ``(*B, 8, 6)`` every branch wrapped the same way (NaN if invalid).
         candidates_ok: ``(*B, 8)`` which branches are within the limits.
+
+    >>> from kinestat.serial.puma762.forward import forward
+    >>> from kinestat.serial.puma762.reverse import reverse_batch_pose
+    >>> q = np.radians([[-150.0, 10.0, 20.0, 30.0, 40.0, 50.0]])
+    >>> sel = select_batch(reverse_batch_pose(forward(q).pose), current_q=q)
+    >>> bool(sel.ok[0]), bool(np.allclose(sel.q, q)), float(sel.motion[0]) < 1e-9
+    (True, True, True)
     """
 
     q: np.ndarray
@@ -116,6 +135,13 @@ def select_batch(batch: ReverseBatch, current_q=None, limits_deg=None, *,
     controller reports it, as axis angles ``current_axis`` (``(*B, 6)`` or ``(6,)``, radians);
     neither means all axis angles zero (the thesis's choice). Joint angles do not say which
     turn axis 1 is on: its axis angle is taken inside the limits when possible.
+
+    >>> from kinestat.serial.puma762.forward import forward
+    >>> from kinestat.serial.puma762.reverse import reverse_batch_pose
+    >>> q = np.radians([[-150.0, 10.0, 20.0, 30.0, 40.0, 50.0]])
+    >>> sel = select_batch(reverse_batch_pose(forward(q).pose), current_q=q)
+    >>> np.round(np.degrees(sel.q), 6)
+    array([[-150.,   10.,   20.,   30.,   40.,   50.]])
     """
     lo, hi = _limits_rad(limits_deg)
     shape = batch.valid.shape[:-1]
@@ -164,7 +190,15 @@ def select_batch(batch: ReverseBatch, current_q=None, limits_deg=None, *,
 def select(result: ReverseResult, current_q=None, limits_deg=None, *,
            current_axis=None) -> Selection:
     """:func:`select_batch` for one :class:`ReverseResult`; raises :class:`JointLimitError`
-    when no solution (or family member) lies within the axis limits."""
+    when no solution (or family member) lies within the axis limits.
+
+    >>> from kinestat.serial.puma762.forward import forward
+    >>> from kinestat.serial.puma762.reverse import reverse_pose
+    >>> q = np.radians([-150.0, 10.0, 20.0, 30.0, 40.0, 50.0])
+    >>> sel = select(reverse_pose(forward(q).pose), current_q=q)
+    >>> np.round(np.degrees(sel.q), 6)
+    array([-150.,   10.,   20.,   30.,   40.,   50.])
+    """
     sel = select_batch(result.batch, current_q, limits_deg, current_axis=current_axis)
     if not bool(sel.ok):
         lo, hi = _limits_rad(limits_deg)
