@@ -194,6 +194,11 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
     if as_json:
         print_json(out)
         return
+    _print_closed_form(out, res, current is not None)
+
+
+def _print_closed_form(out: dict, res, has_current: bool) -> None:
+    """The tables of the PUMA 762 closed form (without --json)."""
     console.print(f"[bold]PUMA 762 reverse analysis[/]: {len(res.solutions)} isolated "
                   f"solution(s), {len(res.families)} wrist-singular family(ies)")
     cols = ["branch", "φ1", "θ2", "θ3", "θ4", "θ5", "θ6", "limits ok"]
@@ -209,7 +214,7 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
         )
     if res.reason:
         console.print(f"[yellow]note:[/] {res.reason}")
-    if current is not None:
+    if has_current:
         sel = out["selected"]
         if sel is None:
             console.print("[red]no solution lies within the axis limits[/]")

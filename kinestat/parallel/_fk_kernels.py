@@ -1,4 +1,7 @@
-"""Compiled (Numba) fast path of the special 6-6 all-mode forward kinematics.
+"""Compiled (Numba) kernels of the special 6-6 all-mode forward kinematics.
+
+(Over 600 lines on purpose: the three stages share many small ``inline="always"`` helpers, and
+Numba's on-disk cache is keyed per source file — splitting them would make stale caches likely.)
 
 The computation of :func:`kinestat.parallel.fk.fk_all` (its NumPy reference is
 ``fk._fk_all_reference``), in three stages
