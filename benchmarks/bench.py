@@ -34,6 +34,9 @@ warnings.filterwarnings("ignore")
 
 import kinestat  # noqa: E402
 from kinestat.io.urdf import to_urdf  # noqa: E402
+from kinestat.serial import puma762 as P  # noqa: E402
+from kinestat.serial.ik import ik  # noqa: E402
+from kinestat.spatial.se3 import pose_error  # noqa: E402
 
 RNG = np.random.default_rng(7)
 TASKS = ("fk", "jacobian", "puma_ik", "numik", "platform")
@@ -67,7 +70,7 @@ class Bench:
     # -- peers -------------------------------------------------------------------------------
     def _load_peers(self) -> None:
         try:
-            import roboticstoolbox as rtb
+            import roboticstoolbox as rtb  # lazy: optional peer
 
             dh = rtb.models.DH.Puma560()
             self.peers["rtb_dh"] = dh
@@ -75,15 +78,15 @@ class Bench:
         except Exception as exc:  # pragma: no cover - peer missing
             self.peers["rtb_error"] = str(exc)
         try:
-            import pinocchio as pin
+            import pinocchio as pin  # lazy: optional peer
 
             pm = pin.buildModelFromXML(self.urdf)
             self.peers["pin"] = (pin, pm, pm.createData(), pm.getFrameId("tool"))
         except Exception as exc:  # pragma: no cover
             self.peers["pin_error"] = str(exc)
         try:
-            import pytorch_kinematics as pk
-            import torch
+            import pytorch_kinematics as pk  # lazy: optional peer
+            import torch  # lazy: optional peer
 
             torch.set_num_threads(os.cpu_count() or 1)
             chain = pk.build_serial_chain_from_urdf(self.urdf.encode(), "tool")
@@ -216,8 +219,6 @@ class Bench:
         """kinestat's PUMA 762 closed form (every branch, verified by forward analysis) against
         RTB's analytic ``ikine_a`` on its Puma560: the same 6R class (shoulder offset, spherical
         wrist), different link lengths."""
-        from kinestat.serial import puma762 as P
-
         note_peer = "solves the PUMA 560 (same 6R class)"
         L = np.radians(P.AXIS_LIMITS_DEG)
         N = 10**4 if self.quick else 10**5
@@ -266,8 +267,6 @@ class Bench:
         configurations within the joint limits, through FK) from one fixed start q = 0, for
         every library. Success is reported by each library and verified here by kinestat's FK:
         position ≤ 1e-6 m, rotation ≤ 1e-6 rad, within the joint limits."""
-        from kinestat.serial.ik import ik, pose_error
-
         m = self.model
         N = 1000 if self.quick else 5000
         qt = m.lower + RNG.random((N, 6)) * (m.upper - m.lower)
@@ -311,7 +310,7 @@ class Bench:
                          note=f"Python loop on {k}; residual E=e'We/2 <= {kw.get('tol', 1e-6):g}")
         if "pk" in self.peers:
             torch, chain = self.peers["pk"]
-            import pytorch_kinematics as pk
+            import pytorch_kinematics as pk  # lazy: optional peer
 
             k = min(N, 200 if self.quick else 1000)
             lim = torch.tensor(np.c_[m.lower, m.upper])
@@ -338,10 +337,9 @@ class Bench:
     def platform(self) -> None:
         """All-mode forward kinematics of the 2011 prototype platform (no peer library solves
         it): the compiled path against kinestat's NumPy reference ``fk_all``."""
-        try:
+        try:  # lazy: the platform code may be absent in a partial checkout
             from kinestat.io.library import prototype
-            from kinestat.parallel import _fk_kernels
-            from kinestat.parallel.fk import fk_all
+            from kinestat.parallel.fk import _fk_all_reference, fk_all
         except ImportError as exc:  # pragma: no cover - platform package absent
             print(f"  platform FK not available: {exc}", file=sys.stderr)
             return
@@ -349,20 +347,20 @@ class Bench:
         N = 2000 if self.quick else 20000
         L = p.free_lengths * (1 + RNG.uniform(-0.1, 0.1, (N, 6)))
         one = L[0]
-        fast = _fk_kernels.fk_all_fast(p, one)
-        assert fast.count == fk_all(p, one, backend="numpy").count
+        fast = fk_all(p, one)
+        assert fast.count == _fk_all_reference(p, one).count
         n = 200 if self.quick else 2000
         self.add("platform fk all-mode single", "kinestat",
-                 median_time(lambda: _fk_kernels.fk_all_fast(p, one), number=n),
+                 median_time(lambda: fk_all(p, one), number=n),
                  note=f"compiled; {int(fast.count)} modes")
         self.add("platform fk all-mode single", "fk_all (NumPy reference)",
-                 median_time(lambda: fk_all(p, one, backend="numpy"), number=max(n // 20, 5)))
+                 median_time(lambda: _fk_all_reference(p, one), number=max(n // 20, 5)))
         self.add("platform fk all-mode batch", "kinestat",
-                 median_time(lambda: _fk_kernels.fk_all_fast(p, L), repeat=5), items=N,
+                 median_time(lambda: fk_all(p, L), repeat=5), items=N,
                  note="compiled, 16 slots per set")
         k = N // 10
         self.add("platform fk all-mode batch", "fk_all (NumPy reference)",
-                 median_time(lambda: fk_all(p, L[:k], backend="numpy"), repeat=3), items=k,
+                 median_time(lambda: _fk_all_reference(p, L[:k]), repeat=3), items=k,
                  note="on N/10")
 
     def run(self, only: list[str] | None) -> None:

@@ -1,4 +1,6 @@
-"""``kinestat fk``: forward kinematics of a model at one configuration."""
+"""``kinestat fk``: forward kinematics (the theses' forward analysis) of a model at one
+configuration, reported in the model's own words (its joint names; the PUMA 762's S6/a67 only
+for the PUMA 762)."""
 
 from __future__ import annotations
 
@@ -7,6 +9,9 @@ import typer
 
 from kinestat.cli._output import console, parse_floats, print_json, table
 from kinestat.errors import InputError
+
+#: the model whose end frame is described in the thesis's words (P_tool_F, S6_F, a67_F)
+_PUMA762 = "puma762"
 
 
 def register(app: typer.Typer) -> None:
@@ -30,14 +35,17 @@ def fk_command(
     frames: bool = typer.Option(False, "--frames", help="Also report every link frame."),
     as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
 ) -> None:
-    """Pose of the end frame; for the PUMA 762 also P_tool_F, S6_F and a67_F (Vibhute eq. 2-34).
+    """Pose of the end frame T_base_end and the tool point; for the PUMA 762 also P_tool_F,
+    S6_F and a67_F in the thesis's words (Vibhute eq. 2-34).
 
-    JSON: {"pose", "tool_point", "s6" (z of the end frame), "a67" (x of the end frame),
-    "euler_deg", "euler_seq", "gimbal_lock", "q"} (+ "frames" with --frames).
+    JSON: {"model", "q", "joint_names", "pose" (T_base_end), "tool_point" (p_base_tool),
+    "euler_deg", "euler_seq", "gimbal_lock", "length_unit"} plus the end frame's z and x axes:
+    "s6" and "a67" for the puma762 model, "z_base_end" and "x_base_end" for any other model
+    (+ "frames" with --frames, "warning" outside the joint limits).
     """
-    import kinestat
-    from kinestat.serial.fk import fk_frames
-    from kinestat.spatial.euler import euler_from_matrix
+    import kinestat  # lazy: pulls in numba and scipy; keeps `kinestat --help` fast
+    from kinestat.serial.fk import fk_frames  # lazy: as above
+    from kinestat.spatial.euler import euler_from_matrix  # lazy: scipy
 
     m = kinestat.load(model)
     if (q is None) == (q_deg is None):
@@ -45,17 +53,21 @@ def fk_command(
     vals = parse_floats(q if q is not None else q_deg, m.n, "q" if q is not None else "q-deg")
     if q_deg is not None:
         vals = np.where(m.prismatic, vals, np.deg2rad(vals))
-    p6 = parse_floats(tool_point_6, 3, "tool-point-6")
+    p_end_tool = parse_floats(tool_point_6, 3, "tool-point-6")
     F = fk_frames(m, vals)
-    T = F[-1]
-    ang, lock = euler_from_matrix(T[:3, :3], euler, degrees=True, return_degenerate=True)
+    T_base_end = F[-1]
+    ang, lock = euler_from_matrix(T_base_end[:3, :3], euler, degrees=True,
+                                  return_degenerate=True)
+    puma = m.name == _PUMA762
+    z_key, x_key = ("s6", "a67") if puma else ("z_base_end", "x_base_end")
     out = {
         "model": m.name,
         "q": vals,
-        "pose": T,
-        "tool_point": T[:3, :3] @ p6 + T[:3, 3],
-        "s6": T[:3, 2],
-        "a67": T[:3, 0],
+        "joint_names": [j.name for j in m.joints],
+        "pose": T_base_end,
+        "tool_point": T_base_end[:3, :3] @ p_end_tool + T_base_end[:3, 3],
+        z_key: T_base_end[:3, 2],
+        x_key: T_base_end[:3, 0],
         "euler_seq": euler,
         "euler_deg": ang,
         "gimbal_lock": bool(lock),
@@ -68,16 +80,33 @@ def fk_command(
     if as_json:
         print_json(out)
         return
+    _print_human(m, vals, out, F if frames else None, puma)
+
+
+def _print_human(m, vals: np.ndarray, out: dict, F, puma: bool) -> None:
+    """The tables of ``kinestat fk`` (without --json), in the model's own words."""
+    T_base_end = out["pose"]
     console.print(f"[bold]{m.name}[/] ({m.n} joints, lengths in {m.length_unit})")
-    console.print(table("End pose", ["", "x", "y", "z", "t"],
-                        [[r] + list(T[i]) for i, r in enumerate(["1", "2", "3", "4"])]))
-    console.print(table("Tool", ["", "x", "y", "z"], [
-        ["tool point", *out["tool_point"]], ["s6 (z)", *out["s6"]], ["a67 (x)", *out["a67"]],
+    console.print(table("Joints", ["joint", "kind", "value"], [
+        [j.name or str(i + 1), j.kind,
+         f"{vals[i]:.6g} {m.length_unit}" if j.kind == "prismatic"
+         else f"{np.rad2deg(vals[i]):.6g} deg"]
+        for i, j in enumerate(m.joints)
     ]))
-    console.print(f"Euler {euler} (deg): " + ", ".join(f"{a:.4f}" for a in ang)
-                  + ("  [gimbal lock]" if lock else ""))
+    console.print(table("End pose T_base_end", ["", "x", "y", "z", "t"],
+                        [[r] + list(T_base_end[i]) for i, r in enumerate(["1", "2", "3", "4"])]))
+    if puma:
+        rows = [["tool point P_tool_F", *out["tool_point"]], ["S6_F (z)", *out["s6"]],
+                ["a67_F (x)", *out["a67"]]]
+    else:
+        rows = [["tool point", *out["tool_point"]], ["end z axis", *out["z_base_end"]],
+                ["end x axis", *out["x_base_end"]]]
+    console.print(table("Tool", ["", "x", "y", "z"], rows))
+    ang = out["euler_deg"]
+    console.print(f"Euler {out['euler_seq']} (deg): " + ", ".join(f"{a:.4f}" for a in ang)
+                  + ("  [gimbal lock]" if out["gimbal_lock"] else ""))
     if "warning" in out:
         console.print(f"[yellow]warning:[/] {out['warning']}")
-    if frames:
+    if F is not None:
         console.print(table("Link frame origins", ["frame", "x", "y", "z"],
                             [[i, *F[i, :3, 3]] for i in range(len(F))]))

@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+from typing import Literal, get_args
+
 import numpy as np
 import typer
 
 from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, KinestatError
+
+#: ``--limits``: the PUMA 762 axis-limit sets (puma_rev_analysis.m, or Table 2-1)
+AxisLimitSet = Literal["matlab", "table"]
 
 
 def register(app: typer.Typer) -> None:
@@ -48,7 +53,7 @@ def ik_command(
         None, "--current-axis-deg", help="PUMA 762: the current configuration as robot axis "
         "angles (degrees; axis 1 = φ1 + 180)."
     ),
-    limits: str = typer.Option(
+    limits: str = typer.Option(  # an AxisLimitSet
         "matlab", "--limits", help="PUMA 762 axis limits: 'matlab' (puma_rev_analysis.m, joint 5 "
         "±100°) or 'table' (Table 2-1, joint 5 ±110°)."
     ),
@@ -96,7 +101,8 @@ def ik_command(
 
 def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_axis_deg,
                  limits, normalize, as_json) -> None:
-    from kinestat.serial import puma762 as P
+    from kinestat.serial import puma762 as P  # lazy: numba kernels; keeps `kinestat --help` fast
+    from kinestat.spatial.validate import as_unit_vector  # lazy: kinestat.spatial loads scipy
 
     if model != "puma762":
         raise InputError(
@@ -107,19 +113,16 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
                if v is None]
     if missing:
         raise InputError(f"the PUMA 762 closed form needs {', '.join(missing)} as well")
-    if limits not in ("matlab", "table"):
+    if limits not in get_args(AxisLimitSet):
         raise InputError(f"--limits must be 'matlab' or 'table', got {limits!r}")
-    lim = P.AXIS_LIMITS_MATLAB_DEG if limits == "matlab" else P.AXIS_LIMITS_TABLE_2_1_DEG
+    lim = {"matlab": P.AXIS_LIMITS_MATLAB_DEG, "table": P.AXIS_LIMITS_TABLE_2_1_DEG}[limits]
     p = parse_floats(tool_point, 3, "tool-point")
     z = parse_floats(s6, 3, "s6")
     x = parse_floats(a67, 3, "a67")
     p6 = parse_floats(tool_point_6, 3, "tool-point-6")
     if normalize:
-        for name, v in (("s6", z), ("a67", x)):
-            if np.linalg.norm(v) == 0.0:
-                raise InputError(f"--{name}: a zero vector has no direction")
-        z = z / np.linalg.norm(z)
-        x = x / np.linalg.norm(x)
+        z = as_unit_vector(z, "--s6", normalize=True)
+        x = as_unit_vector(x, "--a67", normalize=True)
     if current_deg is not None and current_axis_deg is not None:
         raise InputError("give the current configuration once: --current-deg or "
                          "--current-axis-deg")
@@ -191,6 +194,11 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
     if as_json:
         print_json(out)
         return
+    _print_closed_form(out, res, current is not None)
+
+
+def _print_closed_form(out: dict, res, has_current: bool) -> None:
+    """The tables of the PUMA 762 closed form (without --json)."""
     console.print(f"[bold]PUMA 762 reverse analysis[/]: {len(res.solutions)} isolated "
                   f"solution(s), {len(res.families)} wrist-singular family(ies)")
     cols = ["branch", "φ1", "θ2", "θ3", "θ4", "θ5", "θ6", "limits ok"]
@@ -206,7 +214,7 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
         )
     if res.reason:
         console.print(f"[yellow]note:[/] {res.reason}")
-    if current is not None:
+    if has_current:
         sel = out["selected"]
         if sel is None:
             console.print("[red]no solution lies within the axis limits[/]")
@@ -221,8 +229,8 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
 
 def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits,
                as_json) -> None:
-    import kinestat
-    from kinestat.serial.ik import ik
+    import kinestat  # lazy: pulls in numba and scipy; keeps `kinestat --help` fast
+    from kinestat.serial.ik import ik  # lazy: as above
 
     if restarts < 0:
         raise InputError(f"--restarts must be 0 or more, got {restarts}")
@@ -256,7 +264,9 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
         ok = np.atleast_1d(r.success)
         pe = np.atleast_1d(r.position_error)
         re = np.atleast_1d(r.rotation_error)
-        cols = ["#"] + [f"q{i + 1}" for i in range(m.n)] + ["ok", "pos err", "rot err"]
+        names = [j.name if j.name and j.name != str(i + 1) else f"q{i + 1}"
+                 for i, j in enumerate(m.joints)]
+        cols = ["#", *names, "ok", "pos err", "rot err"]
         rows = [[i, *qs[i], "yes" if ok[i] else "NO", f"{pe[i]:.1e}", f"{re[i]:.1e}"]
                 for i in range(qs.shape[0])]
         console.print(table(f"{m.name}: numerical IK (rotating joints in degrees, lengths in "

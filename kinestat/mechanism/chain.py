@@ -30,8 +30,10 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kinestat.errors import InputError, ModelError
-from kinestat.mechanism.joints import Joint
+from kinestat.mechanism.joints import Joint, JointKind, kind_from_pitch
+from kinestat.spatial.displacement import frame_from_points
 from kinestat.spatial.transforms import inv, rot_x, rot_z, trans_x, trans_z
+from kinestat.spatial.validate import as_pose
 
 __all__ = [
     "ChainModel",
@@ -52,15 +54,8 @@ def _readonly(a: np.ndarray) -> np.ndarray:
 
 
 def _check_pose(T, name: str) -> np.ndarray:
-    T = np.asarray(T, dtype=float)
-    if T.shape != (4, 4) or not np.all(np.isfinite(T)):
-        raise ModelError(f"{name} must be a finite 4x4 homogeneous transform")
-    R = T[:3, :3]
-    if np.max(np.abs(R @ R.T - np.eye(3))) > 1e-6 or abs(np.linalg.det(R) - 1) > 1e-6:
-        raise ModelError(f"{name}: rotation part is not orthonormal with determinant +1")
-    if np.max(np.abs(T[3] - [0, 0, 0, 1])) > 0:
-        raise ModelError(f"{name}: last row must be [0, 0, 0, 1]")
-    return T
+    """A model's constant pose (base, tool, Ci): a rigid ``(4, 4)`` with an exact last row."""
+    return as_pose(T, name, single=True, error=ModelError)
 
 
 @dataclass(frozen=True, eq=False)
@@ -79,6 +74,10 @@ class ChainModel:
         q_home: a reference configuration (the initial one for Nadkarni decks).
         extra: notation-specific data kept for write-back (e.g. Nadkarni's frame points and
             seventh joint), as a tuple of ``(key, value)`` pairs.
+
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]], name='rr')
+    >>> arm, arm.n, arm.constants.shape
+    (ChainModel('rr', RR, notation='standard_dh', unit='mm'), 2, (3, 4, 4))
     """
 
     name: str
@@ -120,18 +119,12 @@ class ChainModel:
         if qh.shape != (n,) or not np.all(np.isfinite(qh)):
             raise ModelError(f"model {self.name!r}: q_home must be {n} finite values")
         object.__setattr__(self, "q_home", _readonly(qh))
-        kinds = _readonly(
-            np.array([{"revolute": 0, "prismatic": 1, "screw": 2}[j.kind] for j in joints],
-                     dtype=np.int64)
-        )
+        kinds = _readonly(np.array([int(j.code) for j in joints], dtype=np.int64))
         pitches = _readonly(np.array([j.pitch if j.kind == "screw" else 0.0 for j in joints]))
         object.__setattr__(self, "_kinds", kinds)
         object.__setattr__(self, "_pitches", pitches)
-        # the arguments of the compiled kernels, contiguous and ready (kinestat.serial._kernels)
-        object.__setattr__(self, "kernel_args", (self.constants, kinds, pitches))
-        packed = np.concatenate([self.constants.ravel(), kinds.astype(float), pitches])
-        object.__setattr__(self, "kernel_packed", _readonly(packed))
-        object.__setattr__(self, "n_joints", n)  # a plain attribute (the fast paths read it)
+        # the compiled kernels' per-model data lives outside the model, in
+        # kinestat.serial._kernel_cache (Pinocchio's Model/Data split)
 
     # -- derived, cheap views ------------------------------------------------------------------
     @property
@@ -141,13 +134,13 @@ class ChainModel:
 
     @property
     def kind_codes(self) -> np.ndarray:
-        """Joint kinds as codes: 0 revolute, 1 prismatic, 2 screw."""
+        """Joint kinds as :class:`~kinestat.mechanism.joints.JointKind` codes (int64, read-only)."""
         return self._kinds  # type: ignore[attr-defined]
 
     @property
     def prismatic(self) -> np.ndarray:
         """Boolean mask of prismatic joints."""
-        return self.kind_codes == 1
+        return self.kind_codes == JointKind.PRISMATIC
 
     @property
     def pitches(self) -> np.ndarray:
@@ -251,6 +244,10 @@ def from_standard_dh(
     Tz(di + qi) · …`` for a prismatic one and ``Rz(θi + qi) · Tz(di + h qi) · …`` for a screw
     (lecture notes' H_i^{i-1}; Nadkarni eq. 2-7). Rz and Tz commute, so each link is
     ``Z(qi) · Ci`` with ``Ci = Rz(θi) Tz(di) Tx(ai) Rx(αi)``.
+
+    >>> arm = from_standard_dh([[0.0, 0.5, 1.0, np.pi / 2]], ['prismatic'])
+    >>> arm.joints[0].kind, arm.constants[1][:3, 3]
+    ('prismatic', array([1. , 0. , 0.5]))
     """
     P, joints, base, tool = _prepare(rows, "standard DH table", kinds, pitches, limits, names,
                                      base, tool)
@@ -285,6 +282,10 @@ def from_modified_dh(
 
     Link j is ``Rx(α_ij) · Tx(a_ij) · Rz(θj + qj) · Tz(Sj)`` (Craig; Crane & Duffy, Vibhute
     eq. 2-26), i.e. ``Pj · Z(qj)`` with ``Pj = Rx(α) Tx(a) Rz(θ) Tz(d)``.
+
+    >>> arm = from_modified_dh([[0.0, 1.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0]])
+    >>> arm.constants[0][:3, 3], arm.constants[1][:3, 3]
+    (array([1., 0., 0.]), array([1., 0., 0.]))
     """
     P, joints, base, tool = _prepare(rows, "modified DH table", kinds, pitches, limits, names,
                                      base, tool)
@@ -306,9 +307,10 @@ def frame_from_three_points(p1, p2, p3, *, what: str = "frame points") -> np.nda
 
     :func:`kinestat.spatial.displacement.frame_from_points`, with ``what`` naming the points in
     error messages (e.g. "SET FIVE frame points").
-    """
-    from kinestat.spatial.displacement import frame_from_points
 
+    >>> frame_from_three_points([1.0, 0.0, 0.0], [1.0, 0.0, 1.0], [2.0, 0.0, 0.0])[:3, 3]
+    array([1., 0., 0.])
+    """
     try:
         return frame_from_points(p1, p2, p3)
     except InputError as exc:
@@ -340,9 +342,12 @@ def from_nadkarni(
     Nadkarni's transformation x(i-1) ← x(i) is ``Rz(θi) Tz(ri) Tx(ai) Rx(αi)`` (eqs. 2-5, 2-7),
     standard DH with d = r, and x*(i) = x(i-1) · Rz(θi) Tz(ri). The base x(0) follows from the
     initial x*(1) = x*(0) given by the three points (eqs. 2-13 to 2-15).
-    """
-    from kinestat.mechanism.joints import kind_from_pitch
 
+    >>> rows = [[0.0, 0.0, 1.0, 0.0, 0.0], [0.0, 0.0, 1.0, 0.0, 0.0]]
+    >>> m = from_nadkarni(rows, [[0, 0, 0], [0, 0, 1], [1, 0, 0]], n_active=None)
+    >>> m.notation, m.n, m.q_home
+    ('nadkarni', 2, array([0., 0.]))
+    """
     R = _numbers(joints_rows, "Nadkarni joint rows")
     if R.ndim != 2 or R.shape[1] != 5 or R.shape[0] == 0:
         raise ModelError(

@@ -13,19 +13,54 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from enum import IntEnum
+from typing import Literal
 
 from kinestat.errors import ModelError
 
-__all__ = ["Joint", "JOINT_KINDS", "PRISMATIC_PITCH_THRESHOLD", "kind_from_pitch"]
+__all__ = ["Joint", "JointKind", "JointKindName", "JOINT_KINDS", "PRISMATIC_PITCH_THRESHOLD",
+           "kind_from_pitch"]
 
-JOINT_KINDS = ("revolute", "prismatic", "screw")
+#: the joint kinds as written in model files and on :attr:`Joint.kind`
+JointKindName = Literal["revolute", "prismatic", "screw"]
+
+JOINT_KINDS: tuple[JointKindName, ...] = ("revolute", "prismatic", "screw")
+
+
+class JointKind(IntEnum):
+    """Joint kind codes shared by the NumPy code and the compiled kernels (which compare plain
+    ints: ``kind == PRISMATIC`` with ``PRISMATIC = int(JointKind.PRISMATIC)``).
+
+    >>> JointKind.from_name("screw")
+    <JointKind.SCREW: 2>
+    >>> JointKind.PRISMATIC.label
+    'prismatic'
+    """
+
+    REVOLUTE = 0
+    PRISMATIC = 1
+    SCREW = 2
+
+    @classmethod
+    def from_name(cls, name: str) -> JointKind:
+        """The code of a kind name (``"revolute"``, ``"prismatic"``, ``"screw"``)."""
+        return cls[name.upper()]
+
+    @property
+    def label(self) -> JointKindName:
+        """The kind's name as in model files."""
+        return JOINT_KINDS[self.value]
 
 #: DISP's rule (Nadkarni App. I, SET FOUR): a joint whose pitch exceeds 1e5 is prismatic.
 PRISMATIC_PITCH_THRESHOLD = 1e5
 
 
 def kind_from_pitch(pitch: float) -> str:
-    """Joint kind from a DISP pitch: > 1e5 prismatic, 0 revolute, otherwise screw."""
+    """Joint kind from a DISP pitch: > 1e5 prismatic, 0 revolute, otherwise screw.
+
+    >>> kind_from_pitch(0.0), kind_from_pitch(0.2), kind_from_pitch(1e6)
+    ('revolute', 'screw', 'prismatic')
+    """
     if not math.isfinite(pitch):
         raise ModelError(f"joint pitch must be finite, got {pitch!r}")
     if pitch > PRISMATIC_PITCH_THRESHOLD:
@@ -41,9 +76,12 @@ class Joint:
 
     ``lower``/``upper`` are limits on the joint value q (radians for revolute and screw joints,
     length for prismatic ones); infinite when the joint is unlimited.
+
+    >>> Joint('screw', pitch=0.5, name='lead').rotates, Joint('prismatic', pitch=3.0).pitch
+    (True, 0.0)
     """
 
-    kind: str = "revolute"
+    kind: JointKindName = "revolute"
     pitch: float = 0.0
     lower: float = -math.inf
     upper: float = math.inf
@@ -65,6 +103,11 @@ class Joint:
             raise ModelError(
                 f"joint {self.name or '?'}: limits [{self.lower}, {self.upper}] are not an interval"
             )
+
+    @property
+    def code(self) -> JointKind:
+        """The kind as a :class:`JointKind` code."""
+        return JointKind.from_name(self.kind)
 
     @property
     def rotates(self) -> bool:

@@ -30,6 +30,13 @@ class MechanismFrames:
 
     ``x_star`` and ``x`` are ``(..., N, 4, 4)``; ``origin_star``/``origin`` ``(..., N, 3)`` are
     their origins X*(i), X(i); ``axis`` U(i) and ``normal`` ρn(i) are ``(..., N, 3)``.
+
+    >>> SET_FIVE = [[0, 0, 0], [0, 0, 1], [1, 0, 0]]  # x*(1) at the origin, z up, x along x
+    >>> f = mechanism_frames([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]], SET_FIVE)
+    >>> f.origin_star, f.axis
+    (array([[0., 0., 0.],
+           [1., 0., 0.]]), array([[0., 0., 1.],
+           [0., 0., 1.]]))
     """
 
     x_star: np.ndarray
@@ -61,6 +68,12 @@ def mechanism_frames(rows, frame_points, initial_rows=None) -> MechanismFrames:
         frame_points: SET FIVE, three points on x*(1) in the initial configuration.
         initial_rows: the configuration in which SET FIVE was measured (default: ``rows``).
             x*(0) is x*(1) there; a later θ1/r1 moves x*(1) about/along x*(0)'s z (eq. 2-13).
+
+    >>> SET_FIVE = [[0, 0, 0], [0, 0, 1], [1, 0, 0]]
+    >>> f = mechanism_frames([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, np.pi / 2]], SET_FIVE)
+    >>> np.round(f.origin, 12) + 0.0
+    array([[1., 0., 0.],
+           [1., 1., 0.]])
     """
     R = np.asarray(rows, dtype=float)
     if R.ndim < 2 or R.shape[-1] < 4:
@@ -88,6 +101,11 @@ def hand_points(hand_pose) -> np.ndarray:
     """The three hand points DISP reports: origin, unit point on +z, unit point on +x.
 
     Returns ``(..., 3, 3)`` (rows are points), the form of a SET TWO body position.
+
+    >>> hand_points(np.eye(4))
+    array([[0., 0., 0.],
+           [0., 0., 1.],
+           [1., 0., 0.]])
     """
     T = np.asarray(hand_pose, dtype=float)
     o = T[..., :3, 3]

@@ -1,6 +1,10 @@
-"""Compiled (Numba) fast path of the special 6-6 all-mode forward kinematics.
+"""Compiled (Numba) kernels of the special 6-6 all-mode forward kinematics.
 
-The same computation as :func:`kinestat.parallel.fk.fk_all` (the reference), in three stages
+(Over 600 lines on purpose: the three stages share many small ``inline="always"`` helpers, and
+Numba's on-disk cache is keyed per source file — splitting them would make stale caches likely.)
+
+The computation of :func:`kinestat.parallel.fk.fk_all` (its NumPy reference is
+``fk._fk_all_reference``), in three stages
 per chunk of leg-length sets:
 
 1. compiled, parallel over the sets: the reduction to the equivalent 3-3 (Vibhute 2011
@@ -14,22 +18,23 @@ per chunk of leg-length sets:
    with their mirror images through the base plane (polished and checked too), in 16 slots.
 
 Scalar code per set, no temporaries beyond one chunk (:data:`CHUNK`). Compiled on first use and
-cached on disk (``cache=True``, in ``__pycache__``). :func:`fk_all_fast` is a drop-in for
-``fk_all`` (same arguments, checks and :class:`~kinestat.parallel.fk.FKSolutions`): the same
-modes, polished to the same tolerance. The mirror pairs can sit in another slot order: it
-follows the order in which the eigenvalue solver returns the roots, and the polynomial's
-coefficients (a direct 9-point DFT here, NumPy's FFT there) differ in the last bits.
+cached on disk (``cache=True``, in ``__pycache__``). :func:`kinestat.parallel.fk.fk_all` always
+runs them; its private NumPy reference finds the same modes, polished to the same tolerance.
+The mirror pairs can sit in another slot order: it follows the order in which the eigenvalue
+solver returns the roots, and the polynomial's coefficients (a direct 9-point DFT here, NumPy's
+FFT there) differ in the last bits.
 """
 
 from __future__ import annotations
 
 import math
 import os
-import weakref
 from concurrent.futures import ThreadPoolExecutor
 
 import numba as nb
 import numpy as np
+
+from kinestat.parallel._fk_tolerances import COMBO_TOL, IMAG_TOL, SIG_TOL
 
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
@@ -38,9 +43,10 @@ CHUNK = 4096
 _PARALLEL_MIN = 16  # smaller batches run on one thread (starting the workers costs more)
 _NSLOT = 16
 _NCAND = 32
-_COMBO_TOL = 1e-3  # as fk33._COMBO_TOL
-_IMAG_TOL = 1e-3  # as fk33._root_angles
-_SIG_TOL = 1e-6  # as fk33.first_occurrences
+# tolerances shared with the NumPy path (kinestat.parallel.fk33), defined once
+_COMBO_TOL = COMBO_TOL
+_IMAG_TOL = IMAG_TOL
+_SIG_TOL = SIG_TOL
 
 # flags of stage 1
 _FEASIBLE = 1
@@ -586,7 +592,6 @@ def stage3_serial(G, sides2, scale, minvt, cvec, order, Fb, Ft_inv, Mb, Mt, base
 
 
 # -- the Python entry points -----------------------------------------------------------------------
-_CONSTANTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _POOL: list[ThreadPoolExecutor] = []  # created on first use
 _EIG_SPLIT = 256  # matrices per thread below which the eigenvalues stay on one thread
 
@@ -603,56 +608,13 @@ def _eigvals(comp: np.ndarray) -> np.ndarray:
     return np.concatenate(list(_POOL[0].map(np.linalg.eigvals, parts)))
 
 
-def _constants(platform) -> tuple:
-    """The kernels' constant arguments for a special 6-6 platform (cached per platform)."""
-    got = _CONSTANTS.get(platform)
-    if got is not None:
-        return got
-    from kinestat.parallel.fk import _layout, reduction_matrix
-    from kinestat.parallel.fk33 import _W, _X, mirror_matrices, triangle_frame
-
-    lay = _layout(platform)
-    order = np.array(lay.order, dtype=np.int64)
-    M, c = reduction_matrix(platform)
-    minvt = np.ascontiguousarray(np.linalg.inv(M).T)
-    base_tri = platform.base_points[order[:3]]
-    top_tri = platform.top_points[order[3:]]
-    Fb = triangle_frame(base_tri)
-    Ft = triangle_frame(top_tri)
-    Ft_inv = np.linalg.inv(Ft)
-    scale = float(np.linalg.norm(base_tri[1] - base_tri[0]))
-    base_loc = (base_tri - Fb[:3, 3]) @ Fb[:3, :3] / scale
-    top_loc = (top_tri - Ft[:3, 3]) @ Ft[:3, :3] / scale
-    sides2 = np.array([np.sum((top_loc[i] - top_loc[j]) ** 2)
-                       for i, j in ((0, 1), (1, 2), (2, 0))])
-    O, Pp, Q = base_loc
-    # circles of R (about OQ, toward P), S (about OP, toward Q), T (about PQ, toward O), with
-    # the indices of their squared lengths in [or, os, ps, pt, qt, qr]
-    G = np.zeros((3, 12))
-    for i, (a, b, third, ia, ib) in enumerate(((O, Q, Pp, 0, 5), (O, Pp, Q, 1, 2),
-                                               (Pp, Q, O, 3, 4))):
-        e = b - a
-        d = np.linalg.norm(e)
-        e = e / d
-        n = (third - a) - ((third - a) @ e) * e
-        n = n / np.linalg.norm(n)
-        G[i, 0:3], G[i, 3:6], G[i, 6:9] = a, e, n
-        G[i, 9], G[i, 10], G[i, 11] = d, ia, ib
-    Mb, Mt = mirror_matrices(base_tri, top_tri)
-    got = (G, sides2, scale, minvt, np.ascontiguousarray(c), order,
-           np.ascontiguousarray(_W), np.ascontiguousarray(_X), np.ascontiguousarray(Fb),
-           np.ascontiguousarray(Ft_inv), np.ascontiguousarray(Mb), np.ascontiguousarray(Mt),
-           np.ascontiguousarray(platform.base_points), np.ascontiguousarray(platform.top_points))
-    _CONSTANTS[platform] = got
-    return got
-
-
-def fk_all_arrays(platform, L: np.ndarray, tol: float = 1e-9,
+def fk_all_arrays(constants: tuple, L: np.ndarray, tol: float = 1e-9,
                   polish: int = 4) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(poses (N, 16, 4, 4), valid (N, 16), residual (N, 16))`` of validated leg lengths
-    ``L (N, 6)`` (finite, positive; model leg order) — the arrays of ``fk_all``."""
-    G, sides2, scale, minvt, cvec, order, W, X, Fb, Ft_inv, Mb, Mt, base, top = \
-        _constants(platform)
+    ``L (N, 6)`` (finite, positive; model leg order) — the arrays of ``fk_all``. ``constants``
+    are the platform's kernel constants (:func:`kinestat.parallel.fk.kernel_constants`, cached
+    per platform outside it)."""
+    G, sides2, scale, minvt, cvec, order, W, X, Fb, Ft_inv, Mb, Mt, base, top = constants
     L = np.ascontiguousarray(L, dtype=float)
     N = L.shape[0]
     poses = np.empty((N, _NSLOT, 4, 4))
@@ -675,14 +637,8 @@ def fk_all_arrays(platform, L: np.ndarray, tol: float = 1e-9,
 
 
 def fk_all_fast(platform, lengths, *, tol: float = 1e-9, polish: int = 4):
-    """:func:`kinestat.parallel.fk.fk_all` through the compiled kernels: the same arguments,
-    checks and :class:`~kinestat.parallel.fk.FKSolutions`."""
-    from kinestat.parallel.fk import FKSolutions, _layout, check_lengths
+    """Deprecated old name of :func:`kinestat.parallel.fk.fk_all` (which always runs these
+    kernels)."""
+    from kinestat.parallel.fk import fk_all  # lazy: parallel.fk imports this module (cycle)
 
-    L = check_lengths(lengths)
-    _layout(platform)
-    shape = L.shape[:-1]
-    poses, valid, res = fk_all_arrays(platform, L.reshape(-1, 6), tol, polish)
-    return FKSolutions(poses=poses.reshape(shape + (_NSLOT, 4, 4)),
-                       valid=valid.reshape(shape + (_NSLOT,)),
-                       residual=res.reshape(shape + (_NSLOT,)))
+    return fk_all(platform, lengths, tol=tol, polish=polish)

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from kinestat.spatial.se3 import so3_exp
+
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Cross product over the last axis (faster than ``np.cross`` for large batches)."""
@@ -12,18 +14,8 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
-def rotvec_matrix(w: np.ndarray) -> np.ndarray:
-    """Rotation matrices ``(..., 3, 3)`` of rotation vectors ``(..., 3)`` (Rodrigues)."""
-    th = np.sqrt(np.sum(w * w, axis=-1))
-    small = th < 1e-8
-    safe = np.where(small, 1.0, th)
-    a = np.where(small, 1.0 - th**2 / 6.0, np.sin(safe) / safe)
-    b = np.where(small, 0.5 - th**2 / 24.0, (1.0 - np.cos(safe)) / safe**2)
-    K = np.zeros(w.shape[:-1] + (3, 3))
-    K[..., 0, 1], K[..., 0, 2] = -w[..., 2], w[..., 1]
-    K[..., 1, 0], K[..., 1, 2] = w[..., 2], -w[..., 0]
-    K[..., 2, 0], K[..., 2, 1] = -w[..., 1], w[..., 0]
-    return np.eye(3) + a[..., None, None] * K + b[..., None, None] * (K @ K)
+#: Rodrigues' formula, :func:`kinestat.spatial.se3.so3_exp` (old name)
+rotvec_matrix = so3_exp
 
 
 def apply_twist(pose: np.ndarray, twist: np.ndarray) -> np.ndarray:

@@ -17,19 +17,26 @@ determinant ``Π(1 − t) − Π t`` — zero for an architecturally singular la
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Literal
 
 import numpy as np
 
 from kinestat.errors import InputError, ModelError, SingularityError, UnreachableError
+from kinestat.parallel import _fk_kernels
 from kinestat.parallel._refine import apply_twist, leg_residual, refine_where
 from kinestat.parallel.fk33 import (
+    _W,
+    _X,
     MAX_SOLUTIONS,
     _fk33_modes,
     assemble_modes,
     first_occurrences,
+    mirror_matrices,
     pose_signature,
+    triangle_frame,
 )
 from kinestat.parallel.legs import as_pose
 from kinestat.parallel.platform import Platform, SpecialLayout
@@ -150,8 +157,55 @@ def _pose_distance(a: np.ndarray, b: np.ndarray, scale: float) -> np.ndarray:
     return np.maximum(dr, dp)
 
 
+Backend = Literal["numba", "numpy"]
+
+_KERNEL_CONSTANTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _kernel_constants(platform: Platform) -> tuple:
+    """The compiled kernels' constant arguments for a special 6-6 platform, cached per platform
+    outside the (immutable) platform."""
+    got = _KERNEL_CONSTANTS.get(platform)
+    if got is not None:
+        return got
+    lay = _layout(platform)
+    order = np.array(lay.order, dtype=np.int64)
+    M, c = reduction_matrix(platform)
+    minvt = np.ascontiguousarray(np.linalg.inv(M).T)
+    base_tri = platform.base_points[order[:3]]
+    top_tri = platform.top_points[order[3:]]
+    Fb = triangle_frame(base_tri)
+    Ft = triangle_frame(top_tri)
+    Ft_inv = np.linalg.inv(Ft)
+    scale = float(np.linalg.norm(base_tri[1] - base_tri[0]))
+    base_loc = (base_tri - Fb[:3, 3]) @ Fb[:3, :3] / scale
+    top_loc = (top_tri - Ft[:3, 3]) @ Ft[:3, :3] / scale
+    sides2 = np.array([np.sum((top_loc[i] - top_loc[j]) ** 2)
+                       for i, j in ((0, 1), (1, 2), (2, 0))])
+    O, Pp, Q = base_loc
+    # circles of R (about OQ, toward P), S (about OP, toward Q), T (about PQ, toward O), with
+    # the indices of their squared lengths in [or, os, ps, pt, qt, qr]
+    G = np.zeros((3, 12))
+    for i, (a, b, third, ia, ib) in enumerate(((O, Q, Pp, 0, 5), (O, Pp, Q, 1, 2),
+                                               (Pp, Q, O, 3, 4))):
+        e = b - a
+        d = np.linalg.norm(e)
+        e = e / d
+        n = (third - a) - ((third - a) @ e) * e
+        n = n / np.linalg.norm(n)
+        G[i, 0:3], G[i, 3:6], G[i, 6:9] = a, e, n
+        G[i, 9], G[i, 10], G[i, 11] = d, ia, ib
+    Mb, Mt = mirror_matrices(base_tri, top_tri)
+    got = (G, sides2, scale, minvt, np.ascontiguousarray(c), order,
+           np.ascontiguousarray(_W), np.ascontiguousarray(_X), np.ascontiguousarray(Fb),
+           np.ascontiguousarray(Ft_inv), np.ascontiguousarray(Mb), np.ascontiguousarray(Mt),
+           np.ascontiguousarray(platform.base_points), np.ascontiguousarray(platform.top_points))
+    _KERNEL_CONSTANTS[platform] = got
+    return got
+
+
 def fk_all(platform: Platform, lengths, *, tol: float = 1e-9, polish: int = 4,
-           backend: str = "numba") -> FKSolutions:
+           backend: Backend = "numba") -> FKSolutions:
     """Every real assembly mode of a special 6-6 platform, batched over leg-length sets.
 
     Args:
@@ -161,20 +215,31 @@ def fk_all(platform: Platform, lengths, *, tol: float = 1e-9, polish: int = 4,
             (model length unit).
         polish: at most this many Newton steps on the six real legs, for closed-form poses
             whose legs are off by more than ``tol / 10``.
-
-        backend: ``"numba"`` (default) runs the compiled kernel of
-            :mod:`kinestat.parallel._fk_kernels`; ``"numpy"`` this reference implementation.
+        backend: deprecated, for the tests: ``"numba"`` (the default; the compiled kernels of
+            :mod:`kinestat.parallel._fk_kernels`) or ``"numpy"`` (the private NumPy reference).
             Both find the same modes (the order of the pairs may differ).
 
     Returns:
         :class:`FKSolutions` with up to 16 modes per set (mirror pairs in slots 2i, 2i+1).
     """
-    if backend == "numba":
-        from kinestat.parallel._fk_kernels import fk_all_fast
-
-        return fk_all_fast(platform, lengths, tol=tol, polish=polish)
-    if backend != "numpy":
+    if backend == "numpy":
+        return _fk_all_reference(platform, lengths, tol=tol, polish=polish)
+    if backend != "numba":
         raise InputError(f"backend must be 'numba' or 'numpy', got {backend!r}")
+    L = check_lengths(lengths)
+    _layout(platform)
+    shape = L.shape[:-1]
+    poses, valid, res = _fk_kernels.fk_all_arrays(_kernel_constants(platform),
+                                                  L.reshape(-1, 6), tol, polish)
+    n = poses.shape[1]
+    return FKSolutions(poses=poses.reshape(shape + (n, 4, 4)), valid=valid.reshape(shape + (n,)),
+                       residual=res.reshape(shape + (n,)))
+
+
+def _fk_all_reference(platform: Platform, lengths, *, tol: float = 1e-9,
+                      polish: int = 4) -> FKSolutions:
+    """The NumPy reference of :func:`fk_all` (for the tests): the closed-form 3-3 modes of
+    :mod:`kinestat.parallel.fk33`, polished and verified on the six real legs."""
     L = check_lengths(lengths)
     lay = _layout(platform)
     sq = _reduce_sq(platform, L)

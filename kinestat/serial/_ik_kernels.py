@@ -1,13 +1,14 @@
 """Compiled (Numba) kernels of the numerical inverse kinematics (:mod:`kinestat.serial.ik`).
 
 One target at a time, in registers and a few small per-target buffers, exactly the iteration
-of the NumPy reference ``ik(..., backend="numpy")``: the SE(3) error ``[log(R_t Rᵀ)^∨; δp/L]``,
-the damped least-squares (Levenberg–Marquardt) step on the space Jacobian with its velocity rows
-moved to the end point, projection into the joint limits, the stall tests and random restarts,
-and the final verdict from the forward kinematics of the returned configuration. The targets
-are spread over the cores with ``prange``; each draws its restarts from its own counter-based
-random stream (SplitMix64 keyed by the seed and the target's index), so the result does not
-depend on the number of threads or on how the batch is chunked.
+of the NumPy reference (:mod:`kinestat.serial._reference`): the SE(3) error
+``[log(R_t Rᵀ)^∨; δp/L]``, the damped least-squares (Levenberg–Marquardt) step on the space
+Jacobian with its velocity rows moved to the end point, projection into the joint limits, the
+stall tests and random restarts, and the final verdict from the forward kinematics of the
+returned configuration. The targets are spread over the cores with ``prange``; each draws its
+restarts from its own counter-based random stream (SplitMix64 keyed by the seed and the
+target's index), so the result does not depend on the number of threads or on how the batch
+is chunked.
 
 FK and Jacobian come from :mod:`kinestat.serial._kernels` (the same inlined steps). Compiled on
 first use and cached on disk (``cache=True``, in ``__pycache__``).
@@ -20,14 +21,26 @@ import math
 import numba as nb
 import numpy as np
 
-from kinestat.serial._kernels import _jac_column, _start, _step
+from kinestat.serial._kernels import PRISMATIC, _jac_column, _start, _step
+from kinestat.serial._lm_constants import (
+    CHECK_EVERY,
+    MU_DOWN,
+    MU_MIN,
+    MU_STALL,
+    MU_START,
+    MU_UP,
+    POLISHED,
+    STALL_RATIO,
+    TARGET_LAST_ROW_TOL,
+    TARGET_ORTHO_TOL,
+    WITHIN,
+)
 
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
 _PI = math.pi
 _TWO_PI = 2.0 * math.pi
 _SQRT8 = 2.0 * math.sqrt(2.0)
-_CHECK = 10  # iterations between progress checks (as the reference)
 
 # pose validation codes
 POSE_OK = 0
@@ -64,8 +77,8 @@ def _uniform(state):
 @nb.njit(**_OPTS)
 def validate_poses(T):
     """First offending pose of ``T (N, 4, 4)`` as ``(code, index)``, checked in the reference's
-    order: any non-finite entry; then a rotation part not orthonormal to 1e-6 or with
-    |det − 1| > 1e-6; then a last row other than [0, 0, 0, 1] (to 1e-12)."""
+    order: any non-finite entry; then a rotation part not orthonormal or with |det − 1| beyond
+    ``TARGET_ORTHO_TOL``; then a last row other than [0, 0, 0, 1] (to ``TARGET_LAST_ROW_TOL``)."""
     N = T.shape[0]
     for k in range(N):
         for i in range(4):
@@ -81,11 +94,12 @@ def validate_poses(T):
         det = (T[k, 0, 0] * (T[k, 1, 1] * T[k, 2, 2] - T[k, 1, 2] * T[k, 2, 1])
                - T[k, 0, 1] * (T[k, 1, 0] * T[k, 2, 2] - T[k, 1, 2] * T[k, 2, 0])
                + T[k, 0, 2] * (T[k, 1, 0] * T[k, 2, 1] - T[k, 1, 1] * T[k, 2, 0]))
-        if dev > 1e-6 or abs(det - 1.0) > 1e-6:
+        if dev > TARGET_ORTHO_TOL or abs(det - 1.0) > TARGET_ORTHO_TOL:
             return POSE_NOT_RIGID, k
     for k in range(N):
-        if (abs(T[k, 3, 0]) > 1e-12 or abs(T[k, 3, 1]) > 1e-12 or abs(T[k, 3, 2]) > 1e-12
-                or abs(T[k, 3, 3] - 1.0) > 1e-12):
+        if (abs(T[k, 3, 0]) > TARGET_LAST_ROW_TOL or abs(T[k, 3, 1]) > TARGET_LAST_ROW_TOL
+                or abs(T[k, 3, 2]) > TARGET_LAST_ROW_TOL
+                or abs(T[k, 3, 3] - 1.0) > TARGET_LAST_ROW_TOL):
             return POSE_LAST_ROW, k
     return POSE_OK, -1
 
@@ -266,7 +280,7 @@ def _damped_step(J, t, e, mu, L, inv_L, kinds, Js, A, x):
     px, py, pz = t[3], t[7], t[11]
     for j in range(n):
         wx, wy, wz = J[0, j], J[1, j], J[2, j]
-        D = L if kinds[j] == 1 else 1.0
+        D = L if kinds[j] == PRISMATIC else 1.0
         sv = inv_L * D
         Js[j, 0] = wx * D
         Js[j, 1] = wy * D
@@ -290,7 +304,7 @@ def _damped_step(J, t, e, mu, L, inv_L, kinds, Js, A, x):
         return False
     ok = True
     for j in range(n):
-        if kinds[j] == 1:
+        if kinds[j] == PRISMATIC:
             x[j] *= L
         if not math.isfinite(x[j]):
             ok = False
@@ -306,7 +320,7 @@ def _project(q, ref, kinds, lo, hi, limits, out):
     for j in range(q.shape[0]):
         v = q[j]
         if limits:
-            if kinds[j] != 1:
+            if kinds[j] != PRISMATIC:
                 d = v - ref[j]
                 # within half a turn of ref: v is its own wrapped value (to rounding); inside
                 # the limits it is then the nearest shift, every other one being > π away
@@ -330,7 +344,7 @@ def _random_q(state, kinds, lo, hi, L, out):
     """A random configuration within the limits (a rotating joint with no finite limit, or
     more than a turn of range, gets one turn), as the reference's ``_random_q``."""
     for j in range(out.shape[0]):
-        rot = kinds[j] != 1
+        rot = kinds[j] != PRISMATIC
         lo_f = lo[j] if math.isfinite(lo[j]) else (-_PI if rot else -L)
         hi_f = hi[j] if math.isfinite(hi[j]) else (_PI if rot else L)
         span = min(hi_f - lo_f, _TWO_PI) if rot else hi_f - lo_f
@@ -370,7 +384,7 @@ def _solve(C, kinds, pitch, lo, hi, q0, M, L, pos_tol, rot_tol, max_iter, restar
     best_cost = cost
     for j in range(n):
         q_out[j] = q[j]
-    mu = 1e-3
+    mu = MU_START
     checkpoint = np.inf
     it_total = 0
     it_attempt = 0
@@ -378,8 +392,8 @@ def _solve(C, kinds, pitch, lo, hi, q0, M, L, pos_tol, rot_tol, max_iter, restar
     while True:
         pe = math.sqrt(e[3] * e[3] + e[4] * e[4] + e[5] * e[5])
         re = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
-        within = pe <= 0.5 * pos_tol_s and re <= 0.5 * rot_tol
-        done = pe <= 1e-3 * pos_tol_s and re <= 1e-3 * rot_tol
+        within = pe <= WITHIN * pos_tol_s and re <= WITHIN * rot_tol
+        done = pe <= POLISHED * pos_tol_s and re <= POLISHED * rot_tol
         accept = False
         if not done:
             if _damped_step(J, t, e, mu, L, inv_L, kinds, Js, A, dq):
@@ -404,13 +418,13 @@ def _solve(C, kinds, pitch, lo, hi, q0, M, L, pos_tol, rot_tol, max_iter, restar
                             q_out[j] = q[j]
             it_total += 1
             it_attempt += 1
-        mu = max(mu / 3.0, 1e-12) if accept else mu * 8.0
-        check = it_attempt % _CHECK == 0 and not done
-        slow = check and cost > 0.9 * checkpoint
+        mu = max(mu / MU_DOWN, MU_MIN) if accept else mu * MU_UP
+        check = it_attempt % CHECK_EVERY == 0 and not done
+        slow = check and cost > STALL_RATIO * checkpoint
         if check:
             checkpoint = cost
         stalled = (not done and not within
-                   and (mu > 1e10 or slow or it_attempt >= max_iter))
+                   and (mu > MU_STALL or slow or it_attempt >= max_iter))
         restart = stalled and attempts <= restarts
         done = done or (within and (not accept or it_attempt >= max_iter))
         if done or (stalled and not restart):
@@ -418,7 +432,7 @@ def _solve(C, kinds, pitch, lo, hi, q0, M, L, pos_tol, rot_tol, max_iter, restar
         if restart:
             state = _random_q(state, kinds, lo, hi, L, qt)
             _project(qt, q0, kinds, lo, hi, limits, q)
-            mu = 1e-3
+            mu = MU_START
             checkpoint = np.inf
             it_attempt = 0
             attempts += 1
@@ -433,7 +447,7 @@ def _solve(C, kinds, pitch, lo, hi, q0, M, L, pos_tol, rot_tol, max_iter, restar
     for j in range(n):
         if limits:
             inside = inside and q_out[j] >= lo[j] and q_out[j] <= hi[j]
-        elif kinds[j] != 1:
+        elif kinds[j] != PRISMATIC:
             q_out[j] = (q_out[j] + _PI) % _TWO_PI - _PI
     t = _fk(C, kinds, pitch, q_out)
     dp = math.sqrt((t[3] - pt[0]) ** 2 + (t[7] - pt[1]) ** 2 + (t[11] - pt[2]) ** 2)

@@ -1,7 +1,7 @@
 """Compiled kernels (Numba) for forward kinematics and the Jacobian of serial chains.
 
-They compute exactly what :func:`kinestat.serial.fk.fk_reference` and
-:func:`kinestat.serial.jacobian.jacobian_reference` compute, without temporaries: the running
+They compute exactly what the NumPy references :func:`kinestat.serial._reference.fk_reference`
+and :func:`kinestat.serial._reference.jacobian_reference` compute, without temporaries: the running
 transform is held in twelve scalars, ``T · Z(q)`` touches only the columns it changes and
 ``T · C`` is an affine product. Batches are split over the cores with ``prange``.
 
@@ -16,6 +16,12 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.mechanism.joints import JointKind
+
+#: joint kind codes as plain ints (Numba freezes them at compile time)
+PRISMATIC = int(JointKind.PRISMATIC)
+SCREW = int(JointKind.SCREW)
+
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
 
@@ -23,7 +29,7 @@ _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"
 def _step(C, kind, h, qi, t):
     """Apply ``Z(qi) · C`` to the running transform ``t`` (12 values, row-major 3x4)."""
     r00, r01, r02, p0, r10, r11, r12, p1, r20, r21, r22, p2 = t
-    if kind != 1:
+    if kind != PRISMATIC:
         c = math.cos(qi)
         s = math.sin(qi)
         a0 = c * r00 + s * r01
@@ -33,7 +39,7 @@ def _step(C, kind, h, qi, t):
         r11 = c * r11 - s * r10
         r21 = c * r21 - s * r20
         r00, r10, r20 = a0, a1, a2
-        if kind == 2:
+        if kind == SCREW:
             d = h * qi
             p0 += d * r02
             p1 += d * r12
@@ -118,7 +124,7 @@ def fk_batch(C, kinds, pitch, Q, out):
 def _jac_column(t, kind, h, J, j):
     ux, uy, uz = t[2], t[6], t[10]
     px, py, pz = t[3], t[7], t[11]
-    if kind == 1:
+    if kind == PRISMATIC:
         J[0, j] = 0.0
         J[1, j] = 0.0
         J[2, j] = 0.0

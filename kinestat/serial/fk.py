@@ -1,10 +1,11 @@
-"""Forward kinematics of serial chains, batched.
+"""Forward kinematics (fk) of serial chains, batched — the theses' "forward analysis".
 
-``T(q) = C0 · Z(q1) · C1 · … · Z(qn) · Cn`` (DESIGN.md; the lecture notes'
+``T_base_end(q) = C0 · Z(q1) · C1 · … · Z(qn) · Cn`` (DESIGN.md; the lecture notes'
 ``H_n^0 = H_1^0 H_2^1 … H_n^{n-1}``).
 
-:func:`fk` runs compiled kernels (:mod:`kinestat.serial._kernels`); :func:`fk_reference` is the
-plain NumPy implementation they are tested against.
+:func:`fk` always runs the compiled kernels (:mod:`kinestat.serial._kernels`); the plain NumPy
+implementation they are tested against is :func:`kinestat.serial._reference.fk_reference`
+(private, for tests). The kernels' per-model arrays live in :mod:`kinestat.serial._kernel_cache`.
 """
 
 from __future__ import annotations
@@ -15,24 +16,29 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
+from kinestat.mechanism.joints import JointKind
 from kinestat.serial import _kernels
+from kinestat.serial._kernel_cache import _BY_ID, kernel_data
+from kinestat.serial.chunks import CHUNK_ROWS, chunk_slices
 
-__all__ = ["joint_motion", "fk", "fk_reference", "fk_frames", "joint_axes", "iter_fk",
+__all__ = ["joint_motion", "fk", "forward_analysis", "fk_frames", "joint_axes", "iter_fk",
            "CHUNK_ROWS"]
-
-#: rows per chunk for the NumPy paths and for :func:`iter_fk` (bounded temporaries)
-CHUNK_ROWS = 1 << 15
 
 
 def joint_motion(model: ChainModel, q: np.ndarray) -> np.ndarray:
     """The joint transforms ``Z(qi)``, shape ``(..., n, 4, 4)``.
 
     Revolute ``Rz(q)``, prismatic ``Tz(q)``, screw ``Rz(q) Tz(h q)`` (Nadkarni eq. 2-14).
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> slider = from_standard_dh([[0.0, 0.0, 0.0, 0.0]], ["prismatic"])
+    >>> joint_motion(slider, np.array([2.5]))[0, :3, 3]
+    array([0. , 0. , 2.5])
     """
     q = np.asarray(q, dtype=float)
     kinds = model.kind_codes
-    rot = kinds != 1
-    ang = np.where(rot, q, 0.0)
+    pris = kinds == JointKind.PRISMATIC
+    ang = np.where(pris, 0.0, q)
     c, s = np.cos(ang), np.sin(ang)
     Z = np.zeros(q.shape + (4, 4))
     Z[..., 0, 0] = c
@@ -41,7 +47,8 @@ def joint_motion(model: ChainModel, q: np.ndarray) -> np.ndarray:
     Z[..., 1, 1] = c
     Z[..., 2, 2] = 1.0
     Z[..., 3, 3] = 1.0
-    Z[..., 2, 3] = np.where(kinds == 1, q, 0.0) + np.where(kinds == 2, model.pitches * q, 0.0)
+    Z[..., 2, 3] = (np.where(pris, q, 0.0)
+                    + np.where(kinds == JointKind.SCREW, model.pitches * q, 0.0))
     return Z
 
 
@@ -83,56 +90,61 @@ _S8 = (8,)
 
 
 def fk(model: ChainModel, q) -> np.ndarray:
-    """End pose(s) ``(..., 4, 4)`` for joint values ``q`` of shape ``(..., n)``."""
+    """End pose(s) ``T_base_end (..., 4, 4)`` for joint values ``q`` of shape ``(..., n)``.
+
+    Also known as the forward analysis (Nadkarni; Vibhute): :func:`forward_analysis` is an
+    alias.
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]])  # planar RR
+    >>> np.round(fk(arm, [np.pi / 2, 0.0])[:3, 3], 12) + 0.0
+    array([0., 2., 0.])
+    >>> fk(arm, np.zeros((5, 3, 2))).shape
+    (5, 3, 4, 4)
+    """
     # fast path for one configuration: a contiguous float64 vector of the right length goes
     # straight to the compiled entry point (no per-call type dispatch)
-    if type(q) is _ND and q.strides == _S8 and q.dtype is _F64 and len(q) == model.n_joints:
-        out = (_FK_ONE or _entry("fk_one"))(model.kernel_packed, q)  # type: ignore[attr-defined]
-        if out is None:
-            raise _nonfinite()
-        return out
+    if type(q) is _ND and q.strides == _S8 and q.dtype is _F64:
+        d = _BY_ID.get(id(model))
+        if d is not None and len(q) == d.n:
+            out = (_FK_ONE or _entry("fk_one"))(d.packed, q)
+            if out is None:
+                raise _nonfinite()
+            return out
     q = _as_q(model, q)
+    d = kernel_data(model)
     if q.ndim == 1:
-        out = _kernels.fk_one(model.kernel_packed, q)  # type: ignore[attr-defined]
+        out = _kernels.fk_one(d.packed, q)
         if out is None:
             raise _nonfinite()
         return out
-    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
     lead = q.shape[:-1]
     Q = np.ascontiguousarray(q.reshape(-1, model.n))
     out = np.empty((Q.shape[0], 4, 4))
-    if _kernels.fk_batch(C, kinds, pitch, Q, out):
+    if _kernels.fk_batch(d.constants, d.kinds, d.pitches, Q, out):
         raise _nonfinite()
     return out.reshape(lead + (4, 4))
+
+
+#: the theses' name for :func:`fk`
+forward_analysis = fk
 
 
 def iter_fk(
     model: ChainModel, q, chunk_rows: int = CHUNK_ROWS
 ) -> Iterator[tuple[slice, np.ndarray]]:
     """Stream end poses over a large batch ``q (N, n)`` chunk by chunk: yields
-    ``(rows, poses)`` so that 10^7 configurations need only one chunk of output at a time."""
+    ``(rows, poses)`` so that 10^7 configurations need only one chunk of output at a time.
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0]])
+    >>> [(rows.start, T.shape) for rows, T in iter_fk(arm, np.zeros((5, 1)), chunk_rows=2)]
+    [(0, (2, 4, 4)), (2, (2, 4, 4)), (4, (1, 4, 4))]
+    """
     q = _as_q(model, q)
     Q = q.reshape(-1, model.n)
-    for start in range(0, Q.shape[0], chunk_rows):
-        rows = slice(start, min(start + chunk_rows, Q.shape[0]))
+    for rows in chunk_slices(Q.shape[0], chunk_rows):
         yield rows, fk(model, Q[rows])
-
-
-def fk_reference(model: ChainModel, q) -> np.ndarray:
-    """Plain NumPy forward kinematics (the reference the kernels are tested against)."""
-    q = model.check_q(q)
-    lead = q.shape[:-1]
-    Q = q.reshape(-1, model.n)
-    out = np.empty((Q.shape[0], 4, 4))
-    C = model.constants
-    for start in range(0, Q.shape[0], CHUNK_ROWS):
-        part = Q[start:start + CHUNK_ROWS]
-        Z = joint_motion(model, part)
-        T = np.broadcast_to(C[0], part.shape[:-1] + (4, 4))
-        for i in range(model.n):
-            T = T @ Z[:, i] @ C[i + 1]
-        out[start:start + CHUNK_ROWS] = T
-    return out.reshape(lead + (4, 4))
 
 
 def fk_frames(model: ChainModel, q) -> np.ndarray:
@@ -141,6 +153,11 @@ def fk_frames(model: ChainModel, q) -> np.ndarray:
     ``F_0 = C0`` is the frame in which joint 1 moves (its z axis is joint 1's axis), ``F_{i-1}``
     the frame of joint i, and ``F_n`` the end pose. For chains built from standard DH (and
     Nadkarni's notation) ``F_i`` is the DH frame x(i).
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+    >>> fk_frames(arm, [0.0, 0.0])[:, 0, 3]  # x of the frame origins
+    array([0., 1., 2.])
     """
     q = model.check_q(q)
     Z = joint_motion(model, q)
@@ -159,6 +176,12 @@ def joint_axes(model: ChainModel, q) -> tuple[np.ndarray, np.ndarray]:
 
     Returns ``(u, rho_n)`` each ``(..., n, 3)``; ρn(i) is the point of axis i nearest the origin
     (Nadkarni's "normal vector to the joint axis from the origin").
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+    >>> u, rho = joint_axes(arm, [0.0, 0.0])
+    >>> u[1], rho[1]
+    (array([0., 0., 1.]), array([1., 0., 0.]))
     """
     F = fk_frames(model, q)[..., :-1, :, :]
     u = F[..., :3, 2]

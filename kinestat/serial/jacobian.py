@@ -14,13 +14,23 @@ from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import _kernels
 from kinestat.serial import fk as _fkmod
-from kinestat.serial.fk import _F64, _ND, _S8, _as_q, fk_frames
+from kinestat.serial._kernel_cache import _BY_ID, kernel_data
+from kinestat.serial.fk import _F64, _ND, _S8, _as_q
 
-__all__ = ["jacobian", "jacobian_reference", "jacobian_from_frames", "fk_and_jacobian"]
+__all__ = ["jacobian", "jacobian_from_frames", "fk_and_jacobian"]
 
 
 def jacobian_from_frames(model: ChainModel, frames: np.ndarray) -> np.ndarray:
-    """Jacobian ``(..., 6, n)`` from the link frames returned by :func:`fk_frames`."""
+    """Jacobian ``(..., 6, n)`` from the link frames returned by
+    :func:`~kinestat.serial.fk.fk_frames` (the NumPy form of :func:`jacobian`).
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> from kinestat.serial.fk import fk_frames
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+    >>> J = jacobian_from_frames(arm, fk_frames(arm, [0.3, 0.4]))
+    >>> bool(np.allclose(J, jacobian(arm, [0.3, 0.4])))
+    True
+    """
     F = frames[..., :-1, :, :]
     u = F[..., :3, 2]
     rho = F[..., :3, 3]
@@ -31,42 +41,52 @@ def jacobian_from_frames(model: ChainModel, frames: np.ndarray) -> np.ndarray:
     return np.swapaxes(np.concatenate([w, v], axis=-1), -1, -2)
 
 
-def jacobian_reference(model: ChainModel, q) -> np.ndarray:
-    """Plain NumPy Jacobian (the reference the kernels are tested against)."""
-    return jacobian_from_frames(model, fk_frames(model, q))
-
-
 def jacobian(model: ChainModel, q) -> np.ndarray:
-    """Space Jacobian ``(..., 6, n)`` mapping joint rates to the end twist ``[ω; v_O]``."""
-    if type(q) is _ND and q.strides == _S8 and q.dtype is _F64 and len(q) == model.n_joints:
-        J = (_fkmod._JAC_ONE or _fkmod._entry("jacobian_one"))(
-            model.kernel_packed, q)  # type: ignore[attr-defined]
-        if J is None:
-            raise InputError("q contains NaN or infinity")
-        return J
+    """Space Jacobian ``(..., 6, n)`` mapping joint rates to the end twist ``[ω; v_O]``.
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]])  # planar RR
+    >>> J = jacobian(arm, [0.0, 0.0])
+    >>> J[2], J[4]  # ω_z and v_Oy: joint 2's axis passes through x = 1
+    (array([1., 1.]), array([ 0., -1.]))
+    """
+    if type(q) is _ND and q.strides == _S8 and q.dtype is _F64:
+        d = _BY_ID.get(id(model))
+        if d is not None and len(q) == d.n:
+            J = (_fkmod._JAC_ONE or _fkmod._entry("jacobian_one"))(d.packed, q)
+            if J is None:
+                raise InputError("q contains NaN or infinity")
+            return J
     q = _as_q(model, q)
+    d = kernel_data(model)
     if q.ndim == 1:
-        J = _kernels.jacobian_one(model.kernel_packed, q)  # type: ignore[attr-defined]
+        J = _kernels.jacobian_one(d.packed, q)
         if J is None:
             raise InputError("q contains NaN or infinity")
         return J
-    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
     lead = q.shape[:-1]
     Q = np.ascontiguousarray(q.reshape(-1, model.n))
     out = np.empty((Q.shape[0], 6, model.n))
-    if _kernels.jacobian_batch(C, kinds, pitch, Q, out):
+    if _kernels.jacobian_batch(d.constants, d.kinds, d.pitches, Q, out):
         raise InputError("q contains NaN or infinity")
     return out.reshape(lead + (6, model.n))
 
 
 def fk_and_jacobian(model: ChainModel, q) -> tuple[np.ndarray, np.ndarray]:
-    """End poses ``(..., 4, 4)`` and Jacobians ``(..., 6, n)`` in one pass."""
+    """End poses ``(..., 4, 4)`` and Jacobians ``(..., 6, n)`` in one pass.
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> arm = from_standard_dh([[0.0, 0.0, 1.0, 0.0], [0.0, 0.0, 1.0, 0.0]])
+    >>> T, J = fk_and_jacobian(arm, np.zeros((3, 2)))
+    >>> T.shape, J.shape
+    ((3, 4, 4), (3, 6, 2))
+    """
     q = _as_q(model, q)
-    C, kinds, pitch = model.kernel_args  # type: ignore[attr-defined]
+    d = kernel_data(model)
     lead = q.shape[:-1]
     Q = np.ascontiguousarray(q.reshape(-1, model.n))
     T = np.empty((Q.shape[0], 4, 4))
     J = np.empty((Q.shape[0], 6, model.n))
-    if _kernels.fk_jacobian_batch(C, kinds, pitch, Q, T, J):
+    if _kernels.fk_jacobian_batch(d.constants, d.kinds, d.pitches, Q, T, J):
         raise InputError("q contains NaN or infinity")
     return T.reshape(lead + (4, 4)), J.reshape(lead + (6, model.n))

@@ -31,7 +31,9 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError
+from kinestat.spatial.tolerances import ORTHO_TOL as _ORTHO_TOL
 from kinestat.spatial.transforms import as_array, make_pose, skew
+from kinestat.spatial.validate import as_pose, as_unit_vector, batch_index
 
 __all__ = [
     "ScrewDisplacement",
@@ -47,7 +49,7 @@ __all__ = [
 ]
 
 #: Poses are accepted when their rotation part is orthonormal to this tolerance.
-ORTHO_TOL: float = 1e-6
+ORTHO_TOL: float = _ORTHO_TOL
 #: Rotation angles (rad) at or below this are treated as zero: a pure translation.
 ANGLE_TOL: float = 1e-12
 #: Components of ``u`` within this of zero count as zero for the sign convention.
@@ -58,10 +60,7 @@ def _dot(a, b) -> np.ndarray:
     return np.einsum("...i,...i->...", a, b)
 
 
-def _where(mask: np.ndarray) -> str:
-    if mask.ndim == 0:
-        return ""
-    return f" at batch index {tuple(int(i) for i in np.argwhere(mask)[0])}"
+_where = batch_index
 
 
 def _frozen(a) -> np.ndarray:
@@ -78,6 +77,12 @@ def frame_from_points(p1, p2, p3, *, tol: float = 1e-9) -> np.ndarray:
 
     Raises :class:`InputError` when two points coincide or the three are collinear (the sine of
     the angle at ``p1`` below ``tol``).
+
+    >>> frame_from_points([1.0, 0.0, 0.0], [1.0, 0.0, 2.0], [3.0, 0.0, 0.0])
+    array([[1., 0., 0., 1.],
+           [0., 1., 0., 0.],
+           [0., 0., 1., 0.],
+           [0., 0., 0., 1.]])
     """
     p1 = as_array(p1, shape_tail=(3,), name="point 1")
     p2 = as_array(p2, shape_tail=(3,), name="point 2")
@@ -112,33 +117,30 @@ def frame_from_points(p1, p2, p3, *, tol: float = 1e-9) -> np.ndarray:
 
 
 def frame_from_triple(points, *, tol: float = 1e-9) -> np.ndarray:
-    """:func:`frame_from_points` for points ``(..., 3, 3)`` given as rows ``p1, p2, p3``."""
+    """:func:`frame_from_points` for points ``(..., 3, 3)`` given as rows ``p1, p2, p3``.
+
+    >>> frame_from_triple([[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]])
+    array([[1., 0., 0., 0.],
+           [0., 1., 0., 0.],
+           [0., 0., 1., 0.],
+           [0., 0., 0., 1.]])
+    """
     P = as_array(points, shape_tail=(3, 3), name="points")
     return frame_from_points(P[..., 0, :], P[..., 1, :], P[..., 2, :], tol=tol)
 
 
 def _check_pose(T, name: str, tol: float) -> np.ndarray:
-    T = as_array(T, shape_tail=(4, 4), name=name)
-    R = T[..., :3, :3]
-    err = np.max(np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)), axis=(-1, -2))
-    det = np.linalg.det(R)
-    bad = (err > tol) | (np.abs(det - 1.0) > tol)
-    if np.any(bad):
-        raise InputError(
-            f"{name}{_where(bad)} is not a rigid pose: its rotation part has "
-            f"max|R R^T - I| = {err[bad].flat[0]:.3g} and det = {det[bad].flat[0]:.6g}; "
-            f"it must be orthonormal with det +1 (tolerance {tol:g})"
-        )
-    bottom = np.max(np.abs(T[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])), axis=-1)
-    bad = bottom > tol
-    if np.any(bad):
-        raise InputError(f"{name}{_where(bad)}: the last row of a pose must be [0, 0, 0, 1]")
-    return T
+    return as_pose(T, name, tol=tol, last_row_tol=tol)
 
 
 def relative_displacement(T1, T2, *, tol: float = ORTHO_TOL) -> np.ndarray:
     """``D = T2 T1^-1`` ``(..., 4, 4)``, i.e. ``Q = Q2 Q1^T``, ``q = q2 - Q q1``
-    (Nadkarni eqs. 3-12, 3-13); ``X2 = Q X1 + q`` for every body point."""
+    (Nadkarni eqs. 3-12, 3-13); ``X2 = Q X1 + q`` for every body point.
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> relative_displacement(trans([1.0, 0.0, 0.0]), trans([1.0, 2.0, 0.0]))[:3, 3]
+    array([0., 2., 0.])
+    """
     T1 = _check_pose(T1, "pose 1", tol)
     T2 = _check_pose(T2, "pose 2", tol)
     Q = T2[..., :3, :3] @ np.swapaxes(T1[..., :3, :3], -1, -2)
@@ -154,6 +156,11 @@ class ScrewDisplacement:
     perpendicular from the origin to the axis; ``theta`` ``(...)`` rotation in (-pi, pi];
     ``d`` ``(...)`` translation along ``u``; ``is_translation`` ``(...)`` no rotation.
     See the module docstring for the conventions.
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> D = screw_from_poses(np.eye(4), trans([0.0, 0.0, 2.0]) @ rot_z(np.pi / 2))
+    >>> D.axis, round(float(D.theta), 12), float(D.d), bool(D.is_translation)
+    (array([0., 0., 1.]), 1.570796326795, 2.0, False)
     """
 
     axis: np.ndarray
@@ -235,6 +242,12 @@ def screw_from_displacement(
     closed-form solution of eq. 3-41. Rotations of at most ``angle_tol`` (rad) count as none (a
     pure translation; ``angle_tol=0`` makes :func:`pose_from_screw` an exact inverse for every
     input); a pure translation of at most ``length_tol`` (model units) counts as no motion.
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> D = trans([1.0, 0.0, 0.0]) @ rot_z(np.pi / 2) @ trans([-1.0, 0.0, 0.0])
+    >>> s = screw_from_displacement(D)
+    >>> s.point, round(float(s.theta), 12)  # a quarter turn about the vertical through x = 1
+    (array([1., 0., 0.]), 1.570796326795)
     """
     D = _check_pose(D, "displacement", tol)
     Q, q = D[..., :3, :3], D[..., :3, 3]
@@ -259,14 +272,27 @@ def screw_from_displacement(
 
 def screw_from_poses(T1, T2, **kw) -> ScrewDisplacement:
     """Screw axis of the displacement taking a body from pose ``T1`` to ``T2`` (``(..., 4, 4)``,
-    global frame): Nadkarni ch. III (SCREWM). Keywords as :func:`screw_from_displacement`."""
+    global frame): Nadkarni ch. III (SCREWM). Keywords as :func:`screw_from_displacement`.
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> s = screw_from_poses(np.eye(4), trans([0.0, 0.0, 3.0]))
+    >>> bool(s.is_translation), s.axis, float(s.d)
+    (True, array([0., 0., 1.]), 3.0)
+    """
     tol = kw.get("tol", ORTHO_TOL)
     return screw_from_displacement(relative_displacement(T1, T2, tol=tol), **kw)
 
 
 def screw_from_points(points1, points2, *, tol: float = 1e-9, **kw) -> ScrewDisplacement:
     """Screw axis between two body positions each located by three points ``(..., 3, 3)``
-    (rows ``p1, p2, p3`` as in :func:`frame_from_points`; Nadkarni's SET TWO cards)."""
+    (rows ``p1, p2, p3`` as in :func:`frame_from_points`; Nadkarni's SET TWO cards).
+
+    >>> P1 = [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [1.0, 0.0, 0.0]]
+    >>> P2 = [[0.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]
+    >>> s = screw_from_points(P1, P2)
+    >>> s.axis, round(float(np.degrees(s.theta)), 9)
+    (array([0., 0., 1.]), 90.0)
+    """
     T1 = frame_from_triple(points1, tol=tol)
     T2 = frame_from_triple(points2, tol=tol)
     return screw_from_poses(T1, T2, **kw)
@@ -274,7 +300,13 @@ def screw_from_points(points1, points2, *, tol: float = 1e-9, **kw) -> ScrewDisp
 
 def screws_between(poses, **kw) -> ScrewDisplacement:
     """Screws between consecutive poses ``(..., N, 4, 4)`` -> batch ``(..., N-1)``
-    (Nadkarni's DISP with MS = 1). For point triples use ``frame_from_triple`` first."""
+    (Nadkarni's DISP with MS = 1). For point triples use ``frame_from_triple`` first.
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> s = screws_between(np.stack([np.eye(4), trans([1.0, 0.0, 0.0]), trans([1.0, 1.0, 0.0])]))
+    >>> s.d
+    array([1., 1.])
+    """
     P = as_array(poses, shape_tail=(4, 4), name="poses")
     if P.ndim < 3 or P.shape[-3] < 2:
         raise InputError(f"screws_between needs at least two poses (..., N, 4, 4), got {P.shape}")
@@ -286,16 +318,16 @@ def pose_from_screw(axis, point, theta, d) -> np.ndarray:
     line through ``point`` along ``axis`` (normalised) and translation ``d`` along it, so that
     ``T2 = D @ T1``. ``Q = I + sin(theta) [u]x + 2 sin^2(theta/2) [u]x^2`` (Rodrigues) and
     ``q = (I - Q) point + d u``, the latter as ``2 sin^2(theta/2) c - sin(theta) u x c`` with
-    ``c`` the part of ``point`` normal to ``u`` (accurate even for far-away axes)."""
-    u = as_array(axis, shape_tail=(3,), name="axis")
+    ``c`` the part of ``point`` normal to ``u`` (accurate even for far-away axes).
+
+    >>> D = pose_from_screw([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], np.pi, 0.0)  # half turn about x = 1
+    >>> np.round(D[:3, 3], 12) + 0.0
+    array([2., 0., 0.])
+    """
+    u = as_unit_vector(axis, "axis", normalize=True)
     c = as_array(point, shape_tail=(3,), name="point")
     theta = as_array(theta, name="theta")
     d = as_array(d, name="d")
-    nu = np.linalg.norm(u, axis=-1)
-    bad = nu == 0.0
-    if np.any(bad):
-        raise InputError(f"axis is the zero vector{_where(bad)}: give a nonzero axis direction")
-    u = u / nu[..., None]
     s, h2 = np.sin(theta), 2.0 * np.sin(0.5 * theta) ** 2
     K = skew(u)
     Q = np.eye(3) + s[..., None, None] * K + h2[..., None, None] * (K @ K)
@@ -308,7 +340,12 @@ def interpolate_screw(T1, T2, s, **kw) -> np.ndarray:
     """Pose(s) at fraction ``s`` of the screw motion from ``T1`` to ``T2`` (``s = 0`` gives
     ``T1``, ``s = 1`` gives ``T2``): rotation ``s theta`` and translation ``s d`` about/along the
     fixed screw axis (Nadkarni's screw path, analysis type II). ``s`` broadcasts against the
-    batch shape of the poses; values outside [0, 1] extrapolate."""
+    batch shape of the poses; values outside [0, 1] extrapolate.
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> interpolate_screw(np.eye(4), trans([2.0, 0.0, 0.0]), 0.25)[:3, 3]
+    array([0.5, 0. , 0. ])
+    """
     sc = screw_from_poses(T1, T2, **kw)
     s = as_array(s, name="s")
     D = pose_from_screw(sc.axis, sc.point, s * sc.theta, s * sc.d)

@@ -51,7 +51,11 @@ ORTHO_TOL: float = 1e-6
 
 
 def check_sequence(seq: str) -> str:
-    """Return ``seq`` if it is one of :data:`EULER_SEQUENCES`, else raise :class:`InputError`."""
+    """Return ``seq`` if it is one of :data:`EULER_SEQUENCES`, else raise :class:`InputError`.
+
+    >>> check_sequence('ZYX')
+    'ZYX'
+    """
     if not isinstance(seq, str) or seq not in EULER_SEQUENCES:
         raise InputError(
             f"unknown Euler sequence {seq!r}: use three axes from x, y, z with no two consecutive "
@@ -62,7 +66,11 @@ def check_sequence(seq: str) -> str:
 
 
 def is_proper_sequence(seq: str) -> bool:
-    """True for the proper (symmetric) Euler sequences such as ``ZXZ``; False for Tait-Bryan."""
+    """True for the proper (symmetric) Euler sequences such as ``ZXZ``; False for Tait-Bryan.
+
+    >>> is_proper_sequence('ZXZ'), is_proper_sequence('ZYX')
+    (True, False)
+    """
     return check_sequence(seq)[0].lower() == seq[2].lower()
 
 
@@ -70,6 +78,11 @@ def matrix_from_euler(angles, seq: str, *, degrees: bool = False) -> np.ndarray:
     """Rotation matrices ``(..., 3, 3)`` from Euler angles ``(..., 3)`` in sequence ``seq``.
 
     Lecture notes (Euler angles of the end effector); composition as in SciPy's ``from_euler``.
+
+    >>> np.round(matrix_from_euler([90.0, 0.0, 0.0], 'ZYX', degrees=True), 12) + 0.0
+    array([[ 0., -1.,  0.],
+           [ 1.,  0.,  0.],
+           [ 0.,  0.,  1.]])
     """
     check_sequence(seq)
     a = as_array(angles, shape_tail=(3,), name="Euler angles")
@@ -160,6 +173,10 @@ def euler_from_matrix(
 
     Raises :class:`InputError` for an unknown sequence, a NaN, or a matrix that is not a rotation
     within ``tol``.
+
+    >>> R = matrix_from_euler([30.0, 20.0, 10.0], 'ZYX', degrees=True)
+    >>> np.round(euler_from_matrix(R, 'ZYX', degrees=True), 9)
+    array([30., 20., 10.])
     """
     check_sequence(seq)
     R = as_array(R, shape_tail=(3, 3), name="R")

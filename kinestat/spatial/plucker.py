@@ -14,6 +14,7 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.spatial.transforms import as_array
+from kinestat.spatial.validate import as_unit_vector
 
 __all__ = [
     "LINE_KINDS",
@@ -59,7 +60,11 @@ def _dot(a, b) -> np.ndarray:
 
 def line_from_points(p1, p2) -> np.ndarray:
     """Line through ``p1`` and ``p2`` (``(..., 3)`` each): ``S = (r2 - r1)/|r2 - r1|``,
-    ``S0 = r1 x S`` (Vibhute eqs. A-2, A-7)."""
+    ``S0 = r1 x S`` (Vibhute eqs. A-2, A-7).
+
+    >>> line_from_points([0.0, 1.0, 0.0], [1.0, 1.0, 0.0])  # [S; p x S]
+    array([ 1.,  0.,  0.,  0.,  0., -1.])
+    """
     p1 = as_array(p1, shape_tail=(3,), name="p1")
     p2 = as_array(p2, shape_tail=(3,), name="p2")
     s = p2 - p1
@@ -73,14 +78,13 @@ def line_from_points(p1, p2) -> np.ndarray:
 
 
 def line_from_point_direction(p, s) -> np.ndarray:
-    """Line through point ``p`` with direction ``s`` (any nonzero length): ``[S; p x S]``."""
+    """Line through point ``p`` with direction ``s`` (any nonzero length): ``[S; p x S]``.
+
+    >>> line_from_point_direction([0.0, 1.0, 0.0], [2.0, 0.0, 0.0])
+    array([ 1.,  0.,  0.,  0.,  0., -1.])
+    """
     p = as_array(p, shape_tail=(3,), name="point")
-    s = as_array(s, shape_tail=(3,), name="direction")
-    n = np.linalg.norm(s, axis=-1)
-    bad = n == 0.0
-    if np.any(bad):
-        raise InputError(f"direction is the zero vector{_where(bad)}: give a nonzero direction")
-    S = s / n[..., None]
+    S = as_unit_vector(s, "direction", normalize=True)
     return np.concatenate(np.broadcast_arrays(S, np.cross(p, S)), axis=-1)
 
 
@@ -89,6 +93,9 @@ def normalize_line(line, *, tol: float = 1e-6) -> np.ndarray:
 
     Raises :class:`InputError` if ``S = 0`` (a line at infinity) or the Plücker condition
     ``S . S0 = 0`` (Vibhute eq. A-8) fails by more than ``tol`` relative to ``|S| |S0|``.
+
+    >>> normalize_line([2.0, 0.0, 0.0, 0.0, 0.0, -2.0])
+    array([ 1.,  0.,  0.,  0.,  0., -1.])
     """
     L = as_array(line, shape_tail=(6,), name="line")
     S, S0 = L[..., :3], L[..., 3:]
@@ -108,7 +115,11 @@ def normalize_line(line, *, tol: float = 1e-6) -> np.ndarray:
 
 
 def is_line(line, tol: float = 1e-9) -> np.ndarray:
-    """True where ``line`` satisfies the Plücker condition ``S . S0 = 0`` with ``S != 0``."""
+    """True where ``line`` satisfies the Plücker condition ``S . S0 = 0`` with ``S != 0``.
+
+    >>> bool(is_line([1.0, 0.0, 0.0, 0.0, 0.0, -1.0])), bool(is_line([1.0, 0, 0, 1.0, 0, 0]))
+    (True, False)
+    """
     L = np.asarray(line, dtype=float)
     S, S0 = L[..., :3], L[..., 3:]
     n = np.linalg.norm(S, axis=-1)
@@ -116,14 +127,23 @@ def is_line(line, tol: float = 1e-9) -> np.ndarray:
 
 
 def point_on_line(line) -> np.ndarray:
-    """Foot of the perpendicular from the origin to the line: ``S x S0 / (S . S)``."""
+    """Foot of the perpendicular from the origin to the line: ``S x S0 / (S . S)``.
+
+    >>> point_on_line([1.0, 0.0, 0.0, 0.0, 0.0, -1.0]) + 0.0
+    array([0., 1., 0.])
+    """
     L = normalize_line(line)
     return np.cross(L[..., :3], L[..., 3:])
 
 
 def transform_line(T, line) -> np.ndarray:
     """Express lines given in frame B in frame A, with ``T`` the pose of B in A:
-    ``S' = R S``, ``S0' = R S0 + p x R S``."""
+    ``S' = R S``, ``S0' = R S0 + p x R S``.
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> transform_line(trans([0.0, 0.0, 5.0]), [1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
+    array([1., 0., 0., 0., 5., 0.])
+    """
     T = as_array(T, shape_tail=(4, 4), name="T")
     L = normalize_line(line)
     R, p = T[..., :3, :3], T[..., :3, 3]
@@ -138,6 +158,11 @@ def mutual_moment(l1, l2) -> np.ndarray:
     Equals ``(r1 - r2) . (S1 x S2)`` for points ``r1``, ``r2`` on the lines, i.e. ``-a sin(alpha)``
     with ``a`` the common-normal length and ``alpha`` the twist angle from S1 to S2 about it. Zero
     exactly when the lines are coplanar (intersect or are parallel).
+
+    >>> x_axis = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+    >>> y_at_z1 = line_from_point_direction([0.0, 0.0, 1.0], [0.0, 1.0, 0.0])
+    >>> float(mutual_moment(x_axis, y_at_z1))  # -distance x sin(angle)
+    -1.0
     """
     a = normalize_line(l1)
     b = normalize_line(l2)
@@ -153,6 +178,11 @@ class CommonNormal:
     where any perpendicular will do, a fixed perpendicular to ``S1``); ``distance`` its length.
     For parallel lines the common normal is not unique: the one through the foot of the
     perpendicular from the origin to line 1 is returned.
+
+    >>> y_at_z1 = line_from_point_direction([0.0, 0.0, 1.0], [0.0, 1.0, 0.0])
+    >>> n = common_normal([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], y_at_z1)
+    >>> n.foot1, n.foot2, float(n.distance)
+    (array([0., 0., 0.]), array([0., 0., 1.]), 1.0)
     """
 
     foot1: np.ndarray
@@ -212,6 +242,11 @@ def common_normal(l1, l2, *, tol: float = 1e-9, angle_tol: float = 1e-9) -> Comm
 
     Lines whose directions differ by less than ``angle_tol`` (``|S1 x S2|``) are treated as
     parallel; feet closer than ``tol`` (length unit of the lines) as meeting.
+
+    >>> y_at_z1 = line_from_point_direction([0.0, 0.0, 1.0], [0.0, 1.0, 0.0])
+    >>> n = common_normal([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], y_at_z1)
+    >>> n.direction, float(n.distance)
+    (array([0., 0., 1.]), 1.0)
     """
     foot1, foot2, direction, dist, _ = _normal(
         normalize_line(l1), normalize_line(l2), angle_tol, tol
@@ -220,7 +255,12 @@ def common_normal(l1, l2, *, tol: float = 1e-9, angle_tol: float = 1e-9) -> Comm
 
 
 def line_distance(l1, l2, *, angle_tol: float = 1e-9) -> np.ndarray:
-    """Shortest distance between two lines ``(..., 6)`` (0 where they meet)."""
+    """Shortest distance between two lines ``(..., 6)`` (0 where they meet).
+
+    >>> y_at_z2 = line_from_point_direction([0.0, 0.0, 2.0], [0.0, 1.0, 0.0])
+    >>> float(line_distance([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], y_at_z2))
+    2.0
+    """
     return _normal(normalize_line(l1), normalize_line(l2), angle_tol, 0.0)[3]
 
 
@@ -230,7 +270,12 @@ class LinePair:
     ``distance``, the ``angle`` between their directions in [0, pi], and the feet of the common
     normal ``foot1`` (on line 1) and ``foot2`` (on line 2). For intersecting lines both feet are
     the intersection point; for coincident lines both are the foot of the perpendicular from the
-    origin."""
+    origin.
+
+    >>> p = classify_lines([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], [0.0, 1.0, 0.0, 0.0, 0.0, 0.0])
+    >>> LINE_KINDS[int(p.kind)], float(p.distance), round(float(p.angle), 12)
+    ('intersecting', 0.0, 1.570796326795)
+    """
 
     kind: np.ndarray
     distance: np.ndarray
@@ -260,6 +305,10 @@ def classify_lines(l1, l2, tol: float = 1e-9, *, angle_tol: float = 1e-9) -> Lin
 
     ``tol`` is the distance (in the lines' length unit) below which they are taken to meet and
     ``angle_tol`` the ``|S1 x S2|`` below which they are parallel.
+
+    >>> x_at_y1 = line_from_point_direction([0.0, 1.0, 0.0], [1.0, 0.0, 0.0])
+    >>> LINE_KINDS[int(classify_lines([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], x_at_y1).kind)]
+    'parallel'
     """
     a, b = normalize_line(l1), normalize_line(l2)
     foot1, foot2, _, dist, parallel = _normal(a, b, angle_tol, tol)

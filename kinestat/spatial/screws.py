@@ -50,14 +50,22 @@ def _where(mask: np.ndarray) -> str:
 
 
 def twist(omega, v) -> np.ndarray:
-    """Twist ``[w; v_O]`` ``(..., 6)`` from angular velocity and the origin point's velocity."""
+    """Twist ``[w; v_O]`` ``(..., 6)`` from angular velocity and the origin point's velocity.
+
+    >>> twist([0.0, 0.0, 1.0], [1.0, 0.0, 0.0])
+    array([0., 0., 1., 1., 0., 0.])
+    """
     w = as_array(omega, shape_tail=(3,), name="omega")
     v = as_array(v, shape_tail=(3,), name="v")
     return np.concatenate(np.broadcast_arrays(w, v), axis=-1)
 
 
 def wrench(force, moment) -> np.ndarray:
-    """Wrench ``[f; m_O]`` ``(..., 6)`` from a force and its moment about the origin."""
+    """Wrench ``[f; m_O]`` ``(..., 6)`` from a force and its moment about the origin.
+
+    >>> wrench([0.0, 0.0, -10.0], [0.0, 0.0, 0.0])
+    array([  0.,   0., -10.,   0.,   0.,   0.])
+    """
     f = as_array(force, shape_tail=(3,), name="force")
     m = as_array(moment, shape_tail=(3,), name="moment")
     return np.concatenate(np.broadcast_arrays(f, m), axis=-1)
@@ -67,6 +75,10 @@ def adjoint(T) -> np.ndarray:
     """6x6 matrices ``[[R, 0], [[p]x R, R]]`` ``(..., 6, 6)`` of poses ``T`` (pose of B in A).
 
     Maps twists and wrenches written in B to the same twists and wrenches written in A.
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> adjoint(trans([1.0, 0.0, 0.0])).shape
+    (6, 6)
     """
     T = as_array(T, shape_tail=(4, 4), name="T")
     R, p = T[..., :3, :3], T[..., :3, 3]
@@ -78,26 +90,47 @@ def adjoint(T) -> np.ndarray:
 
 
 def transform_twist(T, V) -> np.ndarray:
-    """Twist ``V`` written in frame B, rewritten in frame A (``T`` = pose of B in A)."""
+    """Twist ``V`` written in frame B, rewritten in frame A (``T`` = pose of B in A).
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> spin = twist([0.0, 0.0, 1.0], [0.0, 0.0, 0.0])
+    >>> transform_twist(trans([1.0, 0.0, 0.0]), spin)  # the spin about the line x = 1
+    array([ 0.,  0.,  1.,  0., -1.,  0.])
+    """
     V = as_array(V, shape_tail=(6,), name="twist")
     return np.einsum("...ij,...j->...i", adjoint(T), V)
 
 
 def transform_wrench(T, W) -> np.ndarray:
-    """Wrench ``W`` written in frame B, rewritten in frame A (``T`` = pose of B in A)."""
+    """Wrench ``W`` written in frame B, rewritten in frame A (``T`` = pose of B in A).
+
+    >>> from kinestat.spatial.transforms import rot_z, trans
+    >>> transform_wrench(trans([1.0, 0.0, 0.0]), wrench([0.0, 0.0, -10.0], [0.0, 0.0, 0.0]))
+    array([  0.,   0., -10.,   0.,  10.,   0.])
+    """
     W = as_array(W, shape_tail=(6,), name="wrench")
     return np.einsum("...ij,...j->...i", adjoint(T), W)
 
 
 def reciprocal_product(s1, s2) -> np.ndarray:
-    """Reciprocal product ``a1 . b2 + b1 . a2`` of screws ``[a1; b1]`` and ``[a2; b2]``."""
+    """Reciprocal product ``a1 . b2 + b1 . a2`` of screws ``[a1; b1]`` and ``[a2; b2]``.
+
+    >>> spin, push = twist([0.0, 0, 1.0], [0.0, 0, 0]), wrench([0.0, 0, 1.0], [0.0, 0, 0])
+    >>> float(reciprocal_product(spin, push))  # coaxial, both of zero pitch
+    0.0
+    """
     s1 = as_array(s1, shape_tail=(6,), name="screw 1")
     s2 = as_array(s2, shape_tail=(6,), name="screw 2")
     return _dot(s1[..., :3], s2[..., 3:]) + _dot(s1[..., 3:], s2[..., :3])
 
 
 def power(V, W) -> np.ndarray:
-    """Power ``w . m_O + v_O . f`` of wrench ``W`` on twist ``V`` (same frame); frame invariant."""
+    """Power ``w . m_O + v_O . f`` of wrench ``W`` on twist ``V`` (same frame); frame invariant.
+
+    >>> V, W = twist([0.0, 0.0, 2.0], [1.0, 0.0, 0.0]), wrench([3.0, 0.0, 0.0], [0.0, 0.0, 0.5])
+    >>> float(power(V, W))  # f·v_O + m_O·ω = 3 + 1
+    4.0
+    """
     return reciprocal_product(V, W)
 
 
@@ -116,6 +149,9 @@ def pitch(s, *, tol: float = 1e-12) -> np.ndarray:
     """Pitch ``h = a . b / a . a`` of screws ``[a; b]``; ``inf`` where ``|a| <= tol |b|``.
 
     For a twist: translation per radian along the axis; for a wrench: couple per unit force.
+
+    >>> float(pitch([0.0, 0.0, 1.0, 0.0, 0.0, 0.5]))
+    0.5
     """
     a, b, na, _, infinite = _split(s, tol, "screw")
     return np.where(infinite, np.inf, _dot(a, b) / np.where(infinite, 1.0, na * na))
@@ -123,7 +159,11 @@ def pitch(s, *, tol: float = 1e-12) -> np.ndarray:
 
 def screw_magnitude(s, *, tol: float = 1e-12) -> np.ndarray:
     """``|a|`` of screws ``[a; b]`` (angular speed, force), or ``|b|`` where the pitch is
-    infinite (translation speed, couple)."""
+    infinite (translation speed, couple).
+
+    >>> float(screw_magnitude([0.0, 0.0, 2.0, 0.0, 0.0, 1.0]))
+    2.0
+    """
     _, _, na, nb, infinite = _split(s, tol, "screw")
     return np.where(infinite, nb, na)
 
@@ -131,7 +171,11 @@ def screw_magnitude(s, *, tol: float = 1e-12) -> np.ndarray:
 def screw_axis(s, *, tol: float = 1e-12) -> np.ndarray:
     """Axis line ``[S; S0]`` ``(..., 6)`` of screws ``[a; b]``: ``S = a/|a|``,
     ``S0 = (b - h a)/|a|``. For infinite pitch, the line through the origin along ``b``
-    (every parallel line is an axis then)."""
+    (every parallel line is an axis then).
+
+    >>> screw_axis([0.0, 0.0, 2.0, 2.0, 0.0, 1.0])
+    array([0., 0., 1., 1., 0., 0.])
+    """
     a, b, na, nb, infinite = _split(s, tol, "screw")
     sa = np.where(infinite, 1.0, na)[..., None]
     h = np.where(infinite, 0.0, _dot(a, b) / (sa[..., 0] ** 2))[..., None]
@@ -142,7 +186,11 @@ def screw_axis(s, *, tol: float = 1e-12) -> np.ndarray:
 
 def screw_from_axis(line, pitch, magnitude=1.0) -> np.ndarray:
     """Screw ``magnitude * [S; S0 + h S]`` on axis ``line`` with pitch ``h``; for ``h = inf``,
-    ``magnitude * [0; S]``. A twist (``magnitude`` = angular speed) or a wrench (force)."""
+    ``magnitude * [0; S]``. A twist (``magnitude`` = angular speed) or a wrench (force).
+
+    >>> screw_from_axis([0.0, 0.0, 1.0, 0.0, 0.0, 0.0], 0.5, 2.0)
+    array([0., 0., 2., 0., 0., 1.])
+    """
     L = normalize_line(line)
     h = np.asarray(pitch, dtype=float)
     if np.any(np.isnan(h)):
@@ -160,7 +208,14 @@ def screw_from_axis(line, pitch, magnitude=1.0) -> np.ndarray:
 
 def twist_matrix(V) -> np.ndarray:
     """4x4 matrices ``[[w]x, v; 0, 0]`` of twists ``[w; v]``; ``expm`` of it (times t) is the
-    rigid displacement produced by the twist in time t."""
+    rigid displacement produced by the twist in time t.
+
+    >>> twist_matrix([0.0, 0.0, 1.0, 1.0, 0.0, 0.0]) + 0.0
+    array([[ 0., -1.,  0.,  1.],
+           [ 1.,  0.,  0.,  0.],
+           [ 0.,  0.,  0.,  0.],
+           [ 0.,  0.,  0.,  0.]])
+    """
     V = as_array(V, shape_tail=(6,), name="twist")
     out = np.zeros(V.shape[:-1] + (4, 4))
     out[..., :3, :3] = skew(V[..., :3])

@@ -31,7 +31,11 @@ __all__ = [
 
 
 def as_array(x, *, shape_tail: tuple[int, ...] = (), name: str = "value") -> np.ndarray:
-    """Convert to a float64 array, checking the trailing shape and finiteness."""
+    """Convert to a float64 array, checking the trailing shape and finiteness.
+
+    >>> as_array([1, 2], name='q')
+    array([1., 2.])
+    """
     try:
         a = np.asarray(x, dtype=float)
     except (TypeError, ValueError) as exc:  # strings, ragged lists, None in a list...
@@ -58,22 +62,38 @@ def _rot(angle, axis: int) -> np.ndarray:
 
 
 def rot_x(angle) -> np.ndarray:
-    """4x4 rotation about x by ``angle`` (radians), batched over ``angle``."""
+    """4x4 rotation about x by ``angle`` (radians), batched over ``angle``.
+
+    >>> np.round(rot_x(np.pi / 2) @ [0.0, 1.0, 0.0, 1.0], 12) + 0.0
+    array([0., 0., 1., 1.])
+    """
     return _rot(angle, 0)
 
 
 def rot_y(angle) -> np.ndarray:
-    """4x4 rotation about y by ``angle`` (radians), batched over ``angle``."""
+    """4x4 rotation about y by ``angle`` (radians), batched over ``angle``.
+
+    >>> np.round(rot_y(np.pi / 2) @ [0.0, 0.0, 1.0, 1.0], 12) + 0.0
+    array([1., 0., 0., 1.])
+    """
     return _rot(angle, 1)
 
 
 def rot_z(angle) -> np.ndarray:
-    """4x4 rotation about z by ``angle`` (radians), batched over ``angle``."""
+    """4x4 rotation about z by ``angle`` (radians), batched over ``angle``.
+
+    >>> rot_z([0.0, 0.5, 1.0]).shape
+    (3, 4, 4)
+    """
     return _rot(angle, 2)
 
 
 def trans(p) -> np.ndarray:
-    """4x4 pure translation by the vector(s) ``p`` of shape ``(..., 3)``."""
+    """4x4 pure translation by the vector(s) ``p`` of shape ``(..., 3)``.
+
+    >>> trans([1.0, 2.0, 3.0])[:3, 3]
+    array([1., 2., 3.])
+    """
     p = np.asarray(p, dtype=float)
     out = np.zeros(p.shape[:-1] + (4, 4))
     out[..., [0, 1, 2, 3], [0, 1, 2, 3]] = 1.0
@@ -82,19 +102,31 @@ def trans(p) -> np.ndarray:
 
 
 def trans_x(d) -> np.ndarray:
-    """4x4 translation along x by ``d``."""
+    """4x4 translation along x by ``d``.
+
+    >>> trans_x(2.0)[:3, 3]
+    array([2., 0., 0.])
+    """
     d = np.asarray(d, dtype=float)
     return trans(np.stack([d, np.zeros_like(d), np.zeros_like(d)], axis=-1))
 
 
 def trans_z(d) -> np.ndarray:
-    """4x4 translation along z by ``d``."""
+    """4x4 translation along z by ``d``.
+
+    >>> trans_z(2.0)[:3, 3]
+    array([0., 0., 2.])
+    """
     d = np.asarray(d, dtype=float)
     return trans(np.stack([np.zeros_like(d), np.zeros_like(d), d], axis=-1))
 
 
 def make_pose(R, p) -> np.ndarray:
-    """Pose from rotation ``(..., 3, 3)`` and translation ``(..., 3)``."""
+    """Pose from rotation ``(..., 3, 3)`` and translation ``(..., 3)``.
+
+    >>> make_pose(np.eye(3), [1.0, 2.0, 3.0])[:, 3]
+    array([1., 2., 3., 1.])
+    """
     R = np.asarray(R, dtype=float)
     p = np.asarray(p, dtype=float)
     shape = np.broadcast_shapes(R.shape[:-2], p.shape[:-1])
@@ -106,17 +138,30 @@ def make_pose(R, p) -> np.ndarray:
 
 
 def rotation(T) -> np.ndarray:
-    """Rotation part ``(..., 3, 3)`` of poses."""
+    """Rotation part ``(..., 3, 3)`` of poses.
+
+    >>> rotation(trans([1.0, 2.0, 3.0])).shape
+    (3, 3)
+    """
     return np.asarray(T)[..., :3, :3]
 
 
 def translation(T) -> np.ndarray:
-    """Translation part ``(..., 3)`` of poses."""
+    """Translation part ``(..., 3)`` of poses.
+
+    >>> translation(trans([1.0, 2.0, 3.0]))
+    array([1., 2., 3.])
+    """
     return np.asarray(T)[..., :3, 3]
 
 
 def inv(T) -> np.ndarray:
-    """Inverse of rigid transforms, ``[R p; 0 1]^-1 = [R^T, -R^T p; 0 1]``."""
+    """Inverse of rigid transforms, ``[R p; 0 1]^-1 = [R^T, -R^T p; 0 1]``.
+
+    >>> T_base_tool = trans([1.0, 2.0, 3.0]) @ rot_z(0.3)
+    >>> bool(np.allclose(inv(T_base_tool) @ T_base_tool, np.eye(4)))
+    True
+    """
     T = np.asarray(T, dtype=float)
     R = T[..., :3, :3]
     Rt = np.swapaxes(R, -1, -2)
@@ -124,7 +169,11 @@ def inv(T) -> np.ndarray:
 
 
 def compose(*Ts) -> np.ndarray:
-    """Product ``T1 @ T2 @ ...`` with broadcasting over leading dimensions."""
+    """Product ``T1 @ T2 @ ...`` with broadcasting over leading dimensions.
+
+    >>> compose(trans([1.0, 0.0, 0.0]), trans([0.0, 2.0, 0.0]))[:3, 3]
+    array([1., 2., 0.])
+    """
     out = np.asarray(Ts[0], dtype=float)
     for T in Ts[1:]:
         out = out @ np.asarray(T, dtype=float)
@@ -132,20 +181,33 @@ def compose(*Ts) -> np.ndarray:
 
 
 def apply(T, points) -> np.ndarray:
-    """Transform points ``(..., 3)`` by poses ``(..., 4, 4)``."""
+    """Transform points ``(..., 3)`` by poses ``(..., 4, 4)``.
+
+    >>> apply(trans([1.0, 0.0, 0.0]), [[0.0, 0.0, 0.0], [1.0, 1.0, 1.0]])
+    array([[1., 0., 0.],
+           [2., 1., 1.]])
+    """
     T = np.asarray(T, dtype=float)
     points = np.asarray(points, dtype=float)
     return np.einsum("...ij,...j->...i", T[..., :3, :3], points) + T[..., :3, 3]
 
 
 def apply_vector(T, vectors) -> np.ndarray:
-    """Rotate free vectors ``(..., 3)`` by the rotation part of poses."""
+    """Rotate free vectors ``(..., 3)`` by the rotation part of poses.
+
+    >>> apply_vector(trans([1.0, 0.0, 0.0]), [0.0, 0.0, 1.0])
+    array([0., 0., 1.])
+    """
     T = np.asarray(T, dtype=float)
     return np.einsum("...ij,...j->...i", T[..., :3, :3], np.asarray(vectors, dtype=float))
 
 
 def is_rotation(R, tol: float = 1e-9) -> np.ndarray:
-    """True where ``R`` is orthonormal with determinant +1 (to ``tol``)."""
+    """True where ``R`` is orthonormal with determinant +1 (to ``tol``).
+
+    >>> bool(is_rotation(rot_z(0.5)[:3, :3])), bool(is_rotation(2 * np.eye(3)))
+    (True, False)
+    """
     R = np.asarray(R, dtype=float)
     eye = np.eye(3)
     ortho = np.max(np.abs(R @ np.swapaxes(R, -1, -2) - eye), axis=(-1, -2)) <= tol
@@ -153,7 +215,11 @@ def is_rotation(R, tol: float = 1e-9) -> np.ndarray:
 
 
 def skew(v) -> np.ndarray:
-    """Skew-symmetric matrices ``[v]x`` of shape ``(..., 3, 3)`` with ``[v]x w = v x w``."""
+    """Skew-symmetric matrices ``[v]x`` of shape ``(..., 3, 3)`` with ``[v]x w = v x w``.
+
+    >>> skew([1.0, 2.0, 3.0]) @ [4.0, 5.0, 6.0]  # = (1, 2, 3) x (4, 5, 6)
+    array([-3.,  6., -3.])
+    """
     v = np.asarray(v, dtype=float)
     out = np.zeros(v.shape[:-1] + (3, 3))
     out[..., 0, 1] = -v[..., 2]

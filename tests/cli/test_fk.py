@@ -48,3 +48,23 @@ def test_fk_prismatic_values_are_lengths(capsys):
 def test_fk_errors(capsys, args, msg):
     assert main(args) == 2
     assert msg in capsys.readouterr().err
+
+
+def test_fk_other_models_use_their_own_words(capsys):
+    out = run_json(capsys, "fk", "puma560", "--q", "0.1,0.2,0.3,0.4,0.5,0.6", "--json")
+    m = kinestat.load("puma560")
+    T = kinestat.fk(m, [0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+    assert "s6" not in out and "a67" not in out
+    np.testing.assert_allclose(out["z_base_end"], T[:3, 2], atol=1e-12)
+    np.testing.assert_allclose(out["x_base_end"], T[:3, 0], atol=1e-12)
+    assert out["joint_names"] == [j.name for j in m.joints]
+    assert main(["fk", "puma560", "--q", "0.1,0.2,0.3,0.4,0.5,0.6"]) == 0
+    text = capsys.readouterr().out
+    assert "S6" not in text and "a67" not in text
+    assert all(j.name in text for j in m.joints)
+
+
+def test_fk_puma762_human_output_keeps_thesis_words(capsys):
+    assert main(["fk", "puma762", "--q-deg", "200,10,20,30,40,50"]) == 0
+    text = capsys.readouterr().out
+    assert "S6_F" in text and "a67_F" in text

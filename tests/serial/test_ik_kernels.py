@@ -15,7 +15,7 @@ from kinestat.errors import InputError, UnreachableError
 from kinestat.mechanism.chain import from_modified_dh, from_standard_dh
 from kinestat.serial import _ik_kernels as K
 from kinestat.serial import puma762 as P
-from kinestat.serial.fk import fk_reference
+from kinestat.serial._reference import fk_reference
 from kinestat.serial.ik import ik, iter_ik, model_scale, pose_error, wrap_joints
 
 TWO_PI = 2 * math.pi

@@ -6,8 +6,9 @@ import pytest
 import kinestat
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import from_modified_dh, from_standard_dh
-from kinestat.serial.fk import fk_reference, iter_fk
-from kinestat.serial.jacobian import fk_and_jacobian, jacobian_reference
+from kinestat.serial._reference import fk_reference, jacobian_reference
+from kinestat.serial.fk import iter_fk
+from kinestat.serial.jacobian import fk_and_jacobian
 
 
 def random_chain(rng):

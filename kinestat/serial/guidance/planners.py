@@ -42,10 +42,10 @@ from scipy.spatial.transform import Rotation
 from kinestat.errors import InputError
 from kinestat.spatial.displacement import (
     frame_from_triple,
-    pose_from_screw,
     screw_from_poses,
 )
-from kinestat.spatial.transforms import as_array, make_pose, trans
+from kinestat.spatial.se3 import pose_error, twist_exp
+from kinestat.spatial.transforms import as_array, make_pose
 
 __all__ = [
     "Path",
@@ -112,40 +112,10 @@ def _pose(T, name: str) -> np.ndarray:
     return T
 
 
-def twist_exp(V) -> np.ndarray:
-    """Rigid displacement ``(..., 4, 4)`` produced by the twist ``V = [ω; v_O]`` ``(..., 6)``
-    (the matrix exponential of :func:`kinestat.spatial.screws.twist_matrix`), via its screw:
-    θ = |ω|, u = ω/θ, d = u·v, ρn = ω×v/θ² (eqs. 4-19a read backwards)."""
-    V = as_array(V, shape_tail=(6,), name="twist")
-    w, v = V[..., :3], V[..., 3:]
-    th = np.linalg.norm(w, axis=-1)
-    rot = th > 1e-15
-    ths = np.where(rot, th, 1.0)
-    u = np.where(rot[..., None], w / ths[..., None], np.array([0.0, 0.0, 1.0]))
-    d = np.sum(u * v, axis=-1)
-    point = np.where(rot[..., None], np.cross(w, v) / (ths**2)[..., None], 0.0)
-    D = pose_from_screw(u, point, np.where(rot, th, 0.0), np.where(rot, d, 0.0))
-    return np.where(rot[..., None, None], D, trans(v))
-
-
 def twist_between(T1, T2) -> np.ndarray:
     """Twist ``ξ`` ``(..., 6)`` with ``twist_exp(ξ) @ T1 = T2``: the screw displacement of
     Nadkarni ch. III as ``[θU; hθU − θU×ρn]`` (eq. 4-19a with k = 1)."""
     return screw_from_poses(T1, T2).twist
-
-
-def pose_error(T, T_ref) -> tuple[np.ndarray, np.ndarray]:
-    """``(distance between origins, rotation angle in rad)`` between poses, batched."""
-    T = np.asarray(T, dtype=float)
-    T_ref = np.asarray(T_ref, dtype=float)
-    dp = np.linalg.norm(T[..., :3, 3] - T_ref[..., :3, 3], axis=-1)
-    R = np.swapaxes(T_ref[..., :3, :3], -1, -2) @ T[..., :3, :3]
-    c = np.clip((np.trace(R, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
-    # acos is inaccurate near 0: use the skew part for small angles
-    s = 0.5 * np.linalg.norm(
-        np.stack([R[..., 2, 1] - R[..., 1, 2], R[..., 0, 2] - R[..., 2, 0],
-                  R[..., 1, 0] - R[..., 0, 1]], axis=-1), axis=-1)
-    return dp, np.arctan2(s, c)
 
 
 def _rot(axis, angle) -> np.ndarray:

@@ -32,6 +32,7 @@ from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.fk import fk_frames
 from kinestat.serial.jacobian import jacobian
+from kinestat.serial.lengths import characteristic_length
 from kinestat.spatial.transforms import as_array
 
 __all__ = [
@@ -74,21 +75,6 @@ class StepSolution:
     residual: np.ndarray
     damping: np.ndarray
     method: str
-
-
-def characteristic_length(model: ChainModel, q) -> float:
-    """RMS distance from the end-frame origin to the joint-axis origins at ``q`` (one config).
-
-    Used to make twists and Jacobians dimensionless; falls back to 1 for a degenerate chain
-    whose joints all sit at the hand origin.
-    """
-    q = model.check_q(q)
-    if q.ndim != 1:
-        raise InputError("characteristic_length takes one configuration q of shape (n,)")
-    F = fk_frames(model, q)
-    d = F[:-1, :3, 3] - F[-1, :3, 3]
-    L = float(np.sqrt(np.mean(np.sum(d * d, axis=-1))))
-    return L if L > 1e-9 else 1.0
 
 
 def column_scale(model: ChainModel, length: float) -> np.ndarray:

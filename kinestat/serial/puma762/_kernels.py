@@ -1,6 +1,7 @@
 """Compiled (Numba) kernels of the PUMA 762 closed form (:mod:`kinestat.serial.puma762`).
 
-They compute what the NumPy reference ``puma762._reverse_kernel`` + ``pose_residuals`` compute,
+They compute what the NumPy reference (:mod:`kinestat.serial.puma762._reference`:
+``reverse_arrays`` + :func:`~kinestat.serial.puma762.forward.pose_residuals`) computes,
 one pose at a time in scalars: the wrist centre, φ1 (two roots), θ3 (two roots), θ2, then for
 each arm the wrist angles θ5 (two roots), θ4 and θ6 (Vibhute eqs. 2-47..2-53 as written out in
 the reference), and — when asked — the forward analysis of every branch (eq. 2-33) as the
@@ -18,26 +19,29 @@ import math
 import numba as nb
 import numpy as np
 
+# mechanism parameters and status codes: defined once, in params (Numba freezes them)
+from kinestat.serial.puma762.params import (
+    _A,
+    _CA,
+    _S,
+    _SA,
+    A23,
+    S2,
+    S4,
+    S6,
+    STATUS_INSIDE_CYLINDER,
+    STATUS_OK,
+    STATUS_TOO_FAR,
+    STATUS_TOO_NEAR,
+)
+from kinestat.spatial.tolerances import ORTHO_TOL
+
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
-# Mechanism parameters (Vibhute Tables 2-2 and 2-3, mm); the same numbers as puma762.py.
-A23 = 650.0
-S2 = 190.0
-S4 = 600.0
-S6 = 125.0
-_CA = (0.0, 1.0, 0.0, 0.0, 0.0)  # cos α12, α23, α34, α45, α56
-_SA = (1.0, 0.0, -1.0, 1.0, 1.0)  # sin α
-_A = (0.0, A23, 0.0, 0.0, 0.0)  # a12 .. a56
-_S = (S2, 0.0, S4, 0.0, S6)  # S2 .. S6
 _PI = math.pi
 _TWO_PI = 2.0 * math.pi
 _SQRT8 = 2.0 * math.sqrt(2.0)
 _NO_ARM = (0.0,) * 12
-
-STATUS_OK = 0
-STATUS_INSIDE_CYLINDER = 1
-STATUS_TOO_FAR = 2
-STATUS_TOO_NEAR = 3
 
 # classification of the branches of one pose (single-pose entry points)
 KIND_INVALID = 0
@@ -310,7 +314,7 @@ def _same(a0, a1, a2, a3, b0, b1, b2, b3, tol):
 @nb.njit(**_OPTS)
 def _classify(q, valid, sing, fsum, fval, dup_tol, kind):
     """Mark each branch: invalid, a distinct isolated solution, a distinct wrist-singular family
-    or a duplicate of an earlier one (``puma762._reverse_one``'s rules)."""
+    or a duplicate of an earlier one (the reference rules of ``puma762.reverse.reverse_one``)."""
     for k in range(8):
         if not valid[k]:
             kind[k] = KIND_INVALID
@@ -411,7 +415,7 @@ def reverse_vectors_one(p, z, x, p6, unit_tol, tol, s5_tol):
 @nb.njit(**_OPTS)
 def reverse_pose_one(M, tol, s5_tol):
     """:func:`reverse_vectors_one` for a 4x4 pose ``M``: checks it is a finite rigid transform
-    (|R Rᵀ − I| ≤ 1e-6, det R ≥ 0), then ``frame6`` of its columns (tolerance 1e-6)."""
+    (|R Rᵀ − I| ≤ ORTHO_TOL, det R ≥ 0), then ``frame6`` of its columns (tolerance ORTHO_TOL)."""
     err = ERR_NONE
     bad = 0.0
     for i in range(4):
@@ -428,7 +432,7 @@ def reverse_pose_one(M, tol, s5_tol):
         det = (M[0, 0] * (M[1, 1] * M[2, 2] - M[1, 2] * M[2, 1])
                - M[0, 1] * (M[1, 0] * M[2, 2] - M[1, 2] * M[2, 0])
                + M[0, 2] * (M[1, 0] * M[2, 1] - M[1, 1] * M[2, 0]))
-        if dev > 1e-6 or det < 0.0:
+        if dev > ORTHO_TOL or det < 0.0:
             err = ERR_NOT_RIGID
     if err == ERR_NONE:
         z0, z1, z2 = M[0, 2], M[1, 2], M[2, 2]
@@ -436,11 +440,11 @@ def reverse_pose_one(M, tol, s5_tol):
         dz = abs(math.sqrt(z0 * z0 + z1 * z1 + z2 * z2) - 1.0)
         dx = abs(math.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - 1.0)
         dd = abs(z0 * x0 + z1 * x1 + z2 * x2)
-        if dz > 1e-6:
+        if dz > ORTHO_TOL:
             err, bad = ERR_Z_NOT_UNIT, dz
-        elif dx > 1e-6:
+        elif dx > ORTHO_TOL:
             err, bad = ERR_X_NOT_UNIT, dx
-        elif dd > 1e-6:
+        elif dd > ORTHO_TOL:
             err, bad = ERR_NOT_PERPENDICULAR, dd
         else:
             _frame6(M[0, 3], M[1, 3], M[2, 3], z0, z1, z2, x0, x1, x2, 0.0, 0.0, 0.0, T)
