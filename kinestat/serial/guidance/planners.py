@@ -270,6 +270,7 @@ class GeneralPath:
 def screw_path(start, target) -> ScrewPath:
     """Type II (eqs. 4-18, 4-19): the screw displacement from ``start`` to ``target``.
 
+    >>> from kinestat.spatial.transforms import trans
     >>> p = screw_path(np.eye(4), trans([0.0, 0.0, 4.0]))
     >>> p.step_twist(0.0, 0.25, np.eye(4)).tolist()      # constant B = ξ/k (eq. 4-19)
     [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
@@ -319,6 +320,7 @@ def general_path(start, target) -> GeneralPath:
     θ its angle, ``u_v = R/|R|`` with R from the start origin to the target origin; re-planned
     from the actual hand at every step as DISP's GENM does (``replan_each_step``).
 
+    >>> from kinestat.spatial.transforms import trans
     >>> p = general_path(np.eye(4), trans([3.0, 0.0, 0.0]))
     >>> (p.step_twist(0.5, 0.75, trans([1.0, 1.0, 0.0])).round(3) + 0.0).tolist()
     [0.0, 0.0, 0.0, 1.0, -0.5, 0.0]
@@ -342,6 +344,7 @@ def command_path(start, direction, distance: float, angle: float,
     ``distance`` d along it and ``angle`` θ (rad) about the line through the hand origin
     parallel to R: ``U = R/|R|``, ``h = d/θ``, ``ρn = ρo``; θ = 0 is a pure translation.
 
+    >>> from kinestat.spatial.transforms import trans
     >>> c = command_path(trans([15.0, -25.0, 12.0]), [0, 0, 1], 4.0, 0.0)
     >>> c.end[:3, 3].tolist()                              # Illustration 6, command 1's d
     [15.0, -25.0, 16.0]
@@ -379,6 +382,7 @@ def auto_steps(path, length: float, *, max_step_deg: float = 1.0,
     With these defaults (1°, L/100) the neglected second-order terms of a step are of order
     ½ δθ² ℓ ≈ 1.5e-4 ℓ (ℓ a lever arm ~ L), see docs/guidance.md.
 
+    >>> from kinestat.spatial.transforms import trans
     >>> auto_steps(screw_path(np.eye(4), trans([3.0, 0.0, 0.0])), length=10.0)
     30
     """
