@@ -26,9 +26,11 @@ $(DEV_STAMP): $(RUN_STAMP) requirements/dev.txt
 run: $(RUN_STAMP)
 	$(BIN)/kinestat control
 
-# The whole test suite (lint first, then pytest; pytest fails when no test runs).
+# The whole test suite: lint, the layer contract (.importlinter, docs/architecture.md), then
+# pytest (which fails when no test runs).
 test: $(DEV_STAMP)
 	$(BIN)/ruff check kinestat tests $(wildcard benchmarks)
+	$(BIN)/lint-imports
 	$(BIN)/pytest
 
 $(BENCH_STAMP): $(DEV_STAMP) requirements/bench.txt

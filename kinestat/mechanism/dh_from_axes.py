@@ -48,6 +48,7 @@ from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel, from_standard_dh
 from kinestat.spatial.plucker import COINCIDENT, INTERSECTING, LINE_KINDS, PARALLEL, SKEW
 from kinestat.spatial.transforms import inv, rot_x, rot_z, trans_x, trans_z
+from kinestat.spatial.validate import as_pose
 
 __all__ = [
     "RELATIONS",
@@ -272,21 +273,6 @@ def default_base(feet, u, *, tool=None, tol: float = 1e-9, tol_dist=1e-9) -> np.
     return P @ rot_z(row[..., 0]) @ trans_z(slide)
 
 
-def _check_poses(T, name: str) -> np.ndarray:
-    T = np.asarray(T, dtype=float)
-    if T.ndim < 2 or T.shape[-2:] != (4, 4):
-        raise InputError(f"{name} must be a 4x4 homogeneous transform, got shape {T.shape}")
-    if not np.all(np.isfinite(T)):
-        raise InputError(f"{name} contains NaN or infinity")
-    R = T[..., :3, :3]
-    err = np.max(np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)), axis=(-1, -2))
-    if np.any(err > 1e-6) or np.any(np.abs(np.linalg.det(R) - 1.0) > 1e-6):
-        raise InputError(f"{name}: the rotation part is not orthonormal with determinant +1")
-    if np.any(T[..., 3, :] != np.array([0.0, 0.0, 0.0, 1.0])):
-        raise InputError(f"{name}: the last row must be [0, 0, 0, 1]")
-    return T
-
-
 def assign_dh_frames(
     axes, *, base=None, tool=None, tol: float = 1e-9
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -314,11 +300,11 @@ def assign_dh_frames(
     lead = u.shape[:-2]
     scale = np.max(np.linalg.norm(feet, axis=-1), axis=-1)
     if tool is not None:
-        tool = _check_poses(tool, "tool")
+        tool = as_pose(tool, "tool", last_row_tol=0.0)
         lead = np.broadcast_shapes(lead, tool.shape[:-2])
         scale = np.maximum(scale, np.linalg.norm(tool[..., :3, 3], axis=-1))
     if base is not None:
-        base = _check_poses(base, "base")
+        base = as_pose(base, "base", last_row_tol=0.0)
         lead = np.broadcast_shapes(lead, base.shape[:-2])
         scale = np.maximum(scale, np.linalg.norm(base[..., :3, 3], axis=-1))
     tol_dist = tol * np.maximum(scale, 1.0)

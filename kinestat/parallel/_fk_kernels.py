@@ -634,11 +634,3 @@ def fk_all_arrays(constants: tuple, L: np.ndarray, tol: float = 1e-9,
                                              Mb, Mt, base, top, part, flags, roots, float(tol),
                                              int(polish), poses[rows], valid[rows], res[rows])
     return poses, valid, res
-
-
-def fk_all_fast(platform, lengths, *, tol: float = 1e-9, polish: int = 4):
-    """Deprecated old name of :func:`kinestat.parallel.fk.fk_all` (which always runs these
-    kernels)."""
-    from kinestat.parallel.fk import fk_all  # lazy: parallel.fk imports this module (cycle)
-
-    return fk_all(platform, lengths, tol=tol, polish=polish)

@@ -42,7 +42,7 @@ def test_random_lengths_match_reference(spread):
     p = prototype()
     rng = np.random.default_rng(int(spread * 100))
     L = p.free_lengths * (1 + rng.uniform(-spread, spread, (400, 6)))
-    a = F.fk_all_fast(p, L)
+    a = fk_all(p, L)
     assert_same(a, fk_all(p, L, backend="numpy"))
     # every valid mode reproduces its legs (reverse kinematics, independent of both solvers)
     modes = a.poses[a.valid]
@@ -52,12 +52,12 @@ def test_random_lengths_match_reference(spread):
 
 def test_thesis_example_and_shapes():
     p = prototype()
-    a = F.fk_all_fast(p, THESIS_LEGS)
+    a = fk_all(p, THESIS_LEGS)
     assert a.poses.shape == (16, 4, 4) and int(a.count) == 8
     assert_same(a, fk_all(p, THESIS_LEGS, backend="numpy"))
     rng = np.random.default_rng(7)
     L = p.free_lengths * (1 + rng.uniform(-0.1, 0.1, (2, 3, 6)))
-    b = F.fk_all_fast(p, L)
+    b = fk_all(p, L)
     assert b.poses.shape == (2, 3, 16, 4, 4) and b.residual.shape == (2, 3, 16)
     assert_same(b, fk_all(p, L, backend="numpy"))
 
@@ -75,18 +75,18 @@ def test_other_designs_and_relabelled_legs():
                             leg_names=tuple(p.leg_names[i] for i in perm)))
     for q in designs:
         L = q.free_lengths * (1 + rng.uniform(-0.2, 0.2, (150, 6)))
-        assert_same(F.fk_all_fast(q, L), fk_all(q, L, backend="numpy"))
+        assert_same(fk_all(q, L), fk_all(q, L, backend="numpy"))
 
 
 def test_chunks_and_thread_paths_give_the_same_answers(monkeypatch):
     p = prototype()
     rng = np.random.default_rng(9)
     L = p.free_lengths * (1 + rng.uniform(-0.2, 0.2, (50, 6)))
-    whole = F.fk_all_fast(p, L)  # one chunk, parallel kernels
-    few = F.fk_all_fast(p, L[:5])  # single-thread kernels
+    whole = fk_all(p, L)  # one chunk, parallel kernels
+    few = fk_all(p, L[:5])  # single-thread kernels
     np.testing.assert_array_equal(few.poses, whole.poses[:5])
     monkeypatch.setattr(F, "CHUNK", 7)
-    chunked = F.fk_all_fast(p, L)
+    chunked = fk_all(p, L)
     np.testing.assert_array_equal(chunked.poses, whole.poses)
     np.testing.assert_array_equal(chunked.valid, whole.valid)
 
@@ -97,7 +97,7 @@ def test_chunks_and_thread_paths_give_the_same_answers(monkeypatch):
 ])
 def test_bad_lengths_raise_as_the_reference(legs):
     msgs = []
-    for solve in (F.fk_all_fast, fk_all):
+    for solve in (fk_all, fk_all):
         with pytest.raises(InputError) as ei:
             solve(prototype(), legs)
         msgs.append(str(ei.value))
@@ -108,7 +108,7 @@ def test_impossible_lengths_and_non_special_platform():
     p = prototype()
     legs = np.array([[500.0, 81, 81, 68, 67, 68], [1.0] * 6, [200.0, 200, 200, 10, 10, 10],
                      [1e300] * 6])
-    a = F.fk_all_fast(p, legs)
+    a = fk_all(p, legs)
     assert not np.any(a.valid)
     assert_same(a, fk_all(p, legs, backend="numpy"))
     rng = np.random.default_rng(10)
@@ -116,4 +116,4 @@ def test_impossible_lengths_and_non_special_platform():
                        top_points=rng.normal(0, 30, (6, 3)) * [1, 1, 0], stiffness=np.ones(6),
                        free_lengths=np.full(6, 80.0), home_pose=p.home_pose)
     with pytest.raises(ModelError, match="special"):
-        F.fk_all_fast(general, np.full(6, 80.0))
+        fk_all(general, np.full(6, 80.0))

@@ -1,0 +1,74 @@
+"""The architecture rules of docs/architecture.md that the import contract cannot state.
+
+The layer contract itself is `.importlinter`, checked by `lint-imports` in `make test` (and here,
+so that a plain `pytest` run checks it too)."""
+
+from __future__ import annotations
+
+import ast
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "kinestat"
+SOURCES = sorted(PACKAGE.rglob("*.py"))
+MAX_FUNCTION_LINES = 120
+MAX_MODULE_LINES = 600
+
+
+def _tree(path: Path) -> tuple[ast.Module, list[str]]:
+    text = path.read_text(encoding="utf-8")
+    return ast.parse(text), text.splitlines()
+
+
+def _functions(tree: ast.Module):
+    return [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef | ast.AsyncFunctionDef)]
+
+
+def test_the_import_contract_holds():
+    exe = shutil.which("lint-imports", path=str(Path(sys.executable).parent))
+    if exe is None:
+        pytest.skip("lint-imports is not installed (requirements/dev.txt installs it)")
+    run = subprocess.run([exe, "--no-cache"], cwd=PACKAGE.parent, capture_output=True, text=True,
+                         timeout=300)
+    assert run.returncode == 0, run.stdout[-4000:] + run.stderr[-2000:]
+
+
+def test_function_local_imports_say_why():
+    missing = []
+    for path in SOURCES:
+        tree, lines = _tree(path)
+        for fn in _functions(tree):
+            for node in ast.walk(fn):
+                if isinstance(node, ast.Import | ast.ImportFrom):
+                    span = lines[node.lineno - 1:node.end_lineno]
+                    if not any("# lazy:" in line for line in span):
+                        missing.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno}")
+    assert not missing, "function-local imports without a '# lazy: <reason>' comment: " + \
+        ", ".join(missing)
+
+
+def test_functions_are_short():
+    long = []
+    for path in SOURCES:
+        tree, _ = _tree(path)
+        for fn in _functions(tree):
+            size = fn.end_lineno - fn.lineno + 1
+            if size > MAX_FUNCTION_LINES:
+                long.append(f"{path.relative_to(PACKAGE.parent)}:{fn.lineno} {fn.name} ({size})")
+    assert not long, f"functions over {MAX_FUNCTION_LINES} lines: " + ", ".join(long)
+
+
+def test_long_modules_say_why_at_the_top():
+    unexplained = []
+    for path in SOURCES:
+        tree, lines = _tree(path)
+        doc = ast.get_docstring(tree) or ""
+        if len(lines) > MAX_MODULE_LINES and f"{MAX_MODULE_LINES} lines" not in doc:
+            unexplained.append(f"{path.relative_to(PACKAGE.parent)} ({len(lines)} lines)")
+    assert not unexplained, (
+        f"modules over {MAX_MODULE_LINES} lines without a reason in their docstring "
+        "(write 'Over 600 lines on purpose: <why>'): " + ", ".join(unexplained))
