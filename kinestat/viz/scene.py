@@ -291,7 +291,7 @@ def guidance_scene(result, *, title: str = "guidance run") -> dict:
         fr = [{"name": names[i], "pose": _pose(F[r, i])} for i in range(m.n)]
         fr.append({"name": "end", "pose": _pose(E[r])})
         st = int(stage[r]) if r < len(stage) else 0
-        steps.append({"label": f"step {r}" + (f" (stage {st})" if st else ""),
+        steps.append({"label": f"step {r}" + (f" (stage {st})" if st > 0 else ""),
                       "q": [float(x) for x in Q[r]], "frames": fr, "items": []})
     colors = {"singular": "#d62728", "joint_limit": "#ff7f0e", "least_squares": "#9467bd"}
     for ev in result.events:
