@@ -257,6 +257,7 @@
   else { if (robot) drawRobot(robot, q); setInfo(scene.info); legend(scene.items); }
   fit(); render();
   status.ready = true;
+  status.load_ms = performance.now();   // since navigation start: parse, build, first render
   status.webgl = renderer.getContext() ? true : false;
   window.kinestatViewer = { scene: scene, status: status, showStep: showStep, chainFrames: chainFrames };
   document.getElementById("kinestat-status").textContent = JSON.stringify(status);
