@@ -157,6 +157,7 @@ def disp(
                                    "(B from the hand origin's second-order displacement, "
                                    "ceil(dθ°²/40) sub-steps), which reproduces Table A2-9 with "
                                    "the illustration5-published deck."),
+    view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
 ) -> None:
     """Run a DISP deck (Nadkarni 1977): MS 1 screw axes, 2 mechanism data, 3 both, 0/4/5/6
     guidance of types II/III/IV/I.
@@ -194,6 +195,10 @@ def disp(
                 console.print(f"note: {n}")
         for p in written:
             console.print(f"wrote {p}")
+    if view and run.result is not None:
+        from kinestat.viz.show import show_guidance  # lazy: viewer only with --view
+
+        show_guidance(run.result, f"DISP MS = {d.ms}: {d.source}")
     if run.result is not None:
         run.result.raise_if_stopped()
 

@@ -7,15 +7,13 @@ See docs/viewer.md for the scene format and what each page shows.
 
 from __future__ import annotations
 
-import os
-import tempfile
 import webbrowser
 from pathlib import Path
 
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, err_console, parse_floats, parse_pose
+from kinestat.cli._output import console, parse_floats, parse_pose
 from kinestat.errors import InputError
 from kinestat.io.textfile import write_text_atomic
 
@@ -67,16 +65,13 @@ def _emit(scene: dict, out: _Out, model=None) -> None:
         finally:
             srv.server_close()
         return
-    path = out.html
-    if path is None:
-        fd, name = tempfile.mkstemp(prefix="kinestat-view-", suffix=".html")
-        os.close(fd)
-        path = Path(name)
+    if out.html is None:
+        from kinestat.viz.show import show  # lazy: as above
 
-    write_text_atomic(path, render_html(scene))
-    console.print(f"wrote {path}")
-    if out.html is None and not out.no_open and not webbrowser.open(path.resolve().as_uri()):
-        err_console.print("kinestat view: no browser found; open the file above")
+        show(scene, open_browser=not out.no_open)
+        return
+    write_text_atomic(out.html, render_html(scene))
+    console.print(f"wrote {out.html}")
 
 
 def _load_model(spec: str):

@@ -49,9 +49,27 @@ def rph_model_path(tmp_path_factory):
 
 
 @pytest.fixture(scope="session")
-def control_log(tmp_path_factory):
-    """A simulated control run's log, made by the public command (`kinestat control --log`)."""
-    p = tmp_path_factory.mktemp("run") / "log.jsonl"
-    code = main(["control", "--log", str(p), "--no-plot", "--json"])
+def control_run(tmp_path_factory):
+    """A simulated control run made by the public command, ``kinestat control --log FILE
+    --view`` (the browser replaced by a recorder): (log path, opened URLs, JSON stdout)."""
+    import contextlib
+    import io
+    import json
+    import tempfile
+    import webbrowser
+
+    d = tmp_path_factory.mktemp("run")
+    p = d / "log.jsonl"
+    opened: list[str] = []
+    buf = io.StringIO()
+    with pytest.MonkeyPatch.context() as mp, contextlib.redirect_stdout(buf):
+        mp.setattr(webbrowser, "open", lambda url, *a, **k: opened.append(url) or True)
+        mp.setattr(tempfile, "tempdir", str(d))
+        code = main(["control", "--log", str(p), "--no-plot", "--json", "--view"])
     assert code == 0 and p.is_file()
-    return p
+    return p, opened, json.loads(buf.getvalue())
+
+
+@pytest.fixture(scope="session")
+def control_log(control_run):
+    return control_run[0]

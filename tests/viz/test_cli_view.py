@@ -121,3 +121,58 @@ def test_serve_answers_page_scene_and_ik():
     finally:
         srv.shutdown()
         srv.server_close()
+
+
+@pytest.fixture
+def opened(monkeypatch, tmp_path):
+    """Record what the commands hand to the browser; temporary pages go to tmp_path."""
+    import tempfile
+    import webbrowser
+
+    urls: list[str] = []
+    monkeypatch.setattr(webbrowser, "open", lambda url, *a, **k: urls.append(url) or True)
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    return urls
+
+
+def _opened_scene(url: str) -> dict:
+    from pathlib import Path
+    from urllib.parse import urlparse
+    from urllib.request import url2pathname
+
+    return _scene(Path(url2pathname(urlparse(url).path)))
+
+
+def test_view_flags_of_existing_commands(opened, capsys):
+    import json
+
+    legs = "81.47,81.27,80.97,68,67.8,68.1"
+    assert main(["platform", "fk", "--legs", legs, "--json", "--view"]) == 0
+    out = json.loads(capsys.readouterr().out)  # the JSON output stays clean
+    s = _opened_scene(opened[-1])
+    tops = [np.array(f["pose"]) for f in s["frames"] if f["name"].startswith("top")]
+    assert s["kind"] == "platform" and len(tops) == out["count"]
+    for k, (T, sol) in enumerate(zip(tops, out["solutions"], strict=True)):
+        shift = np.array(sol["pose"])
+        shift[0, 3] += T[0, 3] - np.array(sol["pose"])[0, 3]
+        np.testing.assert_allclose(T, shift, atol=1e-9)
+        assert k == 0 or T[0, 3] > tops[k - 1][0, 3]
+    assert main(["screw", "--points1", "0,0,0,0,0,1,1,0,0", "--points2", "2,1,0,2,1,1,2,2,0",
+                 "--view"]) == 0
+    assert _opened_scene(opened[-1])["kind"] == "screw"
+    capsys.readouterr()
+    assert main(["disp", "illustration5", "--json", "--view"]) == 0
+    rec = json.loads(capsys.readouterr().out)
+    s = _opened_scene(opened[-1])
+    # one animation step per row of the DISP table; the hand path ends where DISP says
+    assert s["kind"] == "disp" and len(s["steps"]) == len(rec["table"])
+    np.testing.assert_allclose(s["items"][0]["points"], rec["hand_origins"], atol=1e-9)
+    assert len(opened) == 3
+
+
+def test_control_view_flag(control_run):
+    log, urls, report = control_run
+    assert report["converged"] and len(urls) == 1
+    s = _opened_scene(urls[0])
+    assert s["kind"] == "log"
+    assert "".join(st["state"] for st in s["steps"]) == report["states"]
