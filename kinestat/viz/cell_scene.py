@@ -135,6 +135,8 @@ def cell_scene(start: dict, cycles: list[dict], end: dict | None = None, *, plat
                       "items": _cycle_items(platform, mount, Fall[k], meas, c.get("true"),
                                             force_scale)})
     s["steps"] = steps
+    # the view opens on the wrist, the platform, the tool and the workpiece (zoom out for more)
+    s["focus"] = {"point": _pt(cycles[0]["measured"]["tip"]), "radius": 0.35 * scale}
     s["info"] = [f"{len(cycles)} cycles, states {''.join(c.get('state', '?') for c in cycles)}"]
     if end is not None and isinstance(end.get("report"), dict):
         rep = end["report"]

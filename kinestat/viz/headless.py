@@ -131,8 +131,10 @@ class Browser:
             self._events.append(self._recv(deadline))
 
     # -- pages ------------------------------------------------------------------------------
-    def load(self, html: str | os.PathLike, *, screenshot: bool = True) -> PageResult:
-        """Open ``html`` (a file) in a fresh tab; status, console, screenshot."""
+    def load(self, html: str | os.PathLike, *, screenshot: bool = True,
+             fragment: str = "") -> PageResult:
+        """Open ``html`` (a file; ``fragment`` e.g. ``"step=5"``) in a fresh tab; status,
+        console, screenshot."""
         target = self.send("Target.createTarget", {"url": "about:blank"})["targetId"]
         session = self.send("Target.attachToTarget",
                             {"targetId": target, "flatten": True})["sessionId"]
@@ -145,7 +147,8 @@ class Browser:
                 self.send(f"{domain}.enable", {}, session)
             self._events = [e for e in self._events if e.get("sessionId") != session]
             t0 = time.perf_counter()
-            self.send("Page.navigate", {"url": Path(html).resolve().as_uri()}, session)
+            url = Path(html).resolve().as_uri() + (f"#{fragment}" if fragment else "")
+            self.send("Page.navigate", {"url": url}, session)
             self._wait_event("Page.loadEventFired", session)
             dt = time.perf_counter() - t0
             text = self.send("Runtime.evaluate", {"expression": _STATUS_JS,

@@ -14,7 +14,9 @@ point a 3-list. The keys:
   ``kinds``, ``pitches``, ``lower``/``upper`` (radians or length), ``q`` (shown first) and
   ``live`` (sliders shown);
 - ``items``: static drawables (below); ``steps``: ``[{"label", "q", "frames", "items",
-  "info"}]`` for animations, per step the same frames plus items drawn at that step only.
+  "info"}]`` for animations, per step the same frames plus items drawn at that step only;
+- optional: ``show_frames`` (joint frames drawn at first), ``focus`` (``{"point", "radius"}``,
+  where the camera looks first), ``force_unit``, ``ik_url`` (served pages).
 
 Drawables (``type``): ``segment`` (``a``, ``b``, ``radius``), ``polyline`` (``points``),
 ``polygon`` (``points``, ``opacity``), ``arrow`` (``origin``, ``vector``), ``line`` (an axis

@@ -242,7 +242,8 @@
   function fit() {
     const box = new THREE.Box3().setFromObject(world);
     if (box.isEmpty()) box.set(new THREE.Vector3(-S, -S, -S), new THREE.Vector3(S, S, S));
-    const c = box.getCenter(new THREE.Vector3()), r = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1e-9);
+    let c = box.getCenter(new THREE.Vector3()), r = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1e-9);
+    if (scene.focus) { c = v3(scene.focus.point); r = scene.focus.radius; }   // e.g. the tool of the cell
     const d = r / Math.sin(camera.fov * Math.PI / 360);
     camera.position.copy(c).add(new THREE.Vector3(0.9, -1.4, 0.8).normalize().multiplyScalar(d));
     camera.near = d / 100; camera.far = d * 100; camera.updateProjectionMatrix();
@@ -253,7 +254,10 @@
     camera.aspect = view.clientWidth / view.clientHeight; camera.updateProjectionMatrix(); render();
   });
 
-  if (steps.length) showStep(0);
+  // "#step=N" in the address opens the animation at step N (links, screenshots)
+  const wanted = /step=(\d+)/.exec(location.hash || "");
+  const first = wanted ? Math.min(Number(wanted[1]), Math.max(steps.length - 1, 0)) : 0;
+  if (steps.length) { timeline.value = first; showStep(first); }
   else { if (robot) drawRobot(robot, q); setInfo(scene.info); legend(scene.items); }
   fit(); render();
   status.ready = true;
