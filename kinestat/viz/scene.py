@@ -121,9 +121,13 @@ def model_scene(model: ChainModel, q=None, *, show_frames: bool = False) -> dict
 
 
 # -- the platform -----------------------------------------------------------------------------
+def _unloaded(f: float, fmax: float) -> bool:
+    return fmax <= 0 or abs(f) <= 1e-9 * fmax
+
+
 def force_color(f: float, fmax: float) -> str:
     """Leg colour: red for tension (f > 0), blue for compression, grey when unloaded."""
-    if fmax <= 0 or abs(f) <= 1e-12 * max(fmax, 1.0):
+    if _unloaded(f, fmax):
         return NEUTRAL
     t = min(abs(f) / fmax, 1.0)
     base = (214, 39, 40) if f > 0 else (31, 119, 180)
@@ -161,7 +165,7 @@ def _platform_items(platform, T, offset: np.ndarray, forces, tag: str) -> list[d
          "opacity": 0.75, "label": f"{tag} top plate"},
     ]
     for name, b, p, f in zip(platform.leg_names, B, P, forces, strict=True):
-        kind = "tension" if f > 0 else "compression"
+        kind = "unloaded" if _unloaded(f, fmax) else ("tension" if f > 0 else "compression")
         items.append({"type": "segment", "a": _pt(b), "b": _pt(p), "radius": r,
                       "color": force_color(float(f), fmax),
                       "label": f"{tag} leg {name}: {float(f):+.4g} ({kind})"})
