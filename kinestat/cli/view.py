@@ -116,6 +116,10 @@ def view_root(
 ) -> None:
     """3D views in the browser (three.js): model, platform, screw, disp, log."""
     if ctx.invoked_subcommand is not None:
+        if log is not None or html is not None or serve or port != 0 or no_open \
+                or host != "127.0.0.1":
+            raise InputError(f"put the options after the view's name, e.g. kinestat view "
+                             f"{ctx.invoked_subcommand} … --html FILE (--log goes alone)")
         return
     if log is None:
         raise InputError("give a view (model, platform, screw, disp, log) or --log FILE; "

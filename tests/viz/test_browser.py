@@ -12,17 +12,14 @@ import numpy as np
 import pytest
 
 import kinestat
+from kinestat.cli.main import main
 from kinestat.io.disp_deck import embedded_deck
-from kinestat.parallel.fk import fk_list
-from kinestat.parallel.legs import leg_lengths
-from kinestat.parallel.platform import prototype
 from kinestat.serial.fk import fk_frames
 from kinestat.serial.guidance.disp import run_deck
-from kinestat.spatial.displacement import frame_from_triple
 from kinestat.viz import headless
-from kinestat.viz.cell_scene import cell_scene, read_cycle_log
+from kinestat.viz.cell_scene import read_cycle_log
 from kinestat.viz.html import render_html
-from kinestat.viz.scene import guidance_scene, model_scene, platform_scene, screw_scene
+from kinestat.viz.scene import model_scene
 
 pytestmark = pytest.mark.skipif(
     headless.find_browser() is None,
@@ -33,23 +30,21 @@ pytestmark = pytest.mark.skipif(
 MIN_VARIANCE = 20.0
 
 
-def _pages(rph_model_path, control_log):
-    p = prototype()
-    L = leg_lengths(p, p.home_pose) + np.array([0.5, 0.3, 0.0, 0.0, -0.2, 0.1])
-    P1 = np.array([[0, 0, 0], [0, 0, 1], [1, 0, 0]], float)
-    P2 = np.array([[2, 1, 0.5], [2, 1, 1.5], [2, 2, 0.5]], float)
-    run = run_deck(embedded_deck("illustration5"))
-    start, cycles, end = read_cycle_log(control_log)
-    rph = kinestat.load(str(rph_model_path))
+def _views(rph_model_path, control_log):
+    """Every kind of page, each as `kinestat view … --html` writes it: (args, model, q)."""
+    log = read_cycle_log(control_log)[1]
+    res = run_deck(embedded_deck("illustration5")).result
     return {
-        "model": (kinestat.load("puma762"), np.radians([10, -30, 20, 5, 40, -15]), None),
-        "model-rph": (rph, np.array([0.4, 120.0, -1.1]), None),
-        "platform": (None, None, platform_scene(p, fk_list(p, L), legs=L)),
-        "screw": (None, None, screw_scene(frame_from_triple(P1), frame_from_triple(P2),
-                                          points1=P1, points2=P2)),
-        "disp": (run.result.model, run.result.q[0], guidance_scene(run.result)),
-        "log": (kinestat.load("puma762"), np.radians(cycles[0]["measured"]["joints_deg"]),
-                cell_scene(start, cycles, end)),
+        "model": (["model", "puma762", "--q-deg", "10,-30,20,5,40,-15", "--frames"],
+                  kinestat.load("puma762"), np.radians([10, -30, 20, 5, 40, -15])),
+        "model-rph": (["model", str(rph_model_path), "--q", "0.4,120,-1.1", "--frames"],
+                      kinestat.load(str(rph_model_path)), np.array([0.4, 120.0, -1.1])),
+        "platform": (["platform", "--legs", "81.47,81.27,80.97,68,67.8,68.1"], None, None),
+        "screw": (["screw", "--points1", "0,0,0,0,0,1,1,0,0", "--points2",
+                   "2,1,0.5,2,1,1.5,2,2,0.5"], None, None),
+        "disp": (["disp", "illustration5"], res.model, res.q[0]),
+        "log": (["log", str(control_log)], kinestat.load("puma762"),
+                np.radians(log[0]["measured"]["joints_deg"])),
     }
 
 
@@ -57,11 +52,9 @@ def _pages(rph_model_path, control_log):
 def pages(tmp_path_factory, rph_model_path, control_log):
     d = tmp_path_factory.mktemp("pages")
     out = {}
-    for name, (m, q, scene) in _pages(rph_model_path, control_log).items():
-        if scene is None:
-            scene = model_scene(m, q, show_frames=True)
+    for name, (args, m, q) in _views(rph_model_path, control_log).items():
         path = d / f"{name}.html"
-        path.write_text(render_html(scene), encoding="utf-8")
+        assert main(["view", *args, "--html", str(path)]) == 0
         out[name] = (path, m, q)
     return out
 

@@ -80,6 +80,7 @@ def test_port_in_use(capsys):
     (["view", "disp", "no-such-deck", "--html", "x.html"], "neither a file"),
     (["view", "disp", "illustration1", "--html", "x.html"], "no guidance run"),
     (["view"], "give a view"),
+    (["view", "--html", "x.html", "model", "puma762"], "after the view's name"),
 ])
 def test_bad_input_one_line(args, msg, capsys, tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
