@@ -57,7 +57,7 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         d = Path(tmp)
         disp_html, log_html = d / "disp.html", d / "log.html"
-        with contextlib.redirect_stdout(io.StringIO()):  # the commands' own reports
+        with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
             assert kinestat_main(["view", "disp", "illustration5", "--steps", "1000",
                                   "--html", str(disp_html)]) == 0
             log = _control_log(d, 200)

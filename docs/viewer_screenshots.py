@@ -23,7 +23,7 @@ VIEWS = {
     "platform": (["platform", "--legs", "81.47,81.27,80.97,68,67.8,68.1"], None),
     "screw": (["screw", "--points1", "0,0,0,0,0,1,1,0,0",
                "--points2", "2,1,0.5,2,1,1.5,2,2,0.5"], None),
-    "disp": (["disp", "illustration5"], "middle"),
+    "disp": (["disp", "illustration4"], "middle"),
     "log": (["log", "{log}"], "last"),
 }
 
