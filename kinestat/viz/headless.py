@@ -55,6 +55,7 @@ class PageResult:
     console: tuple[str, ...]
     png: bytes | None
     seconds: float
+    value: object = None
 
 
 class Browser:
@@ -131,10 +132,11 @@ class Browser:
             self._events.append(self._recv(deadline))
 
     # -- pages ------------------------------------------------------------------------------
-    def load(self, html: str | os.PathLike, *, screenshot: bool = True,
-             fragment: str = "") -> PageResult:
-        """Open ``html`` (a file; ``fragment`` e.g. ``"step=5"``) in a fresh tab; status,
-        console, screenshot."""
+    def load(self, html: str | os.PathLike, *, screenshot: bool = True, fragment: str = "",
+             evaluate: str | None = None) -> PageResult:
+        """Open ``html`` (a file, or an ``http://`` address; ``fragment`` e.g. ``"step=5"``)
+        in a fresh tab; status, console, screenshot, and the value of the JavaScript expression
+        ``evaluate`` run after the load (a promise is awaited; the value must be JSON)."""
         target = self.send("Target.createTarget", {"url": "about:blank"})["targetId"]
         session = self.send("Target.attachToTarget",
                             {"targetId": target, "flatten": True})["sessionId"]
@@ -147,13 +149,22 @@ class Browser:
                 self.send(f"{domain}.enable", {}, session)
             self._events = [e for e in self._events if e.get("sessionId") != session]
             t0 = time.perf_counter()
-            url = Path(html).resolve().as_uri() + (f"#{fragment}" if fragment else "")
+            url = str(html) if str(html).startswith(("http://", "https://")) else \
+                Path(html).resolve().as_uri()
+            url += f"#{fragment}" if fragment else ""
             self.send("Page.navigate", {"url": url}, session)
             self._wait_event("Page.loadEventFired", session)
             dt = time.perf_counter() - t0
             text = self.send("Runtime.evaluate", {"expression": _STATUS_JS,
                                                   "returnByValue": True}, session)
             text = text.get("result", {}).get("value") or ""
+            value = None
+            if evaluate is not None:
+                ans = self.send("Runtime.evaluate", {"expression": evaluate, "awaitPromise": True,
+                                                     "returnByValue": True}, session)
+                if "exceptionDetails" in ans:
+                    raise InputError(f"page script failed: {ans['exceptionDetails'].get('text')}")
+                value = ans.get("result", {}).get("value")
             png = None
             if screenshot:
                 png = base64.b64decode(self.send("Page.captureScreenshot", {"format": "png"},
@@ -166,7 +177,7 @@ class Browser:
             self._events = [e for e in self._events if e.get("sessionId") != session]
             self.send("Target.closeTarget", {"targetId": target})
         return PageResult(status=json.loads(text) if text else {}, console=console, png=png,
-                          seconds=dt)
+                          seconds=dt, value=value)
 
     def close(self) -> None:
         if self._proc.poll() is None:

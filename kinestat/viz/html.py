@@ -22,6 +22,7 @@ _PAGE = """<!DOCTYPE html>
 <head>
 <meta charset="utf-8">
 <meta name="viewport" content="width=device-width, initial-scale=1">
+<link rel="icon" href="data:,">
 <meta name="generator" content="kinestat viewer (three.js __THREE__)">
 <title>__TITLE__</title>
 <style>
@@ -48,7 +49,7 @@ html, body { margin: 0; height: 100%; font: 13px system-ui, sans-serif; color: #
 <input type="range" id="timeline" min="0" max="0" step="1" value="0"></div>
 <div id="sliders"></div>
 <div id="ik" hidden><input id="ik-target" size="28" placeholder="x,y,z target of the end">
-<button id="ik-go">IK</button><div id="ik-out"></div></div>
+<button id="ik-go">IK</button><div id="ik-out"></div><select id="ik-pick" hidden></select></div>
 <pre id="pose"></pre>
 <pre id="info"></pre>
 <div id="legend"></div>

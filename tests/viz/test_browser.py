@@ -100,3 +100,59 @@ def test_script_error_is_reported(tmp_path, browser):
     page = browser.load(path, screenshot=False)
     assert not page.status.get("ready")
     assert any("no-such-item" in line for line in page.console)
+
+
+SLIDER_JS = """(() => {
+  const el = document.getElementById("joint2");
+  el.value = 37.3; el.dispatchEvent(new Event("input"));
+  return {value: Number(el.value), frames: window.kinestatViewer.status.fk_frames};
+})()"""
+
+
+def test_slider_moves_the_arm_by_page_fk(pages, browser):
+    """Dragging a slider recomputes every frame in the page, equal to kinestat.fk."""
+    path, m, q = pages["model"]
+    page = browser.load(path, screenshot=False, evaluate=SLIDER_JS)
+    assert page.console == ()
+    q2 = q.copy()
+    q2[1] = np.radians(page.value["value"])  # the slider's value, on its step grid
+    assert abs(page.value["value"] - 37.3) < 0.5
+    np.testing.assert_allclose(np.array(page.value["frames"]), fk_frames(m, q2), atol=1e-9,
+                               rtol=0)
+
+
+IK_JS = """(async () => {
+  document.getElementById("ik-target").value = "%s";
+  document.getElementById("ik-go").click();
+  const out = document.getElementById("ik-out");
+  for (let i = 0; i < 600 && !out.textContent; i++) await new Promise(r => setTimeout(r, 50));
+  const v = window.kinestatViewer;
+  return {text: out.textContent, n: document.getElementById("ik-pick").options.length,
+          frames: v.status.fk_frames};
+})()"""
+
+
+def test_served_page_asks_the_server_for_ik(browser):
+    """--serve: the page's IK box sends the target to the server and shows the answer."""
+    import threading
+
+    from kinestat.viz.serve import make_server
+
+    m = kinestat.load("puma762")
+    q = np.radians([30, -40, 20, 10, 50, 0])
+    srv = make_server(model_scene(m, q), model=m)
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    try:
+        T0 = kinestat.fk(m, q)
+        target = T0[:3, 3] + [40.0, -25.0, 15.0]
+        url = f"http://127.0.0.1:{srv.server_address[1]}/"
+        page = browser.load(url, screenshot=False,
+                            evaluate=IK_JS % ",".join(repr(float(x)) for x in target))
+    finally:
+        srv.shutdown()
+        srv.server_close()
+    assert page.console == () and page.status["ready"]
+    assert "solution" in page.value["text"] and page.value["n"] >= 2
+    end = np.array(page.value["frames"])[-1]
+    np.testing.assert_allclose(end[:3, 3], target, atol=1e-6)
+    np.testing.assert_allclose(end[:3, :3], T0[:3, :3], atol=1e-9)

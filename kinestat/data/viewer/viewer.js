@@ -189,6 +189,15 @@
     });
   }
 
+  function setQ(values) {   // exact joint values (IK answers): the sliders only display them
+    q = values.slice();
+    robot.kinds.forEach((kind, i) => {
+      const k = kind !== "prismatic" ? 180 / Math.PI : 1, el = document.getElementById("joint" + (i + 1));
+      el.value = q[i] * k; el.nextSibling.textContent = (q[i] * k).toFixed(2) + (kind !== "prismatic" ? "°" : "");
+    });
+    drawRobot(robot, q); render();
+  }
+
   const steps = scene.steps || [];
   function showStep(k) {
     status.step = k;
@@ -224,17 +233,22 @@
   const ikPanel = document.getElementById("ik");
   if (robot && robot.live && location.protocol.startsWith("http") && scene.ik_url) {
     ikPanel.hidden = false;
+    const end0 = chainFrames(robot, q)[q.length];
+    document.getElementById("ik-target").value = [end0[0][3], end0[1][3], end0[2][3]].map((x) => x.toFixed(3)).join(",");
     document.getElementById("ik-go").addEventListener("click", async () => {
       const t = document.getElementById("ik-target").value.split(",").map(Number);
       const res = await fetch(scene.ik_url, { method: "POST", headers: { "Content-Type": "application/json" },
         body: JSON.stringify({ q: q, target: t }) });
       const ans = await res.json();
-      const out = document.getElementById("ik-out");
-      if (!ans.solutions || !ans.solutions.length) { out.textContent = ans.error || "no solution"; return; }
-      out.textContent = ans.solutions.length + " solution(s); showing the nearest";
-      q = ans.solutions[0].slice();
-      robot.kinds.forEach((kind, i) => { const el = document.getElementById("joint" + (i + 1));
-        el.value = q[i] * (kind !== "prismatic" ? 180 / Math.PI : 1); el.dispatchEvent(new Event("input")); });
+      const out = document.getElementById("ik-out"), pick = document.getElementById("ik-pick");
+      pick.innerHTML = "";
+      if (!ans.solutions || !ans.solutions.length) { out.textContent = ans.error || "no solution"; pick.hidden = true; return; }
+      out.textContent = ans.solutions.length + " solution(s), nearest first";
+      ans.solutions.forEach((sol, k) => { const o = document.createElement("option"); o.value = k;
+        o.textContent = "solution " + (k + 1); pick.appendChild(o); });
+      pick.hidden = false;
+      pick.onchange = () => setQ(ans.solutions[Number(pick.value)]);
+      setQ(ans.solutions[0]);
     });
   }
 
