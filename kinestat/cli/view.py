@@ -58,6 +58,7 @@ def _emit(scene: dict, out: _Out, model=None) -> None:
         host, port = srv.server_address[:2]
         url = f"http://{host}:{port}/"
         console.print(f"kinestat view: serving {url} (Ctrl-C stops)")
+        console.file.flush()  # the address must reach a pipe before serving blocks
         if not out.no_open:
             webbrowser.open(url)
         try:

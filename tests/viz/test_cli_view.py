@@ -177,3 +177,36 @@ def test_control_view_flag(control_run):
     s = _opened_scene(urls[0])
     assert s["kind"] == "log"
     assert "".join(st["state"] for st in s["steps"]) == report["states"]
+
+
+def test_serve_command_prints_its_loopback_address_and_serves():
+    """`kinestat view model … --serve --no-open` in its own process: the printed address
+    answers with the page; the process is stopped by its pid."""
+    import os
+    import re
+    import signal
+    import subprocess
+    import sys
+    import urllib.request
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[2]
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    proc = subprocess.Popen(
+        [sys.executable, "-c", "import sys; from kinestat.cli.main import main; "
+         "sys.exit(main(sys.argv[1:]))", "view", "model", "puma762", "--serve", "--no-open"],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        line = proc.stdout.readline()
+        m = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
+        assert m, line + proc.stderr.read() if proc.poll() is not None else line
+        page = urllib.request.urlopen(m.group(0), timeout=20).read().decode()
+        assert 'id="kinestat-scene"' in page and '"ik_url":"/ik"' in page
+    finally:
+        proc.send_signal(signal.SIGINT)
+        try:
+            proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+            proc.wait()
+    assert proc.returncode == 130  # interrupted: "kinestat: interrupted"
