@@ -78,7 +78,36 @@ def main(argv: list[str]) -> int:
             png.write_bytes(r.png)
             print(f"{png}: canvas variance {headless.canvas_variance(r.png):.0f}, "
                   f"loaded in {r.status['load_ms']:.0f} ms")
+        served(b, out)
     return 0
+
+
+def served(b: headless.Browser, out: Path) -> None:
+    """The served PUMA page after an IK request through the page (the gizmo's ball moved)."""
+    import threading
+
+    import numpy as np
+
+    import kinestat
+    from kinestat.viz.scene import model_scene
+    from kinestat.viz.serve import make_server
+
+    m = kinestat.load("puma762")
+    q = np.radians([30, -40, 20, 10, 50, 0])
+    target = (kinestat.fk(m, q)[:3, 3] + [150.0, -100.0, 120.0]).tolist()
+    srv = make_server(model_scene(m, q), model=m)
+    threading.Thread(target=srv.serve_forever, daemon=True).start()
+    try:
+        js = ("(async () => { const v = window.kinestatViewer; "
+              f"v.gizmo.object.position.set({target[0]}, {target[1]}, {target[2]}); "
+              f"await v.ikTo({target}); return 1; }})()")
+        r = b.load(f"http://127.0.0.1:{srv.server_address[1]}/", evaluate=js)
+    finally:
+        srv.shutdown()
+        srv.server_close()
+    png = out / "viewer-model-served.png"
+    png.write_bytes(r.png)
+    print(f"{png}: served page after IK, console {list(r.console)}")
 
 
 if __name__ == "__main__":

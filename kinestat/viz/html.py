@@ -48,7 +48,8 @@ html, body { margin: 0; height: 100%; font: 13px system-ui, sans-serif; color: #
 <div id="player" hidden><button id="play">play</button> <span id="step-label"></span>
 <input type="range" id="timeline" min="0" max="0" step="1" value="0"></div>
 <div id="sliders"></div>
-<div id="ik" hidden><input id="ik-target" size="28" placeholder="x,y,z target of the end">
+<div id="ik" hidden><div>IK: drag the orange ball, or type a target</div>
+<input id="ik-target" size="28" placeholder="x,y,z target of the end">
 <button id="ik-go">IK</button><div id="ik-out"></div><select id="ik-pick" hidden></select></div>
 <pre id="pose"></pre>
 <pre id="info"></pre>

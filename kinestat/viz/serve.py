@@ -2,9 +2,11 @@
 
 ``GET /`` is the page (:func:`kinestat.viz.html.render_html`), ``GET /scene.json`` the scene,
 ``POST /ik`` with ``{"q": [...], "target": [x, y, z]}`` moves the end frame's origin to the
-target keeping its orientation and answers ``{"solutions": [[...], ...]}`` nearest first: every
-closed-form solution for the PUMA 762 (:func:`kinestat.serial.puma762.reverse_pose`), else the
-numerical :func:`kinestat.ik` from the current configuration. Every answer is checked by FK.
+target keeping its orientation and answers ``{"solutions": [[...], ...], "outside_limits": k}``:
+every closed-form solution for the PUMA 762 (:func:`kinestat.serial.puma762.reverse_pose`), else
+the numerical :func:`kinestat.ik` from the current configuration; each checked by FK, rotating
+joints turned by whole turns into their limits, those still outside the joint limits only
+counted, the rest nearest the current configuration first.
 """
 
 from __future__ import annotations
@@ -39,10 +41,25 @@ def ik_answer(model: ChainModel, q, target) -> dict:
         res = kinestat.ik(model, T, q)
         cands = [np.asarray(res.q)] if bool(np.all(res.success)) else []
     scale = max(float(np.linalg.norm(t)), 1.0)
-    good = [c for c in cands
+    good = [c for c in (_near(model, np.asarray(c, dtype=float), q) for c in cands)
             if np.max(np.abs(kinestat.fk(model, c) - T)) <= 1e-6 * scale]
-    good.sort(key=lambda c: float(np.sum((np.asarray(c) - q) ** 2)))
-    return {"solutions": [[float(x) for x in c] for c in good]}
+    inside = [c for c in good if bool(model.within_limits(c))]
+    inside.sort(key=lambda c: float(np.sum((c - q) ** 2)))
+    return {"solutions": [[float(x) for x in c] for c in inside],
+            "outside_limits": len(good) - len(inside)}
+
+
+def _near(model: ChainModel, c: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """``c`` with every rotating joint turned by whole turns to the value nearest ``q`` that
+    lies within its limits (nearest ``q`` when none does)."""
+    out = c.copy()
+    for i in np.flatnonzero(~model.prismatic):
+        base = q[i] + (c[i] - q[i] + np.pi) % (2 * np.pi) - np.pi
+        options = sorted((base + k * 2 * np.pi for k in (-1, 0, 1, -2, 2)),
+                         key=lambda x: abs(x - q[i]))
+        fits = [x for x in options if model.lower[i] <= x <= model.upper[i]]
+        out[i] = fits[0] if fits else base
+    return out
 
 
 def _handler(page: bytes, scene_bytes: bytes, model: ChainModel | None):

@@ -127,8 +127,11 @@ IK_JS = """(async () => {
   const out = document.getElementById("ik-out");
   for (let i = 0; i < 600 && !out.textContent; i++) await new Promise(r => setTimeout(r, 50));
   const v = window.kinestatViewer;
-  return {text: out.textContent, n: document.getElementById("ik-pick").options.length,
-          frames: v.status.fk_frames};
+  const first = {text: out.textContent, n: document.getElementById("ik-pick").options.length,
+                 frames: v.status.fk_frames, gizmo: v.gizmo !== null};
+  const ball = v.gizmo.object.position.toArray();   // where the gizmo's ball was put
+  await v.ikTo(%s);                                 // what letting go of the ball does
+  return {...first, ball: ball, frames2: v.status.fk_frames};
 })()"""
 
 
@@ -146,13 +149,18 @@ def test_served_page_asks_the_server_for_ik(browser):
         T0 = kinestat.fk(m, q)
         target = T0[:3, 3] + [40.0, -25.0, 15.0]
         url = f"http://127.0.0.1:{srv.server_address[1]}/"
-        page = browser.load(url, screenshot=False,
-                            evaluate=IK_JS % ",".join(repr(float(x)) for x in target))
+        target2 = T0[:3, 3] + [-30.0, 20.0, -40.0]
+        page = browser.load(url, screenshot=False, evaluate=IK_JS % (
+            ",".join(repr(float(x)) for x in target), [float(x) for x in target2]))
     finally:
         srv.shutdown()
         srv.server_close()
     assert page.console == () and page.status["ready"]
-    assert "solution" in page.value["text"] and page.value["n"] >= 2
+    assert "solution" in page.value["text"] and page.value["n"] >= 2 and page.value["gizmo"]
     end = np.array(page.value["frames"])[-1]
     np.testing.assert_allclose(end[:3, 3], target, atol=1e-6)
     np.testing.assert_allclose(end[:3, :3], T0[:3, :3], atol=1e-9)
+    np.testing.assert_allclose(page.value["ball"], target, atol=1e-9)  # the typed target
+    end2 = np.array(page.value["frames2"])[-1]
+    np.testing.assert_allclose(end2[:3, 3], target2, atol=1e-6)
+    np.testing.assert_allclose(end2[:3, :3], T0[:3, :3], atol=1e-9)

@@ -97,7 +97,7 @@ def test_serve_answers_page_scene_and_ik():
     from kinestat.viz.serve import make_server
 
     m = kinestat.load("puma762")
-    q = np.radians([10, -30, 20, 5, 40, -15])
+    q = np.radians([40, -30, 20, 5, 40, -15])  # within the PUMA 762 limits (axis 1: 20..340)
     srv = make_server(model_scene(m, q), port=0, model=m)
     host, port = srv.server_address[:2]
     assert host == "127.0.0.1"
@@ -115,6 +115,8 @@ def test_serve_answers_page_scene_and_ik():
                                      headers={"Content-Type": "application/json"})
         ans = json.loads(urllib.request.urlopen(req, timeout=30).read())
         assert len(ans["solutions"]) >= 2  # the PUMA's closed form gives several branches
+        assert ans["outside_limits"] >= 0
+        assert all(m.within_limits(np.array(sol)) for sol in ans["solutions"])
         for sol in ans["solutions"]:
             T = kinestat.fk(m, np.array(sol))
             np.testing.assert_allclose(T[:3, 3], target, atol=1e-6)

@@ -229,32 +229,54 @@
   showFrames.checked = !!scene.show_frames;
   showFrames.addEventListener("change", () => { if (robot) drawRobot(robot, q); render(); });
 
-  // ---- IK request (served pages only) --------------------------------------------------------
+  // ---- IK request (served pages only): a target box and a draggable target gizmo -------------
   const ikPanel = document.getElementById("ik");
+  let gizmo = null, ikTo = null;
   if (robot && robot.live && location.protocol.startsWith("http") && scene.ik_url) {
     ikPanel.hidden = false;
+    const targetBox = document.getElementById("ik-target");
     const end0 = chainFrames(robot, q)[q.length];
-    document.getElementById("ik-target").value = [end0[0][3], end0[1][3], end0[2][3]].map((x) => x.toFixed(3)).join(",");
-    document.getElementById("ik-go").addEventListener("click", async () => {
-      const t = document.getElementById("ik-target").value.split(",").map(Number);
+    const showTarget = (t) => { targetBox.value = t.map((x) => x.toFixed(3)).join(","); };
+    showTarget([end0[0][3], end0[1][3], end0[2][3]]);
+    ikTo = async (t) => {    // ask the server for every solution putting the end origin at t
+      showTarget(t);
       const res = await fetch(scene.ik_url, { method: "POST", headers: { "Content-Type": "application/json" },
         body: JSON.stringify({ q: q, target: t }) });
       const ans = await res.json();
       const out = document.getElementById("ik-out"), pick = document.getElementById("ik-pick");
       pick.innerHTML = "";
-      if (!ans.solutions || !ans.solutions.length) { out.textContent = ans.error || "no solution"; pick.hidden = true; return; }
-      out.textContent = ans.solutions.length + " solution(s), nearest first";
+      const outside = ans.outside_limits ? " (" + ans.outside_limits + " more outside the joint limits)" : "";
+      if (!ans.solutions || !ans.solutions.length) {
+        out.textContent = (ans.error || "no solution within the joint limits") + outside; pick.hidden = true; return ans;
+      }
+      out.textContent = ans.solutions.length + " solution(s), nearest first" + outside;
       ans.solutions.forEach((sol, k) => { const o = document.createElement("option"); o.value = k;
         o.textContent = "solution " + (k + 1); pick.appendChild(o); });
       pick.hidden = false;
       pick.onchange = () => setQ(ans.solutions[Number(pick.value)]);
       setQ(ans.solutions[0]);
+      return ans;
+    };
+    document.getElementById("ik-go").addEventListener("click", () => {
+      const t = targetBox.value.split(",").map(Number);
+      target.position.set(t[0], t[1], t[2]); ikTo(t);
     });
+    // the gizmo: drag the orange ball (three.js TransformControls); letting go asks for IK
+    const target = new THREE.Mesh(new THREE.SphereGeometry(0.03 * S, 20, 12), material("#ff7f0e"));
+    target.position.set(end0[0][3], end0[1][3], end0[2][3]);
+    world.add(target);
+    gizmo = new THREE.TransformControls(camera, renderer.domElement);
+    gizmo.setSize(0.8); gizmo.attach(target); world.add(gizmo.getHelper());
+    gizmo.addEventListener("change", () => render());
+    gizmo.addEventListener("dragging-changed", (e) => { controls.enabled = !e.value; });
+    gizmo.addEventListener("objectChange", () => showTarget(target.position.toArray()));
+    gizmo.addEventListener("mouseUp", () => ikTo(target.position.toArray()));
   }
 
   function render() { renderer.render(world, camera); }
   function fit() {
-    const box = new THREE.Box3().setFromObject(world);
+    const box = new THREE.Box3();   // the drawn content only (not the IK gizmo's helper plane)
+    for (const g of [staticGroup, robotGroup, stepGroup]) box.expandByObject(g);
     if (box.isEmpty()) box.set(new THREE.Vector3(-S, -S, -S), new THREE.Vector3(S, S, S));
     let c = box.getCenter(new THREE.Vector3()), r = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1e-9);
     if (scene.focus) { c = v3(scene.focus.point); r = scene.focus.radius; }   // e.g. the tool of the cell
@@ -277,6 +299,7 @@
   status.ready = true;
   status.load_ms = performance.now();   // since navigation start: parse, build, first render
   status.webgl = renderer.getContext() ? true : false;
-  window.kinestatViewer = { scene: scene, status: status, showStep: showStep, chainFrames: chainFrames };
+  window.kinestatViewer = { scene: scene, status: status, showStep: showStep, chainFrames: chainFrames,
+    gizmo: gizmo, ikTo: ikTo };
   document.getElementById("kinestat-status").textContent = JSON.stringify(status);
 })();
