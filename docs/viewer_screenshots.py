@@ -94,7 +94,7 @@ def served(b: headless.Browser, out: Path) -> None:
 
     m = kinestat.load("puma762")
     q = np.radians([30, -40, 20, 10, 50, 0])
-    target = (kinestat.fk(m, q)[:3, 3] + [150.0, -100.0, 120.0]).tolist()
+    target = (kinestat.fk(m, q)[:3, 3] + [-150.0, 100.0, 120.0]).tolist()
     srv = make_server(model_scene(m, q), model=m)
     threading.Thread(target=srv.serve_forever, daemon=True).start()
     try:
