@@ -7,7 +7,7 @@ RUN_STAMP := $(VENV)/.run-installed
 DEV_STAMP := $(VENV)/.dev-installed
 BENCH_STAMP := $(VENV)/.bench-installed
 
-.PHONY: run test lint bench clean
+.PHONY: run test lint bench clean browser vendor-three browser vendor-three
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)
@@ -26,9 +26,35 @@ $(DEV_STAMP): $(RUN_STAMP) requirements/dev.txt
 run: $(RUN_STAMP)
 	$(BIN)/kinestat control
 
+# Headless Chromium for the viewer's browser tests (tests/viz/test_browser.py): the Debian
+# package `chromium`, installed with apt-get when it is missing and we are root. Otherwise the
+# browser tests skip and say why (set KINESTAT_BROWSER to use another Chromium/Chrome).
+browser:
+	@if [ -n "$$KINESTAT_BROWSER" ] || command -v chromium >/dev/null 2>&1 \
+	    || command -v chromium-browser >/dev/null 2>&1 || command -v google-chrome >/dev/null 2>&1; then \
+	  :; \
+	elif [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  echo "make browser: installing chromium (apt-get)"; \
+	  (apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null) \
+	    || echo "make browser: chromium could not be installed; the browser tests will skip"; \
+	else \
+	  echo "make browser: no chromium and not root (or no apt-get); the browser tests will skip"; \
+	fi
+
+# Re-vendor three.js into kinestat/data/viewer/ (needs node/npm; see docs/viewer.md).
+THREE_VERSION ?= 0.187.0
+ESBUILD_VERSION ?= 0.28.2
+vendor-three:
+	rm -rf build/three && mkdir -p build/three
+	cd build/three && npm install --no-save --silent three@$(THREE_VERSION) esbuild@$(ESBUILD_VERSION) \
+	  && printf "export * from 'three';\nexport { OrbitControls } from 'three/addons/controls/OrbitControls.js';\nexport { TransformControls } from 'three/addons/controls/TransformControls.js';\n" > entry.js \
+	  && node_modules/.bin/esbuild entry.js --bundle --minify --format=iife --global-name=THREE \
+	       --legal-comments=none --outfile=../../kinestat/data/viewer/three.min.js
+	cp build/three/node_modules/three/LICENSE kinestat/data/viewer/LICENSE-three.txt
+
 # The whole test suite: lint, the layer contract (.importlinter, docs/architecture.md), then
 # pytest (which fails when no test runs).
-test: $(DEV_STAMP)
+test: $(DEV_STAMP) browser
 	$(BIN)/ruff check kinestat tests $(wildcard benchmarks)
 	$(BIN)/lint-imports
 	$(BIN)/pytest

@@ -155,6 +155,7 @@ def control_command(
     log: Path = typer.Option(
         None, "--log", help="Cycle log file, JSON lines (default: "
         "./kinestat-runs/<timestamp>/log.jsonl)."),
+    view: bool = typer.Option(False, "--view", help="Also open a 3D replay in the browser."),
     as_json: bool = typer.Option(False, "--json", help="Print the final report as JSON."),
 ) -> None:
     """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
@@ -205,6 +206,10 @@ def control_command(
         print_json(out)
     else:
         _print_report(out)
+    if view:
+        from kinestat.viz.show import show_log  # lazy: viewer only with --view
+
+        show_log(log_path)
     if not report.converged:
         raise KinestatError(f"kinestatic control did not converge: {report.stop_reason}")
 

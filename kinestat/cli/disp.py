@@ -93,6 +93,7 @@ def disp(
                                    "ceil(dθ°²/40) sub-steps, a final correction step); it "
                                    "reproduces that table with the illustration5-published "
                                    "deck. Not stated in the thesis."),
+    view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
 ) -> None:
     """Run a DISP deck (Nadkarni 1977): MS 1 screw axes, 2 mechanism data, 3 both, 0/4/5/6
     guidance of types II/III/IV/I.
@@ -135,6 +136,10 @@ def disp(
                 console.print(f"note: {n}")
         for p in written:
             console.print(f"wrote {p}")
+    if view and run.result is not None:
+        from kinestat.viz.show import show_guidance  # lazy: viewer only with --view
+
+        show_guidance(run.result, f"DISP MS = {d.ms}: {d.source}")
     if run.result is not None:
         run.result.raise_if_stopped()
 

@@ -189,6 +189,7 @@ def guide(
     speed: float = typer.Option(None, "--speed", help="Hand speed for the joint rates "
                                 "(Nadkarni suggestion 1): deg/s of rotation, or length/s for a "
                                 "pure translation."),
+    view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
     as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
     plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png here."),
 ) -> None:
@@ -254,6 +255,10 @@ def guide(
                                  for i in range(m.n)]))
         for p in written:
             console.print(f"wrote {p}")
+    if view:
+        from kinestat.viz.show import show_guidance  # lazy: viewer only with --view
+
+        show_guidance(result, f"kinestat guide {m.name}")
     result.raise_if_stopped()
 
 

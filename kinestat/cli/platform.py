@@ -107,6 +107,7 @@ def info_command(
 def fk_command(
     legs: str = typer.Option(..., "--legs", help="Six leg lengths in leg order (O,P,Q,R,S,T)."),
     platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
+    view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
     as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
 ) -> None:
     """Every real assembly mode for six leg lengths, each verified by reverse kinematics.
@@ -137,6 +138,10 @@ def fk_command(
              "max_leg_error": float(np.max(np.abs(leg_lengths(p, T) - L)))} for T in poses]
     out = {"count": len(sols), "method": method, "leg_names": list(p.leg_names),
            "leg_lengths": L, "solutions": sols}
+    if view:
+        from kinestat.viz.show import show_platform_modes  # lazy: viewer only with --view
+
+        show_platform_modes(p, poses, L)
     if as_json:
         print_json(out)
         return

@@ -49,6 +49,7 @@ def screw(
                                 "x,y,z,x,y,z,x,y,z: origin, a point on +z, a point in the z-x "
                                 "half plane with x > 0 (Nadkarni eqs. 3-1 to 3-3)."),
     points2: str = typer.Option(None, "--points2", help="Second position, as --points1."),
+    view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
     as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
 ) -> None:
     """Screw axis of the displacement between two positions of a body (Nadkarni ch. III).
@@ -69,6 +70,14 @@ def screw(
         if points1 is None or points2 is None:
             raise InputError("both --points1 and --points2 are needed")
         sc = screw_from_points(_points(points1, "points1"), _points(points2, "points2"))
+    if view:
+        from kinestat.viz.show import show_screw  # lazy: viewer only with --view
+
+        if by_pose:
+            show_screw(_pose(pose1, "pose1"), _pose(pose2, "pose2"))
+        else:
+            P1, P2 = _points(points1, "points1"), _points(points2, "points2")
+            show_screw(frame_from_triple(P1), frame_from_triple(P2), P1, P2)
     if as_json:
         print_json(screw_json(sc))
         return

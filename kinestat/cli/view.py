@@ -1,0 +1,289 @@
+"""``kinestat view``: an interactive 3D page of a model, the platform, a screw, a DISP run or a
+control run, written as one self-contained HTML file (``--html FILE``) or served on loopback
+(``--serve``). Without either, the page is written to a temporary file and opened.
+
+See docs/viewer.md for the scene format and what each page shows.
+"""
+
+from __future__ import annotations
+
+import webbrowser
+from pathlib import Path
+
+import numpy as np
+import typer
+
+from kinestat.cli._output import console, parse_floats, parse_pose
+from kinestat.errors import InputError
+from kinestat.io.textfile import write_text_atomic
+
+view_app = typer.Typer(
+    name="view",
+    help="3D views in the browser: model, platform, screw, disp, log (or --log FILE).",
+    invoke_without_command=True,
+)
+
+HTML_HELP = "Write the page to this HTML file (self-contained, opens offline)."
+SERVE_HELP = "Serve the page on HOST:PORT until interrupted (IK answered by the server)."
+
+
+def register(app: typer.Typer) -> None:
+    app.add_typer(view_app, name="view")
+
+
+class _Out:
+    """The output options every view command takes."""
+
+    def __init__(self, html: Path | None, serve: bool, host: str, port: int, no_open: bool):
+        self.html, self.serve, self.host, self.port, self.no_open = html, serve, host, port, no_open
+
+
+def _out_options(html: Path | None, serve: bool, host: str, port: int, no_open: bool) -> _Out:
+    if html is not None and serve:
+        raise InputError("give either --html FILE or --serve, not both")
+    if not 0 <= port <= 65535:
+        raise InputError(f"--port must be 0..65535, got {port}")
+    return _Out(html, serve, host, port, no_open)
+
+
+def _emit(scene: dict, out: _Out, model=None) -> None:
+    # lazy: the viewer (three.js page, HTTP server) loads only when a view is asked for
+    from kinestat.viz.html import render_html
+
+    if out.serve:
+        # lazy: the HTTP server and IK only with --serve
+        from kinestat.viz.serve import make_server
+
+        srv = make_server(scene, host=out.host, port=out.port, model=model)
+        host, port = srv.server_address[:2]
+        url = f"http://{host}:{port}/"
+        console.print(f"kinestat view: serving {url} (Ctrl-C stops)")
+        console.file.flush()  # the address must reach a pipe before serving blocks
+        if not out.no_open:
+            webbrowser.open(url)
+        try:
+            srv.serve_forever()
+        finally:
+            srv.server_close()
+        return
+    if out.html is None:
+        from kinestat.viz.show import show  # lazy: as above
+
+        show(scene, open_browser=not out.no_open)
+        return
+    write_text_atomic(out.html, render_html(scene))
+    console.print(f"wrote {out.html}")
+
+
+def _load_model(spec: str):
+    import kinestat  # lazy: model loading only for this view
+
+    p = Path(spec)
+    if p.suffix.lower() == ".urdf":
+        from kinestat.io.urdf import read_urdf  # lazy: URDF only for .urdf files
+
+        return read_urdf(p)
+    return kinestat.load(spec)
+
+
+# The output options, repeated on every command (Typer has no shared option groups).
+def _html_opt():
+    return typer.Option(None, "--html", help=HTML_HELP)
+
+
+def _serve_opt():
+    return typer.Option(False, "--serve", help=SERVE_HELP)
+
+
+def _host_opt():
+    return typer.Option("127.0.0.1", "--host", help="Address to serve on (default loopback).")
+
+
+def _port_opt():
+    return typer.Option(0, "--port", help="Port to serve on (0: a free one, printed).")
+
+
+def _no_open_opt():
+    return typer.Option(False, "--no-open", help="Do not open a browser.")
+
+
+@view_app.callback()
+def view_root(
+    ctx: typer.Context,
+    log: Path = typer.Option(None, "--log", help="Replay a control run's cycle log "
+                             "(same as `kinestat view log FILE`)."),
+    html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
+    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+) -> None:
+    """3D views in the browser (three.js): model, platform, screw, disp, log."""
+    if ctx.invoked_subcommand is not None:
+        if log is not None or html is not None or serve or port != 0 or no_open \
+                or host != "127.0.0.1":
+            raise InputError(f"put the options after the view's name, e.g. kinestat view "
+                             f"{ctx.invoked_subcommand} … --html FILE (--log goes alone)")
+        return
+    if log is None:
+        raise InputError("give a view (model, platform, screw, disp, log) or --log FILE; "
+                         "see kinestat view --help")
+    view_log(log, None, html, serve, host, port, no_open)
+
+
+@view_app.command("model")
+def view_model(
+    model: str = typer.Argument(..., help="Embedded model name, a TOML model or a URDF file."),
+    q: str = typer.Option(None, "--q", help="Joint values shown first (radians / length)."),
+    q_deg: str = typer.Option(None, "--q-deg", help="Joint values, rotating joints in degrees."),
+    frames: bool = typer.Option(False, "--frames", help="Show every joint frame."),
+    html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
+    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+) -> None:
+    """A serial model with joint sliders (FK in the page); IK of a target with --serve."""
+    from kinestat.viz.scene import model_scene  # lazy: scenes load only for a view
+
+    out = _out_options(html, serve, host, port, no_open)
+    m = _load_model(model)
+    if q is not None and q_deg is not None:
+        raise InputError("give at most one of --q and --q-deg")
+    vals = None
+    if q is not None:
+        vals = parse_floats(q, m.n, "q")
+    elif q_deg is not None:
+        vals = parse_floats(q_deg, m.n, "q-deg")
+        vals = np.where(m.prismatic, vals, np.deg2rad(vals))
+    _emit(model_scene(m, vals, show_frames=frames), out, model=m)
+
+
+@view_app.command("platform")
+def view_platform(
+    legs: str = typer.Option(None, "--legs", help="Six leg lengths: show every assembly mode."),
+    pose: str = typer.Option(None, "--pose", help="One pose instead ('home', a file or 16 "
+                             "numbers)."),
+    wrench: str = typer.Option(None, "--wrench", help="Legs carry j^-1 w instead of their "
+                               "spring forces: fx,fy,fz,mx,my,mz (moment about O0)."),
+    platform: str = typer.Option(None, "--platform", help="TOML platform file (default: the "
+                                 "embedded 2011 prototype)."),
+    html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
+    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+) -> None:
+    """The platform: plates, legs coloured by force (red tension, blue compression), the
+    wrench and its axis; with --legs every assembly mode side by side, the physical one marked."""
+    from kinestat.viz.scene import platform_scene  # lazy: scenes load only for a view
+
+    out = _out_options(html, serve, host, port, no_open)
+    p, poses, L = _platform_poses(legs, pose, platform)
+    w = None if wrench is None else parse_floats(wrench, 6, "wrench")
+    _emit(platform_scene(p, poses, legs=L, wrench=w), out)
+
+
+def _platform_poses(legs, pose, platform):
+    # lazy: the platform and its FK load only for this view
+    from kinestat.io.platform_toml import read_platform
+    from kinestat.parallel.fk import fk_list, fk_numeric
+    from kinestat.parallel.legs import as_pose
+    from kinestat.parallel.platform import prototype
+
+    p = prototype() if platform is None else read_platform(platform)
+    if legs is not None and pose is not None:
+        raise InputError("give at most one of --legs and --pose")
+    if legs is not None:
+        L = parse_floats(legs, 6, "legs")
+        if np.any(L <= 0):
+            raise InputError("--legs: leg lengths must be positive")
+        poses = fk_list(p, L) if p.layout is not None else [fk_numeric(p, L)]
+        return p, poses, L
+    if pose is None or pose.strip().lower() == "home":
+        return p, [p.home_pose.copy()], None
+    return p, [as_pose(parse_pose(pose, "pose"), "--pose")], None
+
+
+@view_app.command("screw")
+def view_screw(
+    points1: str = typer.Option(None, "--points1", help="First position by three body points "
+                                "x,y,z,x,y,z,x,y,z (origin, +z, z-x half plane)."),
+    points2: str = typer.Option(None, "--points2", help="Second position, as --points1."),
+    pose1: str = typer.Option(None, "--pose1", help="First pose (file or 16 numbers)."),
+    pose2: str = typer.Option(None, "--pose2", help="Second pose, as --pose1."),
+    html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
+    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+) -> None:
+    """Both body positions, the screw axis, the rotation about and translation along it."""
+    # lazy: scenes load only for a view
+    from kinestat.spatial.displacement import frame_from_triple
+    from kinestat.viz.scene import screw_scene
+
+    out = _out_options(html, serve, host, port, no_open)
+    by_points = points1 is not None or points2 is not None
+    if by_points == (pose1 is not None or pose2 is not None):
+        raise InputError("give either --points1 and --points2, or --pose1 and --pose2")
+    if by_points:
+        if points1 is None or points2 is None:
+            raise InputError("both --points1 and --points2 are needed")
+        P1 = parse_floats(points1, 9, "points1").reshape(3, 3)
+        P2 = parse_floats(points2, 9, "points2").reshape(3, 3)
+        scene = screw_scene(frame_from_triple(P1), frame_from_triple(P2), points1=P1,
+                            points2=P2)
+    else:
+        if pose1 is None or pose2 is None:
+            raise InputError("both --pose1 and --pose2 are needed")
+        scene = screw_scene(parse_pose(pose1, "pose1"), parse_pose(pose2, "pose2"))
+    _emit(scene, out)
+
+
+@view_app.command("disp")
+def view_disp(
+    deck: str = typer.Argument(..., help="A DISP deck file or an embedded deck name."),
+    steps: str = typer.Option(None, "--steps", help="Step count N, or N1,N2,… per stage."),
+    disp_1977: bool = typer.Option(False, "--disp-1977", help="The 1977 program's step rule."),
+    html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
+    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+) -> None:
+    """Animate a DISP deck's guidance run: the arm step by step, the hand path, events."""
+    from kinestat.viz.scene import guidance_scene  # lazy: scenes load only for a view
+
+    out = _out_options(html, serve, host, port, no_open)
+    result, title = disp_result(deck, steps, disp_1977)
+    _emit(guidance_scene(result, title=title), out)
+
+
+def disp_result(deck: str, steps: str | None = None, disp_1977: bool = False):
+    """The guidance result of a deck (MS 0, 4, 5, 6) and a title; InputError otherwise."""
+    # lazy: the DISP program is only needed by this view
+    from kinestat.io.disp_deck import embedded_deck, list_embedded_decks, read_deck
+    from kinestat.serial.guidance.disp import parse_steps, run_deck
+    from kinestat.serial.guidance.run import GuidanceOptions
+
+    if Path(deck).exists():
+        d = read_deck(Path(deck))
+    elif deck.strip().lower().removesuffix(".dat") in list_embedded_decks():
+        d = embedded_deck(deck.strip().lower().removesuffix(".dat"))
+    else:
+        raise InputError(f"DECK {deck!r} is neither a file nor an embedded deck; embedded "
+                         f"decks: {', '.join(list_embedded_decks())}")
+    opts = GuidanceOptions.disp_1977() if disp_1977 else GuidanceOptions()
+    run = run_deck(d, steps=parse_steps(steps), options=opts)
+    if run.result is None:
+        raise InputError(f"deck {deck!r} (MS = {d.ms}) has no guidance run to animate; "
+                         "MS 0, 4, 5 and 6 guide the hand")
+    return run.result, f"DISP MS = {d.ms}: {d.source}"
+
+
+@view_app.command("log")
+def view_log(
+    log: Path = typer.Argument(..., help="A control run's cycle log (RUN/log.jsonl)."),
+    platform: str = typer.Option(None, "--platform", help="TOML platform file of the run "
+                                 "(default: the embedded 2011 prototype)."),
+    html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
+    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+) -> None:
+    """Replay a control run: robot, platform, tool, workpiece, measured and true forces, the
+    state a–e per cycle, with a timeline slider."""
+    from kinestat.viz.cell_scene import cell_scene, read_cycle_log  # lazy: only for this view
+
+    out = _out_options(html, serve, host, port, no_open)
+    p = None
+    if platform is not None:
+        from kinestat.io.platform_toml import read_platform  # lazy: only with --platform
+
+        p = read_platform(platform)
+    start, cycles, end = read_cycle_log(log)
+    _emit(cell_scene(start, cycles, end, platform=p, title=f"control run {log}"), out)

@@ -1,0 +1,119 @@
+"""Serve a viewer page on loopback, with inverse kinematics answered by Python.
+
+``GET /`` is the page (:func:`kinestat.viz.html.render_html`), ``GET /scene.json`` the scene,
+``POST /ik`` with ``{"q": [...], "target": [x, y, z]}`` moves the end frame's origin to the
+target keeping its orientation and answers ``{"solutions": [[...], ...], "outside_limits": k}``:
+every closed-form solution for the PUMA 762 (:func:`kinestat.serial.puma762.reverse_pose`), else
+the numerical :func:`kinestat.ik` from the current configuration; each checked by FK, rotating
+joints turned by whole turns into their limits, those still outside the joint limits only
+counted, the rest nearest the current configuration first.
+"""
+
+from __future__ import annotations
+
+import errno
+import json
+import socket
+from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
+
+import numpy as np
+
+import kinestat
+from kinestat.errors import InputError, KinestatError
+from kinestat.mechanism.chain import ChainModel
+from kinestat.serial import puma762
+from kinestat.viz.html import render_html, scene_json
+
+__all__ = ["ik_answer", "make_server"]
+
+
+def ik_answer(model: ChainModel, q, target) -> dict:
+    """IK for the end origin at ``target`` (orientation kept): ``{"solutions": [...]}``."""
+    q = model.check_q(np.asarray(q, dtype=float))
+    t = np.asarray(target, dtype=float)
+    if t.shape != (3,) or not np.all(np.isfinite(t)):
+        raise InputError("target must be three finite numbers x,y,z")
+    T = kinestat.fk(model, q).copy()
+    T[:3, 3] = t
+    if model.name == "puma762":
+        cands = list(puma762.reverse_pose(T).solutions)
+    else:
+        res = kinestat.ik(model, T, q)
+        cands = [np.asarray(res.q)] if bool(np.all(res.success)) else []
+    scale = max(float(np.linalg.norm(t)), 1.0)
+    good = [c for c in (_near(model, np.asarray(c, dtype=float), q) for c in cands)
+            if np.max(np.abs(kinestat.fk(model, c) - T)) <= 1e-6 * scale]
+    inside = [c for c in good if bool(model.within_limits(c))]
+    inside.sort(key=lambda c: float(np.sum((c - q) ** 2)))
+    return {"solutions": [[float(x) for x in c] for c in inside],
+            "outside_limits": len(good) - len(inside)}
+
+
+def _near(model: ChainModel, c: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """``c`` with every rotating joint turned by whole turns to the value nearest ``q`` that
+    lies within its limits (nearest ``q`` when none does)."""
+    out = c.copy()
+    for i in np.flatnonzero(~model.prismatic):
+        base = q[i] + (c[i] - q[i] + np.pi) % (2 * np.pi) - np.pi
+        options = sorted((base + k * 2 * np.pi for k in (-1, 0, 1, -2, 2)),
+                         key=lambda x: abs(x - q[i]))
+        fits = [x for x in options if model.lower[i] <= x <= model.upper[i]]
+        out[i] = fits[0] if fits else base
+    return out
+
+
+def _handler(page: bytes, scene_bytes: bytes, model: ChainModel | None):
+    class Handler(BaseHTTPRequestHandler):
+        def log_message(self, format, *args):  # noqa: A002 - quiet server
+            pass
+
+        def _send(self, code: int, body: bytes, ctype: str) -> None:
+            self.send_response(code)
+            self.send_header("Content-Type", ctype)
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+        def do_GET(self) -> None:  # noqa: N802 - http.server's name
+            if self.path in ("/", "/index.html"):
+                self._send(200, page, "text/html; charset=utf-8")
+            elif self.path == "/scene.json":
+                self._send(200, scene_bytes, "application/json")
+            else:
+                self._send(404, b"not found", "text/plain")
+
+        def do_POST(self) -> None:  # noqa: N802
+            if self.path != "/ik" or model is None:
+                self._send(404, b"not found", "text/plain")
+                return
+            try:
+                n = int(self.headers.get("Content-Length", "0"))
+                req = json.loads(self.rfile.read(n) or b"{}")
+                ans = ik_answer(model, req.get("q"), req.get("target"))
+            except (KinestatError, ValueError, TypeError) as exc:
+                ans = {"solutions": [], "error": str(exc)}
+            self._send(200, json.dumps(ans).encode(), "application/json")
+
+    return Handler
+
+
+def make_server(scene: dict, *, host: str = "127.0.0.1", port: int = 0,
+                model: ChainModel | None = None) -> ThreadingHTTPServer:
+    """A bound (not yet serving) HTTP server for ``scene``; ``port`` 0 picks a free port.
+
+    Raises:
+        InputError: the port is in use or the address cannot be bound.
+    """
+    if model is not None and scene.get("robot") and scene["robot"].get("live"):
+        scene = {**scene, "ik_url": "/ik"}
+    page = render_html(scene).encode("utf-8")
+    try:
+        return ThreadingHTTPServer((host, port), _handler(page, scene_json(scene).encode(),
+                                                          model))
+    except OSError as exc:
+        if exc.errno == errno.EADDRINUSE:
+            raise InputError(f"port {port} on {host} is in use; choose another with --port "
+                             "(0 picks a free one)") from exc
+        if isinstance(exc, socket.gaierror) or exc.errno == errno.EADDRNOTAVAIL:
+            raise InputError(f"cannot bind the viewer to {host}:{port}: {exc}") from exc
+        raise InputError(f"cannot serve the viewer on {host}:{port}: {exc}") from exc
