@@ -7,7 +7,7 @@ RUN_STAMP := $(VENV)/.run-installed
 DEV_STAMP := $(VENV)/.dev-installed
 BENCH_STAMP := $(VENV)/.bench-installed
 
-.PHONY: run test lint bench clean browser vendor-three browser vendor-three
+.PHONY: run test lint bench clean browser vendor-three
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)

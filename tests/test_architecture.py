@@ -28,6 +28,22 @@ def _functions(tree: ast.Module):
     return [n for n in ast.walk(tree) if isinstance(n, ast.FunctionDef | ast.AsyncFunctionDef)]
 
 
+def _unexplained_imports(fn: ast.AST, lines: list[str]) -> list[int]:
+    """Line numbers of the imports in ``fn`` with no ``# lazy: <reason>``: on the import itself,
+    or on the comment line right above the run of consecutive imports it belongs to."""
+    imports = sorted((n for n in ast.walk(fn) if isinstance(n, ast.Import | ast.ImportFrom)),
+                     key=lambda n: n.lineno)
+    missing, first = [], None
+    for k, node in enumerate(imports):
+        if k == 0 or node.lineno != imports[k - 1].end_lineno + 1:
+            first = node  # a new run of consecutive imports starts here
+        above = lines[first.lineno - 2].strip() if first.lineno >= 2 else ""
+        own = lines[node.lineno - 1:node.end_lineno]
+        if not (above.startswith("# lazy:") or any("# lazy:" in line for line in own)):
+            missing.append(node.lineno)
+    return missing
+
+
 def test_the_import_contract_holds():
     exe = shutil.which("lint-imports", path=str(Path(sys.executable).parent))
     if exe is None:
@@ -42,11 +58,9 @@ def test_function_local_imports_say_why():
     for path in SOURCES:
         tree, lines = _tree(path)
         for fn in _functions(tree):
-            for node in ast.walk(fn):
-                if isinstance(node, ast.Import | ast.ImportFrom):
-                    span = lines[node.lineno - 1:node.end_lineno]
-                    if not any("# lazy:" in line for line in span):
-                        missing.append(f"{path.relative_to(PACKAGE.parent)}:{node.lineno}")
+            missing += [f"{path.relative_to(PACKAGE.parent)}:{line}"
+                        for line in _unexplained_imports(fn, lines)]
+    missing = sorted(set(missing))
     assert not missing, "function-local imports without a '# lazy: <reason>' comment: " + \
         ", ".join(missing)
 

@@ -177,10 +177,10 @@ def view_platform(
 
 def _platform_poses(legs, pose, platform):
     # lazy: the platform and its FK load only for this view
+    from kinestat.io.library import prototype
     from kinestat.io.platform_toml import read_platform
     from kinestat.parallel.fk import fk_list, fk_numeric
     from kinestat.parallel.legs import as_pose
-    from kinestat.parallel.platform import prototype
 
     p = prototype() if platform is None else read_platform(platform)
     if legs is not None and pose is not None:
@@ -248,9 +248,9 @@ def view_disp(
 def disp_result(deck: str, steps: str | None = None, disp_1977: bool = False):
     """The guidance result of a deck (MS 0, 4, 5, 6) and a title; InputError otherwise."""
     # lazy: the DISP program is only needed by this view
+    from kinestat.cli._guidance import parse_steps
+    from kinestat.disp import disp_options, run_deck
     from kinestat.io.disp_deck import embedded_deck, list_embedded_decks, read_deck
-    from kinestat.serial.guidance.disp import parse_steps, run_deck
-    from kinestat.serial.guidance.run import GuidanceOptions
 
     if Path(deck).exists():
         d = read_deck(Path(deck))
@@ -259,7 +259,7 @@ def disp_result(deck: str, steps: str | None = None, disp_1977: bool = False):
     else:
         raise InputError(f"DECK {deck!r} is neither a file nor an embedded deck; embedded "
                          f"decks: {', '.join(list_embedded_decks())}")
-    opts = GuidanceOptions.disp_1977() if disp_1977 else GuidanceOptions()
+    opts = disp_options(disp_1977=disp_1977)
     run = run_deck(d, steps=parse_steps(steps), options=opts)
     if run.result is None:
         raise InputError(f"deck {deck!r} (MS = {d.ms}) has no guidance run to animate; "

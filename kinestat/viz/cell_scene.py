@@ -16,7 +16,7 @@ import numpy as np
 import kinestat
 from kinestat.control.log import read_log
 from kinestat.errors import InputError
-from kinestat.parallel.platform import prototype
+from kinestat.io.library import prototype
 from kinestat.viz.scene import _base, _pt, chain_frames, force_color, robot_record
 
 __all__ = ["read_cycle_log", "cell_scene"]

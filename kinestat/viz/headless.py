@@ -219,7 +219,7 @@ def _console_text(e: dict) -> str:
 def canvas_variance(png: bytes | str | os.PathLike, *, panel_width: int = 330) -> float:
     """Grey-level variance of the 3D canvas (the window left of the side panel) in a screenshot;
     0 for a blank canvas."""
-    import io
+    import io  # lazy: with Pillow, only where screenshots are analysed
 
     from PIL import Image  # lazy: Pillow only where screenshots are analysed
 

@@ -13,9 +13,9 @@ import pytest
 
 import kinestat
 from kinestat.cli.main import main
+from kinestat.disp import run_deck
 from kinestat.io.disp_deck import embedded_deck
 from kinestat.serial.fk import fk_frames
-from kinestat.serial.guidance.disp import run_deck
 from kinestat.viz import headless
 from kinestat.viz.cell_scene import read_cycle_log
 from kinestat.viz.html import render_html

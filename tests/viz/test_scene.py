@@ -10,10 +10,10 @@ import pytest
 
 import kinestat
 from kinestat.errors import InputError
+from kinestat.io.library import prototype
 from kinestat.io.urdf import read_urdf, to_urdf
 from kinestat.parallel.fk import fk_list
 from kinestat.parallel.legs import leg_lengths, top_points_in_base
-from kinestat.parallel.platform import prototype
 from kinestat.serial.fk import fk_frames
 from kinestat.spatial.displacement import frame_from_triple, screw_from_poses
 from kinestat.viz.cell_scene import cell_scene, read_cycle_log
@@ -131,8 +131,8 @@ def test_screw_scene_axis_and_path():
 
 
 def test_guidance_scene_steps_follow_the_run():
+    from kinestat.disp import run_deck
     from kinestat.io.disp_deck import embedded_deck
-    from kinestat.serial.guidance.disp import run_deck
 
     run = run_deck(embedded_deck("illustration5"))
     res = run.result
