@@ -25,7 +25,7 @@ from kinestat.app.calibrations import (
     resolve_platform,
 )
 from kinestat.app.sim_cell import SimHarness, start_counts
-from kinestat.control.controller import ControllerConfig, StepMethod
+from kinestat.control.controller import ControllerConfig, Procedure, StepMethod
 from kinestat.control.envelope import Envelope
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, run
@@ -124,6 +124,7 @@ class ControlRequest:
     max_iterations: int = 60
     calibration: str = "thesis"
     platform: str | None = None
+    procedure: Procedure = "kinestat"
 
 
 def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: np.ndarray,
@@ -162,7 +163,7 @@ def _config(req: ControlRequest, model: ControlModel) -> ControllerConfig:
         model=model, force=req.force, start_tool_point=req.start_tool_point,
         force_tol=req.force_tol, align_tol_deg=req.align_tol_deg, method=req.method,
         step=req.step, approach_step=req.approach_step, estimator=req.estimator,
-        max_iterations=req.max_iterations, envelope=Envelope())
+        max_iterations=req.max_iterations, envelope=Envelope(), procedure=req.procedure)
 
 
 @dataclass(frozen=True, eq=False)

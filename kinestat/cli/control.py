@@ -169,6 +169,10 @@ def control_command(
         "thesis", "--sim-legs",
         help="The simulated legs' TRUE law: 'thesis', 'nominal' or a calibration TOML file "
         "(simulation only)."),
+    procedure: str = typer.Option(
+        "kinestat", "--procedure",
+        help="'kinestat' (the improved loop) or 'thesis' (ForceCorrection.m as written: one "
+        "reorientation about the tool point, then fixed --step translations along S6)."),
     as_json: bool = typer.Option(False, "--json", help="Print the final report as JSON."),
 ) -> None:
     """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
@@ -179,7 +183,8 @@ def control_command(
     logged; faults end in a safe stop (ST). Exit status 0 when converged, 2 otherwise.
 
     JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
-    tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots.
+    tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
+    torque_about_tool, torque_about_base (N·mm, fixed frame), procedure, calibration, cycles.
     """
     d = parse_floats(direction, 3, "direction")
     if np.linalg.norm(d) == 0:
@@ -201,11 +206,12 @@ def control_command(
                          align_tol_deg=align_tol_deg, method=method, step=step,
                          approach_step=approach_step, estimator=estimator, samples=samples,
                          max_iterations=max_iterations, calibration=calibration,
-                         platform=platform)
+                         platform=platform, procedure=procedure)
     prepared = prepare_control(req)
 
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
-                      f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), method {method}, "
+                      f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {procedure}, method "
+                      f"{method}, calibration {calibration}, "
                       + ("simulated cell" if simulated else f"Galil {galil}, sensor {serial}"))
     report = run_control(prepared, log_path, progress=_print_progress)
     out = report.as_dict()
@@ -231,7 +237,9 @@ def _print_report(out: dict) -> None:
                       f"{out['states']}")
     out_console.print(f"  {out['stop_reason']}")
     rows = []
-    for key, label in (("force", "force (N)"), ("torque", "torque about tool point (N·mm)"),
+    for key, label in (("force", "force (N)"),
+                       ("torque_about_tool", "torque about tool point (N·mm)"),
+                       ("torque_about_base", "torque about robot base (N·mm)"),
                        ("true_force", "true force (N)"), ("tool_axis", "tool axis S6"),
                        ("tool_point", "tool point (mm)")):
         if out.get(key) is not None:
