@@ -194,6 +194,7 @@ def _cmd_record(cmd: Command) -> dict | None:
         "predicted_force": None if p is None else p.force,
         "predicted_force_magnitude": None if p is None else p.force_magnitude,
         "predicted_deflections": None if p is None else p.deflections,
+        "predicted_top_pose": None if p is None else p.top_pose,
     }
 
 
@@ -221,7 +222,8 @@ def _config_record(config: ControllerConfig) -> dict:
         "mount": config.model.mount,
         "envelope": {"max_deflection": env.max_deflection, "max_load": env.max_load,
                      "max_joint_step_deg": env.max_joint_step_deg,
-                     "max_stream_faults": env.max_stream_faults},
+                     "max_stream_faults": env.max_stream_faults,
+                     "motion_range": env.motion_range},
         "states": STATES,
     }
 
