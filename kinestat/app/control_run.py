@@ -34,6 +34,8 @@ from kinestat.control.wrench import Estimator
 from kinestat.devices.cell_io import DeviceIO
 from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import GalilClient
+from kinestat.devices.motion import MOVE_RULES, MoveRule
+from kinestat.errors import InputError
 from kinestat.parallel.platform import Platform
 from kinestat.sim.contact import Cell, make_cell
 from kinestat.sim.sensor import Sensor
@@ -125,6 +127,7 @@ class ControlRequest:
     calibration: str = "thesis"
     platform: str | None = None
     procedure: Procedure = "kinestat"
+    move_rule: MoveRule = "coordinated"
 
 
 def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: np.ndarray,
@@ -181,7 +184,11 @@ class PreparedRun:
 def prepare_control(req: ControlRequest) -> PreparedRun:
     """Assemble the cell and the controller of ``req`` (checks every setting; nothing starts)."""
     direction = req.force / np.linalg.norm(req.force)
-    header: dict = {"simulated": isinstance(req.cell, SimulatedCell)}
+    if req.move_rule not in MOVE_RULES:
+        raise InputError(f"--move-rule must be one of {', '.join(MOVE_RULES)}, got "
+                         f"{req.move_rule!r}")
+    header: dict = {"simulated": isinstance(req.cell, SimulatedCell),
+                    "move_rule": req.move_rule}
     platform = resolve_platform(req.platform)
     cal = resolve_calibration(req.calibration, platform)
     header["calibration"] = cal.name
@@ -213,13 +220,14 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
         if isinstance(req.cell, SimulatedCell):
             with SimHarness(prepared.cell, prepared.sensor, start_counts=start_counts(config),
                             rate_hz=req.cell.rate_hz, seed=req.cell.seed) as h:
-                io = h.device_io(samples=req.samples)
+                io = h.device_io(samples=req.samples, move_rule=req.move_rule)
                 return run(config, io, cycle_log, progress=progress, extra_header=header)
         d = req.cell
         client = GalilClient(d.host, d.port).connect()
         try:
             with EncoderReader(d.serial, fmt=d.serial_format) as reader:
-                io = DeviceIO(client, reader, samples=req.samples, settle=0.1)
+                io = DeviceIO(client, reader, samples=req.samples, settle=0.1,
+                              move_rule=req.move_rule)
                 return run(config, io, cycle_log, progress=progress, extra_header=header)
         finally:
             client.close()

@@ -173,6 +173,10 @@ def control_command(
         "kinestat", "--procedure",
         help="'kinestat' (the improved loop) or 'thesis' (ForceCorrection.m as written: one "
         "reorientation about the tool point, then fixed --step translations along S6)."),
+    move_rule: str = typer.Option(
+        "coordinated", "--move-rule",
+        help="Per-axis speeds of each move: 'coordinated' (the axes start and finish together), "
+        "'thesis' (galil_control.m's |delta|/4 counts/s) or 'max'."),
     as_json: bool = typer.Option(False, "--json", help="Print the final report as JSON."),
 ) -> None:
     """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
@@ -206,7 +210,7 @@ def control_command(
                          align_tol_deg=align_tol_deg, method=method, step=step,
                          approach_step=approach_step, estimator=estimator, samples=samples,
                          max_iterations=max_iterations, calibration=calibration,
-                         platform=platform, procedure=procedure)
+                         platform=platform, procedure=procedure, move_rule=move_rule)
     prepared = prepare_control(req)
 
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "

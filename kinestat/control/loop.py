@@ -66,8 +66,9 @@ class CellIO(Protocol):
     def robot_counts(self) -> np.ndarray:
         """The robot's axis positions, encoder counts A..F."""
 
-    def move(self, axis_counts: np.ndarray) -> None:
-        """Move to absolute axis counts and return when the motion is complete."""
+    def move(self, axis_counts: np.ndarray) -> dict | None:
+        """Move to absolute axis counts and return when the motion is complete; optionally
+        return the move's plan (``{"delta_counts": [6], "speed": [6], ...}``) for the log."""
 
     def sensor(self) -> SensorReading:
         """Leg counts measured after the last motion completed."""
@@ -286,8 +287,15 @@ def _start_move(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run) ->
                "reason": cmd.reason, "commanded": _cmd_record(cmd)})
     if cmd.kind == "stop":
         raise SafetyStop(cmd.reason)
-    io.move(cmd.axis_counts)
+    _move(io, log, cmd, 0, r)
+
+
+def _move(io: CellIO, log: CycleLog, cmd: Command, cycle: int, r: _Run) -> None:
+    """Send one move; log its plan (per-axis deltas and speeds) when the cell reports one."""
+    plan = io.move(cmd.axis_counts)
     r.moves += 1
+    if plan:
+        log.write({"type": "move", "cycle": cycle, "t": r.t(), "move": plan})
 
 
 def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
@@ -331,8 +339,7 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
     if cmd.kind == "measure":  # measure again without moving (the thesis's procedure)
         return False
     require([] if cmd.axis_counts is not None else ["a move without axis counts"])
-    io.move(cmd.axis_counts)
-    r.moves += 1
+    _move(io, log, cmd, r.state.cycle, r)
     return False
 
 
