@@ -34,8 +34,9 @@ from kinestat.control.wrench import Estimator
 from kinestat.devices.cell_io import DeviceIO
 from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import GalilClient
+from kinestat.devices.homing import is_homed
 from kinestat.devices.motion import MOVE_RULES, MoveRule
-from kinestat.errors import InputError
+from kinestat.errors import InputError, SafetyStop
 from kinestat.parallel.platform import Platform
 from kinestat.sim.contact import Cell, make_cell
 from kinestat.sim.sensor import Sensor
@@ -128,6 +129,7 @@ class ControlRequest:
     platform: str | None = None
     procedure: Procedure = "kinestat"
     move_rule: MoveRule = "coordinated"
+    assume_homed: bool = False
 
 
 def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: np.ndarray,
@@ -225,6 +227,12 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
         d = req.cell
         client = GalilClient(d.host, d.port).connect()
         try:
+            if not req.assume_homed and not is_homed(client):
+                reason = (f"the robot behind the Galil at {d.host}:{d.port} is not homed in "
+                          "this controller session: run `kinestat home --galil "
+                          f"{d.host}:{d.port}` first (or pass --assume-homed); nothing moved")
+                cycle_log.write({"type": "fault", "reason": reason, "action": "nothing sent"})
+                raise SafetyStop(reason)
             with EncoderReader(d.serial, fmt=d.serial_format) as reader:
                 io = DeviceIO(client, reader, samples=req.samples, settle=0.1,
                               move_rule=req.move_rule)

@@ -148,6 +148,8 @@ class SimHarness:
         self.fmt = fmt
         self.controller = DmcSimulator(clock=clock, initial_counts=start_counts,
                                        coupling=coupling, record=record)
+        # the robot is placed at known, calibrated counts: homed by construction
+        self.controller.variables["HOMED"] = 1.0
         self.server = GalilSimServer(controller=self.controller)
         self.emitter = EncoderEmitter(self.counts_now, rate_hz=rate_hz, fmt=fmt,  # type: ignore[arg-type]
                                       **(emitter_options or {}))

@@ -177,6 +177,10 @@ def control_command(
         "coordinated", "--move-rule",
         help="Per-axis speeds of each move: 'coordinated' (the axes start and finish together), "
         "'thesis' (galil_control.m's |delta|/4 counts/s) or 'max'."),
+    assume_homed: bool = typer.Option(
+        False, "--assume-homed",
+        help="With --galil: move even if the controller does not report this session homed "
+        "(`kinestat home`)."),
     as_json: bool = typer.Option(False, "--json", help="Print the final report as JSON."),
 ) -> None:
     """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
@@ -210,7 +214,8 @@ def control_command(
                          align_tol_deg=align_tol_deg, method=method, step=step,
                          approach_step=approach_step, estimator=estimator, samples=samples,
                          max_iterations=max_iterations, calibration=calibration,
-                         platform=platform, procedure=procedure, move_rule=move_rule)
+                         platform=platform, procedure=procedure, move_rule=move_rule,
+                         assume_homed=assume_homed)
     prepared = prepare_control(req)
 
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
