@@ -53,7 +53,7 @@ def coordinated_move_plan(current, target, speed_max, accel_max) -> MovePlan:
 
     >>> p = coordinated_move_plan([0] * 6, [1000, 500, 0, 0, 0, 0], [100] * 6, [1000] * 6)
     >>> p.speed[:2].tolist(), p.accel[:2].tolist()
-    [[100.0, 50.0], [1000.0, 500.0]]
+    ([100.0, 50.0], [1000.0, 500.0])
     """
     cur = as_axes6(current, "coordinated_move_plan current")
     tgt = as_axes6(target, "coordinated_move_plan target")
