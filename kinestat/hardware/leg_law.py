@@ -19,7 +19,7 @@ This module derives from a calibration the quantities the controller and the sim
 * :func:`rescale_counts`: the same calibration on finer counts (the simulator's ideal sensor).
 
 At the thesis maps' zero-force counts, the nominal model reads |F| = 4.995 N and a moment of
-366 N·mm about the base origin on an unloaded platform (checked in tests/hardware).
+366 N·mm about the platform base's origin O0 on an unloaded platform (tests/hardware).
 """
 
 from __future__ import annotations
