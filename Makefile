@@ -55,7 +55,7 @@ vendor-three:
 # The whole test suite: lint, the layer contract (.importlinter, docs/architecture.md), then
 # pytest (which fails when no test runs).
 test: $(DEV_STAMP) browser
-	$(BIN)/ruff check kinestat tests $(wildcard benchmarks)
+	$(BIN)/ruff check kinestat tests $(wildcard benchmarks scripts)
 	$(BIN)/lint-imports
 	$(BIN)/pytest
 
@@ -68,7 +68,7 @@ bench: $(BENCH_STAMP)
 	$(BIN)/python benchmarks/bench.py $(ARGS)
 
 lint: $(DEV_STAMP)
-	$(BIN)/ruff check kinestat tests $(wildcard benchmarks)
+	$(BIN)/ruff check kinestat tests $(wildcard benchmarks scripts)
 
 clean:
 	rm -rf $(VENV) build *.egg-info

@@ -17,8 +17,15 @@ from pathlib import Path
 
 import numpy as np
 
-from kinestat.app.sim_cell import SimHarness, control_model, start_counts
-from kinestat.control.controller import ControllerConfig, StepMethod
+from kinestat.app.calibrations import (
+    NamedCalibration,
+    calibrated_model,
+    ideal_counts,
+    resolve_calibration,
+    resolve_platform,
+)
+from kinestat.app.sim_cell import SimHarness, start_counts
+from kinestat.control.controller import ControllerConfig, Procedure, StepMethod
 from kinestat.control.envelope import Envelope
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, run
@@ -27,10 +34,12 @@ from kinestat.control.wrench import Estimator
 from kinestat.devices.cell_io import DeviceIO
 from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import GalilClient
-from kinestat.hardware.puma762_axes import THESIS_TOOL_POINT_6
-from kinestat.parallel.platform import special_6_6
-from kinestat.sim.contact import Cell, centred_mount, make_cell
-from kinestat.sim.sensor import Sensor, ideal_calibration
+from kinestat.devices.homing import is_homed
+from kinestat.devices.motion import MOVE_RULES, MoveRule
+from kinestat.errors import InputError, SafetyStop
+from kinestat.parallel.platform import Platform
+from kinestat.sim.contact import Cell, make_cell
+from kinestat.sim.sensor import Sensor
 
 __all__ = [
     "DEFAULT_START",
@@ -88,6 +97,7 @@ class SimulatedCell:
     noise: float = 0.0
     rate_hz: float = 200.0
     seed: int = 0
+    sim_legs: str = "thesis"
 
 
 @dataclass(frozen=True)
@@ -115,30 +125,42 @@ class ControlRequest:
     estimator: Estimator = "point"
     samples: int = 1
     max_iterations: int = 60
+    calibration: str = "thesis"
+    platform: str | None = None
+    procedure: Procedure = "kinestat"
+    move_rule: MoveRule = "coordinated"
+    assume_homed: bool = False
 
 
-def simulated_cell(settings: SimulatedCell, start_point: np.ndarray,
-                   direction: np.ndarray) -> tuple[Cell, Sensor]:
-    """The thesis's experiment as a simulated cell and its leg sensor (Vibhute §5.1)."""
-    sensor = (Sensor(calibration=ideal_calibration()) if settings.ideal_sensor
-              else Sensor(noise=settings.noise))
+def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: np.ndarray,
+                   platform: Platform | None = None, truth: NamedCalibration | None = None
+                   ) -> tuple[Cell, Sensor]:
+    """The thesis's experiment as a simulated cell and its leg sensor (Vibhute §5.1): the
+    platform (default the prototype) with legs that follow ``truth`` (default
+    ``settings.sim_legs``), the sensor reading counts through the truth's length maps."""
+    platform = resolve_platform(None) if platform is None else platform
+    truth = resolve_calibration(settings.sim_legs, platform) if truth is None else truth
+    legs = truth.calibration
+    if settings.ideal_sensor:
+        legs, = ideal_counts(legs)
+    sensor = Sensor(calibration=legs, noise=settings.noise)
     pp, pn = default_plane(start_point, direction, DEFAULT_PLANE_DISTANCE,
                            DEFAULT_PLANE_TILT_DEG)
     if settings.plane_point is not None:
         pp = settings.plane_point
     if settings.plane_normal is not None:
         pn = settings.plane_normal
-    cell = make_cell(special_6_6(), plane_point=pp, plane_normal=pn,
-                     friction=settings.friction)
+    cell = make_cell(platform, plane_point=pp, plane_normal=pn, friction=settings.friction,
+                     legs=truth.calibration)
     return cell, sensor
 
 
-def device_model() -> ControlModel:
-    """The controller's model of the real cell: the special 6-6 platform centred on the flange,
-    the thesis's tool point ``P_tool_6`` (App. D.1) and leg calibration."""
-    platform = special_6_6()
-    return ControlModel(platform=platform, mount=centred_mount(platform),
-                        tool_point_6=THESIS_TOOL_POINT_6)
+def device_model(calibration: str = "thesis", platform: str | None = None) -> ControlModel:
+    """The controller's model of the real cell: the platform (default the special 6-6
+    prototype) centred on the flange, the thesis's tool point ``P_tool_6`` (App. D.1) and the
+    leg calibration (default the thesis's maps)."""
+    plat = resolve_platform(platform)
+    return calibrated_model(plat, resolve_calibration(calibration, plat))
 
 
 def _config(req: ControlRequest, model: ControlModel) -> ControllerConfig:
@@ -146,7 +168,7 @@ def _config(req: ControlRequest, model: ControlModel) -> ControllerConfig:
         model=model, force=req.force, start_tool_point=req.start_tool_point,
         force_tol=req.force_tol, align_tol_deg=req.align_tol_deg, method=req.method,
         step=req.step, approach_step=req.approach_step, estimator=req.estimator,
-        max_iterations=req.max_iterations, envelope=Envelope())
+        max_iterations=req.max_iterations, envelope=Envelope(), procedure=req.procedure)
 
 
 @dataclass(frozen=True, eq=False)
@@ -164,19 +186,31 @@ class PreparedRun:
 def prepare_control(req: ControlRequest) -> PreparedRun:
     """Assemble the cell and the controller of ``req`` (checks every setting; nothing starts)."""
     direction = req.force / np.linalg.norm(req.force)
-    header: dict = {"simulated": isinstance(req.cell, SimulatedCell)}
+    if req.move_rule not in MOVE_RULES:
+        raise InputError(f"--move-rule must be one of {', '.join(MOVE_RULES)}, got "
+                         f"{req.move_rule!r}")
+    header: dict = {"simulated": isinstance(req.cell, SimulatedCell),
+                    "move_rule": req.move_rule}
+    platform = resolve_platform(req.platform)
+    cal = resolve_calibration(req.calibration, platform)
+    header["calibration"] = cal.name
+    header["platform"] = req.platform or "prototype"
     if isinstance(req.cell, SimulatedCell):
         s = req.cell
-        cell, sensor = simulated_cell(s, req.start_tool_point, direction)
-        config = _config(req, control_model(cell, sensor))
+        truth = resolve_calibration(s.sim_legs, platform)
+        if s.ideal_sensor:  # the controller reads the same fine counts
+            _, fine = ideal_counts(truth.calibration, cal.calibration)
+            cal = NamedCalibration(cal.name, fine)
+        cell, sensor = simulated_cell(s, req.start_tool_point, direction, platform, truth)
+        config = _config(req, calibrated_model(platform, cal))
         header.update({"plane_point": cell.workpiece.point, "plane_normal": cell.workpiece.normal,
                        "friction": s.friction, "ideal_sensor": s.ideal_sensor, "noise": s.noise,
-                       "rate_hz": s.rate_hz})
+                       "rate_hz": s.rate_hz, "sim_legs": truth.name})
         return PreparedRun(req, config, header, cell, sensor)
     d = req.cell
     header.update({"galil": f"{d.host}:{d.port}", "serial": d.serial,
                    "serial_format": d.serial_format})
-    return PreparedRun(req, _config(req, device_model()), header)
+    return PreparedRun(req, _config(req, calibrated_model(platform, cal)), header)
 
 
 def run_control(prepared: PreparedRun, log_path: Path, *,
@@ -188,13 +222,20 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
         if isinstance(req.cell, SimulatedCell):
             with SimHarness(prepared.cell, prepared.sensor, start_counts=start_counts(config),
                             rate_hz=req.cell.rate_hz, seed=req.cell.seed) as h:
-                io = h.device_io(samples=req.samples)
+                io = h.device_io(samples=req.samples, move_rule=req.move_rule)
                 return run(config, io, cycle_log, progress=progress, extra_header=header)
         d = req.cell
         client = GalilClient(d.host, d.port).connect()
         try:
+            if not req.assume_homed and not is_homed(client):
+                reason = (f"the robot behind the Galil at {d.host}:{d.port} is not homed in "
+                          "this controller session: run `kinestat home --galil "
+                          f"{d.host}:{d.port}` first (or pass --assume-homed); nothing moved")
+                cycle_log.write({"type": "fault", "reason": reason, "action": "nothing sent"})
+                raise SafetyStop(reason)
             with EncoderReader(d.serial, fmt=d.serial_format) as reader:
-                io = DeviceIO(client, reader, samples=req.samples, settle=0.1)
+                io = DeviceIO(client, reader, samples=req.samples, settle=0.1,
+                              move_rule=req.move_rule)
                 return run(config, io, cycle_log, progress=progress, extra_header=header)
         finally:
             client.close()

@@ -26,7 +26,8 @@ from kinestat.control.controller import ControllerConfig, axis_counts_to_q
 from kinestat.control.model import ControlModel
 from kinestat.devices.cell_io import DeviceIO, SensorSample
 from kinestat.devices.encoder_stream import EncoderReader, Format
-from kinestat.devices.galil import GalilClient
+from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
+from kinestat.devices.motion import coordinated_move_plan
 from kinestat.errors import DeviceError, KinestatError
 from kinestat.hardware.puma762_axes import (
     AXIS4_TO_5_COUPLING,
@@ -147,6 +148,8 @@ class SimHarness:
         self.fmt = fmt
         self.controller = DmcSimulator(clock=clock, initial_counts=start_counts,
                                        coupling=coupling, record=record)
+        # the robot is placed at known, calibrated counts: homed by construction
+        self.controller.variables["HOMED"] = 1.0
         self.server = GalilSimServer(controller=self.controller)
         self.emitter = EncoderEmitter(self.counts_now, rate_hz=rate_hz, fmt=fmt,  # type: ignore[arg-type]
                                       **(emitter_options or {}))
@@ -256,14 +259,20 @@ class InProcessIO:
         """The exact robot's axis counts A..F."""
         return self._counts.copy()
 
-    def move(self, axis_counts) -> None:
-        """Reach ``axis_counts`` exactly, solving the cell at ``substeps`` points on the way."""
+    def move(self, axis_counts) -> dict:
+        """Reach ``axis_counts`` exactly, solving the cell at ``substeps`` points on the way
+        (the straight joint-space path of a coordinated move); returns the coordinated plan
+        (:func:`kinestat.devices.motion.coordinated_move_plan`, the thesis's maxima)."""
         new = np.asarray(axis_counts, dtype=np.int64)
         old = self._counts.astype(float)
         for s in np.linspace(0.0, 1.0, self.substeps + 1)[1:]:
             self.state.solve(self._q(old + s * (new - old)))
         self._counts = new.copy()
         self.moves.append(new.copy())
+        plan = coordinated_move_plan(old, new, THESIS_SPEED_MAX, THESIS_ACCEL)
+        return {"delta_counts": (new - old).astype(np.int64).tolist(),
+                "speed": plan.speed.tolist(), "accel": plan.accel.tolist(),
+                "rule": "coordinated"}
 
     def sensor(self) -> SensorSample:
         """Leg counts of the cell at the present pose, through the sensor model."""

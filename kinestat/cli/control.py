@@ -61,14 +61,16 @@ def _run_dir(base: Path) -> Path:
 
 
 def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise, friction,
-          rate, seed) -> SimulatedCell | RealDevices:
+          rate, seed, sim_legs="thesis") -> SimulatedCell | RealDevices:
     """The cell the options describe: simulated (no device options) or the real devices."""
     if (galil is None) != (serial is None):
         raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
                          "neither to run the simulated cell")
-    if galil is not None and (plane_point or plane_normal or ideal_sensor or noise or friction):
-        raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction "
-                         "describe the simulated cell; they cannot be used with real devices")
+    if galil is not None and (plane_point or plane_normal or ideal_sensor or noise or friction
+                              or sim_legs != "thesis"):
+        raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction/"
+                         "--sim-legs describe the simulated cell; they cannot be used with real "
+                         "devices")
     if serial_format not in ("ks", "legacy"):
         raise InputError(f"--serial-format must be 'ks' or 'legacy', got {serial_format!r}")
     if ideal_sensor and noise:
@@ -80,7 +82,8 @@ def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor,
         return SimulatedCell(
             plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
             plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
-            friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed)
+            friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed,
+            sim_legs=sim_legs)
     host, port = _host_port(galil)
     return RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
 
@@ -156,6 +159,29 @@ def control_command(
         None, "--log", help="Cycle log file, JSON lines (default: "
         "./kinestat-runs/<timestamp>/log.jsonl)."),
     view: bool = typer.Option(False, "--view", help="Also open a 3D replay in the browser."),
+    calibration: str = typer.Option(
+        "thesis", "--calibration",
+        help="Leg calibration the controller uses (counts -> leg length and force): 'thesis' "
+        "(the 2011 prototype's maps), 'nominal' (the design springs) or a TOML file "
+        "(docs/control.md)."),
+    platform: str = typer.Option(
+        None, "--platform", help="Platform TOML file (default the 2011 prototype)."),
+    sim_legs: str = typer.Option(
+        "thesis", "--sim-legs",
+        help="The simulated legs' TRUE law: 'thesis', 'nominal' or a calibration TOML file "
+        "(simulation only)."),
+    procedure: str = typer.Option(
+        "kinestat", "--procedure",
+        help="'kinestat' (the improved loop) or 'thesis' (ForceCorrection.m as written: one "
+        "reorientation about the tool point, then fixed --step translations along S6)."),
+    move_rule: str = typer.Option(
+        "coordinated", "--move-rule",
+        help="Per-axis speeds of each move: 'coordinated' (the axes start and finish together), "
+        "'thesis' (galil_control.m's |delta|/4 counts/s) or 'max'."),
+    assume_homed: bool = typer.Option(
+        False, "--assume-homed",
+        help="With --galil: move even if the controller does not report this session homed "
+        "(`kinestat home`)."),
     as_json: bool = typer.Option(False, "--json", help="Print the final report as JSON."),
 ) -> None:
     """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
@@ -166,7 +192,8 @@ def control_command(
     logged; faults end in a safe stop (ST). Exit status 0 when converged, 2 otherwise.
 
     JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
-    tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots.
+    tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
+    torque_about_tool, torque_about_base (N·mm, fixed frame), procedure, calibration, cycles.
     """
     d = parse_floats(direction, 3, "direction")
     if np.linalg.norm(d) == 0:
@@ -182,16 +209,19 @@ def control_command(
     plot_dir = None if no_plot else (plot if plot is not None else run_dir)
 
     cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
-                 friction, rate, seed)
+                 friction, rate, seed, sim_legs)
     simulated = isinstance(cell, SimulatedCell)
     req = ControlRequest(force=force * d, start_tool_point=p0, cell=cell, force_tol=force_tol,
                          align_tol_deg=align_tol_deg, method=method, step=step,
                          approach_step=approach_step, estimator=estimator, samples=samples,
-                         max_iterations=max_iterations)
+                         max_iterations=max_iterations, calibration=calibration,
+                         platform=platform, procedure=procedure, move_rule=move_rule,
+                         assume_homed=assume_homed)
     prepared = prepare_control(req)
 
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
-                      f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), method {method}, "
+                      f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {procedure}, method "
+                      f"{method}, calibration {calibration}, "
                       + ("simulated cell" if simulated else f"Galil {galil}, sensor {serial}"))
     report = run_control(prepared, log_path, progress=_print_progress)
     out = report.as_dict()
@@ -221,7 +251,9 @@ def _print_report(out: dict) -> None:
                       f"{out['states']}")
     out_console.print(f"  {out['stop_reason']}")
     rows = []
-    for key, label in (("force", "force (N)"), ("torque", "torque about tool point (N·mm)"),
+    for key, label in (("force", "force (N)"),
+                       ("torque_about_tool", "torque about tool point (N·mm)"),
+                       ("torque_about_base", "torque about robot base (N·mm)"),
                        ("true_force", "true force (N)"), ("tool_axis", "tool axis S6"),
                        ("tool_point", "tool point (mm)")):
         if out.get(key) is not None:

@@ -28,6 +28,7 @@ COMMAND_MODULES: list[str] = [
     "platform",
     "control",
     "view",
+    "home",
 ]
 
 app = typer.Typer(

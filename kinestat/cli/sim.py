@@ -78,12 +78,21 @@ def galil(
                                      "coupling of the thesis's PUMA."),
     duration: float = typer.Option(None, "--duration", help="Stop after this many seconds "
                                    "(default: run until Ctrl-C)."),
+    seed: int = typer.Option(None, "--seed", help="Start the robot at an arbitrary, unknown "
+                             "position drawn with this seed (encoders read 0 at power-up; "
+                             "home it with `kinestat home`)."),
     as_json: bool = typer.Option(False, "--json", help="Print the address as JSON."),
 ) -> None:
     """Run a simulated Galil DMC (six axes, trapezoidal profiles) until Ctrl-C."""
     _check_duration(duration)
     c0 = _int_counts(initial_counts, "initial-counts")
-    ctrl = DmcSimulator(initial_counts=c0, **({"coupling": 0.0} if no_coupling else {}))
+    kw = {"coupling": 0.0} if no_coupling else {}
+    if seed is not None:
+        if initial_counts != "0,0,0,0,0,0":
+            raise InputError("--seed (an unknown start) and --initial-counts exclude each other")
+        ctrl = DmcSimulator.unknown_start(seed, **kw)
+    else:
+        ctrl = DmcSimulator(initial_counts=c0, **kw)
     server = GalilSimServer(host, port, allow_remote=allow_remote, controller=ctrl)
     with server:
         if as_json:

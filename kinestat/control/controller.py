@@ -69,6 +69,8 @@ __all__ = [
     "ControllerState",
     "Command",
     "StepMethod",
+    "Procedure",
+    "PROCEDURES",
     "CommandKind",
     "Action",
     "start",
@@ -95,10 +97,16 @@ StepMethod = Literal["fixed", "stiffness"]
 """How the step along S6 is chosen: the thesis's fixed step or a Newton step from the
 platform stiffness (see the module docstring)."""
 METHODS: tuple[str, ...] = get_args(StepMethod)
-CommandKind = Literal["move", "done", "stop"]
-"""What a :class:`Command` asks for: send axis counts, report the goal, or stop safely."""
-Action = Literal["start", "approach", "align", "force", ""]
-"""Why a move is made (Vibhute Fig. 5-2 steps); "" for done/stop."""
+CommandKind = Literal["move", "measure", "done", "stop"]
+"""What a :class:`Command` asks for: send axis counts, measure again without moving (the
+thesis's procedure, :mod:`kinestat.control.procedure`), report the goal, or stop safely."""
+Action = Literal["start", "approach", "align", "force", "measure", "reorient", "translate", ""]
+"""Why a move is made (Vibhute Fig. 5-2 steps; "measure", "reorient", "translate" are the steps
+of ForceCorrection.m as written); "" for done/stop."""
+Procedure = Literal["kinestat", "thesis"]
+"""``kinestat``: :func:`decide` (the improved loop); ``thesis``: ForceCorrection.m as written
+(:func:`kinestat.control.procedure.decide_thesis`)."""
+PROCEDURES: tuple[str, ...] = get_args(Procedure)
 ESTIMATORS: tuple[str, ...] = get_args(Estimator)
 
 
@@ -161,6 +169,7 @@ class ControllerConfig:
             :meth:`kinestat.control.wrench.Measurement.estimate`.
         repeat_limit: a target commanded this many times means a limit cycle → stop.
         envelope: the safety envelope.
+        procedure: "kinestat" (default) or "thesis" (ForceCorrection.m's steps as written).
     """
 
     model: ControlModel
@@ -179,6 +188,7 @@ class ControllerConfig:
     estimator: Estimator = "point"
     repeat_limit: int = 3
     envelope: Envelope = field(default_factory=Envelope)
+    procedure: Procedure = "kinestat"
 
     def __post_init__(self) -> None:
         F = np.asarray(self.force, dtype=float)
@@ -201,6 +211,8 @@ class ControllerConfig:
             raise InputError(f"estimator must be one of {ESTIMATORS}, got {self.estimator!r}")
         if self.method not in METHODS:
             raise InputError(f"method must be one of {METHODS}, got {self.method!r}")
+        if self.procedure not in PROCEDURES:
+            raise InputError(f"procedure must be one of {PROCEDURES}, got {self.procedure!r}")
         for name in ("force_tol", "align_tol_deg", "step", "contact_force"):
             v = float(getattr(self, name))
             if not (math.isfinite(v) and v > 0):
@@ -236,6 +248,7 @@ class ControllerState:
         top_pose: (4, 4) the last measured top pose (the tracking FK's seed).
         history: keys of the targets commanded so far (limit-cycle detection).
         done: the run is over (goal reached or stopped).
+        reoriented: the thesis's procedure made (or no longer needs) its one reorientation.
     """
 
     cycle: int
@@ -246,6 +259,7 @@ class ControllerState:
     top_pose: np.ndarray
     history: tuple = ()
     done: bool = False
+    reoriented: bool = False
 
 
 @dataclass(frozen=True, eq=False)

@@ -7,9 +7,15 @@ What the cell must never do (Vibhute 2011 Table 3-1 and the PUMA 762's axis limi
   ``max_joint_step_deg`` in one command;
 * deflect a leg by more than ``max_deflection`` (5 mm, Table 3-1 "Individual Connector
   Deflection");
-* load the platform beyond ``max_load`` (50 N, Table 3-1 "Maximum perpendicular load").
+* load the platform beyond ``max_load`` (50 N, Table 3-1 "Maximum perpendicular load");
+* move the top relative to the base beyond Table 3-1's motion ranges: 4 mm along the base's z
+  axis (perpendicular to the base plane), 3.5 mm along its x and y axes, 6° about z and 4°
+  about x and y (:func:`top_motion`: the displacement of the top triangle's centroid from
+  where it sits when the legs are unloaded, and the rotation vector of the top's rotation
+  from its unloaded orientation, both in the base frame; each component against its range).
 
-Loads and deflections are checked on every measurement AND predicted before a command is sent:
+Loads, deflections and the top's motion are checked on every measurement AND predicted before a
+command is sent:
 :func:`predict` assumes the worst case for a step — the tip pinned where it is (a sticking
 contact; a sliding one loads the platform less) — and maps the flange's displacement at the tip
 through the platform's point stiffness at the tip, ``K_tip``, the inverse of the tip's
@@ -28,6 +34,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
@@ -41,7 +48,10 @@ from kinestat.spatial.transforms import apply, inv, skew
 __all__ = [
     "MAX_DEFLECTION",
     "MAX_LOAD",
+    "MOTION_RANGE",
     "Envelope",
+    "top_motion",
+    "check_motion",
     "Prediction",
     "tip_compliance",
     "tip_stiffness",
@@ -56,6 +66,9 @@ MAX_DEFLECTION = 5.0
 """Largest leg deflection |l − l0|, mm (Vibhute Table 3-1)."""
 MAX_LOAD = 50.0
 """Largest load on the platform, N (Vibhute Table 3-1)."""
+MOTION_RANGE = (3.5, 3.5, 4.0, 4.0, 4.0, 6.0)
+"""Table 3-1's motion ranges of the top relative to the base: x, y, z (mm), rotation about x,
+y, z (degrees; the OCR lost the degree signs)."""
 
 
 @dataclass(frozen=True)
@@ -68,14 +81,22 @@ class Envelope:
         max_joint_step_deg: largest axis motion in one command, degrees.
         max_stream_faults: sensor-stream faults (lost, corrupt, garbled packets) tolerated while
             acquiring one measurement; more means the link is unreliable → stop.
+        motion_range: the top's largest motion from its unloaded pose, base frame: x, y, z
+            (mm) and rotation about x, y, z (degrees), Table 3-1 (:data:`MOTION_RANGE`).
     """
 
     max_deflection: float = MAX_DEFLECTION
     max_load: float = MAX_LOAD
     max_joint_step_deg: float = 30.0
     max_stream_faults: int = 5
+    motion_range: tuple[float, ...] = MOTION_RANGE
 
     def __post_init__(self) -> None:
+        r = np.asarray(self.motion_range, dtype=float)
+        if r.shape != (6,) or not np.all(np.isfinite(r)) or np.any(r <= 0):
+            raise InputError(f"envelope motion_range must be 6 positive numbers (x, y, z mm; "
+                             f"about x, y, z degrees), got {self.motion_range!r}")
+        object.__setattr__(self, "motion_range", tuple(float(v) for v in r))
         for name in ("max_deflection", "max_load", "max_joint_step_deg"):
             v = float(getattr(self, name))
             if not (math.isfinite(v) and v > 0):
@@ -92,11 +113,13 @@ class Prediction:
         force: (3,) force the tool would apply to the workpiece, fixed frame (N).
         deflections: (6,) leg deflections ``l − l0`` (mm).
         tip_motion: (3,) displacement of the flange-carried point at the tip (mm, fixed frame).
+        top_pose: (4, 4) the predicted top pose in the base frame (first order), or None.
     """
 
     force: np.ndarray
     deflections: np.ndarray
     tip_motion: np.ndarray
+    top_pose: np.ndarray | None = None
 
     @property
     def force_magnitude(self) -> float:
@@ -154,8 +177,41 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     dl = np.cross(Bp, S) @ D[:3] + S @ D[3:]
     force = -(TB_new[:3, :3] @ (F + dF))
     defl = meas.deflections(model) + dl
+    top = np.eye(4)
+    Rd = Rotation.from_rotvec(D[:3]).as_matrix()
+    top[:3, :3] = Rd @ meas.top_pose[:3, :3]
+    top[:3, 3] = Rd @ meas.top_pose[:3, 3] + D[3:]
     return Prediction(force=force, deflections=defl, tip_motion=apply(Tn @ inv(meas.flange_pose),
-                                                                      tip_F) - tip_F)
+                                                                      tip_F) - tip_F,
+                      top_pose=top)
+
+
+def top_motion(model: ControlModel, top_pose) -> np.ndarray:
+    """The top's motion from its unloaded pose (Table 3-1's quantities), base frame: (6,)
+    ``[dx, dy, dz]`` (mm) of the top triangle's centroid and ``[rx, ry, rz]`` (degrees), the
+    rotation vector of ``R_top R_home⁻¹``."""
+    T = np.asarray(top_pose, dtype=float)
+    H = model.platform.home_pose
+    c = model.platform.top_points.mean(axis=0)
+    d = (T[:3, :3] @ c + T[:3, 3]) - (H[:3, :3] @ c + H[:3, 3])
+    r = Rotation.from_matrix(T[:3, :3] @ H[:3, :3].T).as_rotvec(degrees=True)
+    return np.concatenate([d, r])
+
+
+_MOTION_NAMES = ("x", "y", "z", "about x", "about y", "about z")
+
+
+def check_motion(envelope: Envelope, model: ControlModel, top_pose, what: str) -> list[str]:
+    """Violations of Table 3-1's motion ranges by the top at ``top_pose`` (``what``: "measured"
+    or "predicted")."""
+    m = top_motion(model, top_pose)
+    out = []
+    for k, (v, lim) in enumerate(zip(m, envelope.motion_range, strict=True)):
+        if abs(v) > lim:
+            unit = "mm" if k < 3 else "°"
+            out.append(f"{what} top motion {_MOTION_NAMES[k]} {v:+.3f} {unit} is beyond the "
+                       f"±{lim:g} {unit} range (Vibhute Table 3-1)")
+    return out
 
 
 def check_target(envelope: Envelope, force_target) -> list[str]:
@@ -182,6 +238,7 @@ def check_measurement(envelope: Envelope, model: ControlModel, meas: Measurement
     if abs(defl[k]) > envelope.max_deflection:
         out.append(f"leg {model.platform.leg_names[k]} is deflected {defl[k]:+.3f} mm, beyond "
                    f"±{envelope.max_deflection:g} mm")
+    out += check_motion(envelope, model, meas.top_pose, "measured")
     return out
 
 
@@ -217,6 +274,8 @@ def check_command(envelope: Envelope, model: ControlModel, axis_deg_new, axis_de
         if abs(dk) > envelope.max_deflection:
             out.append(f"leg {model.platform.leg_names[k]} would deflect {dk:+.3f} mm after the "
                        f"move, beyond ±{envelope.max_deflection:g} mm")
+        if prediction.top_pose is not None:
+            out += check_motion(envelope, model, prediction.top_pose, "predicted")
     return out
 
 

@@ -36,6 +36,7 @@ from kinestat.control.controller import (
 )
 from kinestat.control.envelope import require
 from kinestat.control.log import CycleLog
+from kinestat.control.procedure import decide_thesis
 from kinestat.control.wrench import Estimator, Measurement, measure
 from kinestat.errors import DeviceError, KinestatError, SafetyStop
 
@@ -65,8 +66,9 @@ class CellIO(Protocol):
     def robot_counts(self) -> np.ndarray:
         """The robot's axis positions, encoder counts A..F."""
 
-    def move(self, axis_counts: np.ndarray) -> None:
-        """Move to absolute axis counts and return when the motion is complete."""
+    def move(self, axis_counts: np.ndarray) -> dict | None:
+        """Move to absolute axis counts and return when the motion is complete; optionally
+        return the move's plan (``{"delta_counts": [6], "speed": [6], ...}``) for the log."""
 
     def sensor(self) -> SensorReading:
         """Leg counts measured after the last motion completed."""
@@ -105,6 +107,11 @@ class RunReport:
     faults: list[str] = field(default_factory=list)
     estimator: Estimator = "point"
     equivalent_wrench: np.ndarray | None = None
+    torque_about_tool: np.ndarray | None = None
+    torque_about_base: np.ndarray | None = None
+    procedure: str = "kinestat"
+    calibration: str = ""
+    cycles: list[dict] = field(default_factory=list)
 
     def as_dict(self) -> dict:
         """The report as plain JSON-ready values (the issue's keys first)."""
@@ -135,6 +142,12 @@ class RunReport:
             "faults": list(self.faults),
             "estimator": self.estimator,
             "equivalent_wrench": arr(self.equivalent_wrench),
+            "torque_about_tool": arr(self.torque_about_tool),
+            "torque_about_base": arr(self.torque_about_base),
+            "procedure": self.procedure,
+            "calibration": self.calibration,
+            "cycles": [{k: (arr(v) if isinstance(v, np.ndarray) else v) for k, v in c.items()}
+                       for c in self.cycles],
         }
 
 
@@ -152,6 +165,8 @@ def _meas_record(config: ControllerConfig, m: Measurement) -> dict:
         "estimate": m.estimate(config.estimator),
         "torque": m.torque,
         "moment_origin": m.wrench[3:],
+        "torque_about_tool": m.torque,
+        "torque_about_base": m.wrench[3:],
         "tool_point": m.tool_point,
         "tool_axis": m.s6,
         "a67": m.a67,
@@ -180,6 +195,7 @@ def _cmd_record(cmd: Command) -> dict | None:
         "predicted_force": None if p is None else p.force,
         "predicted_force_magnitude": None if p is None else p.force_magnitude,
         "predicted_deflections": None if p is None else p.deflections,
+        "predicted_top_pose": None if p is None else p.top_pose,
     }
 
 
@@ -197,6 +213,9 @@ def _config_record(config: ControllerConfig) -> dict:
         "max_iterations": config.max_iterations,
         "vernier": config.vernier,
         "estimator": config.estimator,
+        "procedure": config.procedure,
+        "calibration": config.model.calibration_name,
+        "force_source": config.model.force_source,
         "start_tool_point": config.start_tool_point,
         "start_s6": config.start_s6,
         "start_a67": config.start_a67,
@@ -204,7 +223,8 @@ def _config_record(config: ControllerConfig) -> dict:
         "mount": config.model.mount,
         "envelope": {"max_deflection": env.max_deflection, "max_load": env.max_load,
                      "max_joint_step_deg": env.max_joint_step_deg,
-                     "max_stream_faults": env.max_stream_faults},
+                     "max_stream_faults": env.max_stream_faults,
+                     "motion_range": env.motion_range},
         "states": STATES,
     }
 
@@ -223,6 +243,7 @@ class _Run:
     moves: int = 0
     converged: bool = False
     reason: str = ""
+    cycles: list[dict] = field(default_factory=list)
 
     def t(self) -> float:
         return time.monotonic() - self.t0
@@ -266,8 +287,15 @@ def _start_move(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run) ->
                "reason": cmd.reason, "commanded": _cmd_record(cmd)})
     if cmd.kind == "stop":
         raise SafetyStop(cmd.reason)
-    io.move(cmd.axis_counts)
+    _move(io, log, cmd, 0, r)
+
+
+def _move(io: CellIO, log: CycleLog, cmd: Command, cycle: int, r: _Run) -> None:
+    """Send one move; log its plan (per-axis deltas and speeds) when the cell reports one."""
+    plan = io.move(cmd.axis_counts)
     r.moves += 1
+    if plan:
+        log.write({"type": "move", "cycle": cycle, "t": r.t(), "move": plan})
 
 
 def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
@@ -288,9 +316,11 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
     meas = measure(config.model, q, sample.counts, r.state.top_pose, seq=sample.seq,
                    age=sample.age)
     r.last_meas = meas
-    cmd, r.state = decide(config, r.state, meas)
+    decide_fn = decide_thesis if config.procedure == "thesis" else decide
+    cmd, r.state = decide_fn(config, r.state, meas)
     r.states.append(cmd.label)
     r.last_truth = io.truth()
+    r.cycles.append(_cycle_summary(cmd, r.state, meas, r.last_truth))
     rec = {"type": "cycle", "cycle": r.state.cycle, "t": r.t(),
            "state": cmd.label, "decision": cmd.kind, "action": cmd.action,
            "reason": cmd.reason, "force_error": cmd.force_error,
@@ -306,10 +336,25 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
         return True
     if cmd.kind == "stop":
         raise SafetyStop(cmd.reason)
+    if cmd.kind == "measure":  # measure again without moving (the thesis's procedure)
+        return False
     require([] if cmd.axis_counts is not None else ["a move without axis counts"])
-    io.move(cmd.axis_counts)
-    r.moves += 1
+    _move(io, log, cmd, r.state.cycle, r)
     return False
+
+
+def _cycle_summary(cmd: Command, state: ControllerState, meas: Measurement,
+                   truth: dict | None) -> dict:
+    """The cycle's entry of the report's ``cycles``: state, action, the commanded tool point
+    and S6 (the last commanded ones for measure/done/stop), the measured force (the
+    equivalent wrench's) and, simulated, the true force."""
+    t = cmd.target if cmd.target is not None else state.target
+    tf = None if not truth or truth.get("tool_force") is None else np.asarray(
+        truth["tool_force"], dtype=float)
+    return {"cycle": state.cycle, "state": cmd.label,
+            "action": cmd.action if cmd.kind in ("move", "measure") else cmd.kind,
+            "tool_point": t.tool_point.copy(), "s6": t.s6.copy(),
+            "force": meas.wrench[:3].copy(), "true_force": tf}
 
 
 def _fault_reason(exc: BaseException) -> str:
@@ -326,6 +371,7 @@ def _finish(config: ControllerConfig, r: _Run, log: CycleLog) -> RunReport:
     """The report of the run, also written as the log's ``end`` record."""
     report = _report(config, r.converged, r.state, r.states, r.moves, r.reason, r.last_meas,
                      r.last_truth, log, r.faults, r.t(), r.last_counts)
+    report.cycles = r.cycles
     log.write({"type": "end", "report": report.as_dict()})
     return report
 
@@ -347,13 +393,16 @@ def _report(config, converged, state, states, moves, reason, m, truth, log, faul
     rep = RunReport(converged=converged, iterations=0 if state is None else state.cycle,
                     moves=moves, stop_reason=reason, method=config.method, states=states,
                     log=str(log.path), elapsed_s=elapsed, target_force=config.force_target,
-                    faults=faults, estimator=config.estimator)
+                    faults=faults, estimator=config.estimator, procedure=config.procedure,
+                    calibration=config.model.calibration_name)
     if m is not None:
         f = m.estimate(config.estimator)
         rep.force = np.array(f, dtype=float)
         rep.torque = m.torque
         rep.force_magnitude = float(np.linalg.norm(f))
         rep.equivalent_wrench = m.wrench.copy()
+        rep.torque_about_tool = m.torque
+        rep.torque_about_base = m.wrench[3:].copy()
         rep.tool_axis = m.s6.copy()
         rep.tool_point = m.tool_point.copy()
         rep.final_joints_deg = np.degrees(m.q)

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Literal, get_args
 
 import numpy as np
 
@@ -21,7 +22,11 @@ from kinestat.parallel.platform import Platform
 from kinestat.serial import puma762
 from kinestat.spatial.transforms import apply, as_array, inv
 
-__all__ = ["ControlModel"]
+__all__ = ["ControlModel", "ForceSource"]
+
+ForceSource = Literal["springs", "calibration"]
+"""Where the leg forces come from: the platform's linear springs ``k (l − l0)`` at the measured
+lengths, or the calibration's count → force maps (the thesis's eq_wrench.m ``legf``)."""
 
 
 def _ro(a) -> np.ndarray:
@@ -43,6 +48,10 @@ class ControlModel:
         axis_deg_per_count: (6,) robot encoder resolution, degrees per count.
         coupling: axis-5 counts turned per axis-4 count, compensated by the motion controller
             (:func:`kinestat.hardware.puma762_axes.axis45_compensation`); 0 when there is none.
+        force_source: "springs" (the platform's ``k (l − l0)``) or "calibration" (the
+            calibration's force maps; give the platform its calibrated springs,
+            :func:`kinestat.hardware.leg_law.calibrated_platform`, for the predictions).
+        calibration_name: a label for reports ("thesis-2011", "nominal", a file name).
     """
 
     platform: Platform
@@ -52,8 +61,13 @@ class ControlModel:
     limits_deg: np.ndarray = field(default_factory=lambda: puma762.AXIS_LIMITS_DEG)
     axis_deg_per_count: np.ndarray = field(default_factory=lambda: AXIS_DEG_PER_COUNT)
     coupling: float = AXIS4_TO_5_COUPLING
+    force_source: ForceSource = "springs"
+    calibration_name: str = ""
 
     def __post_init__(self) -> None:
+        if self.force_source not in get_args(ForceSource):
+            raise ModelError(f"force_source must be one of {get_args(ForceSource)}, got "
+                             f"{self.force_source!r}")
         M = as_array(self.mount, shape_tail=(4, 4), name="mount")
         if M.shape != (4, 4):
             raise ModelError(f"mount must be one 4x4 transform, got shape {M.shape}")

@@ -2,13 +2,14 @@
 
 Vibhute 2011 ch. 4 step 2 (serialdaq_plat.m → leg_to_T10.m → eq_wrench.m): the leg counts
 become leg lengths through the calibration, the platform's forward kinematics (tracking mode,
-from the previous pose) gives the top's pose, the spring forces ``k (l − l0)`` along the legs
-give the wrench, and the flange pose ``F_6T`` (from the robot's encoders) carries it into the
-fixed frame.
+from the previous pose) gives the top's pose, the leg forces along the legs — from the
+calibration's count → force maps (``ControlModel.force_source = "calibration"``, the thesis's
+``legf``) or the springs ``k (l − l0)`` — give the wrench, and the flange pose ``F_6T``
+(from the robot's encoders) carries it into the fixed frame.
 
 Two estimates of the contact force come out of each measurement:
 
-* the **equivalent wrench** ``W_eq = −j k (l − l0)`` (the thesis's eq_wrench.m): all six
+* the **equivalent wrench** ``W_eq = −j f`` (the thesis's eq_wrench.m): all six
   components, straight from the six leg forces;
 * the **point-contact force**: a tool tip touching a workpiece at a point transmits a pure
   force through the tip, ``w = [F; p × F]``, so the three components of F are fitted to the six
@@ -34,7 +35,7 @@ import numpy as np
 
 from kinestat.control.model import ControlModel
 from kinestat.errors import InputError
-from kinestat.hardware.leg_calibration import counts_to_lengths
+from kinestat.hardware.leg_calibration import counts_to_forces, counts_to_lengths
 from kinestat.parallel.statics import line_jacobian, spring_forces, wrench_from_leg_lengths
 from kinestat.serial import puma762
 from kinestat.spatial.screws import transform_wrench
@@ -144,9 +145,11 @@ def measure(model: ControlModel, q, counts, previous_top_pose, *, seq: int | Non
     plat = model.platform
     lengths = counts_to_lengths(c, model.calibration, plat.leg_names)
     # tracking FK from the previous pose (checked: no singularity crossed, nearest mode), then
-    # w = j k (l - l0), the external wrench on the top (base frame, about O0)
-    top, w_ext = wrench_from_leg_lengths(plat, lengths, previous_top_pose)
-    tension = spring_forces(plat, lengths)
+    # w = j f, the external wrench on the top (base frame, about O0), with the leg tensions f
+    # from the calibration's force maps or the springs k (l - l0)
+    tension = (counts_to_forces(c, model.calibration, plat.leg_names)
+               if model.force_source == "calibration" else spring_forces(plat, lengths))
+    top, w_ext = wrench_from_leg_lengths(plat, lengths, previous_top_pose, forces=tension)
     j = line_jacobian(plat, top)
     tool, s6, a67, T6 = tool_frame(q, model)
     TB = T6 @ model.mount

@@ -19,6 +19,7 @@ from typing import Any
 import numpy as np
 
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
+from kinestat.devices.motion import MOVE_RULES, MoveRule, move_plan
 from kinestat.errors import DeviceError, InputError, KinestatError
 from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, axis45_compensation
 
@@ -52,14 +53,17 @@ class DeviceIO:
     Moves compensate the axis 4 -> 5 coupling (``coupling``, as the model's). After each move it
     waits ``settle`` seconds past the end of the motion and averages ``samples`` fresh packets
     received after that. ``truth`` is an optional callable returning the true state
-    (simulation only).
+    (simulation only). ``move_rule`` chooses each move's per-axis speeds
+    (:mod:`kinestat.devices.motion`): "coordinated" (default: the axes start and finish
+    together, within the profile's maxima), "thesis" (galil_control.m's ``|Δ|/4``) or "max".
     """
 
     def __init__(self, client: GalilClient, reader: Any, *, profile: MotionProfile | None = None,
                  settle: float = 0.03, samples: int = 1, motion_timeout: float = 30.0,
                  coupling: float = AXIS4_TO_5_COUPLING,
                  truth: Callable[[], dict] | None = None,
-                 clock: Callable[[], float] = time.monotonic) -> None:
+                 clock: Callable[[], float] = time.monotonic,
+                 move_rule: MoveRule = "coordinated") -> None:
         if not (math.isfinite(settle) and settle >= 0):
             raise InputError(f"settle must be >= 0 seconds, got {settle!r}")
         if int(samples) < 1:
@@ -71,6 +75,9 @@ class DeviceIO:
         self.samples = int(samples)
         self.motion_timeout = float(motion_timeout)
         self.coupling = float(coupling)
+        if move_rule not in MOVE_RULES:
+            raise InputError(f"move_rule must be one of {MOVE_RULES}, got {move_rule!r}")
+        self.move_rule = move_rule
         self._truth = truth
         self._clock = clock
         self._t_ready = clock()
@@ -79,16 +86,18 @@ class DeviceIO:
         """The robot's axis positions A..F, encoder counts (``TP``)."""
         return np.asarray(self.client.position_counts(), dtype=np.int64)
 
-    def move(self, axis_counts: np.ndarray) -> None:
+    def move(self, axis_counts: np.ndarray) -> dict:
         """Move with the axis 4 -> 5 compensation (Vibhute App. D.9), keep reading the sensor
         stream while the axes move (so that the serial buffer never overflows), then reset the
-        axis-5 encoder (``DP``) as :meth:`GalilClient.move_compensated` does."""
+        axis-5 encoder (``DP``) as :meth:`GalilClient.move_compensated` does. Returns the
+        move's plan: ``{"delta_counts", "speed", "accel", "rule"}`` (what was sent)."""
         c = np.asarray(axis_counts, dtype=np.int64)
-        corr = axis45_compensation(c[3], c[4], self.client.axis_position("D"),
-                                   self.coupling)
+        now = np.asarray(self.client.position_counts(), dtype=np.int64)
+        corr = axis45_compensation(c[3], c[4], int(now[3]), self.coupling)
         cmd = c.copy()
         cmd[4] = int(corr.axis5_command)
-        self.client.move_absolute(cmd, self.profile.speed, self.profile.accel)
+        plan = move_plan(self.move_rule, now, cmd, self.profile.speed, self.profile.accel)
+        self.client.move_absolute(cmd, plan.speed, plan.accel, plan.decel)
         deadline = self._clock() + self.motion_timeout
         while self.client.is_moving():
             if self._clock() > deadline:
@@ -96,6 +105,8 @@ class DeviceIO:
             self.reader.poll()
         self.client.define_position({"E": int(corr.axis5_reset)})
         self._t_ready = self._clock() + self.settle
+        return {"delta_counts": (cmd - now).tolist(), "speed": plan.speed.tolist(),
+                "accel": plan.accel.tolist(), "rule": self.move_rule}
 
     def sensor(self) -> SensorSample:
         """The mean of ``samples`` fresh packets received after the motion settled, with the

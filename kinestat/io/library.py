@@ -21,12 +21,13 @@ from importlib import resources
 from pathlib import Path
 
 from kinestat.errors import InputError
+from kinestat.io.calibration_toml import CalibrationFile, loads_calibration, read_calibration
 from kinestat.io.model_toml import loads_model, read_model
 from kinestat.io.platform_toml import loads_platform
 from kinestat.mechanism.chain import ChainModel
 from kinestat.parallel.platform import Platform
 
-__all__ = ["load", "list_models", "prototype"]
+__all__ = ["load", "list_models", "prototype", "list_calibrations", "load_calibration"]
 
 
 def _models_dir():
@@ -81,3 +82,43 @@ def prototype() -> Platform:
     """
     res = resources.files("kinestat.data") / "platforms" / "prototype-2011.toml"
     return loads_platform(res.read_text(encoding="utf-8"), source=str(res))
+
+
+def _calibrations_dir():
+    return resources.files("kinestat.data") / "calibrations"
+
+
+CALIBRATION_ALIASES = {"thesis": "thesis-2011"}
+"""Short names of embedded calibrations (``--calibration thesis``)."""
+
+
+def list_calibrations() -> list[str]:
+    """Names of the embedded leg calibrations, sorted.
+
+    >>> list_calibrations()
+    ['thesis-2011']
+    """
+    return sorted(p.name[:-5] for p in _calibrations_dir().iterdir()
+                  if p.name.endswith(".toml"))
+
+
+def load_calibration(name_or_path: str | os.PathLike) -> CalibrationFile:
+    """An embedded leg calibration by name (``"thesis"`` = ``"thesis-2011"``) or a TOML
+    calibration file by path (schema: :mod:`kinestat.io.calibration_toml`).
+
+    >>> c = load_calibration("thesis")
+    >>> c.name, c.calibration.leg_names[:2], float(c.calibration.force_coeffs[0, 1])
+    ('thesis-2011', ('O', 'S'), -0.029796)
+    """
+    s = os.fspath(name_or_path)
+    s = CALIBRATION_ALIASES.get(s, s)
+    if s in list_calibrations():
+        res = _calibrations_dir() / f"{s}.toml"
+        return loads_calibration(res.read_text(encoding="utf-8"), source=f"<embedded {s}>")
+    p = Path(s)
+    if p.suffix == ".toml" or p.exists():
+        if not p.exists():
+            raise InputError(f"calibration file {s!r} does not exist")
+        return read_calibration(p)
+    raise InputError(f"unknown calibration {s!r}: not an embedded calibration "
+                     f"({', '.join(['thesis', *list_calibrations()])}) and not a TOML file path")

@@ -43,12 +43,14 @@ plane, ``f_n ≥ 0`` (unilateral), and every leg deflection within the legs' str
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError, ModelError, UnreachableError
+from kinestat.hardware.leg_calibration import LegCalibration
+from kinestat.hardware.leg_law import calibrated_platform, tension_slopes, tensions_at_lengths
 from kinestat.hardware.puma762_axes import THESIS_TOOL_POINT_6
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.platform import Platform
@@ -134,6 +136,8 @@ class Cell:
         tool_tip: (3,) the tool tip in the top frame.
         workpiece: the planar workpiece.
         stroke: largest leg deflection the legs take (mm), see :data:`DEFAULT_STROKE`.
+        leg_law: a non-linear true leg law (a calibration whose maps compose to the tension as
+            a function of length); None: the platform's linear springs. See :func:`make_cell`.
     """
 
     platform: Platform
@@ -141,6 +145,7 @@ class Cell:
     tool_tip: np.ndarray
     workpiece: Workpiece
     stroke: float = DEFAULT_STROKE
+    leg_law: LegCalibration | None = None
 
     def __post_init__(self) -> None:
         M = as_array(self.mount, shape_tail=(4, 4), name="mount")
@@ -201,13 +206,22 @@ def make_cell(
     tool_point_6=DEFAULT_TOOL_POINT_6,
     tool_tip=None,
     stroke: float = DEFAULT_STROKE,
+    legs: LegCalibration | None = None,
 ) -> Cell:
     """Assemble a :class:`Cell`.
 
     ``mount`` defaults to :func:`centred_mount`. The tool tip is ``tool_tip`` (top frame) if
     given, else the point of the top that sits at ``tool_point_6`` (frame 6) when the platform
     is unloaded — by default the thesis's (0, 0, 235) mm.
+
+    ``legs``: the legs' TRUE law, a calibration (counts → length, counts → tension); the
+    platform's springs are replaced by it (free lengths where it reads no force, unloaded home
+    pose there: :func:`kinestat.hardware.leg_law.calibrated_platform`), and a non-linear law
+    is kept as :attr:`Cell.leg_law` so that the equilibrium uses it exactly.
     """
+    if legs is not None:
+        platform = calibrated_platform(platform, legs)
+        nonlinear = legs.force_coeffs.shape[1] > 2 or legs.length_coeffs.shape[1] > 2
     M = centred_mount(platform) if mount is None else as_array(mount, shape_tail=(4, 4),
                                                                   name="mount")
     if tool_tip is None:
@@ -216,7 +230,25 @@ def make_cell(
     else:
         tip = tool_tip
     return Cell(platform=platform, mount=M, tool_tip=tip,
-                workpiece=Workpiece(plane_point, plane_normal, friction), stroke=stroke)
+                workpiece=Workpiece(plane_point, plane_normal, friction), stroke=stroke,
+                leg_law=legs if legs is not None and nonlinear else None)
+
+
+def _springs(cell: Cell, X: np.ndarray) -> Platform:
+    """The platform whose linear springs agree with the true legs at pose ``X`` in force and
+    slope (the platform itself when the legs are linear): its ``spring_wrench`` and
+    ``stiffness`` are then exact for a non-linear :attr:`Cell.leg_law`."""
+    plat = cell.platform
+    if cell.leg_law is None:
+        return plat
+    L = leg_lengths(plat, X)
+    f = tensions_at_lengths(cell.leg_law, L, plat.leg_names)
+    k = tension_slopes(cell.leg_law, L, plat.leg_names)
+    if np.any(~np.isfinite(k)) or np.any(k <= 0):
+        raise UnreachableError(f"simulated cell: the true leg law has a non-positive slope "
+                               f"({np.round(k, 4).tolist()} N/mm) at leg lengths "
+                               f"{np.round(L, 3).tolist()}")
+    return replace(plat, stiffness=k, free_lengths=L - f / k)
 
 
 @dataclass(frozen=True, eq=False)
@@ -294,8 +326,9 @@ def _solve_frictionless(cell: Cell, n: np.ndarray, c: np.ndarray, X0: np.ndarray
         it += 1
         p = apply(X, cell.tool_tip)
         wc = np.concatenate([n, np.cross(p, n)])
-        r = np.concatenate([spring_wrench(plat, X) - lam * wc, [n @ (p - c)]])
-        K = stiffness(plat, X, twist_order="axis")
+        sp = _springs(cell, X)
+        r = np.concatenate([spring_wrench(sp, X) - lam * wc, [n @ (p - c)]])
+        K = stiffness(sp, X, twist_order="axis")
         G = np.zeros((6, 6))
         G[3:, :3] = skew(n) @ skew(p)
         G[3:, 3:] = -skew(n)
@@ -312,7 +345,7 @@ def _solve_frictionless(cell: Cell, n: np.ndarray, c: np.ndarray, X0: np.ndarray
             break
     p = apply(X, cell.tool_tip)
     wc = np.concatenate([n, np.cross(p, n)])
-    res = float(np.max(np.abs(spring_wrench(plat, X) - lam * wc)))
+    res = float(np.max(np.abs(spring_wrench(_springs(cell, X), X) - lam * wc)))
     return X, lam, res, abs(float(n @ (p - c))), it
 
 
@@ -324,9 +357,10 @@ def _solve_stick(cell: Cell, a: np.ndarray, X0: np.ndarray, tol: float, max_iter
     while it < max_iter:
         it += 1
         p = apply(X, cell.tool_tip)
-        r = np.concatenate([spring_wrench(plat, X) - np.concatenate([f, np.cross(p, f)]),
+        sp = _springs(cell, X)
+        r = np.concatenate([spring_wrench(sp, X) - np.concatenate([f, np.cross(p, f)]),
                             p - a])
-        K = stiffness(plat, X, twist_order="axis")
+        K = stiffness(sp, X, twist_order="axis")
         A = np.zeros((9, 9))
         A[:6, :6] = K
         A[3:6, :3] -= skew(f) @ skew(p)
@@ -342,7 +376,8 @@ def _solve_stick(cell: Cell, a: np.ndarray, X0: np.ndarray, tol: float, max_iter
         if np.max(np.abs(d[:6])) < 1e-13 * max(1.0, plat.scale):
             break
     p = apply(X, cell.tool_tip)
-    res = float(np.max(np.abs(spring_wrench(plat, X) - np.concatenate([f, np.cross(p, f)]))))
+    res = float(np.max(np.abs(spring_wrench(_springs(cell, X), X)
+                              - np.concatenate([f, np.cross(p, f)]))))
     return X, f, res, float(np.max(np.abs(p - a))), it
 
 

@@ -27,6 +27,13 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.hardware.puma762_axes import AXES, AXIS4_TO_5_COUPLING, COUNT_LIMIT
+from kinestat.hardware.puma762_homing import (
+    HOME_COUNTS,
+    INDEX_PERIOD_COUNTS,
+    POT_COUNTS_PER_V,
+    READY_POT_V,
+    index_layout,
+)
 
 __all__ = ["TC_MESSAGES", "SimClock", "RealClock", "trapezoid", "DmcSimulator"]
 
@@ -153,6 +160,7 @@ class _Reject(Exception):
 
 
 _NAME = re.compile(r"^([A-Z]{2})(.*)$")
+_ASSIGN = re.compile(r"^([A-Za-z][A-Za-z0-9]{0,7})\s*=\s*(\S+)$")
 
 
 class DmcSimulator:
@@ -160,7 +168,17 @@ class DmcSimulator:
 
     ``initial_counts`` are the encoder (and true) positions at start; the encoders are
     calibrated (encoder == true) then. ``coupling`` is the axis 4 -> 5 ratio (0 disables it).
-    ``index_period`` / ``index_phase`` place the encoder index marks for ``FI``.
+    ``index_period`` (one number or six; default Table 2-1's one motor revolution, 3200 counts
+    on axes 1-3 and 1000 on 4-6) / ``index_phase`` place the encoder index marks for ``FI``.
+
+    Start-up (Vibhute App. D.4): ``inputs`` are the digital inputs ``@IN[n]`` (default all 0:
+    VAL and arm power on; a 1 on input 3 or 1 is a failed power-on check); ``pot_ready``
+    (physical counts of the pots' ready position, None: pots read the ready voltages at the
+    initial counts) and ``pot_noise`` (V, standard deviation, seeded by ``seed``) make
+    ``@AN[n]`` read ``READYPOT_n + (motor_n − ready_n) / POT_ENCSCALE_n``. Variables
+    (``NAME=value``, ``MG NAME``) are kept for the session; the homing procedure sets ``HOMED``
+    (:attr:`homed`). :meth:`unknown_start` builds a robot at an arbitrary position whose
+    encoders read 0 at power-up, laid out so that startup_initialize.m homes it.
     """
 
     def __init__(
@@ -169,9 +187,13 @@ class DmcSimulator:
         clock: SimClock | RealClock | None = None,
         initial_counts: Sequence[float] = (0, 0, 0, 0, 0, 0),
         coupling: float = AXIS4_TO_5_COUPLING,
-        index_period: float = 4000.0,
+        index_period: float | Sequence[float] = tuple(INDEX_PERIOD_COUNTS),
         index_phase: Sequence[float] = (0, 0, 0, 0, 0, 0),
         record: bool = False,
+        inputs: dict[int, float] | None = None,
+        pot_ready: Sequence[float] | None = None,
+        pot_noise: float = 0.0,
+        seed: int | None = None,
     ) -> None:
         c0 = np.asarray(initial_counts, dtype=float)
         if c0.shape != (6,) or not np.all(np.isfinite(c0)):
@@ -179,12 +201,20 @@ class DmcSimulator:
                              f"{initial_counts!r}")
         if not math.isfinite(coupling):
             raise InputError("DmcSimulator: coupling must be finite")
-        if not (math.isfinite(index_period) and index_period > 0):
+        per = np.broadcast_to(np.asarray(index_period, dtype=float), (6,))
+        if not (np.all(np.isfinite(per)) and np.all(per > 0)):
             raise InputError("DmcSimulator: index_period must be > 0")
+        if not (math.isfinite(pot_noise) and pot_noise >= 0):
+            raise InputError("DmcSimulator: pot_noise must be >= 0 volts")
         self.clock = clock if clock is not None else RealClock()
         self.coupling = float(coupling)
-        self.index_period = float(index_period)
+        self.index_period = tuple(float(p) for p in per)
         self.index_phase = tuple(float(p) for p in index_phase)
+        self.inputs: dict[int, float] = dict(inputs or {})
+        self.pot_ready = np.asarray(c0 if pot_ready is None else pot_ready, dtype=float)
+        self.pot_noise = float(pot_noise)
+        self._rng = np.random.default_rng(seed)
+        self.variables: dict[str, float] = {}
         self.record = record
         self._axes = [_Axis(motor=float(c)) for c in c0]
         self._motor4_ref = float(c0[3])
@@ -192,6 +222,36 @@ class DmcSimulator:
         self._lock = threading.RLock()
         self._rules: list[list] = []  # [prefix, action, code, times]
         self.commands: list[str] = []
+
+    @classmethod
+    def unknown_start(cls, seed: int | None = None, *, pot_noise: float = 0.002,
+                      **kw) -> DmcSimulator:
+        """A robot at an arbitrary position (within ±25° of home on axes 1-3, ±19° on 4-6),
+        its encoders reading 0 at power-up, with index marks and pots laid out by
+        :func:`kinestat.hardware.puma762_homing.index_layout` so that startup_initialize.m
+        homes it (physical counts: the home pose is :data:`HOME_COUNTS`)."""
+        rng = np.random.default_rng(seed)
+        span = np.array([20000, 28000, 22000, 3000, 3000, 1400])
+        start = HOME_COUNTS + rng.integers(-span, span + 1)
+        phase, ready = index_layout(kw.get("index_period", INDEX_PERIOD_COUNTS))
+        sim = cls(initial_counts=start, index_phase=tuple(phase), pot_ready=ready,
+                  pot_noise=pot_noise, seed=None if seed is None else seed + 1, **kw)
+        for ax in sim._axes:
+            ax.enc_offset = -ax.motor  # encoders read 0 at power-up
+        sim._motor4_ref = float(HOME_COUNTS[3])  # axis 5's coupling: a fixed mechanism
+        return sim
+
+    @property
+    def homed(self) -> bool:
+        """The homing procedure completed in this session (variable ``HOMED`` = 1)."""
+        with self._lock:
+            return self.variables.get("HOMED") == 1.0
+
+    def motor_counts(self) -> np.ndarray:
+        """Motor positions in physical counts (where the index marks and pots are)."""
+        with self._lock:
+            self._update()
+            return np.array([ax.motor for ax in self._axes])
 
     # -- fault injection
     def reject_next(self, prefix: str, code: int = 1, times: int = 1) -> None:
@@ -294,6 +354,16 @@ class DmcSimulator:
             return ":" if data is None else f"{data}\r\n:"
 
     def _execute(self, cmd: str) -> str | None:
+        v = _ASSIGN.match(cmd)
+        if v is not None:  # a variable: NAME=value
+            try:
+                val = float(v.group(2))
+            except ValueError:
+                raise _Reject(4) from None
+            if not math.isfinite(val):
+                raise _Reject(4)
+            self.variables[v.group(1)] = val
+            return None
         m = _NAME.match(cmd)
         if m is None:
             raise _Reject(1)
@@ -440,7 +510,7 @@ class DmcSimulator:
                 goal = ax.motor + ax.rel
                 speed = ax.sp
             elif ax.mode == "FI":
-                p, ph = self.index_period, self.index_phase[i]
+                p, ph = self.index_period[i], self.index_phase[i]
                 k = (math.floor((ax.motor - ph) / p) + 1 if ax.jg > 0
                      else math.ceil((ax.motor - ph) / p) - 1)
                 goal, speed, zero = ph + k * p, abs(ax.jg), True
@@ -492,8 +562,18 @@ class DmcSimulator:
             if key == "TV":
                 return float(round(ax.velocity))
             return float(getattr(ax, key.lower()))
-        if re.fullmatch(r"@IN\[\d+\]", op):
-            return 0.0  # inputs read 0: "VAL power on", "arm power on" (startup_initialize.m)
+        m = re.fullmatch(r"@(IN|AN)\[(\d+)\]", op)
+        if m:
+            n = int(m.group(2))
+            if m.group(1) == "IN":  # 0: "VAL power on", "arm power on" (startup_initialize.m)
+                return float(self.inputs.get(n, 0.0))
+            if not 1 <= n <= 6:
+                raise _Reject(6)
+            i = n - 1
+            v = READY_POT_V[i] + (self._axes[i].motor - self.pot_ready[i]) / POT_COUNTS_PER_V[i]
+            return float(v + (self._rng.normal(0.0, self.pot_noise) if self.pot_noise else 0.0))
+        if op in self.variables:
+            return self.variables[op]
         try:
             v = float(op)
         except ValueError:

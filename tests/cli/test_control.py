@@ -13,6 +13,7 @@ from kinestat.cli.main import main
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
 from kinestat.devices.cell_io import MotionProfile
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
+from kinestat.hardware.leg_calibration import THESIS_CALIBRATION
 from kinestat.parallel.platform import special_6_6
 from kinestat.sim.contact import make_cell
 from kinestat.sim.sensor import Sensor
@@ -107,7 +108,8 @@ def test_real_device_options_drive_external_devices(tmp_path, capsys):
     plat = special_6_6()
     p0 = np.array([float(v) for v in DEFAULT_START.split(",")])
     pp, pn = default_plane(p0, THESIS_FORCE_DIRECTION, 2.5, 5.0)
-    cell = make_cell(plat, plane_point=pp, plane_normal=pn)
+    # the external cell's legs follow the thesis's calibration, the CLI's default (issue 12)
+    cell = make_cell(plat, plane_point=pp, plane_normal=pn, legs=THESIS_CALIBRATION)
     sensor = Sensor()
     cfg = ControllerConfig(model=harness_mod.control_model(cell, sensor),
                            force=4 * THESIS_FORCE_DIRECTION, start_tool_point=p0)
