@@ -65,15 +65,24 @@ def test_function_local_imports_say_why():
         ", ".join(missing)
 
 
+def _body_lines(fn: ast.FunctionDef | ast.AsyncFunctionDef) -> int:
+    """Lines of a function's body after its docstring: a command's signature of option
+    declarations is not logic."""
+    body = fn.body[1:] if (fn.body and isinstance(fn.body[0], ast.Expr)
+                           and isinstance(fn.body[0].value, ast.Constant)
+                           and isinstance(fn.body[0].value.value, str)) else fn.body
+    return 0 if not body else fn.end_lineno - body[0].lineno + 1
+
+
 def test_functions_are_short():
     long = []
     for path in SOURCES:
         tree, _ = _tree(path)
         for fn in _functions(tree):
-            size = fn.end_lineno - fn.lineno + 1
+            size = _body_lines(fn)
             if size > MAX_FUNCTION_LINES:
                 long.append(f"{path.relative_to(PACKAGE.parent)}:{fn.lineno} {fn.name} ({size})")
-    assert not long, f"functions over {MAX_FUNCTION_LINES} lines: " + ", ".join(long)
+    assert not long, f"function bodies over {MAX_FUNCTION_LINES} lines: " + ", ".join(long)
 
 
 def test_long_modules_say_why_at_the_top():
