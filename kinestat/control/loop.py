@@ -10,8 +10,9 @@ reader, and :class:`kinestat.app.sim_cell.InProcessIO` with the simulated cell i
 Safe stop: any device fault (a ``?`` from the Galil, a dropped link, a timeout), stale or
 unreliable sensor data (no fresh packet in time, a frozen sequence, more stream faults than
 the envelope tolerates), an envelope violation, a measurement the platform's kinematics cannot
-explain, or Ctrl-C ends the run with ``ST`` sent to the motion controller when the link is up,
-a ``fault`` record in the log and a report saying why (:class:`RunReport`).
+explain, Ctrl-C, SIGTERM or SIGHUP (:mod:`kinestat.app.signals`) ends the run with ``ST``
+sent to the motion controller (on a fresh connection if the link failed), a ``fault`` record
+in the log and a report saying why (:class:`RunReport`).
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from kinestat.control.controller import (
 from kinestat.control.envelope import require
 from kinestat.control.log import CycleLog
 from kinestat.control.wrench import Estimator, Measurement, measure
-from kinestat.errors import DeviceError, KinestatError, SafetyStop
+from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
 
 __all__ = ["SensorReading", "CellIO", "RunReport", "run"]
 
@@ -282,6 +283,8 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
         raise SafetyStop(f"sensor link unreliable: {len(sample.faults)} stream faults "
                          f"while acquiring one measurement (limit "
                          f"{config.envelope.max_stream_faults}); first: {sample.faults[0]}")
+    if not np.all(np.isfinite(np.asarray(sample.counts, dtype=float))):
+        raise SafetyStop("the sensor returned no valid leg counts for this measurement")
     counts_r = io.robot_counts()
     r.last_counts = np.asarray(counts_r)
     q = axis_counts_to_q(config.model, counts_r)
@@ -314,6 +317,8 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
 
 def _fault_reason(exc: BaseException) -> str:
     """The report's reason for a fault that ends the run."""
+    if isinstance(exc, StopRequested):
+        return f"stopped by {exc.signal_name}"
     if isinstance(exc, KeyboardInterrupt):
         return "interrupted by the user"
     if isinstance(exc, SafetyStop):

@@ -98,9 +98,11 @@ def test_a_frozen_sensor_stops_the_cell(tmp_path):
 
 
 def test_a_closed_link_stops_the_cell(tmp_path):
+    """Issue 11 item 3: the controller still accepts connections, so ST goes out on a fresh
+    one (before, the report said "the Galil link is down: ST could not be sent")."""
     rep, recs, commands, _, _ = _run(tmp_path, inject=lambda h: h.server.drop_link())
     assert not rep.converged and "device fault" in rep.stop_reason
-    assert "link is down" in rep.stop_reason and "ST" not in commands
+    assert "ST sent on a fresh connection" in rep.stop_reason and commands[-1] == "ST"
     _assert_log_complete(recs, rep)
 
 
