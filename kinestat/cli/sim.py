@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import signal
 import threading
 import time
 
 import numpy as np
 import typer
 
+from kinestat.app.signals import stop_on_signals
 from kinestat.cli._output import console, parse_floats, print_json
 from kinestat.errors import InputError
 from kinestat.hardware.encoder_packets import (
@@ -43,25 +43,21 @@ def _int_counts(text: str, option: str) -> np.ndarray:
 
 
 def _run_until_stopped(duration: float | None, stop_event: threading.Event | None = None) -> None:
-    """Block until ``duration`` seconds pass (forever if None) or Ctrl-C."""
+    """Block until ``duration`` seconds pass (forever if None), Ctrl-C, SIGTERM or SIGHUP
+    (:func:`kinestat.app.signals.stop_on_signals`); the caller's ``with`` blocks then close
+    the simulators' sockets and pty."""
     _check_duration(duration)
     ev = stop_event or threading.Event()
     t_end = None if duration is None else time.monotonic() + duration
-    previous = None
-    if threading.current_thread() is threading.main_thread():
-        # SIGTERM (e.g. from a process manager) stops as cleanly as Ctrl-C
-        previous = signal.signal(signal.SIGTERM, lambda *_: ev.set())
-    try:
-        while not ev.is_set():
-            left = None if t_end is None else t_end - time.monotonic()
-            if left is not None and left <= 0:
-                break
-            ev.wait(0.2 if left is None else min(0.2, left))
-    except KeyboardInterrupt:
-        pass
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+    with stop_on_signals():
+        try:
+            while not ev.is_set():
+                left = None if t_end is None else t_end - time.monotonic()
+                if left is not None and left <= 0:
+                    break
+                ev.wait(0.2 if left is None else min(0.2, left))
+        except KeyboardInterrupt:  # Ctrl-C, or StopRequested (SIGTERM / SIGHUP)
+            pass
 
 
 @sim_app.command("galil")
