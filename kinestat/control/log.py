@@ -58,7 +58,11 @@ class CycleLog:
 
     def close(self) -> None:
         if not self._f.closed:
-            self._f.close()
+            try:
+                self._f.close()
+            except OSError as exc:  # the last buffered line could not be written
+                raise InputError(f"cannot write the cycle log {str(self.path)!r}: "
+                                 f"{exc.strerror or exc}") from exc
 
     def __enter__(self) -> CycleLog:
         return self

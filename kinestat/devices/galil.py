@@ -158,6 +158,7 @@ class GalilClient:
         self.timeout = float(timeout)
         self._sock: socket.socket | None = None
         self._buf = b""
+        self._in_flight: str | None = None  # a command sent whose reply was not read yet
 
     # -- connection
     def connect(self, timeout: float | None = None) -> GalilClient:
@@ -178,6 +179,7 @@ class GalilClient:
     def close(self) -> None:
         """Close the connection (idempotent)."""
         s, self._sock = self._sock, None
+        self._in_flight = None
         if s is not None:
             try:
                 s.close()
@@ -215,9 +217,9 @@ class GalilClient:
         self.close()
         return ProtocolError(f"Galil at {self.host}:{self.port}: {message}; connection closed")
 
-    def _drain(self, cmd: str, discard: bool) -> None:
+    def _drain(self, cmd: str, discard: bool) -> bytes:
         """Read whatever is already waiting on the socket without blocking; a protocol fault
-        unless ``discard``."""
+        unless ``discard`` (then the bytes are returned)."""
         assert self._sock is not None
         pending = self._buf
         self._buf = b""
@@ -243,6 +245,7 @@ class GalilClient:
         if pending and not discard:
             raise self._fault(f"{len(pending)} unexpected byte(s) {pending[:40]!r} waiting "
                               f"before {cmd!r} (a stale or unsolicited reply)")
+        return pending
 
     def _exchange(self, cmd: str, *, discard_pending: bool = False) -> str:
         if not isinstance(cmd, str) or not cmd.strip():
@@ -256,18 +259,61 @@ class GalilClient:
             raw = cmd.encode("ascii") + b"\r"
         except UnicodeEncodeError as exc:
             raise InputError(f"Galil commands are ASCII: {cmd!r}") from exc
-        self._drain(cmd, discard_pending)
+        unread = self._in_flight  # a previous exchange was interrupted before its reply
+        if unread is not None and not discard_pending:
+            raise self._fault(f"the reply to {unread!r} was never read (interrupted); "
+                              f"{cmd!r} would take it for its own")
+        pending = self._drain(cmd, discard_pending)
+        self._in_flight = cmd
         try:
             self._sock.sendall(raw)
         except OSError as exc:
             self.close()
             raise DeviceError(f"Galil link to {self.host}:{self.port} failed while sending "
                               f"{cmd!r}: {exc}") from exc
-        return self._read_reply(cmd)
+        if unread is not None:
+            # the interrupted command's reply may have been lost, be waiting, or still be on
+            # its way: replies come in order, so ours is the last one to arrive
+            reply, extra = self._receive_last(cmd, pending), b""
+        else:
+            reply, extra = self._receive(cmd)
+        self._in_flight = None
+        if extra:
+            raise self._fault(f"{len(extra)} unexpected byte(s) {extra[:40]!r} after the reply "
+                              f"to {cmd!r} (an unsolicited reply)")
+        try:
+            return match_reply(cmd, reply, f"Galil at {self.host}:{self.port}")
+        except ProtocolError:
+            self.close()
+            raise
 
-    def _read_reply(self, cmd: str) -> str:
+    def _receive_last(self, cmd: str, buf: bytes, quiet: float = 0.05) -> bytes:
+        """The last of the replies arriving until none came for ``quiet`` seconds."""
+        reply, extra = self._receive(cmd, buf)
+        t_end = time.monotonic() + quiet
+        while self._sock is not None:
+            if (parts := split_reply(extra)) is not None:
+                reply, extra = parts
+                t_end = time.monotonic() + quiet
+                continue
+            left = t_end - time.monotonic()
+            if left <= 0:
+                break
+            self._sock.settimeout(left)
+            try:
+                chunk = self._sock.recv(4096)
+            except OSError:  # includes the quiet timeout
+                break
+            if not chunk:
+                break
+            extra += chunk
+        if self._sock is not None:
+            self._sock.settimeout(self.timeout)
+        return reply
+
+    def _receive(self, cmd: str, buf: bytes = b"") -> tuple[bytes, bytes]:
+        """Read up to the end of one reply (the first ``:`` or ``?``): (reply, bytes after)."""
         deadline = time.monotonic() + self.timeout
-        buf = b""
         while (parts := split_reply(buf)) is None:
             remaining = deadline - time.monotonic()
             if remaining <= 0:
@@ -289,15 +335,7 @@ class GalilClient:
                 raise DeviceError(f"Galil at {self.host}:{self.port} closed the link while "
                                   f"answering {cmd!r}")
             buf += chunk
-        reply, extra = parts
-        if extra:
-            raise self._fault(f"{len(extra)} unexpected byte(s) {extra[:40]!r} after the reply "
-                              f"to {cmd!r} (an unsolicited reply)")
-        try:
-            return match_reply(cmd, reply, f"Galil at {self.host}:{self.port}")
-        except ProtocolError:
-            self.close()
-            raise
+        return parts
 
     def _tell_error(self) -> tuple[int | None, str]:
         reply = self._exchange("TC1")

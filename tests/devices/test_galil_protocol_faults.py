@@ -175,3 +175,56 @@ def test_st_reports_accurately_when_the_controller_is_gone():
     assert what.startswith("ST could not be sent: the link was down; a fresh connection "
                            "failed too: cannot connect")
     assert time.monotonic() - t0 < 1.0 and not g.connected
+
+
+def _delaying_server(delay_for: bytes, delay: float):
+    """A TCP server answering like a DMC (':' for commands, ' 1.0000\\r\\n:' for MG), late for
+    ``delay_for``; returns (listener, received commands)."""
+    import socket
+    import threading
+
+    lst = socket.socket()
+    lst.bind(("127.0.0.1", 0))
+    lst.listen(1)
+    got: list[bytes] = []
+
+    def serve():
+        conn, _ = lst.accept()
+        buf = b""
+        with conn:
+            while True:
+                chunk = conn.recv(1024)
+                if not chunk:
+                    return
+                buf += chunk
+                while b"\r" in buf:
+                    cmd, buf = buf.split(b"\r", 1)
+                    got.append(cmd)
+                    if cmd == delay_for:
+                        time.sleep(delay)
+                    conn.sendall(b" 1.0000\r\n:" if cmd.startswith(b"MG") else b":")
+
+    threading.Thread(target=serve, daemon=True).start()
+    return lst, got
+
+
+def test_an_interrupted_exchange_never_shifts_the_replies():
+    """A signal (KeyboardInterrupt) while waiting for 'MG _BGA': its reply comes later. ST must
+    skip it (and be acknowledged by its own ':'); any other command refuses to go on."""
+    lst, got = _delaying_server(b"MG _BGA", 0.1)
+    with GalilClient("127.0.0.1", lst.getsockname()[1], timeout=1.0) as g:
+        real = g._receive
+
+        def interrupted(cmd, buf=b""):
+            g._receive = real
+            raise KeyboardInterrupt
+
+        g._receive = interrupted
+        with pytest.raises(KeyboardInterrupt):
+            g.is_moving()
+        g.stop()  # reads the late ' 1.0000\r\n:' first, then ST's own ':'
+        assert got[-1] == b"ST" and g.connected
+        g._in_flight = "MG _BGA"  # as if interrupted again
+        with pytest.raises(ProtocolError, match="never read"):
+            g.command("SH")
+    lst.close()
