@@ -50,3 +50,44 @@ def test_outside_the_main_thread_nothing_is_installed():
     t.start()
     t.join()
     assert result == {"same": True, "installed": False}
+
+
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
+def test_a_signal_mid_run_stops_the_in_process_cell_with_a_complete_log(tmp_path, sig):
+    """The loop over the in-process cell (InProcessIO): the signal arrives while the cell
+    moves (here: from inside a move), the run ends in a safe stop."""
+    import numpy as np
+
+    from kinestat.app.sim_cell import InProcessIO, control_model, start_counts
+    from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
+    from kinestat.control.log import CycleLog, read_log
+    from kinestat.control.loop import run
+    from kinestat.parallel.platform import special_6_6
+    from kinestat.sim.contact import make_cell
+    from kinestat.sim.sensor import Sensor
+
+    f = np.asarray(THESIS_FORCE_DIRECTION)
+    p0 = np.array([-400.0, 800.0, -100.0])
+    cell = make_cell(special_6_6(), plane_point=p0 + 2.5 * f, plane_normal=-f)
+    sensor = Sensor()
+    cfg = ControllerConfig(model=control_model(cell, sensor, coupling=0.0), force=4.0 * f,
+                           start_tool_point=p0)
+    io = InProcessIO(cell, sensor, start_counts=start_counts(cfg))
+    real_move = io.move
+    moves = []
+
+    def move(counts):
+        moves.append(1)
+        if len(moves) == 2:  # the first approach step
+            os.kill(os.getpid(), sig)
+        real_move(counts)
+
+    io.move = move
+    path = tmp_path / "log.jsonl"
+    with stop_on_signals(), CycleLog(path) as log:
+        rep = run(cfg, io, log)
+    recs = read_log(path)
+    assert not rep.converged and rep.stop_reason.startswith(f"stopped by {sig.name}")
+    assert io.stopped
+    assert [r["type"] for r in recs][-2:] == ["fault", "end"]
+    assert recs[-2]["reason"] == f"stopped by {sig.name}"
