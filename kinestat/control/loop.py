@@ -253,9 +253,18 @@ def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
     except Exception as exc:  # a bug: stop the robot first, keep the log, then let it show
         r.reason = _safe_stop(io, log, f"internal error {type(exc).__name__}: {exc}", r.faults,
                               r.t0)
-        _finish(config, r, log)
+        _once_more_if_interrupted(_finish, config, r, log)
         raise
-    return _finish(config, r, log)
+    return _once_more_if_interrupted(_finish, config, r, log)
+
+
+def _once_more_if_interrupted(fn, *args):
+    """``fn(*args)``, called again if a signal interrupted it (a stop or the final log must not
+    be cut short; :mod:`kinestat.app.signals` raises only on the first signal)."""
+    try:
+        return fn(*args)
+    except KeyboardInterrupt:
+        return fn(*args)
 
 
 def _start_move(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run) -> None:
@@ -336,14 +345,18 @@ def _finish(config: ControllerConfig, r: _Run, log: CycleLog) -> RunReport:
 
 
 def _safe_stop(io: CellIO, log: CycleLog, reason: str, faults: list[str], t0: float) -> str:
-    """Stop the robot (best effort), log the fault; return the reason with what was done."""
+    """Stop the robot (best effort), log the fault; return the reason with what was done.
+
+    A signal arriving during the stop (while ``ST`` is sent, or a fresh connection is opened
+    for it) does not cut it short: the stop is sent again and the fault still logged.
+    """
     try:
-        stopped = io.stop()
+        stopped = _once_more_if_interrupted(io.stop)
     except Exception as exc:  # noqa: BLE001 - a failing stop must not hide the fault
         stopped = f"stopping failed: {exc}"
     faults.append(reason)
-    log.write({"type": "fault", "t": time.monotonic() - t0, "reason": reason,
-               "action": stopped})
+    _once_more_if_interrupted(log.write, {"type": "fault", "t": time.monotonic() - t0,
+                                          "reason": reason, "action": stopped})
     return f"{reason} ({stopped})"
 
 
