@@ -11,6 +11,9 @@ takes the previous command's acknowledgement, or its data, as its answer. The cl
 * checks the reply's kind against the command (:func:`match_reply`): data where a query was
   sent, a bare ``:`` where none was. Anything else raises
   :class:`~kinestat.errors.ProtocolError`.
+
+A reply's data may therefore not contain ``:`` or ``?`` (none of the numeric replies the
+client reads does; a string message with them is refused rather than guessed at).
 """
 
 from __future__ import annotations
@@ -20,8 +23,8 @@ from kinestat.errors import ProtocolError
 __all__ = ["QUERY_COMMANDS", "expects_data", "split_reply", "match_reply"]
 
 QUERY_COMMANDS = frozenset({"TP", "MG", "TC", "RP", "TE", "TV", "TS", "TI", "TB", "QR", "LM",
-                            "MT", "ID", "RV"})
-"""DMC commands whose reply carries data before the ``:``."""
+                            "MT", "ID", "RV", "SC", "TD", "TT", "TH", "TZ", "LS", "LL"})
+"""DMC commands whose reply carries data before the ``:`` (any command with ``?`` too)."""
 
 
 def expects_data(cmd: str) -> bool:
