@@ -85,3 +85,16 @@ class DeviceError(KinestatError):
 
 class ProtocolError(DeviceError):
     """A packet or reply did not follow the protocol (corrupt, out of sequence, unparseable)."""
+
+
+class StopRequested(KeyboardInterrupt):
+    """A termination signal (SIGTERM, SIGHUP) asked the program to stop: handled as Ctrl-C is.
+
+    A ``KeyboardInterrupt`` (not an ``Exception``), so that no ``except Exception`` on the way
+    swallows it; ``signal_name`` is e.g. ``"SIGTERM"``.
+    """
+
+    def __init__(self, signum: int, signal_name: str) -> None:
+        self.signum = int(signum)
+        self.signal_name = signal_name
+        super().__init__(f"stopped by {signal_name}")

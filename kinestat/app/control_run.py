@@ -25,13 +25,13 @@ from kinestat.app.calibrations import (
     resolve_platform,
 )
 from kinestat.app.sim_cell import SimHarness, start_counts
-from kinestat.control.controller import ControllerConfig, Procedure, StepMethod
-from kinestat.control.envelope import Envelope
+from kinestat.control.controller import MAX_ITERATIONS, ControllerConfig, Procedure, StepMethod
+from kinestat.control.envelope import Envelope, sent_command_guard
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, run
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Estimator
-from kinestat.devices.cell_io import DeviceIO
+from kinestat.devices.cell_io import MAX_SAMPLES, DeviceIO
 from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import GalilClient
 from kinestat.devices.homing import is_homed
@@ -42,6 +42,8 @@ from kinestat.sim.contact import Cell, make_cell
 from kinestat.sim.sensor import Sensor
 
 __all__ = [
+    "MAX_ITERATIONS",
+    "MAX_SAMPLES",
     "DEFAULT_START",
     "DEFAULT_DIRECTION",
     "DEFAULT_PLANE_DISTANCE",
@@ -185,6 +187,9 @@ class PreparedRun:
 
 def prepare_control(req: ControlRequest) -> PreparedRun:
     """Assemble the cell and the controller of ``req`` (checks every setting; nothing starts)."""
+    if not (isinstance(req.samples, int) and 1 <= req.samples <= MAX_SAMPLES):
+        raise InputError(f"samples (sensor packets averaged per measurement) must be in "
+                         f"1..{MAX_SAMPLES}, got {req.samples!r}")
     direction = req.force / np.linalg.norm(req.force)
     if req.move_rule not in MOVE_RULES:
         raise InputError(f"--move-rule must be one of {', '.join(MOVE_RULES)}, got "
@@ -216,29 +221,38 @@ def prepare_control(req: ControlRequest) -> PreparedRun:
 def run_control(prepared: PreparedRun, log_path: Path, *,
                 progress: Callable[[dict], None] | None = None) -> RunReport:
     """Start the devices (simulated or real) and run the kinestatic procedure (Vibhute ch. 5)
-    on the prepared cell, logging every cycle to ``log_path``."""
+    on the prepared cell, logging every cycle to ``log_path``.
+
+    The devices are started and connected BEFORE the log is created: a refused connection or
+    a missing serial device leaves no (empty) log behind. Every final command (axis 5
+    compensated) goes through the envelope (:func:`~kinestat.control.envelope.sent_command_guard`).
+    """
     req, config, header = prepared.request, prepared.config, prepared.header
-    with CycleLog(log_path) as cycle_log:
-        if isinstance(req.cell, SimulatedCell):
-            with SimHarness(prepared.cell, prepared.sensor, start_counts=start_counts(config),
-                            rate_hz=req.cell.rate_hz, seed=req.cell.seed) as h:
-                io = h.device_io(samples=req.samples, move_rule=req.move_rule)
+    safety = {"guard": sent_command_guard(config.envelope, config.model),
+              "max_stream_faults": config.envelope.max_stream_faults,
+              "move_rule": req.move_rule}
+    if isinstance(req.cell, SimulatedCell):
+        with SimHarness(prepared.cell, prepared.sensor, start_counts=start_counts(config),
+                        rate_hz=req.cell.rate_hz, seed=req.cell.seed) as h:
+            io = h.device_io(samples=req.samples, **safety)
+            with CycleLog(log_path) as cycle_log:
                 return run(config, io, cycle_log, progress=progress, extra_header=header)
-        d = req.cell
-        client = GalilClient(d.host, d.port).connect()
-        try:
-            if not req.assume_homed and not is_homed(client):
-                reason = (f"the robot behind the Galil at {d.host}:{d.port} is not homed in "
-                          "this controller session: run `kinestat home --galil "
-                          f"{d.host}:{d.port}` first (or pass --assume-homed); nothing moved")
+    d = req.cell
+    client = GalilClient(d.host, d.port).connect()
+    try:
+        if not req.assume_homed and not is_homed(client):
+            reason = (f"the robot behind the Galil at {d.host}:{d.port} is not homed in "
+                      "this controller session: run `kinestat home --galil "
+                      f"{d.host}:{d.port}` first (or pass --assume-homed); nothing moved")
+            with CycleLog(log_path) as cycle_log:
                 cycle_log.write({"type": "fault", "reason": reason, "action": "nothing sent"})
-                raise SafetyStop(reason)
-            with EncoderReader(d.serial, fmt=d.serial_format) as reader:
-                io = DeviceIO(client, reader, samples=req.samples, settle=0.1,
-                              move_rule=req.move_rule)
+            raise SafetyStop(reason)
+        with EncoderReader(d.serial, fmt=d.serial_format) as reader:
+            io = DeviceIO(client, reader, samples=req.samples, settle=0.1, **safety)
+            with CycleLog(log_path) as cycle_log:
                 return run(config, io, cycle_log, progress=progress, extra_header=header)
-        finally:
-            client.close()
+    finally:
+        client.close()
 
 
 def plot_run(log_path: Path, plot_dir: Path) -> list[str]:

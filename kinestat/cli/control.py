@@ -21,6 +21,8 @@ from kinestat.app.control_run import (
     DEFAULT_PLANE_DISTANCE,
     DEFAULT_PLANE_TILT_DEG,
     DEFAULT_START,
+    MAX_ITERATIONS,
+    MAX_SAMPLES,
     ControlRequest,
     RealDevices,
     SimulatedCell,
@@ -28,6 +30,7 @@ from kinestat.app.control_run import (
     prepare_control,
     run_control,
 )
+from kinestat.app.signals import stop_on_signals
 from kinestat.cli._output import console as out_console
 from kinestat.cli._output import err_console, parse_floats, print_json, table
 from kinestat.errors import InputError, KinestatError
@@ -145,12 +148,13 @@ def control_command(
                                help="Real encoder stream: serial device or pyserial URL."),
     serial_format: str = typer.Option(
         "ks", "--serial-format", help="Encoder packet format: 'ks' or 'legacy' (thesis)."),
-    samples: int = typer.Option(1, "--samples",
-                                help="Sensor packets averaged per measurement."),
+    samples: int = typer.Option(
+        1, "--samples", help=f"Sensor packets averaged per measurement (1..{MAX_SAMPLES})."),
     rate: float = typer.Option(200.0, "--rate", help="Simulated encoder packet rate (Hz)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the simulated sensor noise."),
-    max_iterations: int = typer.Option(60, "--max-iterations",
-                                       help="Measurement cycles before giving up."),
+    max_iterations: int = typer.Option(
+        60, "--max-iterations",
+        help=f"Measurement cycles before giving up (1..{MAX_ITERATIONS})."),
     plot: Path = typer.Option(
         None, "--plot", help="Directory for the wrench-vs-state plot (default: the run "
         "directory)."),
@@ -195,6 +199,8 @@ def control_command(
     tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
     torque_about_tool, torque_about_base (N·mm, fixed frame), procedure, calibration, cycles.
     """
+    _check_counts(samples, max_iterations)
+    _check_plot_dir(plot, no_plot)
     d = parse_floats(direction, 3, "direction")
     if np.linalg.norm(d) == 0:
         raise InputError("--direction must not be the zero vector")
@@ -223,25 +229,48 @@ def control_command(
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {procedure}, method "
                       f"{method}, calibration {calibration}, "
                       + ("simulated cell" if simulated else f"Galil {galil}, sensor {serial}"))
-    report = run_control(prepared, log_path, progress=_print_progress)
-    out = report.as_dict()
-    plots: list[str] = []
-    if plot_dir is not None:
+    # SIGTERM / SIGHUP stop the cell as Ctrl-C does: ST, a fault and an end record, status 2
+    with stop_on_signals():
         try:
-            plots = plot_run(log_path, plot_dir)
-        except InputError as exc:
-            err_console.print(f"[yellow]no plot:[/] {exc}")
-    out["plots"] = plots
-    if as_json:
-        print_json(out)
-    else:
-        _print_report(out)
+            report = run_control(prepared, log_path, progress=_print_progress)
+        except KeyboardInterrupt as exc:  # before or after the loop: nothing was moving
+            raise KinestatError(f"kinestat control: {exc or 'interrupted'} before the run "
+                                "started or after it ended") from exc
+        out = report.as_dict()
+        plots: list[str] = []
+        if plot_dir is not None:
+            try:
+                plots = plot_run(log_path, plot_dir)
+            except InputError as exc:
+                err_console.print(f"[yellow]no plot:[/] {exc}")
+        out["plots"] = plots
+        if as_json:
+            print_json(out)
+        else:
+            _print_report(out)
     if view:
         from kinestat.viz.show import show_log  # lazy: viewer only with --view
 
         show_log(log_path)
     if not report.converged:
         raise KinestatError(f"kinestatic control did not converge: {report.stop_reason}")
+
+
+def _check_counts(samples: int, max_iterations: int) -> None:
+    """The documented ceilings of --samples and --max-iterations, before anything starts."""
+    if not 1 <= samples <= MAX_SAMPLES:
+        raise InputError(f"--samples must be in 1..{MAX_SAMPLES} (packets averaged per "
+                         f"measurement), got {samples}")
+    if not 1 <= max_iterations <= MAX_ITERATIONS:
+        raise InputError(f"--max-iterations must be in 1..{MAX_ITERATIONS}, got "
+                         f"{max_iterations}")
+
+
+def _check_plot_dir(plot: Path | None, no_plot: bool) -> None:
+    """--plot names a directory: refuse an existing file before running (as ``disp --plot``)."""
+    if plot is not None and not no_plot and plot.exists() and not plot.is_dir():
+        raise InputError(f"--plot {str(plot)!r} exists and is not a directory; give a "
+                         "directory for the wrench-vs-state plot")
 
 
 def _print_report(out: dict) -> None:

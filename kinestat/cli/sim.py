@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
-import signal
 import threading
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 
 import numpy as np
 import typer
 
+from kinestat.app.signals import stop_on_signals
 from kinestat.cli._output import console, parse_floats, print_json
 from kinestat.errors import InputError
 from kinestat.hardware.encoder_packets import (
@@ -42,26 +44,30 @@ def _int_counts(text: str, option: str) -> np.ndarray:
     return vals
 
 
+@contextmanager
+def _until_stopped() -> Iterator[None]:
+    """Ctrl-C, SIGTERM and SIGHUP end the block quietly
+    (:func:`kinestat.app.signals.stop_on_signals`): installed BEFORE a simulator announces
+    its address, so a signal sent as soon as it is announced is handled, and the ``with``
+    blocks inside close the simulators' sockets and pty."""
+    with stop_on_signals():
+        try:
+            yield
+        except KeyboardInterrupt:  # Ctrl-C, or StopRequested (SIGTERM / SIGHUP)
+            pass
+
+
 def _run_until_stopped(duration: float | None, stop_event: threading.Event | None = None) -> None:
-    """Block until ``duration`` seconds pass (forever if None) or Ctrl-C."""
+    """Block until ``duration`` seconds pass (forever if None) or ``stop_event`` is set; a
+    signal ends it through :func:`_until_stopped`."""
     _check_duration(duration)
     ev = stop_event or threading.Event()
     t_end = None if duration is None else time.monotonic() + duration
-    previous = None
-    if threading.current_thread() is threading.main_thread():
-        # SIGTERM (e.g. from a process manager) stops as cleanly as Ctrl-C
-        previous = signal.signal(signal.SIGTERM, lambda *_: ev.set())
-    try:
-        while not ev.is_set():
-            left = None if t_end is None else t_end - time.monotonic()
-            if left is not None and left <= 0:
-                break
-            ev.wait(0.2 if left is None else min(0.2, left))
-    except KeyboardInterrupt:
-        pass
-    finally:
-        if previous is not None:
-            signal.signal(signal.SIGTERM, previous)
+    while not ev.is_set():
+        left = None if t_end is None else t_end - time.monotonic()
+        if left is not None and left <= 0:
+            break
+        ev.wait(0.2 if left is None else min(0.2, left))
 
 
 @sim_app.command("galil")
@@ -94,7 +100,7 @@ def galil(
     else:
         ctrl = DmcSimulator(initial_counts=c0, **kw)
     server = GalilSimServer(host, port, allow_remote=allow_remote, controller=ctrl)
-    with server:
+    with _until_stopped(), server:
         if as_json:
             print_json({"host": server.host, "port": server.port, "axes": "ABCDEF"})
         else:
@@ -125,7 +131,7 @@ def encoders(
     # legacy lines carry 16 bits and wrap, as the thesis's counters did
     legs = _int_counts(counts, "counts")
     emitter = EncoderEmitter(constant_counts(legs), rate_hz=rate, fmt=fmt)
-    with emitter:
+    with _until_stopped(), emitter:
         channels = legs_to_channels(legs.astype(int)).tolist()
         if as_json:
             print_json({"path": emitter.path, "rate_hz": rate, "format": fmt,

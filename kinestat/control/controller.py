@@ -64,6 +64,7 @@ __all__ = [
     "THESIS_FORCE_DIRECTION",
     "STATES",
     "METHODS",
+    "MAX_ITERATIONS",
     "Target",
     "ControllerConfig",
     "ControllerState",
@@ -145,6 +146,11 @@ class Target:
                                               self.a67 * 1e9])).astype(np.int64).tolist())
 
 
+MAX_ITERATIONS = 1000
+"""Most measurement cycles a run may be given (each is a move and a measurement, seconds on the
+real cell; the default is 60 and the thesis's runs take under 10)."""
+
+
 @dataclass(frozen=True, eq=False)
 class ControllerConfig:
     """Settings of one kinestatic control run (immutable).
@@ -219,8 +225,9 @@ class ControllerConfig:
                 raise InputError(f"{name} must be a positive number, got {getattr(self, name)!r}")
         if not (math.isfinite(self.approach_step) and self.approach_step > 0):
             raise InputError(f"approach_step must be positive, got {self.approach_step!r}")
-        if int(self.max_iterations) < 1:
-            raise InputError("max_iterations must be at least 1")
+        if not 1 <= int(self.max_iterations) <= MAX_ITERATIONS:
+            raise InputError(f"max_iterations must be in 1..{MAX_ITERATIONS}, got "
+                             f"{self.max_iterations!r}")
         if self.contact_force >= np.linalg.norm(F):
             raise InputError(f"the contact threshold {self.contact_force} N must be below the "
                              f"requested force {np.linalg.norm(F):.3g} N")

@@ -59,6 +59,8 @@ __all__ = [
     "check_target",
     "check_measurement",
     "check_command",
+    "check_sent_counts",
+    "sent_command_guard",
     "require",
 ]
 
@@ -283,3 +285,24 @@ def require(violations: list[str], what: str = "safety envelope") -> None:
     """Raise :class:`SafetyStop` listing ``violations`` (no-op when empty)."""
     if violations:
         raise SafetyStop(f"{what}: " + "; ".join(violations))
+
+
+def check_sent_counts(envelope: Envelope, model: ControlModel, sent_counts,
+                      counts_now) -> list[str]:
+    """Violations of the counts actually sent to the motion controller (after the axis 4 -> 5
+    compensation changed axis 5): axis limits and the per-command step of every axis,
+    measured from the encoder positions read just before (:func:`check_command`)."""
+    res = np.asarray(model.axis_deg_per_count, dtype=float)
+    sent = np.asarray(sent_counts, dtype=float) * res
+    now = None if counts_now is None else np.asarray(counts_now, dtype=float) * res
+    return check_command(envelope, model, sent, now, None)
+
+
+def sent_command_guard(envelope: Envelope, model: ControlModel):
+    """A ``guard(sent_counts, counts_now)`` for the device side
+    (:class:`kinestat.devices.cell_io.DeviceIO`): raises :class:`SafetyStop` on
+    :func:`check_sent_counts`'s violations, so nothing outside the envelope is ever sent."""
+    def guard(sent_counts, counts_now) -> None:
+        require(check_sent_counts(envelope, model, sent_counts, counts_now),
+                "final command (axis 5 compensated)")
+    return guard

@@ -43,8 +43,12 @@ class CycleLog:
         """Write one record as a line, then flush it to the disk."""
         if self._f.closed:
             raise InputError(f"cycle log {str(self.path)!r} is closed")
-        self._f.write(json.dumps(jsonable(record), separators=(",", ":")) + "\n")
-        self._f.flush()
+        try:
+            self._f.write(json.dumps(jsonable(record), separators=(",", ":")) + "\n")
+            self._f.flush()
+        except OSError as exc:
+            raise InputError(f"cannot write the cycle log {str(self.path)!r}: "
+                             f"{exc.strerror or exc}") from exc
         if self.fsync:
             try:
                 os.fsync(self._f.fileno())
@@ -54,7 +58,11 @@ class CycleLog:
 
     def close(self) -> None:
         if not self._f.closed:
-            self._f.close()
+            try:
+                self._f.close()
+            except OSError as exc:  # the last buffered line could not be written
+                raise InputError(f"cannot write the cycle log {str(self.path)!r}: "
+                                 f"{exc.strerror or exc}") from exc
 
     def __enter__(self) -> CycleLog:
         return self

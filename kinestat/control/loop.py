@@ -10,8 +10,9 @@ reader, and :class:`kinestat.app.sim_cell.InProcessIO` with the simulated cell i
 Safe stop: any device fault (a ``?`` from the Galil, a dropped link, a timeout), stale or
 unreliable sensor data (no fresh packet in time, a frozen sequence, more stream faults than
 the envelope tolerates), an envelope violation, a measurement the platform's kinematics cannot
-explain, or Ctrl-C ends the run with ``ST`` sent to the motion controller when the link is up,
-a ``fault`` record in the log and a report saying why (:class:`RunReport`).
+explain, Ctrl-C, SIGTERM or SIGHUP (:mod:`kinestat.app.signals`) ends the run with ``ST``
+sent to the motion controller (on a fresh connection if the link failed), a ``fault`` record
+in the log and a report saying why (:class:`RunReport`).
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from kinestat.control.envelope import require
 from kinestat.control.log import CycleLog
 from kinestat.control.procedure import decide_thesis
 from kinestat.control.wrench import Estimator, Measurement, measure
-from kinestat.errors import DeviceError, KinestatError, SafetyStop
+from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
 
 __all__ = ["SensorReading", "CellIO", "RunReport", "run"]
 
@@ -273,9 +274,18 @@ def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
     except Exception as exc:  # a bug: stop the robot first, keep the log, then let it show
         r.reason = _safe_stop(io, log, f"internal error {type(exc).__name__}: {exc}", r.faults,
                               r.t0)
-        _finish(config, r, log)
+        _once_more_if_interrupted(_finish, config, r, log)
         raise
-    return _finish(config, r, log)
+    return _once_more_if_interrupted(_finish, config, r, log)
+
+
+def _once_more_if_interrupted(fn, *args):
+    """``fn(*args)``, called again if a signal interrupted it (a stop or the final log must not
+    be cut short; :mod:`kinestat.app.signals` raises only on the first signal)."""
+    try:
+        return fn(*args)
+    except KeyboardInterrupt:
+        return fn(*args)
 
 
 def _start_move(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run) -> None:
@@ -310,6 +320,8 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
         raise SafetyStop(f"sensor link unreliable: {len(sample.faults)} stream faults "
                          f"while acquiring one measurement (limit "
                          f"{config.envelope.max_stream_faults}); first: {sample.faults[0]}")
+    if not np.all(np.isfinite(np.asarray(sample.counts, dtype=float))):
+        raise SafetyStop("the sensor returned no valid leg counts for this measurement")
     counts_r = io.robot_counts()
     r.last_counts = np.asarray(counts_r)
     q = axis_counts_to_q(config.model, counts_r)
@@ -359,6 +371,8 @@ def _cycle_summary(cmd: Command, state: ControllerState, meas: Measurement,
 
 def _fault_reason(exc: BaseException) -> str:
     """The report's reason for a fault that ends the run."""
+    if isinstance(exc, StopRequested):
+        return f"stopped by {exc.signal_name}"
     if isinstance(exc, KeyboardInterrupt):
         return "interrupted by the user"
     if isinstance(exc, SafetyStop):
@@ -377,14 +391,18 @@ def _finish(config: ControllerConfig, r: _Run, log: CycleLog) -> RunReport:
 
 
 def _safe_stop(io: CellIO, log: CycleLog, reason: str, faults: list[str], t0: float) -> str:
-    """Stop the robot (best effort), log the fault; return the reason with what was done."""
+    """Stop the robot (best effort), log the fault; return the reason with what was done.
+
+    A signal arriving during the stop (while ``ST`` is sent, or a fresh connection is opened
+    for it) does not cut it short: the stop is sent again and the fault still logged.
+    """
     try:
-        stopped = io.stop()
+        stopped = _once_more_if_interrupted(io.stop)
     except Exception as exc:  # noqa: BLE001 - a failing stop must not hide the fault
         stopped = f"stopping failed: {exc}"
     faults.append(reason)
-    log.write({"type": "fault", "t": time.monotonic() - t0, "reason": reason,
-               "action": stopped})
+    _once_more_if_interrupted(log.write, {"type": "fault", "t": time.monotonic() - t0,
+                                          "reason": reason, "action": stopped})
     return f"{reason} ({stopped})"
 
 

@@ -18,12 +18,22 @@ from typing import Any
 
 import numpy as np
 
+from kinestat.devices.encoder_stream import TooManyFaultsError
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.devices.motion import MOVE_RULES, MoveRule, move_plan
-from kinestat.errors import DeviceError, InputError, KinestatError
+from kinestat.devices.motion_check import POSITION_TOLERANCE_COUNTS, check_arrival
+from kinestat.devices.safe_stop import RECONNECT_TIMEOUT, send_stop
+from kinestat.errors import DeviceError, InputError
 from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, axis45_compensation
 
-__all__ = ["SensorSample", "MotionProfile", "DeviceIO"]
+__all__ = ["MAX_SAMPLES", "SensorSample", "MotionProfile", "DeviceIO"]
+
+MAX_SAMPLES = 1000
+"""Most sensor packets averaged per measurement (5 s of the 200 Hz stream)."""
+
+DEFAULT_MAX_STREAM_FAULTS = 5
+"""Stream faults tolerated while acquiring one measurement (the envelope's default,
+:class:`kinestat.control.envelope.Envelope`; the composition root passes the envelope's)."""
 
 
 @dataclass(frozen=True)
@@ -52,10 +62,19 @@ class DeviceIO:
 
     Moves compensate the axis 4 -> 5 coupling (``coupling``, as the model's). After each move it
     waits ``settle`` seconds past the end of the motion and averages ``samples`` fresh packets
-    received after that. ``truth`` is an optional callable returning the true state
-    (simulation only). ``move_rule`` chooses each move's per-axis speeds
-    (:mod:`kinestat.devices.motion`): "coordinated" (default: the axes start and finish
+    received after that (a running sum: nothing grows with ``samples``; at most
+    :data:`MAX_SAMPLES`). More than ``max_stream_faults`` stream faults while acquiring one
+    measurement end it at once (the loop then stops). ``truth`` is an optional callable
+    returning the true state (simulation only). ``move_rule`` chooses each move's per-axis
+    speeds (:mod:`kinestat.devices.motion`): "coordinated" (default: the axes start and finish
     together, within the profile's maxima), "thesis" (galil_control.m's ``|Δ|/4``) or "max".
+
+    Safety: ``guard(sent_counts, counts_now)`` is called with the FINAL counts of every axis
+    (axis 5 compensated) and the positions read just before, and must raise to refuse them
+    (:func:`kinestat.control.envelope.sent_command_guard`); after each move the read-back
+    positions must agree with the command within ``position_tolerance`` counts before the
+    axis-5 encoder is redefined (:mod:`kinestat.devices.motion_check`). :meth:`stop` sends
+    ``ST``, on a fresh connection if the link failed (:mod:`kinestat.devices.safe_stop`).
     """
 
     def __init__(self, client: GalilClient, reader: Any, *, profile: MotionProfile | None = None,
@@ -63,11 +82,15 @@ class DeviceIO:
                  coupling: float = AXIS4_TO_5_COUPLING,
                  truth: Callable[[], dict] | None = None,
                  clock: Callable[[], float] = time.monotonic,
-                 move_rule: MoveRule = "coordinated") -> None:
+                 move_rule: MoveRule = "coordinated",
+                 guard: Callable[[np.ndarray, np.ndarray], None] | None = None,
+                 position_tolerance: float = POSITION_TOLERANCE_COUNTS,
+                 max_stream_faults: int | None = DEFAULT_MAX_STREAM_FAULTS,
+                 reconnect_timeout: float = RECONNECT_TIMEOUT) -> None:
         if not (math.isfinite(settle) and settle >= 0):
             raise InputError(f"settle must be >= 0 seconds, got {settle!r}")
-        if int(samples) < 1:
-            raise InputError(f"samples must be at least 1, got {samples!r}")
+        if not 1 <= int(samples) <= MAX_SAMPLES:
+            raise InputError(f"samples must be in 1..{MAX_SAMPLES}, got {samples!r}")
         self.client = client
         self.reader = reader
         self.profile = profile or MotionProfile()
@@ -81,6 +104,10 @@ class DeviceIO:
         self._truth = truth
         self._clock = clock
         self._t_ready = clock()
+        self.guard = guard
+        self.position_tolerance = float(position_tolerance)
+        self.max_stream_faults = max_stream_faults
+        self.reconnect_timeout = float(reconnect_timeout)
 
     def robot_counts(self) -> np.ndarray:
         """The robot's axis positions A..F, encoder counts (``TP``)."""
@@ -88,21 +115,29 @@ class DeviceIO:
 
     def move(self, axis_counts: np.ndarray) -> dict:
         """Move with the axis 4 -> 5 compensation (Vibhute App. D.9), keep reading the sensor
-        stream while the axes move (so that the serial buffer never overflows), then reset the
-        axis-5 encoder (``DP``) as :meth:`GalilClient.move_compensated` does. Returns the
-        move's plan: ``{"delta_counts", "speed", "accel", "rule"}`` (what was sent)."""
+        stream while the axes move (so that the serial buffer never overflows), check the
+        read-back positions, then reset the axis-5 encoder (``DP``) as
+        :meth:`GalilClient.move_compensated` does. Returns the move's plan:
+        ``{"delta_counts", "speed", "accel", "rule"}`` (what was sent).
+
+        The final command (axis 5 compensated from the axis-4 position just read) goes through
+        ``guard`` before anything is sent.
+        """
         c = np.asarray(axis_counts, dtype=np.int64)
-        now = np.asarray(self.client.position_counts(), dtype=np.int64)
+        now = self.robot_counts()
         corr = axis45_compensation(c[3], c[4], int(now[3]), self.coupling)
         cmd = c.copy()
         cmd[4] = int(corr.axis5_command)
         plan = move_plan(self.move_rule, now, cmd, self.profile.speed, self.profile.accel)
+        if self.guard is not None:
+            self.guard(cmd, now)
         self.client.move_absolute(cmd, plan.speed, plan.accel, plan.decel)
         deadline = self._clock() + self.motion_timeout
         while self.client.is_moving():
             if self._clock() > deadline:
                 raise DeviceError(f"motion not complete after {self.motion_timeout} s")
             self.reader.poll()
+        check_arrival(cmd, self.robot_counts(), self.position_tolerance)
         self.client.define_position({"E": int(corr.axis5_reset)})
         self._t_ready = self._clock() + self.settle
         return {"delta_counts": (cmd - now).tolist(), "speed": plan.speed.tolist(),
@@ -110,29 +145,35 @@ class DeviceIO:
 
     def sensor(self) -> SensorSample:
         """The mean of ``samples`` fresh packets received after the motion settled, with the
-        stream faults seen while waiting for them."""
-        got: list[np.ndarray] = []
+        stream faults seen while waiting for them (summed as they come: no list of samples).
+
+        With more than ``max_stream_faults`` faults it returns at once with the faults and no
+        counts (NaN): the loop stops on them."""
+        total = np.zeros(6)
+        n = 0
         faults: list[str] = []
         last = None
-        while len(got) < self.samples:
-            r = self.reader.read()
+        budget = self.max_stream_faults
+        while n < self.samples:
+            left = None if budget is None else max(0, budget - len(faults))
+            try:
+                r = self.reader.read() if left is None else self.reader.read(max_faults=left)
+            except TooManyFaultsError as exc:
+                faults.extend(f"{f.kind}: {f.message}" for f in exc.faults)
+                return SensorSample(counts=np.full(6, np.nan), faults=tuple(faults))
             faults.extend(f"{f.kind}: {f.message}" for f in r.faults)
             if r.received_at >= self._t_ready:
-                got.append(np.asarray(r.counts, dtype=float))
+                total += np.asarray(r.counts, dtype=float)
+                n += 1
                 last = r
         assert last is not None
-        return SensorSample(counts=np.mean(got, axis=0), seq=last.seq, age=last.age,
+        return SensorSample(counts=total / n, seq=last.seq, age=last.age,
                             faults=tuple(faults))
 
     def stop(self) -> str:
-        """Send ``ST`` when the link is up (best effort); say what was done."""
-        if not self.client.connected:
-            return "the Galil link is down: ST could not be sent"
-        try:
-            self.client.stop()
-        except KinestatError as exc:
-            return f"ST failed: {exc}"
-        return "ST sent to the Galil"
+        """Send ``ST`` (best effort, bounded): on the open link, or once on a fresh connection
+        if the link failed (:func:`kinestat.devices.safe_stop.send_stop`); say what was done."""
+        return send_stop(self.client, reconnect_timeout=self.reconnect_timeout)
 
     def truth(self) -> dict | None:
         """The true state when simulated (the ``truth`` callable), else None."""

@@ -54,6 +54,7 @@ from kinestat.hardware.encoder_packets import (
 )
 
 __all__ = [
+    "TooManyFaultsError",
     # re-exported from kinestat.hardware.encoder_packets (documented in docs/devices.md)
     "CHANNELS",
     "COUNT_MAX",
@@ -292,6 +293,15 @@ class StaleDataError(ProtocolError):
         super().__init__(message)
 
 
+class TooManyFaultsError(ProtocolError):
+    """More stream faults than allowed arrived while waiting for a fresh packet
+    (:meth:`EncoderReader.read` with ``max_faults``); ``faults`` are those faults."""
+
+    def __init__(self, message: str, *, faults: tuple[StreamFault, ...]) -> None:
+        self.faults = faults
+        super().__init__(message)
+
+
 @dataclass(frozen=True)
 class Reading:
     """The latest valid counts: ``counts`` per leg 1..6, ``channel_counts`` per channel A..F.
@@ -461,11 +471,15 @@ class EncoderReader:
         self._returned_id = self._latest_id
         return self._reading(now)
 
-    def read(self, timeout: float | None = None) -> Reading:
+    def read(self, timeout: float | None = None, *, max_faults: int | None = None) -> Reading:
         """Wait for a packet newer than the last one returned (by :meth:`read` or
         :meth:`latest`); :class:`StaleDataError` if none arrives in time.
 
-        ``timeout`` defaults to ``stale_after``.
+        ``timeout`` defaults to ``stale_after``. With ``max_faults``, more stream faults than
+        that while waiting raise :class:`TooManyFaultsError` at once (carrying them), so a
+        burst of corrupt packets is reported as such however slowly it arrives. Repeated
+        packets (``duplicate``) do not count there: a frozen sensor is a staleness, reported
+        by the stale timer.
         """
         limit = self.stale_after if timeout is None else float(timeout)
         t_end = self._clock() + limit
@@ -475,5 +489,11 @@ class EncoderReader:
             if self._latest_id != self._returned_id:
                 self._returned_id = self._latest_id
                 return self._reading(now)
+            if max_faults is not None and sum(
+                    f.kind != "duplicate" for f in self._pending_faults) > max_faults:
+                faults, self._pending_faults = tuple(self._pending_faults), []
+                raise TooManyFaultsError(f"encoder stream {self.port!r}: {len(faults)} stream "
+                                         f"faults while waiting for a packet (limit "
+                                         f"{max_faults})", faults=faults)
             if now >= t_end:
                 raise self._stale(now, f"no new packet within {limit:.3f} s")

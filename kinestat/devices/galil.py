@@ -22,6 +22,8 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from kinestat.devices.galil_replies import match_reply, split_reply
+from kinestat.devices.motion_check import check_arrival
 from kinestat.errors import DeviceError, InputError, ProtocolError
 from kinestat.hardware.puma762_axes import (
     AXES,
@@ -156,13 +158,16 @@ class GalilClient:
         self.timeout = float(timeout)
         self._sock: socket.socket | None = None
         self._buf = b""
+        self._in_flight: str | None = None  # a command sent whose reply was not read yet
 
     # -- connection
-    def connect(self) -> GalilClient:
-        """Open the TCP connection (closing any previous one)."""
+    def connect(self, timeout: float | None = None) -> GalilClient:
+        """Open the TCP connection (closing any previous one); ``timeout`` bounds the connect
+        (default the client's ``timeout``)."""
         self.close()
+        t = self.timeout if timeout is None else float(timeout)
         try:
-            self._sock = socket.create_connection((self.host, self.port), timeout=self.timeout)
+            self._sock = socket.create_connection((self.host, self.port), timeout=t)
         except OSError as exc:
             raise DeviceError(f"cannot connect to the Galil at {self.host}:{self.port}: {exc}. "
                               "Check the address and that the controller/simulator runs") from exc
@@ -174,6 +179,7 @@ class GalilClient:
     def close(self) -> None:
         """Close the connection (idempotent)."""
         s, self._sock = self._sock, None
+        self._in_flight = None
         if s is not None:
             try:
                 s.close()
@@ -191,19 +197,57 @@ class GalilClient:
         self.close()
 
     # -- raw commands
-    def command(self, cmd: str) -> str:
+    def command(self, cmd: str, *, discard_pending: bool = False) -> str:
         """Send one command; return its data (without the ``:``), or raise.
 
         ``?`` -> :class:`GalilCommandError` with the ``TC1`` code and message; no reply within
-        ``timeout`` or a closed link -> :class:`DeviceError`.
+        ``timeout`` or a closed link -> :class:`DeviceError`. Bytes already waiting before the
+        command, bytes after its reply, or a reply of the wrong kind (data for a command, a
+        bare ``:`` for a query: :mod:`kinestat.devices.galil_replies`) ->
+        :class:`ProtocolError`, and the connection is closed. ``discard_pending`` drops the
+        waiting bytes instead (for ``ST``, which must go out whatever came before).
         """
-        reply = self._exchange(cmd)
+        reply = self._exchange(cmd, discard_pending=discard_pending)
         if reply == "?":
             code, message = self._tell_error()
             raise GalilCommandError(cmd, code, message)
         return reply
 
-    def _exchange(self, cmd: str) -> str:
+    def _fault(self, message: str) -> ProtocolError:
+        self.close()
+        return ProtocolError(f"Galil at {self.host}:{self.port}: {message}; connection closed")
+
+    def _drain(self, cmd: str, discard: bool) -> bytes:
+        """Read whatever is already waiting on the socket without blocking; a protocol fault
+        unless ``discard`` (then the bytes are returned)."""
+        assert self._sock is not None
+        pending = self._buf
+        self._buf = b""
+        self._sock.setblocking(False)
+        try:
+            while True:
+                try:
+                    chunk = self._sock.recv(4096)
+                except (BlockingIOError, InterruptedError):
+                    break
+                except OSError as exc:
+                    self.close()
+                    raise DeviceError(f"Galil link to {self.host}:{self.port} failed before "
+                                      f"{cmd!r}: {exc}") from exc
+                if not chunk:
+                    self.close()
+                    raise DeviceError(f"Galil at {self.host}:{self.port} closed the link "
+                                      f"(seen before sending {cmd!r})")
+                pending += chunk
+        finally:
+            if self._sock is not None:
+                self._sock.settimeout(self.timeout)
+        if pending and not discard:
+            raise self._fault(f"{len(pending)} unexpected byte(s) {pending[:40]!r} waiting "
+                              f"before {cmd!r} (a stale or unsolicited reply)")
+        return pending
+
+    def _exchange(self, cmd: str, *, discard_pending: bool = False) -> str:
         if not isinstance(cmd, str) or not cmd.strip():
             raise InputError(f"Galil command must be a non-empty string, got {cmd!r}")
         if any(c in cmd for c in ";\r\n"):
@@ -212,19 +256,65 @@ class GalilClient:
             raise DeviceError(f"Galil at {self.host}:{self.port} is not connected; call "
                               "connect() first")
         try:
-            self._sock.sendall(cmd.encode("ascii") + b"\r")
+            raw = cmd.encode("ascii") + b"\r"
         except UnicodeEncodeError as exc:
             raise InputError(f"Galil commands are ASCII: {cmd!r}") from exc
+        unread = self._in_flight  # a previous exchange was interrupted before its reply
+        if unread is not None and not discard_pending:
+            raise self._fault(f"the reply to {unread!r} was never read (interrupted); "
+                              f"{cmd!r} would take it for its own")
+        pending = self._drain(cmd, discard_pending)
+        self._in_flight = cmd
+        try:
+            self._sock.sendall(raw)
         except OSError as exc:
             self.close()
             raise DeviceError(f"Galil link to {self.host}:{self.port} failed while sending "
                               f"{cmd!r}: {exc}") from exc
-        return self._read_reply(cmd)
+        if unread is not None:
+            # the interrupted command's reply may have been lost, be waiting, or still be on
+            # its way: replies come in order, so ours is the last one to arrive
+            reply, extra = self._receive_last(cmd, pending), b""
+        else:
+            reply, extra = self._receive(cmd)
+        self._in_flight = None
+        if extra:
+            raise self._fault(f"{len(extra)} unexpected byte(s) {extra[:40]!r} after the reply "
+                              f"to {cmd!r} (an unsolicited reply)")
+        try:
+            return match_reply(cmd, reply, f"Galil at {self.host}:{self.port}")
+        except ProtocolError:
+            self.close()
+            raise
 
-    def _read_reply(self, cmd: str) -> str:
+    def _receive_last(self, cmd: str, buf: bytes, quiet: float = 0.05) -> bytes:
+        """The last of the replies arriving until none came for ``quiet`` seconds."""
+        reply, extra = self._receive(cmd, buf)
+        t_end = time.monotonic() + quiet
+        while self._sock is not None:
+            if (parts := split_reply(extra)) is not None:
+                reply, extra = parts
+                t_end = time.monotonic() + quiet
+                continue
+            left = t_end - time.monotonic()
+            if left <= 0:
+                break
+            self._sock.settimeout(left)
+            try:
+                chunk = self._sock.recv(4096)
+            except OSError:  # includes the quiet timeout
+                break
+            if not chunk:
+                break
+            extra += chunk
+        if self._sock is not None:
+            self._sock.settimeout(self.timeout)
+        return reply
+
+    def _receive(self, cmd: str, buf: bytes = b"") -> tuple[bytes, bytes]:
+        """Read up to the end of one reply (the first ``:`` or ``?``): (reply, bytes after)."""
         deadline = time.monotonic() + self.timeout
-        buf = self._buf
-        while not (buf.endswith(b":") or buf.endswith(b"?")):
+        while (parts := split_reply(buf)) is None:
             remaining = deadline - time.monotonic()
             if remaining <= 0:
                 self.close()
@@ -245,11 +335,7 @@ class GalilClient:
                 raise DeviceError(f"Galil at {self.host}:{self.port} closed the link while "
                                   f"answering {cmd!r}")
             buf += chunk
-        self._buf = b""
-        text = buf.decode("ascii", errors="replace")
-        if text.endswith("?"):
-            return "?"
-        return text[:-1].strip()
+        return parts
 
     def _tell_error(self) -> tuple[int | None, str]:
         reply = self._exchange("TC1")
@@ -324,14 +410,17 @@ class GalilClient:
 
         The sequence of ``Axis_4_5_Correction.m`` + ``galil_control.m``: read axis 4, command
         axis 5 to the corrected position, wait for the motion, then ``DP ,,,,<axis5 target>``
-        so the axis-5 encoder reads the true position again. Returns the final ``TP``.
+        so the axis-5 encoder reads the true position again — only after the read-back
+        positions agreed with the command (:func:`~kinestat.devices.motion_check.check_arrival`,
+        else :class:`DeviceError` and no ``DP``). Returns the final ``TP``.
         """
         c = _per_axis(counts, "move_compensated counts", positive=False)
         d_now = self.axis_position("D")
         corr = axis45_compensation(c[3], c[4], d_now, coupling)
         c[4] = float(corr.axis5_command)
         self.move_absolute(c, speed, accel, decel)
-        self.wait_motion_complete(timeout, poll_interval)
+        final = self.wait_motion_complete(timeout, poll_interval)
+        check_arrival(c, final, what="compensated move")  # before DP: never hide a mismatch
         self.define_position({"E": int(corr.axis5_reset)})
         return self.position_counts()
 
@@ -347,8 +436,9 @@ class GalilClient:
         self.command("DP " + ",".join(fields))
 
     def stop(self) -> None:
-        """``ST``: decelerate every axis to a stop."""
-        self.command("ST")
+        """``ST``: decelerate every axis to a stop (bytes waiting on the link are dropped
+        first: the stop must go out whatever came before)."""
+        self.command("ST", discard_pending=True)
 
     def motor_off(self) -> None:
         """``MO``: servo off on every axis."""

@@ -265,6 +265,13 @@ class DmcSimulator:
         with self._lock:
             self._rules.append([prefix, "silence", 0, int(times)])
 
+    def stale_before_next(self, prefix: str, text: str = " 0.0000\r\n:", times: int = 1
+                          ) -> None:
+        """Execute the next ``times`` commands starting with ``prefix`` normally but send
+        ``text`` (a stale reply) ahead of their reply, as if an old answer were still queued."""
+        with self._lock:
+            self._rules.append([prefix, "stale", 0, int(times), str(text)])
+
     def _rule_for(self, cmd: str) -> list | None:
         for r in self._rules:
             if cmd.startswith(r[0]) and r[3] > 0:
@@ -340,6 +347,9 @@ class DmcSimulator:
             if self.record:
                 self.commands.append(cmd)
             rule = self._rule_for(cmd)
+            stale = ""
+            if rule is not None and rule[1] == "stale":
+                stale, rule = rule[4], None
             if rule is not None:
                 if rule[1] == "silence":
                     return None
@@ -350,8 +360,8 @@ class DmcSimulator:
                 data = self._execute(cmd)
             except _Reject as rej:
                 self._code = rej.code
-                return "?"
-            return ":" if data is None else f"{data}\r\n:"
+                return stale + "?"
+            return stale + (":" if data is None else f"{data}\r\n:")
 
     def _execute(self, cmd: str) -> str | None:
         v = _ASSIGN.match(cmd)

@@ -3,7 +3,8 @@
 :class:`GalilSimServer` serves a simulator on TCP in a background thread, like the real
 controller's port 23: commands end with CR, LF or ``;`` and each gets its own reply. It binds
 127.0.0.1 by default and refuses any non-loopback address unless ``allow_remote=True``
-(:func:`check_bind_address`).
+(:func:`resolve_bind_address`: the host is resolved once and the checked address is the one
+bound).
 """
 
 from __future__ import annotations
@@ -19,27 +20,43 @@ import numpy as np
 from kinestat.errors import DeviceError, InputError
 from kinestat.sim.dmc import DmcSimulator
 
-__all__ = ["check_bind_address", "GalilSimServer"]
+__all__ = ["resolve_bind_address", "check_bind_address", "GalilSimServer"]
+
+
+def resolve_bind_address(host: str, port: int, allow_remote: bool
+                         ) -> tuple[socket.AddressFamily, tuple]:
+    """Resolve ``host`` ONCE and check the address that will be bound: ``(family, sockaddr)``.
+
+    A non-loopback address (``0.0.0.0``, ``::``, ``""``, a LAN address, a name resolving to
+    one) is refused unless ``allow_remote`` is the bool True: anyone who can reach the
+    simulator could command motion. ``allow_remote`` must be a real bool (``"false"`` is
+    refused, not taken as true). The server binds exactly the ``sockaddr`` returned.
+    """
+    if not isinstance(allow_remote, bool):
+        raise InputError(f"allow_remote must be True or False, got {allow_remote!r} "
+                         f"({type(allow_remote).__name__})")
+    if not isinstance(host, str):
+        raise InputError(f"simulator bind address must be a string, got {host!r}")
+    try:
+        infos = socket.getaddrinfo(host or None, port, type=socket.SOCK_STREAM,
+                                   proto=socket.IPPROTO_TCP, flags=socket.AI_PASSIVE)
+    except (socket.gaierror, UnicodeError) as exc:
+        raise InputError(f"cannot resolve simulator bind address {host!r}: {exc}") from exc
+    family, _, _, _, sockaddr = infos[0]
+    addr = str(sockaddr[0])
+    if not allow_remote and not ipaddress.ip_address(addr.split("%")[0]).is_loopback:
+        shown = host or "all interfaces"
+        raise InputError(f"refusing to bind the Galil simulator to {shown!r} ({addr}): not a "
+                         "loopback address, and it accepts motion commands from anyone who "
+                         "can reach it. Use 127.0.0.1, or pass allow_remote=True / "
+                         "--allow-remote deliberately")
+    return family, sockaddr
 
 
 def check_bind_address(host: str, allow_remote: bool) -> None:
-    """Refuse a non-loopback bind address unless ``allow_remote`` (raises InputError)."""
-    if allow_remote:
-        return
-    if host in ("", "0.0.0.0", "::"):
-        raise InputError(f"refusing to bind the Galil simulator to {host or 'all interfaces'!r}: "
-                         "it accepts motion commands from anyone who can reach it. Use "
-                         "127.0.0.1, or pass allow_remote=True / --allow-remote deliberately")
-    try:
-        infos = socket.getaddrinfo(host, None, proto=socket.IPPROTO_TCP)
-    except socket.gaierror as exc:
-        raise InputError(f"cannot resolve simulator bind address {host!r}: {exc}") from exc
-    addrs = {info[4][0] for info in infos}
-    bad = [a for a in addrs if not ipaddress.ip_address(a.split("%")[0]).is_loopback]
-    if bad:
-        raise InputError(f"refusing to bind the Galil simulator to {host!r} ({', '.join(bad)}): "
-                         "not a loopback address. Use 127.0.0.1, or pass allow_remote=True / "
-                         "--allow-remote deliberately")
+    """Refuse a non-loopback bind address unless ``allow_remote`` (raises InputError); see
+    :func:`resolve_bind_address`, which also returns what to bind."""
+    resolve_bind_address(host, 0, allow_remote)
 
 
 class GalilSimServer:
@@ -51,9 +68,9 @@ class GalilSimServer:
 
     def __init__(self, host: str = "127.0.0.1", port: int = 0, *, allow_remote: bool = False,
                  controller: DmcSimulator | None = None) -> None:
-        check_bind_address(host, allow_remote)
         if not (isinstance(port, int) and 0 <= port <= 65535):
             raise InputError(f"port must be an integer in 0..65535, got {port!r}")
+        self._family, self._sockaddr = resolve_bind_address(host, port, allow_remote)
         self.host = host
         self._requested_port = port
         self.controller = controller if controller is not None else DmcSimulator()
@@ -73,12 +90,10 @@ class GalilSimServer:
         """Bind, listen and serve in a daemon thread; raises DeviceError if it cannot bind."""
         if self._thread is not None:
             return self
-        try:
-            infos = socket.getaddrinfo(self.host, self._requested_port, type=socket.SOCK_STREAM)
-            family, _, _, _, sockaddr = infos[0]
-            lst = socket.socket(family, socket.SOCK_STREAM)
+        try:  # exactly the address resolve_bind_address checked
+            lst = socket.socket(self._family, socket.SOCK_STREAM)
             lst.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-            lst.bind(sockaddr)
+            lst.bind(self._sockaddr)
             lst.listen(8)
         except OSError as exc:
             raise DeviceError(f"Galil simulator cannot listen on {self.host}:"
@@ -122,6 +137,22 @@ class GalilSimServer:
 
     def silence_next(self, prefix: str, times: int = 1) -> None:
         self.controller.silence_next(prefix, times)
+
+    def stale_before_next(self, prefix: str, text: str = " 0.0000\r\n:", times: int = 1
+                          ) -> None:
+        self.controller.stale_before_next(prefix, text, times)
+
+    def send_unsolicited(self, raw: bytes) -> int:
+        """Write ``raw`` to every client now, answering nothing (an unsolicited or late
+        reply); returns the number of connections written to."""
+        with self._lock:
+            conns = list(self._conns)
+        n = 0
+        for c in conns:
+            with contextlib.suppress(OSError):
+                c.sendall(bytes(raw))
+                n += 1
+        return n
 
     def drop_link(self) -> None:
         """Close every client connection now (clients see the link drop)."""

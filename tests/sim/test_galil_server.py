@@ -229,3 +229,43 @@ def test_simulator_argument_checks():
         GalilSimServer(port=70000)
     with pytest.raises(InputError):
         SimClock().advance(-1)
+
+
+# ----------------------------------------------------------------------------- issue 11 item 11
+
+
+@pytest.mark.parametrize("flag", ["false", "False", 0, 1, None, "yes"])
+def test_allow_remote_must_be_a_real_bool(flag):
+    with pytest.raises(InputError, match="allow_remote must be True or False"):
+        GalilSimServer("0.0.0.0", 0, allow_remote=flag)
+    with pytest.raises(InputError, match="allow_remote must be True or False"):
+        check_bind_address("127.0.0.1", flag)
+
+
+def test_the_host_is_resolved_once_and_the_checked_address_is_bound(monkeypatch):
+    """A name that resolves to loopback when checked and to 0.0.0.0 later (DNS rebinding)
+    must not end up bound to all interfaces."""
+    real = socket.getaddrinfo
+    calls = []
+
+    def rebinding(host, *a, **k):
+        calls.append(host)
+        if host == "sim.example" and len(calls) > 1:
+            return real("0.0.0.0", *a, **k)
+        return real("127.0.0.1" if host == "sim.example" else host, *a, **k)
+
+    monkeypatch.setattr(socket, "getaddrinfo", rebinding)
+    srv = GalilSimServer("sim.example", 0).start()
+    try:
+        assert srv._listener.getsockname()[0] == "127.0.0.1"
+        assert calls == ["sim.example"]
+    finally:
+        srv.stop()
+
+
+def test_allow_remote_true_binds_all_interfaces_deliberately():
+    srv = GalilSimServer("0.0.0.0", 0, allow_remote=True).start()
+    try:
+        assert srv._listener.getsockname()[0] == "0.0.0.0"
+    finally:
+        srv.stop()
