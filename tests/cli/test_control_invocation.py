@@ -48,7 +48,8 @@ def test_a_missing_serial_device_leaves_no_log(tmp_path, capsys):
     log = tmp_path / "log.jsonl"
     with GalilSimServer() as server:
         code = main(["control", "--galil", f"127.0.0.1:{server.port}", "--serial",
-                     str(tmp_path / "no-such-tty"), "--log", str(log), "--no-plot"])
+                     str(tmp_path / "no-such-tty"), "--log", str(log), "--no-plot",
+                     "--assume-homed"])  # an unhomed robot is refused first (and logged)
     assert code == 2 and "cannot open encoder stream" in capsys.readouterr().err
     assert not log.exists()
 
