@@ -14,7 +14,7 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.spatial.transforms import as_array
-from kinestat.spatial.validate import as_unit_vector
+from kinestat.spatial.validate import as_unit_vector, frozen
 
 __all__ = [
     "LINE_KINDS",
@@ -40,11 +40,6 @@ __all__ = [
 LINE_KINDS: tuple[str, ...] = ("skew", "parallel", "intersecting", "coincident")
 SKEW, PARALLEL, INTERSECTING, COINCIDENT = range(4)
 
-
-def _frozen(a) -> np.ndarray:
-    a = np.array(a)
-    a.flags.writeable = False
-    return a
 
 
 def _where(mask: np.ndarray) -> str:
@@ -192,7 +187,7 @@ class CommonNormal:
 
     def __post_init__(self) -> None:
         for name in ("foot1", "foot2", "direction", "distance"):
-            object.__setattr__(self, name, _frozen(getattr(self, name)))
+            object.__setattr__(self, name, frozen(getattr(self, name)))
 
 
 def _any_perpendicular(S: np.ndarray) -> np.ndarray:
@@ -285,7 +280,7 @@ class LinePair:
 
     def __post_init__(self) -> None:
         for name in ("kind", "distance", "angle", "foot1", "foot2"):
-            object.__setattr__(self, name, _frozen(getattr(self, name)))
+            object.__setattr__(self, name, frozen(getattr(self, name)))
 
     @property
     def kind_name(self):
