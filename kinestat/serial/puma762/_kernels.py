@@ -19,6 +19,11 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial._numba_options import PI as _PI
+from kinestat.serial._numba_options import SQRT8 as _SQRT8
+from kinestat.serial._numba_options import TWO_PI as _TWO_PI
+
 # mechanism parameters and status codes: defined once, in params (Numba freezes them)
 from kinestat.serial.puma762.params import (
     _A,
@@ -36,11 +41,6 @@ from kinestat.serial.puma762.params import (
 )
 from kinestat.spatial.tolerances import ORTHO_TOL
 
-_OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
-
-_PI = math.pi
-_TWO_PI = 2.0 * math.pi
-_SQRT8 = 2.0 * math.sqrt(2.0)
 _NO_ARM = (0.0,) * 12
 
 # classification of the branches of one pose (single-pose entry points)
@@ -225,21 +225,25 @@ def solve_pose(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, pe, re):
     return status
 
 
+@nb.njit(inline="always", **_OPTS)
+def _solve_row(T, k, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re):
+    """:func:`solve_pose` of pose ``k``; returns 1 when it is not finite (its row is left
+    unwritten), else 0."""
+    for i in range(4):
+        for j in range(4):
+            if not math.isfinite(T[k, i, j]):
+                return 1
+    status[k] = solve_pose(T[k], tol, s5_tol, verify, q[k], valid[k], sing[k], fsum[k],
+                           fval[k], pe[k], re[k])
+    return 0
+
+
 @nb.njit(**_OPTS)
 def reverse_serial(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re):
     """:func:`reverse_batch` on one thread (small batches: no thread start-up)."""
     bad = 0
     for k in range(T.shape[0]):
-        finite = True
-        for i in range(4):
-            for j in range(4):
-                if not math.isfinite(T[k, i, j]):
-                    finite = False
-        if not finite:
-            bad += 1
-            continue
-        status[k] = solve_pose(T[k], tol, s5_tol, verify, q[k], valid[k], sing[k], fsum[k],
-                               fval[k], pe[k], re[k])
+        bad += _solve_row(T, k, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re)
     return bad
 
 
@@ -247,19 +251,9 @@ def reverse_serial(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, p
 def reverse_batch(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re):
     """:func:`solve_pose` over ``T (N, 4, 4)``; returns the number of non-finite poses (their
     rows are left unwritten)."""
-    N = T.shape[0]
     bad = 0
-    for k in nb.prange(N):
-        finite = True
-        for i in range(4):
-            for j in range(4):
-                if not math.isfinite(T[k, i, j]):
-                    finite = False
-        if not finite:
-            bad += 1
-            continue
-        status[k] = solve_pose(T[k], tol, s5_tol, verify, q[k], valid[k], sing[k], fsum[k],
-                               fval[k], pe[k], re[k])
+    for k in nb.prange(T.shape[0]):
+        bad += _solve_row(T, k, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re)
     return bad
 
 
