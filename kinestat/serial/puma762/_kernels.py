@@ -257,6 +257,28 @@ def reverse_batch(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe
     return bad
 
 
+@nb.njit(inline="always", **_OPTS)
+def _axes_deviation(z0, z1, z2, x0, x1, x2):
+    """|‖S6‖ − 1|, |‖a67‖ − 1| and |S6·a67| of the end effector's two unit vectors."""
+    return (abs(math.sqrt(z0 * z0 + z1 * z1 + z2 * z2) - 1.0),
+            abs(math.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - 1.0),
+            abs(z0 * x0 + z1 * x1 + z2 * x2))
+
+
+@nb.njit(inline="always", **_OPTS)
+def _axes_problem(z0, z1, z2, x0, x1, x2, tol):
+    """(error code, deviation) of S6 and a67 against ``tol``: ``(ERR_NONE, 0)`` when both are
+    unit vectors and perpendicular."""
+    dz, dx, dd = _axes_deviation(z0, z1, z2, x0, x1, x2)
+    if dz > tol:
+        return ERR_Z_NOT_UNIT, dz
+    if dx > tol:
+        return ERR_X_NOT_UNIT, dx
+    if dd > tol:
+        return ERR_NOT_PERPENDICULAR, dd
+    return ERR_NONE, 0.0
+
+
 @nb.njit(**_OPTS)
 def _frame6(p0, p1, p2, z0, z1, z2, x0, x1, x2, t0, t1, t2, T):
     """``frame6``: normalise S6, Gram–Schmidt a67 against it, y = z × x, origin p − R p6."""
@@ -291,9 +313,10 @@ def frame6_rows(P, Z, X, P6, T):
     for k in range(P.shape[0]):
         z0, z1, z2 = Z[k, 0], Z[k, 1], Z[k, 2]
         x0, x1, x2 = X[k, 0], X[k, 1], X[k, 2]
-        dz = max(dz, abs(math.sqrt(z0 * z0 + z1 * z1 + z2 * z2) - 1.0))
-        dx = max(dx, abs(math.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - 1.0))
-        dd = max(dd, abs(z0 * x0 + z1 * x1 + z2 * x2))
+        ez, ex, ed = _axes_deviation(z0, z1, z2, x0, x1, x2)
+        dz = max(dz, ez)
+        dx = max(dx, ex)
+        dd = max(dd, ed)
         _frame6(P[k, 0], P[k, 1], P[k, 2], z0, z1, z2, x0, x1, x2, P6[k, 0], P6[k, 1],
                 P6[k, 2], T[k])
     return dz, dx, dd
@@ -391,16 +414,8 @@ def reverse_vectors_one(p, z, x, p6, unit_tol, tol, s5_tol):
             err = ERR_NONFINITE_P6
     T = np.empty((4, 4))
     if err == ERR_NONE:
-        dz = abs(math.sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]) - 1.0)
-        dx = abs(math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) - 1.0)
-        dd = abs(z[0] * x[0] + z[1] * x[1] + z[2] * x[2])
-        if dz > unit_tol:
-            err, bad = ERR_Z_NOT_UNIT, dz
-        elif dx > unit_tol:
-            err, bad = ERR_X_NOT_UNIT, dx
-        elif dd > unit_tol:
-            err, bad = ERR_NOT_PERPENDICULAR, dd
-        else:
+        err, bad = _axes_problem(z[0], z[1], z[2], x[0], x[1], x[2], unit_tol)
+        if err == ERR_NONE:
             _frame6(p[0], p[1], p[2], z[0], z[1], z[2], x[0], x[1], x[2], p6[0], p6[1], p6[2],
                     T)
     return _solve_one(T, tol, s5_tol, err, bad)
@@ -431,15 +446,7 @@ def reverse_pose_one(M, tol, s5_tol):
     if err == ERR_NONE:
         z0, z1, z2 = M[0, 2], M[1, 2], M[2, 2]
         x0, x1, x2 = M[0, 0], M[1, 0], M[2, 0]
-        dz = abs(math.sqrt(z0 * z0 + z1 * z1 + z2 * z2) - 1.0)
-        dx = abs(math.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - 1.0)
-        dd = abs(z0 * x0 + z1 * x1 + z2 * x2)
-        if dz > ORTHO_TOL:
-            err, bad = ERR_Z_NOT_UNIT, dz
-        elif dx > ORTHO_TOL:
-            err, bad = ERR_X_NOT_UNIT, dx
-        elif dd > ORTHO_TOL:
-            err, bad = ERR_NOT_PERPENDICULAR, dd
-        else:
+        err, bad = _axes_problem(z0, z1, z2, x0, x1, x2, ORTHO_TOL)
+        if err == ERR_NONE:
             _frame6(M[0, 3], M[1, 3], M[2, 3], z0, z1, z2, x0, x1, x2, 0.0, 0.0, 0.0, T)
     return _solve_one(T, tol, s5_tol, err, bad)
