@@ -48,7 +48,7 @@ from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel, from_standard_dh
 from kinestat.spatial.plucker import COINCIDENT, INTERSECTING, LINE_KINDS, PARALLEL, SKEW
 from kinestat.spatial.transforms import inv, rot_x, rot_z, trans_x, trans_z
-from kinestat.spatial.validate import as_pose, frozen
+from kinestat.spatial.validate import as_pose, freeze_fields
 
 __all__ = [
     "RELATIONS",
@@ -377,8 +377,7 @@ class DHFromAxes:
     model: ChainModel
 
     def __post_init__(self) -> None:
-        for k in ("table", "frames", "base", "tool"):
-            object.__setattr__(self, k, frozen(getattr(self, k)))
+        freeze_fields(self, ("table", "frames", "base", "tool"))
         object.__setattr__(self, "relations", tuple(self.relations))
 
     @property

@@ -14,7 +14,8 @@ from kinestat.errors import InputError
 from kinestat.spatial.tolerances import LAST_ROW_TOL, ORTHO_TOL, UNIT_TOL
 from kinestat.spatial.transforms import as_array
 
-__all__ = ["as_array", "as_pose", "as_vector3", "as_unit_vector", "batch_index", "frozen"]
+__all__ = ["as_array", "as_pose", "as_vector3", "as_unit_vector", "batch_index", "frozen",
+           "freeze_fields"]
 
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -139,3 +140,10 @@ def frozen(a, dtype=None) -> np.ndarray:
     out = np.array(a, dtype=dtype, copy=True)
     out.setflags(write=False)
     return out
+
+
+def freeze_fields(obj, names) -> None:
+    """Replace the attributes ``names`` of a frozen dataclass instance ``obj`` by read-only
+    copies (:func:`frozen`), from its ``__post_init__``."""
+    for name in names:
+        object.__setattr__(obj, name, frozen(getattr(obj, name)))
