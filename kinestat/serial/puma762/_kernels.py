@@ -258,6 +258,12 @@ def reverse_batch(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe
 
 
 @nb.njit(inline="always", **_OPTS)
+def _finite3(v):
+    """True when the three components of ``v`` are finite."""
+    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
+
+
+@nb.njit(inline="always", **_OPTS)
 def _axes_deviation(z0, z1, z2, x0, x1, x2):
     """|‖S6‖ − 1|, |‖a67‖ − 1| and |S6·a67| of the end effector's two unit vectors."""
     return (abs(math.sqrt(z0 * z0 + z1 * z1 + z2 * z2) - 1.0),
@@ -400,18 +406,14 @@ def reverse_vectors_one(p, z, x, p6, unit_tol, tol, s5_tol):
     duplicate) and of invalid branches."""
     err = ERR_NONE
     bad = 0.0
-    for i in range(3):
-        if not math.isfinite(p[i]) and err == ERR_NONE:
-            err = ERR_NONFINITE_P
-    for i in range(3):
-        if not math.isfinite(z[i]) and err == ERR_NONE:
-            err = ERR_NONFINITE_Z
-    for i in range(3):
-        if not math.isfinite(x[i]) and err == ERR_NONE:
-            err = ERR_NONFINITE_X
-    for i in range(3):
-        if not math.isfinite(p6[i]) and err == ERR_NONE:
-            err = ERR_NONFINITE_P6
+    if not _finite3(p):
+        err = ERR_NONFINITE_P
+    elif not _finite3(z):
+        err = ERR_NONFINITE_Z
+    elif not _finite3(x):
+        err = ERR_NONFINITE_X
+    elif not _finite3(p6):
+        err = ERR_NONFINITE_P6
     T = np.empty((4, 4))
     if err == ERR_NONE:
         err, bad = _axes_problem(z[0], z[1], z[2], x[0], x[1], x[2], unit_tol)
