@@ -7,7 +7,6 @@ target (``--no-settle`` turns them off); ``kinestat disp`` behaves as DISP did.
 from __future__ import annotations
 
 import math
-import re
 from pathlib import Path
 
 import numpy as np
@@ -24,6 +23,7 @@ from kinestat.cli._output import console, parse_floats, print_json, table, to_js
 from kinestat.disp import result_record
 from kinestat.errors import InputError, ParseError
 from kinestat.io.disp_deck import OperatorCommand, parse_operator_command
+from kinestat.io.disp_deck.commands import parse_key_values, parse_number
 from kinestat.io.library import load
 from kinestat.mechanism.nadkarni import hand_points
 from kinestat.serial.fk import fk
@@ -40,33 +40,6 @@ from kinestat.serial.guidance.velocity import joint_rates
 
 __all__ = ["register", "parse_command", "parse_move", "read_commands"]
 
-_SPLIT = re.compile(r",(?=\s*[A-Za-z_]+\s*=)")
-
-
-def _keyvals(text: str, what: str, allowed: dict[str, str]) -> dict[str, str]:
-    out: dict[str, str] = {}
-    for part in _SPLIT.split(text.strip()):
-        if "=" not in part:
-            raise InputError(f"{what} {text!r}: expected key=value items, got {part!r}")
-        k, v = (s.strip() for s in part.split("=", 1))
-        k = allowed.get(k.lower())
-        if k is None:
-            raise InputError(f"{what} {text!r}: unknown key {part.split('=')[0]!r}; "
-                             f"use {', '.join(sorted(set(allowed.values())))}")
-        out[k] = v
-    return out
-
-
-def _num(v: str, what: str) -> float:
-    try:
-        x = float(v)
-    except ValueError:
-        raise InputError(f"{what}: {v!r} is not a number") from None
-    if not math.isfinite(x):
-        raise InputError(f"{what}: must be finite, got {v!r}")
-    return x
-
-
 def _command_dict(c: OperatorCommand) -> dict:
     return {"frame": c.frame, "direction": np.array(c.direction), "distance": c.distance,
             "angle_deg": c.angle_deg}
@@ -82,12 +55,12 @@ def parse_command(text: str) -> dict:
 def parse_move(text: str) -> dict:
     """``"axis=0,0,1,angle=30,dir=1,0,0,d=5"``: type I Examples 1–3 — rotate by ``angle``
     (deg) about ``axis`` through the hand origin while it moves ``d`` along ``dir``."""
-    kv = _keyvals(text, "--move", {"axis": "axis", "angle": "angle", "dir": "dir",
+    kv = parse_key_values(text, "--move", {"axis": "axis", "angle": "angle", "dir": "dir",
                                    "direction": "dir", "d": "d", "distance": "d"})
     axis = parse_floats(kv.get("axis", "0,0,1"), 3, "move axis")
     direction = parse_floats(kv.get("dir", "1,0,0"), 3, "move dir")
-    return {"axis": axis, "angle_deg": _num(kv.get("angle", "0"), "--move angle"),
-            "direction": direction, "distance": _num(kv.get("d", "0"), "--move d")}
+    return {"axis": axis, "angle_deg": parse_number(kv.get("angle", "0"), "--move angle"),
+            "direction": direction, "distance": parse_number(kv.get("d", "0"), "--move d")}
 
 
 def read_commands(path: Path) -> list[dict]:

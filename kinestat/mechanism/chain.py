@@ -33,7 +33,7 @@ from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.joints import Joint, JointKind, kind_from_pitch
 from kinestat.spatial.displacement import frame_from_points
 from kinestat.spatial.transforms import inv, rot_x, rot_z, trans_x, trans_z
-from kinestat.spatial.validate import as_pose
+from kinestat.spatial.validate import as_pose, frozen
 
 __all__ = [
     "ChainModel",
@@ -46,11 +46,6 @@ __all__ = [
 
 NOTATIONS = ("chain", "standard_dh", "modified_dh", "nadkarni")
 
-
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.array(a, dtype=float, copy=True)
-    a.setflags(write=False)
-    return a
 
 
 def _check_pose(T, name: str) -> np.ndarray:
@@ -86,8 +81,8 @@ class ChainModel:
     length_unit: str = "mm"
     notation: str = "chain"
     parameters: np.ndarray | None = None
-    base: np.ndarray = field(default_factory=lambda: _readonly(np.eye(4)))
-    tool: np.ndarray = field(default_factory=lambda: _readonly(np.eye(4)))
+    base: np.ndarray = field(default_factory=lambda: frozen(np.eye(4), float))
+    tool: np.ndarray = field(default_factory=lambda: frozen(np.eye(4), float))
     q_home: np.ndarray | None = None
     description: str = ""
     extra: tuple = ()
@@ -105,22 +100,22 @@ class ChainModel:
             )
         for i in range(n + 1):
             _check_pose(C[i], f"model {self.name!r} constant transform C{i}")
-        object.__setattr__(self, "constants", _readonly(C))
+        object.__setattr__(self, "constants", frozen(C, float))
         if self.notation not in NOTATIONS:
             raise ModelError(f"unknown notation {self.notation!r}; expected one of {NOTATIONS}")
         if self.parameters is not None:
             P = np.asarray(self.parameters, dtype=float)
             if P.shape != (n, 4):
                 raise ModelError(f"model {self.name!r}: parameters must be (n, 4) rows")
-            object.__setattr__(self, "parameters", _readonly(P))
-        object.__setattr__(self, "base", _readonly(_check_pose(self.base, "base")))
-        object.__setattr__(self, "tool", _readonly(_check_pose(self.tool, "tool")))
+            object.__setattr__(self, "parameters", frozen(P, float))
+        object.__setattr__(self, "base", frozen(_check_pose(self.base, "base"), float))
+        object.__setattr__(self, "tool", frozen(_check_pose(self.tool, "tool"), float))
         qh = np.zeros(n) if self.q_home is None else np.asarray(self.q_home, dtype=float)
         if qh.shape != (n,) or not np.all(np.isfinite(qh)):
             raise ModelError(f"model {self.name!r}: q_home must be {n} finite values")
-        object.__setattr__(self, "q_home", _readonly(qh))
-        kinds = _readonly(np.array([int(j.code) for j in joints], dtype=np.int64))
-        pitches = _readonly(np.array([j.pitch if j.kind == "screw" else 0.0 for j in joints]))
+        object.__setattr__(self, "q_home", frozen(qh, float))
+        kinds = frozen(np.array([int(j.code) for j in joints], dtype=np.int64), float)
+        pitches = frozen(np.array([j.pitch if j.kind == "screw" else 0.0 for j in joints]), float)
         object.__setattr__(self, "_kinds", kinds)
         object.__setattr__(self, "_pitches", pitches)
         # the compiled kernels' per-model data lives outside the model, in
@@ -382,7 +377,7 @@ def from_nadkarni(
         rows, kinds, pitches=pitches, limits=limits, base=base, tool=hand, name=name,
         length_unit=length_unit, q_home=q0, description=description,
     )
-    extra = (("frame_points", _readonly(fp)), ("rows", _readonly(R)), ("n_active", n))
+    extra = (("frame_points", frozen(fp, float)), ("rows", frozen(R, float)), ("n_active", n))
     object.__setattr__(model, "notation", "nadkarni")
     object.__setattr__(model, "extra", extra)
     return model

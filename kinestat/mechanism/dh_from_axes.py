@@ -48,7 +48,7 @@ from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel, from_standard_dh
 from kinestat.spatial.plucker import COINCIDENT, INTERSECTING, LINE_KINDS, PARALLEL, SKEW
 from kinestat.spatial.transforms import inv, rot_x, rot_z, trans_x, trans_z
-from kinestat.spatial.validate import as_pose
+from kinestat.spatial.validate import as_pose, freeze_fields
 
 __all__ = [
     "RELATIONS",
@@ -353,11 +353,6 @@ def assign_dh_frames(
             np.stack(np.broadcast_arrays(*rels), axis=-1).astype(np.int64), residual)
 
 
-def _readonly(a) -> np.ndarray:
-    a = np.array(a, copy=True)
-    a.setflags(write=False)
-    return a
-
 
 @dataclass(frozen=True, eq=False)
 class DHFromAxes:
@@ -382,8 +377,7 @@ class DHFromAxes:
     model: ChainModel
 
     def __post_init__(self) -> None:
-        for k in ("table", "frames", "base", "tool"):
-            object.__setattr__(self, k, _readonly(getattr(self, k)))
+        freeze_fields(self, ("table", "frames", "base", "tool"))
         object.__setattr__(self, "relations", tuple(self.relations))
 
     @property

@@ -11,92 +11,25 @@
 - :mod:`~kinestat.parallel.stiffness` — spatial stiffness under load, equilibrium poses.
 - :mod:`~kinestat.parallel.planar_springs` — the thesis's planar spring examples.
 - :mod:`~kinestat.parallel.singularity` — singular poses and architecturally singular designs.
+
+Every name in the modules' ``__all__`` is importable from ``kinestat.parallel``.
 """
 
 from __future__ import annotations
 
-from kinestat.parallel.fk import (
-    FKSolutions,
-    fk_all,
-    fk_list,
-    fk_numeric,
-    fk_tracking,
-    reduce_to_33,
-)
-from kinestat.parallel.fk33 import fk_33
-from kinestat.parallel.legs import leg_lengths, leg_vectors, top_points_in_base
-from kinestat.parallel.planar_springs import (
-    springs_in_parallel,
-    springs_in_series,
-    two_spring_compliance,
-    two_spring_force,
-    two_spring_stiffness,
-)
-from kinestat.parallel.platform import (
-    LEG_NAMES,
-    Platform,
-    SpecialDesign,
-    SpecialLayout,
-    special_6_6,
-    special_layout,
-)
-from kinestat.parallel.singularity import (
-    check_design,
-    is_architecturally_singular,
-    singularity_measure,
-)
-from kinestat.parallel.statics import (
-    forces_from_wrench,
-    jacobian_det,
-    leg_lines,
-    line_jacobian,
-    spring_forces,
-    spring_wrench,
-    wrench_from_forces,
-    wrench_from_leg_lengths,
-)
-from kinestat.parallel.stiffness import (
-    equilibrium_pose,
-    load_asymmetry,
-    stiffness,
-    stiffness_terms,
-)
+import sys
 
-__all__ = [
-    "LEG_NAMES",
-    "FKSolutions",
-    "Platform",
-    "SpecialDesign",
-    "SpecialLayout",
-    "check_design",
-    "equilibrium_pose",
-    "fk_33",
-    "fk_all",
-    "fk_list",
-    "fk_numeric",
-    "fk_tracking",
-    "forces_from_wrench",
-    "is_architecturally_singular",
-    "jacobian_det",
-    "leg_lengths",
-    "leg_lines",
-    "leg_vectors",
-    "line_jacobian",
-    "load_asymmetry",
-    "reduce_to_33",
-    "singularity_measure",
-    "special_6_6",
-    "special_layout",
-    "spring_forces",
-    "spring_wrench",
-    "springs_in_parallel",
-    "springs_in_series",
-    "stiffness",
-    "stiffness_terms",
-    "top_points_in_base",
-    "two_spring_compliance",
-    "two_spring_force",
-    "two_spring_stiffness",
-    "wrench_from_forces",
-    "wrench_from_leg_lengths",
-]
+from kinestat.parallel.fk import *  # noqa: F403
+from kinestat.parallel.fk33 import *  # noqa: F403
+from kinestat.parallel.legs import *  # noqa: F403
+from kinestat.parallel.planar_springs import *  # noqa: F403
+from kinestat.parallel.platform import *  # noqa: F403
+from kinestat.parallel.singularity import *  # noqa: F403
+from kinestat.parallel.statics import *  # noqa: F403
+from kinestat.parallel.stiffness import *  # noqa: F403
+
+_MODULES = ("fk", "fk33", "legs", "planar_springs", "platform", "singularity", "statics",
+            "stiffness")
+
+# the package's public names are its modules' public names (each module's __all__)
+__all__ = sorted({name for m in _MODULES for name in sys.modules[f"{__name__}.{m}"].__all__})

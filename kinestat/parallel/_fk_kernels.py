@@ -98,9 +98,17 @@ def _pair(G, cen, rad, u, v, d2, K, P):
 
 
 @nb.njit(**_OPTS)
-def _setup(G, sides2, scale, minvt, cvec, order, L, sq, cen, rad, rad2, K, P):
-    """Squared 3-3 lengths ``sq`` of the leg lengths ``L`` (model order), the circles and the
-    three pair equations (rows of K, P: f1 = RS, f2 = TR, f3 = ST). False if not finite."""
+def _setup(G, sides2, scale, minvt, cvec, order, L):
+    """Squared 3-3 lengths ``sq (6,)`` of the leg lengths ``L`` (model order), the circles
+    (``cen (3, 3)``, ``rad``, ``rad2 (3,)``) and the three pair equations (rows of ``K, P
+    (3, 5)``: f1 = RS, f2 = TR, f3 = ST); returns ``finite, cen, rad, rad2, K, P`` (finite:
+    False if the lengths are not)."""
+    sq = np.empty(6)
+    cen = np.empty((3, 3))
+    rad = np.empty(3)
+    rad2 = np.empty(3)
+    K = np.empty((3, 5))
+    P = np.empty((3, 5))
     finite = True
     for j in range(6):
         s = 0.0
@@ -117,7 +125,7 @@ def _setup(G, sides2, scale, minvt, cvec, order, L, sq, cen, rad, rad2, K, P):
     _pair(G, cen, rad, 0, 1, sides2[0], K[0], P[0])  # f1: R (u = x), S (v = y)
     _pair(G, cen, rad, 2, 0, sides2[2], K[1], P[1])  # f2: T (u = z), R (v = x)
     _pair(G, cen, rad, 1, 2, sides2[1], K[2], P[2])  # f3: S (u = y), T (v = z)
-    return finite
+    return finite, cen, rad, rad2, K, P
 
 
 @nb.njit(**_OPTS)
@@ -179,14 +187,8 @@ def _companion(G, sides2, scale, minvt, cvec, order, W, X, L, C):
     """Stage 1 for one set: the companion matrix ``C (8, 8)`` of its fold-angle polynomial,
     prepared as ``fk33._root_angles`` does; returns the flags (feasible, reversed, leading
     coefficient nonzero)."""
-    sq = np.empty(6)
-    cen = np.empty((3, 3))
-    rad = np.empty(3)
-    rad2 = np.empty(3)
-    K = np.empty((3, 5))
-    P = np.empty((3, 5))
     coef = np.empty(9)
-    finite = _setup(G, sides2, scale, minvt, cvec, order, L, sq, cen, rad, rad2, K, P)
+    finite, cen, rad, rad2, K, P = _setup(G, sides2, scale, minvt, cvec, order, L)
     feasible = finite and rad2[0] >= -1e-12 and rad2[1] >= -1e-12 and rad2[2] >= -1e-12
     _polynomial(P, W, X, coef)
     big = 0.0
@@ -456,12 +458,6 @@ def _first_occurrences(poses, valid, scale, keep):
 def _modes(G, sides2, scale, minvt, cvec, order, Fb, Ft_inv, Mb, Mt, base, top, L, flags,
            roots, tol, polish, poses, valid, res):
     """Stage 3 for one set: every verified distinct mode and its mirror image in 16 slots."""
-    sq = np.empty(6)
-    cen = np.empty((3, 3))
-    rad = np.empty(3)
-    rad2 = np.empty(3)
-    K = np.empty((3, 5))
-    P = np.empty((3, 5))
     thS = np.empty(2)
     thT = np.empty(2)
     rc = np.empty(4)
@@ -483,7 +479,7 @@ def _modes(G, sides2, scale, minvt, cvec, order, Fb, Ft_inv, Mb, Mt, base, top, 
     if not (flags & _FEASIBLE) or not (flags & _LEAD_OK):
         return
     rev = (flags & _REVERSED) != 0
-    _setup(G, sides2, scale, minvt, cvec, order, L, sq, cen, rad, rad2, K, P)
+    _, cen, rad, rad2, K, P = _setup(G, sides2, scale, minvt, cvec, order, L)
     for ri in range(8):
         z = roots[ri]
         az = abs(z)

@@ -27,6 +27,7 @@ from functools import lru_cache
 import numpy as np
 
 from kinestat.errors import InputError
+from kinestat.parallel._fk_tolerances import COMBO_TOL, IMAG_TOL, SIG_TOL
 from kinestat.parallel._refine import cross, refine_where
 from kinestat.spatial.transforms import as_array
 
@@ -168,7 +169,7 @@ def _companion_eigvals(c: np.ndarray) -> np.ndarray:
     return np.linalg.eigvals(M)
 
 
-def _root_angles(poly_w: np.ndarray, imag_tol: float = 1e-3):
+def _root_angles(poly_w: np.ndarray, imag_tol: float = IMAG_TOL):
     """Fold angles θ_R ∈ [0, π] of the (nearly) real roots w ≥ 0 of P(w) (..., 9); NaN elsewhere.
 
     Roots with a small imaginary part are kept (a multiple root, e.g. several modes sharing
@@ -273,7 +274,7 @@ def pose_signature(pose: np.ndarray, scale: float) -> np.ndarray:
                           axis=-1)
 
 
-def first_occurrences(sig: np.ndarray, valid: np.ndarray, tol: float = 1e-6) -> np.ndarray:
+def first_occurrences(sig: np.ndarray, valid: np.ndarray, tol: float = SIG_TOL) -> np.ndarray:
     """Mask (..., K) of valid entries whose signature does not repeat an earlier valid one."""
     sig = np.where(valid[..., None], sig, 0.0)
     n2 = np.sum(sig * sig, axis=-1)
@@ -322,9 +323,8 @@ def assemble_modes(batch_shape, bi, qi, pose, err, tol, base_tri, top_tri, scale
 
 #: Candidates per leg-length set: 8 roots × 4 (θ_S, θ_T) combinations, θ_R ≥ 0 only.
 _NCAND = 32
-#: A (θ_S, θ_T) combination is a candidate when it satisfies the third pair equation this well
-#: (nondimensional; the best combination of each root is always a candidate).
-_COMBO_TOL = 1e-3
+#: A (θ_S, θ_T) combination is a candidate when it satisfies the third pair equation to
+#: ``COMBO_TOL`` (nondimensional; the best combination of each root is always a candidate).
 
 
 @lru_cache(maxsize=64)
@@ -369,7 +369,7 @@ def _fk33_modes(base_tri, top_tri, sq):
     thT = _solve_partner([k[bi] for k in f2[5]], cR, sR, fixed_is_u=False)  # (M, 2)
     res = np.abs(_pair_residual([k[bi] for k in f3[5]], thS[:, :, None], thT[:, None, :]))
     res = np.where(np.isfinite(res), res, np.inf).reshape(-1, 4)
-    take = (res <= _COMBO_TOL) | (res == res.min(axis=-1, keepdims=True))
+    take = (res <= COMBO_TOL) | (res == res.min(axis=-1, keepdims=True))
     take &= np.isfinite(res)
     m, c = np.nonzero(take)
     bi, qi = bi[m], 4 * ri[m] + c

@@ -12,41 +12,23 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from kinestat.errors import InputError, SingularityError
-from kinestat.spatial.transforms import apply, as_array
+from kinestat.errors import SingularityError
+from kinestat.spatial.transforms import apply
+from kinestat.spatial.validate import as_pose as _as_pose
 
 if TYPE_CHECKING:  # the platform module imports this one (its design check)
     from kinestat.parallel.platform import Platform
+
+_LAST_ROW_TOL = 1e-12  # poses computed here carry rounding in their last row at most
 
 __all__ = ["as_pose", "top_points_in_base", "leg_vectors", "leg_lengths", "leg_directions",
            "leg_lines", "line_jacobian"]
 
 
 def as_pose(pose, name: str = "pose") -> np.ndarray:
-    """Check and convert poses ``(..., 4, 4)``: finite, rigid (orthonormal, det +1)."""
-    T = as_array(pose, shape_tail=(4, 4), name=name)
-    R = T[..., :3, :3]
-    err = np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)).max(axis=(-1, -2), initial=0.0)
-    det = np.linalg.det(R)
-    bad_rot = (err > 1e-6) | (np.abs(det - 1.0) > 1e-6)
-    bad_row = np.abs(T[..., 3, :] - np.array([0.0, 0.0, 0.0, 1.0])).max(axis=-1) > 1e-12
-
-    def first(bad: np.ndarray) -> tuple[tuple[int, ...], str]:
-        if T.ndim == 2:
-            return (), ""
-        i = tuple(int(k) for k in np.argwhere(bad)[0])
-        return i, f" at batch index {i}"
-
-    if np.any(bad_row):
-        _, where = first(bad_row)
-        raise InputError(f"{name} is not a rigid transform{where}: its last row must be 0 0 0 1")
-    if np.any(bad_rot):
-        i, where = first(bad_rot)
-        raise InputError(
-            f"{name} is not a rigid transform{where}: its rotation part has max|R R^T - I| = "
-            f"{float(err[i]):.2g} and det = {float(det[i]):.6g}; it must be orthonormal with "
-            "det +1 (tolerance 1e-06: give the rotation to enough digits)")
-    return T
+    """Poses ``(..., 4, 4)`` checked by :func:`kinestat.spatial.validate.as_pose` (finite,
+    rotation orthonormal with det +1 to 1e-6), the last row ``[0, 0, 0, 1]`` to 1e-12."""
+    return _as_pose(pose, name, last_row_tol=_LAST_ROW_TOL)
 
 
 def top_points_in_base(platform: Platform, pose) -> np.ndarray:

@@ -50,11 +50,6 @@ _TOP_EDGE = {0: (3, 4), 1: (4, 5), 2: (5, 3)}  # O1 on R1S1, P1 on S1T1, Q1 on T
 _BASE_EDGE = {4: (0, 1), 5: (1, 2), 3: (2, 0)}  # S0 on O0P0, T0 on P0Q0, R0 on Q0O0
 
 
-def _frozen(a) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.flags.writeable = False
-    return a
-
 
 def _vec(value, n: int, name: str) -> np.ndarray:
     """A scalar or n numbers as a float array (n,), finite."""

@@ -35,12 +35,10 @@ from kinestat.serial._lm_constants import (
     TARGET_ORTHO_TOL,
     WITHIN,
 )
-
-_OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
-
-_PI = math.pi
-_TWO_PI = 2.0 * math.pi
-_SQRT8 = 2.0 * math.sqrt(2.0)
+from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial._numba_options import PI as _PI
+from kinestat.serial._numba_options import SQRT8 as _SQRT8
+from kinestat.serial._numba_options import TWO_PI as _TWO_PI
 
 # pose validation codes
 POSE_OK = 0

@@ -17,12 +17,12 @@ import numba as nb
 import numpy as np
 
 from kinestat.mechanism.joints import JointKind
+from kinestat.serial._numba_options import OPTS as _OPTS
 
 #: joint kind codes as plain ints (Numba freezes them at compile time)
 PRISMATIC = int(JointKind.PRISMATIC)
 SCREW = int(JointKind.SCREW)
 
-_OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -86,38 +86,31 @@ def _row_finite(Q, k, n):
     return True
 
 
+@nb.njit(inline="always", **_OPTS)
+def _unpack(P, q):
+    """The joint constants ``C (n+1, 4, 4)`` and the offset of the kinds in the packed chain
+    ``P``; ``C`` is None when ``q (n,)`` is not finite."""
+    n = q.shape[0]
+    o = (n + 1) * 16
+    for i in range(n):
+        if not math.isfinite(q[i]):
+            return None, o
+    return P[:o].reshape((n + 1, 4, 4)), o
+
+
 @nb.njit(**_OPTS)
 def fk_one(P, q):
     """End pose of one configuration of the packed chain ``P``; None if q is not finite."""
+    C, o = _unpack(P, q)
+    if C is None:
+        return None
     n = q.shape[0]
-    for i in range(n):
-        if not math.isfinite(q[i]):
-            return None
-    C = P[: (n + 1) * 16].reshape((n + 1, 4, 4))
-    o = (n + 1) * 16
     t = _start(C[0])
     for i in range(n):
         t = _step(C[i + 1], int(P[o + i]), P[o + n + i], q[i], t)
     out = np.empty((4, 4))
     _store(t, out)
     return out
-
-
-@nb.njit(parallel=True, **_OPTS)
-def fk_batch(C, kinds, pitch, Q, out):
-    """End poses of ``Q (N, n)`` into ``out (N, 4, 4)``; returns the number of non-finite rows."""
-    N = Q.shape[0]
-    n = kinds.shape[0]
-    bad = 0
-    for k in nb.prange(N):
-        if not _row_finite(Q, k, n):
-            bad += 1
-            continue
-        t = _start(C[0])
-        for i in range(n):
-            t = _step(C[i + 1], kinds[i], pitch[i], Q[k, i], t)
-        _store(t, out[k])
-    return bad
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -144,12 +137,10 @@ def _jac_column(t, kind, h, J, j):
 @nb.njit(**_OPTS)
 def jacobian_one(P, q):
     """Space Jacobian ``(6, n)`` of one configuration of the packed chain ``P``."""
+    C, o = _unpack(P, q)
+    if C is None:
+        return None
     n = q.shape[0]
-    for i in range(n):
-        if not math.isfinite(q[i]):
-            return None
-    C = P[: (n + 1) * 16].reshape((n + 1, 4, 4))
-    o = (n + 1) * 16
     J = np.empty((6, n))
     t = _start(C[0])
     for i in range(n):
@@ -161,8 +152,9 @@ def jacobian_one(P, q):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def jacobian_batch(C, kinds, pitch, Q, out):
-    """Jacobians of ``Q (N, n)`` into ``out (N, 6, n)``; returns the number of non-finite rows."""
+def _chain_batch(C, kinds, pitch, Q, T_out, J_out, want_J):
+    """End poses of ``Q (N, n)`` into ``T_out (N, 4, 4)`` and, when ``want_J``, the Jacobians
+    into ``J_out (N, 6, n)`` (one pass); returns the number of non-finite rows."""
     N = Q.shape[0]
     n = kinds.shape[0]
     bad = 0
@@ -172,27 +164,29 @@ def jacobian_batch(C, kinds, pitch, Q, out):
             continue
         t = _start(C[0])
         for i in range(n):
-            _jac_column(t, kinds[i], pitch[i], out[k], i)
-            t = _step(C[i + 1], kinds[i], pitch[i], Q[k, i], t)
-    return bad
-
-
-@nb.njit(parallel=True, **_OPTS)
-def fk_jacobian_batch(C, kinds, pitch, Q, T_out, J_out):
-    """End poses and Jacobians together (one pass) for ``Q (N, n)``."""
-    N = Q.shape[0]
-    n = kinds.shape[0]
-    bad = 0
-    for k in nb.prange(N):
-        if not _row_finite(Q, k, n):
-            bad += 1
-            continue
-        t = _start(C[0])
-        for i in range(n):
-            _jac_column(t, kinds[i], pitch[i], J_out[k], i)
+            if want_J:
+                _jac_column(t, kinds[i], pitch[i], J_out[k], i)
             t = _step(C[i + 1], kinds[i], pitch[i], Q[k, i], t)
         _store(t, T_out[k])
     return bad
+
+
+_NO_J = np.empty((0, 6, 0))
+
+
+def fk_batch(C, kinds, pitch, Q, out):
+    """End poses of ``Q (N, n)`` into ``out (N, 4, 4)``; returns the number of non-finite rows."""
+    return _chain_batch(C, kinds, pitch, Q, out, _NO_J, False)
+
+
+def jacobian_batch(C, kinds, pitch, Q, out):
+    """Jacobians of ``Q (N, n)`` into ``out (N, 6, n)``; returns the number of non-finite rows."""
+    return _chain_batch(C, kinds, pitch, Q, np.empty((Q.shape[0], 4, 4)), out, True)
+
+
+def fk_jacobian_batch(C, kinds, pitch, Q, T_out, J_out):
+    """End poses and Jacobians together (one pass) for ``Q (N, n)``."""
+    return _chain_batch(C, kinds, pitch, Q, T_out, J_out, True)
 
 
 _ENTRY: dict[str, object] = {}

@@ -84,6 +84,24 @@ def _nonfinite() -> InputError:
     return InputError("q contains NaN or infinity")
 
 
+def evaluate(model: ChainModel, q, one, batch, tail: tuple[int, ...]) -> np.ndarray:
+    """Run a compiled chain kernel on checked joint values ``q (..., n)``: ``one(packed, q)`` for
+    one configuration, ``batch(constants, kinds, pitches, Q, out)`` into ``out (N, *tail)``
+    otherwise; shaped ``(..., *tail)``."""
+    q = _as_q(model, q)
+    d = kernel_data(model)
+    if q.ndim == 1:
+        out = one(d.packed, q)
+    else:
+        Q = np.ascontiguousarray(q.reshape(-1, model.n))
+        out = np.empty((Q.shape[0],) + tail)
+        bad = batch(d.constants, d.kinds, d.pitches, Q, out)
+        out = None if bad else out.reshape(q.shape[:-1] + tail)
+    if out is None:
+        raise _nonfinite()
+    return out
+
+
 _F64 = np.dtype(np.float64)
 _ND = np.ndarray
 _S8 = (8,)
@@ -111,19 +129,7 @@ def fk(model: ChainModel, q) -> np.ndarray:
             if out is None:
                 raise _nonfinite()
             return out
-    q = _as_q(model, q)
-    d = kernel_data(model)
-    if q.ndim == 1:
-        out = _kernels.fk_one(d.packed, q)
-        if out is None:
-            raise _nonfinite()
-        return out
-    lead = q.shape[:-1]
-    Q = np.ascontiguousarray(q.reshape(-1, model.n))
-    out = np.empty((Q.shape[0], 4, 4))
-    if _kernels.fk_batch(d.constants, d.kinds, d.pitches, Q, out):
-        raise _nonfinite()
-    return out.reshape(lead + (4, 4))
+    return evaluate(model, q, _kernels.fk_one, _kernels.fk_batch, (4, 4))
 
 
 #: the theses' name for :func:`fk`

@@ -57,19 +57,8 @@ def jacobian(model: ChainModel, q) -> np.ndarray:
             if J is None:
                 raise InputError("q contains NaN or infinity")
             return J
-    q = _as_q(model, q)
-    d = kernel_data(model)
-    if q.ndim == 1:
-        J = _kernels.jacobian_one(d.packed, q)
-        if J is None:
-            raise InputError("q contains NaN or infinity")
-        return J
-    lead = q.shape[:-1]
-    Q = np.ascontiguousarray(q.reshape(-1, model.n))
-    out = np.empty((Q.shape[0], 6, model.n))
-    if _kernels.jacobian_batch(d.constants, d.kinds, d.pitches, Q, out):
-        raise InputError("q contains NaN or infinity")
-    return out.reshape(lead + (6, model.n))
+    return _fkmod.evaluate(model, q, _kernels.jacobian_one, _kernels.jacobian_batch,
+                           (6, model.n))
 
 
 def fk_and_jacobian(model: ChainModel, q) -> tuple[np.ndarray, np.ndarray]:

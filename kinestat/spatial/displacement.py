@@ -33,7 +33,7 @@ from scipy.spatial.transform import Rotation
 from kinestat.errors import InputError
 from kinestat.spatial.tolerances import ORTHO_TOL as _ORTHO_TOL
 from kinestat.spatial.transforms import as_array, make_pose, skew
-from kinestat.spatial.validate import as_pose, as_unit_vector, batch_index
+from kinestat.spatial.validate import as_pose, as_unit_vector, batch_index, freeze_fields
 
 __all__ = [
     "ScrewDisplacement",
@@ -62,11 +62,6 @@ def _dot(a, b) -> np.ndarray:
 
 _where = batch_index
 
-
-def _frozen(a) -> np.ndarray:
-    a = np.array(a)
-    a.flags.writeable = False
-    return a
 
 
 def frame_from_points(p1, p2, p3, *, tol: float = 1e-9) -> np.ndarray:
@@ -170,8 +165,7 @@ class ScrewDisplacement:
     is_translation: np.ndarray
 
     def __post_init__(self) -> None:
-        for name in ("axis", "point", "theta", "d", "is_translation"):
-            object.__setattr__(self, name, _frozen(getattr(self, name)))
+        freeze_fields(self, ("axis", "point", "theta", "d", "is_translation"))
 
     @property
     def shape(self) -> tuple[int, ...]:

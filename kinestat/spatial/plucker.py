@@ -14,7 +14,7 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.spatial.transforms import as_array
-from kinestat.spatial.validate import as_unit_vector
+from kinestat.spatial.validate import as_unit_vector, freeze_fields
 
 __all__ = [
     "LINE_KINDS",
@@ -40,11 +40,6 @@ __all__ = [
 LINE_KINDS: tuple[str, ...] = ("skew", "parallel", "intersecting", "coincident")
 SKEW, PARALLEL, INTERSECTING, COINCIDENT = range(4)
 
-
-def _frozen(a) -> np.ndarray:
-    a = np.array(a)
-    a.flags.writeable = False
-    return a
 
 
 def _where(mask: np.ndarray) -> str:
@@ -191,8 +186,7 @@ class CommonNormal:
     distance: np.ndarray
 
     def __post_init__(self) -> None:
-        for name in ("foot1", "foot2", "direction", "distance"):
-            object.__setattr__(self, name, _frozen(getattr(self, name)))
+        freeze_fields(self, ("foot1", "foot2", "direction", "distance"))
 
 
 def _any_perpendicular(S: np.ndarray) -> np.ndarray:
@@ -284,8 +278,7 @@ class LinePair:
     foot2: np.ndarray
 
     def __post_init__(self) -> None:
-        for name in ("kind", "distance", "angle", "foot1", "foot2"):
-            object.__setattr__(self, name, _frozen(getattr(self, name)))
+        freeze_fields(self, ("kind", "distance", "angle", "foot1", "foot2"))
 
     @property
     def kind_name(self):

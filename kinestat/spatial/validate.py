@@ -14,7 +14,8 @@ from kinestat.errors import InputError
 from kinestat.spatial.tolerances import LAST_ROW_TOL, ORTHO_TOL, UNIT_TOL
 from kinestat.spatial.transforms import as_array
 
-__all__ = ["as_array", "as_pose", "as_vector3", "as_unit_vector", "batch_index"]
+__all__ = ["as_array", "as_pose", "as_vector3", "as_unit_vector", "batch_index", "frozen",
+           "freeze_fields"]
 
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -127,3 +128,22 @@ def as_unit_vector(u, name: str = "direction", *, tol: float = UNIT_TOL,
         raise error(f"{name}{batch_index(bad)} must be a unit vector: its length differs from 1 "
                     f"by {dev:.3g} (tolerance {tol:g})")
     return a
+
+
+def frozen(a, dtype=None) -> np.ndarray:
+    """A read-only copy of ``a`` (as ``dtype`` when given): the arrays held by immutable models.
+
+    >>> f = frozen([1, 2], float)
+    >>> f, f.flags.writeable
+    (array([1., 2.]), False)
+    """
+    out = np.array(a, dtype=dtype, copy=True)
+    out.setflags(write=False)
+    return out
+
+
+def freeze_fields(obj, names) -> None:
+    """Replace the attributes ``names`` of a frozen dataclass instance ``obj`` by read-only
+    copies (:func:`frozen`), from its ``__post_init__``."""
+    for name in names:
+        object.__setattr__(obj, name, frozen(getattr(obj, name)))

@@ -17,6 +17,7 @@ import numpy as np
 
 from kinestat.control.controller import STATES
 from kinestat.errors import InputError
+from kinestat.viz._files import save_figures
 
 __all__ = ["STATE_COLOURS", "cycle_series", "wrench_figure", "write_plots"]
 
@@ -108,12 +109,4 @@ def wrench_figure(records: list[dict], title: str | None = None):
 def write_plots(records: list[dict], directory: str | os.PathLike,
                 title: str | None = None) -> list[Path]:
     """Write ``wrench-vs-state.png`` into ``directory`` (created); return the paths written."""
-    d = Path(directory)
-    try:
-        d.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"cannot create the plot directory {str(d)!r}: {exc}") from exc
-    fig = wrench_figure(records, title)
-    path = d / "wrench-vs-state.png"
-    fig.savefig(path, dpi=110)
-    return [path]
+    return save_figures(directory, [("wrench-vs-state.png", wrench_figure(records, title))])

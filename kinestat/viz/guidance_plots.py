@@ -11,9 +11,9 @@ from pathlib import Path
 
 import numpy as np
 
-from kinestat.errors import InputError
 from kinestat.serial.guidance.events import JointLimitStop, NotConverged, Singularity
 from kinestat.serial.guidance.run import GuidanceResult, joint_display
+from kinestat.viz._files import save_figures
 
 __all__ = ["joints_figure", "hand_path_figure", "write_guidance_plots"]
 
@@ -100,18 +100,5 @@ def hand_path_figure(result: GuidanceResult, title: str | None = None):
 def write_guidance_plots(result: GuidanceResult, directory: str | os.PathLike,
                          title: str | None = None) -> list[Path]:
     """Write ``joints.png`` and ``hand-path.png`` into ``directory`` (created)."""
-    d = Path(directory)
-    try:
-        d.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"cannot create the plot directory {str(d)!r}: {exc}") from exc
-    out = []
-    for name, fig in (("joints.png", joints_figure(result, title)),
-                      ("hand-path.png", hand_path_figure(result, title))):
-        path = d / name
-        try:
-            fig.savefig(path, dpi=110)
-        except OSError as exc:
-            raise InputError(f"cannot write the plot {str(path)!r}: {exc}") from exc
-        out.append(path)
-    return out
+    return save_figures(directory, [("joints.png", joints_figure(result, title)),
+                                    ("hand-path.png", hand_path_figure(result, title))])

@@ -16,20 +16,11 @@ from kinestat.mechanism.dh_from_axes import (
     dh_row_from_frames,
 )
 from kinestat.serial.fk import fk, fk_frames, joint_axes
+from tests._independent import dh_matrix
 
 REL = st.sampled_from(RELATIONS)
 KIND = st.sampled_from(["revolute", "revolute", "prismatic", "screw"])
 
-
-def notes_matrix(theta, d, a, alpha):
-    """The lecture notes' closed-form H_i^{i-1}, typed from the notes (independent of kinestat)."""
-    ct, st_, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-    return np.array([
-        [ct, -st_ * ca, st_ * sa, a * ct],
-        [st_, ct * ca, -ct * sa, a * st_],
-        [0, sa, ca, d],
-        [0, 0, 0, 1.0],
-    ])
 
 
 def random_pose(rng, spread=1.0):
@@ -266,13 +257,13 @@ def test_tool_on_last_axis_uses_tool_x(rng):
     orig, q0, r2 = generated_chain(3, ["skew", "intersecting", "skew"], ["revolute"] * 3)
     u, rho = joint_axes(orig, q0)
     F = fk_frames(orig, q0)[2]
-    T = F @ notes_matrix(0.7, 0.4, 0.0, 0.0)  # on axis 3, z along it
+    T = F @ dh_matrix(0.7, 0.4, 0.0, 0.0)  # on axis 3, z along it
     res = dh_from_axes(np.stack([rho, u], axis=1), tool=T)
     assert res.relations[-1] == "coincident"
     np.testing.assert_allclose(res.tool, np.eye(4), atol=1e-12)
     assert res.table[-1, 1] == pytest.approx(0.4, abs=1e-12)
-    T2 = F @ notes_matrix(0.7, 0.4, 0.0, 0.0) @ notes_matrix(0, 0, 0, np.pi / 2)  # tool y along
-    T2 = T2 @ notes_matrix(np.pi / 2, 0, 0, 0) @ notes_matrix(0, 0, 0, np.pi / 2)
+    T2 = F @ dh_matrix(0.7, 0.4, 0.0, 0.0) @ dh_matrix(0, 0, 0, np.pi / 2)  # tool y along
+    T2 = T2 @ dh_matrix(np.pi / 2, 0, 0, 0) @ dh_matrix(0, 0, 0, np.pi / 2)
     res2 = dh_from_axes(np.stack([rho, u], axis=1), tool=T2)
     np.testing.assert_allclose(fk(res2.model, np.zeros(3)), T2, atol=1e-12)
 
@@ -321,9 +312,9 @@ def test_link_transform_is_the_notes_closed_form(rng):
     for _ in range(50):
         row = np.r_[rng.uniform(-np.pi, np.pi), rng.uniform(-2, 2), rng.uniform(0, 2),
                     rng.uniform(-np.pi, np.pi)]
-        np.testing.assert_allclose(dh_link(row), notes_matrix(*row), atol=1e-14)
+        np.testing.assert_allclose(dh_link(row), dh_matrix(*row), atol=1e-14)
         B = random_pose(rng)
-        np.testing.assert_allclose(dh_row_from_frames(B, B @ notes_matrix(*row)), row,
+        np.testing.assert_allclose(dh_row_from_frames(B, B @ dh_matrix(*row)), row,
                                    atol=1e-12)
 
 
@@ -363,7 +354,7 @@ def test_bad_base_tool_and_kinds_raise_input_error():
     with pytest.raises(InputError, match="origin"):
         dh_from_axes(axes, base=shifted)
     with pytest.raises(InputError, match="z axis"):
-        dh_from_axes(axes, base=notes_matrix(0, 0, 0, np.pi))
+        dh_from_axes(axes, base=dh_matrix(0, 0, 0, np.pi))
     with pytest.raises(InputError, match="orthonormal"):
         dh_from_axes(axes, tool=np.diag([2.0, 1, 1, 1]))
     with pytest.raises(InputError, match="4x4"):

@@ -9,17 +9,7 @@ import kinestat
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import from_modified_dh, from_standard_dh
 from kinestat.serial.fk import fk_frames, joint_axes
-
-
-def dh_matrix(theta, d, a, alpha):
-    """The lecture notes' H_i^{i-1}, written out element by element (independent of kinestat)."""
-    ct, st_, ca, sa = np.cos(theta), np.sin(theta), np.cos(alpha), np.sin(alpha)
-    return np.array([
-        [ct, -st_ * ca, st_ * sa, a * ct],
-        [st_, ct * ca, -ct * sa, a * st_],
-        [0, sa, ca, d],
-        [0, 0, 0, 1.0],
-    ])
+from tests._independent import dh_matrix
 
 
 def crane_duffy_matrix(alpha, a, theta, S):

@@ -17,6 +17,7 @@ from kinestat.mechanism.chain import from_standard_dh
 from kinestat.serial import puma762 as P
 from kinestat.serial.ik import ik, model_scale, pose_error, rotation_log, wrap_joints
 from kinestat.spatial.transforms import make_pose, rot_z, trans
+from tests.serial._ik_checks import check_limits_respected_or_ignored
 
 TWO_PI = 2 * math.pi
 
@@ -91,15 +92,8 @@ def test_no_false_success_on_unreachable_targets(puma):
 
 
 def test_limits_respected_or_ignored():
-    """Planar 2R arm, elbow limited to [0.1, 0.5]: a target made with elbow 1.0 has both its
-    solutions (elbow ±1.0) outside the limits."""
-    m = from_standard_dh([[0, 0, 1.0, 0], [0, 0, 1.0, 0]], limits=[(-3, 3), (0.1, 0.5)],
-                         name="2R", length_unit="m")
-    target = kinestat.fk(m, [0.3, 1.0])
-    r = ik(m, target, q0=[0.0, 0.3], restarts=3)
-    assert not r.success and np.all(m.within_limits(r.q))
-    r2 = ik(m, target, q0=[0.0, 0.3], respect_limits=False)
-    assert r2.success and np.allclose(np.abs(r2.q[1]), 1.0, atol=1e-8)
+    """Planar 2R arm, elbow limited to [0.1, 0.5] (see the check)."""
+    check_limits_respected_or_ignored()
 
 
 def test_prismatic_joints_are_clipped_never_wrapped():

@@ -17,6 +17,7 @@ from kinestat.serial import _ik_kernels as K
 from kinestat.serial import puma762 as P
 from kinestat.serial._reference import fk_reference
 from kinestat.serial.ik import ik, iter_ik, model_scale, pose_error, wrap_joints
+from tests.serial._ik_checks import check_limits_respected_or_ignored
 
 TWO_PI = 2 * math.pi
 
@@ -370,13 +371,7 @@ def test_ik_answers_do_not_depend_on_batching_or_threads():
 
 
 def test_ik_limits_ignored_and_prismatic_joints():
-    m = from_standard_dh([[0, 0, 1.0, 0], [0, 0, 1.0, 0]], limits=[(-3, 3), (0.1, 0.5)],
-                         name="2R", length_unit="m")
-    target = kinestat.fk(m, [0.3, 1.0])
-    r = ik(m, target, q0=[0.0, 0.3], restarts=3)
-    assert not r.success and np.all(m.within_limits(r.q))
-    r2 = ik(m, target, q0=[0.0, 0.3], respect_limits=False)
-    assert r2.success and np.allclose(np.abs(r2.q[1]), 1.0, atol=1e-8)
+    r2 = check_limits_respected_or_ignored()
     assert np.all((r2.q >= -math.pi) & (r2.q < math.pi))
     rpr = from_standard_dh(
         [[0, 0, 0, -math.pi / 2], [0, 0, 0, math.pi / 2], [0, 0.5, 0.2, 0]],

@@ -63,7 +63,8 @@ _KEYS = {"frame": "frame", "nty": "frame", "dir": "dir", "direction": "dir", "d"
 _SPLIT = re.compile(r",(?=\s*[A-Za-z_]+\s*=)")
 
 
-def _number(text: str, what: str) -> float:
+def parse_number(text: str, what: str) -> float:
+    """A finite number from ``text``; ``InputError`` naming ``what`` otherwise."""
     try:
         x = float(text)
     except ValueError:
@@ -73,16 +74,18 @@ def _number(text: str, what: str) -> float:
     return x
 
 
-def _key_values(text: str, what: str) -> dict[str, str]:
+def parse_key_values(text: str, what: str, keys: dict[str, str] = _KEYS) -> dict[str, str]:
+    """``"k=v, k=v, …"`` (values may hold commas) → ``{canonical key: value}``; ``keys`` maps
+    each accepted spelling (lower case) to its canonical key."""
     out: dict[str, str] = {}
     for part in _SPLIT.split(text.strip()):
         if "=" not in part:
             raise InputError(f"{what} {text!r}: expected key=value items, got {part!r}")
         k, v = (s.strip() for s in part.split("=", 1))
-        key = _KEYS.get(k.lower())
+        key = keys.get(k.lower())
         if key is None:
             raise InputError(f"{what} {text!r}: unknown key {k!r}; use "
-                             f"{', '.join(sorted(set(_KEYS.values())))}")
+                             f"{', '.join(sorted(set(keys.values())))}")
         out[key] = v
     return out
 
@@ -101,24 +104,25 @@ def parse_operator_command(text: str, what: str = "command") -> OperatorCommand:
     if not isinstance(text, str):
         raise InputError(f"{what} must be text, got {type(text).__name__}")
     if "=" not in text:
-        vals = [_number(t, what) for t in text.replace(",", " ").split()]
+        vals = [parse_number(t, what) for t in text.replace(",", " ").split()]
         if len(vals) != 6 or vals[0] not in (0.0, 1.0):
             raise InputError(f"{what} {text!r}: expected 'NTY DCx DCy DCz DD THA' with NTY 0 "
                              "or 1, or key=value items")
         return OperatorCommand(int(vals[0]), tuple(vals[1:4]), vals[4], vals[5])
-    kv = _key_values(text, what)
+    kv = parse_key_values(text, what)
     frame = kv.get("frame", "global").lower()
     nty = {"global": 0, "hand": 1, "0": 0, "1": 1}.get(frame)
     if nty is None:
         raise InputError(f"{what} {text!r}: frame must be 'global' or 'hand', got {frame!r}")
     if "dir" not in kv:
         raise InputError(f"{what} {text!r}: give the direction, e.g. dir=0,0,1")
-    direction = [_number(t, f"{what} dir") for t in kv["dir"].split(",") if t.strip()]
+    direction = [parse_number(t, f"{what} dir") for t in kv["dir"].split(",") if t.strip()]
     if len(direction) != 3:
         raise InputError(f"{what} {text!r}: dir needs 3 comma-separated numbers, got "
                          f"{kv['dir']!r}")
     try:
-        return OperatorCommand(nty, tuple(direction), _number(kv.get("d", "0"), f"{what} d"),
-                               _number(kv.get("angle", "0"), f"{what} angle"))
+        distance = parse_number(kv.get("d", "0"), f"{what} d")
+        return OperatorCommand(nty, tuple(direction), distance,
+                               parse_number(kv.get("angle", "0"), f"{what} angle"))
     except InputError as exc:
         raise InputError(f"{what} {text!r}: {exc}") from None

@@ -26,6 +26,7 @@ from kinestat.io.disp_deck.validate import (
     _raise_if,
 )
 from kinestat.mechanism.joints import PRISMATIC_PITCH_THRESHOLD
+from kinestat.spatial.validate import frozen
 
 
 @dataclass(frozen=True)
@@ -68,12 +69,6 @@ class DeckJoint:
         return math.radians(self.theta_deg)
 
 
-def _readonly(a: np.ndarray) -> np.ndarray:
-    a = np.array(a, dtype=float) + 0.0  # own copy; -0.0 -> 0.0
-    a.setflags(write=False)
-    return a
-
-
 def _points_array(value, shape: tuple[int, ...], what: str) -> np.ndarray:
     try:
         a = np.asarray(value, dtype=float)
@@ -83,7 +78,7 @@ def _points_array(value, shape: tuple[int, ...], what: str) -> np.ndarray:
         raise InputError(f"{what} must have shape {shape}, got {a.shape}")
     if not np.all(np.isfinite(a)):
         raise InputError(f"{what} contains NaN or infinity")
-    return _readonly(a)
+    return frozen(a + 0.0)  # own copy; -0.0 -> 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -224,7 +219,7 @@ class DispDeck:
         :func:`kinestat.mechanism.chain.from_nadkarni` take. ``(0, 5)`` without SET FOUR.
         """
         rows = [(j.r, j.alpha, j.a, j.theta, j.pitch) for j in self.joints or ()]
-        return _readonly(np.array(rows, dtype=float).reshape(len(rows), 5))
+        return frozen(np.array(rows, dtype=float).reshape(len(rows), 5) + 0.0)
 
     @property
     def hand_from_seventh_joint(self) -> bool:

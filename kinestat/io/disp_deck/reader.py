@@ -73,19 +73,24 @@ def read_deck(path_or_text: str | os.PathLike | bytes) -> DispDeck:
     return parse_deck(_decode(data, str(path)), source=str(path))
 
 
+def _set_cards(cur: _Cursor, spec, count: int, ends: str):
+    """Cards 1..``count`` of one SET, read one at a time (``spec(i)``: card i's format);
+    ``ends`` words a deck that ends early, ``{done}`` standing for the cards read."""
+    for i in range(1, count + 1):
+        yield cur.take(spec(i), ends.format(done=i - 1))
+
+
 def _read_set_two(cur: _Cursor, ms: int, np_: int) -> np.ndarray:
     """SET TWO: 3 × NP cards, three points per position (3F10.2)."""
     n_cards = 3 * np_
     pts = np.zeros((n_cards, 3))
-    reads = []
-    for c in range(1, n_cards + 1):
-        r = cur.take(
-            _spec_two(c),
-            f"the deck ends after {c - 1} of the {n_cards} SET TWO cards (3 x NP, "
-            f"NP = {np_}); add the missing cards or fix NP in SET ONE",
-        )
-        pts[c - 1] = r.values
-        reads.append(r)
+    reads = list(_set_cards(
+        cur, _spec_two, n_cards,
+        f"the deck ends after {{done}} of the {n_cards} SET TWO cards (3 x NP, NP = {np_}); "
+        "add the missing cards or fix NP in SET ONE",
+    ))
+    for c, r in enumerate(reads):
+        pts[c] = r.values
     positions = pts.reshape(np_, 3, 3)
     for k in range(np_):
         if k == 0 and not np.any(positions[0]):
@@ -109,12 +114,11 @@ def _read_set_two(cur: _Cursor, ms: int, np_: int) -> np.ndarray:
 def _read_set_three(cur: _Cursor, np_: int) -> tuple[OperatorCommand, ...]:
     """SET THREE: NP operator command cards (I10,5F10.3)."""
     cmds = []
-    for i in range(1, np_ + 1):
-        r = cur.take(
-            _spec_three(i),
-            f"the deck ends after {i - 1} of the {np_} SET THREE cards (NP = {np_}); add "
-            "the missing commands or fix NP in SET ONE",
-        )
+    for r in _set_cards(
+        cur, _spec_three, np_,
+        f"the deck ends after {{done}} of the {np_} SET THREE cards (NP = {np_}); add the "
+        "missing commands or fix NP in SET ONE",
+    ):
         nty, dx, dy, dz, dd, tha = r.values
         if nty not in (0, 1):
             raise cur.fail(
@@ -136,12 +140,11 @@ def _read_set_four(cur: _Cursor, ms: int, hand7: bool) -> tuple[DeckJoint, ...]:
     if problem := _n_problem(ms, n, hand7):
         raise cur.fail(rn, 0, problem)
     js = []
-    for i in range(1, n + 1):
-        r = cur.take(
-            _spec_joint(i),
-            f"the deck ends after {i - 1} of the N = {n} SET FOUR joint cards; add the "
-            "missing joints or fix N",
-        )
+    for r in _set_cards(
+        cur, _spec_joint, n,
+        f"the deck ends after {{done}} of the N = {n} SET FOUR joint cards; add the missing "
+        "joints or fix N",
+    ):
         if problem := _pitch_problem(r.values[4]):
             raise cur.fail(r, 4, problem)
         js.append(DeckJoint(*r.values))
@@ -150,13 +153,10 @@ def _read_set_four(cur: _Cursor, ms: int, hand7: bool) -> tuple[DeckJoint, ...]:
 
 def _read_set_five(cur: _Cursor) -> np.ndarray:
     """SET FIVE: three points on x*(1) (3F10.3)."""
-    reads = [
-        cur.take(
-            _spec_five(c),
-            f"the deck ends after {c - 1} of the 3 SET FIVE cards (three points on x*(1))",
-        )
-        for c in (1, 2, 3)
-    ]
+    reads = list(_set_cards(
+        cur, _spec_five, 3,
+        "the deck ends after {done} of the 3 SET FIVE cards (three points on x*(1))",
+    ))
     frame_points = np.array([r.values for r in reads], dtype=float)
     if problem := _frame_problem(frame_points):
         raise ParseError(

@@ -30,20 +30,13 @@ def _format_int(value: int, f: _Field, where: str) -> str:
 def _format_real(value: float, f: _Field, where: str, exact: bool) -> str:
     """The shortest-precision text of ``value`` that fits the field and reads back exactly."""
     w = f.width
-    candidates = []
-    # the format's decimals first, then more, then fewer ('#' keeps the point of "25.")
-    for dec in [*range(f.decimals, w), *range(f.decimals - 1, -1, -1)]:
-        s = f"{value:#.{dec}f}"
-        if len(s) > w:
-            continue
-        candidates.append(s)
-        if float(s) == value:
-            return s.rjust(w)
-    for p in range(w):
-        s = f"{value:#.{p}E}"
-        if len(s) > w:
-            break
-        candidates.append(s)
+    # the format's decimals first, then more, then fewer ('#' keeps the point of "25."), then
+    # scientific notation
+    texts = [*(f"{value:#.{dec}f}" for dec in [*range(f.decimals, w),
+                                               *range(f.decimals - 1, -1, -1)]),
+             *(f"{value:#.{p}E}" for p in range(w))]
+    candidates = [s for s in texts if len(s) <= w]
+    for s in candidates:
         if float(s) == value:
             return s.rjust(w)
     if exact or not candidates:

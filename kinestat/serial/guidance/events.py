@@ -137,19 +137,25 @@ class LeastSquaresStep(GuidanceEvent):
 
 
 @dataclass(frozen=True, eq=False)
-class NotConverged(GuidanceEvent):
+class _Unreached(GuidanceEvent):
+    """Base of the events that stop a run short of its pose: raised as ``UnreachableError``."""
+
+    stops: ClassVar[bool] = True
+
+    def error(self, message: str) -> KinestatError:
+        return UnreachableError(message)
+
+
+@dataclass(frozen=True, eq=False)
+class NotConverged(_Unreached):
     """The closed-loop Newton correction did not reach the ideal pose of the step."""
 
     kind: ClassVar[str] = "not_converged"
-    stops: ClassVar[bool] = True
 
     position_error: float = 0.0
     angle_error_deg: float = 0.0
     iterations: int = 0
     action: str = "stopped"
-
-    def error(self, message: str) -> KinestatError:
-        return UnreachableError(message)
 
 
 @dataclass(frozen=True, eq=False)
@@ -164,15 +170,11 @@ class SettleStep(GuidanceEvent):
 
 
 @dataclass(frozen=True, eq=False)
-class TargetNotReached(GuidanceEvent):
+class TargetNotReached(_Unreached):
     """Settling gave up: the stage target is out of reach or beyond a singularity."""
 
     kind: ClassVar[str] = "target_not_reached"
-    stops: ClassVar[bool] = True
 
     position_error: float = 0.0
     angle_error_deg: float = 0.0
     action: str = "stopped"
-
-    def error(self, message: str) -> KinestatError:
-        return UnreachableError(message)

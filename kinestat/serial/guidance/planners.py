@@ -131,8 +131,16 @@ def _s(s) -> np.ndarray:
     return s
 
 
+class _PathEnd:
+    """``end``: the ideal pose at ``s = 1``, for paths that define ``pose_at``."""
+
+    @property
+    def end(self) -> np.ndarray:
+        return self.pose_at(1.0)
+
+
 @dataclass(frozen=True, eq=False)
-class ScrewPath:
+class ScrewPath(_PathEnd):
     """Screw path (analysis type II; type IV commands): ``pose_at(s) = exp(s ξ) · start``.
 
     ``twist`` ξ ``(6,)`` is the whole screw displacement ``[θU; hθU − θU×ρn]``; the step twist
@@ -143,10 +151,6 @@ class ScrewPath:
     start: np.ndarray
     twist: np.ndarray
     kind: str = "screw"
-
-    @property
-    def end(self) -> np.ndarray:
-        return self.pose_at(1.0)
 
     def pose_at(self, s) -> np.ndarray:
         s = _s(s)
@@ -165,7 +169,7 @@ class ScrewPath:
 
 
 @dataclass(frozen=True, eq=False)
-class LinePath:
+class LinePath(_PathEnd):
     """Type III: the three hand points move on straight lines (Nadkarni eq. 4-20, SPLITM).
 
     ``points0``/``points1`` ``(3, 3)`` are the origin, a point on +z and a point on the +x side
@@ -181,10 +185,6 @@ class LinePath:
     @property
     def start(self) -> np.ndarray:
         return self.pose_at(0.0)
-
-    @property
-    def end(self) -> np.ndarray:
-        return self.pose_at(1.0)
 
     def points_at(self, s) -> np.ndarray:
         s = _s(s)[..., None, None]
@@ -205,7 +205,7 @@ class LinePath:
 
 
 @dataclass(frozen=True, eq=False)
-class GeneralPath:
+class GeneralPath(_PathEnd):
     """Type I: rotation θ about the fixed direction ``u_w`` through the moving hand origin and
     translation r of the origin along ``u_v`` (eqs. 4-9 to 4-17).
 
@@ -225,10 +225,6 @@ class GeneralPath:
     r: float
     kind: str = "general"
     replan_each_step: bool = False
-
-    @property
-    def end(self) -> np.ndarray:
-        return self.pose_at(1.0)
 
     def pose_at(self, s) -> np.ndarray:
         s = _s(s)

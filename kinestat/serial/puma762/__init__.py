@@ -35,106 +35,27 @@ importable from ``kinestat.serial.puma762``.
 
 from __future__ import annotations
 
+from kinestat.serial.puma762 import forward as _forward
 from kinestat.serial.puma762 import params as _params
-from kinestat.serial.puma762.forward import (
-    ForwardResult,
-    forward,
-    frame6,
-    link_transform,
-    pose_residuals,
-    wrist_center,
-)
-from kinestat.serial.puma762.params import (
-    A23,
-    ALPHA_DEG,
-    AXIS_LIMITS_DEG,
-    AXIS_LIMITS_MATLAB_DEG,
-    AXIS_LIMITS_TABLE_2_1_DEG,
-    AXIS_OFFSET,
-    N_BRANCHES,
-    S2,
-    S4,
-    S6,
-    STATUS_INSIDE_CYLINDER,
-    STATUS_OK,
-    STATUS_TOO_FAR,
-    STATUS_TOO_NEAR,
-)
-from kinestat.serial.puma762.reverse import (
-    BACKENDS,
-    CHUNK_ROWS,
-    Backend,
-    ClosedLoop,
-    ReverseBatch,
-    ReverseResult,
-    WristFamily,
-    close_loop,
-    iter_reverse_batch_pose,
-    reverse,
-    reverse_batch,
-    reverse_batch_pose,
-    reverse_pose,
-    status_message,
-)
-from kinestat.serial.puma762.selection import (
-    Selection,
-    from_axis_angles,
-    select,
-    select_batch,
-    to_axis_angles,
-    within_limits,
-    wrap_into_limits,
-)
+from kinestat.serial.puma762 import reverse as _reverse
+from kinestat.serial.puma762 import selection as _selection
+from kinestat.serial.puma762.forward import *  # noqa: F403 (re-exported: its __all__)
+from kinestat.serial.puma762.params import *  # noqa: F403
+from kinestat.serial.puma762.reverse import *  # noqa: F403
+from kinestat.serial.puma762.selection import *  # noqa: F403
 
 # the link table (cos α, sin α, a, S of links 1-2 .. 5-6), read by the tests
 _CA, _SA, _A, _S = _params._CA, _params._SA, _params._A, _params._S
 
 #: the theses' names: forward analysis = fk, reverse analysis = ik (closed form)
-forward_analysis = forward
-reverse_analysis = reverse
+forward_analysis = _forward.forward
+reverse_analysis = _reverse.reverse
 
 __all__ = [
-    "A23",
-    "S2",
-    "S4",
-    "S6",
-    "ALPHA_DEG",
-    "AXIS_OFFSET",
-    "AXIS_LIMITS_DEG",
-    "AXIS_LIMITS_MATLAB_DEG",
-    "AXIS_LIMITS_TABLE_2_1_DEG",
-    "N_BRANCHES",
-    "STATUS_OK",
-    "STATUS_INSIDE_CYLINDER",
-    "STATUS_TOO_FAR",
-    "STATUS_TOO_NEAR",
-    "link_transform",
-    "ForwardResult",
-    "forward",
-    "frame6",
-    "wrist_center",
-    "ClosedLoop",
-    "close_loop",
-    "ReverseBatch",
-    "reverse_batch",
-    "WristFamily",
-    "ReverseResult",
-    "reverse",
-    "reverse_pose",
-    "reverse_batch_pose",
-    "iter_reverse_batch_pose",
-    "BACKENDS",
-    "Backend",
+    *_params.__all__,
+    *_forward.__all__,
+    *_reverse.__all__,
+    *_selection.__all__,
     "forward_analysis",
     "reverse_analysis",
-    "CHUNK_ROWS",
-    "pose_residuals",
-    "to_axis_angles",
-    "from_axis_angles",
-    "wrap_into_limits",
-    "Selection",
-    "select_batch",
-    "select",
-    "within_limits",
-    "status_message",
 ]

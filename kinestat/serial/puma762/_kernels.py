@@ -19,6 +19,11 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial._numba_options import PI as _PI
+from kinestat.serial._numba_options import SQRT8 as _SQRT8
+from kinestat.serial._numba_options import TWO_PI as _TWO_PI
+
 # mechanism parameters and status codes: defined once, in params (Numba freezes them)
 from kinestat.serial.puma762.params import (
     _A,
@@ -36,11 +41,6 @@ from kinestat.serial.puma762.params import (
 )
 from kinestat.spatial.tolerances import ORTHO_TOL
 
-_OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
-
-_PI = math.pi
-_TWO_PI = 2.0 * math.pi
-_SQRT8 = 2.0 * math.sqrt(2.0)
 _NO_ARM = (0.0,) * 12
 
 # classification of the branches of one pose (single-pose entry points)
@@ -225,21 +225,25 @@ def solve_pose(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, pe, re):
     return status
 
 
+@nb.njit(inline="always", **_OPTS)
+def _solve_row(T, k, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re):
+    """:func:`solve_pose` of pose ``k``; returns 1 when it is not finite (its row is left
+    unwritten), else 0."""
+    for i in range(4):
+        for j in range(4):
+            if not math.isfinite(T[k, i, j]):
+                return 1
+    status[k] = solve_pose(T[k], tol, s5_tol, verify, q[k], valid[k], sing[k], fsum[k],
+                           fval[k], pe[k], re[k])
+    return 0
+
+
 @nb.njit(**_OPTS)
 def reverse_serial(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re):
     """:func:`reverse_batch` on one thread (small batches: no thread start-up)."""
     bad = 0
     for k in range(T.shape[0]):
-        finite = True
-        for i in range(4):
-            for j in range(4):
-                if not math.isfinite(T[k, i, j]):
-                    finite = False
-        if not finite:
-            bad += 1
-            continue
-        status[k] = solve_pose(T[k], tol, s5_tol, verify, q[k], valid[k], sing[k], fsum[k],
-                               fval[k], pe[k], re[k])
+        bad += _solve_row(T, k, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re)
     return bad
 
 
@@ -247,20 +251,38 @@ def reverse_serial(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, p
 def reverse_batch(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re):
     """:func:`solve_pose` over ``T (N, 4, 4)``; returns the number of non-finite poses (their
     rows are left unwritten)."""
-    N = T.shape[0]
     bad = 0
-    for k in nb.prange(N):
-        finite = True
-        for i in range(4):
-            for j in range(4):
-                if not math.isfinite(T[k, i, j]):
-                    finite = False
-        if not finite:
-            bad += 1
-            continue
-        status[k] = solve_pose(T[k], tol, s5_tol, verify, q[k], valid[k], sing[k], fsum[k],
-                               fval[k], pe[k], re[k])
+    for k in nb.prange(T.shape[0]):
+        bad += _solve_row(T, k, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re)
     return bad
+
+
+@nb.njit(inline="always", **_OPTS)
+def _finite3(v):
+    """True when the three components of ``v`` are finite."""
+    return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _axes_deviation(z0, z1, z2, x0, x1, x2):
+    """|‖S6‖ − 1|, |‖a67‖ − 1| and |S6·a67| of the end effector's two unit vectors."""
+    return (abs(math.sqrt(z0 * z0 + z1 * z1 + z2 * z2) - 1.0),
+            abs(math.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - 1.0),
+            abs(z0 * x0 + z1 * x1 + z2 * x2))
+
+
+@nb.njit(inline="always", **_OPTS)
+def _axes_problem(z0, z1, z2, x0, x1, x2, tol):
+    """(error code, deviation) of S6 and a67 against ``tol``: ``(ERR_NONE, 0)`` when both are
+    unit vectors and perpendicular."""
+    dz, dx, dd = _axes_deviation(z0, z1, z2, x0, x1, x2)
+    if dz > tol:
+        return ERR_Z_NOT_UNIT, dz
+    if dx > tol:
+        return ERR_X_NOT_UNIT, dx
+    if dd > tol:
+        return ERR_NOT_PERPENDICULAR, dd
+    return ERR_NONE, 0.0
 
 
 @nb.njit(**_OPTS)
@@ -297,9 +319,10 @@ def frame6_rows(P, Z, X, P6, T):
     for k in range(P.shape[0]):
         z0, z1, z2 = Z[k, 0], Z[k, 1], Z[k, 2]
         x0, x1, x2 = X[k, 0], X[k, 1], X[k, 2]
-        dz = max(dz, abs(math.sqrt(z0 * z0 + z1 * z1 + z2 * z2) - 1.0))
-        dx = max(dx, abs(math.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - 1.0))
-        dd = max(dd, abs(z0 * x0 + z1 * x1 + z2 * x2))
+        ez, ex, ed = _axes_deviation(z0, z1, z2, x0, x1, x2)
+        dz = max(dz, ez)
+        dx = max(dx, ex)
+        dd = max(dd, ed)
         _frame6(P[k, 0], P[k, 1], P[k, 2], z0, z1, z2, x0, x1, x2, P6[k, 0], P6[k, 1],
                 P6[k, 2], T[k])
     return dz, dx, dd
@@ -383,30 +406,18 @@ def reverse_vectors_one(p, z, x, p6, unit_tol, tol, s5_tol):
     duplicate) and of invalid branches."""
     err = ERR_NONE
     bad = 0.0
-    for i in range(3):
-        if not math.isfinite(p[i]) and err == ERR_NONE:
-            err = ERR_NONFINITE_P
-    for i in range(3):
-        if not math.isfinite(z[i]) and err == ERR_NONE:
-            err = ERR_NONFINITE_Z
-    for i in range(3):
-        if not math.isfinite(x[i]) and err == ERR_NONE:
-            err = ERR_NONFINITE_X
-    for i in range(3):
-        if not math.isfinite(p6[i]) and err == ERR_NONE:
-            err = ERR_NONFINITE_P6
+    if not _finite3(p):
+        err = ERR_NONFINITE_P
+    elif not _finite3(z):
+        err = ERR_NONFINITE_Z
+    elif not _finite3(x):
+        err = ERR_NONFINITE_X
+    elif not _finite3(p6):
+        err = ERR_NONFINITE_P6
     T = np.empty((4, 4))
     if err == ERR_NONE:
-        dz = abs(math.sqrt(z[0] * z[0] + z[1] * z[1] + z[2] * z[2]) - 1.0)
-        dx = abs(math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) - 1.0)
-        dd = abs(z[0] * x[0] + z[1] * x[1] + z[2] * x[2])
-        if dz > unit_tol:
-            err, bad = ERR_Z_NOT_UNIT, dz
-        elif dx > unit_tol:
-            err, bad = ERR_X_NOT_UNIT, dx
-        elif dd > unit_tol:
-            err, bad = ERR_NOT_PERPENDICULAR, dd
-        else:
+        err, bad = _axes_problem(z[0], z[1], z[2], x[0], x[1], x[2], unit_tol)
+        if err == ERR_NONE:
             _frame6(p[0], p[1], p[2], z[0], z[1], z[2], x[0], x[1], x[2], p6[0], p6[1], p6[2],
                     T)
     return _solve_one(T, tol, s5_tol, err, bad)
@@ -437,15 +448,7 @@ def reverse_pose_one(M, tol, s5_tol):
     if err == ERR_NONE:
         z0, z1, z2 = M[0, 2], M[1, 2], M[2, 2]
         x0, x1, x2 = M[0, 0], M[1, 0], M[2, 0]
-        dz = abs(math.sqrt(z0 * z0 + z1 * z1 + z2 * z2) - 1.0)
-        dx = abs(math.sqrt(x0 * x0 + x1 * x1 + x2 * x2) - 1.0)
-        dd = abs(z0 * x0 + z1 * x1 + z2 * x2)
-        if dz > ORTHO_TOL:
-            err, bad = ERR_Z_NOT_UNIT, dz
-        elif dx > ORTHO_TOL:
-            err, bad = ERR_X_NOT_UNIT, dx
-        elif dd > ORTHO_TOL:
-            err, bad = ERR_NOT_PERPENDICULAR, dd
-        else:
+        err, bad = _axes_problem(z0, z1, z2, x0, x1, x2, ORTHO_TOL)
+        if err == ERR_NONE:
             _frame6(M[0, 3], M[1, 3], M[2, 3], z0, z1, z2, x0, x1, x2, 0.0, 0.0, 0.0, T)
     return _solve_one(T, tol, s5_tol, err, bad)
