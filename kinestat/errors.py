@@ -85,3 +85,7 @@ class DeviceError(KinestatError):
 
 class ProtocolError(DeviceError):
     """A packet or reply did not follow the protocol (corrupt, out of sequence, unparseable)."""
+
+
+class ClusterError(KinestatError):
+    """A study's compute cluster failed: the Dask scheduler unreachable, no workers joined."""
