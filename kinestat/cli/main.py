@@ -27,6 +27,7 @@ COMMAND_MODULES: list[str] = [
     "dh_from_axes",
     "platform",
     "control",
+    "sweep",
 ]
 
 app = typer.Typer(

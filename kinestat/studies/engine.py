@@ -128,7 +128,7 @@ def _compute(client, study: Study, store: StudyStore, todo: list[int], progress:
 
     computed = 0
     futures = [submit(i) for _, i in zip(range(in_flight), pending, strict=False)]
-    queue = as_completed(futures)
+    queue = as_completed(futures, loop=client.loop)
     with prog:
         for fut in queue:
             try:
