@@ -4,7 +4,8 @@ Every study takes ``--output DIR`` (default ``./kinestat-runs/<study>-<spec hash
 command resumes an interrupted run), ``--scheduler tcp://HOST:PORT`` (default: an embedded local
 cluster, one worker process per core), ``--json``, and ``--samples N --seed S`` (random inputs) or
 ``--grid N`` (N values per axis over its range, both ends, full tensor grid). Output: summary.json
-(only once complete), per-chunk Parquet rows under chunks/, PNG plots under plots/. See
+(only once complete), per-chunk partial summaries under chunks/, Parquet rows under rows/, PNG
+plots under plots/. See
 docs/sweeps.md.
 """
 
@@ -85,7 +86,7 @@ def _run(study_name: str, spec: dict, *, output, scheduler, workers, threads, ti
     console.print(table(f"{study_name}: {res.chunks_total} chunks "
                         f"({res.chunks_computed} computed, {res.chunks_reused} reused) in "
                         f"{res.elapsed_s:.1f} s", ["quantity", "value"], rows, fmt="{:.6g}"))
-    console.print(f"output: {res.output} (summary.json, chunks/, plots/)")
+    console.print(f"output: {res.output} (summary.json, rows/ Parquet, plots/)")
 
 
 def _samples_default(grid, samples, default):

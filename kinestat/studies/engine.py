@@ -65,6 +65,14 @@ def compute_chunk_task(name: str, text: str, i: int):
     return i, rows, partial
 
 
+def check_address(address: str) -> None:
+    """Refuse a scheduler address that is not ``[PROTOCOL://]HOST:PORT``."""
+    rest = address.split("://", 1)[-1]
+    host, _, port = rest.rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise InputError(f"--scheduler {address!r}: expected an address tcp://HOST:PORT")
+
+
 @contextmanager
 def open_client(scheduler: str | None, workers: int | None, processes: bool,
                 timeout_s: float) -> Iterator:
@@ -72,6 +80,7 @@ def open_client(scheduler: str | None, workers: int | None, processes: bool,
     import distributed  # lazy: Dask costs ~1 s to import and only studies need it
 
     if scheduler:
+        check_address(scheduler)
         try:
             client = distributed.Client(scheduler, timeout=f"{timeout_s}s",
                                         set_as_default=False)
@@ -93,10 +102,17 @@ def open_client(scheduler: str | None, workers: int | None, processes: bool,
             client.close()
         return
     n = workers or os.cpu_count() or 1
-    with distributed.LocalCluster(n_workers=n, threads_per_worker=1, processes=processes,
-                                  dashboard_address=None, silence_logs=logging.ERROR,
-                                  host="127.0.0.1") as cluster, \
-            distributed.Client(cluster, set_as_default=False) as client:
+    if n < 1:
+        raise InputError(f"--workers must be at least 1, got {n}")
+    extra = {"host": "127.0.0.1"} if processes else {}  # threads talk in-process
+    try:
+        cluster = distributed.LocalCluster(n_workers=n, threads_per_worker=1,
+                                           processes=processes,
+                                           dashboard_address="127.0.0.1:0",  # any free port
+                                           silence_logs=logging.ERROR, **extra)
+    except (OSError, RuntimeError, TimeoutError) as exc:
+        raise ClusterError(f"the local Dask cluster did not start ({exc})") from None
+    with cluster, distributed.Client(cluster, set_as_default=False) as client:
         yield client
 
 
@@ -161,15 +177,18 @@ def run_study(study: Study, output: str | os.PathLike | None = None, *,
     store = StudyStore(root, study.name, study.spec, spec_hash(study.spec), study.n_chunks)
     if scheduler is not None and not scheduler.strip():
         raise InputError("--scheduler: empty address; give tcp://HOST:PORT")
-    store.open()
-    done = store.done_chunks()
+    done = store.check()
     todo = [i for i in range(study.n_chunks) if i not in done]
     if max_chunks is not None:
         todo = todo[:max_chunks]
     computed = 0
     if todo:
+        # connect first: a bad scheduler leaves no output directory behind
         with open_client(scheduler, workers, processes, timeout_s) as client:
+            store.open()
             computed = _compute(client, study, store, todo, progress, len(done))
+    else:
+        store.open()
     complete = len(done) + computed == study.n_chunks
     summary, plot_files = None, []
     if complete:

@@ -97,6 +97,8 @@ def parse_values(text: str, name: str, grid: int | None = None) -> list[float]:
                                         for k in range(n)]
         else:
             vals = [float(v) for v in s.split(",")]
+    except InputError:
+        raise
     except ValueError:
         raise InputError(f"--{name}: cannot read {text!r}; give a number, numbers separated by "
                          "commas, lo:hi or lo:hi:n") from None

@@ -3,7 +3,7 @@
 Layout::
 
     DIR/manifest.json              study, spec, spec hash, chunk count, "complete" flag
-    DIR/chunks/part-000042.parquet the chunk's rows (one Parquet dataset over all parts)
+    DIR/rows/part-000042.parquet   the chunk's rows (DIR/rows is one Parquet dataset)
     DIR/chunks/part-000042.json    the chunk's partial summary; its presence marks the chunk done
     DIR/summary.json               written only when every chunk is done ("complete": true)
     DIR/plots/*.png                plots of the complete study
@@ -58,10 +58,23 @@ class StudyStore:
         self.root = Path(root)
         self.study, self.spec, self.hash, self.n_chunks = study, spec, spec_hash, n_chunks
         self.chunks = self.root / "chunks"
+        self.rows = self.root / "rows"
 
     # -- opening ---------------------------------------------------------------------------
+    def check(self) -> set[int]:
+        """Check (reading only) that the directory is new, empty or holds this very study;
+        returns the chunks already done."""
+        self._check()
+        return self.done_chunks()
+
     def open(self) -> None:
-        """Create the directory or check that it holds this very study (then resume)."""
+        """Create the directory (with its manifest) unless it holds this study already."""
+        if not self._check():
+            self.root.mkdir(parents=True, exist_ok=True)
+            self._write_manifest(complete=False)
+
+    def _check(self) -> bool:
+        """True if the directory holds this study; False if it is new or empty."""
         man = self.root / MANIFEST
         if man.exists():
             try:
@@ -74,12 +87,13 @@ class StudyStore:
                     f"--output {self.root} holds a different study ({old.get('study')!r}, "
                     f"spec {str(old.get('spec_hash'))[:12]}); its inputs differ from this run's "
                     "— choose another --output or delete that directory")
-            return
+            return True
+        if self.root.exists() and not self.root.is_dir():
+            raise InputError(f"--output {self.root} is a file; give a directory")
         if self.root.exists() and any(self.root.iterdir()):
             raise InputError(f"--output {self.root} exists and is not a kinestat study "
                              "directory (no manifest.json); choose an empty or new directory")
-        self.root.mkdir(parents=True, exist_ok=True)
-        self._write_manifest(complete=False)
+        return False
 
     def _write_manifest(self, complete: bool) -> None:
         write_atomic(self.root / MANIFEST, _json_bytes({
@@ -88,7 +102,7 @@ class StudyStore:
 
     # -- chunks ----------------------------------------------------------------------------
     def _part(self, i: int, ext: str) -> Path:
-        return self.chunks / f"part-{i:06d}.{ext}"
+        return (self.rows if ext == "parquet" else self.chunks) / f"part-{i:06d}.{ext}"
 
     def done_chunks(self) -> set[int]:
         """Chunks whose partial summary is on disk (and belongs to this spec)."""
