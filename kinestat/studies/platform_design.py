@@ -55,7 +55,8 @@ def _defaults(platform) -> dict[str, float]:
     return {"base_side": one(d.base_side, "base sides"), "top_side": one(d.top_side, "top sides"),
             "base_offset": one(d.base_offset, "base offsets"),
             "top_offset": one(d.top_offset, "top offsets"), "height": d.height,
-            "twist_deg": round(math.degrees(d.twist), 12), "stiffness": one(d.stiffness, "spring constants")}
+            "twist_deg": round(math.degrees(d.twist), 12),
+            "stiffness": one(d.stiffness, "spring constants")}
 
 
 def platform_design_spec(platform: str | None = None, *, values: dict[str, str] | None = None,

@@ -98,8 +98,7 @@ class ToleranceStudy(Study):
 
     def errors(self, r: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """Wrench errors ``(m, 6)`` [Δf; Δm_c] and a failure mask ``(m,)`` for draws ``r``."""
-        from kinestat.parallel import Platform, leg_lengths, spring_wrench, \
-            wrench_from_leg_lengths
+        from kinestat.parallel import Platform, leg_lengths, spring_wrench, wrench_from_leg_lengths
 
         p = self.platform
         T = pc.displaced_poses(p, r["d"])
