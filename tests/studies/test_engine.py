@@ -94,3 +94,42 @@ def test_other_spec_in_same_directory_is_refused(tmp_path):
     (tmp_path / "y" / "notes.txt").write_text("mine")
     with pytest.raises(InputError, match="not a kinestat study"):
         run_study(a, tmp_path / "y", workers=1, processes=False, progress=False, plots=False)
+
+
+def test_killed_run_resumes_to_the_same_summary(tmp_path):
+    """SIGKILL a real `kinestat sweep` mid-run, then resume: the result equals the reference."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    from .conftest import ROOT
+
+    out = tmp_path / "killed"
+    spec = workspace_spec("puma762", grid=5, chunk_size=150)
+    study = build_study("workspace", spec)
+    cmd = [sys.executable, "-m", "kinestat.cli.main", "sweep", "workspace", "--grid", "5",
+           "--chunk-size", "150", "--threads", "--workers", "1", "--no-plots", "--quiet",
+           "--output", str(out)]
+    proc = subprocess.Popen(cmd, env={**os.environ, "PYTHONPATH": str(ROOT)},
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
+    try:
+        deadline = time.monotonic() + 60
+        while len(list(out.glob("chunks/part-*.json"))) < 3:
+            assert proc.poll() is None, "the run ended before it could be killed"
+            assert time.monotonic() < deadline, "no chunk written within 60 s"
+            time.sleep(0.05)
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait(timeout=30)
+    finally:
+        if proc.poll() is None:
+            os.killpg(proc.pid, signal.SIGKILL)
+            proc.wait(timeout=30)
+    done = len(list(out.glob("chunks/part-*.json")))
+    assert 3 <= done < study.n_chunks
+    assert not (out / "summary.json").exists()
+    res = run_study(study, out, workers=1, processes=False, progress=False, plots=False)
+    assert res.complete and res.chunks_reused == done
+    assert res.summary == run_reference(study)
