@@ -133,3 +133,11 @@ def test_killed_run_resumes_to_the_same_summary(tmp_path):
     res = run_study(study, out, workers=1, processes=False, progress=False, plots=False)
     assert res.complete and res.chunks_reused == done
     assert res.summary == run_reference(study)
+
+
+def test_every_study_plots_png(tmp_path, references):
+    for name, spec in _studies().items():
+        files = build_study(name, spec).plot(references[name], tmp_path / name)
+        assert files
+        for f in files:
+            assert (tmp_path / name / f).read_bytes()[:4] == b"\x89PNG"
