@@ -77,7 +77,11 @@ def check_address(address: str) -> None:
 def open_client(scheduler: str | None, workers: int | None, processes: bool,
                 timeout_s: float) -> Iterator:
     """A connected ``distributed.Client``: to ``scheduler`` or to a fresh local cluster."""
-    import distributed  # lazy: Dask costs ~1 s to import and only studies need it
+    try:
+        import distributed  # lazy: Dask costs ~1 s to import and only studies need it
+    except ImportError as exc:
+        raise ClusterError(f"kinestat sweep needs dask.distributed ({exc}); install the "
+                           "pinned requirements (requirements/run.txt)") from None
 
     if scheduler:
         check_address(scheduler)
