@@ -105,7 +105,7 @@ def open_client(scheduler: str | None, workers: int | None, processes: bool,
         finally:
             client.close()
         return
-    n = workers or os.cpu_count() or 1
+    n = (os.cpu_count() or 1) if workers is None else workers
     if n < 1:
         raise InputError(f"--workers must be at least 1, got {n}")
     extra = {"host": "127.0.0.1"} if processes else {}  # threads talk in-process

@@ -68,3 +68,10 @@ def test_bad_specs_exit_2_with_one_line(capsys, tmp_path, args, message):
     lines = [x for x in err.splitlines() if x.strip()]
     assert len(lines) == 1 and lines[0].startswith("kinestat: error:") and message in lines[0]
     assert not out.exists()  # nothing that could be mistaken for a result
+
+
+def test_zero_workers_is_an_error(capsys, tmp_path):
+    code, _, err = run(capsys, "workspace", "--grid", "2", "--workers", "0", "--output",
+                       str(tmp_path / "w"))
+    assert code == 2 and "--workers must be at least 1" in err
+    assert not (tmp_path / "w").exists()
