@@ -11,7 +11,9 @@ and reports evaluations per second, the peak resident memory of every worker and
 then the cost of one platform design (256 poses) for the scaling estimate, and the Parquet
 output rate with rows written.
 
-Run: ``.venv/bin/python benchmarks/sweeps.py [N]`` (default N = 10^7 configurations).
+Run: ``.venv/bin/python benchmarks/sweeps.py [N]`` (default N = 10^7 configurations), or
+``benchmarks/sweeps.py --huge 1e8`` for a 10^8-configuration planar workspace study (memory
+bounded: the same worker RSS as a small study).
 """
 
 from __future__ import annotations
@@ -90,7 +92,50 @@ def _external(study, out: Path) -> tuple[float, list[float]]:
             p.wait(timeout=30)
 
 
+PLANAR = """name = "planar2"
+notation = "standard_dh"
+length_unit = "m"
+angle_unit = "deg"
+[[joints]]
+name = "1"
+type = "revolute"
+theta = 0.0
+d = 0.0
+a = 1.0
+alpha = 0.0
+limits = [-180.0, 180.0]
+[[joints]]
+name = "2"
+type = "revolute"
+theta = 0.0
+d = 0.0
+a = 0.5
+alpha = 0.0
+limits = [-180.0, 180.0]
+"""
+
+
+def huge(n: int) -> int:
+    """Bounded memory at scale: n planar 2-link configurations (2 worker processes)."""
+    tmp = Path(tempfile.mkdtemp(prefix="kinestat-bench-"))
+    model = tmp / "planar2.toml"
+    model.write_text(PLANAR)
+    spec = workspace_spec(str(model), samples=n, seed=1, chunk_size=1 << 20, arrays=False)
+    study = build_study("workspace", spec)
+    dt, rss = _local(study, tmp / "huge", 2)
+    res = run_study(study, tmp / "huge", progress=False, plots=False)  # complete: reduce only
+    print(f"planar 2-link workspace, {n:,} configurations, {study.n_chunks} chunks of 2^20, "
+          f"2 local worker processes: {dt:.0f} s ({n / dt / 1e6:.2f} M/s); points "
+          f"{res.summary['points']:,}, reach {res.summary['reach_min']:.6f} .. "
+          f"{res.summary['reach_max']:.6f}; workers peak RSS "
+          f"{', '.join(f'{x:.0f}' for x in rss)} MiB; client peak RSS {_peak_rss_mib():.0f} MiB; "
+          f"load average {os.getloadavg()[0]:.1f}")
+    return 0
+
+
 def main(argv: list[str]) -> int:
+    if len(argv) > 2 and argv[1] == "--huge":
+        return huge(int(float(argv[2])))
     n = int(float(argv[1])) if len(argv) > 1 else 10**7
     tmp = Path(tempfile.mkdtemp(prefix="kinestat-bench-"))
     spec = workspace_spec("puma762", samples=n, seed=1, arrays=False)
