@@ -98,3 +98,7 @@ class StopRequested(KeyboardInterrupt):
         self.signum = int(signum)
         self.signal_name = signal_name
         super().__init__(f"stopped by {signal_name}")
+
+
+class ClusterError(KinestatError):
+    """A study's compute cluster failed: the Dask scheduler unreachable, no workers joined."""

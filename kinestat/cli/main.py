@@ -29,6 +29,7 @@ COMMAND_MODULES: list[str] = [
     "control",
     "view",
     "home",
+    "sweep",
 ]
 
 app = typer.Typer(

@@ -21,18 +21,13 @@ from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, AXIS_DEG_PER_COU
 from kinestat.parallel.platform import Platform
 from kinestat.serial import puma762
 from kinestat.spatial.transforms import apply, as_array, inv
+from kinestat.spatial.validate import frozen
 
 __all__ = ["ControlModel", "ForceSource"]
 
 ForceSource = Literal["springs", "calibration"]
 """Where the leg forces come from: the platform's linear springs ``k (l − l0)`` at the measured
 lengths, or the calibration's count → force maps (the thesis's eq_wrench.m ``legf``)."""
-
-
-def _ro(a) -> np.ndarray:
-    out = np.array(a, dtype=float)
-    out.setflags(write=False)
-    return out
 
 
 @dataclass(frozen=True, eq=False)
@@ -71,21 +66,21 @@ class ControlModel:
         M = as_array(self.mount, shape_tail=(4, 4), name="mount")
         if M.shape != (4, 4):
             raise ModelError(f"mount must be one 4x4 transform, got shape {M.shape}")
-        object.__setattr__(self, "mount", _ro(M))
+        object.__setattr__(self, "mount", frozen(M, float))
         p6 = as_array(self.tool_point_6, shape_tail=(3,), name="tool_point_6")
         if p6.shape != (3,):
             raise ModelError(f"tool_point_6 must be 3 numbers, got shape {p6.shape}")
-        object.__setattr__(self, "tool_point_6", _ro(p6))
+        object.__setattr__(self, "tool_point_6", frozen(p6, float))
         L = as_array(self.limits_deg, shape_tail=(2,), name="axis limits")
         if L.shape != (6, 2) or np.any(L[:, 0] >= L[:, 1]):
             raise ModelError(f"axis limits must be 6 (lower, upper) pairs in degrees with "
                              f"lower < upper, got {L.tolist()}")
-        object.__setattr__(self, "limits_deg", _ro(L))
+        object.__setattr__(self, "limits_deg", frozen(L, float))
         r = as_array(self.axis_deg_per_count, name="axis resolution")
         if r.shape != (6,) or np.any(r <= 0):
             raise ModelError(f"axis resolution must be 6 positive degrees-per-count values, "
                              f"got {r.tolist()}")
-        object.__setattr__(self, "axis_deg_per_count", _ro(r))
+        object.__setattr__(self, "axis_deg_per_count", frozen(r, float))
         if not math.isfinite(float(self.coupling)):
             raise ModelError("axis 4 -> 5 coupling must be finite")
         object.__setattr__(self, "coupling", float(self.coupling))

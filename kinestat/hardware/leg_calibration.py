@@ -35,6 +35,7 @@ import numpy as np
 from numpy.polynomial import polynomial as P
 
 from kinestat.errors import InputError
+from kinestat.spatial.validate import frozen
 
 __all__ = [
     "ENCODER_LINES_PER_INCH",
@@ -65,12 +66,6 @@ MM_PER_COUNT = 25.4 / COUNTS_PER_INCH
 THESIS_SENSOR_LEGS: tuple[str, ...] = ("O", "S", "P", "T", "Q", "R")
 
 
-def _frozen(a) -> np.ndarray:
-    a = np.array(a, dtype=float)
-    a.flags.writeable = False
-    return a
-
-
 @dataclass(frozen=True, eq=False)
 class LegCalibration:
     """Per-sensor-leg polynomial maps from counts (ascending coefficients, one row per leg).
@@ -94,7 +89,7 @@ class LegCalibration:
                 raise InputError(f"{attr} must have shape (6, n >= 1), got {a.shape}")
             if not np.all(np.isfinite(a)):
                 raise InputError(f"{attr} contains NaN or infinity")
-            object.__setattr__(self, attr, _frozen(a))
+            object.__setattr__(self, attr, frozen(a, float))
         names = tuple(str(n) for n in self.leg_names)
         if len(names) != 6 or len(set(names)) != 6:
             raise InputError(f"leg_names must be six distinct names, got {names}")
@@ -226,7 +221,7 @@ def fit_polynomial(counts, values, degree: int = 1) -> CalibrationFit:
     coef = poly.convert().coef
     coef = np.concatenate([coef, np.zeros(degree + 1 - coef.size)])
     res = y - P.polyval(x, coef)
-    return CalibrationFit(coefficients=_frozen(coef), residuals=_frozen(res),
+    return CalibrationFit(coefficients=frozen(coef, float), residuals=frozen(res, float),
                           rms=float(np.sqrt(np.mean(res**2))), max_abs=float(np.max(np.abs(res))))
 
 

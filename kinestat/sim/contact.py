@@ -57,6 +57,7 @@ from kinestat.parallel.platform import Platform
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
 from kinestat.spatial.transforms import apply, apply_vector, as_array, inv, make_pose, skew
+from kinestat.spatial.validate import frozen
 
 __all__ = [
     "DEFAULT_TOOL_POINT_6",
@@ -92,12 +93,6 @@ def _unit(v, name: str) -> np.ndarray:
     return a / n
 
 
-def _frozen(a) -> np.ndarray:
-    out = np.array(a, dtype=float)
-    out.setflags(write=False)
-    return out
-
-
 @dataclass(frozen=True, eq=False)
 class Workpiece:
     """A rigid planar workpiece: a plane through ``point`` with unit ``normal`` pointing out of
@@ -112,8 +107,8 @@ class Workpiece:
         p = as_array(self.point, shape_tail=(3,), name="workpiece point")
         if p.shape != (3,):
             raise InputError(f"workpiece point must be 3 numbers, got shape {p.shape}")
-        object.__setattr__(self, "point", _frozen(p))
-        object.__setattr__(self, "normal", _frozen(_unit(self.normal, "workpiece normal")))
+        object.__setattr__(self, "point", frozen(p, float))
+        object.__setattr__(self, "normal", frozen(_unit(self.normal, "workpiece normal"), float))
         mu = float(self.friction)
         if not (math.isfinite(mu) and mu >= 0.0):
             raise InputError(f"friction coefficient must be a finite number >= 0, got "
@@ -156,11 +151,11 @@ class Cell:
                 or np.any(M[3] != [0.0, 0.0, 0.0, 1.0])):
             raise ModelError("mount must be a rigid transform (orthonormal rotation, last row "
                              "0 0 0 1)")
-        object.__setattr__(self, "mount", _frozen(M))
+        object.__setattr__(self, "mount", frozen(M, float))
         tip = as_array(self.tool_tip, shape_tail=(3,), name="tool tip")
         if tip.shape != (3,):
             raise ModelError(f"tool tip must be 3 numbers, got shape {tip.shape}")
-        object.__setattr__(self, "tool_tip", _frozen(tip))
+        object.__setattr__(self, "tool_tip", frozen(tip, float))
         s = float(self.stroke)
         if not (math.isfinite(s) and s > 0):
             raise ModelError(f"leg stroke must be a positive number of mm, got {self.stroke!r}")

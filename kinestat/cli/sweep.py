@@ -1,0 +1,230 @@
+"""``kinestat sweep``: studies at scale on Dask — workspace, platform range, design, tolerance.
+
+Every study takes ``--output DIR`` (default ``./kinestat-runs/<study>-<spec hash>``, so the same
+command resumes an interrupted run), ``--scheduler tcp://HOST:PORT`` (default: an embedded local
+cluster, one worker process per core), ``--json``, and ``--samples N --seed S`` (random inputs) or
+``--grid N`` (N values per axis over its range, both ends, full tensor grid). Output: summary.json
+(only once complete), per-chunk partial summaries under chunks/, Parquet rows under rows/, PNG
+plots under plots/. See
+docs/sweeps.md.
+"""
+
+from __future__ import annotations
+
+import typer
+
+from kinestat.cli._output import console, parse_floats, print_json, table
+
+sweep_app = typer.Typer(
+    name="sweep",
+    help="Studies at scale on Dask: workspace, platform-range, platform-design, tolerance.",
+    no_args_is_help=True,
+)
+
+OUTPUT = typer.Option(None, "--output", help="Output directory (default "
+                      "./kinestat-runs/<study>-<spec hash>; an existing one resumes).")
+SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler address tcp://HOST:PORT "
+                         "(default: an embedded local cluster).")
+WORKERS = typer.Option(None, "--workers", help="Local cluster: worker count (default: cores).")
+THREADS = typer.Option(False, "--threads", help="Local cluster: thread workers, not processes.")
+TIMEOUT = typer.Option(10.0, "--timeout", help="Seconds to wait for the scheduler and a worker.")
+SEED = typer.Option(0, "--seed", help="Seed of the random inputs (--samples).")
+CHUNK = typer.Option(None, "--chunk-size", help="Evaluations per chunk (default per study).")
+MAX_CHUNKS = typer.Option(None, "--max-chunks", help="Stop after computing this many new chunks "
+                          "(a staged run; rerun the command to resume).")
+NO_ARRAYS = typer.Option(False, "--no-arrays", help="Write only summaries, no per-row Parquet.")
+NO_PLOTS = typer.Option(False, "--no-plots", help="Do not write PNG plots.")
+QUIET = typer.Option(False, "--quiet", help="No progress bar.")
+JSON = typer.Option(False, "--json", help='JSON: {"study", "summary", "output", "chunks", '
+                    '"elapsed_s", "complete", "plots"}.')
+PLATFORM = typer.Option(None, "--platform", help="TOML platform file (default: the embedded "
+                        "2011 prototype).")
+RANGE_MM = typer.Option("3.5,3.5,4", "--range-mm", help="Motion range +- x,y,z (length unit; "
+                        "Vibhute Table 3-1).")
+RANGE_DEG = typer.Option("4,4,6", "--range-deg", help="Motion range +- about x,y,z (degrees).")
+MAX_DEFL = typer.Option(5.0, "--max-deflection", help="Connector deflection limit (Table 3-1).")
+MAX_LOAD = typer.Option(50.0, "--max-load", help="Perpendicular load limit |F_z| (Table 3-1).")
+
+_BULKY = ("histograms", "slices", "stiffness_home")
+
+
+def register(app: typer.Typer) -> None:
+    app.add_typer(sweep_app, name="sweep")
+
+
+def _run(study_name: str, spec: dict, *, output, scheduler, workers, threads, timeout,
+         max_chunks, no_plots, quiet, as_json) -> None:
+    from kinestat.studies.base import build_study
+    from kinestat.studies.engine import run_study
+
+    study = build_study(study_name, spec)
+    res = run_study(study, output, scheduler=scheduler, workers=workers,
+                    processes=not threads, max_chunks=max_chunks, progress=not quiet,
+                    timeout_s=timeout, plots=not no_plots)
+    out = res.to_json()
+    if as_json:
+        if out["summary"] is not None:
+            out["summary"] = {k: v for k, v in out["summary"].items()
+                              if k not in ("histograms", "slices")}
+        print_json(out)
+        return
+    if not res.complete:
+        console.print(f"[yellow]incomplete[/]: {res.chunks_reused + res.chunks_computed} of "
+                      f"{res.chunks_total} chunks in {res.output}; run the command again to "
+                      "resume")
+        return
+    rows = []
+    for k, v in res.summary.items():
+        if k in _BULKY or v is None:
+            continue
+        if isinstance(v, dict):
+            for kk, vv in v.items():
+                if not isinstance(vv, (dict, list)):
+                    rows.append([f"{k}.{kk}", vv])
+        elif not isinstance(v, list):
+            rows.append([k, v])
+    console.print(table(f"{study_name}: {res.chunks_total} chunks "
+                        f"({res.chunks_computed} computed, {res.chunks_reused} reused) in "
+                        f"{res.elapsed_s:.1f} s", ["quantity", "value"], rows, fmt="{:.6g}"))
+    console.print(f"output: {res.output} (summary.json, rows/ Parquet, plots/)")
+
+
+def _samples_default(grid, samples, default):
+    return default if grid is None and samples is None else samples
+
+
+@sweep_app.command("workspace")
+def workspace_command(
+    model: str = typer.Option("puma762", "--model", help="Embedded model name or TOML file."),
+    grid: int = typer.Option(None, "--grid", help="N values per joint over its limits."),
+    samples: int = typer.Option(None, "--samples", help="Random configurations (default "
+                                "100000 if no --grid)."),
+    seed: int = SEED,
+    task: str = typer.Option("auto", "--task", help="Jacobian rows for manipulability/"
+                             "condition: auto, full, position, planar."),
+    chunk_size: int = CHUNK, output: str = OUTPUT, scheduler: str = SCHEDULER,
+    workers: int = WORKERS, threads: bool = THREADS, timeout: float = TIMEOUT,
+    max_chunks: int = MAX_CHUNKS, no_arrays: bool = NO_ARRAYS, no_plots: bool = NO_PLOTS,
+    quiet: bool = QUIET, as_json: bool = JSON,
+) -> None:
+    """Workspace and dexterity of an arm: reach, Yoshikawa manipulability, condition number.
+
+    Summary: points, reach_max, reach_min (distance of the end point from the base origin),
+    reach_bound, manipulability {min, mean, max}, condition {min, mean, max}, singular.
+    """
+    from kinestat.studies.workspace import DEFAULT_CHUNK, workspace_spec
+
+    spec = workspace_spec(model, grid=grid, samples=_samples_default(grid, samples, 100_000),
+                          seed=seed, chunk_size=chunk_size or DEFAULT_CHUNK, task=task,
+                          arrays=not no_arrays)
+    _run("workspace", spec, output=output, scheduler=scheduler, workers=workers,
+         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
+         quiet=quiet, as_json=as_json)
+
+
+@sweep_app.command("platform-range")
+def platform_range_command(
+    platform: str = PLATFORM,
+    grid: int = typer.Option(None, "--grid", help="N values per axis over the motion range."),
+    samples: int = typer.Option(None, "--samples", help="Random poses (default 20000 if no "
+                                "--grid)."),
+    seed: int = SEED, range_mm: str = RANGE_MM, range_deg: str = RANGE_DEG,
+    max_deflection: float = MAX_DEFL, max_load: float = MAX_LOAD,
+    chunk_size: int = CHUNK, output: str = OUTPUT, scheduler: str = SCHEDULER,
+    workers: int = WORKERS, threads: bool = THREADS, timeout: float = TIMEOUT,
+    max_chunks: int = MAX_CHUNKS, no_arrays: bool = NO_ARRAYS, no_plots: bool = NO_PLOTS,
+    quiet: bool = QUIET, as_json: bool = JSON,
+) -> None:
+    """The platform over its working range: leg deflections/forces, load, stiffness, singularity.
+
+    Summary: poses, within_deflection, within_load, within_both, fraction_within, statistics of
+    max_deflection, max_leg_force, force_z, singularity, k_eig_min/max, k_cond; stiffness_home
+    (K at home, as `kinestat platform stiffness`); axis_check (Table 3-1 axis by axis).
+    """
+    from kinestat.studies.platform_range import DEFAULT_CHUNK, platform_range_spec
+
+    spec = platform_range_spec(
+        platform, grid=grid, samples=_samples_default(grid, samples, 20_000), seed=seed,
+        range_mm=parse_floats(range_mm, 3, "range-mm"),
+        range_deg=parse_floats(range_deg, 3, "range-deg"), max_deflection=max_deflection,
+        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays)
+    _run("platform-range", spec, output=output, scheduler=scheduler, workers=workers,
+         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
+         quiet=quiet, as_json=as_json)
+
+
+@sweep_app.command("platform-design")
+def platform_design_command(
+    platform: str = PLATFORM,
+    base_side: str = typer.Option(None, "--base-side", help="Base triangle side(s): v, "
+                                  "v1,v2,..., lo:hi (with --grid) or lo:hi:n."),
+    top_side: str = typer.Option(None, "--top-side", help="Top triangle side(s)."),
+    base_offset: str = typer.Option(None, "--base-offset", help="Base edge offset(s)."),
+    top_offset: str = typer.Option(None, "--top-offset", help="Top edge offset(s)."),
+    height: str = typer.Option(None, "--height", help="Home height(s)."),
+    twist_deg: str = typer.Option(None, "--twist-deg", help="Home twist(s), degrees."),
+    stiffness: str = typer.Option(None, "--stiffness", help="Spring constant(s)."),
+    grid: int = typer.Option(None, "--grid", help="Values taken from each lo:hi range."),
+    samples: int = typer.Option(None, "--samples", help="Random designs within each "
+                                "parameter's smallest and largest value instead of the grid."),
+    seed: int = SEED,
+    poses: int = typer.Option(256, "--poses", help="Random poses in the range per design."),
+    range_mm: str = RANGE_MM, range_deg: str = RANGE_DEG,
+    max_deflection: float = MAX_DEFL, max_load: float = MAX_LOAD,
+    chunk_size: int = CHUNK, output: str = OUTPUT, scheduler: str = SCHEDULER,
+    workers: int = WORKERS, threads: bool = THREADS, timeout: float = TIMEOUT,
+    max_chunks: int = MAX_CHUNKS, no_arrays: bool = NO_ARRAYS, no_plots: bool = NO_PLOTS,
+    quiet: bool = QUIET, as_json: bool = JSON,
+) -> None:
+    """Special 6-6 designs scored on Vibhute Table 3-1 (unswept parameters: the --platform's).
+
+    Summary: designs, valid, meets_spec, fraction_within {min, mean, max}, min_singularity,
+    best (highest fraction of the motion range within spec), reference (the --platform's own
+    design, if in the grid).
+    """
+    from kinestat.studies.platform_design import DEFAULT_CHUNK, platform_design_spec
+
+    given = {"base_side": base_side, "top_side": top_side, "base_offset": base_offset,
+             "top_offset": top_offset, "height": height, "twist_deg": twist_deg,
+             "stiffness": stiffness}
+    spec = platform_design_spec(
+        platform, values={k: v for k, v in given.items() if v is not None}, grid=grid,
+        samples=samples, seed=seed, poses=poses, range_mm=parse_floats(range_mm, 3, "range-mm"),
+        range_deg=parse_floats(range_deg, 3, "range-deg"), max_deflection=max_deflection,
+        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays)
+    _run("platform-design", spec, output=output, scheduler=scheduler, workers=workers,
+         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
+         quiet=quiet, as_json=as_json)
+
+
+@sweep_app.command("tolerance")
+def tolerance_command(
+    platform: str = PLATFORM,
+    samples: int = typer.Option(10_000, "--samples", help="Monte-Carlo samples."),
+    seed: int = SEED,
+    sigma_mount: float = typer.Option(0.05, "--sigma-mount", help="Mounting error of every "
+                                      "attachment point, per coordinate (length unit, 1 sigma)."),
+    sigma_k: float = typer.Option(0.05, "--sigma-k", help="Relative spring constant error."),
+    sigma_offset: float = typer.Option(0.01, "--sigma-offset", help="Encoder zero error per "
+                                       "leg (length unit)."),
+    range_mm: str = RANGE_MM, range_deg: str = RANGE_DEG,
+    chunk_size: int = CHUNK, output: str = OUTPUT, scheduler: str = SCHEDULER,
+    workers: int = WORKERS, threads: bool = THREADS, timeout: float = TIMEOUT,
+    max_chunks: int = MAX_CHUNKS, no_arrays: bool = NO_ARRAYS, no_plots: bool = NO_PLOTS,
+    quiet: bool = QUIET, as_json: bool = JSON,
+) -> None:
+    """Monte-Carlo of mounting and calibration errors -> error of the measured wrench.
+
+    Summary: samples, failed, force_error and torque_error {mean, rms, max} (torque about the
+    top's centre at home), component_rms.
+    """
+    from kinestat.studies.tolerance import DEFAULT_CHUNK, tolerance_spec
+
+    spec = tolerance_spec(platform, samples=samples, seed=seed, sigma_mount=sigma_mount,
+                          sigma_k=sigma_k, sigma_offset=sigma_offset,
+                          range_mm=parse_floats(range_mm, 3, "range-mm"),
+                          range_deg=parse_floats(range_deg, 3, "range-deg"),
+                          chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays)
+    _run("tolerance", spec, output=output, scheduler=scheduler, workers=workers,
+         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
+         quiet=quiet, as_json=as_json)

@@ -1,0 +1,245 @@
+"""Design study of the special 6-6 platform, scored on Vibhute 2011 Table 3-1.
+
+Designs are the tensor product of the values given for each parameter of
+:func:`kinestat.parallel.special_6_6` — base and top triangle sides, base and top edge offsets,
+home height, home twist and spring constant — (``grid`` mode; a range ``lo:hi`` takes ``--grid``
+values) or random designs drawn uniformly between each parameter's smallest and largest value
+(``samples`` mode). Parameters not swept keep the base platform's values (default the 2011
+prototype), so the prototype is in the grid whenever each list includes its value.
+
+Each design is scored on the same ``poses`` random displacements over Table 3-1's motion range:
+
+* ``fraction_within`` — the fraction of them within the connector deflection and load limits
+  (the score; ties go to the lower design index);
+* ``meets_spec`` — each motion of Table 3-1 alone, to ± its full range, stays within the limits
+  (:func:`platform_common.axis_check`) and the range holds no singular pose;
+* ``min_singularity`` — the worst (smallest) singularity measure over the poses and home.
+
+Impossible or architecturally singular designs are counted as ``invalid`` with the reason.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+
+from kinestat.errors import InputError, KinestatError
+from kinestat.studies import grids
+from kinestat.studies import platform_common as pc
+from kinestat.studies import reduce as red
+from kinestat.studies.base import Study
+
+__all__ = ["PlatformDesignStudy", "platform_design_spec", "PARAMETERS"]
+
+#: swept parameters (CLI option names), each a single number (equal sides/offsets)
+PARAMETERS = ("base_side", "top_side", "base_offset", "top_offset", "height", "twist_deg",
+              "stiffness")
+DEFAULT_CHUNK = 16
+_BINS = 20
+
+
+def _defaults(platform) -> dict[str, float]:
+    d = platform.design
+    if d is None:
+        raise InputError(f"platform {platform.name!r} has no special 6-6 design parameters; "
+                         "a design study needs a design-form platform file")
+
+    def one(v, what):
+        if max(v) - min(v) > 1e-12 * max(1.0, abs(max(v))):
+            raise InputError(f"platform {platform.name!r}: the design study sweeps one value "
+                             f"per parameter, but its {what} are {list(v)}")
+        return float(v[0])
+
+    return {"base_side": one(d.base_side, "base sides"), "top_side": one(d.top_side, "top sides"),
+            "base_offset": one(d.base_offset, "base offsets"),
+            "top_offset": one(d.top_offset, "top offsets"), "height": d.height,
+            "twist_deg": round(math.degrees(d.twist), 12),
+            "stiffness": one(d.stiffness, "spring constants")}
+
+
+def platform_design_spec(platform: str | None = None, *, values: dict[str, str] | None = None,
+                         grid: int | None = None, samples: int | None = None, seed: int = 0,
+                         poses: int = 256, range_mm=pc.TABLE_3_1["range_mm"],
+                         range_deg=pc.TABLE_3_1["range_deg"],
+                         max_deflection: float = pc.TABLE_3_1["max_deflection"],
+                         max_load: float = pc.TABLE_3_1["max_load"],
+                         chunk_size: int = DEFAULT_CHUNK, arrays: bool = True) -> dict:
+    """Check the inputs and build the spec of a design study.
+
+    ``values`` maps parameter names (:data:`PARAMETERS`) to text: ``v``, ``v1,v2``, ``lo:hi``
+    (``grid`` values) or ``lo:hi:n``. ``samples`` draws random designs instead of the grid.
+    """
+    label, text = pc.platform_text(platform)
+    base = _defaults(pc.load_platform(label, text))
+    values = dict(values or {})
+    unknown = set(values) - set(PARAMETERS)
+    if unknown:
+        raise InputError(f"unknown design parameters {sorted(unknown)}; known: {PARAMETERS}")
+    lists = {k: (grids.parse_values(values[k], k.replace("_", "-"), grid if samples is None
+                                    else 2) if k in values else [base[k]])
+             for k in PARAMETERS}
+    if poses < 1:
+        raise InputError(f"--poses must be at least 1, got {poses}")
+    spec = {"study": "platform-design", "platform": label, "platform_text": text,
+            "values": lists, "reference": base, "poses": int(poses),
+            "range_mm": [float(x) for x in range_mm], "range_deg": [float(x) for x in range_deg],
+            "max_deflection": float(max_deflection), "max_load": float(max_load),
+            "chunk_size": int(chunk_size), "arrays": bool(arrays), "seed": int(seed)}
+    if samples is not None:
+        if samples < 1:
+            raise InputError(f"--samples must be at least 1, got {samples}")
+        spec.update(mode="samples", samples=int(samples))
+    else:
+        spec.update(mode="grid")
+    PlatformDesignStudy(spec)
+    return spec
+
+
+class PlatformDesignStudy(Study):
+    """Special 6-6 designs scored on Table 3-1."""
+
+    name = "platform-design"
+
+    def __init__(self, spec: dict) -> None:
+        super().__init__(spec)
+        self.box = pc.range_box(spec["range_mm"], spec["range_deg"])
+        self.lists = {k: np.asarray(spec["values"][k], float) for k in PARAMETERS}
+        sizes = [len(v) for v in self.lists.values()]
+        self.total = math.prod(sizes) if spec["mode"] == "grid" else spec["samples"]
+        if self.total > grids.MAX_POINTS:
+            raise InputError(f"{self.total:.3e} designs is too many")
+        self.chunk = int(spec["chunk_size"])
+        self._chunks = grids.chunk_count(self.total, self.chunk)
+        base = pc.load_platform(spec["platform"], spec["platform_text"])
+        self.names = (base.name, base.length_unit, base.force_unit)
+        rng = grids.chunk_rng(spec["seed"], 0, grids.STREAM_POSES)
+        self.displacements = rng.uniform(-self.box, self.box, size=(spec["poses"], 6))
+
+    @property
+    def n_chunks(self) -> int:
+        return self._chunks
+
+    @property
+    def n_items(self) -> int:
+        return self.total
+
+    def designs(self, i: int) -> np.ndarray:
+        """Design parameters ``(rows, 7)`` (order :data:`PARAMETERS`) of chunk ``i``."""
+        start, stop = grids.chunk_range(i, self.total, self.chunk)
+        vals = list(self.lists.values())
+        if self.spec["mode"] == "samples":
+            rng = grids.chunk_rng(self.spec["seed"], i)
+            lo = np.array([v.min() for v in vals])
+            hi = np.array([v.max() for v in vals])
+            return rng.uniform(lo, hi, size=(stop - start, len(vals)))
+        idx = np.arange(start, stop, dtype=np.int64)
+        out = np.empty((idx.size, len(vals)))
+        for j in range(len(vals) - 1, -1, -1):
+            out[:, j] = vals[j][idx % len(vals[j])]
+            idx //= len(vals[j])
+        return out
+
+    def score(self, params) -> dict:
+        """Build one design and score it (see the module docstring)."""
+        from kinestat.parallel import special_6_6
+
+        b, a, bo, to, h, tw, k = (float(x) for x in params)
+        name, lu, fu = self.names
+        try:
+            plat = special_6_6(base_side=b, top_side=a, base_offset=bo, top_offset=to,
+                               height=h, twist=math.radians(tw), stiffness=k, name=name,
+                               length_unit=lu, force_unit=fu)
+        except KinestatError as exc:
+            return {"valid": False, "reason": type(exc).__name__}
+        lim = (self.spec["max_deflection"], self.spec["max_load"])
+        r = pc.evaluate_poses(plat, pc.displaced_poses(plat, self.displacements), *lim)
+        ax = pc.axis_check(plat, self.box, *lim)
+        from kinestat.parallel import singularity_measure
+
+        sing = min(float(r["singularity"].min()), ax["min_singularity"],
+                   float(singularity_measure(plat, plat.home_pose)))
+        return {"valid": True, "fraction_within": float(r["ok"].mean()),
+                "meets_spec": bool(ax["meets"] and sing > pc.SINGULAR_TOL),
+                "min_singularity": sing,
+                "max_deflection": float(r["max_deflection"].max()),
+                "max_force_z": float(r["force_z"].max()),
+                "axis_max_deflection": ax["max_deflection"], "axis_max_force_z": ax["max_force_z"]}
+
+    def _is_reference(self, params) -> bool:
+        ref = np.array([self.spec["reference"][k] for k in PARAMETERS])
+        return bool(np.all(np.abs(np.asarray(params) - ref) <= 1e-9 * np.maximum(1, abs(ref))))
+
+    def compute_chunk(self, i: int):
+        P = self.designs(i)
+        start = i * self.chunk
+        scores = [self.score(p) for p in P]
+        valid = np.array([s["valid"] for s in scores])
+        nan = float("nan")
+
+        def col(key):
+            return np.array([s.get(key, nan) for s in scores], dtype=float)
+
+        frac, sing = col("fraction_within"), col("min_singularity")
+        meets = np.array([s.get("meets_spec", False) for s in scores])
+        best = None
+        for j, s in enumerate(scores):
+            if s["valid"] and (best is None or s["fraction_within"] > best["fraction_within"]):
+                best = {"index": start + j, "params": dict(zip(PARAMETERS, P[j].tolist(),
+                                                               strict=True)), **s}
+        ref = None
+        for j, p in enumerate(P):
+            if self._is_reference(p):
+                ref = {"index": start + j, "params": dict(zip(PARAMETERS, p.tolist(),
+                                                              strict=True)), **scores[j]}
+                break
+        reasons: dict[str, int] = {}
+        for s in scores:
+            if not s["valid"]:
+                reasons[s["reason"]] = reasons.get(s["reason"], 0) + 1
+        partial = {"designs": len(scores), "valid": int(valid.sum()),
+                   "meets_spec": int(meets.sum()), "invalid_reasons": reasons,
+                   "fraction_within": red.stats(frac), "min_singularity": red.stats(sing),
+                   "hist_fraction": red.histogram(frac, np.linspace(0, 1, _BINS + 1)),
+                   "best": best, "reference": ref}
+        rows = {}
+        if self.spec["arrays"]:
+            rows = {k: P[:, j] for j, k in enumerate(PARAMETERS)}
+            rows.update(index=np.arange(start, start + len(P)), valid=valid, meets_spec=meets,
+                        fraction_within=frac, min_singularity=sing,
+                        max_deflection=col("max_deflection"), max_force_z=col("max_force_z"))
+        return rows, partial
+
+    def reduce(self, partials: list[dict]) -> dict:
+        best = None
+        for p in partials:  # chunk order: the first of equal scores wins
+            b = p["best"]
+            if b is not None and (best is None or b["fraction_within"] > best["fraction_within"]):
+                best = b
+        ref = next((p["reference"] for p in partials if p["reference"] is not None), None)
+        reasons: dict[str, int] = {}
+        for p in partials:
+            for k, v in p["invalid_reasons"].items():
+                reasons[k] = reasons.get(k, 0) + v
+        frac = red.finish_stats(red.merge_stats([p["fraction_within"] for p in partials]))
+        sing = red.finish_stats(red.merge_stats([p["min_singularity"] for p in partials]))
+        return {"platform": self.names[0], "mode": self.spec["mode"],
+                "designs": sum(p["designs"] for p in partials),
+                "valid": sum(p["valid"] for p in partials),
+                "meets_spec": sum(p["meets_spec"] for p in partials),
+                "invalid_reasons": dict(sorted(reasons.items())),
+                "poses_per_design": self.spec["poses"],
+                "fraction_within": {k: frac[k] for k in ("min", "mean", "max")},
+                "min_singularity": {k: sing[k] for k in ("min", "mean", "max")},
+                "best": best, "reference": ref,
+                "histograms": {"fraction_within": red.merge_histograms(
+                    [p["hist_fraction"] for p in partials])}}
+
+    def plot(self, summary: dict, directory: Path) -> list[str]:
+        from kinestat.studies import plots
+
+        return [plots.histogram_png(summary["histograms"]["fraction_within"],
+                                    directory / "fraction_within.png",
+                                    "fraction of the motion range within spec",
+                                    f"{summary['designs']} designs ({summary['valid']} valid)")]

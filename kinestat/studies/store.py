@@ -1,0 +1,154 @@
+"""A study's output directory: manifest, per-chunk results written atomically, final summary.
+
+Layout::
+
+    DIR/manifest.json              study, spec, spec hash, chunk count, "complete" flag
+    DIR/rows/part-000042.parquet   the chunk's rows (DIR/rows is one Parquet dataset)
+    DIR/chunks/part-000042.json    the chunk's partial summary; its presence marks the chunk done
+    DIR/summary.json               written only when every chunk is done ("complete": true)
+    DIR/plots/*.png                plots of the complete study
+
+Every file is written to a temporary name in its directory and renamed into place, so a killed
+run leaves whole files or none. A rerun with the same spec skips chunks whose ``.json`` exists;
+a different spec in the same directory is refused. ``summary.json`` never exists for an
+incomplete study, so partial output cannot be taken for a result.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+
+from kinestat.errors import InputError
+
+__all__ = ["StudyStore", "write_atomic"]
+
+MANIFEST = "manifest.json"
+SUMMARY = "summary.json"
+FORMAT = "kinestat-study/1"
+
+
+def write_atomic(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file in the same directory + rename."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _json_bytes(obj) -> bytes:
+    return (json.dumps(obj, indent=1, allow_nan=False) + "\n").encode()
+
+
+class StudyStore:
+    """The output directory of one study (see the module docstring)."""
+
+    def __init__(self, root: Path, study: str, spec: dict, spec_hash: str, n_chunks: int):
+        self.root = Path(root)
+        self.study, self.spec, self.hash, self.n_chunks = study, spec, spec_hash, n_chunks
+        self.chunks = self.root / "chunks"
+        self.rows = self.root / "rows"
+
+    # -- opening ---------------------------------------------------------------------------
+    def check(self) -> set[int]:
+        """Check (reading only) that the directory is new, empty or holds this very study;
+        returns the chunks already done."""
+        self._check()
+        return self.done_chunks()
+
+    def open(self) -> None:
+        """Create the directory (with its manifest) unless it holds this study already."""
+        if not self._check():
+            self.root.mkdir(parents=True, exist_ok=True)
+            self._write_manifest(complete=False)
+
+    def _check(self) -> bool:
+        """True if the directory holds this study; False if it is new or empty."""
+        man = self.root / MANIFEST
+        if man.exists():
+            try:
+                old = json.loads(man.read_text())
+            except (OSError, ValueError) as exc:
+                raise InputError(f"--output {self.root}: unreadable {MANIFEST} ({exc}); "
+                                 "choose another directory") from None
+            if old.get("spec_hash") != self.hash or old.get("study") != self.study:
+                raise InputError(
+                    f"--output {self.root} holds a different study ({old.get('study')!r}, "
+                    f"spec {str(old.get('spec_hash'))[:12]}); its inputs differ from this run's "
+                    "— choose another --output or delete that directory")
+            return True
+        if self.root.exists() and not self.root.is_dir():
+            raise InputError(f"--output {self.root} is a file; give a directory")
+        if self.root.exists() and any(self.root.iterdir()):
+            raise InputError(f"--output {self.root} exists and is not a kinestat study "
+                             "directory (no manifest.json); choose an empty or new directory")
+        return False
+
+    def _write_manifest(self, complete: bool) -> None:
+        write_atomic(self.root / MANIFEST, _json_bytes({
+            "format": FORMAT, "study": self.study, "spec_hash": self.hash,
+            "chunks": self.n_chunks, "complete": complete, "spec": self.spec}))
+
+    # -- chunks ----------------------------------------------------------------------------
+    def _part(self, i: int, ext: str) -> Path:
+        return (self.rows if ext == "parquet" else self.chunks) / f"part-{i:06d}.{ext}"
+
+    def done_chunks(self) -> set[int]:
+        """Chunks whose partial summary is on disk (and belongs to this spec)."""
+        done = set()
+        if not self.chunks.is_dir():
+            return done
+        for p in self.chunks.glob("part-*.json"):
+            try:
+                i = int(p.stem.split("-")[1])
+            except (IndexError, ValueError):
+                continue
+            if 0 <= i < self.n_chunks:
+                done.add(i)
+        return done
+
+    def write_chunk(self, i: int, columns: dict[str, np.ndarray], partial: dict) -> None:
+        """Rows (Parquet) first, then the partial summary that marks chunk ``i`` done."""
+        if columns:
+            import pyarrow as pa  # lazy: only studies write Parquet
+            import pyarrow.parquet as pq
+
+            table = pa.table({k: np.ascontiguousarray(v) for k, v in columns.items()})
+            sink = pa.BufferOutputStream()
+            pq.write_table(table, sink, compression="zstd")
+            write_atomic(self._part(i, "parquet"), sink.getvalue().to_pybytes())
+        write_atomic(self._part(i, "json"), _json_bytes(
+            {"chunk": i, "spec_hash": self.hash, "partial": partial}))
+
+    def read_partials(self) -> list[dict]:
+        """Partial summaries of chunks 0..n-1, in order (all must be done)."""
+        out = []
+        for i in range(self.n_chunks):
+            doc = json.loads(self._part(i, "json").read_text())
+            if doc.get("spec_hash") != self.hash or doc.get("chunk") != i:
+                raise InputError(f"{self._part(i, 'json')} belongs to another study; delete "
+                                 f"{self.root} and run again")
+            out.append(doc["partial"])
+        return out
+
+    # -- completion ------------------------------------------------------------------------
+    def write_summary(self, document: dict) -> Path:
+        """Write ``summary.json`` and mark the manifest complete."""
+        path = self.root / SUMMARY
+        write_atomic(path, _json_bytes(document))
+        self._write_manifest(complete=True)
+        return path
+
+    def is_complete(self) -> bool:
+        return (self.root / SUMMARY).exists()
