@@ -54,8 +54,8 @@ def register(app: typer.Typer) -> None:
 
 def _run(study_name: str, spec: dict, *, output, scheduler, workers, threads, timeout,
          max_chunks, no_plots, quiet, as_json) -> None:
-    from kinestat.studies.base import build_study
-    from kinestat.studies.engine import run_study
+    from kinestat.studies.base import build_study  # lazy: start-up (the studies load Dask)
+    from kinestat.studies.engine import run_study  # lazy: start-up (the studies load Dask)
 
     study = build_study(study_name, spec)
     res = run_study(study, output, scheduler=scheduler, workers=workers,
@@ -112,7 +112,10 @@ def workspace_command(
     Summary: points, reach_max, reach_min (distance of the end point from the base origin),
     reach_bound, manipulability {min, mean, max}, condition {min, mean, max}, singular.
     """
-    from kinestat.studies.workspace import DEFAULT_CHUNK, workspace_spec
+    from kinestat.studies.workspace import (  # lazy: start-up (the studies load Dask)
+        DEFAULT_CHUNK,
+        workspace_spec,
+    )
 
     spec = workspace_spec(model, grid=grid, samples=_samples_default(grid, samples, 100_000),
                           seed=seed, chunk_size=chunk_size or DEFAULT_CHUNK, task=task,
@@ -141,7 +144,10 @@ def platform_range_command(
     max_deflection, max_leg_force, force_z, singularity, k_eig_min/max, k_cond; stiffness_home
     (K at home, as `kinestat platform stiffness`); axis_check (Table 3-1 axis by axis).
     """
-    from kinestat.studies.platform_range import DEFAULT_CHUNK, platform_range_spec
+    from kinestat.studies.platform_range import (  # lazy: start-up (the studies load Dask)
+        DEFAULT_CHUNK,
+        platform_range_spec,
+    )
 
     spec = platform_range_spec(
         platform, grid=grid, samples=_samples_default(grid, samples, 20_000), seed=seed,
@@ -182,7 +188,10 @@ def platform_design_command(
     best (highest fraction of the motion range within spec), reference (the --platform's own
     design, if in the grid).
     """
-    from kinestat.studies.platform_design import DEFAULT_CHUNK, platform_design_spec
+    from kinestat.studies.platform_design import (  # lazy: start-up (the studies load Dask)
+        DEFAULT_CHUNK,
+        platform_design_spec,
+    )
 
     given = {"base_side": base_side, "top_side": top_side, "base_offset": base_offset,
              "top_offset": top_offset, "height": height, "twist_deg": twist_deg,
@@ -218,7 +227,10 @@ def tolerance_command(
     Summary: samples, failed, force_error and torque_error {mean, rms, max} (torque about the
     top's centre at home), component_rms.
     """
-    from kinestat.studies.tolerance import DEFAULT_CHUNK, tolerance_spec
+    from kinestat.studies.tolerance import (  # lazy: start-up (the studies load Dask)
+        DEFAULT_CHUNK,
+        tolerance_spec,
+    )
 
     spec = tolerance_spec(platform, samples=samples, seed=seed, sigma_mount=sigma_mount,
                           sigma_k=sigma_k, sigma_offset=sigma_offset,

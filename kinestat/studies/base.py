@@ -11,6 +11,7 @@ summary. Nothing here knows about Dask; :mod:`kinestat.studies.engine` does the 
 from __future__ import annotations
 
 import hashlib
+import importlib
 import json
 from abc import ABC, abstractmethod
 from functools import lru_cache
@@ -76,7 +77,6 @@ class Study(ABC):
 
 
 def _load_class(name: str) -> type[Study]:
-    import importlib
 
     mod, cls = STUDIES[name].split(":")
     return getattr(importlib.import_module(mod), cls)

@@ -121,8 +121,8 @@ def open_client(scheduler: str | None, workers: int | None, processes: bool,
 
 
 def _progress(enabled: bool, total: int, done: int, label: str):
-    from rich.console import Console
-    from rich.progress import (
+    from rich.console import Console  # lazy: the progress bar only when a study runs
+    from rich.progress import (  # lazy: the progress bar only when a study runs
         BarColumn,
         MofNCompleteColumn,
         Progress,
@@ -140,7 +140,7 @@ def _progress(enabled: bool, total: int, done: int, label: str):
 
 def _compute(client, study: Study, store: StudyStore, todo: list[int], progress: bool,
              done: int) -> int:
-    from distributed import as_completed
+    from distributed import as_completed  # lazy: Dask only when a study runs
 
     text = spec_json(study.spec)
     key = f"{study.name}-{spec_hash(study.spec)[:12]}"

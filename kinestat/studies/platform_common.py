@@ -17,8 +17,13 @@ import math
 from importlib import resources
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError
+from kinestat.io.platform_toml import loads_platform
+from kinestat.io.textfile import read_text_file
+from kinestat.parallel import leg_lengths, singularity_measure, spring_wrench, stiffness
+from kinestat.parallel.legs import top_points_in_base
 
 __all__ = ["TABLE_3_1", "platform_text", "load_platform", "displaced_poses",
            "evaluate_poses", "axis_check", "range_box"]
@@ -36,14 +41,12 @@ def platform_text(path: str | None) -> tuple[str, str]:
     if path is None:
         res = resources.files("kinestat.data") / "platforms" / "prototype-2011.toml"
         return "prototype-2011", res.read_text(encoding="utf-8")
-    from kinestat.io.textfile import read_text_file
 
     return str(path), read_text_file(path, "platform file")
 
 
 def load_platform(label: str, text: str):
     """The platform described by TOML ``text`` (``label`` names it in errors)."""
-    from kinestat.io.platform_toml import loads_platform
 
     return loads_platform(text, source=label)
 
@@ -57,7 +60,6 @@ def range_box(range_mm, range_deg) -> np.ndarray:
 
 
 def _rotvec(r: np.ndarray) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
 
     return Rotation.from_rotvec(r.reshape(-1, 3)).as_matrix().reshape(r.shape[:-1] + (3, 3))
 
@@ -65,7 +67,6 @@ def _rotvec(r: np.ndarray) -> np.ndarray:
 def displaced_poses(platform, d: np.ndarray) -> np.ndarray:
     """Poses ``(..., 4, 4)`` displaced from home by ``d (..., 6)`` = (x, y, z, rx, ry, rz)
     at the top's centre (see the module docstring)."""
-    from kinestat.parallel.legs import top_points_in_base
 
     H = platform.home_pose
     c = top_points_in_base(platform, H).mean(axis=0)
@@ -87,7 +88,6 @@ def evaluate_poses(platform, T: np.ndarray, max_deflection: float, max_load: flo
     order; D = diag(1, 1, 1, 1/s, 1/s, 1/s), s = platform.scale, so every entry is force per
     length); ``ok`` within both limits and not singular.
     """
-    from kinestat.parallel import leg_lengths, singularity_measure, spring_wrench, stiffness
 
     defl = np.abs(leg_lengths(platform, T) - platform.free_lengths)
     w = spring_wrench(platform, T)

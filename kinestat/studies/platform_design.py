@@ -26,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from kinestat.errors import InputError, KinestatError
+from kinestat.parallel import singularity_measure, special_6_6
 from kinestat.studies import grids
 from kinestat.studies import platform_common as pc
 from kinestat.studies import reduce as red
@@ -143,7 +144,6 @@ class PlatformDesignStudy(Study):
 
     def score(self, params) -> dict:
         """Build one design and score it (see the module docstring)."""
-        from kinestat.parallel import special_6_6
 
         b, a, bo, to, h, tw, k = (float(x) for x in params)
         name, lu, fu = self.names
@@ -156,7 +156,6 @@ class PlatformDesignStudy(Study):
         lim = (self.spec["max_deflection"], self.spec["max_load"])
         r = pc.evaluate_poses(plat, pc.displaced_poses(plat, self.displacements), *lim)
         ax = pc.axis_check(plat, self.box, *lim)
-        from kinestat.parallel import singularity_measure
 
         sing = min(float(r["singularity"].min()), ax["min_singularity"],
                    float(singularity_measure(plat, plat.home_pose)))
@@ -237,7 +236,7 @@ class PlatformDesignStudy(Study):
                     [p["hist_fraction"] for p in partials])}}
 
     def plot(self, summary: dict, directory: Path) -> list[str]:
-        from kinestat.studies import plots
+        from kinestat.studies import plots  # lazy: matplotlib only when plotting
 
         return [plots.histogram_png(summary["histograms"]["fraction_within"],
                                     directory / "fraction_within.png",

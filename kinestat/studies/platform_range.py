@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from kinestat.errors import InputError
+from kinestat.parallel import stiffness
 from kinestat.studies import grids
 from kinestat.studies import platform_common as pc
 from kinestat.studies import reduce as red
@@ -113,7 +114,6 @@ class PlatformRangeStudy(Study):
 
     def home(self) -> dict:
         """K at home (ray order, model units) and its normalised eigenvalues."""
-        from kinestat.parallel import stiffness
 
         p = self.platform
         r = pc.evaluate_poses(p, p.home_pose, self.spec["max_deflection"], self.spec["max_load"])
@@ -144,7 +144,7 @@ class PlatformRangeStudy(Study):
         return out
 
     def plot(self, summary: dict, directory: Path) -> list[str]:
-        from kinestat.studies import plots
+        from kinestat.studies import plots  # lazy: matplotlib only when plotting
 
         u, f = summary["length_unit"], summary["force_unit"]
         h = summary["histograms"]

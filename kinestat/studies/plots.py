@@ -13,7 +13,7 @@ def _plt():
     import matplotlib  # lazy: plotting is optional and slow to import
 
     matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    import matplotlib.pyplot as plt  # lazy: matplotlib only when plotting
 
     return plt
 
@@ -43,7 +43,7 @@ def slice_png(counts, edges_x, edges_y, path: Path, xlabel: str, ylabel: str,
               title: str) -> str:
     """A 2-D occupancy image (counts per cell, log colour scale)."""
     plt = _plt()
-    from matplotlib.colors import LogNorm
+    from matplotlib.colors import LogNorm  # lazy: matplotlib only when plotting
 
     c = np.asarray(counts, dtype=float)
     fig, ax = plt.subplots(figsize=(5.5, 5))

@@ -122,7 +122,7 @@ class StudyStore:
         """Rows (Parquet) first, then the partial summary that marks chunk ``i`` done."""
         if columns:
             import pyarrow as pa  # lazy: only studies write Parquet
-            import pyarrow.parquet as pq
+            import pyarrow.parquet as pq  # lazy: pyarrow only when rows are written
 
             table = pa.table({k: np.ascontiguousarray(v) for k, v in columns.items()})
             sink = pa.BufferOutputStream()

@@ -19,6 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from kinestat.errors import InputError, KinestatError
+from kinestat.parallel import Platform, leg_lengths, spring_wrench, wrench_from_leg_lengths
+from kinestat.parallel.legs import top_points_in_base
 from kinestat.studies import grids
 from kinestat.studies import platform_common as pc
 from kinestat.studies import reduce as red
@@ -69,7 +71,6 @@ class ToleranceStudy(Study):
         self.total = spec["samples"]
         self.chunk = int(spec["chunk_size"])
         self._chunks = grids.chunk_count(self.total, self.chunk)
-        from kinestat.parallel.legs import top_points_in_base
 
         p = self.platform
         self.centre = top_points_in_base(p, p.home_pose).mean(axis=0)
@@ -98,7 +99,6 @@ class ToleranceStudy(Study):
 
     def errors(self, r: dict[str, np.ndarray]) -> tuple[np.ndarray, np.ndarray]:
         """Wrench errors ``(m, 6)`` [Δf; Δm_c] and a failure mask ``(m,)`` for draws ``r``."""
-        from kinestat.parallel import Platform, leg_lengths, spring_wrench, wrench_from_leg_lengths
 
         p = self.platform
         T = pc.displaced_poses(p, r["d"])
@@ -166,7 +166,7 @@ class ToleranceStudy(Study):
         return out
 
     def plot(self, summary: dict, directory: Path) -> list[str]:
-        from kinestat.studies import plots
+        from kinestat.studies import plots  # lazy: matplotlib only when plotting
 
         u, f = summary["length_unit"], summary["force_unit"]
         h = summary["histograms"]

@@ -25,7 +25,9 @@ from pathlib import Path
 
 import numpy as np
 
+import kinestat
 from kinestat.errors import InputError
+from kinestat.io.model_toml import loads_model
 from kinestat.studies import grids
 from kinestat.studies import reduce as red
 from kinestat.studies.base import Study
@@ -41,10 +43,8 @@ _BINS = 64
 
 def _load_model(spec: dict):
     if spec.get("model_text") is None:
-        import kinestat
 
         return kinestat.load(spec["model"])
-    from kinestat.io.model_toml import loads_model
 
     return loads_model(spec["model_text"], source=spec["model"])
 
@@ -58,7 +58,6 @@ def workspace_spec(model: str, *, grid: int | None = None, samples: int | None =
     one of ``grid`` (values per joint, both limits included) and ``samples`` (uniform within the
     limits, seeded) is given.
     """
-    import kinestat
 
     m = kinestat.load(model)  # unknown names and bad files fail here, before any output
     text = None
@@ -161,7 +160,6 @@ class WorkspaceStudy(Study):
 
     def evaluate(self, q: np.ndarray) -> dict[str, np.ndarray]:
         """End points, reach, manipulability and condition number at configurations ``q``."""
-        import kinestat
 
         T = kinestat.fk(self.model, q)
         J = kinestat.jacobian(self.model, q)
@@ -216,7 +214,7 @@ class WorkspaceStudy(Study):
         }
 
     def plot(self, summary: dict, directory: Path) -> list[str]:
-        from kinestat.studies import plots
+        from kinestat.studies import plots  # lazy: matplotlib only when plotting
 
         u = summary["length_unit"]
         h = summary["histograms"]

@@ -11,7 +11,8 @@ from scipy.spatial.transform import Rotation
 
 from kinestat.cli.main import main
 from kinestat.errors import InputError
-from kinestat.parallel import leg_lengths, prototype, special_6_6, spring_wrench
+from kinestat.io.library import prototype
+from kinestat.parallel import leg_lengths, special_6_6, spring_wrench
 from kinestat.studies.base import build_study
 from kinestat.studies.engine import run_reference
 from kinestat.studies.platform_design import platform_design_spec
