@@ -79,6 +79,66 @@ def _floats(text: str | None, n: int, where: str, source: str) -> np.ndarray:
     return v
 
 
+def _limit(text: str | None, default: float, where: str, source: str) -> float:
+    """A joint limit attribute (absent: ``default``); not a number is a ParseError."""
+    if text is None:
+        return default
+    try:
+        v = float(text)
+    except ValueError:
+        raise ParseError(f"cannot read a number from {text[:40]!r}", file=source,
+                         field=where) from None
+    if math.isnan(v):
+        raise ParseError("a limit cannot be NaN", file=source, field=where)
+    return v
+
+
+def _path_to_tip(root: ET.Element, tip: str | None, source: str) -> list[ET.Element]:
+    """The joints from the root link to ``tip`` (default: the only leaf), root first.
+
+    Linear in the number of joints. A link that is the child of two joints, or a cycle of
+    joints, is a ParseError naming the joint.
+    """
+    joint_to: dict[str, ET.Element] = {}  # child link -> the joint leading to it
+    parents_of: dict[str, str | None] = {}  # child link -> its parent link
+    for j in root.findall("joint"):
+        parent, child = j.find("parent"), j.find("child")
+        if parent is None or child is None:
+            raise ParseError(f"joint {j.get('name')!r} lacks a parent or child", file=source)
+        c = child.get("link")
+        if c in joint_to:
+            raise ParseError(f"joint {j.get('name')!r}: link {c!r} is already the child of "
+                             f"joint {joint_to[c].get('name')!r} (a serial chain is a tree)",
+                             file=source)
+        joint_to[c] = j
+        parents_of[c] = parent.get("link")
+    links = [lk.get("name") for lk in root.findall("link")]
+    roots = [lk for lk in links if lk not in joint_to]
+    if len(roots) != 1:
+        raise ParseError(f"expected one root link, found {roots[:10]}", file=source)
+    has_child = set(parents_of.values())
+    leaves = [lk for lk in links if lk not in has_child]
+    if tip is None:
+        if len(leaves) != 1:
+            raise ParseError(f"several leaf links {leaves[:10]}: choose one with tip=",
+                             file=source)
+        tip = leaves[0]
+    if tip not in set(links):
+        raise ParseError(f"no link named {tip!r}", file=source)
+    path: list[ET.Element] = []
+    seen: set[str] = set()
+    link = tip
+    while link in joint_to:
+        if link in seen:
+            raise ParseError(f"joint {joint_to[link].get('name')!r} closes a cycle of joints "
+                             f"through link {link!r}; a serial chain has none", file=source)
+        seen.add(link)
+        path.append(joint_to[link])
+        link = parents_of[link]
+    path.reverse()
+    return path
+
+
 def _pose(xyz: np.ndarray, rpy: np.ndarray) -> np.ndarray:
     T = np.eye(4)
     T[:3, :3] = Rotation.from_euler("xyz", rpy).as_matrix()
@@ -119,32 +179,7 @@ def from_urdf(
         raise ParseError(f"not valid XML: {exc}", file=source) from exc
     if root.tag != "robot":
         raise ParseError("the root element must be <robot>", file=source)
-    joints = {}
-    children = set()
-    for j in root.findall("joint"):
-        parent, child = j.find("parent"), j.find("child")
-        if parent is None or child is None:
-            raise ParseError(f"joint {j.get('name')!r} lacks a parent or child", file=source)
-        joints[child.get("link")] = j
-        children.add(child.get("link"))
-    links = [lk.get("name") for lk in root.findall("link")]
-    roots = [lk for lk in links if lk not in children]
-    if len(roots) != 1:
-        raise ParseError(f"expected one root link, found {roots}", file=source)
-    parents_of = {c: j.find("parent").get("link") for c, j in joints.items()}
-    leaves = [lk for lk in links if lk not in set(parents_of.values())]
-    if tip is None:
-        if len(leaves) != 1:
-            raise ParseError(f"several leaf links {leaves}: choose one with tip=", file=source)
-        tip = leaves[0]
-    if tip not in links:
-        raise ParseError(f"no link named {tip!r}", file=source)
-    path = []
-    link = tip
-    while link in joints:
-        path.append(joints[link])
-        link = parents_of[link]
-    path.reverse()
+    path = _path_to_tip(root, tip, source)
     consts = [np.eye(4)]
     kinds: list[Joint] = []
     for j in path:
@@ -172,8 +207,8 @@ def from_urdf(
         lo, hi = -math.inf, math.inf
         if lim is not None and jtype != "continuous":
             s = scale if jtype == "prismatic" else 1.0
-            lo = float(lim.get("lower", "-inf")) * s
-            hi = float(lim.get("upper", "inf")) * s
+            lo = _limit(lim.get("lower"), -math.inf, where + " limit lower", source) * s
+            hi = _limit(lim.get("upper"), math.inf, where + " limit upper", source) * s
         kinds.append(Joint(kind="prismatic" if jtype == "prismatic" else "revolute",
                            lower=lo, upper=hi, name=str(j.get("name"))))
     if not kinds:
