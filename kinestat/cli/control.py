@@ -16,7 +16,7 @@ import numpy as np
 import typer
 
 from kinestat.cli._output import console as out_console
-from kinestat.cli._output import err_console, parse_floats, print_json, table
+from kinestat.cli._output import err_console, literal, parse_floats, print_json, table
 from kinestat.errors import InputError, KinestatError
 
 DEFAULT_START = "-400,800,-100"
@@ -215,7 +215,8 @@ def control_command(
 
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), method {method}, "
-                      + ("simulated cell" if simulated else f"Galil {galil}, sensor {serial}"))
+                      + ("simulated cell" if simulated
+                         else literal(f"Galil {galil}, sensor {serial}")))
     with CycleLog(log_path) as cycle_log:
         if simulated:
             sc = start_counts(config)
@@ -233,7 +234,7 @@ def control_command(
 
             plots = [str(p) for p in write_plots(read_log(log_path), plot_dir)]
         except InputError as exc:
-            err_console.print(f"[yellow]no plot:[/] {exc}")
+            err_console.print(f"[yellow]no plot:[/] {literal(exc)}")
     out["plots"] = plots
     if as_json:
         print_json(out)
@@ -263,7 +264,7 @@ def _print_report(out: dict) -> None:
     out_console.print(f"Kinestatic control {ok} after {out['iterations']} cycles "
                       f"({out['moves']} moves, {out['elapsed_s']:.1f} s); states "
                       f"{out['states']}")
-    out_console.print(f"  {out['stop_reason']}")
+    out_console.print(f"  {literal(out['stop_reason'])}")
     rows = []
     for key, label in (("force", "force (N)"), ("torque", "torque about tool point (N·mm)"),
                        ("true_force", "true force (N)"), ("tool_axis", "tool axis S6"),
@@ -282,6 +283,6 @@ def _print_report(out: dict) -> None:
     if out.get("final_axis_deg") is not None:
         out_console.print("robot axes (deg): " + ", ".join(f"{v:.4f}"
                                                            for v in out["final_axis_deg"]))
-    out_console.print(f"log: {out['log']}")
+    out_console.print(f"log: {literal(out['log'])}")
     for p in out.get("plots", []):
-        out_console.print(f"plot: {p}")
+        out_console.print(f"plot: {literal(p)}")

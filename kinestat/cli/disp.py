@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, err_console, print_json, table, to_jsonable
+from kinestat.cli._output import console, err_console, literal, print_json, table, to_jsonable
 from kinestat.errors import InputError
 
 __all__ = ["register", "print_result", "guidance_options", "progress_reporter", "load_deck"]
@@ -182,7 +182,7 @@ def disp(
             rec["plots"] = [str(p) for p in written]
         print_json(to_jsonable(rec))
     else:
-        console.print(f"[bold]DISP MS = {d.ms}[/bold]: {d.analysis} ({d.source})")
+        console.print(f"[bold]DISP MS = {d.ms}[/bold]: {d.analysis} ({literal(d.source)})")
         if run.screws is not None:
             _print_screws(run.screws)
         if run.joints is not None:
@@ -191,9 +191,9 @@ def disp(
             print_result(run.result, run.notes)
         else:
             for n in run.notes:
-                console.print(f"note: {n}")
+                console.print(f"note: {literal(n)}")
         for p in written:
-            console.print(f"wrote {p}")
+            console.print(f"wrote {literal(p)}")
     if run.result is not None:
         run.result.raise_if_stopped()
 

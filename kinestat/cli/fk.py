@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, parse_floats, print_json, table
+from kinestat.cli._output import console, literal, parse_floats, print_json, table
 from kinestat.errors import InputError
 
 
@@ -68,16 +68,16 @@ def fk_command(
     if as_json:
         print_json(out)
         return
-    console.print(f"[bold]{m.name}[/] ({m.n} joints, lengths in {m.length_unit})")
+    console.print(f"[bold]{literal(m.name)}[/] ({m.n} joints, lengths in {literal(m.length_unit)})")
     console.print(table("End pose", ["", "x", "y", "z", "t"],
                         [[r] + list(T[i]) for i, r in enumerate(["1", "2", "3", "4"])]))
     console.print(table("Tool", ["", "x", "y", "z"], [
         ["tool point", *out["tool_point"]], ["s6 (z)", *out["s6"]], ["a67 (x)", *out["a67"]],
     ]))
     console.print(f"Euler {euler} (deg): " + ", ".join(f"{a:.4f}" for a in ang)
-                  + ("  [gimbal lock]" if lock else ""))
+                  + ("  \\[gimbal lock]" if lock else ""))
     if "warning" in out:
-        console.print(f"[yellow]warning:[/] {out['warning']}")
+        console.print(f"[yellow]warning:[/] {literal(out['warning'])}")
     if frames:
         console.print(table("Link frame origins", ["frame", "x", "y", "z"],
                             [[i, *F[i, :3, 3]] for i in range(len(F))]))

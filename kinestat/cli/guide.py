@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, parse_floats, print_json, table, to_jsonable
+from kinestat.cli._output import console, literal, parse_floats, print_json, table, to_jsonable
 from kinestat.cli.disp import guidance_options, print_result, progress_reporter
 from kinestat.errors import InputError, ParseError
 
@@ -263,7 +263,7 @@ def guide(
                                 [[str(i + 1), f"{peak[i]:.4g} {units[i]}"]
                                  for i in range(m.n)]))
         for p in written:
-            console.print(f"wrote {p}")
+            console.print(f"wrote {literal(p)}")
     result.raise_if_stopped()
 
 

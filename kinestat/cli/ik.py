@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
+from kinestat.cli._output import console, literal, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, KinestatError
 
 
@@ -202,10 +202,10 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
         console.print(
             f"family (branch {f['branch']}): φ1={f['phi1_deg']:.4f} θ2={f['theta2_deg']:.4f} "
             f"θ3={f['theta3_deg']:.4f} θ5={f['theta5_deg']:.4f}, {f['relation']} with value "
-            f"{f['value_deg']:.4f}°" + ("" if f["within_limits"] else "  [outside limits]")
+            f"{f['value_deg']:.4f}°" + ("" if f["within_limits"] else "  \\[outside limits]")
         )
     if res.reason:
-        console.print(f"[yellow]note:[/] {res.reason}")
+        console.print(f"[yellow]note:[/] {literal(res.reason)}")
     if current is not None:
         sel = out["selected"]
         if sel is None:
