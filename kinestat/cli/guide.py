@@ -12,6 +12,7 @@ import typer
 from kinestat.cli._output import console, literal, parse_floats, print_json, table, to_jsonable
 from kinestat.cli.disp import guidance_options, print_result, progress_reporter
 from kinestat.errors import InputError, ParseError
+from kinestat.io.textfile import read_text_file
 
 __all__ = ["register", "parse_command", "parse_move", "read_commands"]
 
@@ -77,7 +78,7 @@ def read_commands(path: Path) -> list[dict]:
     """Commands from a file: one per line, either ``frame=…,dir=…,d=…,angle=…`` or the six
     numbers of a DISP SET THREE card ``NTY DCx DCy DCz DD THA``; ``#`` starts a comment."""
     try:
-        text = path.read_text()
+        text = read_text_file(path, "commands file")  # binary: a ParseError, not a crash
     except OSError as exc:
         raise InputError(f"cannot read commands file {str(path)!r}: {exc.strerror}") from exc
     out = []
