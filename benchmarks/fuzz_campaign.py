@@ -60,14 +60,14 @@ def run_reader(name: str, n_inputs: int, budget_s: float, seed: int, timeout_s: 
     import warnings
 
     from kinestat.errors import KinestatError
-    from tests.fuzz.corpus import READERS, mutate, seeds
+    from tests.fuzz.corpus import CLI_READER, READERS, mutate, seeds
 
     if mem_bytes:
         resource.setrlimit(resource.RLIMIT_AS, (mem_bytes, mem_bytes))
     warnings.simplefilter("ignore")  # numeric warnings are not failures here
     sys.setrecursionlimit(max(sys.getrecursionlimit(), 1000))
     signal.signal(signal.SIGALRM, _on_alarm)
-    reader = READERS[name]
+    reader = CLI_READER if name == "cli" else READERS[name]
     rng = random.Random(f"{seed}:{name}")
     work = Path(tempfile.mkdtemp(prefix=f"kinestat-fuzz-{name}-"))
     pool = seeds(name)
@@ -128,13 +128,14 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--budget", type=float, default=600.0, help="seconds per reader")
     ap.add_argument("--timeout", type=float, default=5.0, help="seconds per input (a hang)")
     ap.add_argument("--seed", type=int, default=1)
-    ap.add_argument("--readers", default=",".join(READERS), help="comma-separated")
+    ap.add_argument("--readers", default=",".join(READERS),
+                    help="comma-separated; 'cli' fuzzes command lines (in-process)")
     ap.add_argument("--save-dir", default=None, help="keep one input per distinct failure")
     ap.add_argument("--memory-mb", type=int, default=2048, help="address-space cap per worker")
     ap.add_argument("--json", action="store_true", help="print the figures as JSON")
     args = ap.parse_args(argv)
     names = [n for n in args.readers.split(",") if n]
-    unknown = set(names) - set(READERS)
+    unknown = set(names) - set(READERS) - {"cli"}
     if unknown:
         ap.error(f"unknown readers {sorted(unknown)}; known: {', '.join(READERS)}")
     results = []

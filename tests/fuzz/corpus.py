@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import tomli_w
 
-__all__ = ["READERS", "Reader", "mutate", "seeds", "NASTY_VALUES", "to_bytes"]
+__all__ = ["CLI_READER", "READERS", "Reader", "mutate", "seeds", "NASTY_VALUES", "to_bytes"]
 
 #: Values the campaign substitutes for numbers and strings.
 NASTY_VALUES: tuple[str, ...] = (
@@ -207,6 +207,21 @@ def _deck_seeds() -> list[str]:
                   if p.name.endswith(".dat"))
 
 
+#: Fast, side-effect-free command lines (no files written, no simulator started); an input is
+#: a command line split on blanks.
+_CLI_SEEDS: tuple[str, ...] = (
+    "fk puma762 --q-deg 10,20,30,40,50,60",
+    "fk puma560 --q 0.1,0.2,0.3,0.4,0.5,0.6 --json",
+    "ik puma762 --pose 1,0,0,700,0,1,0,200,0,0,1,600,0,0,0,1 --json",
+    "screw --pose1 1,0,0,0,0,1,0,0,0,0,1,0,0,0,0,1 --pose2 0,-1,0,1,1,0,0,2,0,0,1,3,0,0,0,1",
+    "platform info",
+    "platform ik --pose 1,0,0,30,0,1,0,51.96,0,0,1,60,0,0,0,1 --json",
+    "platform statics --pose 1,0,0,30,0,1,0,51.96,0,0,1,60,0,0,0,1 --wrench 0,0,-10,0,0,0",
+    "control --forse 4",
+    "disp illustration1 --json",
+)
+
+
 @cache
 def seeds(reader: str) -> tuple[str, ...]:
     """The valid seed inputs of ``reader`` (a key of :data:`READERS`)."""
@@ -233,6 +248,8 @@ def seeds(reader: str) -> tuple[str, ...]:
         return tuple(_deck_seeds())
     if reader == "text":
         return (*_model_seeds()[:1], _deck_seeds()[0], "plain text\n")
+    if reader == "cli":
+        return _CLI_SEEDS
     raise KeyError(reader)
 
 
@@ -293,6 +310,23 @@ def _text(text: str, workdir: Path):
     return read_text_file(_write(workdir, "any.txt", text), "text file")
 
 
+def _cli(text: str, workdir: Path):
+    """Run one command line in-process; a traceback (an exception out of ``main``) or an error
+    that is not exactly one ``kinestat: error:`` line fails."""
+    import contextlib
+    import io
+
+    from kinestat.cli.main import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        code = main([a for a in text.split(" ") if a])
+    lines = err.getvalue().splitlines()
+    if code == 2 and lines and lines[0].startswith("kinestat: error:") and len(lines) != 1:
+        raise AssertionError(f"a {len(lines)}-line error: {err.getvalue()[:200]!r}")
+    return code
+
+
 @dataclass(frozen=True)
 class Reader:
     """One reader under test: ``call(text, workdir)`` feeds it one input."""
@@ -313,3 +347,6 @@ READERS: dict[str, Reader] = {r.name: r for r in (
     Reader("disp_deck", _deck),
     Reader("text", _text),
 )}
+
+#: The command line, fuzzed by the campaign only (``--readers cli``): slower than the readers.
+CLI_READER = Reader("cli", _cli)
