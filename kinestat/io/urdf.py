@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from kinestat.errors import ModelError, ParseError
+from kinestat.errors import InputError, ModelError, ParseError
 from kinestat.io.textfile import read_text_file
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import Joint
@@ -187,7 +187,12 @@ def from_urdf(
         o = j.find("origin")
         xyz = _floats(o.get("xyz") if o is not None else None, 3, where + " origin xyz", source)
         rpy = _floats(o.get("rpy") if o is not None else None, 3, where + " origin rpy", source)
-        Tj = _pose(xyz * scale, rpy)
+        with np.errstate(over="ignore", invalid="ignore"):
+            xyz = xyz * scale
+        if not np.all(np.isfinite(xyz)):
+            raise ParseError(f"origin xyz times scale {scale:g} is not finite", file=source,
+                             field=where + " origin xyz")
+        Tj = _pose(xyz, rpy)
         jtype = j.get("type")
         if jtype == "fixed":
             consts[-1] = consts[-1] @ Tj
@@ -209,12 +214,18 @@ def from_urdf(
             s = scale if jtype == "prismatic" else 1.0
             lo = _limit(lim.get("lower"), -math.inf, where + " limit lower", source) * s
             hi = _limit(lim.get("upper"), math.inf, where + " limit upper", source) * s
-        kinds.append(Joint(kind="prismatic" if jtype == "prismatic" else "revolute",
-                           lower=lo, upper=hi, name=str(j.get("name"))))
+        try:
+            kinds.append(Joint(kind="prismatic" if jtype == "prismatic" else "revolute",
+                               lower=lo, upper=hi, name=str(j.get("name"))))
+        except InputError as exc:  # limits that are not an interval
+            raise ParseError(str(exc), file=source, field=where + " limit") from exc
     if not kinds:
         raise ModelError(f"{source}: no moving joint between the root and {tip!r}")
-    return ChainModel(name=name or str(root.get("name", "urdf")), joints=tuple(kinds),
-                      constants=np.array(consts), length_unit=length_unit)
+    try:
+        return ChainModel(name=name or str(root.get("name", "urdf")), joints=tuple(kinds),
+                          constants=np.array(consts), length_unit=length_unit)
+    except InputError as exc:  # e.g. limits that are not an interval
+        raise ParseError(str(exc), file=source) from exc
 
 
 def read_urdf(path: str | os.PathLike, **kwargs) -> ChainModel:

@@ -235,3 +235,15 @@ def test_urdf_chain_of_16000_joints(tmp_path, no_hang):
     assert model.n == n
     # every joint sits 0.1 above the previous one along z: the origins add up
     assert np.isclose(np.asarray(model.constants)[:, 2, 3].sum(), 0.1 * n)
+
+
+def test_urdf_origin_overflowing_with_the_scale_and_reversed_limits():
+    far = _chain_urdf(1).replace('xyz="0 0 0.1"', 'xyz="1e300 0 0"')
+    with pytest.raises(ParseError, match="not finite") as ei:
+        from_urdf(far, scale=1e10, source="arm.urdf")
+    assert ei.value.field == "joint 'j1' origin xyz"
+    reversed_ = _chain_urdf(1).replace('<axis xyz="0 0 1"/>',
+                                       '<axis xyz="0 0 1"/><limit lower="2" upper="1"/>')
+    with pytest.raises(ParseError, match="not an interval") as ei:
+        from_urdf(reversed_, source="arm.urdf")
+    assert ei.value.file == "arm.urdf" and ei.value.field == "joint 'j1' limit"
