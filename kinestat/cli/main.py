@@ -87,8 +87,10 @@ def main(argv: list[str] | None = None) -> int:
     except SystemExit as exc:
         code = exc.code
         return code if isinstance(code, int) else (0 if code is None else 1)
-    except NoArgsIsHelpError as exc:  # bare ``kinestat``: the help, status 2
-        exc.show()
+    except NoArgsIsHelpError as exc:  # bare ``kinestat``: the help on stdout, status 2
+        text = exc.format_message()  # empty when rich has already printed the help
+        if text.strip():
+            typer.echo(text)
         return 2
     except UsageError as exc:
         typer.echo(_usage_error(exc), err=True)
@@ -109,7 +111,8 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         typer.echo("kinestat: interrupted", err=True)
         return 130
-    # a command's own return value is not an exit status; ``typer.Exit(n)`` arrives as ``n``
+    # without standalone mode ``typer.Exit(n)`` arrives as the return value ``n`` (commands
+    # return None, which is status 0)
     return code if isinstance(code, int) and not isinstance(code, bool) else 0
 
 

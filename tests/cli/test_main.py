@@ -131,3 +131,9 @@ def test_binary_commands_file_is_one_line_exit_2(tmp_path, capsys):
     assert main(["guide", "puma762", "--commands", str(cmds)]) == 2
     err = capsys.readouterr().err
     assert err.startswith(f"kinestat: error: {cmds}: not a text file") and err.count("\n") == 1
+
+
+def test_bare_command_prints_help_not_an_error(capsys):
+    assert main([]) == 2  # as before: Click's no-arguments-is-help status
+    out, err = capsys.readouterr()
+    assert "Usage:" in out and "--version" in out and err == ""
