@@ -140,23 +140,36 @@ def _path_to_tip(root: ET.Element, tip: str | None, source: str) -> list[ET.Elem
 
 
 def _pose(xyz: np.ndarray, rpy: np.ndarray) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, :3] = Rotation.from_euler("xyz", rpy).as_matrix()
-    T[:3, 3] = xyz
-    return T
+    """The URDF origin ``xyz``/``rpy`` as a 4x4 pose: R = Rz(yaw) Ry(pitch) Rx(roll).
+
+    Written out (not scipy's Rotation): it runs once per joint, and a chain may have thousands.
+    """
+    cr, sr = math.cos(rpy[0]), math.sin(rpy[0])
+    cp, sp = math.cos(rpy[1]), math.sin(rpy[1])
+    cy, sy = math.cos(rpy[2]), math.sin(rpy[2])
+    return np.array([
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr, xyz[0]],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr, xyz[1]],
+        [-sp, cp * sr, cp * cr, xyz[2]],
+        [0.0, 0.0, 0.0, 1.0],
+    ])
 
 
 def _align_z(axis: np.ndarray) -> np.ndarray:
-    """A rotation (4x4) taking +z onto ``axis`` (unit)."""
-    z = np.array([0.0, 0.0, 1.0])
-    v = np.cross(z, axis)
-    s, c = np.linalg.norm(v), float(z @ axis)
+    """A rotation (4x4) taking +z onto ``axis`` (unit): about z x axis by the angle between
+    them (Rodrigues: R = I + [v] + [v]^2 (1 - c)/s^2, v = z x axis, s = |v|, c = z . axis)."""
     T = np.eye(4)
-    if s < 1e-15:
+    vx, vy, c = -float(axis[1]), float(axis[0]), float(axis[2])
+    s2 = vx * vx + vy * vy
+    if s2 < 1e-30:
         if c < 0:
             T[:3, :3] = np.diag([1.0, -1.0, -1.0])
         return T
-    T[:3, :3] = Rotation.from_rotvec(v / s * math.atan2(s, c)).as_matrix()
+    k = (1.0 - c) / s2
+    # [v] = [[0, 0, vy], [0, 0, -vx], [-vy, vx, 0]] for v = (vx, vy, 0)
+    T[:3, :3] = [[1.0 - k * vy * vy, k * vx * vy, vy],
+                 [k * vx * vy, 1.0 - k * vx * vx, -vx],
+                 [-vy, vx, 1.0 - k * s2]]
     return T
 
 
@@ -207,7 +220,7 @@ def from_urdf(
             raise ParseError(f"{where}: zero axis", file=source)
         A = _align_z(axis / nrm)
         consts[-1] = consts[-1] @ Tj @ A
-        consts.append(np.linalg.inv(A))
+        consts.append(A.T.copy())  # the inverse of a rotation
         lim = j.find("limit")
         lo, hi = -math.inf, math.inf
         if lim is not None and jtype != "continuous":
