@@ -105,8 +105,9 @@ def main(argv: list[str] | None = None) -> int:
         typer.echo(f"kinestat: error: {_one_line(str(exc))}", err=True)
         return 2
     except OSError as exc:  # the file system or the network said no: not a kinestat bug
-        where = f": {exc.filename}" if exc.filename is not None else ""
-        typer.echo(f"kinestat: error: {exc.strerror or exc}{where}", err=True)
+        name = "" if exc.filename is None else str(exc.filename)
+        where = f": {name if name.isprintable() else repr(name)}" if name else ""
+        typer.echo(f"kinestat: error: {_one_line(str(exc.strerror or exc))}{where}", err=True)
         return 2
     except KeyboardInterrupt:
         typer.echo("kinestat: interrupted", err=True)

@@ -137,3 +137,13 @@ def test_bare_command_prints_help_not_an_error(capsys):
     assert main([]) == 2  # as before: Click's no-arguments-is-help status
     out, err = capsys.readouterr()
     assert "Usage:" in out and "--version" in out and err == ""
+
+
+def test_os_error_on_a_file_name_with_a_line_break_stays_one_line(capsys, monkeypatch):
+    # found by the campaign: "File name too long: <a name with a newline>" printed two lines
+    def refuse(name):
+        raise OSError(36, "File name too long", "a\nb.toml")
+
+    monkeypatch.setattr(kinestat, "load", refuse)
+    assert main(["fk", "x.toml", "--q", "0"]) == 2
+    assert capsys.readouterr().err == "kinestat: error: File name too long: 'a\\nb.toml'\n"
