@@ -1,4 +1,11 @@
-"""Shared output helpers for the CLI: JSON for machines, rich tables for people."""
+"""Shared output helpers for the CLI: JSON for machines, rich tables for people.
+
+Rich reads ``[...]`` in printed strings as markup. Text that comes from the user — a model,
+platform, deck or device name, a file path, a message quoting a file — is printed literally: the
+cells and titles of :func:`table` are escaped here, and a command that interpolates user text in
+its own ``console.print`` line wraps it in :func:`literal`. (A name such as ``arm[/]`` used to
+crash the command with a MarkupError, and ``[link=...]`` put hyperlinks in the terminal.)
+"""
 
 from __future__ import annotations
 
@@ -9,6 +16,7 @@ from typing import Any
 
 import numpy as np
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 from kinestat.errors import InputError
@@ -25,13 +33,24 @@ def print_json(obj: Any) -> None:
     print(json.dumps(to_jsonable(obj), indent=2))
 
 
+def literal(value: Any) -> str:
+    """``str(value)`` escaped so that rich prints it as it is (no markup, no hyperlinks).
+
+    >>> print(literal("arm[/]"), literal("[link=http://x]a[/link]"))
+    arm\\[/] \\[link=http://x]a\\[/link]
+    """
+    return escape(str(value))
+
+
 def table(title: str, columns: list[str], rows: list[list[Any]], fmt: str = "{:.4f}") -> Table:
-    """A rich table; floats formatted with ``fmt``."""
-    t = Table(title=title)
+    """A rich table; floats formatted with ``fmt``. The title, headers and cells are printed
+    literally (they may hold names from the user's files)."""
+    t = Table(title=literal(title))
     for c in columns:
-        t.add_column(c, justify="right", no_wrap=True)
+        t.add_column(literal(c), justify="right", no_wrap=True)
     for r in rows:
-        t.add_row(*[fmt.format(v) if isinstance(v, (float, np.floating)) else str(v) for v in r])
+        t.add_row(*[fmt.format(v) if isinstance(v, (float, np.floating)) else literal(v)
+                    for v in r])
     return t
 
 

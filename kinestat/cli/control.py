@@ -32,7 +32,7 @@ from kinestat.app.control_run import (
 )
 from kinestat.app.signals import stop_on_signals
 from kinestat.cli._output import console as out_console
-from kinestat.cli._output import err_console, parse_floats, print_json, table
+from kinestat.cli._output import err_console, literal, parse_floats, print_json, table
 from kinestat.errors import InputError, KinestatError
 
 
@@ -278,7 +278,7 @@ def _print_report(out: dict) -> None:
     out_console.print(f"Kinestatic control {ok} after {out['iterations']} cycles "
                       f"({out['moves']} moves, {out['elapsed_s']:.1f} s); states "
                       f"{out['states']}")
-    out_console.print(f"  {out['stop_reason']}")
+    out_console.print(f"  {literal(out['stop_reason'])}")
     rows = []
     for key, label in (("force", "force (N)"),
                        ("torque_about_tool", "torque about tool point (N·mm)"),
@@ -299,6 +299,6 @@ def _print_report(out: dict) -> None:
     if out.get("final_axis_deg") is not None:
         out_console.print("robot axes (deg): " + ", ".join(f"{v:.4f}"
                                                            for v in out["final_axis_deg"]))
-    out_console.print(f"log: {out['log']}")
+    out_console.print(f"log: {literal(out['log'])}")
     for p in out.get("plots", []):
-        out_console.print(f"plot: {p}")
+        out_console.print(f"plot: {literal(p)}")

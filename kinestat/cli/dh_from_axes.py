@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, print_json, table
+from kinestat.cli._output import console, literal, print_json, table
 from kinestat.errors import InputError, ParseError
 from kinestat.io.axes_file import read_axes_file
 from kinestat.io.model_toml import write_model as save_model
@@ -71,8 +71,8 @@ def dh_from_axes_command(
                     "model_file": None if write_model is None else str(write_model)})
         return
     unit = "deg" if deg else "rad"
-    console.print(f"[bold]{res.model.name}[/] ({res.n} joints, lengths in "
-                  f"{res.model.length_unit}): H_i^(i-1) = Rz(θ) Tz(d) Tx(a) Rx(α)")
+    console.print(f"[bold]{literal(res.model.name)}[/] ({res.n} joints, lengths in "
+                  f"{literal(res.model.length_unit)}): H_i^(i-1) = Rz(θ) Tz(d) Tx(a) Rx(α)")
     console.print(table("Standard DH table", ["joint", "type", f"θ ({unit})", "d", "a",
                                               f"α ({unit})", "z(i-1) → z(i)"],
                         [[r["joint"], r["type"], r[th_key], r["d"], r["a"], r[al_key],
@@ -83,4 +83,4 @@ def dh_from_axes_command(
         console.print(table("Tool (in frame n)", ["", "x", "y", "z", "o"],
                             [[str(i + 1), *res.tool[i]] for i in range(4)]))
     if write_model is not None:
-        console.print(f"model written to {write_model}")
+        console.print(f"model written to {literal(write_model)}")

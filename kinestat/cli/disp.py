@@ -14,7 +14,7 @@ import typer
 
 from kinestat.cli import _guidance
 from kinestat.cli._guidance import SINGULAR_HELP, parse_steps, print_result, singular_mode
-from kinestat.cli._output import console, err_console, print_json, table, to_jsonable
+from kinestat.cli._output import console, err_console, literal, print_json, table, to_jsonable
 from kinestat.disp import deck_json, disp_options, run_deck
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import DispDeck, embedded_deck, list_embedded_decks, read_deck
@@ -124,7 +124,7 @@ def disp(
             rec["plots"] = [str(p) for p in written]
         print_json(to_jsonable(rec))
     else:
-        console.print(f"[bold]DISP MS = {d.ms}[/bold]: {d.analysis} ({d.source})")
+        console.print(f"[bold]DISP MS = {d.ms}[/bold]: {d.analysis} ({literal(d.source)})")
         if run.screws is not None:
             _print_screws(run.screws)
         if run.joints is not None:
@@ -133,9 +133,9 @@ def disp(
             print_result(run.result, run.notes)
         else:
             for n in run.notes:
-                console.print(f"note: {n}")
+                console.print(f"note: {literal(n)}")
         for p in written:
-            console.print(f"wrote {p}")
+            console.print(f"wrote {literal(p)}")
     if view and run.result is not None:
         from kinestat.viz.show import show_guidance  # lazy: viewer only with --view
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, parse_floats, print_json, table
+from kinestat.cli._output import console, literal, parse_floats, print_json, table
 from kinestat.errors import InputError
 
 #: the model whose end frame is described in the thesis's words (P_tool_F, S6_F, a67_F)
@@ -86,7 +86,7 @@ def fk_command(
 def _print_human(m, vals: np.ndarray, out: dict, F, puma: bool) -> None:
     """The tables of ``kinestat fk`` (without --json), in the model's own words."""
     T_base_end = out["pose"]
-    console.print(f"[bold]{m.name}[/] ({m.n} joints, lengths in {m.length_unit})")
+    console.print(f"[bold]{literal(m.name)}[/] ({m.n} joints, lengths in {literal(m.length_unit)})")
     console.print(table("Joints", ["joint", "kind", "value"], [
         [j.name or str(i + 1), j.kind,
          f"{vals[i]:.6g} {m.length_unit}" if j.kind == "prismatic"
@@ -104,9 +104,9 @@ def _print_human(m, vals: np.ndarray, out: dict, F, puma: bool) -> None:
     console.print(table("Tool", ["", "x", "y", "z"], rows))
     ang = out["euler_deg"]
     console.print(f"Euler {out['euler_seq']} (deg): " + ", ".join(f"{a:.4f}" for a in ang)
-                  + ("  [gimbal lock]" if out["gimbal_lock"] else ""))
+                  + ("  \\[gimbal lock]" if out["gimbal_lock"] else ""))
     if "warning" in out:
-        console.print(f"[yellow]warning:[/] {out['warning']}")
+        console.print(f"[yellow]warning:[/] {literal(out['warning'])}")
     if F is not None:
         console.print(table("Link frame origins", ["frame", "x", "y", "z"],
                             [[i, *F[i, :3, 3]] for i in range(len(F))]))

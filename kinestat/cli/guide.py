@@ -19,12 +19,13 @@ from kinestat.cli._guidance import (
     progress_reporter,
     singular_mode,
 )
-from kinestat.cli._output import console, parse_floats, print_json, table, to_jsonable
+from kinestat.cli._output import console, literal, parse_floats, print_json, table, to_jsonable
 from kinestat.disp import result_record
 from kinestat.errors import InputError, ParseError
 from kinestat.io.disp_deck import OperatorCommand, parse_operator_command
 from kinestat.io.disp_deck.commands import parse_key_values, parse_number
 from kinestat.io.library import load
+from kinestat.io.textfile import read_text_file
 from kinestat.mechanism.nadkarni import hand_points
 from kinestat.serial.fk import fk
 from kinestat.serial.guidance.planners import twist_between
@@ -67,7 +68,7 @@ def read_commands(path: Path) -> list[dict]:
     """Commands from a file: one per line, either ``frame=…,dir=…,d=…,angle=…`` or the six
     numbers of a DISP SET THREE card ``NTY DCx DCy DCz DD THA``; ``#`` starts a comment."""
     try:
-        text = path.read_text()
+        text = read_text_file(path, "commands file")  # binary: a ParseError, not a crash
     except OSError as exc:
         raise InputError(f"cannot read commands file {str(path)!r}: {exc.strerror}") from exc
     out = []
@@ -227,7 +228,7 @@ def guide(
                                 [[str(i + 1), f"{peak[i]:.4g} {units[i]}"]
                                  for i in range(m.n)]))
         for p in written:
-            console.print(f"wrote {p}")
+            console.print(f"wrote {literal(p)}")
     if view:
         from kinestat.viz.show import show_guidance  # lazy: viewer only with --view
 

@@ -7,7 +7,7 @@ from typing import Literal, get_args
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
+from kinestat.cli._output import console, literal, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, KinestatError
 
 #: ``--limits``: the PUMA 762 axis-limit sets (puma_rev_analysis.m, or Table 2-1)
@@ -210,10 +210,10 @@ def _print_closed_form(out: dict, res, has_current: bool) -> None:
         console.print(
             f"family (branch {f['branch']}): φ1={f['phi1_deg']:.4f} θ2={f['theta2_deg']:.4f} "
             f"θ3={f['theta3_deg']:.4f} θ5={f['theta5_deg']:.4f}, {f['relation']} with value "
-            f"{f['value_deg']:.4f}°" + ("" if f["within_limits"] else "  [outside limits]")
+            f"{f['value_deg']:.4f}°" + ("" if f["within_limits"] else "  \\[outside limits]")
         )
     if res.reason:
-        console.print(f"[yellow]note:[/] {res.reason}")
+        console.print(f"[yellow]note:[/] {literal(res.reason)}")
     if has_current:
         sel = out["selected"]
         if sel is None:

@@ -2,8 +2,9 @@
 
 Each command group lives in its own module ``kinestat.cli.<name>`` exposing
 ``register(app: typer.Typer) -> None``; the modules are listed in ``COMMAND_MODULES``.
-Errors derived from :class:`kinestat.errors.KinestatError` are printed as one clear message
-(no traceback) and exit with status 2.
+Errors derived from :class:`kinestat.errors.KinestatError`, and usage errors (an unknown option,
+a missing argument, a bad choice), are printed as one line ``kinestat: error: ...`` on stderr (no
+traceback, no box) and exit with status 2.
 """
 
 from __future__ import annotations
@@ -13,6 +14,11 @@ import sys
 
 import typer
 
+# Typer (0.29, pinned in requirements/run.txt) carries its own copy of Click: its usage errors
+# are these classes, not ``click``'s. ``typer.BadParameter`` is the public face of the same module.
+from typer._click.exceptions import ClickException, NoArgsIsHelpError, UsageError
+
+import kinestat
 from kinestat.errors import KinestatError
 
 # Order is the order of the help listing.
@@ -41,9 +47,30 @@ app = typer.Typer(
 )
 
 
+def _print_version(value: bool) -> None:
+    if value:
+        typer.echo(f"kinestat {kinestat.__version__}")
+        raise typer.Exit(0)
+
+
 @app.callback()
-def _root() -> None:
+def _root(
+    version: bool = typer.Option(False, "--version", help="Print the version and exit.",
+                                 callback=_print_version, is_eager=True),
+) -> None:
     """Kinematics and statics of robot manipulators."""
+
+
+def _one_line(text: str) -> str:
+    """``text`` on one line (blank runs, line breaks included, become one blank)."""
+    return " ".join(text.split())
+
+
+def _usage_error(exc: UsageError) -> str:
+    """The one-line message of a usage error, pointing at the command's ``--help``."""
+    msg = _one_line(exc.format_message())
+    path = exc.ctx.command_path if exc.ctx is not None else "kinestat"
+    return f"kinestat: error: {msg} (see '{path} --help')"
 
 
 for _name in COMMAND_MODULES:
@@ -53,26 +80,44 @@ for _name in COMMAND_MODULES:
 def main(argv: list[str] | None = None) -> int:
     """Console-script entry point; returns the exit status.
 
-    Usage errors and ``--help`` are handled by Typer (usage errors exit with status 2); a
-    :class:`KinestatError`, or an ``OSError`` from the file system or network, is printed as
-    one line on stderr and exits with status 2.
+    ``--help`` prints help and exits with 0. A usage error, a :class:`KinestatError`, or an
+    ``OSError`` from the file system or network, is printed as one line on stderr and exits with
+    status 2. Click runs with ``standalone_mode=False`` so that its errors reach this function
+    instead of being drawn as a box.
     """
     try:
-        app(args=argv, standalone_mode=True)
+        code = app(args=argv, prog_name="kinestat", standalone_mode=False)
     except SystemExit as exc:
         code = exc.code
         return code if isinstance(code, int) else (0 if code is None else 1)
+    except NoArgsIsHelpError as exc:  # bare ``kinestat``: the help on stdout, status 2
+        text = exc.format_message()  # empty when rich has already printed the help
+        if text.strip():
+            typer.echo(text)
+        return 2
+    except UsageError as exc:
+        typer.echo(_usage_error(exc), err=True)
+        return 2
+    except ClickException as exc:  # e.g. a file option Click could not open
+        typer.echo(f"kinestat: error: {_one_line(exc.format_message())}", err=True)
+        return exc.exit_code
+    except typer.Abort:
+        typer.echo("kinestat: aborted", err=True)
+        return 1
     except KinestatError as exc:
-        typer.echo(f"kinestat: error: {exc}", err=True)
+        typer.echo(f"kinestat: error: {_one_line(str(exc))}", err=True)
         return 2
     except OSError as exc:  # the file system or the network said no: not a kinestat bug
-        where = f": {exc.filename}" if exc.filename is not None else ""
-        typer.echo(f"kinestat: error: {exc.strerror or exc}{where}", err=True)
+        name = "" if exc.filename is None else str(exc.filename)
+        where = f": {name if name.isprintable() else repr(name)}" if name else ""
+        typer.echo(f"kinestat: error: {_one_line(str(exc.strerror or exc))}{where}", err=True)
         return 2
     except KeyboardInterrupt:
         typer.echo("kinestat: interrupted", err=True)
         return 130
-    return 0
+    # without standalone mode ``typer.Exit(n)`` arrives as the return value ``n`` (commands
+    # return None, which is status 0)
+    return code if isinstance(code, int) and not isinstance(code, bool) else 0
 
 
 if __name__ == "__main__":  # pragma: no cover

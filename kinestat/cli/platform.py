@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 import typer
 
-from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
+from kinestat.cli._output import console, literal, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, UnreachableError
 from kinestat.io.library import prototype
 from kinestat.io.platform_toml import read_platform
@@ -90,7 +90,8 @@ def info_command(
     if as_json:
         print_json(out)
         return
-    console.print(f"[bold]{p.name}[/] (lengths in {p.length_unit}, forces in {p.force_unit}; "
+    console.print(f"[bold]{literal(p.name)}[/] (lengths in {p.length_unit}, forces in "
+                  f"{p.force_unit}; "
                   f"{'special 6-6' if p.layout is not None else 'general 6-6'})")
     console.print(table("Legs", ["leg", "base x", "base y", "base z", "top x", "top y", "top z",
                                  "k", "free length"],
@@ -145,7 +146,7 @@ def fk_command(
     if as_json:
         print_json(out)
         return
-    console.print(f"[bold]{len(sols)}[/] assembly mode(s) of {p.name} ({method})")
+    console.print(f"[bold]{len(sols)}[/] assembly mode(s) of {literal(p.name)} ({method})")
     for i, s in enumerate(sols):
         console.print(table(f"Mode {i + 1}: pose (max leg error {s['max_leg_error']:.2e} "
                             f"{p.length_unit})", ["", "x", "y", "z", "t"],

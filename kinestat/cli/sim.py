@@ -11,7 +11,7 @@ import numpy as np
 import typer
 
 from kinestat.app.signals import stop_on_signals
-from kinestat.cli._output import console, parse_floats, print_json
+from kinestat.cli._output import console, literal, parse_floats, print_json
 from kinestat.errors import InputError
 from kinestat.hardware.encoder_packets import (
     CHANNELS,
@@ -104,7 +104,7 @@ def galil(
         if as_json:
             print_json({"host": server.host, "port": server.port, "axes": "ABCDEF"})
         else:
-            console.print(f"Galil DMC simulator listening on {server.host}:{server.port} "
+            console.print(f"Galil DMC simulator listening on {literal(server.host)}:{server.port} "
                           "(axes A-F). Ctrl-C to stop.")
         _run_until_stopped(duration)
     if not as_json:
@@ -138,8 +138,8 @@ def encoders(
                         "leg_counts": legs.astype(int).tolist(),
                         "channel_counts": dict(zip(CHANNELS, channels, strict=True))})
         else:
-            console.print(f"Encoder stream ({fmt}, {rate:g} Hz) on {emitter.path} — open it "
-                          "at 115200 baud. Ctrl-C to stop.")
+            console.print(f"Encoder stream ({fmt}, {rate:g} Hz) on {literal(emitter.path)} — "
+                          "open it at 115200 baud. Ctrl-C to stop.")
             console.print("channels " + ", ".join(
                 f"{c}=leg {w}: {v}" for c, w, v in zip(CHANNELS, THESIS_WIRING, channels,
                                                         strict=True)))

@@ -14,18 +14,43 @@ import numpy as np
 from kinestat.errors import ParseError
 from kinestat.mechanism.joints import JOINT_KINDS
 
-__all__ = ["number", "numbers", "string", "matrix", "refuse_unknown",
+__all__ = ["number", "numbers", "string", "choice", "short_repr", "matrix", "refuse_unknown",
            "joint_type_and_pitch"]
 
+
+def _too_big(v: int) -> str:
+    """The message for an integer too large for a float (without echoing its digits)."""
+    return f"expected a finite number, got an integer of {len(str(abs(v)))} digits (too large)"
+
+
 def number(v, source: str, field: str, **where) -> float:
-    """A finite number (not a bool)."""
+    """A finite number (not a bool); an integer too large for a float is refused, not a crash.
+
+    >>> number(10 ** 400, "a.toml", "x")
+    Traceback (most recent call last):
+    kinestat.errors.ParseError: a.toml, field x: expected a finite number, got an integer of \
+401 digits (too large)
+    """
     if isinstance(v, bool) or not isinstance(v, (int, float)):
-        raise ParseError(f"expected a number, got {v!r}", file=source, field=field, **where)
-    x = float(v)
+        raise ParseError(f"expected a number, got {short_repr(v)}", file=source, field=field,
+                         **where)
+    try:
+        x = float(v)
+    except OverflowError:
+        raise ParseError(_too_big(v), file=source, field=field, **where) from None
     if not math.isfinite(x):
         raise ParseError(f"expected a finite number, got {v!r}", file=source, field=field,
                          **where)
     return x
+
+
+def short_repr(v, limit: int = 80) -> str:
+    """``repr(v)`` cut to ``limit`` characters (a fuzzed value can be megabytes long)."""
+    try:
+        text = repr(v)
+    except (ValueError, RecursionError):  # a huge integer, a deeply nested list
+        return f"a {type(v).__name__}"
+    return text if len(text) <= limit else text[:limit - 3] + "..."
 
 
 def numbers(v, n: int, source: str, field: str, scalar_ok: bool = True):
@@ -34,14 +59,28 @@ def numbers(v, n: int, source: str, field: str, scalar_ok: bool = True):
         return number(v, source, field)
     if not isinstance(v, list) or len(v) != n:
         what = f"a number or a list of {n} numbers" if scalar_ok else f"a list of {n} numbers"
-        raise ParseError(f"expected {what}, got {v!r}", file=source, field=field)
+        raise ParseError(f"expected {what}, got {short_repr(v)}", file=source, field=field)
     return [number(x, source, f"{field}[{i}]") for i, x in enumerate(v)]
 
 
 def string(v, source: str, field: str) -> str:
     """A string."""
     if not isinstance(v, str):
-        raise ParseError(f"expected a string, got {v!r}", file=source, field=field)
+        raise ParseError(f"expected a string, got {short_repr(v)}", file=source, field=field)
+    return v
+
+
+def choice(v, allowed, source: str, field: str, what: str | None = None) -> str:
+    """One of the strings ``allowed`` (anything else, a list or a table included, is refused).
+
+    >>> choice([], ("deg", "rad"), "a.toml", "angle_unit")
+    Traceback (most recent call last):
+    kinestat.errors.ParseError: a.toml, field angle_unit: angle_unit must be one of \
+['deg', 'rad'], got []
+    """
+    if not isinstance(v, str) or v not in allowed:
+        raise ParseError(f"{what or field} must be one of {sorted(allowed)}, got {short_repr(v)}",
+                         file=source, field=field)
     return v
 
 
@@ -49,7 +88,7 @@ def matrix(v, source: str, field: str, shape: tuple[int, int]) -> np.ndarray:
     """A finite array of ``shape`` (e.g. a 4x4 pose)."""
     try:
         a = np.array(v, dtype=float)
-    except (TypeError, ValueError) as exc:
+    except (TypeError, ValueError, OverflowError, RecursionError) as exc:
         raise ParseError(f"expected a {shape[0]}x{shape[1]} array of numbers", file=source,
                          field=field) from exc
     if a.shape != shape or not np.all(np.isfinite(a)):
@@ -72,9 +111,9 @@ def joint_type_and_pitch(entry: dict, source: str, where: str) -> tuple[str, flo
     A screw joint needs a non-zero pitch (length per radian); the others take none.
     """
     kind = entry.get("type", "revolute")
-    if kind not in JOINT_KINDS:
-        raise ParseError(f"unknown joint type {kind!r}; expected revolute, prismatic or screw",
-                         file=source, field=f"{where}.type")
+    if not isinstance(kind, str) or kind not in JOINT_KINDS:
+        raise ParseError(f"unknown joint type {short_repr(kind)}; expected revolute, prismatic or "
+                         "screw", file=source, field=f"{where}.type")
     pitch = number(entry.get("pitch", 0.0), source, f"{where}.pitch")
     if kind == "screw" and pitch == 0.0:
         raise ParseError("a screw joint needs a non-zero pitch", file=source,

@@ -21,17 +21,14 @@ the arm::
 
 from __future__ import annotations
 
-import json
-import math
 import os
-import tomllib
 from pathlib import Path
 
 import numpy as np
 
 from kinestat.errors import ParseError
-from kinestat.io._fields import joint_type_and_pitch, matrix, numbers, refuse_unknown
-from kinestat.io.textfile import read_text_file
+from kinestat.io._fields import joint_type_and_pitch, matrix, number, numbers, refuse_unknown
+from kinestat.io.textfile import parse_json, parse_toml, read_text_file
 
 __all__ = ["loads_axes", "read_axes_file"]
 
@@ -114,12 +111,11 @@ def loads_axes(doc: dict, source: str = "<string>") -> dict:
         if k in doc:
             out[k] = matrix(doc[k], source, k, (4, 4))
     if "tol" in doc:
-        tol = doc["tol"]
-        if isinstance(tol, bool) or not isinstance(tol, (int, float)) or not (
-                math.isfinite(tol) and tol >= 0):
+        tol = number(doc["tol"], source, "tol")
+        if tol < 0:
             raise ParseError(f"tol must be a finite non-negative number, got {tol!r}",
                              file=source, field="tol")
-        out["tol"] = float(tol)
+        out["tol"] = tol
     return out
 
 
@@ -127,14 +123,6 @@ def read_axes_file(path: str | os.PathLike) -> dict:
     """Read an axes file (``.json`` as JSON, anything else as TOML); see the module docstring."""
     p = Path(path)
     text = read_text_file(p, "axes file")
-    if p.suffix.lower() == ".json":
-        try:
-            doc = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise ParseError(f"not valid JSON: {exc.msg}", file=str(p), line=exc.lineno) from exc
-    else:
-        try:
-            doc = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise ParseError(f"not valid TOML: {exc}", file=str(p)) from exc
+    parse = parse_json if p.suffix.lower() == ".json" else parse_toml
+    doc = parse(text, str(p))
     return loads_axes(doc, source=str(p))

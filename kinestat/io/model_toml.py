@@ -38,15 +38,21 @@ from __future__ import annotations
 
 import math
 import os
-import tomllib
 from pathlib import Path
 
 import numpy as np
 import tomli_w
 
 from kinestat.errors import InputError, ModelError, ParseError
-from kinestat.io._fields import joint_type_and_pitch, matrix, number, refuse_unknown
-from kinestat.io.textfile import read_text_file, write_text_atomic
+from kinestat.io._fields import (
+    choice,
+    joint_type_and_pitch,
+    matrix,
+    number,
+    refuse_unknown,
+    short_repr,
+)
+from kinestat.io.textfile import parse_toml, read_text_file, write_text_atomic
 from kinestat.mechanism.chain import (
     ChainModel,
     from_modified_dh,
@@ -73,16 +79,22 @@ def _err(msg: str, source: str, field: str | None = None) -> ParseError:
 
 def loads_model(text: str, source: str = "<string>") -> ChainModel:
     """Parse a TOML model from text."""
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise _err(f"not valid TOML: {exc}", source) from exc
-    return _from_doc(doc, source)
+    return _from_doc(parse_toml(text, source), source)
 
 
 def read_model(path: str | os.PathLike) -> ChainModel:
     """Read a TOML model file."""
     return loads_model(read_text_file(path, "model file"), source=str(Path(path)))
+
+
+def _limit(x) -> float:
+    """A limit as a float (±inf allowed); NaN for anything that is not a number of float size."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return math.nan
+    try:
+        return float(x)
+    except OverflowError:
+        return math.nan
 
 
 def _joint_tables(joints: list, fields: tuple[str, ...], to_rad: float, source: str):
@@ -104,9 +116,9 @@ def _joint_tables(joints: list, fields: tuple[str, ...], to_rad: float, source: 
         lim = j.get("limits", [-math.inf, math.inf])
         if not isinstance(lim, list) or len(lim) != 2:
             raise _err("limits must be [lower, upper]", source, f"{where}.limits")
-        lo, hi = (float(x) if isinstance(x, (int, float)) else math.nan for x in lim)
+        lo, hi = (_limit(x) for x in lim)
         if math.isnan(lo) or math.isnan(hi) or lo > hi:
-            raise _err(f"limits {lim!r} are not an interval", source, f"{where}.limits")
+            raise _err(f"limits {short_repr(lim)} are not an interval", source, f"{where}.limits")
         scale = 1.0 if kind == "prismatic" else to_rad
         limits.append((lo * scale, hi * scale))
         names.append(str(j.get("name", i)))
@@ -115,13 +127,8 @@ def _joint_tables(joints: list, fields: tuple[str, ...], to_rad: float, source: 
 
 def _from_doc(doc: dict, source: str) -> ChainModel:
     refuse_unknown(doc, _TOP_KEYS, source, "top-level keys")
-    notation = doc.get("notation")
-    if notation not in _FIELDS:
-        raise _err(f"notation must be one of {sorted(_FIELDS)}, got {notation!r}", source,
-                   "notation")
-    angle_unit = doc.get("angle_unit", "deg")
-    if angle_unit not in ("deg", "rad"):
-        raise _err(f"angle_unit must be 'deg' or 'rad', got {angle_unit!r}", source, "angle_unit")
+    notation = choice(doc.get("notation"), _FIELDS, source, "notation")
+    angle_unit = choice(doc.get("angle_unit", "deg"), ("deg", "rad"), source, "angle_unit")
     to_rad = math.pi / 180.0 if angle_unit == "deg" else 1.0
     # keys of the other notations: refused rather than silently ignored
     unused = ["q_home"] if notation == "nadkarni" else ["frame_points", "hand"]

@@ -45,7 +45,6 @@ from __future__ import annotations
 
 import math
 import os
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -53,7 +52,7 @@ import tomli_w
 
 from kinestat.errors import InputError, ModelError, ParseError
 from kinestat.io._fields import matrix, number, numbers, refuse_unknown, string
-from kinestat.io.textfile import read_text_file, write_text_atomic
+from kinestat.io.textfile import parse_toml, read_text_file, write_text_atomic
 from kinestat.parallel.platform import LEG_NAMES, Platform, special_6_6
 from kinestat.parallel.singularity import check_design
 from kinestat.spatial.transforms import apply
@@ -84,11 +83,7 @@ def _unit(doc: dict, key: str, allowed: tuple[str, ...], source: str) -> str:
 
 def loads_platform(text: str, source: str = "<string>") -> Platform:
     """Parse a TOML platform from text (``source`` names it in error messages)."""
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParseError(f"not valid TOML: {exc}", file=source) from exc
-    return _from_doc(doc, source)
+    return _from_doc(parse_toml(text, source), source)
 
 
 def read_platform(path: str | os.PathLike) -> Platform:

@@ -15,15 +15,13 @@ numbers). Rigidity is checked by the caller (each command knows its tolerance).
 
 from __future__ import annotations
 
-import json
 import os
-import tomllib
 from pathlib import Path
 
 import numpy as np
 
 from kinestat.errors import ParseError
-from kinestat.io.textfile import read_text_file
+from kinestat.io.textfile import parse_json, parse_toml, read_text_file
 
 __all__ = ["read_text_file", "pose_from_document", "read_pose_file"]
 
@@ -37,8 +35,11 @@ def pose_from_document(doc, source: str, *, allow_batch: bool = False) -> np.nda
         doc = doc["pose"]
     try:
         arr = np.asarray(doc, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ParseError("the pose must be a 4x4 array of numbers", file=source) from exc
+    except OverflowError:
+        raise ParseError("the pose must be a 4x4 array of finite numbers: an integer is too "
+                         "large for a float", file=source) from None
+    except (TypeError, ValueError, RecursionError):
+        raise ParseError("the pose must be a 4x4 array of numbers", file=source) from None
     if arr.shape in ((16,), (12,)):
         arr = arr.reshape(-1, 4)
     if arr.shape == (3, 4):
@@ -59,16 +60,9 @@ def read_pose_file(path: str | os.PathLike, *, allow_batch: bool = False) -> np.
     text = read_text_file(p, "pose file")
     suffix = p.suffix.lower()
     if suffix == ".toml":
-        try:
-            doc = tomllib.loads(text)
-        except tomllib.TOMLDecodeError as exc:
-            raise ParseError(f"not valid TOML: {exc}", file=str(p)) from exc
-        return pose_from_document(doc, str(p), allow_batch=allow_batch)
+        return pose_from_document(parse_toml(text, str(p)), str(p), allow_batch=allow_batch)
     if suffix == ".json" or text.lstrip()[:1] in ("{", "["):
-        try:
-            doc = json.loads(text)
-        except json.JSONDecodeError as exc:
-            raise ParseError(f"not valid JSON: {exc.msg}", file=str(p), line=exc.lineno) from exc
+        doc = parse_json(text, str(p))
         return pose_from_document(doc, str(p), allow_batch=allow_batch)
     vals = []
     for lineno, line in enumerate(text.splitlines(), start=1):

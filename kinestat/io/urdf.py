@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from kinestat.errors import ModelError, ParseError
+from kinestat.errors import InputError, ModelError, ParseError
 from kinestat.io.textfile import read_text_file
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import Joint
@@ -79,24 +79,97 @@ def _floats(text: str | None, n: int, where: str, source: str) -> np.ndarray:
     return v
 
 
+def _limit(text: str | None, default: float, where: str, source: str) -> float:
+    """A joint limit attribute (absent: ``default``); not a number is a ParseError."""
+    if text is None:
+        return default
+    try:
+        v = float(text)
+    except ValueError:
+        raise ParseError(f"cannot read a number from {text[:40]!r}", file=source,
+                         field=where) from None
+    if math.isnan(v):
+        raise ParseError("a limit cannot be NaN", file=source, field=where)
+    return v
+
+
+def _path_to_tip(root: ET.Element, tip: str | None, source: str) -> list[ET.Element]:
+    """The joints from the root link to ``tip`` (default: the only leaf), root first.
+
+    Linear in the number of joints. A link that is the child of two joints, or a cycle of
+    joints, is a ParseError naming the joint.
+    """
+    joint_to: dict[str, ET.Element] = {}  # child link -> the joint leading to it
+    parents_of: dict[str, str | None] = {}  # child link -> its parent link
+    for j in root.findall("joint"):
+        parent, child = j.find("parent"), j.find("child")
+        if parent is None or child is None:
+            raise ParseError(f"joint {j.get('name')!r} lacks a parent or child", file=source)
+        c = child.get("link")
+        if c in joint_to:
+            raise ParseError(f"joint {j.get('name')!r}: link {c!r} is already the child of "
+                             f"joint {joint_to[c].get('name')!r} (a serial chain is a tree)",
+                             file=source)
+        joint_to[c] = j
+        parents_of[c] = parent.get("link")
+    links = [lk.get("name") for lk in root.findall("link")]
+    roots = [lk for lk in links if lk not in joint_to]
+    if len(roots) != 1:
+        raise ParseError(f"expected one root link, found {roots[:10]}", file=source)
+    has_child = set(parents_of.values())
+    leaves = [lk for lk in links if lk not in has_child]
+    if tip is None:
+        if len(leaves) != 1:
+            raise ParseError(f"several leaf links {leaves[:10]}: choose one with tip=",
+                             file=source)
+        tip = leaves[0]
+    if tip not in set(links):
+        raise ParseError(f"no link named {tip!r}", file=source)
+    path: list[ET.Element] = []
+    seen: set[str] = set()
+    link = tip
+    while link in joint_to:
+        if link in seen:
+            raise ParseError(f"joint {joint_to[link].get('name')!r} closes a cycle of joints "
+                             f"through link {link!r}; a serial chain has none", file=source)
+        seen.add(link)
+        path.append(joint_to[link])
+        link = parents_of[link]
+    path.reverse()
+    return path
+
+
 def _pose(xyz: np.ndarray, rpy: np.ndarray) -> np.ndarray:
-    T = np.eye(4)
-    T[:3, :3] = Rotation.from_euler("xyz", rpy).as_matrix()
-    T[:3, 3] = xyz
-    return T
+    """The URDF origin ``xyz``/``rpy`` as a 4x4 pose: R = Rz(yaw) Ry(pitch) Rx(roll).
+
+    Written out (not scipy's Rotation): it runs once per joint, and a chain may have thousands.
+    """
+    cr, sr = math.cos(rpy[0]), math.sin(rpy[0])
+    cp, sp = math.cos(rpy[1]), math.sin(rpy[1])
+    cy, sy = math.cos(rpy[2]), math.sin(rpy[2])
+    return np.array([
+        [cy * cp, cy * sp * sr - sy * cr, cy * sp * cr + sy * sr, xyz[0]],
+        [sy * cp, sy * sp * sr + cy * cr, sy * sp * cr - cy * sr, xyz[1]],
+        [-sp, cp * sr, cp * cr, xyz[2]],
+        [0.0, 0.0, 0.0, 1.0],
+    ])
 
 
 def _align_z(axis: np.ndarray) -> np.ndarray:
-    """A rotation (4x4) taking +z onto ``axis`` (unit)."""
-    z = np.array([0.0, 0.0, 1.0])
-    v = np.cross(z, axis)
-    s, c = np.linalg.norm(v), float(z @ axis)
+    """A rotation (4x4) taking +z onto ``axis`` (unit): about z x axis by the angle between
+    them (Rodrigues: R = I + [v] + [v]^2 (1 - c)/s^2, v = z x axis, s = |v|, c = z . axis)."""
     T = np.eye(4)
-    if s < 1e-15:
+    vx, vy, c = -float(axis[1]), float(axis[0]), float(axis[2])
+    s2 = vx * vx + vy * vy
+    if s2 < 1e-30:
         if c < 0:
             T[:3, :3] = np.diag([1.0, -1.0, -1.0])
         return T
-    T[:3, :3] = Rotation.from_rotvec(v / s * math.atan2(s, c)).as_matrix()
+    k = (1.0 - c) / s2
+    # [v] = [[0, 0, vy], [0, 0, -vx], [-vy, vx, 0]] for v = (vx, vy, 0)
+    T[:3, :3] = [[1.0 - k * vy * vy, k * vx * vy, vy],
+                 [k * vx * vy, 1.0 - k * vx * vx, -vx],
+                 [-vy, vx, 1.0 - k * s2]]
     return T
 
 
@@ -119,32 +192,7 @@ def from_urdf(
         raise ParseError(f"not valid XML: {exc}", file=source) from exc
     if root.tag != "robot":
         raise ParseError("the root element must be <robot>", file=source)
-    joints = {}
-    children = set()
-    for j in root.findall("joint"):
-        parent, child = j.find("parent"), j.find("child")
-        if parent is None or child is None:
-            raise ParseError(f"joint {j.get('name')!r} lacks a parent or child", file=source)
-        joints[child.get("link")] = j
-        children.add(child.get("link"))
-    links = [lk.get("name") for lk in root.findall("link")]
-    roots = [lk for lk in links if lk not in children]
-    if len(roots) != 1:
-        raise ParseError(f"expected one root link, found {roots}", file=source)
-    parents_of = {c: j.find("parent").get("link") for c, j in joints.items()}
-    leaves = [lk for lk in links if lk not in set(parents_of.values())]
-    if tip is None:
-        if len(leaves) != 1:
-            raise ParseError(f"several leaf links {leaves}: choose one with tip=", file=source)
-        tip = leaves[0]
-    if tip not in links:
-        raise ParseError(f"no link named {tip!r}", file=source)
-    path = []
-    link = tip
-    while link in joints:
-        path.append(joints[link])
-        link = parents_of[link]
-    path.reverse()
+    path = _path_to_tip(root, tip, source)
     consts = [np.eye(4)]
     kinds: list[Joint] = []
     for j in path:
@@ -152,7 +200,12 @@ def from_urdf(
         o = j.find("origin")
         xyz = _floats(o.get("xyz") if o is not None else None, 3, where + " origin xyz", source)
         rpy = _floats(o.get("rpy") if o is not None else None, 3, where + " origin rpy", source)
-        Tj = _pose(xyz * scale, rpy)
+        with np.errstate(over="ignore", invalid="ignore"):
+            xyz = xyz * scale
+        if not np.all(np.isfinite(xyz)):
+            raise ParseError(f"origin xyz times scale {scale:g} is not finite", file=source,
+                             field=where + " origin xyz")
+        Tj = _pose(xyz, rpy)
         jtype = j.get("type")
         if jtype == "fixed":
             consts[-1] = consts[-1] @ Tj
@@ -167,19 +220,25 @@ def from_urdf(
             raise ParseError(f"{where}: zero axis", file=source)
         A = _align_z(axis / nrm)
         consts[-1] = consts[-1] @ Tj @ A
-        consts.append(np.linalg.inv(A))
+        consts.append(A.T.copy())  # the inverse of a rotation
         lim = j.find("limit")
         lo, hi = -math.inf, math.inf
         if lim is not None and jtype != "continuous":
             s = scale if jtype == "prismatic" else 1.0
-            lo = float(lim.get("lower", "-inf")) * s
-            hi = float(lim.get("upper", "inf")) * s
-        kinds.append(Joint(kind="prismatic" if jtype == "prismatic" else "revolute",
-                           lower=lo, upper=hi, name=str(j.get("name"))))
+            lo = _limit(lim.get("lower"), -math.inf, where + " limit lower", source) * s
+            hi = _limit(lim.get("upper"), math.inf, where + " limit upper", source) * s
+        try:
+            kinds.append(Joint(kind="prismatic" if jtype == "prismatic" else "revolute",
+                               lower=lo, upper=hi, name=str(j.get("name"))))
+        except InputError as exc:  # limits that are not an interval
+            raise ParseError(str(exc), file=source, field=where + " limit") from exc
     if not kinds:
         raise ModelError(f"{source}: no moving joint between the root and {tip!r}")
-    return ChainModel(name=name or str(root.get("name", "urdf")), joints=tuple(kinds),
-                      constants=np.array(consts), length_unit=length_unit)
+    try:
+        return ChainModel(name=name or str(root.get("name", "urdf")), joints=tuple(kinds),
+                          constants=np.array(consts), length_unit=length_unit)
+    except InputError as exc:  # e.g. limits that are not an interval
+        raise ParseError(str(exc), file=source) from exc
 
 
 def read_urdf(path: str | os.PathLike, **kwargs) -> ChainModel:

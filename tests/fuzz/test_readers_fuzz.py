@@ -1,0 +1,114 @@
+"""Every reader, fed damaged input, raises only KinestatError (issue 11, bad input).
+
+Two kinds of input per reader, within the hypothesis profile of tests/conftest.py:
+
+- a valid seed (the embedded models, platform, decks; URDF exported from them; pose and axes
+  files) after 1-4 random mutations (tests/fuzz/corpus.py: huge integers, deep nesting, wrong
+  types, binary bytes, swapped names, truncation, ...);
+- for the TOML/JSON formats, the seed document with one field (at any depth) replaced by an
+  arbitrary value: integers far beyond a float, NaN, strings, booleans, lists, tables.
+
+Whatever the input, the reader returns a result or raises a KinestatError; any other exception
+fails the test.
+"""
+
+from __future__ import annotations
+
+import json
+import random
+import tomllib
+
+import pytest
+import tomli_w
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from kinestat.errors import KinestatError
+from tests.fuzz.corpus import READERS, mutate, seeds
+
+_SUPPRESS = [HealthCheck.too_slow, HealthCheck.data_too_large]
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory):
+    return tmp_path_factory.mktemp("fuzz")
+
+
+def _feed(name: str, text: str, workdir) -> None:
+    try:
+        READERS[name].call(text, workdir)
+    except KinestatError:
+        pass
+
+
+@pytest.mark.parametrize("name", sorted(READERS))
+def test_seeds_are_accepted(name, workdir):
+    # the mutations start from valid input, so they probe the checks, not only the syntax
+    for text in seeds(name):
+        READERS[name].call(text, workdir)
+
+
+@pytest.mark.parametrize("name", sorted(READERS))
+@settings(suppress_health_check=_SUPPRESS)
+@given(data=st.data())
+def test_mutated_input_raises_only_kinestat_errors(name, workdir, data):
+    rng = data.draw(st.randoms(use_true_random=False), label="rng")
+    text = mutate(rng, rng.choice(seeds(name)))
+    _feed(name, text, workdir)
+
+
+_KEYS = st.sampled_from(["name", "notation", "joints", "type", "pitch", "limits", "theta", "d",
+                         "a", "alpha", "r", "angle_unit", "length_unit", "base", "tool",
+                         "q_home", "frame_points", "hand", "design", "legs", "kind", "stiffness",
+                         "home_pose", "leg_names", "axes", "point", "direction", "plucker",
+                         "tol", "pose", "free_lengths", "x"]) | st.text(max_size=4)
+_SCALARS = (
+    st.integers()
+    | st.integers(min_value=10**300, max_value=10**1000)
+    | st.integers(min_value=-(10**1000), max_value=-(10**300))
+    | st.floats()
+    | st.booleans()
+    | st.text(max_size=8)
+    | st.sampled_from(["[/]", "[bold]x", "deg", "rad", "mm", "N", "revolute", "prismatic",
+                      "screw", "standard_dh", "modified_dh", "nadkarni", "special-6-6"])
+)
+_VALUES = st.recursive(_SCALARS, lambda inner: st.lists(inner, max_size=6)
+                       | st.dictionaries(_KEYS, inner, max_size=4), max_leaves=24)
+_STRUCTURED = {
+    "model_toml": "toml", "platform_toml": "toml", "axes_toml": "toml", "axes_json": "json",
+    "pose_json": "json", "pose_toml": "toml",
+}
+
+
+def _replace_somewhere(doc, rng: random.Random, value):
+    """``doc`` with the value at a random path (a dict key or list index, any depth) replaced
+    by ``value`` (or a new key added)."""
+    node, depth = doc, rng.randint(0, 4)
+    for _ in range(depth):
+        children = (list(node.values()) if isinstance(node, dict)
+                    else node if isinstance(node, list) else [])
+        children = [c for c in children if isinstance(c, (dict, list)) and c]
+        if not children:
+            break
+        node = rng.choice(children)
+    if isinstance(node, dict):
+        key = rng.choice([*node, "x"]) if node else "x"
+        node[key] = value
+    elif isinstance(node, list) and node:
+        node[rng.randrange(len(node))] = value
+    return doc
+
+
+@pytest.mark.parametrize("name", sorted(_STRUCTURED))
+@settings(suppress_health_check=_SUPPRESS)
+@given(data=st.data())
+def test_any_value_in_any_field_raises_only_kinestat_errors(name, workdir, data):
+    rng = data.draw(st.randoms(use_true_random=False), label="rng")
+    value = data.draw(_VALUES, label="value")
+    text = rng.choice(seeds(name))
+    if _STRUCTURED[name] == "toml":
+        doc = _replace_somewhere(tomllib.loads(text), rng, value)
+        text = tomli_w.dumps(doc if isinstance(doc, dict) else {"pose": doc})
+    else:
+        text = json.dumps(_replace_somewhere(json.loads(text), rng, value))
+    _feed(name, text, workdir)
