@@ -11,9 +11,7 @@ import typer
 
 from kinestat.cli._output import console, print_json, table
 from kinestat.io.disp_deck import embedded_deck
-from kinestat.io.library import prototype
 from kinestat.mechanism.nadkarni import mechanism_frames
-from kinestat.parallel import fk_list, leg_lengths
 from kinestat.spatial.displacement import frame_from_triple, screws_between
 
 
@@ -68,6 +66,10 @@ def _puma() -> dict:
 
 def _platform() -> dict:
     """Vibhute Appendix B: every assembly mode of the prototype for main.cpp's leg lengths."""
+
+    from kinestat.io.library import prototype  # lazy: start-up
+    from kinestat.parallel.fk import fk_list  # lazy: start-up (numba)
+    from kinestat.parallel.legs import leg_lengths  # lazy: start-up
 
     p = prototype()
     legs = np.array([79.6804, 81.8285, 81.2669, 68.6500, 67.2037, 68.2854])

@@ -15,7 +15,6 @@ import typer
 from kinestat.cli import _guidance
 from kinestat.cli._guidance import SINGULAR_HELP, parse_steps, print_result, singular_mode
 from kinestat.cli._output import console, err_console, print_json, table, to_jsonable
-from kinestat.disp import deck_json, disp_options, run_deck
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import DispDeck, embedded_deck, list_embedded_decks, read_deck
 
@@ -104,6 +103,8 @@ def disp(
     Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
     table up to that point is printed first.
     """
+    from kinestat.disp import deck_json, disp_options, run_deck  # lazy: start-up (numba)
+
     d = load_deck(deck)
     if settle and no_settle:
         raise InputError("give --settle or --no-settle, not both")

@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import typer
@@ -21,22 +22,11 @@ from kinestat.cli._guidance import (
     singular_mode,
 )
 from kinestat.cli._output import console, parse_floats, print_json, table, to_jsonable
-from kinestat.disp import result_record
 from kinestat.errors import InputError, ParseError
-from kinestat.io.disp_deck import OperatorCommand, parse_operator_command
-from kinestat.io.library import load
-from kinestat.mechanism.nadkarni import hand_points
-from kinestat.serial.fk import fk
-from kinestat.serial.guidance.planners import twist_between
-from kinestat.serial.guidance.rules import GuidanceOptions
-from kinestat.serial.guidance.run import run_guidance
-from kinestat.serial.guidance.stages import (
-    PATH_TYPES,
-    command_stages,
-    move_stages,
-    target_stages,
-)
-from kinestat.serial.guidance.velocity import joint_rates
+from kinestat.io.disp_deck import parse_operator_command
+
+if TYPE_CHECKING:
+    from kinestat.io.disp_deck import OperatorCommand
 
 __all__ = ["register", "parse_command", "parse_move", "read_commands"]
 
@@ -120,6 +110,14 @@ class _Cmd:
 
 
 def _stages(model, q0, targets, kind, commands, moves):
+    from kinestat.mechanism.nadkarni import hand_points  # lazy: start-up (`kinestat --help`)
+    from kinestat.serial.fk import fk  # lazy: start-up (numba)
+    from kinestat.serial.guidance.stages import (  # lazy: start-up (numba)
+        command_stages,
+        move_stages,
+        target_stages,
+    )
+
     given = sum(bool(x) for x in (targets, commands, moves))
     if given == 0:
         raise InputError("nothing to do: give --to targets, --command(s) or --move(s)")
@@ -137,6 +135,9 @@ def _rates(result, speed: float) -> tuple[np.ndarray, list[int]]:
     """Joint rates per path step (rad or length per second, eqs. 5-1..5-4) moving along the
     path at ``speed`` (deg/s of hand rotation; length/s for a purely translating step), and the
     step numbers (correction steps at the end of a stage are left out)."""
+    from kinestat.serial.guidance.planners import twist_between  # lazy: start-up (numba)
+    from kinestat.serial.guidance.velocity import joint_rates  # lazy: start-up (numba)
+
     m = result.model
     settle = result.settle_rows()
     out, steps = [], []
@@ -200,6 +201,12 @@ def guide(
     Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
     table up to that point is printed first.
     """
+    from kinestat.disp import result_record  # lazy: start-up (numba)
+    from kinestat.io.library import load  # lazy: start-up (`kinestat --help`)
+    from kinestat.serial.guidance.rules import GuidanceOptions  # lazy: start-up (numba)
+    from kinestat.serial.guidance.run import run_guidance  # lazy: start-up (numba)
+    from kinestat.serial.guidance.stages import PATH_TYPES  # lazy: start-up (numba)
+
     if kind not in PATH_TYPES:
         raise InputError(f"--type must be one of {', '.join(PATH_TYPES)}, got {kind!r}")
     m = load(model)

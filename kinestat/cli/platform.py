@@ -14,14 +14,9 @@ import typer
 
 from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, UnreachableError
-from kinestat.io.library import prototype
-from kinestat.io.platform_toml import read_platform
-from kinestat.parallel.fk import fk_list, fk_numeric
-from kinestat.parallel.kinestatic import decompose_twist, platform_stiffness_axis
-from kinestat.parallel.legs import as_pose, leg_lengths, top_points_in_base
-from kinestat.parallel.singularity import singularity_measure
-from kinestat.parallel.statics import forces_from_wrench, jacobian_det
-from kinestat.parallel.stiffness import TWIST_ORDERS, stiffness
+
+# Domain modules are imported inside the commands (`# lazy: start-up`): registering the
+# commands for `kinestat --help` must not load Numba or SciPy.
 
 PLATFORM_HELP = "TOML platform file (default: the embedded 2011 prototype)."
 POSE_HELP = "'home', a JSON/TOML file holding a 4x4 pose, or 16 comma-separated numbers."
@@ -39,12 +34,17 @@ def register(app: typer.Typer) -> None:
 
 
 def _load(path: str | None):
+    from kinestat.io.library import prototype  # lazy: start-up
+    from kinestat.io.platform_toml import read_platform  # lazy: start-up
+
     return prototype() if path is None else read_platform(path)
 
 
 def _pose(text: str, platform) -> np.ndarray:
     if text.strip().lower() == "home":
         return platform.home_pose.copy()
+    from kinestat.parallel.legs import as_pose  # lazy: start-up
+
     T = parse_pose(text, "pose")
     return as_pose(T, "--pose")
 
@@ -64,6 +64,8 @@ def info_command(
     "stiffness", "free_lengths", "home_pose", "special", "edge_fractions", "jacobian_det_home",
     "singularity_measure_home", "design"}.
     """
+    from kinestat.parallel.singularity import singularity_measure  # lazy: start-up
+    from kinestat.parallel.statics import jacobian_det  # lazy: start-up (numba)
 
     p = _load(platform)
     d = p.design
@@ -114,6 +116,8 @@ def fk_command(
     JSON: {"count", "method", "solutions": [{"pose", "top_points", "above_base",
     "max_leg_error"}]}; top_points are O1..T1 (leg order) in base coordinates.
     """
+    from kinestat.parallel.fk import fk_list, fk_numeric  # lazy: start-up (numba)
+    from kinestat.parallel.legs import leg_lengths, top_points_in_base  # lazy: start-up
 
     p = _load(platform)
     L = parse_floats(legs, 6, "legs")
@@ -154,6 +158,7 @@ def ik_command(
     as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
 ) -> None:
     """Leg lengths at a pose (reverse kinematics). JSON: {"leg_lengths", "leg_names"}."""
+    from kinestat.parallel.legs import leg_lengths  # lazy: start-up
 
     p = _load(platform)
     T = _pose(pose, p)
@@ -180,6 +185,8 @@ def statics_command(
     Forces are tensions (positive: the leg pulls). JSON: {"leg_forces", "jacobian_det",
     "singularity_measure", "leg_names"}.
     """
+    from kinestat.parallel.singularity import singularity_measure  # lazy: start-up
+    from kinestat.parallel.statics import forces_from_wrench, jacobian_det  # lazy: numba
 
     p = _load(platform)
     T = _pose(pose, p)
@@ -213,6 +220,9 @@ def stiffness_command(
 
     JSON: {"stiffness" (6x6), "twist_order", "leg_forces", "asymmetry" (max |K - K^T|)}.
     """
+    from kinestat.parallel.legs import leg_lengths  # lazy: start-up
+    from kinestat.parallel.statics import forces_from_wrench  # lazy: start-up (numba)
+    from kinestat.parallel.stiffness import TWIST_ORDERS, stiffness  # lazy: start-up (numba)
 
     if twist_order not in TWIST_ORDERS:
         raise InputError(f"--twist-order must be one of {list(TWIST_ORDERS)}, got "
@@ -262,6 +272,11 @@ def decompose_command(
     Twists in axis order [omega; v_O]. JSON: {"freedom" (6), "compliance" (6), "lambda" (m),
     "wrench_change" (6, = W lambda = K T_c), "twist_order": "axis"}.
     """
+    from kinestat.parallel.kinestatic import (  # lazy: start-up (numba)
+        decompose_twist,
+        platform_stiffness_axis,
+    )
+
     if not 1 <= len(contact) <= 5:
         raise InputError(f"--contact: give 1 to 5 contact wrenches, got {len(contact)}")
     W = np.stack([parse_floats(c, 6, "contact") for c in contact], axis=1)
