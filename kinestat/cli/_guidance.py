@@ -11,7 +11,7 @@ import numpy as np
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
-from kinestat.cli._output import console, err_console, table
+from kinestat.cli._output import console, err_console, print_pairs, table
 from kinestat.errors import InputError
 
 if TYPE_CHECKING:
@@ -123,4 +123,4 @@ def print_result(result: GuidanceResult, notes=(), title: str = "Joint variables
         summary.append(["STOPPED", result.stop_message or result.stop_kind or ""])
     for n in notes:
         summary.append(["note", n])
-    console.print(table("Summary", ["", ""], summary))
+    print_pairs("Summary", summary)
