@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import typer
 
+from kinestat.cli._options import command_help, json_option
 from kinestat.cli._output import console, print_json, table
 from kinestat.io.disp_deck import embedded_deck
 from kinestat.mechanism.nadkarni import mechanism_frames
@@ -16,7 +17,7 @@ from kinestat.spatial.displacement import frame_from_triple, screws_between
 
 
 def register(app: typer.Typer) -> None:
-    app.command("demo")(demo_command)
+    app.command("demo", help=command_help(demo_command))(demo_command)
 
 
 def _screws() -> dict:
@@ -85,7 +86,7 @@ def _platform() -> dict:
 
 
 def demo_command(
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    as_json: bool = json_option(),
 ) -> None:
     """Run the thesis illustrations on the embedded data and print their results."""
     out = {}

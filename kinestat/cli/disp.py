@@ -14,6 +14,7 @@ import typer
 
 from kinestat.cli import _guidance
 from kinestat.cli._guidance import SINGULAR_HELP, parse_steps, print_result, singular_mode
+from kinestat.cli._options import STEPS_METAVAR, command_help, flag, json_option
 from kinestat.cli._output import console, err_console, print_json, table, to_jsonable
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import DispDeck, embedded_deck, list_embedded_decks, read_deck
@@ -65,28 +66,28 @@ def _print_joints(joints: list[dict]) -> None:
 def disp(
     deck: str = typer.Argument(..., help="A DISP deck file, or an embedded deck name "
                                "(illustration1 … illustration7, illustration5-corrected, …)."),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    as_json: bool = json_option(),
     steps: str = typer.Option(None, "--steps", help="Step count N for every stage, or "
                               "N1,N2,… one per stage (command or target); overrides the deck's "
-                              "IT. 0 = automatic."),
-    settle: bool = typer.Option(False, "--settle", help="Not DISP: after each stage add "
+                              "IT. 0 = automatic.", metavar=STEPS_METAVAR),
+    settle: bool = flag(False, "--settle", help="Not DISP: after each stage add "
                                 "correction steps straight at its target until it is reached "
                                 "(rows marked *)."),
-    no_settle: bool = typer.Option(False, "--no-settle", help="No correction steps (the "
+    no_settle: bool = flag(False, "--no-settle", help="No correction steps (the "
                                    "default, as DISP; kept for compatibility)."),
-    closed_loop: bool = typer.Option(False, "--closed-loop", help="Not DISP: correct every "
+    closed_loop: bool = flag(False, "--closed-loop", help="Not DISP: correct every "
                                      "step onto the ideal path by Newton iterations "
                                      "(error ≤ 1e-12)."),
-    second_order: bool = typer.Option(False, "--second-order", help="Not DISP: include the "
+    second_order: bool = flag(False, "--second-order", help="Not DISP: include the "
                                       "second-order terms of Nadkarni eq. 5-5 in every step."),
     singular: str = typer.Option("perturb", "--singular", help=SINGULAR_HELP),
-    damped: bool = typer.Option(False, "--damped", help="Short for --singular damped (not "
+    damped: bool = flag(False, "--damped", help="Short for --singular damped (not "
                                 "DISP)."),
     plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png into "
-                              "this directory."),
+                              "this directory.", metavar="DIR"),
     cond_limit: float = typer.Option(1e3, "--cond-limit", help="Dimensionless condition "
                                      "number above which a configuration counts as singular."),
-    disp_1977: bool = typer.Option(False, "--disp-1977", help="MS = 4 only: an inferred step "
+    disp_1977: bool = flag(False, "--disp-1977", help="MS = 4 only: an inferred step "
                                    "rule for the type III analysis, fitted to Table A2-9 "
                                    "(B from the hand origin's second-order displacement, "
                                    "ceil(dθ°²/40) sub-steps, a final correction step); it "
@@ -142,4 +143,4 @@ def disp(
 
 def register(app: typer.Typer) -> None:
     """Add the ``disp`` command to the ``kinestat`` app."""
-    app.command("disp")(disp)
+    app.command("disp", help=command_help(disp))(disp)

@@ -21,6 +21,14 @@ from kinestat.cli._guidance import (
     progress_reporter,
     singular_mode,
 )
+from kinestat.cli._options import (
+    POINTS3_METAVAR,
+    Q_METAVAR,
+    STEPS_METAVAR,
+    command_help,
+    flag,
+    json_option,
+)
 from kinestat.cli._output import console, parse_floats, print_json, table, to_jsonable
 from kinestat.errors import InputError, ParseError
 from kinestat.io.disp_deck import parse_operator_command
@@ -160,7 +168,7 @@ def guide(
                                 "(nadkarni-config1, nadkarni-config2, puma762, …)."),
     to: list[str] = typer.Option(None, "--to", help="Target hand position by three points "
                                  "x,y,z,x,y,z,x,y,z (origin, a point on +z, a point on the +x "
-                                 "side); repeat for several targets."),
+                                 "side); repeat for several targets.", metavar=POINTS3_METAVAR),
     kind: str = typer.Option("screw", "--type", help="Path to the targets: screw (type II), "
                              "line (type III: the hand points move on straight lines) or "
                              "general (type I, Example 4)."),
@@ -168,30 +176,32 @@ def guide(
                                       "e.g. 'frame=global,dir=0,0,1,d=4,angle=-30'; "
                                       "repeatable, run in order."),
     commands: Path = typer.Option(None, "--commands", help="File of commands, one per line "
-                                  "(key=value or DISP's 'NTY DCx DCy DCz DD THA')."),
+                                  "(key=value or DISP's 'NTY DCx DCy DCz DD THA').",
+                                  metavar="FILE"),
     move: list[str] = typer.Option(None, "--move", help="Type I Examples 1-3: "
                                    "'axis=0,0,1,angle=30,dir=1,0,0,d=5' rotates about axis "
                                    "through the hand origin while it moves d along dir."),
     q0_deg: str = typer.Option(None, "--q0-deg", help="Initial joint values (degrees for "
                                "revolute joints, length units for prismatic); default: the "
-                               "model's home."),
+                               "model's home.", metavar=Q_METAVAR),
     steps: str = typer.Option(None, "--steps", help="Step count for every stage, or one per "
-                              "stage N1,N2,…; 0 or omitted = automatic."),
-    closed_loop: bool = typer.Option(False, "--closed-loop", help="Newton-correct every step "
+                              "stage N1,N2,…; 0 or omitted = automatic.", metavar=STEPS_METAVAR),
+    closed_loop: bool = flag(False, "--closed-loop", help="Newton-correct every step "
                                      "onto the ideal path."),
-    second_order: bool = typer.Option(False, "--second-order", help="Second-order terms of "
+    second_order: bool = flag(False, "--second-order", help="Second-order terms of "
                                       "Nadkarni eq. 5-5."),
     singular: str = typer.Option("perturb", "--singular", help=SINGULAR_HELP),
-    damped: bool = typer.Option(False, "--damped", help="Short for --singular damped."),
-    no_settle: bool = typer.Option(False, "--no-settle", help="No correction steps at the end "
+    damped: bool = flag(False, "--damped", help="Short for --singular damped."),
+    no_settle: bool = flag(False, "--no-settle", help="No correction steps at the end "
                                    "of a stage (kinestat's default adds them; DISP did not)."),
     cond_limit: float = typer.Option(1e3, "--cond-limit", help="Dimensionless condition number "
                                      "above which a configuration counts as singular."),
     speed: float = typer.Option(None, "--speed", help="Hand speed for the joint rates "
                                 "(Nadkarni suggestion 1): deg/s of rotation, or length/s for a "
                                 "pure translation."),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
-    plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png here."),
+    as_json: bool = json_option(),
+    plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png here.",
+                              metavar="DIR"),
 ) -> None:
     """Guide a manipulator's hand to targets, along commands or moves (Nadkarni ch. IV).
 
@@ -266,4 +276,4 @@ def guide(
 
 def register(app: typer.Typer) -> None:
     """Add the ``guide`` command to the ``kinestat`` app."""
-    app.command("guide")(guide)
+    app.command("guide", help=command_help(guide))(guide)

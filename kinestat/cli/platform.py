@@ -12,6 +12,15 @@ from __future__ import annotations
 import numpy as np
 import typer
 
+from kinestat.cli._options import (
+    LEGS_METAVAR,
+    POSE_METAVAR,
+    TWIST_METAVAR,
+    WRENCH_METAVAR,
+    command_help,
+    help_text,
+    json_option,
+)
 from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, UnreachableError
 
@@ -30,6 +39,8 @@ platform_app = typer.Typer(
 
 
 def register(app: typer.Typer) -> None:
+    for cmd in platform_app.registered_commands:
+        cmd.help = cmd.help or command_help(cmd.callback)
     app.add_typer(platform_app, name="platform")
 
 
@@ -55,8 +66,8 @@ def _pose_rows(T: np.ndarray) -> list[list]:
 
 @platform_app.command("info")
 def info_command(
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    as_json: bool = json_option(),
 ) -> None:
     """Geometry, springs, free lengths and home pose of the platform.
 
@@ -107,9 +118,10 @@ def info_command(
 
 @platform_app.command("fk")
 def fk_command(
-    legs: str = typer.Option(..., "--legs", help="Six leg lengths in leg order (O,P,Q,R,S,T)."),
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    legs: str = typer.Option(..., "--legs", help="Six leg lengths in leg order (O,P,Q,R,S,T).",
+                             metavar=LEGS_METAVAR),
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    as_json: bool = json_option(),
 ) -> None:
     """Every real assembly mode for six leg lengths, each verified by reverse kinematics.
 
@@ -153,9 +165,9 @@ def fk_command(
 
 @platform_app.command("ik")
 def ik_command(
-    pose: str = typer.Option(..., "--pose", help=POSE_HELP),
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    pose: str = typer.Option(..., "--pose", help=POSE_HELP, metavar=POSE_METAVAR),
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    as_json: bool = json_option(),
 ) -> None:
     """Leg lengths at a pose (reverse kinematics). JSON: {"leg_lengths", "leg_names"}."""
     from kinestat.parallel.legs import leg_lengths  # lazy: start-up
@@ -175,10 +187,10 @@ def ik_command(
 
 @platform_app.command("statics")
 def statics_command(
-    pose: str = typer.Option(..., "--pose", help=POSE_HELP),
-    wrench: str = typer.Option(..., "--wrench", help=WRENCH_HELP),
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    pose: str = typer.Option(..., "--pose", help=POSE_HELP, metavar=POSE_METAVAR),
+    wrench: str = typer.Option(..., "--wrench", help=WRENCH_HELP, metavar=WRENCH_METAVAR),
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    as_json: bool = json_option(),
 ) -> None:
     """Leg forces balancing an external wrench at a pose, f = j^-1 w (Vibhute eq. 2-8).
 
@@ -208,13 +220,15 @@ def statics_command(
 
 @platform_app.command("stiffness")
 def stiffness_command(
-    pose: str = typer.Option("home", "--pose", help=POSE_HELP),
+    pose: str = typer.Option("home", "--pose", help=POSE_HELP, metavar=POSE_METAVAR),
     wrench: str = typer.Option(None, "--wrench", help=WRENCH_HELP + " The legs carry "
-                               "j^-1 w instead of their spring forces at the pose."),
+                               "j^-1 w instead of their spring forces at the pose.",
+                               metavar=WRENCH_METAVAR),
     twist_order: str = typer.Option("ray", "--twist-order",
-                                    help="'ray': dD = [dx; dphi] (default); 'axis': [dphi; dx]."),
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+                                    help=help_text("'ray': dD = [dx; dphi] (default); "
+                                                   "'axis': [dphi; dx].")),
+    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    as_json: bool = json_option(),
 ) -> None:
     """Spatial stiffness K (dw = K dD, Vibhute eq. 2-17) at a pose, loaded by the springs or w.
 
@@ -253,18 +267,20 @@ def stiffness_command(
 
 CONTACT_HELP = ("A wrench the contact can exert, fx,fy,fz,mx,my,mz (moment about O0, base "
                 "frame); repeat for 1 to 5 independent wrenches.")
-DECOMPOSE_TWIST_HELP = "Twist wx,wy,wz,vx,vy,vz: [omega; v_O] (rad, length unit), base frame."
+DECOMPOSE_TWIST_HELP = help_text("Twist wx,wy,wz,vx,vy,vz: [omega; v_O] (rad, length unit), "
+                                 "base frame.")
 
 
 @platform_app.command("decompose")
 def decompose_command(
-    twist: str = typer.Option(..., "--twist", help=DECOMPOSE_TWIST_HELP),
-    contact: list[str] = typer.Option(..., "--contact", help=CONTACT_HELP),
-    pose: str = typer.Option("home", "--pose", help=POSE_HELP),
-    wrench: str = typer.Option(None, "--wrench", help=WRENCH_HELP),
+    twist: str = typer.Option(..., "--twist", help=DECOMPOSE_TWIST_HELP, metavar=TWIST_METAVAR),
+    contact: list[str] = typer.Option(..., "--contact", help=CONTACT_HELP, metavar=WRENCH_METAVAR),
+    pose: str = typer.Option("home", "--pose", help=POSE_HELP, metavar=POSE_METAVAR),
+    wrench: str = typer.Option(None, "--wrench", help=WRENCH_HELP, metavar=WRENCH_METAVAR),
     platform: str = typer.Option(None, "--platform",
-                                 help="TOML platform file (default: the embedded 2011 prototype)."),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+                                 help="TOML platform file (default: the embedded 2011 prototype).",
+                                 metavar="FILE"),
+    as_json: bool = json_option(),
 ) -> None:
     """Twist of freedom and twist of compliance of a twist against contact wrenches.
 
