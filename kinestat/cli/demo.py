@@ -9,6 +9,7 @@ from __future__ import annotations
 import numpy as np
 import typer
 
+from kinestat.cli._compile import KERNELS, compiling_notice, is_cold, warm_kernels
 from kinestat.cli._options import command_help, json_option
 from kinestat.cli._output import console, print_json, table
 from kinestat.io.disp_deck import embedded_deck
@@ -18,6 +19,26 @@ from kinestat.spatial.displacement import frame_from_triple, screws_between
 
 def register(app: typer.Typer) -> None:
     app.command("demo", help=command_help(demo_command))(demo_command)
+    app.command("warmup", hidden=True, help=command_help(warmup_command))(warmup_command)
+
+
+def warmup_command(
+    as_json: bool = json_option(),
+) -> None:
+    """Compile kinestat's kernels now (first run only; later runs load them from the cache).
+
+    `make run` calls this, so that no command, and no control loop, spends its first run
+    compiling. JSON: {"seconds": {group: s}, "compiled": [groups that were cold]}.
+    """
+    cold = [g for g in KERNELS if is_cold(g)]
+    with compiling_notice(*KERNELS):
+        took = warm_kernels()
+    if as_json:
+        print_json({"seconds": took, "compiled": cold})
+        return
+    console.print(table("Kernels", ["group", "module", "state", "time (s)"],
+                        [[g, KERNELS[g], "compiled now" if g in cold else "cached", took[g]]
+                         for g in KERNELS], fmt="{:.2f}"))
 
 
 def _screws() -> dict:
@@ -90,6 +111,13 @@ def demo_command(
 ) -> None:
     """Run the thesis illustrations on the embedded data and print their results."""
     out = {}
+    with compiling_notice("puma762", "platform"):
+        _demo(out, as_json)
+    if as_json:
+        print_json(out)
+
+
+def _demo(out: dict, as_json: bool) -> None:
     for name, fn in (("illustration1", _screws), ("illustration2", _transm),
                      ("puma762_appendix_c", _puma), ("platform_appendix_b", _platform)):
         if as_json:
@@ -98,5 +126,3 @@ def demo_command(
         else:
             console.rule(f"[bold]{name}")
             out[name] = fn()
-    if as_json:
-        print_json(out)

@@ -13,6 +13,7 @@ from pathlib import Path
 import typer
 
 from kinestat.cli import _guidance
+from kinestat.cli._compile import compiling_notice
 from kinestat.cli._guidance import SINGULAR_HELP, parse_steps, print_result, singular_mode
 from kinestat.cli._options import STEPS_METAVAR, command_help, flag, json_option
 from kinestat.cli._output import console, err_console, print_json, table, to_jsonable
@@ -112,7 +113,7 @@ def disp(
     opts = disp_options(settle=settle, closed_loop=closed_loop, second_order=second_order,
                         singular=singular_mode(singular, damped), cond_limit=cond_limit,
                         disp_1977=disp_1977)
-    with progress_reporter(not as_json) as prog:
+    with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         run = run_deck(d, steps=parse_steps(steps), options=opts, progress=prog)
     written = []
     if plot is not None and run.result is not None:

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import typer
 
+from kinestat.cli._compile import compiling_notice
 from kinestat.cli._guidance import (
     SINGULAR_HELP,
     parse_steps,
@@ -234,7 +235,7 @@ def guide(
     opts = GuidanceOptions(step_rule="second_order" if second_order else "first_order",
                            closed_loop=closed_loop, singular=singular_mode(singular, damped),
                            settle=not no_settle, cond_limit=cond_limit)
-    with progress_reporter(not as_json) as prog:
+    with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         result = run_guidance(m, q0, stages, steps=parse_steps(steps), options=opts,
                               progress=prog)
     rates = None

@@ -7,6 +7,7 @@ from typing import Literal, get_args
 import numpy as np
 import typer
 
+from kinestat.cli._compile import compiling_notice
 from kinestat.cli._options import (
     POSE_FILE_METAVAR,
     Q_METAVAR,
@@ -145,7 +146,8 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
         current_axis = np.radians(parse_floats(current_axis_deg, 6, "current-axis-deg"))
         current = P.from_axis_angles(current_axis)
 
-    res = P.reverse(p, z, x, p6)
+    with compiling_notice("puma762"):
+        res = P.reverse(p, z, x, p6)
     b = res.batch
     if current_axis is not None:
         cand = P.select_batch(b, None, lim, current_axis=current_axis)
@@ -254,8 +256,9 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
     if q0_deg is not None:
         v = parse_floats(q0_deg, m.n, "q0-deg")
         q0 = np.where(m.prismatic, v, np.radians(v))
-    r = ik(m, T, q0, restarts=restarts, max_iter=max_iter, seed=seed,
-           respect_limits=not ignore_limits)
+    with compiling_notice("serial", "ik"):
+        r = ik(m, T, q0, restarts=restarts, max_iter=max_iter, seed=seed,
+               respect_limits=not ignore_limits)
     q_deg = np.where(m.prismatic, r.q, np.degrees(r.q))
     out = {
         "model": m.name,

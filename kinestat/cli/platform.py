@@ -12,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 import typer
 
+from kinestat.cli._compile import compiling_notice
 from kinestat.cli._options import (
     LEGS_METAVAR,
     POSE_METAVAR,
@@ -138,7 +139,9 @@ def fk_command(
             raise InputError(f"--legs: leg {name} has length {x:g}; leg lengths must be positive "
                              f"(order {', '.join(p.leg_names)})")
     if p.layout is not None:
-        poses, method = fk_list(p, L), "special 6-6 -> 3-3 closed form, all modes"
+        with compiling_notice("platform"):
+            poses = fk_list(p, L)
+        method = "special 6-6 -> 3-3 closed form, all modes"
     else:
         try:
             poses, method = [fk_numeric(p, L)], "numerical (Newton from home), one mode"

@@ -21,6 +21,9 @@ PACKAGES = ["kinestat"] + sorted(
 # `kinestat control` belongs to the cell's helpers; its module imports kinestat.app at the top
 # (see the issue-16 report for the change that makes it lazy too).
 EAGER_CLI = {"control"}
+#: a command that runs compiled kernels (the PUMA 762 closed form, Vibhute App. C example)
+IK_CLOSED_FORM = ["ik", "puma762", "--tool-point", "725,190,650", "--s6", "1,0,0", "--a67",
+                  "0,0,1"]
 
 
 def _loaded_after(statement: str) -> list[str]:
@@ -58,3 +61,32 @@ def test_every_public_name_of_a_package_resolves(package):
 def test_an_unknown_name_is_an_attribute_error():
     with pytest.raises(AttributeError, match="no_such_name"):
         kinestat.no_such_name  # noqa: B018
+
+
+def _ik_in_a_fresh_process(cache_dir) -> subprocess.CompletedProcess:
+    code = "import sys; from kinestat.cli.main import main; sys.exit(main(sys.argv[1:]))"
+    env = {**__import__("os").environ, "NUMBA_CACHE_DIR": str(cache_dir)}
+    return subprocess.run([sys.executable, "-c", code, *IK_CLOSED_FORM, "--json"],
+                          capture_output=True, text=True, timeout=600, env=env)
+
+
+def test_the_first_run_says_it_compiles_and_the_second_does_not(tmp_path):
+    first = _ik_in_a_fresh_process(tmp_path)
+    assert first.returncode == 0, first.stderr
+    assert "compiling kernels (first run only)" in first.stderr
+    json.loads(first.stdout)  # stdout stays clean JSON
+    second = _ik_in_a_fresh_process(tmp_path)
+    assert second.returncode == 0, second.stderr
+    assert "compiling" not in second.stderr
+    assert json.loads(second.stdout) == json.loads(first.stdout)
+
+
+def test_warmup_reports_every_kernel_group(capsys):
+    from kinestat.cli._compile import KERNELS, is_cold
+    from kinestat.cli.main import main
+
+    assert main(["warmup", "--json"]) == 0
+    rec = json.loads(capsys.readouterr().out)
+    assert set(rec["seconds"]) == set(KERNELS)
+    assert set(rec["compiled"]) <= set(KERNELS)
+    assert not any(is_cold(g) for g in KERNELS)  # after a warm-up nothing is cold
