@@ -118,3 +118,20 @@ def test_every_documented_command_runs(doc, tmp_path, monkeypatch):
     if ran == 0 and not skipped:
         pytest.skip(f"{doc.name} shows no kinestat command")
     assert ran or skipped
+
+
+def test_every_timing_in_the_docs_is_from_the_benchmark_record_or_dated():
+    """A µs/ms figure outside docs/performance.md (the benchmarks' record) must appear there or
+    sit in a paragraph that dates it (YYYY-MM-DD): no stale, undated speed claims."""
+    record = (ROOT / "docs" / "performance.md").read_text(encoding="utf-8")
+    stale = []
+    for doc in FILES:
+        if doc.name == "performance.md":
+            continue
+        for para in re.split(r"\n\s*\n", doc.read_text(encoding="utf-8")):
+            dated = re.search(r"20\d\d-\d\d-\d\d", para)
+            for m in re.finditer(r"(\d+(?:\.\d+)?)\s?(µs|ms)\b", para):
+                if not dated and not re.search(rf"(?<![\d.]){re.escape(m.group(1))}\s?"
+                                               rf"{m.group(2)}", record):
+                    stale.append(f"{doc.name}: {m.group(0)} in {para[:80]!r}")
+    assert not stale, "\n".join(stale)
