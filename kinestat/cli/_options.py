@@ -59,3 +59,18 @@ def flag(default: bool, *names: str, help: str) -> Any:
 def json_option() -> Any:
     """``--json``: the same flag on every command."""
     return flag(False, "--json", help=JSON_HELP)
+
+
+def units(length: str | None = None, force: str | None = None) -> dict[str, str]:
+    """The ``units`` object every JSON record carries (docs/cli.md): the length and force units
+    of its numbers; angles are radians except in keys ending ``_deg`` (degrees).
+
+    >>> units("mm", "N")
+    {'length': 'mm', 'force': 'N', 'angle': 'rad', 'angle_deg_keys': 'deg'}
+    """
+    out = {}
+    if length is not None:
+        out["length"] = length
+    if force is not None:
+        out["force"] = force
+    return {**out, "angle": "rad", "angle_deg_keys": "deg"}

@@ -15,7 +15,7 @@ import typer
 from kinestat.cli import _guidance
 from kinestat.cli._compile import compiling_notice
 from kinestat.cli._guidance import SINGULAR_HELP, parse_steps, print_result, singular_mode
-from kinestat.cli._options import STEPS_METAVAR, command_help, flag, json_option
+from kinestat.cli._options import STEPS_METAVAR, command_help, flag, json_option, units
 from kinestat.cli._output import console, err_console, print_json, table, to_jsonable
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import DispDeck, embedded_deck, list_embedded_decks, read_deck
@@ -122,6 +122,8 @@ def disp(
         written = write_guidance_plots(run.result, plot, title=f"DISP MS = {d.ms}: {d.source}")
     if as_json:
         rec = deck_json(run)
+        if run.result is not None:
+            rec["units"] = units(run.result.model.length_unit)
         if written:
             rec["plots"] = [str(p) for p in written]
         print_json(to_jsonable(rec))

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import typer
 
-from kinestat.cli._options import Q_METAVAR, XYZ_METAVAR, command_help, flag, json_option
+from kinestat.cli._options import Q_METAVAR, XYZ_METAVAR, command_help, flag, json_option, units
 from kinestat.cli._output import console, parse_floats, print_json, table
 from kinestat.errors import InputError
 
@@ -75,6 +75,7 @@ def fk_command(
         "euler_deg": ang,
         "gimbal_lock": bool(lock),
         "length_unit": m.length_unit,
+        "units": units(m.length_unit),
     }
     if not m.within_limits(vals):
         out["warning"] = "the configuration is outside the model's joint limits"

@@ -29,6 +29,7 @@ from kinestat.cli._options import (
     command_help,
     flag,
     json_option,
+    units,
 )
 from kinestat.cli._output import console, parse_floats, print_json, table, to_jsonable
 from kinestat.errors import InputError, ParseError
@@ -258,6 +259,7 @@ def guide(
             rec["joint_rate_units"] = [f"{m.length_unit}/s" if p else "deg/s"
                                        for p in m.prismatic]
         rec["notes"] = list(result.notes)
+        rec["units"] = units(m.length_unit)
         if written:
             rec["plots"] = [str(p) for p in written]
         print_json(to_jsonable(rec))
@@ -266,9 +268,9 @@ def guide(
         if rates is not None and rates.size:
             peak = np.max(np.abs(rates), axis=0)
             peak = np.where(m.prismatic, peak, np.degrees(peak))
-            units = [f"{m.length_unit}/s" if p else "deg/s" for p in m.prismatic]
+            rate_units = [f"{m.length_unit}/s" if p else "deg/s" for p in m.prismatic]
             console.print(table("Peak joint rates (Nadkarni eqs. 5-1..5-4)", ["joint", "rate"],
-                                [[str(i + 1), f"{peak[i]:.4g} {units[i]}"]
+                                [[str(i + 1), f"{peak[i]:.4g} {rate_units[i]}"]
                                  for i in range(m.n)]))
         for p in written:
             console.print(f"wrote {p}")

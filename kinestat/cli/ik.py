@@ -15,6 +15,7 @@ from kinestat.cli._options import (
     command_help,
     flag,
     json_option,
+    units,
 )
 from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, KinestatError
@@ -206,7 +207,7 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
             out["selected"] = None
             out["selection_error"] = "no solution lies within the axis limits"
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(out.get("length_unit", "mm"))})
         return
     _print_closed_form(out, res, current is not None)
 
@@ -273,7 +274,7 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
         "attempts": r.attempts,
     }
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(m.length_unit)})
     else:
         qs = np.atleast_2d(q_deg)
         ok = np.atleast_1d(r.success)

@@ -21,6 +21,7 @@ from kinestat.cli._options import (
     command_help,
     help_text,
     json_option,
+    units,
 )
 from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, UnreachableError
@@ -102,7 +103,7 @@ def info_command(
             "home_twist_deg": float(np.degrees(d.twist)), "stiffness": d.stiffness},
     }
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(p.length_unit, p.force_unit)})
         return
     console.print(f"[bold]{p.name}[/] (lengths in {p.length_unit}, forces in {p.force_unit}; "
                   f"{'special 6-6' if p.layout is not None else 'general 6-6'})")
@@ -157,7 +158,7 @@ def fk_command(
     out = {"count": len(sols), "method": method, "leg_names": list(p.leg_names),
            "leg_lengths": L, "solutions": sols}
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(p.length_unit, p.force_unit)})
         return
     console.print(f"[bold]{len(sols)}[/] assembly mode(s) of {p.name} ({method})")
     for i, s in enumerate(sols):
@@ -181,7 +182,7 @@ def ik_command(
     out = {"leg_names": list(p.leg_names), "leg_lengths": L,
            "extension": L - p.free_lengths}
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(p.length_unit, p.force_unit)})
         return
     console.print(table(f"Leg lengths ({p.length_unit})", ["leg", "length", "l - l0"],
                         [[n, x, e] for n, x, e in zip(p.leg_names, L, out["extension"],
@@ -213,7 +214,7 @@ def statics_command(
            "convention": "leg force > 0 is tension; wrench = external wrench on the top, "
                          "moment about O0, base frame"}
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(p.length_unit, p.force_unit)})
         return
     console.print(table(f"Leg tensions ({p.force_unit})", ["leg", "force"],
                         [[n, x] for n, x in zip(p.leg_names, f, strict=True)]))
@@ -257,7 +258,7 @@ def stiffness_command(
     out = {"stiffness": K, "twist_order": twist_order, "leg_forces": forces,
            "asymmetry": float(np.max(np.abs(Kr - Kr.T)))}
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(p.length_unit, p.force_unit)})
         return
     cols = ["dx", "dy", "dz", "dphi_x", "dphi_y", "dphi_z"]
     if twist_order == "axis":
@@ -308,7 +309,7 @@ def decompose_command(
     out = {"freedom": s.freedom, "compliance": s.compliance, "lambda": s.lam,
            "wrench_change": W @ s.lam, "twist_order": "axis"}
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(p.length_unit, p.force_unit)})
         return
     u = p.length_unit
     cols = ["wx (rad)", "wy (rad)", "wz (rad)", f"vx ({u})", f"vy ({u})", f"vz ({u})"]

@@ -5,7 +5,13 @@ from __future__ import annotations
 import numpy as np
 import typer
 
-from kinestat.cli._options import POINTS3_METAVAR, POSE_FILE_METAVAR, command_help, json_option
+from kinestat.cli._options import (
+    POINTS3_METAVAR,
+    POSE_FILE_METAVAR,
+    command_help,
+    json_option,
+    units,
+)
 from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError
 from kinestat.spatial.displacement import (
@@ -74,7 +80,7 @@ def screw(
             raise InputError("both --points1 and --points2 are needed")
         sc = screw_from_points(_points(points1, "points1"), _points(points2, "points2"))
     if as_json:
-        print_json(screw_json(sc))
+        print_json({**screw_json(sc), "units": units("the input's length unit")})
         return
     u, p = sc.axis, sc.point
     rows = [
