@@ -19,6 +19,7 @@ from kinestat.cli._options import (
     TWIST_METAVAR,
     WRENCH_METAVAR,
     command_help,
+    flag,
     help_text,
     json_option,
     units,
@@ -123,12 +124,16 @@ def fk_command(
     legs: str = typer.Option(..., "--legs", help="Six leg lengths in leg order (O,P,Q,R,S,T).",
                              metavar=LEGS_METAVAR),
     platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    all_poses: bool = flag(False, "--all-poses", help="Also print every mode's 4x4 pose."),
     as_json: bool = json_option(),
 ) -> None:
-    """Every real assembly mode for six leg lengths, each verified by reverse kinematics.
+    """Every real assembly mode for six leg lengths, each verified by reverse kinematics; the
+    physical one (the top above the base, nearest the home pose) is marked.
 
     JSON: {"count", "method", "solutions": [{"pose", "top_points", "above_base",
-    "max_leg_error"}]}; top_points are O1..T1 (leg order) in base coordinates.
+    "max_leg_error", "home_distance", "physical"}], "physical_mode" (1-based, as printed)};
+    top_points are O1..T1 (leg order) in base coordinates; home_distance is |p - p_home| +
+    r_top * (rotation angle from home), r_top the top's mean radius.
     """
     from kinestat.parallel.fk import fk_list, fk_numeric  # lazy: start-up (numba)
     from kinestat.parallel.legs import leg_lengths, top_points_in_base  # lazy: start-up
@@ -154,17 +159,57 @@ def fk_command(
                 f"{', '.join(f'{x:.4g}' for x in leg_lengths(p, p.home_pose))})") from exc
     sols = [{"pose": T, "top_points": top_points_in_base(p, T),
              "above_base": bool(T[2, 3] >= 0),
-             "max_leg_error": float(np.max(np.abs(leg_lengths(p, T) - L)))} for T in poses]
+             "max_leg_error": float(np.max(np.abs(leg_lengths(p, T) - L))),
+             "home_distance": _home_distance(p, T)} for T in poses]
+    physical = _physical_mode(sols)
+    for i, s in enumerate(sols):
+        s["physical"] = i == physical
     out = {"count": len(sols), "method": method, "leg_names": list(p.leg_names),
-           "leg_lengths": L, "solutions": sols}
+           "leg_lengths": L, "solutions": sols,
+           "physical_mode": None if physical is None else physical + 1}
     if as_json:
         print_json({**out, "units": units(p.length_unit, p.force_unit)})
         return
+    _print_modes(p, sols, method, physical, all_poses)
+
+
+def _home_distance(p, T: np.ndarray) -> float:
+    """|p - p_home| + r_top * angle(R_home^T R): how far a mode is from the home pose."""
+    H = p.home_pose
+    cos = np.clip((np.trace(H[:3, :3].T @ T[:3, :3]) - 1.0) / 2.0, -1.0, 1.0)
+    r_top = float(np.mean(np.linalg.norm(np.asarray(p.top_points), axis=1)))
+    return float(np.linalg.norm(T[:3, 3] - H[:3, 3]) + r_top * np.arccos(cos))
+
+
+def _physical_mode(sols: list[dict]) -> int | None:
+    """The physical assembly: above the base and nearest the home pose (None if none above)."""
+    above = [i for i, s in enumerate(sols) if s["above_base"]]
+    return min(above, key=lambda i: sols[i]["home_distance"]) if above else None
+
+
+def _print_modes(p, sols: list[dict], method: str, physical: int | None, all_poses: bool) -> None:
+    """One table of the modes (position, yaw, above the base, leg error), the physical one
+    marked, and its pose (every pose with --all-poses)."""
     console.print(f"[bold]{len(sols)}[/] assembly mode(s) of {p.name} ({method})")
+    rows = []
     for i, s in enumerate(sols):
-        console.print(table(f"Mode {i + 1}: pose (max leg error {s['max_leg_error']:.2e} "
-                            f"{p.length_unit})", ["", "x", "y", "z", "t"],
-                            _pose_rows(s["pose"])))
+        T = s["pose"]
+        yaw = float(np.degrees(np.arctan2(T[1, 0], T[0, 0])))
+        rows.append([f"{i + 1}", "physical" if i == physical else "", *T[:3, 3], yaw,
+                     "yes" if s["above_base"] else "no", f"{s['max_leg_error']:.1e}",
+                     s["home_distance"]])
+    u = p.length_unit
+    console.print(table("Assembly modes (top frame in the base frame)",
+                        ["mode", "", f"x ({u})", f"y ({u})", f"z ({u})", "yaw (deg)",
+                         "above base", f"leg error ({u})", "from home"], rows, fmt="{:.4g}"))
+    if physical is None:
+        console.print("no mode has the top above the base: none is marked physical")
+    for i, s in enumerate(sols):
+        if all_poses or i == physical:
+            what = "the physical mode" if i == physical else "pose"
+            console.print(table(f"Mode {i + 1}: {what} (max leg error "
+                                f"{s['max_leg_error']:.2e} {u})", ["", "x", "y", "z", "t"],
+                                _pose_rows(s["pose"])))
 
 
 @platform_app.command("ik")
