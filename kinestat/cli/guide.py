@@ -24,6 +24,7 @@ from kinestat.cli._guidance import (
 )
 from kinestat.cli._options import (
     POINTS3_METAVAR,
+    POSE_FILE_METAVAR,
     Q_METAVAR,
     STEPS_METAVAR,
     command_help,
@@ -31,7 +32,14 @@ from kinestat.cli._options import (
     json_option,
     units,
 )
-from kinestat.cli._output import console, parse_floats, print_json, table, to_jsonable
+from kinestat.cli._output import (
+    console,
+    parse_floats,
+    parse_pose,
+    print_json,
+    table,
+    to_jsonable,
+)
 from kinestat.errors import InputError, ParseError
 from kinestat.io.disp_deck import parse_operator_command
 
@@ -141,6 +149,14 @@ def _stages(model, q0, targets, kind, commands, moves):
     return target_stages(kind, hand_points(fk(model, q0)), targets)
 
 
+def _pose_targets(poses: list[str]) -> list[np.ndarray]:
+    """--to-pose values as the three hand points of each pose (origin, +z and +x points)."""
+    from kinestat.mechanism.nadkarni import hand_points  # lazy: start-up (`kinestat --help`)
+    from kinestat.spatial.validate import as_pose  # lazy: start-up
+
+    return [hand_points(as_pose(parse_pose(t, "to-pose"), "--to-pose")) for t in poses]
+
+
 def _rates(result, speed: float) -> tuple[np.ndarray, list[int]]:
     """Joint rates per path step (rad or length per second, eqs. 5-1..5-4) moving along the
     path at ``speed`` (deg/s of hand rotation; length/s for a purely translating step), and the
@@ -168,6 +184,10 @@ def _rates(result, speed: float) -> tuple[np.ndarray, list[int]]:
 def guide(
     model: str = typer.Argument(..., help="A TOML model file or an embedded model name "
                                 "(nadkarni-config1, nadkarni-config2, puma762, …)."),
+    to_pose: list[str] = typer.Option(None, "--to-pose", metavar=POSE_FILE_METAVAR,
+                                      help="Target hand pose T_base_hand: a pose file or 16 "
+                                      "comma-separated numbers (row by row); repeatable. "
+                                      "Instead of --to."),
     to: list[str] = typer.Option(None, "--to", help="Target hand position by three points "
                                  "x,y,z,x,y,z,x,y,z (origin, a point on +z, a point on the +x "
                                  "side); repeat for several targets.", metavar=POINTS3_METAVAR),
@@ -228,6 +248,10 @@ def guide(
         vals = parse_floats(q0_deg, m.n, "q0-deg")
         q0 = np.where(m.prismatic, vals, np.radians(vals))
     targets = [parse_floats(t, 9, "to").reshape(3, 3) for t in (to or [])]
+    if to_pose:
+        if targets:
+            raise InputError("give the targets as --to points or as --to-pose poses, not both")
+        targets = _pose_targets(to_pose)
     cmds = [parse_command(c) for c in (command or [])]
     if commands is not None:
         cmds += read_commands(commands)
