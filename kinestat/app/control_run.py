@@ -24,6 +24,12 @@ from kinestat.app.calibrations import (
     resolve_calibration,
     resolve_platform,
 )
+from kinestat.app.control_defaults import (
+    DEFAULT_DIRECTION,
+    DEFAULT_PLANE_DISTANCE,
+    DEFAULT_PLANE_TILT_DEG,
+    DEFAULT_START,
+)
 from kinestat.app.sim_cell import SimHarness, start_counts
 from kinestat.control.controller import MAX_ITERATIONS, ControllerConfig, Procedure, StepMethod
 from kinestat.control.envelope import Envelope, sent_command_guard
@@ -60,14 +66,6 @@ __all__ = [
     "plot_run",
 ]
 
-DEFAULT_START = "-400,800,-100"
-"""The start tool point ``P_tool_F`` (mm, fixed frame) of the default run."""
-DEFAULT_DIRECTION = "0.9713,0,-0.2375"
-"""The thesis's force direction ``F_req`` (Vibhute §5.1, sign restored)."""
-DEFAULT_PLANE_DISTANCE = 2.5
-"""The default workpiece plane's distance ahead of the start tool point (mm)."""
-DEFAULT_PLANE_TILT_DEG = 5.0
-"""The default workpiece normal's tilt from −F_req (degrees)."""
 
 def default_plane(start_point: np.ndarray, direction: np.ndarray, distance: float,
                   tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:

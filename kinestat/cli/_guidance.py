@@ -5,15 +5,17 @@ from __future__ import annotations
 
 import contextlib
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
-from kinestat.cli._output import console, err_console, table
+from kinestat.cli._output import console, err_console, print_pairs, table
 from kinestat.errors import InputError
-from kinestat.mechanism.nadkarni import hand_points
-from kinestat.serial.guidance.run import GuidanceResult, joint_display
+
+if TYPE_CHECKING:
+    from kinestat.serial.guidance.run import GuidanceResult
 
 __all__ = ["parse_steps", "progress_reporter", "print_result", "singular_mode", "SINGULAR_HELP"]
 
@@ -85,6 +87,9 @@ def _fmt_event(ev: dict) -> str:
 def print_result(result: GuidanceResult, notes=(), title: str = "Joint variables") -> None:
     """Human-readable tables of a guidance run (rich)."""
     m = result.model
+    from kinestat.mechanism.nadkarni import hand_points  # lazy: start-up (`kinestat --help`)
+    from kinestat.serial.guidance.run import joint_display  # lazy: start-up (numba)
+
     vals = np.round(joint_display(m, result.q), 3) + 0.0  # no "-0.000"
     cols = ["step"] + [
         (f"r{i + 1} {m.length_unit}" if m.prismatic[i] else f"θ{i + 1} deg") for i in range(m.n)]
@@ -118,4 +123,4 @@ def print_result(result: GuidanceResult, notes=(), title: str = "Joint variables
         summary.append(["STOPPED", result.stop_message or result.stop_kind or ""])
     for n in notes:
         summary.append(["note", n])
-    console.print(table("Summary", ["", ""], summary))
+    print_pairs("Summary", summary)

@@ -1,5 +1,11 @@
 """Shared output helpers for the CLI: JSON for machines, rich tables for people.
 
+The one output layer of every command. Human output never cuts what a user needs: table cells
+wrap (``overflow="fold"``) instead of ending in "…", short columns (step numbers, kinds, numbers)
+keep their full width, and summaries are ``key: value`` lines (:func:`print_pairs`), which wrap
+at the console width. The width is ``COLUMNS`` when set (also when piped), else the terminal's,
+else :data:`PIPE_WIDTH` for files and pipes.
+
 Rich reads ``[...]`` in printed strings as markup. Text that comes from the user — a model,
 platform, deck or device name, a file path, a message quoting a file — is printed literally: the
 cells and titles of :func:`table` are escaped here, and a command that interpolates user text in
@@ -10,22 +16,51 @@ crash the command with a MarkupError, and ``[link=...]`` put hyperlinks in the t
 from __future__ import annotations
 
 import json
-import sys
+import os
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-from rich.console import Console
+from rich.console import Console, ConsoleDimensions
 from rich.markup import escape
 from rich.table import Table
+from rich.text import Text
 
 from kinestat.errors import InputError
 from kinestat.io.jsonable import to_jsonable
 from kinestat.io.posefile import read_pose_file
 
-# Wide enough for the tables when output goes to a file or pipe (rich assumes 80 columns there).
-console = Console(width=None if sys.stdout.isatty() else 160)
-err_console = Console(stderr=True)
+#: the width of human output going to a file or pipe when ``COLUMNS`` is not set
+PIPE_WIDTH = 160
+#: a column whose longest cell is at most this wide is never squeezed (steps, kinds, numbers)
+KEEP_WHOLE = 14
+
+
+def _columns_env() -> int | None:
+    cols = os.environ.get("COLUMNS", "").strip()
+    return int(cols) if cols.isdigit() and int(cols) > 0 else None
+
+
+class _Console(Console):
+    """A rich console whose width is read at every print: ``COLUMNS`` (also when piped), else
+    the terminal's width, else :data:`PIPE_WIDTH` (rich alone would assume 80 for a pipe)."""
+
+    @property
+    def size(self) -> ConsoleDimensions:
+        dims = super().size
+        cols = _columns_env()
+        if cols is None and not self.is_terminal:
+            cols = PIPE_WIDTH
+        return ConsoleDimensions(cols or dims.width, dims.height)
+
+    @size.setter
+    def size(self, new_size: tuple[int, int]) -> None:
+        self._width, self._height = new_size
+
+
+console = _Console()
+err_console = _Console(stderr=True)
 
 
 def print_json(obj: Any) -> None:
@@ -42,16 +77,49 @@ def literal(value: Any) -> str:
     return escape(str(value))
 
 
+def _cell(v: Any, fmt: str) -> str:
+    return fmt.format(v) if isinstance(v, float | np.floating) else str(v)
+
+
+def _plain_len(cell: str) -> int:
+    """The printed width of a cell's longest line (cells are printed literally)."""
+    return max(len(line) for line in (cell.splitlines() or [""]))
+
+
 def table(title: str, columns: list[str], rows: list[list[Any]], fmt: str = "{:.4f}") -> Table:
-    """A rich table; floats formatted with ``fmt``. The title, headers and cells are printed
-    literally (they may hold names from the user's files)."""
+    """A rich table that never truncates; floats formatted with ``fmt``.
+
+    Cells wrap (fold) rather than end in "…"; a column whose cells are all short (at most
+    :data:`KEEP_WHOLE` characters, e.g. a step number or an event kind) keeps its full width, so
+    only the long columns give way on a narrow console. The title, headers and cells are printed
+    literally (they may hold names from the user's files).
+    """
+    cells = [[_cell(v, fmt) for v in r] for r in rows]
     t = Table(title=literal(title))
-    for c in columns:
-        t.add_column(literal(c), justify="right", no_wrap=True)
-    for r in rows:
-        t.add_row(*[fmt.format(v) if isinstance(v, (float, np.floating)) else literal(v)
-                    for v in r])
+    for j, c in enumerate(columns):
+        widest = max([_plain_len(c)] + [_plain_len(r[j]) for r in cells if j < len(r)])
+        t.add_column(literal(c), justify="right" if widest <= KEEP_WHOLE else "left",
+                     no_wrap=False, overflow="fold",
+                     min_width=widest if widest <= KEEP_WHOLE else KEEP_WHOLE)
+    for r in cells:
+        t.add_row(*[literal(x) for x in r])
     return t
+
+
+def print_pairs(title: str | None, pairs: Iterable[tuple[str, Any]], fmt: str = "{:.4f}",
+                out: Console | None = None) -> None:
+    """A summary as ``key: value`` lines; values wrap under themselves, never cut.
+
+    Values are plain text (rich markup in them is not interpreted)."""
+    out = out or console
+    grid = Table.grid(padding=(0, 1))
+    grid.add_column(style="bold", no_wrap=True)
+    grid.add_column(overflow="fold")
+    for k, v in pairs:
+        grid.add_row(Text(f"  {k}:"), Text(_cell(v, fmt)))
+    if title:
+        out.print(Text(title, style="bold"))
+    out.print(grid)
 
 
 def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.ndarray:

@@ -16,23 +16,17 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from kinestat.app.control_run import (
+from kinestat.app.control_defaults import (
     DEFAULT_DIRECTION,
     DEFAULT_PLANE_DISTANCE,
     DEFAULT_PLANE_TILT_DEG,
     DEFAULT_START,
-    MAX_ITERATIONS,
-    MAX_SAMPLES,
-    ControlRequest,
-    RealDevices,
-    SimulatedCell,
-    plot_run,
-    prepare_control,
-    run_control,
 )
 from kinestat.app.signals import stop_on_signals
 from kinestat.cli._output import console as out_console
 from kinestat.cli._output import err_console, literal, parse_floats, print_json, table
+from kinestat.control.ceilings import MAX_ITERATIONS
+from kinestat.devices.ceilings import MAX_SAMPLES
 from kinestat.errors import InputError, KinestatError
 
 
@@ -64,8 +58,10 @@ def _run_dir(base: Path) -> Path:
 
 
 def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise, friction,
-          rate, seed, sim_legs="thesis") -> SimulatedCell | RealDevices:
+          rate, seed, sim_legs="thesis"):
     """The cell the options describe: simulated (no device options) or the real devices."""
+    from kinestat.app.control_run import RealDevices, SimulatedCell  # lazy: start-up (numba)
+
     if (galil is None) != (serial is None):
         raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
                          "neither to run the simulated cell")
@@ -214,6 +210,16 @@ def control_command(
     log_path = log if log is not None else run_dir / "log.jsonl"
     plot_dir = None if no_plot else (plot if plot is not None else run_dir)
 
+    # lazy: start-up (the cell loads numba and scipy; `kinestat --help` should not)
+    from kinestat.app.control_run import (
+        ControlRequest,
+        SimulatedCell,
+        plot_run,
+        prepare_control,
+        run_control,
+    )
+    from kinestat.cli._compile import KERNELS, compiling_notice, is_cold, warm_kernels
+
     cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
                  friction, rate, seed, sim_legs)
     simulated = isinstance(cell, SimulatedCell)
@@ -223,12 +229,17 @@ def control_command(
                          max_iterations=max_iterations, calibration=calibration,
                          platform=platform, procedure=procedure, move_rule=move_rule,
                          assume_homed=assume_homed)
+    cold = tuple(g for g in KERNELS if is_cold(g))
+    if cold:  # compile before the run, so that its timing is the loop's own
+        with compiling_notice(*cold):
+            warm_kernels(cold)
     prepared = prepare_control(req)
 
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {procedure}, method "
                       f"{method}, calibration {calibration}, "
-                      + ("simulated cell" if simulated else f"Galil {galil}, sensor {serial}"))
+                      + ("simulated cell" if simulated
+                         else literal(f"Galil {galil}, sensor {serial}")))
     # SIGTERM / SIGHUP stop the cell as Ctrl-C does: ST, a fault and an end record, status 2
     with stop_on_signals():
         try:
@@ -242,7 +253,7 @@ def control_command(
             try:
                 plots = plot_run(log_path, plot_dir)
             except InputError as exc:
-                err_console.print(f"[yellow]no plot:[/] {exc}")
+                err_console.print(f"[yellow]no plot:[/] {literal(exc)}")
         out["plots"] = plots
         if as_json:
             print_json(out)
@@ -277,8 +288,10 @@ def _print_report(out: dict) -> None:
     ok = "[green]converged[/]" if out["converged"] else "[red]not converged[/]"
     out_console.print(f"Kinestatic control {ok} after {out['iterations']} cycles "
                       f"({out['moves']} moves, {out['elapsed_s']:.1f} s); states "
-                      f"{out['states']}")
-    out_console.print(f"  {literal(out['stop_reason'])}")
+                      + (" → ".join(out["states"]) if out["states"]
+                         else "none (stopped before the first cycle)"))
+    if out["converged"]:  # a failed run's reason is the one error line on stderr
+        out_console.print(f"  {literal(out['stop_reason'])}")
     rows = []
     for key, label in (("force", "force (N)"),
                        ("torque_about_tool", "torque about tool point (N·mm)"),

@@ -9,16 +9,36 @@ from __future__ import annotations
 import numpy as np
 import typer
 
+from kinestat.cli._compile import KERNELS, compiling_notice, is_cold, warm_kernels
+from kinestat.cli._options import command_help, json_option
 from kinestat.cli._output import console, print_json, table
 from kinestat.io.disp_deck import embedded_deck
-from kinestat.io.library import prototype
 from kinestat.mechanism.nadkarni import mechanism_frames
-from kinestat.parallel import fk_list, leg_lengths
 from kinestat.spatial.displacement import frame_from_triple, screws_between
 
 
 def register(app: typer.Typer) -> None:
-    app.command("demo")(demo_command)
+    app.command("demo", help=command_help(demo_command))(demo_command)
+    app.command("warmup", hidden=True, help=command_help(warmup_command))(warmup_command)
+
+
+def warmup_command(
+    as_json: bool = json_option(),
+) -> None:
+    """Compile kinestat's kernels now (first run only; later runs load them from the cache).
+
+    `make run` calls this, so that no command, and no control loop, spends its first run
+    compiling. JSON: {"seconds": {group: s}, "compiled": [groups that were cold]}.
+    """
+    cold = [g for g in KERNELS if is_cold(g)]
+    with compiling_notice(*KERNELS):
+        took = warm_kernels()
+    if as_json:
+        print_json({"seconds": took, "compiled": cold})
+        return
+    console.print(table("Kernels", ["group", "module", "state", "time (s)"],
+                        [[g, KERNELS[g], "compiled now" if g in cold else "cached", took[g]]
+                         for g in KERNELS], fmt="{:.2f}"))
 
 
 def _screws() -> dict:
@@ -69,6 +89,10 @@ def _puma() -> dict:
 def _platform() -> dict:
     """Vibhute Appendix B: every assembly mode of the prototype for main.cpp's leg lengths."""
 
+    from kinestat.io.library import prototype  # lazy: start-up
+    from kinestat.parallel.fk import fk_list  # lazy: start-up (numba)
+    from kinestat.parallel.legs import leg_lengths  # lazy: start-up
+
     p = prototype()
     legs = np.array([79.6804, 81.8285, 81.2669, 68.6500, 67.2037, 68.2854])
     modes = fk_list(p, legs)
@@ -83,10 +107,17 @@ def _platform() -> dict:
 
 
 def demo_command(
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    as_json: bool = json_option(),
 ) -> None:
     """Run the thesis illustrations on the embedded data and print their results."""
     out = {}
+    with compiling_notice("puma762", "platform"):
+        _demo(out, as_json)
+    if as_json:
+        print_json(out)
+
+
+def _demo(out: dict, as_json: bool) -> None:
     for name, fn in (("illustration1", _screws), ("illustration2", _transm),
                      ("puma762_appendix_c", _puma), ("platform_appendix_b", _platform)):
         if as_json:
@@ -95,5 +126,3 @@ def demo_command(
         else:
             console.rule(f"[bold]{name}")
             out[name] = fn()
-    if as_json:
-        print_json(out)

@@ -11,6 +11,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
+from kinestat.cli._options import command_help, flag, json_option
 from kinestat.cli._output import console, literal, print_json, table
 from kinestat.errors import InputError, ParseError
 from kinestat.io.axes_file import read_axes_file
@@ -21,18 +22,18 @@ __all__ = ["register"]
 
 
 def register(app: typer.Typer) -> None:
-    app.command("dh-from-axes")(dh_from_axes_command)
+    app.command("dh-from-axes", help=command_help(dh_from_axes_command))(dh_from_axes_command)
 
 
 def dh_from_axes_command(
     file: Path = typer.Argument(..., help="Axes file (TOML, or JSON if it ends in .json)."),
-    deg: bool = typer.Option(True, "--deg/--rad", help="Angles θ, α in degrees (default) or "
+    deg: bool = flag(True, "--deg/--rad", help="Angles θ, α in degrees (default) or "
                              "radians, in the table and the JSON keys (theta_deg or theta)."),
     write_model: Path = typer.Option(None, "--write-model", help="Save the resulting model as a "
                                      "standard-DH TOML model file."),
     tol: float = typer.Option(None, "--tol", help="Tolerance for parallel/meeting axes "
                               "(overrides the file's tol; default 1e-9)."),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    as_json: bool = json_option(),
 ) -> None:
     """Standard DH table (θ, d, a, α) from the joint axes, by the lecture notes' frame assignment.
 

@@ -13,9 +13,10 @@ from pathlib import Path
 import typer
 
 from kinestat.cli import _guidance
+from kinestat.cli._compile import compiling_notice
 from kinestat.cli._guidance import SINGULAR_HELP, parse_steps, print_result, singular_mode
+from kinestat.cli._options import STEPS_METAVAR, command_help, flag, json_option, units
 from kinestat.cli._output import console, err_console, literal, print_json, table, to_jsonable
-from kinestat.disp import deck_json, disp_options, run_deck
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import DispDeck, embedded_deck, list_embedded_decks, read_deck
 
@@ -66,28 +67,28 @@ def _print_joints(joints: list[dict]) -> None:
 def disp(
     deck: str = typer.Argument(..., help="A DISP deck file, or an embedded deck name "
                                "(illustration1 … illustration7, illustration5-corrected, …)."),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    as_json: bool = json_option(),
     steps: str = typer.Option(None, "--steps", help="Step count N for every stage, or "
                               "N1,N2,… one per stage (command or target); overrides the deck's "
-                              "IT. 0 = automatic."),
-    settle: bool = typer.Option(False, "--settle", help="Not DISP: after each stage add "
+                              "IT. 0 = automatic.", metavar=STEPS_METAVAR),
+    settle: bool = flag(False, "--settle", help="Not DISP: after each stage add "
                                 "correction steps straight at its target until it is reached "
                                 "(rows marked *)."),
-    no_settle: bool = typer.Option(False, "--no-settle", help="No correction steps (the "
+    no_settle: bool = flag(False, "--no-settle", help="No correction steps (the "
                                    "default, as DISP; kept for compatibility)."),
-    closed_loop: bool = typer.Option(False, "--closed-loop", help="Not DISP: correct every "
+    closed_loop: bool = flag(False, "--closed-loop", help="Not DISP: correct every "
                                      "step onto the ideal path by Newton iterations "
                                      "(error ≤ 1e-12)."),
-    second_order: bool = typer.Option(False, "--second-order", help="Not DISP: include the "
+    second_order: bool = flag(False, "--second-order", help="Not DISP: include the "
                                       "second-order terms of Nadkarni eq. 5-5 in every step."),
     singular: str = typer.Option("perturb", "--singular", help=SINGULAR_HELP),
-    damped: bool = typer.Option(False, "--damped", help="Short for --singular damped (not "
+    damped: bool = flag(False, "--damped", help="Short for --singular damped (not "
                                 "DISP)."),
     plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png into "
-                              "this directory."),
+                              "this directory.", metavar="DIR"),
     cond_limit: float = typer.Option(1e3, "--cond-limit", help="Dimensionless condition "
                                      "number above which a configuration counts as singular."),
-    disp_1977: bool = typer.Option(False, "--disp-1977", help="MS = 4 only: an inferred step "
+    disp_1977: bool = flag(False, "--disp-1977", help="MS = 4 only: an inferred step "
                                    "rule for the type III analysis, fitted to Table A2-9 "
                                    "(B from the hand origin's second-order displacement, "
                                    "ceil(dθ°²/40) sub-steps, a final correction step); it "
@@ -105,13 +106,15 @@ def disp(
     Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
     table up to that point is printed first.
     """
+    from kinestat.disp import deck_json, disp_options, run_deck  # lazy: start-up (numba)
+
     d = load_deck(deck)
     if settle and no_settle:
         raise InputError("give --settle or --no-settle, not both")
     opts = disp_options(settle=settle, closed_loop=closed_loop, second_order=second_order,
                         singular=singular_mode(singular, damped), cond_limit=cond_limit,
                         disp_1977=disp_1977)
-    with progress_reporter(not as_json) as prog:
+    with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         run = run_deck(d, steps=parse_steps(steps), options=opts, progress=prog)
     written = []
     if plot is not None and run.result is not None:
@@ -120,6 +123,8 @@ def disp(
         written = write_guidance_plots(run.result, plot, title=f"DISP MS = {d.ms}: {d.source}")
     if as_json:
         rec = deck_json(run)
+        if run.result is not None:
+            rec["units"] = units(run.result.model.length_unit)
         if written:
             rec["plots"] = [str(p) for p in written]
         print_json(to_jsonable(rec))
@@ -146,4 +151,4 @@ def disp(
 
 def register(app: typer.Typer) -> None:
     """Add the ``disp`` command to the ``kinestat`` app."""
-    app.command("disp")(disp)
+    app.command("disp", help=command_help(disp))(disp)

@@ -7,6 +7,7 @@ from __future__ import annotations
 import numpy as np
 import typer
 
+from kinestat.cli._options import Q_METAVAR, XYZ_METAVAR, command_help, flag, json_option, units
 from kinestat.cli._output import console, literal, parse_floats, print_json, table
 from kinestat.errors import InputError
 
@@ -15,25 +16,27 @@ _PUMA762 = "puma762"
 
 
 def register(app: typer.Typer) -> None:
-    app.command("fk")(fk_command)
+    app.command("fk", help=command_help(fk_command))(fk_command)
 
 
 def fk_command(
     model: str = typer.Argument(..., help="Embedded model name (e.g. puma762) or a TOML file."),
-    q: str = typer.Option(None, "--q", help="Joint values, comma-separated (radians / length)."),
+    q: str = typer.Option(None, "--q", help="Joint values, comma-separated (radians / length).",
+                          metavar=Q_METAVAR),
     q_deg: str = typer.Option(
-        None, "--q-deg", help="Joint values with rotating joints in degrees (prismatic: length)."
+        None, "--q-deg", help="Joint values with rotating joints in degrees (prismatic: length).",
+        metavar=Q_METAVAR
     ),
     tool_point_6: str = typer.Option(
         "0,0,0", "--tool-point-6", help="Tool point in the end frame (frame n: the PUMA's "
-        "frame 6), x,y,z."
+        "frame 6), x,y,z.", metavar=XYZ_METAVAR
     ),
     euler: str = typer.Option(
         "ZYX", "--euler", help="Euler sequence for the orientation (SciPy style: ZYX intrinsic, "
-        "zyx extrinsic)."
+        "zyx extrinsic).", metavar="SEQ"
     ),
-    frames: bool = typer.Option(False, "--frames", help="Also report every link frame."),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    frames: bool = flag(False, "--frames", help="Also report every link frame."),
+    as_json: bool = json_option(),
 ) -> None:
     """Pose of the end frame T_base_end and the tool point; for the PUMA 762 also P_tool_F,
     S6_F and a67_F in the thesis's words (Vibhute eq. 2-34).
@@ -72,6 +75,7 @@ def fk_command(
         "euler_deg": ang,
         "gimbal_lock": bool(lock),
         "length_unit": m.length_unit,
+        "units": units(m.length_unit),
     }
     if not m.within_limits(vals):
         out["warning"] = "the configuration is outside the model's joint limits"

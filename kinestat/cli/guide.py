@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import typer
 
+from kinestat.cli._compile import compiling_notice
 from kinestat.cli._guidance import (
     SINGULAR_HELP,
     parse_steps,
@@ -19,25 +21,32 @@ from kinestat.cli._guidance import (
     progress_reporter,
     singular_mode,
 )
-from kinestat.cli._output import console, literal, parse_floats, print_json, table, to_jsonable
-from kinestat.disp import result_record
-from kinestat.errors import InputError, ParseError
-from kinestat.io.disp_deck import OperatorCommand, parse_operator_command
-from kinestat.io.disp_deck.commands import parse_key_values, parse_number
-from kinestat.io.library import load
-from kinestat.io.textfile import read_text_file
-from kinestat.mechanism.nadkarni import hand_points
-from kinestat.serial.fk import fk
-from kinestat.serial.guidance.planners import twist_between
-from kinestat.serial.guidance.rules import GuidanceOptions
-from kinestat.serial.guidance.run import run_guidance
-from kinestat.serial.guidance.stages import (
-    PATH_TYPES,
-    command_stages,
-    move_stages,
-    target_stages,
+from kinestat.cli._options import (
+    POINTS3_METAVAR,
+    POSE_FILE_METAVAR,
+    Q_METAVAR,
+    STEPS_METAVAR,
+    command_help,
+    flag,
+    json_option,
+    units,
 )
-from kinestat.serial.guidance.velocity import joint_rates
+from kinestat.cli._output import (
+    console,
+    literal,
+    parse_floats,
+    parse_pose,
+    print_json,
+    table,
+    to_jsonable,
+)
+from kinestat.errors import InputError, ParseError
+from kinestat.io.disp_deck import parse_operator_command
+from kinestat.io.disp_deck.commands import parse_key_values, parse_number
+from kinestat.io.textfile import read_text_file
+
+if TYPE_CHECKING:
+    from kinestat.io.disp_deck import OperatorCommand
 
 __all__ = ["register", "parse_command", "parse_move", "read_commands"]
 
@@ -94,6 +103,14 @@ class _Cmd:
 
 
 def _stages(model, q0, targets, kind, commands, moves):
+    from kinestat.mechanism.nadkarni import hand_points  # lazy: start-up (`kinestat --help`)
+    from kinestat.serial.fk import fk  # lazy: start-up (numba)
+    from kinestat.serial.guidance.stages import (  # lazy: start-up (numba)
+        command_stages,
+        move_stages,
+        target_stages,
+    )
+
     given = sum(bool(x) for x in (targets, commands, moves))
     if given == 0:
         raise InputError("nothing to do: give --to targets, --command(s) or --move(s)")
@@ -107,10 +124,21 @@ def _stages(model, q0, targets, kind, commands, moves):
     return target_stages(kind, hand_points(fk(model, q0)), targets)
 
 
+def _pose_targets(poses: list[str]) -> list[np.ndarray]:
+    """--to-pose values as the three hand points of each pose (origin, +z and +x points)."""
+    from kinestat.mechanism.nadkarni import hand_points  # lazy: start-up (`kinestat --help`)
+    from kinestat.spatial.validate import as_pose  # lazy: start-up
+
+    return [hand_points(as_pose(parse_pose(t, "to-pose"), "--to-pose")) for t in poses]
+
+
 def _rates(result, speed: float) -> tuple[np.ndarray, list[int]]:
     """Joint rates per path step (rad or length per second, eqs. 5-1..5-4) moving along the
     path at ``speed`` (deg/s of hand rotation; length/s for a purely translating step), and the
     step numbers (correction steps at the end of a stage are left out)."""
+    from kinestat.serial.guidance.planners import twist_between  # lazy: start-up (numba)
+    from kinestat.serial.guidance.velocity import joint_rates  # lazy: start-up (numba)
+
     m = result.model
     settle = result.settle_rows()
     out, steps = [], []
@@ -131,9 +159,13 @@ def _rates(result, speed: float) -> tuple[np.ndarray, list[int]]:
 def guide(
     model: str = typer.Argument(..., help="A TOML model file or an embedded model name "
                                 "(nadkarni-config1, nadkarni-config2, puma762, …)."),
+    to_pose: list[str] = typer.Option(None, "--to-pose", metavar=POSE_FILE_METAVAR,
+                                      help="Target hand pose T_base_hand: a pose file or 16 "
+                                      "comma-separated numbers (row by row); repeatable. "
+                                      "Instead of --to."),
     to: list[str] = typer.Option(None, "--to", help="Target hand position by three points "
                                  "x,y,z,x,y,z,x,y,z (origin, a point on +z, a point on the +x "
-                                 "side); repeat for several targets."),
+                                 "side); repeat for several targets.", metavar=POINTS3_METAVAR),
     kind: str = typer.Option("screw", "--type", help="Path to the targets: screw (type II), "
                              "line (type III: the hand points move on straight lines) or "
                              "general (type I, Example 4)."),
@@ -141,22 +173,23 @@ def guide(
                                       "e.g. 'frame=global,dir=0,0,1,d=4,angle=-30'; "
                                       "repeatable, run in order."),
     commands: Path = typer.Option(None, "--commands", help="File of commands, one per line "
-                                  "(key=value or DISP's 'NTY DCx DCy DCz DD THA')."),
+                                  "(key=value or DISP's 'NTY DCx DCy DCz DD THA').",
+                                  metavar="FILE"),
     move: list[str] = typer.Option(None, "--move", help="Type I Examples 1-3: "
                                    "'axis=0,0,1,angle=30,dir=1,0,0,d=5' rotates about axis "
                                    "through the hand origin while it moves d along dir."),
     q0_deg: str = typer.Option(None, "--q0-deg", help="Initial joint values (degrees for "
                                "revolute joints, length units for prismatic); default: the "
-                               "model's home."),
+                               "model's home.", metavar=Q_METAVAR),
     steps: str = typer.Option(None, "--steps", help="Step count for every stage, or one per "
-                              "stage N1,N2,…; 0 or omitted = automatic."),
-    closed_loop: bool = typer.Option(False, "--closed-loop", help="Newton-correct every step "
+                              "stage N1,N2,…; 0 or omitted = automatic.", metavar=STEPS_METAVAR),
+    closed_loop: bool = flag(False, "--closed-loop", help="Newton-correct every step "
                                      "onto the ideal path."),
-    second_order: bool = typer.Option(False, "--second-order", help="Second-order terms of "
+    second_order: bool = flag(False, "--second-order", help="Second-order terms of "
                                       "Nadkarni eq. 5-5."),
     singular: str = typer.Option("perturb", "--singular", help=SINGULAR_HELP),
-    damped: bool = typer.Option(False, "--damped", help="Short for --singular damped."),
-    no_settle: bool = typer.Option(False, "--no-settle", help="No correction steps at the end "
+    damped: bool = flag(False, "--damped", help="Short for --singular damped."),
+    no_settle: bool = flag(False, "--no-settle", help="No correction steps at the end "
                                    "of a stage (kinestat's default adds them; DISP did not)."),
     cond_limit: float = typer.Option(1e3, "--cond-limit", help="Dimensionless condition number "
                                      "above which a configuration counts as singular."),
@@ -164,8 +197,9 @@ def guide(
                                 "(Nadkarni suggestion 1): deg/s of rotation, or length/s for a "
                                 "pure translation."),
     view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
-    plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png here."),
+    as_json: bool = json_option(),
+    plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png here.",
+                              metavar="DIR"),
 ) -> None:
     """Guide a manipulator's hand to targets, along commands or moves (Nadkarni ch. IV).
 
@@ -175,6 +209,12 @@ def guide(
     Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
     table up to that point is printed first.
     """
+    from kinestat.disp import result_record  # lazy: start-up (numba)
+    from kinestat.io.library import load  # lazy: start-up (`kinestat --help`)
+    from kinestat.serial.guidance.rules import GuidanceOptions  # lazy: start-up (numba)
+    from kinestat.serial.guidance.run import run_guidance  # lazy: start-up (numba)
+    from kinestat.serial.guidance.stages import PATH_TYPES  # lazy: start-up (numba)
+
     if kind not in PATH_TYPES:
         raise InputError(f"--type must be one of {', '.join(PATH_TYPES)}, got {kind!r}")
     m = load(model)
@@ -184,6 +224,10 @@ def guide(
         vals = parse_floats(q0_deg, m.n, "q0-deg")
         q0 = np.where(m.prismatic, vals, np.radians(vals))
     targets = [parse_floats(t, 9, "to").reshape(3, 3) for t in (to or [])]
+    if to_pose:
+        if targets:
+            raise InputError("give the targets as --to points or as --to-pose poses, not both")
+        targets = _pose_targets(to_pose)
     cmds = [parse_command(c) for c in (command or [])]
     if commands is not None:
         cmds += read_commands(commands)
@@ -192,7 +236,7 @@ def guide(
     opts = GuidanceOptions(step_rule="second_order" if second_order else "first_order",
                            closed_loop=closed_loop, singular=singular_mode(singular, damped),
                            settle=not no_settle, cond_limit=cond_limit)
-    with progress_reporter(not as_json) as prog:
+    with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         result = run_guidance(m, q0, stages, steps=parse_steps(steps), options=opts,
                               progress=prog)
     rates = None
@@ -215,6 +259,7 @@ def guide(
             rec["joint_rate_units"] = [f"{m.length_unit}/s" if p else "deg/s"
                                        for p in m.prismatic]
         rec["notes"] = list(result.notes)
+        rec["units"] = units(m.length_unit)
         if written:
             rec["plots"] = [str(p) for p in written]
         print_json(to_jsonable(rec))
@@ -223,9 +268,9 @@ def guide(
         if rates is not None and rates.size:
             peak = np.max(np.abs(rates), axis=0)
             peak = np.where(m.prismatic, peak, np.degrees(peak))
-            units = [f"{m.length_unit}/s" if p else "deg/s" for p in m.prismatic]
+            rate_units = [f"{m.length_unit}/s" if p else "deg/s" for p in m.prismatic]
             console.print(table("Peak joint rates (Nadkarni eqs. 5-1..5-4)", ["joint", "rate"],
-                                [[str(i + 1), f"{peak[i]:.4g} {units[i]}"]
+                                [[str(i + 1), f"{peak[i]:.4g} {rate_units[i]}"]
                                  for i in range(m.n)]))
         for p in written:
             console.print(f"wrote {literal(p)}")
@@ -238,4 +283,4 @@ def guide(
 
 def register(app: typer.Typer) -> None:
     """Add the ``guide`` command to the ``kinestat`` app."""
-    app.command("guide")(guide)
+    app.command("guide", help=command_help(guide))(guide)

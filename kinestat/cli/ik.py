@@ -7,6 +7,16 @@ from typing import Literal, get_args
 import numpy as np
 import typer
 
+from kinestat.cli._compile import compiling_notice
+from kinestat.cli._options import (
+    POSE_FILE_METAVAR,
+    Q_METAVAR,
+    XYZ_METAVAR,
+    command_help,
+    flag,
+    json_option,
+    units,
+)
 from kinestat.cli._output import console, literal, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError, KinestatError
 
@@ -15,7 +25,7 @@ AxisLimitSet = Literal["matlab", "table"]
 
 
 def register(app: typer.Typer) -> None:
-    app.command("ik")(ik_command)
+    app.command("ik", help=command_help(ik_command))(ik_command)
 
 
 def _read_poses(text: str) -> np.ndarray:
@@ -36,45 +46,49 @@ def ik_command(
     ),
     tool_point: str = typer.Option(
         None, "--tool-point", help="PUMA 762: P_tool_F, the tool point in the fixed frame, x,y,z "
-        "(mm)."
+        "(mm).", metavar=XYZ_METAVAR
     ),
     s6: str = typer.Option(
-        None, "--s6", help="PUMA 762: S6_F, the sixth joint axis (unit), x,y,z."
+        None, "--s6", help="PUMA 762: S6_F, the sixth joint axis (unit), x,y,z.",
+        metavar=XYZ_METAVAR
     ),
-    a67: str = typer.Option(None, "--a67", help="PUMA 762: a67_F (unit, perpendicular to S6_F)."),
+    a67: str = typer.Option(None, "--a67", help="PUMA 762: a67_F (unit, perpendicular to S6_F).",
+                            metavar=XYZ_METAVAR),
     tool_point_6: str = typer.Option(
-        "0,0,0", "--tool-point-6", help="PUMA 762: P_tool_6, the tool point in frame 6, x,y,z (mm)."
+        "0,0,0", "--tool-point-6", metavar=XYZ_METAVAR,
+        help="PUMA 762: P_tool_6, the tool point in frame 6, x,y,z (mm)."
     ),
     current_deg: str = typer.Option(
         None, "--current-deg", help="PUMA 762: current joint angles φ1,θ2..θ6 (degrees); selects "
-        "the nearest solution within the axis limits."
+        "the nearest solution within the axis limits.", metavar=Q_METAVAR
     ),
     current_axis_deg: str = typer.Option(
         None, "--current-axis-deg", help="PUMA 762: the current configuration as robot axis "
-        "angles (degrees; axis 1 = φ1 + 180)."
+        "angles (degrees; axis 1 = φ1 + 180).", metavar=Q_METAVAR
     ),
     limits: str = typer.Option(  # an AxisLimitSet
         "matlab", "--limits", help="PUMA 762 axis limits: 'matlab' (puma_rev_analysis.m, joint 5 "
         "±100°) or 'table' (Table 2-1, joint 5 ±110°)."
     ),
-    normalize: bool = typer.Option(
+    normalize: bool = flag(
         False, "--normalize", help="PUMA 762: unitise S6_F and a67_F first (as Crane's program "
         "does); they must still be perpendicular."
     ),
     pose: str = typer.Option(
         None, "--pose", help="Numerical IK target: 16 comma-separated numbers (row-major 4x4) or "
-        "a JSON file (4x4, list of 4x4, or {\"pose\": ...})."
+        "a JSON file (4x4, list of 4x4, or {\"pose\": ...}).", metavar=POSE_FILE_METAVAR
     ),
     q0_deg: str = typer.Option(
-        None, "--q0-deg", help="Numerical IK start: joint values, rotating joints in degrees."
+        None, "--q0-deg", help="Numerical IK start: joint values, rotating joints in degrees.",
+        metavar=Q_METAVAR
     ),
     restarts: int = typer.Option(20, "--restarts", help="Numerical IK: random restarts."),
     max_iter: int = typer.Option(100, "--max-iter", help="Numerical IK: iterations per attempt."),
     seed: int = typer.Option(0, "--seed", help="Numerical IK: seed of the random restarts."),
-    ignore_limits: bool = typer.Option(
+    ignore_limits: bool = flag(
         False, "--ignore-limits", help="Numerical IK: ignore the model's joint limits."
     ),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    as_json: bool = json_option(),
 ) -> None:
     """Joint angles that reach a pose.
 
@@ -133,7 +147,8 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
         current_axis = np.radians(parse_floats(current_axis_deg, 6, "current-axis-deg"))
         current = P.from_axis_angles(current_axis)
 
-    res = P.reverse(p, z, x, p6)
+    with compiling_notice("puma762"):
+        res = P.reverse(p, z, x, p6)
     b = res.batch
     if current_axis is not None:
         cand = P.select_batch(b, None, lim, current_axis=current_axis)
@@ -192,7 +207,7 @@ def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_
             out["selected"] = None
             out["selection_error"] = "no solution lies within the axis limits"
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(out.get("length_unit", "mm"))})
         return
     _print_closed_form(out, res, current is not None)
 
@@ -242,8 +257,9 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
     if q0_deg is not None:
         v = parse_floats(q0_deg, m.n, "q0-deg")
         q0 = np.where(m.prismatic, v, np.radians(v))
-    r = ik(m, T, q0, restarts=restarts, max_iter=max_iter, seed=seed,
-           respect_limits=not ignore_limits)
+    with compiling_notice("serial", "ik"):
+        r = ik(m, T, q0, restarts=restarts, max_iter=max_iter, seed=seed,
+               respect_limits=not ignore_limits)
     q_deg = np.where(m.prismatic, r.q, np.degrees(r.q))
     out = {
         "model": m.name,
@@ -258,7 +274,7 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
         "attempts": r.attempts,
     }
     if as_json:
-        print_json(out)
+        print_json({**out, "units": units(m.length_unit)})
     else:
         qs = np.atleast_2d(q_deg)
         ok = np.atleast_1d(r.success)

@@ -5,6 +5,13 @@ from __future__ import annotations
 import numpy as np
 import typer
 
+from kinestat.cli._options import (
+    POINTS3_METAVAR,
+    POSE_FILE_METAVAR,
+    command_help,
+    json_option,
+    units,
+)
 from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
 from kinestat.errors import InputError
 from kinestat.spatial.displacement import (
@@ -43,14 +50,17 @@ def screw_json(sc: ScrewDisplacement) -> dict:
 def screw(
     pose1: str = typer.Option(None, "--pose1", help="First pose: a file (4x4 or 3x4 numbers, or "
                               "JSON such as kinestat fk --json writes) or 16 comma-separated "
-                              "numbers, row by row."),
-    pose2: str = typer.Option(None, "--pose2", help="Second pose, as --pose1."),
+                              "numbers, row by row.", metavar=POSE_FILE_METAVAR),
+    pose2: str = typer.Option(None, "--pose2", help="Second pose, as --pose1.",
+                              metavar=POSE_FILE_METAVAR),
     points1: str = typer.Option(None, "--points1", help="First position by three body points "
                                 "x,y,z,x,y,z,x,y,z: origin, a point on +z, a point in the z-x "
-                                "half plane with x > 0 (Nadkarni eqs. 3-1 to 3-3)."),
-    points2: str = typer.Option(None, "--points2", help="Second position, as --points1."),
+                                "half plane with x > 0 (Nadkarni eqs. 3-1 to 3-3).",
+                                metavar=POINTS3_METAVAR),
+    points2: str = typer.Option(None, "--points2", help="Second position, as --points1.",
+                                metavar=POINTS3_METAVAR),
     view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
-    as_json: bool = typer.Option(False, "--json", help="Machine-readable JSON output."),
+    as_json: bool = json_option(),
 ) -> None:
     """Screw axis of the displacement between two positions of a body (Nadkarni ch. III).
 
@@ -79,7 +89,7 @@ def screw(
             P1, P2 = _points(points1, "points1"), _points(points2, "points2")
             show_screw(frame_from_triple(P1), frame_from_triple(P2), P1, P2)
     if as_json:
-        print_json(screw_json(sc))
+        print_json({**screw_json(sc), "units": units("the input's length unit")})
         return
     u, p = sc.axis, sc.point
     rows = [
@@ -95,4 +105,4 @@ def screw(
 
 def register(app: typer.Typer) -> None:
     """Add the ``screw`` command to the ``kinestat`` app."""
-    app.command("screw")(screw)
+    app.command("screw", help=command_help(screw))(screw)

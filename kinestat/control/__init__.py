@@ -12,21 +12,50 @@ safety envelope, log every cycle.
 The robot's axis conventions and the leg calibration come from :mod:`kinestat.hardware`.
 """
 
-from kinestat.control.controller import (
-    STATES,
-    THESIS_FORCE_DIRECTION,
-    Command,
-    ControllerConfig,
-    ControllerState,
-    Target,
-    decide,
-    start,
-)
-from kinestat.control.envelope import Envelope, predict
-from kinestat.control.log import CycleLog, read_log
-from kinestat.control.loop import CellIO, RunReport, SensorReading, run
-from kinestat.control.model import ControlModel
-from kinestat.control.wrench import Measurement, measure
+from __future__ import annotations
+
+import importlib
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load on first use
+    from kinestat.control.controller import (
+        STATES,
+        THESIS_FORCE_DIRECTION,
+        Command,
+        ControllerConfig,
+        ControllerState,
+        Target,
+        decide,
+        start,
+    )
+    from kinestat.control.envelope import Envelope, predict
+    from kinestat.control.log import CycleLog, read_log
+    from kinestat.control.loop import CellIO, RunReport, SensorReading, run
+    from kinestat.control.model import ControlModel
+    from kinestat.control.wrench import Measurement, measure
+
+# public name -> (module, attribute or None for a submodule), imported on first use
+_LAZY: dict[str, tuple[str, str | None]] = {
+    "STATES": ("kinestat.control.controller", "STATES"),
+    "THESIS_FORCE_DIRECTION": ("kinestat.control.controller", "THESIS_FORCE_DIRECTION"),
+    "Command": ("kinestat.control.controller", "Command"),
+    "ControllerConfig": ("kinestat.control.controller", "ControllerConfig"),
+    "ControllerState": ("kinestat.control.controller", "ControllerState"),
+    "Target": ("kinestat.control.controller", "Target"),
+    "decide": ("kinestat.control.controller", "decide"),
+    "start": ("kinestat.control.controller", "start"),
+    "Envelope": ("kinestat.control.envelope", "Envelope"),
+    "predict": ("kinestat.control.envelope", "predict"),
+    "CycleLog": ("kinestat.control.log", "CycleLog"),
+    "read_log": ("kinestat.control.log", "read_log"),
+    "CellIO": ("kinestat.control.loop", "CellIO"),
+    "RunReport": ("kinestat.control.loop", "RunReport"),
+    "SensorReading": ("kinestat.control.loop", "SensorReading"),
+    "run": ("kinestat.control.loop", "run"),
+    "ControlModel": ("kinestat.control.model", "ControlModel"),
+    "Measurement": ("kinestat.control.wrench", "Measurement"),
+    "measure": ("kinestat.control.wrench", "measure"),
+}
 
 __all__ = [
     "STATES",
@@ -49,3 +78,18 @@ __all__ = [
     "run",
     "start",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Load a public name's module on first use (PEP 562): importing the package stays cheap."""
+    where = _LAZY.get(name)
+    if where is None:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    module = importlib.import_module(where[0])
+    value = module if where[1] is None else getattr(module, where[1])
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -45,6 +45,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.control.envelope import (
     Envelope,
     Prediction,
@@ -146,9 +147,6 @@ class Target:
                                               self.a67 * 1e9])).astype(np.int64).tolist())
 
 
-MAX_ITERATIONS = 1000
-"""Most measurement cycles a run may be given (each is a move and a measurement, seconds on the
-real cell; the default is 60 and the thesis's runs take under 10)."""
 
 
 @dataclass(frozen=True, eq=False)

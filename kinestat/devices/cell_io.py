@@ -18,6 +18,7 @@ from typing import Any
 
 import numpy as np
 
+from kinestat.devices.ceilings import MAX_SAMPLES
 from kinestat.devices.encoder_stream import TooManyFaultsError
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.devices.motion import MOVE_RULES, MoveRule, move_plan
@@ -28,8 +29,6 @@ from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, axis45_compensat
 
 __all__ = ["MAX_SAMPLES", "SensorSample", "MotionProfile", "DeviceIO"]
 
-MAX_SAMPLES = 1000
-"""Most sensor packets averaged per measurement (5 s of the 200 Hz stream)."""
 
 DEFAULT_MAX_STREAM_FAULTS = 5
 """Stream faults tolerated while acquiring one measurement (the envelope's default,

@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError
 from kinestat.spatial.tolerances import ORTHO_TOL as _ORTHO_TOL
@@ -243,6 +242,7 @@ def screw_from_displacement(
     >>> s.point, round(float(s.theta), 12)  # a quarter turn about the vertical through x = 1
     (array([1., 0., 0.]), 1.570796326795)
     """
+    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
     D = _check_pose(D, "displacement", tol)
     Q, q = D[..., :3, :3], D[..., :3, 3]
     shape = D.shape[:-2]

@@ -20,7 +20,6 @@ from __future__ import annotations
 from itertools import product
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError
 from kinestat.spatial.transforms import as_array
@@ -84,6 +83,7 @@ def matrix_from_euler(angles, seq: str, *, degrees: bool = False) -> np.ndarray:
            [ 1.,  0.,  0.],
            [ 0.,  0.,  1.]])
     """
+    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
     check_sequence(seq)
     a = as_array(angles, shape_tail=(3,), name="Euler angles")
     flat = a.reshape(-1, 3)
@@ -144,6 +144,7 @@ def _angles_from_quat(quat: np.ndarray, seq: str) -> tuple[np.ndarray, np.ndarra
 def _zero_third(R: np.ndarray, ang: np.ndarray, seq: str) -> np.ndarray:
     """At gimbal lock, move the third angle into the first (``first +- third``, whichever sign
     reproduces ``R``) where the result still reproduces ``R`` to 1e-12; else keep ``ang``."""
+    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
     best, err_best = ang, np.full(len(ang), np.inf)
     for sgn in (1.0, -1.0):
         cand = np.stack([_wrap(ang[:, 0] + sgn * ang[:, 2]), ang[:, 1], np.zeros(len(ang))], -1)
@@ -178,6 +179,7 @@ def euler_from_matrix(
     >>> np.round(euler_from_matrix(R, 'ZYX', degrees=True), 9)
     array([30., 20., 10.])
     """
+    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
     check_sequence(seq)
     R = as_array(R, shape_tail=(3, 3), name="R")
     _check_rotations(R, tol)

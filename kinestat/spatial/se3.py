@@ -10,7 +10,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from kinestat.spatial.displacement import pose_from_screw
 from kinestat.spatial.transforms import as_array, trans
@@ -47,6 +46,7 @@ def so3_log(R) -> np.ndarray:
     >>> np.round(so3_log(so3_exp([0.1, -0.2, 0.3])), 12)
     array([ 0.1, -0.2,  0.3])
     """
+    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
     R = np.asarray(R, dtype=float)
     flat = R.reshape(-1, 3, 3)
     if flat.shape[0] == 0:

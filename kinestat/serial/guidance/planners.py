@@ -37,7 +37,6 @@ from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError
 from kinestat.spatial.displacement import (
@@ -119,6 +118,7 @@ def twist_between(T1, T2) -> np.ndarray:
 
 
 def _rot(axis, angle) -> np.ndarray:
+    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
     rv = np.asarray(axis, dtype=float) * np.asarray(angle, dtype=float)[..., None]
     flat = rv.reshape(-1, 3)
     return Rotation.from_rotvec(flat).as_matrix().reshape(rv.shape[:-1] + (3, 3))

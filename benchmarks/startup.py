@@ -1,0 +1,94 @@
+"""Start-up time of kinestat, side by side (issue 16): what a user waits for before any work.
+
+`kinestat fk` runs NumPy only (no compiled kernel), so its cold row differs from the warm one
+only by noise; `kinestat ik` with --tool-point runs the PUMA 762's compiled closed form. Each
+row is a fresh Python process (median of ``--repeat`` runs; the cold-cache row is one run
+per repeat, each with an empty ``NUMBA_CACHE_DIR``, so every kernel it uses compiles):
+
+    python benchmarks/startup.py            # a table
+    python benchmarks/startup.py --json     # the same as JSON
+
+Goal (issue 16): ``import kinestat`` and ``kinestat --help`` at most ~2x ``import numpy``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+CLI = "import sys; from kinestat.cli.main import main; sys.exit(main(sys.argv[1:]))"
+FK = ["fk", "puma762", "--q-deg", "0,0,0,0,0,0"]
+IK = ["ik", "puma762", "--tool-point", "725,190,650", "--s6", "1,0,0", "--a67", "0,0,1"]
+
+#: (label, python arguments, cold kernel cache?)
+ROWS: list[tuple[str, list[str], bool]] = [
+    ('python -c "import numpy"', ["-c", "import numpy"], False),
+    ('python -c "import kinestat"', ["-c", "import kinestat"], False),
+    ("kinestat --help", ["-c", CLI, "--help"], False),
+    ("kinestat fk puma762 --q-deg 0,0,0,0,0,0 (warm kernel cache)", ["-c", CLI, *FK], False),
+    ("kinestat fk puma762 --q-deg 0,0,0,0,0,0 (cold kernel cache)", ["-c", CLI, *FK], True),
+    ("kinestat ik puma762 --tool-point ... (closed form; warm)", ["-c", CLI, *IK], False),
+    ("kinestat ik puma762 --tool-point ... (closed form; cold)", ["-c", CLI, *IK], True),
+]
+
+
+def _once(args: list[str], cold: bool) -> float:
+    env = dict(os.environ, PYTHONPATH=str(ROOT), COLUMNS="100")
+    with tempfile.TemporaryDirectory(prefix="kinestat-numba-") as cache:
+        if cold:
+            env["NUMBA_CACHE_DIR"] = cache
+        t0 = time.perf_counter()
+        run = subprocess.run([sys.executable, *args], env=env, capture_output=True, text=True,
+                             timeout=600)
+        took = time.perf_counter() - t0
+    if run.returncode != 0:
+        raise SystemExit(f"{args} failed ({run.returncode}): {run.stderr[-500:]}")
+    return took
+
+
+def measure(repeat: int = 5) -> list[dict]:
+    """Median wall time (s) of each row over ``repeat`` fresh processes, and its ratio to
+    ``import numpy``."""
+    for _, args, _cold in ROWS:  # the warm rows need a warm cache: compile once, untimed
+        _once(args, False)
+    rows = []
+    for label, args, cold in ROWS:
+        times = [_once(args, cold) for _ in range(repeat if not cold else max(1, repeat // 2))]
+        rows.append({"command": label, "median_s": statistics.median(times),
+                     "min_s": min(times), "runs": len(times)})
+    base = rows[0]["median_s"]
+    for r in rows:
+        r["ratio_to_numpy"] = r["median_s"] / base
+    return rows
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=5, help="processes per row (default 5)")
+    ap.add_argument("--json", action="store_true", help="print JSON")
+    a = ap.parse_args(argv)
+    rows = measure(a.repeat)
+    stamp = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    if a.json:
+        print(json.dumps({"date": stamp, "python": sys.version.split()[0], "rows": rows},
+                         indent=2))
+        return 0
+    width = max(len(r["command"]) for r in rows)
+    print(f"start-up, {stamp}, Python {sys.version.split()[0]}, median of fresh processes")
+    print(f"{'command':<{width}}  {'median s':>9}  {'min s':>7}  {'x numpy':>8}")
+    for r in rows:
+        print(f"{r['command']:<{width}}  {r['median_s']:>9.3f}  {r['min_s']:>7.3f}  "
+              f"{r['ratio_to_numpy']:>8.2f}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

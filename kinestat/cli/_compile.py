@@ -1,0 +1,113 @@
+"""The first run's kernel compilation, said out loud and kept out of anyone's timing (issue 16).
+
+kinestat's kernels are compiled by Numba on first use and cached on disk (``__pycache__`` next
+to the source, or ``NUMBA_CACHE_DIR``). A command that is about to use a kernel group asks
+:func:`compiling_notice`; when none of the group's public kernels has a cache index yet, it
+says "compiling kernels (first run only)…" on stderr (a spinner on a terminal, one line
+otherwise). :func:`warm_kernels` compiles the groups ahead of time: ``kinestat warmup`` (hidden;
+``make run`` calls it) and anything that must not count compile time as its own run time.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import importlib
+import os
+import time
+from collections.abc import Iterator
+
+import numpy as np
+
+from kinestat.cli._output import err_console
+
+#: kernel groups -> the module holding their compiled kernels
+KERNELS: dict[str, str] = {
+    "serial": "kinestat.serial._kernels",
+    "ik": "kinestat.serial._ik_kernels",
+    "puma762": "kinestat.serial.puma762._kernels",
+    "platform": "kinestat.parallel._fk_kernels",
+}
+NOTICE = "compiling kernels (first run only)…"
+
+
+def _index_paths(module_name: str) -> list[str]:
+    from numba.core.dispatcher import Dispatcher  # lazy: start-up (Numba ~0.5 s)
+
+    mod = importlib.import_module(module_name)
+    paths = []
+    for name, obj in vars(mod).items():
+        if isinstance(obj, Dispatcher) and not name.startswith("_"):
+            cache_file = getattr(getattr(obj, "_cache", None), "_cache_file", None)
+            path = getattr(cache_file, "_index_path", None)
+            if path:
+                paths.append(path)
+    return paths
+
+
+def is_cold(group: str) -> bool:
+    """True when no public kernel of ``group`` has a cache index on disk (it will compile)."""
+    paths = _index_paths(KERNELS[group])
+    return bool(paths) and not any(os.path.exists(p) for p in paths)
+
+
+@contextlib.contextmanager
+def compiling_notice(*groups: str) -> Iterator[bool]:
+    """Say on stderr that kernels compile when one of ``groups`` is cold; yields whether."""
+    cold = [g for g in groups if is_cold(g)]
+    if not cold:
+        yield False
+        return
+    if err_console.is_terminal:
+        with err_console.status(NOTICE):
+            yield True
+        return
+    err_console.print(f"kinestat: {NOTICE}", highlight=False)
+    yield True
+
+
+def _warm_serial() -> None:
+    from kinestat.io.library import load  # lazy: start-up
+    from kinestat.serial.fk import fk, fk_frames  # lazy: start-up (numba)
+    from kinestat.serial.jacobian import jacobian  # lazy: start-up (numba)
+
+    m = load("puma762")
+    q = np.zeros(m.n)
+    fk(m, q), fk(m, q[None]), fk_frames(m, q), jacobian(m, q), jacobian(m, q[None])
+
+
+def _warm_ik() -> None:
+    from kinestat.io.library import load  # lazy: start-up
+    from kinestat.serial.fk import fk  # lazy: start-up (numba)
+    from kinestat.serial.ik import ik  # lazy: start-up (numba)
+
+    m = load("puma762")
+    ik(m, fk(m, np.full(m.n, 0.1)), restarts=1, max_iter=5)
+
+
+def _warm_puma762() -> None:
+    from kinestat.serial import puma762  # lazy: start-up (numba)
+
+    puma762.reverse([725.0, 190.0, 650.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
+
+
+def _warm_platform() -> None:
+    from kinestat.io.library import prototype  # lazy: start-up
+    from kinestat.parallel.fk import fk_list  # lazy: start-up (numba)
+    from kinestat.parallel.legs import leg_lengths  # lazy: start-up
+
+    p = prototype()
+    fk_list(p, leg_lengths(p, p.home_pose))
+
+
+_WARM = {"serial": _warm_serial, "ik": _warm_ik, "puma762": _warm_puma762,
+         "platform": _warm_platform}
+
+
+def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:
+    """Compile (or load from the cache) the kernels of ``groups``; seconds per group."""
+    took = {}
+    for g in groups:
+        t0 = time.perf_counter()
+        _WARM[g]()
+        took[g] = time.perf_counter() - t0
+    return took

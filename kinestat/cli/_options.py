@@ -1,0 +1,76 @@
+"""The CLI's shared option vocabulary and help text (issue 16; docs/cli.md).
+
+One place for what every command spells the same way: ``--json``, flags without a value
+placeholder, the metavars of comma-separated values (``--q-deg A,B,C,...``), and command help
+from a docstring (paragraphs unwrapped so the help wraps once, at the terminal's width, and
+square brackets kept: rich would take ``[dx; dphi]`` for markup and drop it).
+"""
+
+from __future__ import annotations
+
+import inspect
+import re
+from collections.abc import Callable
+from typing import Any
+
+import typer
+from rich.markup import escape
+
+#: metavars: what a comma-separated option expects
+Q_METAVAR = "A,B,C,..."
+XYZ_METAVAR = "X,Y,Z"
+POINTS3_METAVAR = "X,Y,Z,X,Y,Z,X,Y,Z"
+LEGS_METAVAR = "L1,L2,L3,L4,L5,L6"
+WRENCH_METAVAR = "FX,FY,FZ,MX,MY,MZ"
+TWIST_METAVAR = "WX,WY,WZ,VX,VY,VZ"
+POSE_METAVAR = "home|FILE|T11,...,T44"
+POSE_FILE_METAVAR = "FILE|T11,...,T44"
+STEPS_METAVAR = "N|N1,N2,..."
+JSON_HELP = "Machine-readable JSON output."
+
+
+def help_text(text: str) -> str:
+    """Option or command help as rich shows it as written: ``[...]`` escaped."""
+    return escape(text)
+
+
+def command_help(fn: Callable[..., Any]) -> str:
+    """A command's help from its docstring: each paragraph on one line (rich re-wraps it at the
+    terminal's width, so it is wrapped once), brackets escaped.
+
+    >>> def f():
+    ...     '''First line
+    ...     continues. [dx; dphi]
+    ...
+    ...     Second paragraph.'''
+    >>> command_help(f)
+    'First line continues. \\\\[dx; dphi]\\n\\nSecond paragraph.'
+    """
+    doc = inspect.cleandoc(fn.__doc__ or "")
+    paragraphs = [re.sub(r"\s*\n\s*", " ", p.strip()) for p in re.split(r"\n\s*\n", doc)]
+    return escape("\n\n".join(p for p in paragraphs if p))
+
+
+def flag(default: bool, *names: str, help: str) -> Any:
+    """A boolean flag: shown without a value placeholder (no ``<bool>``)."""
+    return typer.Option(default, *names, help=help_text(help), metavar="")
+
+
+def json_option() -> Any:
+    """``--json``: the same flag on every command."""
+    return flag(False, "--json", help=JSON_HELP)
+
+
+def units(length: str | None = None, force: str | None = None) -> dict[str, str]:
+    """The ``units`` object every JSON record carries (docs/cli.md): the length and force units
+    of its numbers; angles are radians except in keys ending ``_deg`` (degrees).
+
+    >>> units("mm", "N")
+    {'length': 'mm', 'force': 'N', 'angle': 'rad', 'angle_deg_keys': 'deg'}
+    """
+    out = {}
+    if length is not None:
+        out["length"] = length
+    if force is not None:
+        out["force"] = force
+    return {**out, "angle": "rad", "angle_deg_keys": "deg"}
