@@ -84,6 +84,25 @@ def choice(v, allowed, source: str, field: str, what: str | None = None) -> str:
     return v
 
 
+def unit(doc: dict, key: str, source: str, example: str, allowed=None) -> str:
+    """The unit named by ``key``: required (units are never guessed), a string, and one of
+    ``allowed`` when given. ``example`` is the line to add, quoted in the error.
+
+    >>> unit({"angle_unit": "rad"}, "angle_unit", "a.toml", 'angle_unit = "deg"', ("deg", "rad"))
+    'rad'
+    >>> unit({}, "length_unit", "a.toml", 'length_unit = "mm"')
+    Traceback (most recent call last):
+    ...
+    kinestat.errors.ParseError: a.toml, field length_unit: missing 'length_unit': units are never \
+guessed; add a line such as length_unit = "mm"
+    """
+    if key not in doc:
+        raise ParseError(f"missing {key!r}: units are never guessed; add a line such as {example}",
+                         file=source, field=key)
+    return string(doc[key], source, key) if allowed is None else choice(doc[key], allowed,
+                                                                        source, key)
+
+
 def matrix(v, source: str, field: str, shape: tuple[int, int]) -> np.ndarray:
     """A finite array of ``shape`` (e.g. a 4x4 pose)."""
     try:

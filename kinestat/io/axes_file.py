@@ -4,7 +4,7 @@ The file (TOML, or JSON with the same structure) lists the joint axes in one con
 the arm::
 
     name = "my-arm"              # optional (default: the file name)
-    length_unit = "mm"           # optional
+    length_unit = "mm"           # required
     description = "..."          # optional
     tol = 1e-9                   # optional (see kinestat.mechanism.dh_from_axes)
     tool = [[1,0,0,0],[0,1,0,0],[0,0,1,0],[0,0,0,1]]   # optional: tool pose, world frame
@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from kinestat.errors import ParseError
-from kinestat.io._fields import joint_type_and_pitch, matrix, number, numbers, refuse_unknown
+from kinestat.io._fields import joint_type_and_pitch, matrix, number, numbers, refuse_unknown, unit
 from kinestat.io.textfile import parse_json, parse_toml, read_text_file
 
 __all__ = ["loads_axes", "read_axes_file"]
@@ -105,7 +105,8 @@ def loads_axes(doc: dict, source: str = "<string>") -> dict:
         lines = [ln if len(ln) == 6 else [*ln[1], *np.cross(ln[0], ln[1])] for ln in lines]
     out: dict = {"axes": np.array(lines, dtype=float), "kinds": kinds, "pitches": pitches,
                  "names": names, "name": str(doc.get("name", Path(source).stem)),
-                 "length_unit": str(doc.get("length_unit", "mm")),
+                 "length_unit": unit(doc, "length_unit", source,
+                                    'length_unit = "mm" (the unit of the points)'),
                  "description": str(doc.get("description", ""))}
     for k in ("tool", "base"):
         if k in doc:

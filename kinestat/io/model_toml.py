@@ -1,6 +1,7 @@
 """TOML model files: read, write, round trip.
 
-Schema (angles in the file's ``angle_unit``, default degrees; lengths in ``length_unit``)::
+Schema (both units required: angles in the file's ``angle_unit``, lengths in ``length_unit``;
+a file without them is refused, naming the key to add)::
 
     name = "puma762"
     notation = "modified_dh"      # standard_dh | modified_dh | nadkarni
@@ -51,6 +52,7 @@ from kinestat.io._fields import (
     number,
     refuse_unknown,
     short_repr,
+    unit,
 )
 from kinestat.io.textfile import parse_toml, read_text_file, write_text_atomic
 from kinestat.mechanism.chain import (
@@ -128,7 +130,8 @@ def _joint_tables(joints: list, fields: tuple[str, ...], to_rad: float, source: 
 def _from_doc(doc: dict, source: str) -> ChainModel:
     refuse_unknown(doc, _TOP_KEYS, source, "top-level keys")
     notation = choice(doc.get("notation"), _FIELDS, source, "notation")
-    angle_unit = choice(doc.get("angle_unit", "deg"), ("deg", "rad"), source, "angle_unit")
+    angle_unit = unit(doc, "angle_unit", source, 'angle_unit = "deg" (or "rad")',
+                      ("deg", "rad"))
     to_rad = math.pi / 180.0 if angle_unit == "deg" else 1.0
     # keys of the other notations: refused rather than silently ignored
     unused = ["q_home"] if notation == "nadkarni" else ["frame_points", "hand"]
@@ -138,7 +141,7 @@ def _from_doc(doc: dict, source: str) -> ChainModel:
                     if k == "q_home" else "it belongs to the nadkarni notation")
             raise _err(f"'{k}' is not used with the {notation} notation ({hint})", source, k)
     name = str(doc.get("name", Path(source).stem))
-    length_unit = str(doc.get("length_unit", "mm"))
+    length_unit = unit(doc, "length_unit", source, 'length_unit = "mm" (the unit of every length)')
     joints = doc.get("joints")
     if not isinstance(joints, list) or not joints:
         raise _err("expected at least one [[joints]] table", source, "joints")

@@ -51,7 +51,7 @@ import numpy as np
 import tomli_w
 
 from kinestat.errors import InputError, ModelError, ParseError
-from kinestat.io._fields import matrix, number, numbers, refuse_unknown, string
+from kinestat.io._fields import matrix, number, numbers, refuse_unknown, string, unit
 from kinestat.io.textfile import parse_toml, read_text_file, write_text_atomic
 from kinestat.parallel.platform import LEG_NAMES, Platform, special_6_6
 from kinestat.parallel.singularity import check_design
@@ -71,14 +71,7 @@ _LEG_KEYS = {"name", "base", "top", "stiffness", "free_length"}
 
 
 def _unit(doc: dict, key: str, allowed: tuple[str, ...], source: str) -> str:
-    if key not in doc:
-        raise ParseError(f"missing required {key!r} (one of {list(allowed)}): units must be "
-                         "explicit", file=source, field=key)
-    u = string(doc[key], source, key)
-    if u not in allowed:
-        raise ParseError(f"unknown unit {u!r}; expected one of {list(allowed)}", file=source,
-                         field=key)
-    return u
+    return unit(doc, key, source, f"{key} = {allowed[0]!r} (one of {list(allowed)})", allowed)
 
 
 def loads_platform(text: str, source: str = "<string>") -> Platform:

@@ -120,9 +120,11 @@ def test_puma560_axes_file(capsys, tmp_path, rng):
     ('[[axes]]\npoint = [0, 0, 0]\ndirection = [0, 0, 1]\ncolour = 1\n', "unknown keys"),
     ('[[axes]]\nplucker = [0, 0, 1, 1, 0, 1]\n', "Plücker"),
     ('name = "x"\n', "at least one [[axes]]"),
-    ('tool = [[1, 0], [0, 1]]\n[[axes]]\npoint = [0,0,0]\ndirection = [0,0,1]\n', "4x4"),
+    ('length_unit = "mm"\n'
+     'tool = [[1, 0], [0, 1]]\n[[axes]]\npoint = [0,0,0]\ndirection = [0,0,1]\n', "4x4"),
     ('[[axes]\n', "not valid TOML"),
-    ('base = [[1,0,0,0.5],[0,1,0,0],[0,0,1,0],[0,0,0,1]]\n[[axes]]\npoint = [0,0,0]\n'
+    ('length_unit = "mm"\n'
+     'base = [[1,0,0,0.5],[0,1,0,0],[0,0,1,0],[0,0,0,1]]\n[[axes]]\npoint = [0,0,0]\n'
      'direction = [0,0,1]\n', "origin"),
 ])
 def test_errors_are_clean(capsys, tmp_path, body, msg):
@@ -142,7 +144,7 @@ def test_missing_file_and_bad_json(capsys, tmp_path):
     assert "line 2" in capsys.readouterr().err
 
 
-_AXIS = '[[axes]]\npoint = [0, 0, 0]\ndirection = [0, 0, 1]\n'
+_AXIS = 'length_unit = "mm"\n[[axes]]\npoint = [0, 0, 0]\ndirection = [0, 0, 1]\n'
 
 
 @pytest.mark.parametrize("body, where", [
@@ -180,3 +182,11 @@ def test_bad_tol_option_names_the_option(capsys, tmp_path):
     p.write_text(_AXIS)
     assert main(["dh-from-axes", str(p), "--tol", "-1"]) == 2
     assert "--tol must be" in capsys.readouterr().err
+
+
+def test_an_axes_file_without_a_length_unit_is_refused(tmp_path, capsys):
+    p = tmp_path / "axes.toml"
+    p.write_text('[[axes]]\npoint = [0, 0, 0]\ndirection = [0, 0, 1]\n')
+    assert main(["dh-from-axes", str(p)]) == 2
+    err = capsys.readouterr().err
+    assert "missing 'length_unit'" in err and "axes.toml" in err and len(err.splitlines()) == 1

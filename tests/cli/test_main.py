@@ -104,7 +104,8 @@ def test_platform_name_with_markup_is_printed_literally(tmp_path, capsys):
 
 def test_axes_name_and_output_path_with_markup_are_printed_literally(tmp_path, capsys):
     axes = tmp_path / "axes.toml"
-    axes.write_text(f'name = "{NASTY}"\n[[axes]]\npoint = [0, 0, 0]\ndirection = [0, 0, 1]\n'
+    axes.write_text(f'name = "{NASTY}"\nlength_unit = "mm"\n'
+                    '[[axes]]\npoint = [0, 0, 0]\ndirection = [0, 0, 1]\n'
                     '[[axes]]\npoint = [0, 0, 1]\ndirection = [1, 0, 0]\n')
     target = tmp_path / "out[bold]x.toml"
     assert main(["dh-from-axes", str(axes), "--write-model", str(target)]) == 0

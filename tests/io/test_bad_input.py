@@ -31,6 +31,8 @@ DEEP = 100_000
 MODEL = textwrap.dedent("""\
     name = "arm"
     notation = "standard_dh"
+    length_unit = "m"
+    angle_unit = "deg"
     [[joints]]
     theta = 0.0
     d = 0.5
@@ -89,7 +91,8 @@ def test_platform_integer_of_hundreds_of_digits():
 
 @pytest.mark.parametrize("body, field", [
     ('[[axes]]\npoint = [0, 0, {n}]\ndirection = [0, 0, 1]\n', "axes[1].point[2]"),
-    ('tol = {n}\n[[axes]]\npoint = [0, 0, 0]\ndirection = [0, 0, 1]\n', "tol"),
+    ('length_unit = "mm"\ntol = {n}\n[[axes]]\npoint = [0, 0, 0]\ndirection = [0, 0, 1]\n',
+     "tol"),
 ])
 def test_axes_integer_of_hundreds_of_digits(tmp_path, body, field):
     p = tmp_path / "axes.toml"
@@ -166,7 +169,7 @@ def test_parse_helpers_name_the_source():
 def test_wrong_type_for_a_choice(key, value):
     text = MODEL.format(a="0.1", hi="90.0")
     text = (text.replace('notation = "standard_dh"', f"notation = {value}") if key == "notation"
-            else f"angle_unit = {value}\n" + text)
+            else text.replace('angle_unit = "deg"', f"angle_unit = {value}"))
     with pytest.raises(ParseError, match=f"{key} must be one of") as ei:
         loads_model(text, source="arm.toml")
     assert ei.value.field == key
