@@ -23,6 +23,7 @@ from kinestat.app.control_defaults import (
     DEFAULT_START,
 )
 from kinestat.app.signals import stop_on_signals
+from kinestat.cli._options import flag
 from kinestat.cli._output import console as out_console
 from kinestat.cli._output import err_console, literal, parse_floats, print_json, table
 from kinestat.control.ceilings import MAX_ITERATIONS
@@ -158,27 +159,30 @@ def control_command(
     log: Path = typer.Option(
         None, "--log", help="Cycle log file, JSON lines (default: "
         "./kinestat-runs/<timestamp>/log.jsonl)."),
-    view: bool = typer.Option(False, "--view", help="Also open a 3D replay in the browser."),
+    view: bool = flag(False, "--view", help="Also open a 3D replay in the browser."),
     calibration: str = typer.Option(
         "thesis", "--calibration",
         help="Leg calibration the controller uses (counts -> leg length and force): 'thesis' "
         "(the 2011 prototype's maps), 'nominal' (the design springs) or a TOML file "
-        "(docs/control.md)."),
+        "(docs/control.md).", metavar="thesis|nominal|FILE"),
     platform: str = typer.Option(
-        None, "--platform", help="Platform TOML file (default the 2011 prototype)."),
+        None, "--platform", help="Platform TOML file (default the 2011 prototype).",
+        metavar="FILE"),
     sim_legs: str = typer.Option(
         "thesis", "--sim-legs",
         help="The simulated legs' TRUE law: 'thesis', 'nominal' or a calibration TOML file "
-        "(simulation only)."),
+        "(simulation only).", metavar="thesis|nominal|FILE"),
     procedure: str = typer.Option(
         "kinestat", "--procedure",
         help="'kinestat' (the improved loop) or 'thesis' (ForceCorrection.m as written: one "
-        "reorientation about the tool point, then fixed --step translations along S6)."),
+        "reorientation about the tool point, then fixed --step translations along S6).",
+        metavar="kinestat|thesis"),
     move_rule: str = typer.Option(
         "coordinated", "--move-rule",
         help="Per-axis speeds of each move: 'coordinated' (the axes start and finish together), "
-        "'thesis' (galil_control.m's |delta|/4 counts/s) or 'max'."),
-    assume_homed: bool = typer.Option(
+        "'thesis' (galil_control.m's |delta|/4 counts/s) or 'max'.",
+        metavar="coordinated|thesis|max"),
+    assume_homed: bool = flag(
         False, "--assume-homed",
         help="With --galil: move even if the controller does not report this session homed "
         "(`kinestat home`)."),

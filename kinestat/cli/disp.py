@@ -94,7 +94,7 @@ def disp(
                                    "ceil(dθ°²/40) sub-steps, a final correction step); it "
                                    "reproduces that table with the illustration5-published "
                                    "deck. Not stated in the thesis."),
-    view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
+    view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
 ) -> None:
     """Run a DISP deck (Nadkarni 1977): MS 1 screw axes, 2 mechanism data, 3 both, 0/4/5/6
     guidance of types II/III/IV/I.

@@ -196,7 +196,7 @@ def guide(
     speed: float = typer.Option(None, "--speed", help="Hand speed for the joint rates "
                                 "(Nadkarni suggestion 1): deg/s of rotation, or length/s for a "
                                 "pure translation."),
-    view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
+    view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
     as_json: bool = json_option(),
     plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png here.",
                               metavar="DIR"),

@@ -12,6 +12,7 @@ from pathlib import Path
 import typer
 
 from kinestat.app.homing_run import run_home
+from kinestat.cli._options import flag
 from kinestat.cli._output import console, err_console, print_json
 from kinestat.errors import InputError, KinestatError
 
@@ -29,11 +30,12 @@ def _host_port(text: str) -> tuple[str, int]:
 
 def home_command(
     galil: str = typer.Option(..., "--galil", help="Galil controller HOST:PORT (a real DMC "
-                              "or `kinestat sim galil`)."),
-    samples: int = typer.Option(100, "--samples", help="Pot readings averaged per axis."),
+                              "or `kinestat sim galil`).", metavar="HOST:PORT"),
+    samples: int = typer.Option(100, "--samples", help="Pot readings averaged per axis.",
+                                metavar="N"),
     log: Path = typer.Option(None, "--log", help="Step log, JSON lines (default: "
-                             "./kinestat-runs/home-<timestamp>.jsonl)."),
-    as_json: bool = typer.Option(False, "--json", help="Print the report as JSON."),
+                             "./kinestat-runs/home-<timestamp>.jsonl).", metavar="FILE"),
+    as_json: bool = flag(False, "--json", help="Print the report as JSON."),
 ) -> None:
     """Power-on checks, pot-based coarse positioning, index search and home definition
     (startup_initialize.m). Refuses (amplifiers off via MO) when a check fails.

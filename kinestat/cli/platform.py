@@ -126,7 +126,7 @@ def fk_command(
                              metavar=LEGS_METAVAR),
     platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
     all_poses: bool = flag(False, "--all-poses", help="Also print every mode's 4x4 pose."),
-    view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
+    view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
     as_json: bool = json_option(),
 ) -> None:
     """Every real assembly mode for six leg lengths, each verified by reverse kinematics; the

@@ -9,6 +9,7 @@ from kinestat.cli._options import (
     POINTS3_METAVAR,
     POSE_FILE_METAVAR,
     command_help,
+    flag,
     json_option,
     units,
 )
@@ -59,7 +60,7 @@ def screw(
                                 metavar=POINTS3_METAVAR),
     points2: str = typer.Option(None, "--points2", help="Second position, as --points1.",
                                 metavar=POINTS3_METAVAR),
-    view: bool = typer.Option(False, "--view", help="Also open a 3D view in the browser."),
+    view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
     as_json: bool = json_option(),
 ) -> None:
     """Screw axis of the displacement between two positions of a body (Nadkarni ch. III).

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import typer
 
+from kinestat.cli._options import XYZ_METAVAR, flag
 from kinestat.cli._output import console, parse_floats, print_json, table
 
 sweep_app = typer.Typer(
@@ -22,26 +23,28 @@ sweep_app = typer.Typer(
 )
 
 OUTPUT = typer.Option(None, "--output", help="Output directory (default "
-                      "./kinestat-runs/<study>-<spec hash>; an existing one resumes).")
+                      "./kinestat-runs/<study>-<spec hash>; an existing one resumes).",
+                      metavar="DIR")
 SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler address tcp://HOST:PORT "
-                         "(default: an embedded local cluster).")
+                         "(default: an embedded local cluster).", metavar="tcp://HOST:PORT")
 WORKERS = typer.Option(None, "--workers", help="Local cluster: worker count (default: cores).")
-THREADS = typer.Option(False, "--threads", help="Local cluster: thread workers, not processes.")
+THREADS = flag(False, "--threads", help="Local cluster: thread workers, not processes.")
 TIMEOUT = typer.Option(10.0, "--timeout", help="Seconds to wait for the scheduler and a worker.")
 SEED = typer.Option(0, "--seed", help="Seed of the random inputs (--samples).")
 CHUNK = typer.Option(None, "--chunk-size", help="Evaluations per chunk (default per study).")
 MAX_CHUNKS = typer.Option(None, "--max-chunks", help="Stop after computing this many new chunks "
                           "(a staged run; rerun the command to resume).")
-NO_ARRAYS = typer.Option(False, "--no-arrays", help="Write only summaries, no per-row Parquet.")
-NO_PLOTS = typer.Option(False, "--no-plots", help="Do not write PNG plots.")
-QUIET = typer.Option(False, "--quiet", help="No progress bar.")
-JSON = typer.Option(False, "--json", help='JSON: {"study", "summary", "output", "chunks", '
+NO_ARRAYS = flag(False, "--no-arrays", help="Write only summaries, no per-row Parquet.")
+NO_PLOTS = flag(False, "--no-plots", help="Do not write PNG plots.")
+QUIET = flag(False, "--quiet", help="No progress bar.")
+JSON = flag(False, "--json", help='JSON: {"study", "summary", "output", "chunks", '
                     '"elapsed_s", "complete", "plots"}.')
 PLATFORM = typer.Option(None, "--platform", help="TOML platform file (default: the embedded "
-                        "2011 prototype).")
+                        "2011 prototype).", metavar="FILE")
 RANGE_MM = typer.Option("3.5,3.5,4", "--range-mm", help="Motion range +- x,y,z (length unit; "
-                        "Vibhute Table 3-1).")
-RANGE_DEG = typer.Option("4,4,6", "--range-deg", help="Motion range +- about x,y,z (degrees).")
+                        "Vibhute Table 3-1).", metavar=XYZ_METAVAR)
+RANGE_DEG = typer.Option("4,4,6", "--range-deg", help="Motion range +- about x,y,z (degrees).",
+                         metavar=XYZ_METAVAR)
 MAX_DEFL = typer.Option(5.0, "--max-deflection", help="Connector deflection limit (Table 3-1).")
 MAX_LOAD = typer.Option(50.0, "--max-load", help="Perpendicular load limit |F_z| (Table 3-1).")
 

@@ -13,6 +13,16 @@ from pathlib import Path
 import numpy as np
 import typer
 
+from kinestat.cli._options import (
+    LEGS_METAVAR,
+    POINTS3_METAVAR,
+    POSE_FILE_METAVAR,
+    POSE_METAVAR,
+    Q_METAVAR,
+    STEPS_METAVAR,
+    WRENCH_METAVAR,
+    flag,
+)
 from kinestat.cli._output import console, parse_floats, parse_pose
 from kinestat.errors import InputError
 from kinestat.io.textfile import write_text_atomic
@@ -88,30 +98,32 @@ def _load_model(spec: str):
 
 # The output options, repeated on every command (Typer has no shared option groups).
 def _html_opt():
-    return typer.Option(None, "--html", help=HTML_HELP)
+    return typer.Option(None, "--html", help=HTML_HELP, metavar="FILE")
 
 
 def _serve_opt():
-    return typer.Option(False, "--serve", help=SERVE_HELP)
+    return flag(False, "--serve", help=SERVE_HELP)
 
 
 def _host_opt():
-    return typer.Option("127.0.0.1", "--host", help="Address to serve on (default loopback).")
+    return typer.Option("127.0.0.1", "--host", help="Address to serve on (default loopback).",
+                        metavar="HOST")
 
 
 def _port_opt():
-    return typer.Option(0, "--port", help="Port to serve on (0: a free one, printed).")
+    return typer.Option(0, "--port", help="Port to serve on (0: a free one, printed).",
+                        metavar="PORT")
 
 
 def _no_open_opt():
-    return typer.Option(False, "--no-open", help="Do not open a browser.")
+    return flag(False, "--no-open", help="Do not open a browser.")
 
 
 @view_app.callback()
 def view_root(
     ctx: typer.Context,
     log: Path = typer.Option(None, "--log", help="Replay a control run's cycle log "
-                             "(same as `kinestat view log FILE`)."),
+                             "(same as `kinestat view log FILE`).", metavar="FILE"),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     port: int = _port_opt(), no_open: bool = _no_open_opt(),
 ) -> None:
@@ -131,9 +143,11 @@ def view_root(
 @view_app.command("model")
 def view_model(
     model: str = typer.Argument(..., help="Embedded model name, a TOML model or a URDF file."),
-    q: str = typer.Option(None, "--q", help="Joint values shown first (radians / length)."),
-    q_deg: str = typer.Option(None, "--q-deg", help="Joint values, rotating joints in degrees."),
-    frames: bool = typer.Option(False, "--frames", help="Show every joint frame."),
+    q: str = typer.Option(None, "--q", help="Joint values shown first (radians / length).",
+                         metavar=Q_METAVAR),
+    q_deg: str = typer.Option(None, "--q-deg", help="Joint values, rotating joints in degrees.",
+                              metavar=Q_METAVAR),
+    frames: bool = flag(False, "--frames", help="Show every joint frame."),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     port: int = _port_opt(), no_open: bool = _no_open_opt(),
 ) -> None:
@@ -155,13 +169,15 @@ def view_model(
 
 @view_app.command("platform")
 def view_platform(
-    legs: str = typer.Option(None, "--legs", help="Six leg lengths: show every assembly mode."),
+    legs: str = typer.Option(None, "--legs", help="Six leg lengths: show every assembly mode.",
+                             metavar=LEGS_METAVAR),
     pose: str = typer.Option(None, "--pose", help="One pose instead ('home', a file or 16 "
-                             "numbers)."),
+                             "numbers).", metavar=POSE_METAVAR),
     wrench: str = typer.Option(None, "--wrench", help="Legs carry j^-1 w instead of their "
-                               "spring forces: fx,fy,fz,mx,my,mz (moment about O0)."),
+                               "spring forces: fx,fy,fz,mx,my,mz (moment about O0).",
+                               metavar=WRENCH_METAVAR),
     platform: str = typer.Option(None, "--platform", help="TOML platform file (default: the "
-                                 "embedded 2011 prototype)."),
+                                 "embedded 2011 prototype).", metavar="FILE"),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     port: int = _port_opt(), no_open: bool = _no_open_opt(),
 ) -> None:
@@ -199,10 +215,14 @@ def _platform_poses(legs, pose, platform):
 @view_app.command("screw")
 def view_screw(
     points1: str = typer.Option(None, "--points1", help="First position by three body points "
-                                "x,y,z,x,y,z,x,y,z (origin, +z, z-x half plane)."),
-    points2: str = typer.Option(None, "--points2", help="Second position, as --points1."),
-    pose1: str = typer.Option(None, "--pose1", help="First pose (file or 16 numbers)."),
-    pose2: str = typer.Option(None, "--pose2", help="Second pose, as --pose1."),
+                                "x,y,z,x,y,z,x,y,z (origin, +z, z-x half plane).",
+                                metavar=POINTS3_METAVAR),
+    points2: str = typer.Option(None, "--points2", help="Second position, as --points1.",
+                                metavar=POINTS3_METAVAR),
+    pose1: str = typer.Option(None, "--pose1", help="First pose (file or 16 numbers).",
+                              metavar=POSE_FILE_METAVAR),
+    pose2: str = typer.Option(None, "--pose2", help="Second pose, as --pose1.",
+                              metavar=POSE_FILE_METAVAR),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     port: int = _port_opt(), no_open: bool = _no_open_opt(),
 ) -> None:
@@ -232,8 +252,9 @@ def view_screw(
 @view_app.command("disp")
 def view_disp(
     deck: str = typer.Argument(..., help="A DISP deck file or an embedded deck name."),
-    steps: str = typer.Option(None, "--steps", help="Step count N, or N1,N2,… per stage."),
-    disp_1977: bool = typer.Option(False, "--disp-1977", help="The 1977 program's step rule."),
+    steps: str = typer.Option(None, "--steps", help="Step count N, or N1,N2,… per stage.",
+                              metavar=STEPS_METAVAR),
+    disp_1977: bool = flag(False, "--disp-1977", help="The 1977 program's step rule."),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     port: int = _port_opt(), no_open: bool = _no_open_opt(),
 ) -> None:
@@ -271,7 +292,7 @@ def disp_result(deck: str, steps: str | None = None, disp_1977: bool = False):
 def view_log(
     log: Path = typer.Argument(..., help="A control run's cycle log (RUN/log.jsonl)."),
     platform: str = typer.Option(None, "--platform", help="TOML platform file of the run "
-                                 "(default: the embedded 2011 prototype)."),
+                                 "(default: the embedded 2011 prototype).", metavar="FILE"),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     port: int = _port_opt(), no_open: bool = _no_open_opt(),
 ) -> None:

@@ -28,6 +28,15 @@ SKIP: list[tuple[str, str]] = [
     ("kinestat control", "a long run (the kinestatic loop on the simulated cell, tens of "
                          "seconds); tests/cli/test_control.py runs it"),
     ("my-deck.dat", "a user's own deck file"),
+    ("robot.urdf", "a user's own URDF file"),
+    ("arm.toml --samples 1000000", "a user's own model file, and a long run (10^6 samples); "
+                                   "tests/studies runs every study"),
+    ("--samples 100000", "a long run (10^5 random inputs, the studies' scale); the same study "
+                         "runs small from the line before it, and tests/studies runs it"),
+    ("home --galil", "needs a Galil controller on the network (a real DMC, or the "
+                     "`kinestat sim galil` server, which runs until interrupted)"),
+    ("view --log", "replays the cycle log of a `kinestat control` run (a long run, skipped)"),
+    ("--serve", "serves the page until interrupted"),
 ]
 #: a synopsis, not a command: placeholders or alternatives
 SYNOPSIS = re.compile(r"\[|…|\||\bFILE\b|\bMODEL\b|\bTOL\b|--pose P\b|\bW0\b")
