@@ -39,6 +39,7 @@ from scipy.spatial.transform import Rotation
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
+from kinestat.hardware.platform_spec import MAX_DEFLECTION, MAX_LOAD, MOTION_RANGE
 from kinestat.parallel.statics import leg_directions
 from kinestat.parallel.stiffness import stiffness
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
@@ -64,13 +65,6 @@ __all__ = [
     "require",
 ]
 
-MAX_DEFLECTION = 5.0
-"""Largest leg deflection |l − l0|, mm (Vibhute Table 3-1)."""
-MAX_LOAD = 50.0
-"""Largest load on the platform, N (Vibhute Table 3-1)."""
-MOTION_RANGE = (3.5, 3.5, 4.0, 4.0, 4.0, 6.0)
-"""Table 3-1's motion ranges of the top relative to the base: x, y, z (mm), rotation about x,
-y, z (degrees; the OCR lost the degree signs)."""
 
 
 @dataclass(frozen=True)

@@ -27,7 +27,24 @@ from kinestat.io.platform_toml import loads_platform
 from kinestat.mechanism.chain import ChainModel
 from kinestat.parallel.platform import Platform
 
-__all__ = ["load", "list_models", "prototype", "list_calibrations", "load_calibration"]
+__all__ = ["load", "list_models", "prototype", "list_calibrations", "load_calibration",
+           "embedded_text"]
+
+
+def _data(*parts: str):
+    """A file or folder of the embedded data (``kinestat/data``)."""
+    return resources.files("kinestat.data").joinpath(*parts)
+
+
+def embedded_text(*parts: str) -> str:
+    """The text of an embedded data file, e.g. ``embedded_text("platforms",
+    "prototype-2011.toml")`` (for tools that pass a file's text on, such as the studies'
+    workers).
+
+    >>> embedded_text("platforms", "prototype-2011.toml").count("length_unit")
+    1
+    """
+    return _data(*parts).read_text(encoding="utf-8")
 
 
 def _models_dir():
@@ -80,7 +97,7 @@ def prototype() -> Platform:
     >>> p.name, p.length_unit, round(float(p.home_pose[2, 3]), 6)
     ('vibhute-2011-prototype', 'mm', 60.0)
     """
-    res = resources.files("kinestat.data") / "platforms" / "prototype-2011.toml"
+    res = _data("platforms", "prototype-2011.toml")
     return loads_platform(res.read_text(encoding="utf-8"), source=str(res))
 
 

@@ -14,12 +14,13 @@ base-frame axes.
 from __future__ import annotations
 
 import math
-from importlib import resources
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+import kinestat.hardware.platform_spec as spec
 from kinestat.errors import InputError
+from kinestat.io.library import embedded_text
 from kinestat.io.platform_toml import loads_platform
 from kinestat.io.textfile import read_text_file
 from kinestat.parallel import leg_lengths, singularity_measure, spring_wrench, stiffness
@@ -29,8 +30,8 @@ __all__ = ["TABLE_3_1", "platform_text", "load_platform", "displaced_poses",
            "evaluate_poses", "axis_check", "range_box"]
 
 #: Vibhute 2011 Table 3-1 (mm, N, degrees)
-TABLE_3_1 = {"max_deflection": 5.0, "max_load": 50.0, "range_mm": (3.5, 3.5, 4.0),
-             "range_deg": (4.0, 4.0, 6.0)}
+TABLE_3_1 = {"max_deflection": spec.MAX_DEFLECTION, "max_load": spec.MAX_LOAD,
+             "range_mm": spec.MOTION_RANGE_MM, "range_deg": spec.MOTION_RANGE_DEG}
 
 #: dimensionless |det j| below which a pose counts as singular (kinestat.parallel.singularity)
 SINGULAR_TOL = 1e-9
@@ -39,8 +40,7 @@ SINGULAR_TOL = 1e-9
 def platform_text(path: str | None) -> tuple[str, str]:
     """(label, TOML text) of a platform file, or of the embedded 2011 prototype if None."""
     if path is None:
-        res = resources.files("kinestat.data") / "platforms" / "prototype-2011.toml"
-        return "prototype-2011", res.read_text(encoding="utf-8")
+        return "prototype-2011", embedded_text("platforms", "prototype-2011.toml")
 
     return str(path), read_text_file(path, "platform file")
 
