@@ -11,52 +11,20 @@ The stable top-level API::
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
-
-if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load on first use
-    from kinestat.errors import KinestatError
-    from kinestat.io.library import list_models, load
-    from kinestat.mechanism.chain import ChainModel
-    from kinestat.serial.fk import fk
-    from kinestat.serial.ik import ik
-    from kinestat.serial.jacobian import jacobian
-
-# public name -> (module, attribute or None for a submodule), imported on first use
-_LAZY: dict[str, tuple[str, str | None]] = {
-    "KinestatError": ("kinestat.errors", "KinestatError"),
-    "list_models": ("kinestat.io.library", "list_models"),
-    "load": ("kinestat.io.library", "load"),
-    "ChainModel": ("kinestat.mechanism.chain", "ChainModel"),
-    "fk": ("kinestat.serial.fk", "fk"),
-    "ik": ("kinestat.serial.ik", "ik"),
-    "jacobian": ("kinestat.serial.jacobian", "jacobian"),
-}
+import lazy_loader
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "ChainModel",
-    "KinestatError",
-    "load",
-    "list_models",
-    "fk",
-    "jacobian",
-    "ik",
-    "__version__",
-]
-
-
-def __getattr__(name: str) -> Any:
-    """Load a public name's module on first use (PEP 562): importing the package stays cheap."""
-    where = _LAZY.get(name)
-    if where is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module = importlib.import_module(where[0])
-    value = module if where[1] is None else getattr(module, where[1])
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+# the public names load with their module on first use (PEP 562, lazy_loader)
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submodules=None,
+    submod_attrs={
+        'errors': ['KinestatError'],
+        'io.library': ['list_models', 'load'],
+        'mechanism.chain': ['ChainModel'],
+        'serial.fk': ['fk'],
+        'serial.ik': ['ik'],
+        'serial.jacobian': ['jacobian'],
+    },
+)

@@ -14,82 +14,21 @@ The robot's axis conventions and the leg calibration come from :mod:`kinestat.ha
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+import lazy_loader
 
-if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load on first use
-    from kinestat.control.controller import (
-        STATES,
-        THESIS_FORCE_DIRECTION,
-        Command,
-        ControllerConfig,
-        ControllerState,
-        Target,
-        decide,
-        start,
-    )
-    from kinestat.control.envelope import Envelope, predict
-    from kinestat.control.log import CycleLog, read_log
-    from kinestat.control.loop import CellIO, RunReport, SensorReading, run
-    from kinestat.control.model import ControlModel
-    from kinestat.control.wrench import Measurement, measure
-
-# public name -> (module, attribute or None for a submodule), imported on first use
-_LAZY: dict[str, tuple[str, str | None]] = {
-    "STATES": ("kinestat.control.controller", "STATES"),
-    "THESIS_FORCE_DIRECTION": ("kinestat.control.controller", "THESIS_FORCE_DIRECTION"),
-    "Command": ("kinestat.control.controller", "Command"),
-    "ControllerConfig": ("kinestat.control.controller", "ControllerConfig"),
-    "ControllerState": ("kinestat.control.controller", "ControllerState"),
-    "Target": ("kinestat.control.controller", "Target"),
-    "decide": ("kinestat.control.controller", "decide"),
-    "start": ("kinestat.control.controller", "start"),
-    "Envelope": ("kinestat.control.envelope", "Envelope"),
-    "predict": ("kinestat.control.envelope", "predict"),
-    "CycleLog": ("kinestat.control.log", "CycleLog"),
-    "read_log": ("kinestat.control.log", "read_log"),
-    "CellIO": ("kinestat.control.loop", "CellIO"),
-    "RunReport": ("kinestat.control.loop", "RunReport"),
-    "SensorReading": ("kinestat.control.loop", "SensorReading"),
-    "run": ("kinestat.control.loop", "run"),
-    "ControlModel": ("kinestat.control.model", "ControlModel"),
-    "Measurement": ("kinestat.control.wrench", "Measurement"),
-    "measure": ("kinestat.control.wrench", "measure"),
-}
-
-__all__ = [
-    "STATES",
-    "THESIS_FORCE_DIRECTION",
-    "Command",
-    "ControlModel",
-    "ControllerConfig",
-    "ControllerState",
-    "CycleLog",
-    "CellIO",
-    "Envelope",
-    "Measurement",
-    "RunReport",
-    "SensorReading",
-    "Target",
-    "decide",
-    "measure",
-    "predict",
-    "read_log",
-    "run",
-    "start",
-]
-
-
-def __getattr__(name: str) -> Any:
-    """Load a public name's module on first use (PEP 562): importing the package stays cheap."""
-    where = _LAZY.get(name)
-    if where is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module = importlib.import_module(where[0])
-    value = module if where[1] is None else getattr(module, where[1])
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+# the public names load with their module on first use (PEP 562, lazy_loader)
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submodules=None,
+    submod_attrs={
+        'controller': [
+            'Command', 'ControllerConfig', 'ControllerState', 'STATES', 'THESIS_FORCE_DIRECTION',
+            'Target', 'decide', 'start',
+        ],
+        'envelope': ['Envelope', 'predict'],
+        'log': ['CycleLog', 'read_log'],
+        'loop': ['CellIO', 'RunReport', 'SensorReading', 'run'],
+        'model': ['ControlModel'],
+        'wrench': ['Measurement', 'measure'],
+    },
+)

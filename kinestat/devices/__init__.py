@@ -15,75 +15,18 @@ here decides what to do (:mod:`kinestat.control` does) and nothing here imports
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+import lazy_loader
 
-if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load on first use
-    from kinestat.devices.cell_io import DeviceIO, MotionProfile, SensorSample
-    from kinestat.devices.encoder_stream import (
-        EncoderReader,
-        Packet,
-        Reading,
-        StaleDataError,
-        StreamFault,
-        StreamParser,
-        decode_legacy_line,
-        decode_packet,
-        encode_legacy_line,
-        encode_packet,
-    )
-    from kinestat.devices.galil import GalilClient, GalilCommandError, thesis_move_plan
-
-# public name -> (module, attribute or None for a submodule), imported on first use
-_LAZY: dict[str, tuple[str, str | None]] = {
-    "DeviceIO": ("kinestat.devices.cell_io", "DeviceIO"),
-    "MotionProfile": ("kinestat.devices.cell_io", "MotionProfile"),
-    "SensorSample": ("kinestat.devices.cell_io", "SensorSample"),
-    "EncoderReader": ("kinestat.devices.encoder_stream", "EncoderReader"),
-    "Packet": ("kinestat.devices.encoder_stream", "Packet"),
-    "Reading": ("kinestat.devices.encoder_stream", "Reading"),
-    "StaleDataError": ("kinestat.devices.encoder_stream", "StaleDataError"),
-    "StreamFault": ("kinestat.devices.encoder_stream", "StreamFault"),
-    "StreamParser": ("kinestat.devices.encoder_stream", "StreamParser"),
-    "decode_legacy_line": ("kinestat.devices.encoder_stream", "decode_legacy_line"),
-    "decode_packet": ("kinestat.devices.encoder_stream", "decode_packet"),
-    "encode_legacy_line": ("kinestat.devices.encoder_stream", "encode_legacy_line"),
-    "encode_packet": ("kinestat.devices.encoder_stream", "encode_packet"),
-    "GalilClient": ("kinestat.devices.galil", "GalilClient"),
-    "GalilCommandError": ("kinestat.devices.galil", "GalilCommandError"),
-    "thesis_move_plan": ("kinestat.devices.galil", "thesis_move_plan"),
-}
-
-__all__ = [
-    "DeviceIO",
-    "EncoderReader",
-    "GalilClient",
-    "GalilCommandError",
-    "MotionProfile",
-    "Packet",
-    "Reading",
-    "SensorSample",
-    "StaleDataError",
-    "StreamFault",
-    "StreamParser",
-    "decode_legacy_line",
-    "decode_packet",
-    "encode_legacy_line",
-    "encode_packet",
-    "thesis_move_plan",
-]
-
-
-def __getattr__(name: str) -> Any:
-    """Load a public name's module on first use (PEP 562): importing the package stays cheap."""
-    where = _LAZY.get(name)
-    if where is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module = importlib.import_module(where[0])
-    value = module if where[1] is None else getattr(module, where[1])
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+# the public names load with their module on first use (PEP 562, lazy_loader)
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submodules=None,
+    submod_attrs={
+        'cell_io': ['DeviceIO', 'MotionProfile', 'SensorSample'],
+        'encoder_stream': [
+            'EncoderReader', 'Packet', 'Reading', 'StaleDataError', 'StreamFault', 'StreamParser',
+            'decode_legacy_line', 'decode_packet', 'encode_legacy_line', 'encode_packet',
+        ],
+        'galil': ['GalilClient', 'GalilCommandError', 'thesis_move_plan'],
+    },
+)

@@ -15,103 +15,22 @@
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+import lazy_loader
 
-if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load on first use
-    from kinestat.io.axes_file import loads_axes, read_axes_file
-    from kinestat.io.disp_deck import (
-        DeckJoint,
-        DispDeck,
-        OperatorCommand,
-        deck_warnings,
-        embedded_deck,
-        list_embedded_decks,
-        parse_deck,
-        read_deck,
-        write_deck,
-    )
-    from kinestat.io.library import list_models, load, prototype
-    from kinestat.io.model_toml import dumps_model, loads_model, read_model, write_model
-    from kinestat.io.platform_toml import (
-        dumps_platform,
-        loads_platform,
-        read_platform,
-        write_platform,
-    )
-    from kinestat.io.posefile import read_pose_file
-    from kinestat.io.urdf import from_urdf, read_urdf, to_urdf
-
-# public name -> (module, attribute or None for a submodule), imported on first use
-_LAZY: dict[str, tuple[str, str | None]] = {
-    "loads_axes": ("kinestat.io.axes_file", "loads_axes"),
-    "read_axes_file": ("kinestat.io.axes_file", "read_axes_file"),
-    "DeckJoint": ("kinestat.io.disp_deck", "DeckJoint"),
-    "DispDeck": ("kinestat.io.disp_deck", "DispDeck"),
-    "OperatorCommand": ("kinestat.io.disp_deck", "OperatorCommand"),
-    "deck_warnings": ("kinestat.io.disp_deck", "deck_warnings"),
-    "embedded_deck": ("kinestat.io.disp_deck", "embedded_deck"),
-    "list_embedded_decks": ("kinestat.io.disp_deck", "list_embedded_decks"),
-    "parse_deck": ("kinestat.io.disp_deck", "parse_deck"),
-    "read_deck": ("kinestat.io.disp_deck", "read_deck"),
-    "write_deck": ("kinestat.io.disp_deck", "write_deck"),
-    "list_models": ("kinestat.io.library", "list_models"),
-    "load": ("kinestat.io.library", "load"),
-    "prototype": ("kinestat.io.library", "prototype"),
-    "dumps_model": ("kinestat.io.model_toml", "dumps_model"),
-    "loads_model": ("kinestat.io.model_toml", "loads_model"),
-    "read_model": ("kinestat.io.model_toml", "read_model"),
-    "write_model": ("kinestat.io.model_toml", "write_model"),
-    "dumps_platform": ("kinestat.io.platform_toml", "dumps_platform"),
-    "loads_platform": ("kinestat.io.platform_toml", "loads_platform"),
-    "read_platform": ("kinestat.io.platform_toml", "read_platform"),
-    "write_platform": ("kinestat.io.platform_toml", "write_platform"),
-    "read_pose_file": ("kinestat.io.posefile", "read_pose_file"),
-    "from_urdf": ("kinestat.io.urdf", "from_urdf"),
-    "read_urdf": ("kinestat.io.urdf", "read_urdf"),
-    "to_urdf": ("kinestat.io.urdf", "to_urdf"),
-}
-
-__all__ = [
-    "DeckJoint",
-    "DispDeck",
-    "OperatorCommand",
-    "deck_warnings",
-    "dumps_model",
-    "dumps_platform",
-    "embedded_deck",
-    "from_urdf",
-    "list_embedded_decks",
-    "list_models",
-    "load",
-    "loads_axes",
-    "loads_model",
-    "loads_platform",
-    "parse_deck",
-    "prototype",
-    "read_axes_file",
-    "read_deck",
-    "read_model",
-    "read_platform",
-    "read_pose_file",
-    "read_urdf",
-    "to_urdf",
-    "write_deck",
-    "write_model",
-    "write_platform",
-]
-
-
-def __getattr__(name: str) -> Any:
-    """Load a public name's module on first use (PEP 562): importing the package stays cheap."""
-    where = _LAZY.get(name)
-    if where is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module = importlib.import_module(where[0])
-    value = module if where[1] is None else getattr(module, where[1])
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+# the public names load with their module on first use (PEP 562, lazy_loader)
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submodules=None,
+    submod_attrs={
+        'axes_file': ['loads_axes', 'read_axes_file'],
+        'disp_deck': [
+            'DeckJoint', 'DispDeck', 'OperatorCommand', 'deck_warnings', 'embedded_deck',
+            'list_embedded_decks', 'parse_deck', 'read_deck', 'write_deck',
+        ],
+        'library': ['list_models', 'load', 'prototype'],
+        'model_toml': ['dumps_model', 'loads_model', 'read_model', 'write_model'],
+        'platform_toml': ['dumps_platform', 'loads_platform', 'read_platform', 'write_platform'],
+        'posefile': ['read_pose_file'],
+        'urdf': ['from_urdf', 'read_urdf', 'to_urdf'],
+    },
+)

@@ -18,58 +18,17 @@ are imported here; the wiring of a simulated cell to the controller is
 
 from __future__ import annotations
 
-import importlib
-from typing import TYPE_CHECKING, Any
+import lazy_loader
 
-if TYPE_CHECKING:  # for type checkers and IDEs; at run time names load on first use
-    from kinestat.sim.contact import Cell, Equilibrium, Workpiece, equilibrium, make_cell
-    from kinestat.sim.dmc import DmcSimulator, SimClock
-    from kinestat.sim.encoder_emitter import EncoderEmitter, constant_counts
-    from kinestat.sim.galil_server import GalilSimServer
-    from kinestat.sim.sensor import Sensor, ideal_sensor
-
-# public name -> (module, attribute or None for a submodule), imported on first use
-_LAZY: dict[str, tuple[str, str | None]] = {
-    "Cell": ("kinestat.sim.contact", "Cell"),
-    "Equilibrium": ("kinestat.sim.contact", "Equilibrium"),
-    "Workpiece": ("kinestat.sim.contact", "Workpiece"),
-    "equilibrium": ("kinestat.sim.contact", "equilibrium"),
-    "make_cell": ("kinestat.sim.contact", "make_cell"),
-    "DmcSimulator": ("kinestat.sim.dmc", "DmcSimulator"),
-    "SimClock": ("kinestat.sim.dmc", "SimClock"),
-    "EncoderEmitter": ("kinestat.sim.encoder_emitter", "EncoderEmitter"),
-    "constant_counts": ("kinestat.sim.encoder_emitter", "constant_counts"),
-    "GalilSimServer": ("kinestat.sim.galil_server", "GalilSimServer"),
-    "Sensor": ("kinestat.sim.sensor", "Sensor"),
-    "ideal_sensor": ("kinestat.sim.sensor", "ideal_sensor"),
-}
-
-__all__ = [
-    "Cell",
-    "DmcSimulator",
-    "EncoderEmitter",
-    "Equilibrium",
-    "GalilSimServer",
-    "Sensor",
-    "SimClock",
-    "Workpiece",
-    "constant_counts",
-    "equilibrium",
-    "ideal_sensor",
-    "make_cell",
-]
-
-
-def __getattr__(name: str) -> Any:
-    """Load a public name's module on first use (PEP 562): importing the package stays cheap."""
-    where = _LAZY.get(name)
-    if where is None:
-        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module = importlib.import_module(where[0])
-    value = module if where[1] is None else getattr(module, where[1])
-    globals()[name] = value
-    return value
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(__all__))
+# the public names load with their module on first use (PEP 562, lazy_loader)
+__getattr__, __dir__, __all__ = lazy_loader.attach(
+    __name__,
+    submodules=None,
+    submod_attrs={
+        'contact': ['Cell', 'Equilibrium', 'Workpiece', 'equilibrium', 'make_cell'],
+        'dmc': ['DmcSimulator', 'SimClock'],
+        'encoder_emitter': ['EncoderEmitter', 'constant_counts'],
+        'galil_server': ['GalilSimServer'],
+        'sensor': ['Sensor', 'ideal_sensor'],
+    },
+)
