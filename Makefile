@@ -52,8 +52,8 @@ vendor-three:
 	cd build/three && npm install --no-save --silent three@$(THREE_VERSION) esbuild@$(ESBUILD_VERSION) \
 	  && printf "export * from 'three';\nexport { OrbitControls } from 'three/addons/controls/OrbitControls.js';\nexport { TransformControls } from 'three/addons/controls/TransformControls.js';\n" > entry.js \
 	  && node_modules/.bin/esbuild entry.js --bundle --minify --format=iife --global-name=THREE \
-	       --legal-comments=none --outfile=../../kinestat/data/viewer/three.min.js
-	cp build/three/node_modules/three/LICENSE kinestat/data/viewer/LICENSE-three.txt
+	       --legal-comments=none --outfile=../../kinestat/data/viewer/vendor/three.min.js
+	cp build/three/node_modules/three/LICENSE kinestat/data/viewer/vendor/LICENSE-three.txt
 
 # The whole test suite: lint, the layer contract (.importlinter, docs/architecture.md), then
 # pytest (which fails when no test runs).

@@ -14,7 +14,7 @@ from importlib import resources
 
 __all__ = ["scene_json", "render_html", "extract_scene", "THREE_VERSION"]
 
-#: the three.js release vendored in kinestat/data/viewer/three.min.js
+#: the three.js release vendored in kinestat/data/viewer/vendor/three.min.js
 THREE_VERSION = "0.187.0"
 
 _PAGE = """<!DOCTYPE html>
@@ -65,8 +65,8 @@ html, body { margin: 0; height: 100%; font: 13px system-ui, sans-serif; color: #
 
 
 @cache
-def _asset(name: str) -> str:
-    return resources.files("kinestat.data").joinpath("viewer", name).read_text(encoding="utf-8")
+def _asset(*parts: str) -> str:
+    return resources.files("kinestat.data").joinpath("viewer", *parts).read_text(encoding="utf-8")
 
 
 def scene_json(scene: dict) -> str:
@@ -85,7 +85,7 @@ def render_html(scene: dict) -> str:
         "__THREE__": THREE_VERSION,
         "__TITLE__": _escape(f"kinestat: {scene.get('title', 'viewer')}"),
         "__SCENE__": scene_json(scene),
-        "__THREEJS__": _asset("three.min.js").replace("</script", "<\\/script"),
+        "__THREEJS__": _asset("vendor", "three.min.js").replace("</script", "<\\/script"),
         "__VIEWER__": _asset("viewer.js"),
     }
     # one pass over the template: inserted text is never scanned for placeholders
