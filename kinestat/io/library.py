@@ -47,8 +47,22 @@ def embedded_text(*parts: str) -> str:
     return _data(*parts).read_text(encoding="utf-8")
 
 
-def _models_dir():
-    return resources.files("kinestat.data") / "models"
+def _embedded_names(folder: str) -> list[str]:
+    """The names (without ``.toml``) of the embedded files in ``kinestat/data/<folder>``."""
+    return sorted(p.name[:-5] for p in _data(folder).iterdir() if p.name.endswith(".toml"))
+
+
+def _embedded_or_file(s: str, kind: str, folder: str, loads, read):
+    """Embedded file ``s`` of ``folder`` through ``loads``, or the TOML file at path ``s``
+    through ``read``; None when ``s`` is neither (the caller says what it knows)."""
+    if s in _embedded_names(folder):
+        return loads(embedded_text(folder, f"{s}.toml"), source=f"<embedded {s}>")
+    p = Path(s)
+    if p.suffix == ".toml" or p.exists():
+        if not p.exists():
+            raise InputError(f"{kind} file {s!r} does not exist")
+        return read(p)
+    return None
 
 
 def list_models() -> list[str]:
@@ -57,7 +71,7 @@ def list_models() -> list[str]:
     >>> list_models()[:2]
     ['nadkarni-config1', 'nadkarni-config2']
     """
-    return sorted(p.name[:-5] for p in _models_dir().iterdir() if p.name.endswith(".toml"))
+    return _embedded_names("models")
 
 
 def load(name_or_path: str | os.PathLike | ChainModel) -> ChainModel:
@@ -71,14 +85,9 @@ def load(name_or_path: str | os.PathLike | ChainModel) -> ChainModel:
     if isinstance(name_or_path, ChainModel):
         return name_or_path
     s = os.fspath(name_or_path)
-    if s in list_models():
-        res = _models_dir() / f"{s}.toml"
-        return loads_model(res.read_text(encoding="utf-8"), source=f"<embedded {s}>")
-    p = Path(s)
-    if p.suffix == ".toml" or p.exists():
-        if not p.exists():
-            raise InputError(f"model file {s!r} does not exist")
-        return read_model(p)
+    model = _embedded_or_file(s, "model", "models", loads_model, read_model)
+    if model is not None:
+        return model
     raise InputError(
         f"unknown model {s!r}: not an embedded model ({', '.join(list_models())}) "
         "and not a TOML file path"
@@ -101,10 +110,6 @@ def prototype() -> Platform:
     return loads_platform(res.read_text(encoding="utf-8"), source=str(res))
 
 
-def _calibrations_dir():
-    return resources.files("kinestat.data") / "calibrations"
-
-
 CALIBRATION_ALIASES = {"thesis": "thesis-2011"}
 """Short names of embedded calibrations (``--calibration thesis``)."""
 
@@ -115,8 +120,7 @@ def list_calibrations() -> list[str]:
     >>> list_calibrations()
     ['thesis-2011']
     """
-    return sorted(p.name[:-5] for p in _calibrations_dir().iterdir()
-                  if p.name.endswith(".toml"))
+    return _embedded_names("calibrations")
 
 
 def load_calibration(name_or_path: str | os.PathLike) -> CalibrationFile:
@@ -129,13 +133,8 @@ def load_calibration(name_or_path: str | os.PathLike) -> CalibrationFile:
     """
     s = os.fspath(name_or_path)
     s = CALIBRATION_ALIASES.get(s, s)
-    if s in list_calibrations():
-        res = _calibrations_dir() / f"{s}.toml"
-        return loads_calibration(res.read_text(encoding="utf-8"), source=f"<embedded {s}>")
-    p = Path(s)
-    if p.suffix == ".toml" or p.exists():
-        if not p.exists():
-            raise InputError(f"calibration file {s!r} does not exist")
-        return read_calibration(p)
+    cal = _embedded_or_file(s, "calibration", "calibrations", loads_calibration, read_calibration)
+    if cal is not None:
+        return cal
     raise InputError(f"unknown calibration {s!r}: not an embedded calibration "
                      f"({', '.join(['thesis', *list_calibrations()])}) and not a TOML file path")
