@@ -159,7 +159,7 @@ def _eig(A: np.ndarray):
 
 
 def _ratio(v: np.ndarray, axis: int) -> np.ndarray:
-    """Least-squares ratio ``x`` with ``v[.., i+1] = x v[.., i]`` along ``axis`` of ``v (.., 4, 3)``."""
+    """Least-squares ratio x with ``v[.., i+1] = x v[.., i]`` along ``axis`` of v (.., 4, 3)."""
     a = np.moveaxis(v, axis, -1)
     lo, hi = a[..., :-1], a[..., 1:]
     num = np.sum(hi * lo, axis=(-2, -1))
@@ -246,7 +246,7 @@ def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24) -> floa
     lo = np.where(np.isfinite(model.lower), model.lower, -math.pi)
     hi = np.where(np.isfinite(model.upper), model.upper, math.pi)
     q0 = rng.uniform(lo, hi, (n, 6))
-    res = _solve(model, fk(model, q0), form, 1e-9, 4)
+    res = solve_general_6r(model, fk(model, q0), form=form)
     d = np.abs(np.mod(res.q - q0[:, None, :] + math.pi, 2 * math.pi) - math.pi).max(-1)
     return float(np.mean(np.any(np.where(res.valid, d, np.inf) < 1e-6, axis=1)))
 
@@ -274,26 +274,81 @@ def _solve(model, T, form, tol, polish_iters) -> IKAllResult:
     qf = q.reshape(-1, n)
     qf[flat] = newton_polish(model, qf[flat], Tc, polish_iters)
     res = pack(model, qf.reshape(N, C, n), ok, T, MAX_SOLUTIONS, tol=tol,
-               method=f"raghavan-roth{'-reversed' if form.reverse else ''}-shift{form.shift}",
-               reason_none="no real solution: the pose is outside the workspace (no real root "
-                           "of the Raghavan–Roth eigenproblem reproduces it)")
+               method=_method_name(form), reason_none=_REASON_NONE)
     if np.any(deficient):
         r = res.reason.copy()
-        r[deficient & (res.n_solutions == 0)] = (
-            "degenerate elimination: the θ1-θ2 coefficient matrix Q of Raghavan–Roth eq. 9 is "
-            "rank deficient for this pose")
+        r[deficient & (res.n_solutions == 0)] = _REASON_DEFICIENT
         object.__setattr__(res, "reason", r)
     return res
 
 
+_PARALLEL_MIN = 32  # smaller batches run on one thread
+
+_REASON_NONE = ("no real solution: the pose is outside the workspace (no real root of the "
+                "Raghavan–Roth eigenproblem reproduces it)")
+_REASON_DEFICIENT = ("degenerate elimination: the θ1-θ2 coefficient matrix Q of Raghavan–Roth "
+                     "eq. 9 is rank deficient for this pose")
+
+
+@lru_cache(maxsize=64)
+def _compiled_data(model: ChainModel, form: Formulation):
+    """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5)."""
+    C = np.asarray(model.constants)
+    M = form.links(C, np.eye(4)[None])
+    L = rr.left_tensor(M[1], M[2], M[3], M[4], np.array(OFFSETS))[1:].reshape(14, 27)
+    order, sign = form.joints()
+    return (np.ascontiguousarray(C), np.ascontiguousarray(np.stack(M[1:5])),
+            np.ascontiguousarray(L), np.ascontiguousarray(_H3), np.array(OFFSETS),
+            np.array(order, dtype=np.int64), float(sign))
+
+
+def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
+    from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
+
+    C, links_fixed, L, H3, off, order, sign = _compiled_data(model, form)
+    M = form.links(C, T)
+    N = T.shape[0]
+    M1 = np.ascontiguousarray(np.broadcast_to(M[0], (N, 4, 4)))
+    Ts = np.ascontiguousarray(np.broadcast_to(_inv_rigid(M[5]), (N, 4, 4)))
+    q = np.full((N, MAX_SOLUTIONS, 6), np.nan)
+    valid = np.zeros((N, MAX_SOLUTIONS), dtype=bool)
+    pos = np.full((N, MAX_SOLUTIONS), np.nan)
+    rot = np.full((N, MAX_SOLUTIONS), np.nan)
+    flags = np.zeros(N, dtype=np.int64)
+    run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
+    run(C, np.ascontiguousarray(T), M1, Ts, links_fixed, L, H3, off, order, sign, tol,
+        polish_iters, 1e-6, q, valid, pos, rot, flags)
+    nsol = valid.sum(axis=1)
+    reason = np.where(nsol > 0, "", _REASON_NONE).astype(object)
+    reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
+    res = IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
+                      singular=np.zeros_like(valid), family_sign=np.zeros((N, MAX_SOLUTIONS)),
+                      family_value=np.full((N, MAX_SOLUTIONS), np.nan), family_joints=None,
+                      n_solutions=nsol, reason=reason, method=_method_name(form), tol=tol)
+    redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
+    if redo.size:  # the generalised eigenproblem (scipy) for these poses
+        sub = _solve(model, T[redo], form, tol, polish_iters)
+        for f in ("q", "valid", "position_error", "rotation_error", "n_solutions", "reason"):
+            getattr(res, f)[redo] = getattr(sub, f)
+    return res
+
+
+def _method_name(form: Formulation) -> str:
+    return f"raghavan-roth{'-reversed' if form.reverse else ''}-shift{form.shift}"
+
+
 def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
-                     polish_iters: int = 4, form: Formulation | None = None) -> IKAllResult:
+                     polish_iters: int = 4, form: Formulation | None = None,
+                     backend: str = "numba") -> IKAllResult:
     """All IK solutions of a 6R ``model`` for poses ``T (N, 4, 4)`` (Raghavan–Roth 1993).
 
     Returns an :class:`IKAllResult` with ``K = 16`` slots. ``form`` defaults to the model's
-    :func:`formulation`.
+    :func:`formulation`; ``backend`` ``"numba"`` (compiled kernel, for formulations with shift
+    0 or 5) or ``"numpy"`` (the reference).
     """
     check_general(model)
     if form is None:
         form, _ = formulation(model)
+    if backend == "numba" and form.shift in (0, 5):
+        return _solve_compiled(model, T, form, tol, polish_iters)
     return _solve(model, T, form, tol, polish_iters)
