@@ -12,7 +12,7 @@ The stable top-level API::
 from kinestat.errors import KinestatError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.library import list_models, load
-from kinestat.serial.analytic import ik_all
+from kinestat.serial.analytic import ik_all as ik_all
 from kinestat.serial.fk import fk
 from kinestat.serial.ik import ik
 from kinestat.serial.jacobian import jacobian

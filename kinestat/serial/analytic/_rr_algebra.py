@@ -127,8 +127,9 @@ def left_tensor(C2, C3, C4, C5, offsets) -> np.ndarray:
 
 
 def right_tensor(C1) -> np.ndarray:
-    """``(..., 3, 3, 15, 15)`` K: ``invariants(Z2⁻¹ C1⁻¹ Z1⁻¹ (p, l)) = Σ m_a(θ1) m_b(θ2) K[a, b] f``
-    (RR eq. 4's right side before the pose ``(p, l)`` is applied)."""
+    """``(..., 3, 3, 15, 15)`` K with
+    ``invariants(Z2⁻¹ C1⁻¹ Z1⁻¹ (p, l)) = Σ m_a(θ1) m_b(θ2) K[a, b] f`` (RR eq. 4's right side
+    before the pose ``(p, l)`` is applied)."""
     Dm = joint_basis(-1.0)
     M1 = rigid_action(np.linalg.inv(C1))
     return np.einsum("bij,...jk,akl->...abil", Dm, M1, Dm)

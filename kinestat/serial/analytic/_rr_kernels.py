@@ -3,9 +3,10 @@
 NumPy reference and the fallback for poses the kernel flags).
 
 Per pose: the right side of RR eq. 4 from the pose link (15x15 rigid action), the SVD of Q, the
-12x12 matrix quadratic, the eigenvalues of its 24x24 companion (LAPACK dgeev), the power-
-product vector of each real root by inverse iteration, back-substitution, θ6, Newton polishing against FK and verification. Flags: 0 solved, 1 Q rank
-deficient, 2 A2 ill-conditioned (the caller reruns the pose with the generalised eigenproblem).
+12x12 matrix quadratic, the eigenvalues of its 24x24 companion (LAPACK dgeev), the power-product
+vector of each real root by inverse iteration, back-substitution, θ6, Newton polishing against
+FK and verification. Flags: 0 solved, 1 Q rank deficient, 2 A2 ill-conditioned (the caller
+reruns the pose with the generalised eigenproblem).
 """
 
 from __future__ import annotations
