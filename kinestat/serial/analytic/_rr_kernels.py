@@ -164,7 +164,7 @@ def _fk_jac(C, q, J):
 @nb.njit(**_OPTS)
 def _twist_err(F, T, e):
     """First-order spatial twist from F to T; returns its norm."""
-    dR = T[:3, :3] @ F[:3, :3].T
+    dR = np.ascontiguousarray(T[:3, :3]) @ np.ascontiguousarray(F[:3, :3].T)
     w0 = 0.5 * (dR[2, 1] - dR[1, 2])
     w1 = 0.5 * (dR[0, 2] - dR[2, 0])
     w2 = 0.5 * (dR[1, 0] - dR[0, 1])
@@ -351,7 +351,7 @@ def _angles(x3, vec, off, L, Lt, U, s, Vt, links, Ts, th):
     coef = np.ascontiguousarray(U[:, :8].T) @ rhs
     for j in range(8):
         coef[j] = coef[j] / s[j] if s[j] > 1e-12 * s[0] else 0.0
-    S = Vt.T @ coef
+    S = np.ascontiguousarray(Vt.T) @ coef
     th[0] = math.atan2(S[5], S[2])
     th[1] = math.atan2(S[1], S[0])
     th[2] = ph3 + off[0]
@@ -360,7 +360,7 @@ def _angles(x3, vec, off, L, Lt, U, s, Vt, links, Ts, th):
     G = np.eye(4)
     for i in range(5):
         G = _zc(th[i], links[i], G)
-    R6 = G[:3, :3].T @ Ts[:3, :3]
+    R6 = np.ascontiguousarray(G[:3, :3].T) @ np.ascontiguousarray(Ts[:3, :3])
     th[5] = math.atan2(R6[1, 0] - R6[0, 1], R6[0, 0] + R6[1, 1])
     return True
 

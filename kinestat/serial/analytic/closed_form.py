@@ -26,7 +26,8 @@ from kinestat.serial.analytic._common import pack
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
 
-__all__ = ["solve_pieper", "solve_three_parallel"]
+__all__ = ["solve_pieper", "solve_three_parallel", "solve_pieper_compiled",
+           "solve_three_parallel_compiled"]
 
 _WRIST_TOL = 1e-10
 
@@ -140,3 +141,59 @@ def solve_three_parallel(model: ChainModel, T: np.ndarray, data: dict, *, tol: f
                 reason_none="no real solution: the pose is out of reach (subproblem 4 for θ1 or "
                             "θ5, or subproblem 3 for θ3, has no real root), or the wrist is "
                             "singular (axis 6 parallel to axes 2-4)")
+
+
+_REASON_PIEPER = ("no real solution: the wrist centre is out of reach of the arm (subproblem 3 "
+                  "or 2 of the shoulder has no real root)")
+_REASON_3P = ("no real solution: the pose is out of reach (subproblem 4 for θ1 or θ5, or "
+              "subproblem 3 for θ3, has no real root), or the wrist is singular (axis 6 parallel "
+              "to axes 2-4)")
+
+
+def _outputs(N: int, K: int):
+    return (np.full((N, K, 6), np.nan), np.zeros((N, K), dtype=bool), np.full((N, K), np.nan),
+            np.full((N, K), np.nan))
+
+
+def _result(q, valid, pos, rot, sing, sign, fam, joints, reason, method, tol) -> IKAllResult:
+    nsol = valid.sum(axis=1)
+    return IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot, singular=sing,
+                       family_sign=sign, family_value=fam, family_joints=joints,
+                       n_solutions=nsol,
+                       reason=np.where(nsol > 0, "", reason).astype(object), method=method,
+                       tol=tol)
+
+
+def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
+                          wrist_tol: float = _WRIST_TOL) -> IKAllResult:
+    """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first)."""
+    from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
+
+    ax = data["axes"]
+    N = T.shape[0]
+    q, valid, pos, rot = _outputs(N, 8)
+    sing = np.zeros((N, 8), dtype=bool)
+    sign = np.zeros((N, 8))
+    fam = np.full((N, 8), np.nan)
+    K.pieper_batch(np.asarray(model.constants), np.ascontiguousarray(T), np.linalg.inv(ax.T0),
+                   ax.w, ax.r, np.asarray(data["wrist"]), np.asarray(data["shoulder"]),
+                   _perp(ax.w[5]), tol, wrist_tol, 1e-6, q, valid, pos, rot, sing, sign, fam)
+    return _result(q, valid, pos, rot, sing, sign, fam, (3, 5), _REASON_PIEPER, "pieper", tol)
+
+
+def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, *,
+                                  tol: float = 1e-9,
+                                  wrist_tol: float = _WRIST_TOL) -> IKAllResult:
+    """:func:`solve_three_parallel` by the compiled kernel."""
+    from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
+
+    ax = data["axes"]
+    N = T.shape[0]
+    h = ax.w[1]
+    sg = np.array([float(np.sign(ax.w[i] @ h)) for i in (1, 2, 3)])
+    q, valid, pos, rot = _outputs(N, 8)
+    K.three_parallel_batch(np.asarray(model.constants), np.ascontiguousarray(T),
+                           np.linalg.inv(ax.T0), ax.w, ax.r, np.asarray(data["p56"]), _perp(h),
+                           sg, tol, wrist_tol, 1e-6, q, valid, pos, rot)
+    return _result(q, valid, pos, rot, np.zeros((N, 8), dtype=bool), np.zeros((N, 8)),
+                   np.full((N, 8), np.nan), None, _REASON_3P, "three-parallel", tol)

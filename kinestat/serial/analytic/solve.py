@@ -18,9 +18,10 @@ from kinestat.serial.analytic._common import check_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 
-__all__ = ["ik_all", "METHODS", "method_for"]
+__all__ = ["ik_all", "METHODS", "BACKENDS", "method_for"]
 
 METHODS = ("auto", "pieper", "three-parallel", "raghavan-roth")
+BACKENDS = ("numba", "numpy")
 
 
 def _check_model(model: ChainModel) -> None:
@@ -63,8 +64,8 @@ def _reshape(res: IKAllResult, shape: tuple[int, ...]) -> IKAllResult:
     )
 
 
-def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto",
-           tol: float = 1e-9) -> IKAllResult:
+def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
+           backend: str = "numba") -> IKAllResult:
     """Every IK solution of the 6R ``model`` for poses ``T_base_flange (..., 4, 4)``.
 
     Returns an :class:`~kinestat.serial.analytic.result.IKAllResult` (``q (..., K, 6)``,
@@ -72,6 +73,7 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto",
     by :func:`kinestat.fk` within ``tol`` (model length unit; radians). An unreachable pose
     gives no valid slot and a ``reason``; a model that is not six revolute joints, or a pose
     that is not a rigid transform, raises a :class:`~kinestat.errors.KinestatError`.
+    ``backend``: ``"numba"`` (compiled kernels, default) or ``"numpy"`` (the references).
 
     >>> import kinestat, numpy as np
     >>> m = kinestat.load("puma560")
@@ -93,10 +95,16 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto",
     if use in ("pieper", "three-parallel") and use != kind:
         raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
                          f"(its geometry is {kind!r})")
+    if backend not in BACKENDS:
+        raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
+    fast = backend == "numba"
     if use == "pieper":
-        res = closed_form.solve_pieper(model, Tf, data, tol=tol)
+        solver = closed_form.solve_pieper_compiled if fast else closed_form.solve_pieper
+        res = solver(model, Tf, data, tol=tol)
     elif use == "three-parallel":
-        res = closed_form.solve_three_parallel(model, Tf, data, tol=tol)
+        solver = (closed_form.solve_three_parallel_compiled if fast
+                  else closed_form.solve_three_parallel)
+        res = solver(model, Tf, data, tol=tol)
     else:
-        res = general6r.solve_general_6r(model, Tf, tol=tol)
+        res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend)
     return _reshape(res, shape)

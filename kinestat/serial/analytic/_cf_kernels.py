@@ -1,0 +1,265 @@
+"""Compiled (Numba) kernels of the closed forms (:mod:`kinestat.serial.analytic.closed_form`
+is the NumPy reference): Paden–Kahan subproblems on 3-vectors, one pose per ``prange``
+iteration, FK verification and de-duplication in the kernel."""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from kinestat.serial.analytic._rr_kernels import _polish, _wrap, _zc
+
+_OPTS = {"cache": True, "nogil": True, "error_model": "numpy"}
+
+
+@nb.njit(inline="always", **_OPTS)
+def _rot(w, th):
+    """Rodrigues' rotation matrix (MLS eq. 2.14)."""
+    c = math.cos(th)
+    s = math.sin(th)
+    v = 1.0 - c
+    x, y, z = w[0], w[1], w[2]
+    R = np.empty((3, 3))
+    R[0, 0] = c + x * x * v
+    R[0, 1] = x * y * v - z * s
+    R[0, 2] = x * z * v + y * s
+    R[1, 0] = y * x * v + z * s
+    R[1, 1] = c + y * y * v
+    R[1, 2] = y * z * v - x * s
+    R[2, 0] = z * x * v - y * s
+    R[2, 1] = z * y * v + x * s
+    R[2, 2] = c + z * z * v
+    return R
+
+
+@nb.njit(inline="always", **_OPTS)
+def _rotate(w, r, th, x):
+    return r + _rot(w, th) @ (x - r)
+
+
+@nb.njit(inline="always", **_OPTS)
+def _sp1(w, r, p, q):
+    """Subproblem 1: the angle of p → q about (ω, r); returns (θ, |u'|)."""
+    u = p - r
+    v = q - r
+    up = u - np.dot(u, w) * w
+    vp = v - np.dot(v, w) * w
+    return math.atan2(np.dot(w, np.cross(up, vp)), np.dot(up, vp)), math.sqrt(np.dot(up, up))
+
+
+@nb.njit(**_OPTS)
+def _sp2(w1, w2, r, p, q, out, tol):
+    """Subproblem 2 (axes meeting at r): out[k] = (θ1, θ2) for k = 0, 1; returns existence."""
+    u = p - r
+    v = q - r
+    c12 = np.dot(w1, w2)
+    den = c12 * c12 - 1.0
+    a = (c12 * np.dot(w2, u) - np.dot(w1, v)) / den
+    b = (c12 * np.dot(w1, v) - np.dot(w2, u)) / den
+    x = np.cross(w1, w2)
+    uu = np.dot(u, u)
+    g2 = (uu - a * a - b * b - 2.0 * a * b * c12) / np.dot(x, x)
+    if g2 < -tol * (1.0 + uu) or abs(uu - np.dot(v, v)) > tol * (1.0 + uu):
+        return False
+    g = math.sqrt(max(g2, 0.0))
+    for k in range(2):
+        c = r + a * w1 + b * w2 + (g if k == 0 else -g) * x
+        out[k, 1], _ = _sp1(w2, r, p, c)
+        out[k, 0], _ = _sp1(w1, r, c, q)
+    return True
+
+
+@nb.njit(**_OPTS)
+def _sp3(w, r, p, q, delta, out, tol):
+    """Subproblem 3: out[0:2] = θ with |e^{ξ̂θ} p − q| = δ; returns existence."""
+    u = p - r
+    v = q - r
+    up = u - np.dot(u, w) * w
+    vp = v - np.dot(v, w) * w
+    t0 = math.atan2(np.dot(w, np.cross(up, vp)), np.dot(up, vp))
+    h = np.dot(w, p - q)
+    d2 = delta * delta - h * h
+    nu = math.sqrt(np.dot(up, up))
+    nv = math.sqrt(np.dot(vp, vp))
+    if nu * nv == 0.0:
+        return False
+    c = (nu * nu + nv * nv - d2) / (2.0 * nu * nv)
+    if abs(c) > 1.0 + tol:
+        return False
+    a = math.acos(min(max(c, -1.0), 1.0))
+    out[0] = t0 - a
+    out[1] = t0 + a
+    return True
+
+
+@nb.njit(**_OPTS)
+def _sp4(h, w, p, d, out, tol):
+    """Subproblem 4 (one axis): out[0:2] = θ with hᵀ R(ω, θ) p = d; returns existence."""
+    par = np.dot(w, p) * w
+    A = np.dot(h, p - par)
+    B = np.dot(h, np.cross(w, p))
+    C = d - np.dot(h, par)
+    n = math.hypot(A, B)
+    if n <= tol:
+        return False
+    c = C / n
+    if abs(c) > 1.0 + tol:
+        return False
+    phi = math.atan2(B, A)
+    a = math.acos(min(max(c, -1.0), 1.0))
+    out[0] = phi - a
+    out[1] = phi + a
+    return True
+
+
+@nb.njit(**_OPTS)
+def _fk(C, q):
+    G = C[0].copy()
+    for i in range(6):
+        G = _zc(q[i], C[i + 1], G)
+    return G
+
+
+@nb.njit(**_OPTS)
+def _store(n, C, T, q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
+    """Verify q by FK against T and store it unless it repeats a stored one; new count."""
+    F = _fk(C, q)
+    pos = math.sqrt((F[0, 3] - T[0, 3]) ** 2 + (F[1, 3] - T[1, 3]) ** 2
+                    + (F[2, 3] - T[2, 3]) ** 2)
+    d = math.sqrt(np.sum((F[:3, :3] - T[:3, :3]) ** 2))
+    rot = 2.0 * math.asin(min(d / (2.0 * math.sqrt(2.0)), 1.0))
+    if not (pos <= tol and rot <= tol):  # rounding near a singular set: two Newton steps
+        pos, rot = _polish(C, T, q, 2)
+        if not (pos <= tol and rot <= tol):
+            return cnt
+    for i in range(6):
+        q[i] = _wrap(q[i])
+    for j in range(cnt):
+        dmax = 0.0
+        for i in range(6):
+            dmax = max(dmax, abs(_wrap(q[i] - out_q[n, j, i])))
+        if dmax < dedup:
+            return cnt
+    if cnt >= out_q.shape[1]:
+        return cnt
+    out_q[n, cnt] = q
+    out_valid[n, cnt] = True
+    out_pos[n, cnt] = pos
+    out_rot[n, cnt] = rot
+    return cnt + 1
+
+
+@nb.njit(**_OPTS)
+def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
+                 out_pos, out_rot, out_sing, out_sign, out_fam):
+    g = T[n] @ T0inv
+    Rg = np.ascontiguousarray(g[:3, :3])
+    pw = Rg @ w + g[:3, 3]
+    t3 = np.empty(2)
+    if not _sp3(W[2], P[2], w, s, math.sqrt(np.dot(pw - s, pw - s)), t3, tol):
+        return
+    t12 = np.empty((2, 2))
+    t45 = np.empty((2, 2))
+    z = np.zeros(3)
+    q = np.empty(6)
+    cnt = 0
+    for i3 in range(2):
+        w3 = _rotate(W[2], P[2], t3[i3], w)
+        if not _sp2(W[0], W[1], s, w3, pw, t12, tol):
+            continue
+        R3 = _rot(W[2], t3[i3])
+        for i12 in range(2):
+            R123 = _rot(W[0], t12[i12, 0]) @ _rot(W[1], t12[i12, 1]) @ R3
+            Rp = R123.T @ Rg
+            target = Rp @ W[5]
+            cr = np.cross(W[3], target)
+            sing = math.sqrt(np.dot(cr, cr)) < wrist_tol
+            if sing:  # θ4 free: θ4 = 0, align ω6 with θ5 alone
+                t45[0, 0] = 0.0
+                t45[0, 1], _ = _sp1(W[4], z, W[5], target)
+                t45[1, 0] = t45[0, 0]
+                t45[1, 1] = t45[0, 1]
+            elif not _sp2(W[3], W[4], z, W[5], target, t45, tol):
+                continue
+            for i45 in range(2):
+                R5 = _rot(W[4], t45[i45, 1])
+                R45 = _rot(W[3], t45[i45, 0]) @ R5
+                t6, _ = _sp1(W[5], z, x6, R45.T @ (Rp @ x6))
+                q[0] = t12[i12, 0]
+                q[1] = t12[i12, 1]
+                q[2] = t3[i3]
+                q[3] = t45[i45, 0]
+                q[4] = t45[i45, 1]
+                q[5] = t6
+                new = _store(n, C, T[n], q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
+                if new > cnt and sing:
+                    sig = 1.0 if np.dot(W[3], R5 @ W[5]) >= 0.0 else -1.0
+                    out_sing[n, cnt] = True
+                    out_sign[n, cnt] = sig
+                    out_fam[n, cnt] = _wrap(q[3] + sig * q[5])
+                cnt = new
+
+
+@nb.njit(parallel=True, **_OPTS)
+def pieper_batch(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
+                 out_rot, out_sing, out_sign, out_fam):
+    """Spherical-wrist closed form for N poses (outputs pre-filled by the caller)."""
+    for n in nb.prange(T.shape[0]):
+        _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
+                     out_pos, out_rot, out_sing, out_sign, out_fam)
+
+
+@nb.njit(**_OPTS)
+def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
+                         out_valid, out_pos, out_rot):
+    g = T[n] @ T0inv
+    Rg = np.ascontiguousarray(g[:3, :3])
+    tg = np.ascontiguousarray(g[:3, 3])
+    h = W[1]
+    q56 = Rg @ p56 + tg
+    psi = np.empty(2)
+    if not _sp4(h, W[0], q56 - P[0], np.dot(h, p56 - P[0]), psi, tol):
+        return
+    t5 = np.empty(2)
+    t3 = np.empty(2)
+    z = np.zeros(3)
+    q = np.empty(6)
+    cnt = 0
+    for i1 in range(2):
+        Rr = _rot(W[0], psi[i1]) @ Rg
+        if not _sp4(h, W[4], W[5], np.dot(h, Rr @ W[5]), t5, tol):
+            continue
+        hr = Rr.T @ h
+        cr = np.cross(hr, W[5])
+        if math.sqrt(np.dot(cr, cr)) < wrist_tol:
+            continue  # wrist-singular: axis 6 parallel to axes 2-4 (not reported)
+        for i5 in range(2):
+            R5 = _rot(W[4], t5[i5])
+            t6, _ = _sp1(W[5], z, hr, R5.T @ h)
+            R6 = _rot(W[5], t6)
+            R234 = Rr @ (R5 @ R6).T
+            phi, _ = _sp1(h, z, xh, R234 @ xh)
+            y = _rotate(W[5], P[5], -t6, _rotate(W[4], P[4], -t5[i5], P[3]))
+            y = _rotate(W[0], P[0], psi[i1], Rg @ y + tg)
+            if not _sp3(W[2], P[2], P[3], P[1], math.sqrt(np.dot(y - P[1], y - P[1])), t3, tol):
+                continue
+            for i3 in range(2):
+                t2, _ = _sp1(W[1], P[1], _rotate(W[2], P[2], t3[i3], P[3]), y)
+                q[0] = -psi[i1]
+                q[1] = t2
+                q[2] = t3[i3]
+                q[3] = sg[2] * (phi - sg[0] * t2 - sg[1] * t3[i3])
+                q[4] = t5[i5]
+                q[5] = t6
+                cnt = _store(n, C, T[n], q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
+
+
+@nb.njit(parallel=True, **_OPTS)
+def three_parallel_batch(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
+                         out_valid, out_pos, out_rot):
+    """Three-parallel-axes (UR-type) closed form for N poses."""
+    for n in nb.prange(T.shape[0]):
+        _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
+                             out_valid, out_pos, out_rot)
