@@ -9,9 +9,20 @@ import math
 import numba as nb
 import numpy as np
 
-from kinestat.serial.analytic._rr_kernels import _polish, _wrap, _zc
+from kinestat.serial.analytic._rr_kernels import _mm, _mtm, _mtv, _mv, _polish, _wrap, _zc
 
 _OPTS = {"cache": True, "nogil": True, "error_model": "numpy"}
+
+
+@nb.njit(inline="always", **_OPTS)
+def _dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+@nb.njit(inline="always", **_OPTS)
+def _cross(a, b):
+    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
+                     a[0] * b[1] - a[1] * b[0]])
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -36,7 +47,7 @@ def _rot(w, th):
 
 @nb.njit(inline="always", **_OPTS)
 def _rotate(w, r, th, x):
-    return r + _rot(w, th) @ (x - r)
+    return r + _mv(_rot(w, th), x - r)
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -44,9 +55,9 @@ def _sp1(w, r, p, q):
     """Subproblem 1: the angle of p → q about (ω, r); returns (θ, |u'|)."""
     u = p - r
     v = q - r
-    up = u - np.dot(u, w) * w
-    vp = v - np.dot(v, w) * w
-    return math.atan2(np.dot(w, np.cross(up, vp)), np.dot(up, vp)), math.sqrt(np.dot(up, up))
+    up = u - _dot(u, w) * w
+    vp = v - _dot(v, w) * w
+    return math.atan2(_dot(w, _cross(up, vp)), _dot(up, vp)), math.sqrt(_dot(up, up))
 
 
 @nb.njit(**_OPTS)
@@ -54,14 +65,14 @@ def _sp2(w1, w2, r, p, q, out, tol):
     """Subproblem 2 (axes meeting at r): out[k] = (θ1, θ2) for k = 0, 1; returns existence."""
     u = p - r
     v = q - r
-    c12 = np.dot(w1, w2)
+    c12 = _dot(w1, w2)
     den = c12 * c12 - 1.0
-    a = (c12 * np.dot(w2, u) - np.dot(w1, v)) / den
-    b = (c12 * np.dot(w1, v) - np.dot(w2, u)) / den
-    x = np.cross(w1, w2)
-    uu = np.dot(u, u)
-    g2 = (uu - a * a - b * b - 2.0 * a * b * c12) / np.dot(x, x)
-    if g2 < -tol * (1.0 + uu) or abs(uu - np.dot(v, v)) > tol * (1.0 + uu):
+    a = (c12 * _dot(w2, u) - _dot(w1, v)) / den
+    b = (c12 * _dot(w1, v) - _dot(w2, u)) / den
+    x = _cross(w1, w2)
+    uu = _dot(u, u)
+    g2 = (uu - a * a - b * b - 2.0 * a * b * c12) / _dot(x, x)
+    if g2 < -tol * (1.0 + uu) or abs(uu - _dot(v, v)) > tol * (1.0 + uu):
         return False
     g = math.sqrt(max(g2, 0.0))
     for k in range(2):
@@ -76,13 +87,13 @@ def _sp3(w, r, p, q, delta, out, tol):
     """Subproblem 3: out[0:2] = θ with |e^{ξ̂θ} p − q| = δ; returns existence."""
     u = p - r
     v = q - r
-    up = u - np.dot(u, w) * w
-    vp = v - np.dot(v, w) * w
-    t0 = math.atan2(np.dot(w, np.cross(up, vp)), np.dot(up, vp))
-    h = np.dot(w, p - q)
+    up = u - _dot(u, w) * w
+    vp = v - _dot(v, w) * w
+    t0 = math.atan2(_dot(w, _cross(up, vp)), _dot(up, vp))
+    h = _dot(w, p - q)
     d2 = delta * delta - h * h
-    nu = math.sqrt(np.dot(up, up))
-    nv = math.sqrt(np.dot(vp, vp))
+    nu = math.sqrt(_dot(up, up))
+    nv = math.sqrt(_dot(vp, vp))
     if nu * nv == 0.0:
         return False
     c = (nu * nu + nv * nv - d2) / (2.0 * nu * nv)
@@ -97,10 +108,10 @@ def _sp3(w, r, p, q, delta, out, tol):
 @nb.njit(**_OPTS)
 def _sp4(h, w, p, d, out, tol):
     """Subproblem 4 (one axis): out[0:2] = θ with hᵀ R(ω, θ) p = d; returns existence."""
-    par = np.dot(w, p) * w
-    A = np.dot(h, p - par)
-    B = np.dot(h, np.cross(w, p))
-    C = d - np.dot(h, par)
+    par = _dot(w, p) * w
+    A = _dot(h, p - par)
+    B = _dot(h, _cross(w, p))
+    C = d - _dot(h, par)
     n = math.hypot(A, B)
     if n <= tol:
         return False
@@ -154,11 +165,11 @@ def _store(n, C, T, q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
 @nb.njit(**_OPTS)
 def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
                  out_pos, out_rot, out_sing, out_sign, out_fam):
-    g = T[n] @ T0inv
+    g = _mm(T[n], T0inv)
     Rg = np.ascontiguousarray(g[:3, :3])
-    pw = Rg @ w + g[:3, 3]
+    pw = _mv(Rg, w) + g[:3, 3]
     t3 = np.empty(2)
-    if not _sp3(W[2], P[2], w, s, math.sqrt(np.dot(pw - s, pw - s)), t3, tol):
+    if not _sp3(W[2], P[2], w, s, math.sqrt(_dot(pw - s, pw - s)), t3, tol):
         return
     t12 = np.empty((2, 2))
     t45 = np.empty((2, 2))
@@ -171,11 +182,11 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
             continue
         R3 = _rot(W[2], t3[i3])
         for i12 in range(2):
-            R123 = _rot(W[0], t12[i12, 0]) @ _rot(W[1], t12[i12, 1]) @ R3
-            Rp = R123.T @ Rg
-            target = Rp @ W[5]
-            cr = np.cross(W[3], target)
-            sing = math.sqrt(np.dot(cr, cr)) < wrist_tol
+            R123 = _mm(_mm(_rot(W[0], t12[i12, 0]), _rot(W[1], t12[i12, 1])), R3)
+            Rp = _mtm(R123, Rg)
+            target = _mv(Rp, W[5])
+            cr = _cross(W[3], target)
+            sing = math.sqrt(_dot(cr, cr)) < wrist_tol
             if sing:  # θ4 free: θ4 = 0, align ω6 with θ5 alone
                 t45[0, 0] = 0.0
                 t45[0, 1], _ = _sp1(W[4], z, W[5], target)
@@ -185,8 +196,8 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
                 continue
             for i45 in range(2):
                 R5 = _rot(W[4], t45[i45, 1])
-                R45 = _rot(W[3], t45[i45, 0]) @ R5
-                t6, _ = _sp1(W[5], z, x6, R45.T @ (Rp @ x6))
+                R45 = _mm(_rot(W[3], t45[i45, 0]), R5)
+                t6, _ = _sp1(W[5], z, x6, _mtv(R45, _mv(Rp, x6)))
                 q[0] = t12[i12, 0]
                 q[1] = t12[i12, 1]
                 q[2] = t3[i3]
@@ -195,7 +206,7 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
                 q[5] = t6
                 new = _store(n, C, T[n], q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
                 if new > cnt and sing:
-                    sig = 1.0 if np.dot(W[3], R5 @ W[5]) >= 0.0 else -1.0
+                    sig = 1.0 if _dot(W[3], _mv(R5, W[5])) >= 0.0 else -1.0
                     out_sing[n, cnt] = True
                     out_sign[n, cnt] = sig
                     out_fam[n, cnt] = _wrap(q[3] + sig * q[5])
@@ -214,13 +225,13 @@ def pieper_batch(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_
 @nb.njit(**_OPTS)
 def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
                          out_valid, out_pos, out_rot):
-    g = T[n] @ T0inv
+    g = _mm(T[n], T0inv)
     Rg = np.ascontiguousarray(g[:3, :3])
     tg = np.ascontiguousarray(g[:3, 3])
     h = W[1]
-    q56 = Rg @ p56 + tg
+    q56 = _mv(Rg, p56) + tg
     psi = np.empty(2)
-    if not _sp4(h, W[0], q56 - P[0], np.dot(h, p56 - P[0]), psi, tol):
+    if not _sp4(h, W[0], q56 - P[0], _dot(h, p56 - P[0]), psi, tol):
         return
     t5 = np.empty(2)
     t3 = np.empty(2)
@@ -228,22 +239,22 @@ def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedu
     q = np.empty(6)
     cnt = 0
     for i1 in range(2):
-        Rr = _rot(W[0], psi[i1]) @ Rg
-        if not _sp4(h, W[4], W[5], np.dot(h, Rr @ W[5]), t5, tol):
+        Rr = _mm(_rot(W[0], psi[i1]), Rg)
+        if not _sp4(h, W[4], W[5], _dot(h, _mv(Rr, W[5])), t5, tol):
             continue
-        hr = Rr.T @ h
-        cr = np.cross(hr, W[5])
-        if math.sqrt(np.dot(cr, cr)) < wrist_tol:
+        hr = _mtv(Rr, h)
+        cr = _cross(hr, W[5])
+        if math.sqrt(_dot(cr, cr)) < wrist_tol:
             continue  # wrist-singular: axis 6 parallel to axes 2-4 (not reported)
         for i5 in range(2):
             R5 = _rot(W[4], t5[i5])
-            t6, _ = _sp1(W[5], z, hr, R5.T @ h)
+            t6, _ = _sp1(W[5], z, hr, _mtv(R5, h))
             R6 = _rot(W[5], t6)
-            R234 = Rr @ (R5 @ R6).T
-            phi, _ = _sp1(h, z, xh, R234 @ xh)
+            R234 = _mm(Rr, _mm(R5, R6).T)
+            phi, _ = _sp1(h, z, xh, _mv(R234, xh))
             y = _rotate(W[5], P[5], -t6, _rotate(W[4], P[4], -t5[i5], P[3]))
-            y = _rotate(W[0], P[0], psi[i1], Rg @ y + tg)
-            if not _sp3(W[2], P[2], P[3], P[1], math.sqrt(np.dot(y - P[1], y - P[1])), t3, tol):
+            y = _rotate(W[0], P[0], psi[i1], _mv(Rg, y) + tg)
+            if not _sp3(W[2], P[2], P[3], P[1], math.sqrt(_dot(y - P[1], y - P[1])), t3, tol):
                 continue
             for i3 in range(2):
                 t2, _ = _sp1(W[1], P[1], _rotate(W[2], P[2], t3[i3], P[3]), y)

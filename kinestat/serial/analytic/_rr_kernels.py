@@ -28,6 +28,59 @@ FLAG_DEFICIENT = 1
 FLAG_ILL_CONDITIONED = 2
 
 
+@nb.njit(inline="always", **_OPTS)
+def _mm(A, B):
+    """Matrix product by loops (tiny matrices: BLAS calls cost more than the arithmetic)."""
+    n, k = A.shape
+    m = B.shape[1]
+    out = np.zeros((n, m))
+    for i in range(n):
+        for t in range(k):
+            a = A[i, t]
+            if a != 0.0:
+                for j in range(m):
+                    out[i, j] += a * B[t, j]
+    return out
+
+
+@nb.njit(inline="always", **_OPTS)
+def _mv(A, x):
+    """Matrix-vector product by loops."""
+    n, k = A.shape
+    out = np.zeros(n)
+    for i in range(n):
+        acc = 0.0
+        for t in range(k):
+            acc += A[i, t] * x[t]
+        out[i] = acc
+    return out
+
+
+@nb.njit(inline="always", **_OPTS)
+def _mtm(A, B):
+    """``Aᵀ B`` by loops."""
+    k, n = A.shape
+    m = B.shape[1]
+    out = np.zeros((n, m))
+    for t in range(k):
+        for i in range(n):
+            a = A[t, i]
+            for j in range(m):
+                out[i, j] += a * B[t, j]
+    return out
+
+
+@nb.njit(inline="always", **_OPTS)
+def _mtv(A, x):
+    """``Aᵀ x`` by loops."""
+    k, n = A.shape
+    out = np.zeros(n)
+    for t in range(k):
+        for i in range(n):
+            out[i] += A[t, i] * x[t]
+    return out
+
+
 @nb.njit(**_OPTS)
 def _gauss(A, B):
     """Solve ``A X = B`` in place (B ← X) by Gaussian elimination with partial pivoting; A is
@@ -86,7 +139,7 @@ def _rigid_action_inv(T, M):
         t[i] = -(R[i, 0] * T[0, 3] + R[i, 1] * T[1, 3] + R[i, 2] * T[2, 3])
     tt = t[0] * t[0] + t[1] * t[1] + t[2] * t[2]
     tx = np.array([[0.0, -t[2], t[1]], [t[2], 0.0, -t[0]], [-t[1], t[0], 0.0]])
-    txR = tx @ R
+    txR = _mm(tx, R)
     tR = np.empty(3)
     for j in range(3):
         tR[j] = t[0] * R[0, j] + t[1] * R[1, j] + t[2] * R[2, j]
@@ -141,7 +194,7 @@ def _zc(th, C, G):
     Z[1, 1] = c
     Z[2, 2] = 1.0
     Z[3, 3] = 1.0
-    return G @ Z @ C
+    return _mm(_mm(G, Z), C)
 
 
 @nb.njit(**_OPTS)
@@ -164,7 +217,7 @@ def _fk_jac(C, q, J):
 @nb.njit(**_OPTS)
 def _twist_err(F, T, e):
     """First-order spatial twist from F to T; returns its norm."""
-    dR = np.ascontiguousarray(T[:3, :3]) @ np.ascontiguousarray(F[:3, :3].T)
+    dR = _mm(T[:3, :3], F[:3, :3].T)
     w0 = 0.5 * (dR[2, 1] - dR[1, 2])
     w1 = 0.5 * (dR[0, 2] - dR[2, 0])
     w2 = 0.5 * (dR[1, 0] - dR[0, 1])
@@ -236,7 +289,7 @@ def _right_side(M1, Ts, Rh):
     o = np.empty(15)
     for a in range(3):
         _apply_d(a, -1.0, f, u)
-        w = MA @ u
+        w = _mv(MA, u)
         for b in range(3):
             _apply_d(b, -1.0, w, o)
             Rh[:, a * 3 + b] = o
@@ -347,11 +400,11 @@ def _angles(x3, vec, off, L, Lt, U, s, Vt, links, Ts, th):
         for b in range(3):
             for c in range(3):
                 m[a * 9 + b * 3 + c] = m3[a] * m4[b] * m5[c]
-    rhs = Lt @ m
-    coef = np.ascontiguousarray(U[:, :8].T) @ rhs
+    rhs = _mv(Lt, m)
+    coef = _mtv(U[:, :8], rhs)
     for j in range(8):
         coef[j] = coef[j] / s[j] if s[j] > 1e-12 * s[0] else 0.0
-    S = np.ascontiguousarray(Vt.T) @ coef
+    S = _mtv(Vt, coef)
     th[0] = math.atan2(S[5], S[2])
     th[1] = math.atan2(S[1], S[0])
     th[2] = ph3 + off[0]
@@ -360,7 +413,7 @@ def _angles(x3, vec, off, L, Lt, U, s, Vt, links, Ts, th):
     G = np.eye(4)
     for i in range(5):
         G = _zc(th[i], links[i], G)
-    R6 = np.ascontiguousarray(G[:3, :3].T) @ np.ascontiguousarray(Ts[:3, :3])
+    R6 = _mtm(G[:3, :3], Ts[:3, :3])
     th[5] = math.atan2(R6[1, 0] - R6[0, 1], R6[0, 0] + R6[1, 1])
     return True
 
