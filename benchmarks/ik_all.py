@@ -28,11 +28,11 @@ import numpy as np
 warnings.filterwarnings("ignore")
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests", "serial", "analytic"))
 
+from arms import arm  # noqa: E402  (test arms, public constructors)
+
 import kinestat  # noqa: E402
 from kinestat.serial.analytic import ik_all  # noqa: E402
 from kinestat.serial.analytic.geometry import home_axes  # noqa: E402
-
-from arms import arm  # noqa: E402  (test arms, public constructors)
 
 PI = math.pi
 ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1")
@@ -89,7 +89,7 @@ def peer_ssik(model):
     m = ssik.Manipulator.from_dh(al, a, d)
 
     def call(T):
-        return [np.asarray(s, dtype=float) - th for s in m.solve(T)]
+        return [np.asarray(s.q, dtype=float) - th for s in m.solve(T)]
     return call
 
 
@@ -123,7 +123,8 @@ def peer_ikgeo(model, kind):
     R0 = ax.T0[:3, :3]
 
     def call(T):
-        out = bot.get_ik((T[:3, :3] @ R0.T).tolist(), T[:3, 3].tolist())
+        # ik-geo takes the rotation transposed (checked against its forward_kinematics)
+        out = bot.get_ik((T[:3, :3] @ R0.T).T.tolist(), T[:3, 3].tolist())
         return [np.asarray(q) for q, ls in out if not ls]
     return call
 

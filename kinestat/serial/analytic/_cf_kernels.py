@@ -9,7 +9,7 @@ import math
 import numba as nb
 import numpy as np
 
-from kinestat.serial.analytic._rr_kernels import _mm, _mtm, _mtv, _mv, _polish, _wrap, _zc
+from kinestat.serial.analytic._rr_kernels import _mm, _mtm, _mtv, _mv, _polish, _wrap
 
 _OPTS = {"cache": True, "nogil": True, "error_model": "numpy"}
 
@@ -127,10 +127,40 @@ def _sp4(h, w, p, d, out, tol):
 
 @nb.njit(**_OPTS)
 def _fk(C, q):
-    G = C[0].copy()
+    """``C0 Rz(q1) C1 … Rz(q6) C6`` with the running transform in scalars (no temporaries)."""
+    F = np.empty((4, 4))
+    r00, r01, r02, p0 = C[0, 0, 0], C[0, 0, 1], C[0, 0, 2], C[0, 0, 3]
+    r10, r11, r12, p1 = C[0, 1, 0], C[0, 1, 1], C[0, 1, 2], C[0, 1, 3]
+    r20, r21, r22, p2 = C[0, 2, 0], C[0, 2, 1], C[0, 2, 2], C[0, 2, 3]
     for i in range(6):
-        G = _zc(q[i], C[i + 1], G)
-    return G
+        c = math.cos(q[i])
+        s = math.sin(q[i])
+        a0 = c * r00 + s * r01
+        a1 = c * r10 + s * r11
+        a2 = c * r20 + s * r21
+        r01 = c * r01 - s * r00
+        r11 = c * r11 - s * r10
+        r21 = c * r21 - s * r20
+        r00, r10, r20 = a0, a1, a2
+        M = C[i + 1]
+        n00 = r00 * M[0, 0] + r01 * M[1, 0] + r02 * M[2, 0]
+        n01 = r00 * M[0, 1] + r01 * M[1, 1] + r02 * M[2, 1]
+        n02 = r00 * M[0, 2] + r01 * M[1, 2] + r02 * M[2, 2]
+        p0 = r00 * M[0, 3] + r01 * M[1, 3] + r02 * M[2, 3] + p0
+        n10 = r10 * M[0, 0] + r11 * M[1, 0] + r12 * M[2, 0]
+        n11 = r10 * M[0, 1] + r11 * M[1, 1] + r12 * M[2, 1]
+        n12 = r10 * M[0, 2] + r11 * M[1, 2] + r12 * M[2, 2]
+        p1 = r10 * M[0, 3] + r11 * M[1, 3] + r12 * M[2, 3] + p1
+        n20 = r20 * M[0, 0] + r21 * M[1, 0] + r22 * M[2, 0]
+        n21 = r20 * M[0, 1] + r21 * M[1, 1] + r22 * M[2, 1]
+        n22 = r20 * M[0, 2] + r21 * M[1, 2] + r22 * M[2, 2]
+        p2 = r20 * M[0, 3] + r21 * M[1, 3] + r22 * M[2, 3] + p2
+        r00, r01, r02, r10, r11, r12, r20, r21, r22 = n00, n01, n02, n10, n11, n12, n20, n21, n22
+    F[0, 0], F[0, 1], F[0, 2], F[0, 3] = r00, r01, r02, p0
+    F[1, 0], F[1, 1], F[1, 2], F[1, 3] = r10, r11, r12, p1
+    F[2, 0], F[2, 1], F[2, 2], F[2, 3] = r20, r21, r22, p2
+    F[3, 0], F[3, 1], F[3, 2], F[3, 3] = 0.0, 0.0, 0.0, 1.0
+    return F
 
 
 @nb.njit(**_OPTS)
@@ -272,5 +302,23 @@ def three_parallel_batch(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, 
                          out_valid, out_pos, out_rot):
     """Three-parallel-axes (UR-type) closed form for N poses."""
     for n in nb.prange(T.shape[0]):
+        _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
+                             out_valid, out_pos, out_rot)
+
+
+@nb.njit(**_OPTS)
+def pieper_serial(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
+                  out_pos, out_rot, out_sing, out_sign, out_fam):
+    """:func:`pieper_batch` on one thread (small batches: no thread start-up)."""
+    for n in range(T.shape[0]):
+        _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
+                     out_pos, out_rot, out_sing, out_sign, out_fam)
+
+
+@nb.njit(**_OPTS)
+def three_parallel_serial(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
+                          out_valid, out_pos, out_rot):
+    """:func:`three_parallel_batch` on one thread."""
+    for n in range(T.shape[0]):
         _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
                              out_valid, out_pos, out_rot)

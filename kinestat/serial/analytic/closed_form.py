@@ -30,6 +30,7 @@ __all__ = ["solve_pieper", "solve_three_parallel", "solve_pieper_compiled",
            "solve_three_parallel_compiled"]
 
 _WRIST_TOL = 1e-10
+_PARALLEL_MIN = 32  # smaller batches run on one thread
 
 
 def _apply(T: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -175,7 +176,8 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     sing = np.zeros((N, 8), dtype=bool)
     sign = np.zeros((N, 8))
     fam = np.full((N, 8), np.nan)
-    K.pieper_batch(np.asarray(model.constants), np.ascontiguousarray(T), np.linalg.inv(ax.T0),
+    run = K.pieper_batch if N >= _PARALLEL_MIN else K.pieper_serial
+    run(np.asarray(model.constants), np.ascontiguousarray(T), np.linalg.inv(ax.T0),
                    ax.w, ax.r, np.asarray(data["wrist"]), np.asarray(data["shoulder"]),
                    _perp(ax.w[5]), tol, wrist_tol, 1e-6, q, valid, pos, rot, sing, sign, fam)
     return _result(q, valid, pos, rot, sing, sign, fam, (3, 5), _REASON_PIEPER, "pieper", tol)
@@ -192,8 +194,8 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
     h = ax.w[1]
     sg = np.array([float(np.sign(ax.w[i] @ h)) for i in (1, 2, 3)])
     q, valid, pos, rot = _outputs(N, 8)
-    K.three_parallel_batch(np.asarray(model.constants), np.ascontiguousarray(T),
-                           np.linalg.inv(ax.T0), ax.w, ax.r, np.asarray(data["p56"]), _perp(h),
-                           sg, tol, wrist_tol, 1e-6, q, valid, pos, rot)
+    run = K.three_parallel_batch if N >= _PARALLEL_MIN else K.three_parallel_serial
+    run(np.asarray(model.constants), np.ascontiguousarray(T), np.linalg.inv(ax.T0), ax.w, ax.r,
+        np.asarray(data["p56"]), _perp(h), sg, tol, wrist_tol, 1e-6, q, valid, pos, rot)
     return _result(q, valid, pos, rot, np.zeros((N, 8), dtype=bool), np.zeros((N, 8)),
                    np.full((N, 8), np.nan), None, _REASON_3P, "three-parallel", tol)
