@@ -233,7 +233,8 @@ def _twist_err(F, T, e):
 
 @nb.njit(**_OPTS)
 def _polish(C, T, q, iters):
-    """Newton steps ``J δq = ξ`` kept where they lower the error; returns (pos, rot) errors."""
+    """Newton steps ``J δq = ξ`` with backtracking (halved until the error drops); returns the
+    (position, rotation) errors of the final q (updated in place)."""
     J = np.empty((6, 6))
     e = np.empty(6)
     F = _fk_jac(C, q, J)
@@ -247,10 +248,17 @@ def _polish(C, T, q, iters):
         dq = e.copy().reshape((6, 1))
         if _gauss(Jc, dq) < 1e-14:
             break
-        qn = q + dq[:, 0]
-        Fn = _fk_jac(C, qn, Jn)
-        nn = _twist_err(Fn, T, en_v)
-        if not nn < en:
+        step = 1.0
+        moved = False
+        for _half in range(6):  # backtracking: full Newton step, then halves
+            qn = q + step * dq[:, 0]
+            Fn = _fk_jac(C, qn, Jn)
+            nn = _twist_err(Fn, T, en_v)
+            if nn < en:
+                moved = True
+                break
+            step *= 0.5
+        if not moved:
             break
         q[:] = qn
         J[:, :] = Jn

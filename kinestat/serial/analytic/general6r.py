@@ -338,7 +338,7 @@ def _method_name(form: Formulation) -> str:
 
 
 def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
-                     polish_iters: int = 4, form: Formulation | None = None,
+                     polish_iters: int = 8, form: Formulation | None = None,
                      backend: str = "numba") -> IKAllResult:
     """All IK solutions of a 6R ``model`` for poses ``T (N, 4, 4)`` (Raghavan–Roth 1993).
 
