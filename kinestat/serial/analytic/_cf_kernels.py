@@ -322,3 +322,29 @@ def three_parallel_serial(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup,
     for n in range(T.shape[0]):
         _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
                              out_valid, out_pos, out_rot)
+
+
+@nb.njit(**_OPTS)
+def first_non_rigid(T, tol):
+    """Index of the first pose of ``T (N, 4, 4)`` that is not a finite rigid transform (rotation
+    orthonormal with det +1 within tol, last row [0, 0, 0, 1]), or −1."""
+    for n in range(T.shape[0]):
+        bad = False
+        for i in range(4):
+            for j in range(4):
+                if not math.isfinite(T[n, i, j]):
+                    bad = True
+        if bad or T[n, 3, 0] != 0.0 or T[n, 3, 1] != 0.0 or T[n, 3, 2] != 0.0 or \
+                T[n, 3, 3] != 1.0:
+            return n
+        for i in range(3):
+            for j in range(3):
+                d = T[n, i, 0] * T[n, j, 0] + T[n, i, 1] * T[n, j, 1] + T[n, i, 2] * T[n, j, 2]
+                if abs(d - (1.0 if i == j else 0.0)) > tol:
+                    return n
+        det = (T[n, 0, 0] * (T[n, 1, 1] * T[n, 2, 2] - T[n, 1, 2] * T[n, 2, 1])
+               - T[n, 0, 1] * (T[n, 1, 0] * T[n, 2, 2] - T[n, 1, 2] * T[n, 2, 0])
+               + T[n, 0, 2] * (T[n, 1, 0] * T[n, 2, 1] - T[n, 1, 1] * T[n, 2, 0]))
+        if abs(det - 1.0) > tol:
+            return n
+    return -1

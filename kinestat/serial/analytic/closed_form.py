@@ -177,9 +177,13 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     sign = np.zeros((N, 8))
     fam = np.full((N, 8), np.nan)
     run = K.pieper_batch if N >= _PARALLEL_MIN else K.pieper_serial
-    run(np.asarray(model.constants), np.ascontiguousarray(T), np.linalg.inv(ax.T0),
-                   ax.w, ax.r, np.asarray(data["wrist"]), np.asarray(data["shoulder"]),
-                   _perp(ax.w[5]), tol, wrist_tol, 1e-6, q, valid, pos, rot, sing, sign, fam)
+    if "kernel_args" not in data:  # pose-independent, kept with the model's cached geometry
+        data["kernel_args"] = (np.asarray(model.constants), np.linalg.inv(ax.T0), ax.w, ax.r,
+                               np.asarray(data["wrist"]), np.asarray(data["shoulder"]),
+                               _perp(ax.w[5]))
+    C, T0inv, W, P, w, s, x6 = data["kernel_args"]
+    run(C, np.ascontiguousarray(T), T0inv, W, P, w, s, x6, tol, wrist_tol, 1e-6, q, valid, pos,
+        rot, sing, sign, fam)
     return _result(q, valid, pos, rot, sing, sign, fam, (3, 5), _REASON_PIEPER, "pieper", tol)
 
 
@@ -191,11 +195,15 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
 
     ax = data["axes"]
     N = T.shape[0]
-    h = ax.w[1]
-    sg = np.array([float(np.sign(ax.w[i] @ h)) for i in (1, 2, 3)])
+    if "kernel_args" not in data:
+        h = ax.w[1]
+        sg = np.array([float(np.sign(ax.w[i] @ h)) for i in (1, 2, 3)])
+        data["kernel_args"] = (np.asarray(model.constants), np.linalg.inv(ax.T0), ax.w, ax.r,
+                               np.asarray(data["p56"]), _perp(h), sg)
+    C, T0inv, W, P, p56, xh, sg = data["kernel_args"]
     q, valid, pos, rot = _outputs(N, 8)
     run = K.three_parallel_batch if N >= _PARALLEL_MIN else K.three_parallel_serial
-    run(np.asarray(model.constants), np.ascontiguousarray(T), np.linalg.inv(ax.T0), ax.w, ax.r,
-        np.asarray(data["p56"]), _perp(h), sg, tol, wrist_tol, 1e-6, q, valid, pos, rot)
+    run(C, np.ascontiguousarray(T), T0inv, W, P, p56, xh, sg, tol, wrist_tol, 1e-6, q, valid,
+        pos, rot)
     return _result(q, valid, pos, rot, np.zeros((N, 8), dtype=bool), np.zeros((N, 8)),
                    np.full((N, 8), np.nan), None, _REASON_3P, "three-parallel", tol)

@@ -87,9 +87,18 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     _check_model(model)
     if method not in METHODS:
         raise ModelError(f"ik_all: unknown method {method!r}; expected one of {METHODS}")
-    T = check_poses(T_base_flange)
+    T = T_base_flange
+    if type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
+            T.shape[-2:] == (4, 4) and backend == "numba":
+        from kinestat.serial.analytic import _cf_kernels  # lazy: Numba start-up
+
+        Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
+        if _cf_kernels.first_non_rigid(Tf, 1e-6) >= 0:
+            check_poses(T)  # raises with the full message
+    else:
+        T = check_poses(T)
+        Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
     shape = T.shape[:-2]
-    Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
     kind, data = _classified(model)
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
     if use in ("pieper", "three-parallel") and use != kind:
