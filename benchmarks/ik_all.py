@@ -8,8 +8,14 @@ Jaco2-type 6R with a 60° wrist (non-Pieper) and a random general 6R. For every 
 single-call time per pose (one pose per call, median over ``--single`` poses), batched poses/s
 (kinestat: one call on ``--n`` poses; peers have no batch call, so their figure is 1/single),
 completeness (the generating configuration is among the returned solutions, wrapped distance
-< 1e-6), the mean number of solutions, and the worst pose residual of the returned solutions,
-every one recomputed with kinestat's FK. ``n/a`` marks a solver that does not apply (or failed).
+< 1e-6), the mean number of solutions (kinestat: over ``--n`` poses; peers: over the
+``--single`` poses), the worst pose residual of the returned solutions, every one recomputed
+with kinestat's FK, and, per peer on the ``--single`` poses, the fraction of poses where its
+number of distinct verified solutions (residual < 1e-6) equals kinestat's and the number of its
+verified solutions kinestat lacks. ``n/a`` marks a solver that does not apply. The ik-geo
+adapter (product-of-exponentials vectors from kinestat's home axes) is validated only for the
+three-parallel class; its zero completeness elsewhere is an adapter/convention mismatch, not a
+finding about ik-geo.
 """
 
 from __future__ import annotations
@@ -56,6 +62,20 @@ def _score(model, q_true, sols_per_pose):
                              np.linalg.norm(F[:, :3, :3] - T[:3, :3], axis=(-2, -1)))
             worst = max(worst, float(res.max()))
     return found / len(q_true), float(np.mean(counts)), worst
+
+
+def _agreement(mine, sols_per_pose):
+    """Fraction of poses where the peer's distinct solutions (de-duplicated) number as many as
+    kinestat's, and the number of peer solutions kinestat does not have."""
+    same, extra = 0, 0
+    for m, sols in zip(mine, sols_per_pose, strict=True):
+        distinct: list[np.ndarray] = []
+        for s in np.asarray(sols, dtype=float).reshape(-1, 6):
+            if all(_wrapdist(s, d) > 1e-6 for d in distinct):
+                distinct.append(s)
+        same += len(distinct) == len(m)
+        extra += sum(1 for s in distinct if len(m) == 0 or np.min(_wrapdist(m, s)) > 1e-6)
+    return same / len(mine), extra
 
 
 def _single(call, poses):
@@ -181,8 +201,13 @@ def run(n: int, n_single: int) -> dict:
                     continue
                 single, sols = _single(call, T[:n_single])
                 c, mean, w = _score(model, q[:n_single], sols)
+                good = [[x for x in ss if _score(model, [qq], [[x]])[2] < 1e-6]
+                        for qq, ss in zip(q[:n_single], sols, strict=True)]
+                agree, extra = _agreement([res.solutions((i,)) for i in range(n_single)], good)
                 r[peer] = {"single_us": single * 1e6, "batched_poses_per_s": 1.0 / single,
-                           "complete": c, "mean_solutions": mean, "worst_residual": w}
+                           "complete": c, "mean_solutions": mean, "worst_residual": w,
+                           "count_agrees_with_kinestat": agree,
+                           "peer_solutions_kinestat_lacks": extra}
             except Exception as exc:  # noqa: BLE001 - a peer that fails is reported, not fatal
                 r[peer] = {"error": f"{type(exc).__name__}: {exc}"[:120]}
         rows[name] = r
@@ -207,7 +232,8 @@ def main(argv=None) -> int:
         return 0
     print(f"# ik_all benchmark  n={a.n}  single={a.single}  {meta}")
     print(f"{'arm':9} {'solver':12} {'method':24} {'single µs':>10} {'poses/s':>10} "
-          f"{'complete':>8} {'mean #':>7} {'worst res':>10}")
+          f"{'complete':>8} {'mean #':>7} {'worst res':>10} {'same # as ks':>12} "
+          f"{'ks lacks':>8}")
     for name, r in rows.items():
         for solver, v in r.items():
             if v is None:
@@ -219,7 +245,9 @@ def main(argv=None) -> int:
             print(f"{name:9} {solver:12} {v.get('method', ''):24} "
                   f"{_fmt(v['single_us'], '10.1f')} {_fmt(v['batched_poses_per_s'], '10.0f')} "
                   f"{_fmt(v['complete'], '8.4f')} {_fmt(v['mean_solutions'], '7.2f')} "
-                  f"{_fmt(v['worst_residual'], '10.1e')}")
+                  f"{_fmt(v['worst_residual'], '10.1e')} "
+                  f"{_fmt(v.get('count_agrees_with_kinestat'), '12.4f')} "
+                  f"{_fmt(v.get('peer_solutions_kinestat_lacks'), '8d')}")
     return 0
 
 
