@@ -64,6 +64,19 @@ def _reshape(res: IKAllResult, shape: tuple[int, ...]) -> IKAllResult:
     )
 
 
+def _nearest_rigid(Tf: np.ndarray) -> np.ndarray:
+    """Project rotations that are orthonormal only to within the accepted 1e-6 (rounded input,
+    float32) onto the nearest rotation (SVD), so that an exact solution can exist."""
+    R = Tf[:, :3, :3]
+    err = np.abs(np.einsum("nij,nkj->nik", R, R) - np.eye(3)).max(axis=(1, 2))
+    bad = np.flatnonzero(err > 1e-13)
+    if bad.size:
+        Tf = Tf.copy()
+        U, _, Vt = np.linalg.svd(Tf[bad, :3, :3])
+        Tf[bad, :3, :3] = U @ Vt
+    return Tf
+
+
 def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
            backend: str = "numba") -> IKAllResult:
     """Every IK solution of the 6R ``model`` for poses ``T_base_flange (..., 4, 4)``.
@@ -74,6 +87,8 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     gives no valid slot and a ``reason``; a model that is not six revolute joints, or a pose
     that is not a rigid transform, raises a :class:`~kinestat.errors.KinestatError`.
     ``backend``: ``"numba"`` (compiled kernels, default) or ``"numpy"`` (the references).
+    A rotation accepted as orthonormal within 1e-6 but not to rounding (float32 or printed
+    poses) is first replaced by the nearest rotation; residuals refer to that pose.
 
     >>> import kinestat, numpy as np
     >>> m = kinestat.load("puma560")
@@ -99,6 +114,7 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         T = check_poses(T)
         Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
     shape = T.shape[:-2]
+    Tf = _nearest_rigid(Tf)
     kind, data = _classified(model)
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
     if use in ("pieper", "three-parallel") and use != kind:

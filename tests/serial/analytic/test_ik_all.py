@@ -194,3 +194,14 @@ def test_compiled_kernels_match_numpy_references(name):
         for s in sb:
             assert np.min(wrapped_distance(sa, s)) < 1e-6
     np.testing.assert_array_equal(a.singular.sum(-1), b.singular.sum(-1))
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560", "random1"])
+def test_rounded_pose_is_projected_onto_a_rotation(name):
+    model = arm(name)
+    q = np.array([0.3, -0.7, 1.1, 0.4, -0.9, 0.2])
+    T = kinestat.fk(model, q)
+    T32 = T.astype(np.float32)  # orthonormal only to ~1e-7
+    res = ik_all(model, T32)
+    assert int(res.n_solutions) == int(ik_all(model, T).n_solutions) > 0
+    assert np.min(wrapped_distance(res.solutions(), q)) < 1e-5
