@@ -25,6 +25,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         'mechanism.chain': ['ChainModel'],
         'serial.fk': ['fk'],
         'serial.ik': ['ik'],
+        'serial.analytic': ['ik_all'],
         'serial.jacobian': ['jacobian'],
     },
 )

@@ -1,0 +1,255 @@
+"""All-solutions IK benchmark: kinestat.ik_all against ssik, EAIK, ik-geo and RTB ``ikine_a``.
+
+Run ``.venv/bin/python benchmarks/ik_all.py [--n 10000] [--single 200] [--json]``.
+
+Arms (the same random configurations, uniform in [-π, π]^6, fixed seed): UR5 (three parallel
+axes), PUMA 560 (spherical wrist, embedded), PUMA 762 (embedded, Crane–Duffy frames), a Kinova
+Jaco2-type 6R with a 60° wrist (non-Pieper) and a random general 6R. For every solver and arm:
+single-call time per pose (one pose per call, median over ``--single`` poses), batched poses/s
+(kinestat: one call on ``--n`` poses; peers have no batch call, so their figure is 1/single),
+completeness (the generating configuration is among the returned solutions, wrapped distance
+< 1e-6), the mean number of solutions (kinestat: over ``--n`` poses; peers: over the
+``--single`` poses), the worst pose residual of the returned solutions, every one recomputed
+with kinestat's FK, and, per peer on the ``--single`` poses, the fraction of poses where its
+number of distinct verified solutions (residual < 1e-6) equals kinestat's and the number of its
+verified solutions kinestat lacks. ``n/a`` marks a solver that does not apply. The ik-geo
+adapter (product-of-exponentials vectors from kinestat's home axes) is validated only for the
+three-parallel class; its zero completeness elsewhere is an adapter/convention mismatch, not a
+finding about ik-geo.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import sys
+import time
+import warnings
+
+import numpy as np
+
+warnings.filterwarnings("ignore")
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests", "serial", "analytic"))
+
+from arms import arm  # noqa: E402  (test arms, public constructors)
+
+import kinestat  # noqa: E402
+from kinestat.serial.analytic import ik_all  # noqa: E402
+from kinestat.serial.analytic.geometry import home_axes  # noqa: E402
+
+PI = math.pi
+ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1")
+
+
+def _wrapdist(a, b):
+    return np.max(np.abs(np.mod(a - b + PI, 2 * PI) - PI), axis=-1)
+
+
+def _score(model, q_true, sols_per_pose):
+    """Completeness, mean count and worst residual (pos, rot) of lists of solutions."""
+    found, counts, worst = 0, [], 0.0
+    for q, sols in zip(q_true, sols_per_pose, strict=True):
+        sols = np.asarray(sols, dtype=float).reshape(-1, 6)
+        counts.append(len(sols))
+        if len(sols):
+            found += bool(np.min(_wrapdist(sols, q)) < 1e-6)
+            F = kinestat.fk(model, sols)
+            T = kinestat.fk(model, q)
+            res = np.maximum(np.linalg.norm(F[:, :3, 3] - T[:3, 3], axis=-1),
+                             np.linalg.norm(F[:, :3, :3] - T[:3, :3], axis=(-2, -1)))
+            worst = max(worst, float(res.max()))
+    return found / len(q_true), float(np.mean(counts)), worst
+
+
+def _agreement(mine, sols_per_pose):
+    """Fraction of poses where the peer's distinct solutions (de-duplicated) number as many as
+    kinestat's, and the number of peer solutions kinestat does not have."""
+    same, extra = 0, 0
+    for m, sols in zip(mine, sols_per_pose, strict=True):
+        distinct: list[np.ndarray] = []
+        for s in np.asarray(sols, dtype=float).reshape(-1, 6):
+            if all(_wrapdist(s, d) > 1e-6 for d in distinct):
+                distinct.append(s)
+        same += len(distinct) == len(m)
+        extra += sum(1 for s in distinct if len(m) == 0 or np.min(_wrapdist(m, s)) > 1e-6)
+    return same / len(mine), extra
+
+
+def _single(call, poses):
+    """Median seconds per call over the poses (after one warm-up)."""
+    call(poses[0])
+    times, out = [], []
+    for T in poses:
+        t = time.perf_counter()
+        r = call(T)
+        times.append(time.perf_counter() - t)
+        out.append(r)
+    return float(np.median(times)), out
+
+
+# -- peers ----------------------------------------------------------------------------------
+def _dh(model):
+    if model.notation != "standard_dh" or np.any(model.base != np.eye(4)) or \
+            np.any(model.tool != np.eye(4)):
+        return None
+    th, d, a, al = model.parameters.T
+    return th, d, a, al
+
+
+def peer_ssik(model):
+    import ssik
+
+    dh = _dh(model)
+    if dh is None:
+        return None
+    th, d, a, al = dh
+    m = ssik.Manipulator.from_dh(al, a, d)
+
+    def call(T):
+        return [np.asarray(s.q, dtype=float) - th for s in m.solve(T)]
+    return call
+
+
+def peer_eaik(model):
+    from eaik.IK_DH import DhRobot
+
+    dh = _dh(model)
+    if dh is None:
+        return None
+    th, d, a, al = dh
+    bot = DhRobot(al, a, d)
+    if not bot.hasKnownDecomposition():
+        return None
+
+    def call(T):
+        s = bot.IK(T)
+        return [np.asarray(q) - th for q, ls in zip(s.Q, s.is_LS, strict=True) if not ls]
+    return call
+
+
+def peer_ikgeo(model, kind):
+    from ik_geo import Robot
+
+    ax = home_axes(model)
+    h = ax.w.tolist()
+    pts = np.vstack([ax.r, ax.T0[:3, 3]])
+    p = np.vstack([pts[0], np.diff(pts, axis=0)]).tolist()
+    ctor = {"three-parallel": Robot.three_parallel_two_intersecting,
+            "pieper": Robot.spherical_two_intersecting}.get(kind, Robot.gen_six_dof)
+    bot = ctor(h, p)
+    R0 = ax.T0[:3, :3]
+
+    def call(T):
+        # ik-geo takes the rotation transposed (checked against its forward_kinematics)
+        out = bot.get_ik((T[:3, :3] @ R0.T).T.tolist(), T[:3, 3].tolist())
+        return [np.asarray(q) for q, ls in out if not ls]
+    return call
+
+
+def peer_rtb(model):
+    if model.name != "puma560":
+        return None
+    import roboticstoolbox as rtb
+
+    robot = rtb.models.DH.Puma560()
+    mine = np.array([[L.theta, L.d, L.a, L.alpha] for L in robot.links])
+    if not np.allclose(mine, model.parameters, atol=1e-9):
+        return None
+    configs = ("lun", "lud", "lfn", "lfd", "run", "rud", "rfn", "rfd")
+
+    def call(T):
+        out = []
+        for c in configs:
+            sol = robot.ikine_a(T, config=c)
+            if sol.success:
+                out.append(np.asarray(sol.q))
+        return out
+    return call
+
+
+# -- runs -----------------------------------------------------------------------------------
+def run(n: int, n_single: int) -> dict:
+    rng = np.random.default_rng(20261201)
+    rows = {}
+    for name in ARMS:
+        model = arm(name)
+        q = rng.uniform(-PI, PI, (n, 6))
+        T = kinestat.fk(model, q)
+        ik_all(model, T[:64])  # compile / load the kernels
+        t = time.perf_counter()
+        res = ik_all(model, T)
+        dt = time.perf_counter() - t
+        d = _wrapdist(res.q, q[:, None, :])
+        complete = float(np.mean(np.any(np.where(res.valid, d, np.inf) < 1e-6, axis=1)))
+        worst = float(np.nanmax(np.maximum(res.position_error, res.rotation_error)))
+        single, _ = _single(lambda x, m=model: ik_all(m, x), T[:n_single])
+        r = {"kinestat": {"method": res.method, "batched_poses_per_s": n / dt,
+                          "single_us": single * 1e6, "complete": complete,
+                          "mean_solutions": float(res.n_solutions.mean()),
+                          "worst_residual": worst}}
+        kind = res.method if res.method in ("pieper", "three-parallel") else "general"
+        for peer, make in (("ssik", lambda m: peer_ssik(m)), ("eaik", lambda m: peer_eaik(m)),
+                           ("ik-geo", lambda m, k=kind: peer_ikgeo(m, k)),
+                           ("rtb-ikine_a", lambda m: peer_rtb(m))):
+            try:
+                call = make(model)
+                if call is None:
+                    r[peer] = None
+                    continue
+                single, sols = _single(call, T[:n_single])
+                c, mean, w = _score(model, q[:n_single], sols)
+                good = [[x for x in ss if _score(model, [qq], [[x]])[2] < 1e-6]
+                        for qq, ss in zip(q[:n_single], sols, strict=True)]
+                agree, extra = _agreement([res.solutions((i,)) for i in range(n_single)], good)
+                r[peer] = {"single_us": single * 1e6, "batched_poses_per_s": 1.0 / single,
+                           "complete": c, "mean_solutions": mean, "worst_residual": w,
+                           "count_agrees_with_kinestat": agree,
+                           "peer_solutions_kinestat_lacks": extra}
+            except Exception as exc:  # noqa: BLE001 - a peer that fails is reported, not fatal
+                r[peer] = {"error": f"{type(exc).__name__}: {exc}"[:120]}
+        rows[name] = r
+    return rows
+
+
+def _fmt(v, spec):
+    return "n/a" if v is None else format(v, spec)
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=10_000, help="poses per arm for the batched run")
+    ap.add_argument("--single", type=int, default=200, help="poses for single-call timing")
+    ap.add_argument("--json", action="store_true")
+    a = ap.parse_args(argv)
+    rows = run(a.n, a.single)
+    meta = {"cpus": os.cpu_count(), "numba_threads": __import__("numba").get_num_threads(),
+            "machine": platform.platform(), "load_avg": os.getloadavg()}
+    if a.json:
+        print(json.dumps({"meta": meta, "rows": rows}, indent=1))
+        return 0
+    print(f"# ik_all benchmark  n={a.n}  single={a.single}  {meta}")
+    print(f"{'arm':9} {'solver':12} {'method':24} {'single µs':>10} {'poses/s':>10} "
+          f"{'complete':>8} {'mean #':>7} {'worst res':>10} {'same # as ks':>12} "
+          f"{'ks lacks':>8}")
+    for name, r in rows.items():
+        for solver, v in r.items():
+            if v is None:
+                print(f"{name:9} {solver:12} {'n/a (does not apply)':24}")
+                continue
+            if "error" in v:
+                print(f"{name:9} {solver:12} failed: {v['error']}")
+                continue
+            print(f"{name:9} {solver:12} {v.get('method', ''):24} "
+                  f"{_fmt(v['single_us'], '10.1f')} {_fmt(v['batched_poses_per_s'], '10.0f')} "
+                  f"{_fmt(v['complete'], '8.4f')} {_fmt(v['mean_solutions'], '7.2f')} "
+                  f"{_fmt(v['worst_residual'], '10.1e')} "
+                  f"{_fmt(v.get('count_agrees_with_kinestat'), '12.4f')} "
+                  f"{_fmt(v.get('peer_solutions_kinestat_lacks'), '8d')}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

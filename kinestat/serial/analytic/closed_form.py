@@ -1,0 +1,209 @@
+"""Closed-form inverse kinematics by Paden–Kahan subproblems, batched over poses.
+
+Product-of-exponentials form ``g = T T(0)⁻¹ = e^{ξ̂1θ1} ⋯ e^{ξ̂6θ6}`` (MLS §3.3) with the axes of
+:func:`kinestat.serial.analytic.geometry.home_axes`. Two geometries:
+
+- :func:`solve_pieper`: spherical wrist (axes 4, 5, 6 meet at w) and axes 1, 2 meeting at s.
+  ``|g w − s| = |e^{ξ̂3θ3} w − s|`` (subproblem 3: θ3), ``e^{ξ̂1θ1} e^{ξ̂2θ2} (e^{ξ̂3θ3} w) = g w``
+  (subproblem 2: θ1, θ2), ``R4 R5 ω6 = R' ω6`` (subproblem 2: θ4, θ5), θ6 (subproblem 1).
+  Up to 8 solutions; where ω6 lines up with ω4 (|sin| of their angle < ``wrist_tol``) the branch
+  is the one-parameter family ``θ4 + σ θ6 = const``.
+- :func:`solve_three_parallel`: axes 2, 3, 4 parallel to h and axes 5, 6 meeting at p (UR-type).
+  ``hᵀ e^{−ξ̂1θ1} g p = hᵀ p`` (subproblem 4: θ1), ``hᵀ R5 ω6 = hᵀ R1ᵀ Rg ω6`` (subproblem 4:
+  θ5), θ6 and ``φ = Σ θ2..4`` (subproblem 1), θ3 (subproblem 3) and θ2 (subproblem 1) from a
+  point on axis 4. Up to 8 solutions; the wrist-singular set (axis 6 parallel to h) is left
+  out (no slot), as its family couples four joints.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from kinestat.mechanism.chain import ChainModel
+from kinestat.serial.analytic._common import pack
+from kinestat.serial.analytic.result import IKAllResult
+from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
+
+__all__ = ["solve_pieper", "solve_three_parallel", "solve_pieper_compiled",
+           "solve_three_parallel_compiled"]
+
+_WRIST_TOL = 1e-10
+_PARALLEL_MIN = 32  # smaller batches run on one thread
+
+
+def _apply(T: np.ndarray, x: np.ndarray) -> np.ndarray:
+    return np.einsum("...ij,...j->...i", T[..., :3, :3], x) + T[..., :3, 3]
+
+
+def _mv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
+    return np.einsum("...ij,...j->...i", R, x)
+
+
+def _perp(w: np.ndarray) -> np.ndarray:
+    e = np.eye(3)[int(np.argmin(np.abs(w)))]
+    x = np.cross(w, e)
+    return x / np.linalg.norm(x)
+
+
+def _wrap(a):
+    return np.mod(a + math.pi, 2.0 * math.pi) - math.pi
+
+
+def _wrist(W, Rp: np.ndarray, wrist_tol: float):
+    """θ4, θ5, θ6 (``(..., 2)`` each), existence, singular mask and family sign/value for
+    ``R4 R5 R6 = R'`` with axes 4, 5, 6 meeting (directions ``W[3:6]``)."""
+    z = np.zeros(3)
+    target = _mv(Rp, W[5])  # R' ω6
+    t4, t5, ex = sp2(W[3], W[4], z, W[5], target)
+    sing = np.linalg.norm(np.cross(W[3], target), axis=-1) < wrist_tol
+    # on the singular set θ4 is free: take θ4 = 0 and align ω6 by θ5 alone
+    t5s, _, _ = sp1(W[4], z, W[5], target)
+    t4 = np.where(sing[..., None], 0.0, t4)
+    t5 = np.where(sing[..., None], t5s[..., None], t5)
+    ex = ex | sing
+    R45 = rotation_matrix(W[3], t4) @ rotation_matrix(W[4], t5)
+    x = _perp(W[5])
+    t6, _, _ = sp1(W[5], z, x, _mv(np.swapaxes(R45, -1, -2), _mv(Rp, x)[..., None, :]))
+    sig = np.sign(np.sum(W[3] * _mv(rotation_matrix(W[4], t5), W[5]), axis=-1))
+    fam = _wrap(t4 + sig * t6)
+    return t4, t5, t6, ex, sing, sig, fam
+
+
+def solve_pieper(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
+                 wrist_tol: float = _WRIST_TOL) -> IKAllResult:
+    """All solutions (8 slots) for a spherical-wrist arm whose axes 1, 2 meet; ``T (N, 4, 4)``."""
+    ax, w, s = data["axes"], data["wrist"], data["shoulder"]
+    W, P = ax.w, ax.r
+    N = T.shape[0]
+    g = T @ np.linalg.inv(ax.T0)
+    pw = _apply(g, w)  # (N, 3)
+    t3, e3 = sp3(W[2], P[2], w, s, np.linalg.norm(pw - s, axis=-1))  # (N, 2)
+    w3 = rotate(W[2], P[2], t3, w)  # (N, 2, 3)
+    t1, t2, e12 = sp2(W[0], W[1], s, w3, pw[:, None, :])  # (N, 2, 2)
+    t3 = np.broadcast_to(t3[..., None], t1.shape)
+    R123 = rotation_matrix(W[0], t1) @ rotation_matrix(W[1], t2) @ rotation_matrix(W[2], t3)
+    Rp = np.swapaxes(R123, -1, -2) @ g[:, None, None, :3, :3]  # (N, 2, 2, 3, 3)
+    t4, t5, t6, e45, sing, sig, fam = _wrist(W, Rp, wrist_tol)
+    sh = (N, 2, 2, 2)
+    q = np.stack([np.broadcast_to(a[..., None], sh) for a in (t1, t2, t3)]
+                 + [t4, t5, t6], axis=-1).reshape(N, 8, 6)
+    ok = np.broadcast_to(e3[:, None, None, None] & e12[..., None, None] & e45[..., None],
+                         sh).reshape(N, 8)
+    return pack(model, q, ok, T, 8, tol=tol, method="pieper",
+                reason_none="no real solution: the wrist centre is out of reach of the arm "
+                            "(subproblem 3 or 2 of the shoulder has no real root)",
+                singular=np.broadcast_to(sing[..., None], sh).reshape(N, 8),
+                family_sign=np.broadcast_to(sig, sh).reshape(N, 8),
+                family_value=np.broadcast_to(fam, sh).reshape(N, 8), family_joints=(3, 5))
+
+
+def solve_three_parallel(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
+                         wrist_tol: float = _WRIST_TOL) -> IKAllResult:
+    """All solutions (8 slots) for axes 2 ∥ 3 ∥ 4 with axes 5, 6 meeting (UR-type)."""
+    ax, p = data["axes"], data["p56"]
+    W, P = ax.w, ax.r
+    N = T.shape[0]
+    h = W[1]
+    sg = np.array([float(np.sign(W[i] @ h)) for i in (1, 2, 3)])
+    g = T @ np.linalg.inv(ax.T0)
+    Rg = g[:, :3, :3]
+    q56 = _apply(g, p)
+    psi, e1 = sp4(h, W[0], q56 - P[0], float(h @ (p - P[0])))  # ψ = −θ1, (N, 2)
+    t1 = -psi
+    Rr = rotation_matrix(W[0], psi) @ Rg[:, None]  # R1ᵀ Rg, (N, 2, 3, 3)
+    t5, e5 = sp4(h, W[4], W[5], np.einsum("i,...ij,j->...", h, Rr, W[5]))  # (N, 2, 2)
+    Rr2 = np.broadcast_to(Rr[:, :, None], (N, 2, 2, 3, 3))
+    hr = np.einsum("...ji,j->...i", Rr2, h)  # Rrᵀ h
+    R5 = rotation_matrix(W[4], t5)
+    t6, e6, free6 = sp1(W[5], np.zeros(3), hr, np.einsum("...ji,j->...i", R5, h))
+    sing = free6 | (np.linalg.norm(np.cross(hr, W[5]), axis=-1) < wrist_tol)
+    R6 = rotation_matrix(W[5], t6)
+    R234 = Rr2 @ np.swapaxes(R5 @ R6, -1, -2)
+    x = _perp(h)
+    phi, _, _ = sp1(h, np.zeros(3), x, _mv(R234, x))
+    # the point r4 on axis 4 carried by e^{ξ̂2θ2} e^{ξ̂3θ3} e^{ξ̂4θ4} = e^{−ξ̂1θ1} g e^{−ξ̂6θ6} e^{−ξ̂5θ5}
+    y = rotate(W[5], P[5], -t6, rotate(W[4], P[4], -t5, P[3]))
+    y = _apply(g[:, None, None], y)
+    y = rotate(W[0], P[0], np.broadcast_to(psi[:, :, None], t5.shape), y)
+    t3, e3 = sp3(W[2], P[2], P[3], P[1], np.linalg.norm(y - P[1], axis=-1))  # (N, 2, 2, 2)
+    y3 = rotate(W[2], P[2], t3, P[3])
+    t2, _, _ = sp1(W[1], P[1], y3, y[..., None, :])
+    ph = phi[..., None]
+    t4 = sg[2] * (ph - sg[0] * t2 - sg[1] * t3)
+    sh = (N, 2, 2, 2)
+    q = np.stack([np.broadcast_to(t1[:, :, None, None], sh), t2, t3, t4,
+                  np.broadcast_to(t5[..., None], sh), np.broadcast_to(t6[..., None], sh)],
+                 axis=-1).reshape(N, 8, 6)
+    ok = np.broadcast_to(e1[:, None, None, None] & e5[..., None, None]
+                         & (e6 & ~sing)[..., None] & e3[..., None], sh).reshape(N, 8)
+    return pack(model, q, ok, T, 8, tol=tol, method="three-parallel",
+                reason_none="no real solution: the pose is out of reach (subproblem 4 for θ1 or "
+                            "θ5, or subproblem 3 for θ3, has no real root), or the wrist is "
+                            "singular (axis 6 parallel to axes 2-4)")
+
+
+_REASON_PIEPER = ("no real solution: the wrist centre is out of reach of the arm (subproblem 3 "
+                  "or 2 of the shoulder has no real root)")
+_REASON_3P = ("no real solution: the pose is out of reach (subproblem 4 for θ1 or θ5, or "
+              "subproblem 3 for θ3, has no real root), or the wrist is singular (axis 6 parallel "
+              "to axes 2-4)")
+
+
+def _outputs(N: int, K: int):
+    return (np.full((N, K, 6), np.nan), np.zeros((N, K), dtype=bool), np.full((N, K), np.nan),
+            np.full((N, K), np.nan))
+
+
+def _result(q, valid, pos, rot, sing, sign, fam, joints, reason, method, tol) -> IKAllResult:
+    nsol = valid.sum(axis=1)
+    return IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot, singular=sing,
+                       family_sign=sign, family_value=fam, family_joints=joints,
+                       n_solutions=nsol,
+                       reason=np.where(nsol > 0, "", reason).astype(object), method=method,
+                       tol=tol)
+
+
+def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
+                          wrist_tol: float = _WRIST_TOL) -> IKAllResult:
+    """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first)."""
+    from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
+
+    ax = data["axes"]
+    N = T.shape[0]
+    q, valid, pos, rot = _outputs(N, 8)
+    sing = np.zeros((N, 8), dtype=bool)
+    sign = np.zeros((N, 8))
+    fam = np.full((N, 8), np.nan)
+    run = K.pieper_batch if N >= _PARALLEL_MIN else K.pieper_serial
+    if "kernel_args" not in data:  # pose-independent, kept with the model's cached geometry
+        data["kernel_args"] = (np.asarray(model.constants), np.linalg.inv(ax.T0), ax.w, ax.r,
+                               np.asarray(data["wrist"]), np.asarray(data["shoulder"]),
+                               _perp(ax.w[5]))
+    C, T0inv, W, P, w, s, x6 = data["kernel_args"]
+    run(C, np.ascontiguousarray(T), T0inv, W, P, w, s, x6, tol, wrist_tol, 1e-6, q, valid, pos,
+        rot, sing, sign, fam)
+    return _result(q, valid, pos, rot, sing, sign, fam, (3, 5), _REASON_PIEPER, "pieper", tol)
+
+
+def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, *,
+                                  tol: float = 1e-9,
+                                  wrist_tol: float = _WRIST_TOL) -> IKAllResult:
+    """:func:`solve_three_parallel` by the compiled kernel."""
+    from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
+
+    ax = data["axes"]
+    N = T.shape[0]
+    if "kernel_args" not in data:
+        h = ax.w[1]
+        sg = np.array([float(np.sign(ax.w[i] @ h)) for i in (1, 2, 3)])
+        data["kernel_args"] = (np.asarray(model.constants), np.linalg.inv(ax.T0), ax.w, ax.r,
+                               np.asarray(data["p56"]), _perp(h), sg)
+    C, T0inv, W, P, p56, xh, sg = data["kernel_args"]
+    q, valid, pos, rot = _outputs(N, 8)
+    run = K.three_parallel_batch if N >= _PARALLEL_MIN else K.three_parallel_serial
+    run(C, np.ascontiguousarray(T), T0inv, W, P, p56, xh, sg, tol, wrist_tol, 1e-6, q, valid,
+        pos, rot)
+    return _result(q, valid, pos, rot, np.zeros((N, 8), dtype=bool), np.zeros((N, 8)),
+                   np.full((N, 8), np.nan), None, _REASON_3P, "three-parallel", tol)

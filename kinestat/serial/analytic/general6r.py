@@ -1,0 +1,354 @@
+"""Every inverse-kinematics solution of a general 6R chain by the eigenvalue method.
+
+Raghavan & Roth (1993), in the numerically stable form of Manocha & Canny (1994):
+
+1. RR eq. 4 and its 14 invariants give ``P(θ3) R(θ4, θ5) = Q S(θ1, θ2)``
+   (:mod:`kinestat.serial.analytic._rr_algebra`; Manocha–Canny eq. 9), with the constant of
+   ``S`` moved to the left.
+2. θ1, θ2 are eliminated by the left null space of Q (an SVD: 6 equations when rank Q = 8).
+3. The half-angle substitution ``xk = tan(φk/2)`` (φk = θk − offset, fixed offsets keep θk = π
+   off the pole) and multiplication of the 6 equations by ``x4`` give 12 equations, linear in the
+   12 power products ``x4^i x5^j`` (i ≤ 3, j ≤ 2): ``(A2 x3² + A1 x3 + A0) v = 0``
+   (Manocha–Canny eq. 13).
+4. ``x3`` are the eigenvalues of the 24x24 companion pencil (the standard problem with
+   ``A2⁻¹`` when A2 is well conditioned, otherwise the generalised one, ``scipy.linalg.eig``);
+   up to 16 are real (the spurious ``x3 = ±i`` of the half-angle factor are not).
+5. x4, x5 from the eigenvector's power-product ratios; (c1, s1, c2, s2) from the linear
+   equations ``Q S = P R`` (least squares); θ6 from the remaining rotation.
+6. Newton steps against FK polish each root; a root counts only if FK reproduces the pose
+   within ``tol``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import scipy.linalg
+
+from kinestat.errors import ModelError
+from kinestat.mechanism.chain import ChainModel
+from kinestat.serial.analytic import _rr_algebra as rr
+from kinestat.serial.analytic._common import newton_polish, pack
+from kinestat.serial.analytic.result import IKAllResult
+from kinestat.serial.fk import fk
+
+__all__ = ["solve_general_6r", "Formulation", "FORMULATIONS", "formulation", "MAX_SOLUTIONS",
+           "OFFSETS"]
+
+MAX_SOLUTIONS = 16
+"""A general 6R has at most 16 inverse-kinematics solutions (Lee & Liang 1988; RR 1993)."""
+
+OFFSETS = (0.4170, -1.2137, 0.7751)
+"""Shifts (rad) of θ3, θ4, θ5 before the half-angle substitution (any generic values)."""
+
+_COND_MAX = 1e10  # A2 more ill-conditioned than this: generalised eigenproblem
+
+
+@dataclass(frozen=True)
+class Formulation:
+    """Which loop the elimination is written on.
+
+    The IK closes the loop ``Z1 Λ1 Z2 Λ2 … Z6 Λ6 = I`` with ``Λi = Ci`` (i ≤ 5) and the pose link
+    ``Λ6 = C6 T⁻¹ C0``. Any cyclic shift of it (``shift``) and its inverse (``reverse``: joints
+    6…1 with values −q) is the same problem; RR eq. 4 is written on ``Z_J1 M1 … Z_J6 M6 = I``.
+    Special geometries (intersecting or parallel axes) can make one formulation's pencil
+    singular while another stays regular; :func:`formulation` picks one per model.
+    """
+
+    reverse: bool = False
+    shift: int = 0
+
+    def joints(self) -> tuple[tuple[int, ...], float]:
+        """The joint order J (0-based original indices) and the sign of their values."""
+        order = (5, 4, 3, 2, 1, 0) if self.reverse else (0, 1, 2, 3, 4, 5)
+        return order[self.shift:] + order[:self.shift], (-1.0 if self.reverse else 1.0)
+
+    def links(self, C: np.ndarray, T: np.ndarray) -> list:
+        """The six links ``M1 … M6`` (constant ``(4, 4)`` or per pose ``(N, 4, 4)``)."""
+        lam = [C[1], C[2], C[3], C[4], C[5], C[6] @ _inv_rigid(T) @ C[0]]
+        if self.reverse:
+            lam = [_inv_rigid(m) for m in (lam[4], lam[3], lam[2], lam[1], lam[0], lam[5])]
+        return lam[self.shift:] + lam[:self.shift]
+
+
+FORMULATIONS = tuple(Formulation(r, s) for s in (0, 5, 1, 4, 2, 3) for r in (False, True))
+"""Formulations in the order tried (the first two keep the left side pose-independent)."""
+
+
+def _inv_rigid(T: np.ndarray) -> np.ndarray:
+    R = np.swapaxes(T[..., :3, :3], -1, -2)
+    out = np.zeros(T.shape)
+    out[..., :3, :3] = R
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", R, T[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
+_H3 = np.einsum("ai,bj,ck->abcijk", rr.HALF_ANGLE, rr.HALF_ANGLE,
+                rr.HALF_ANGLE).reshape(27, 27)
+
+
+def check_general(model: ChainModel) -> None:
+    """Raise :class:`ModelError` unless the model is six revolute joints."""
+    if model.n != 6:
+        raise ModelError(f"ik_all: model {model.name!r} has {model.n} joints; exactly 6 needed")
+    kinds = [j.kind for j in model.joints]
+    if any(k != "revolute" for k in kinds):
+        raise ModelError(
+            f"ik_all: the general 6R eigenvalue method needs six revolute joints; model "
+            f"{model.name!r} has {kinds} (prismatic/screw joints: only closed forms, none "
+            f"applies to this geometry)"
+        )
+
+
+def _pencil(M: list, N: int):
+    """Per pose: the matrix polynomial ``A (N, 3, 12, 12)``, the reduced left side ``Lt``
+    ``(N, 14, 27)``, the SVD of Q (for back-substitution) and the rank-deficient mask."""
+    Ts = _inv_rigid(M[5])
+    fT = rr.invariants(Ts[..., :3, 3], Ts[..., :3, 2])
+    K = rr.right_tensor(M[0])
+    Rh = np.einsum("...abij,...j->...iab", K, fT)
+    Rh = np.broadcast_to(Rh, (N, 15, 3, 3))[:, 1:].reshape(N, 14, 9)
+    L = rr.left_tensor(M[1], M[2], M[3], M[4], np.array(OFFSETS))
+    Lt = np.broadcast_to(L[..., 1:, :, :, :], (N, 14, 3, 3, 3)).reshape(N, 14, 27).copy()
+    Lt[:, :, 0] -= Rh[:, :, 0]
+    Q = Rh[:, :, 1:]
+    U, s, Vt = np.linalg.svd(Q, full_matrices=True)
+    deficient = s[:, 7] <= 1e-10 * s[:, 0]
+    E = np.swapaxes(U[:, :, 8:], 1, 2) @ Lt  # (N, 6, 27)
+    Ep = (E @ _H3).reshape(N, 6, 3, 3, 3)  # powers of x3, x4, x5
+    A = np.zeros((N, 3, 12, 12))
+    blk = np.moveaxis(Ep, 2, 1).reshape(N, 3, 6, 9)
+    A[:, :, :6, :9] = blk
+    A[:, :, 6:, 3:] = blk
+    return A, Lt, (U, s, Vt), deficient
+
+
+def _eig(A: np.ndarray):
+    """Eigenvalues ``(N, 24)`` and eigenvectors ``(N, 24, 24)`` of the pencils, complex."""
+    N = A.shape[0]
+    A = A / np.max(np.abs(A), axis=(1, 2, 3))[:, None, None, None]
+    A0, A1, A2 = A[:, 0], A[:, 1], A[:, 2]
+    cond = np.linalg.cond(A2)
+    good = np.isfinite(cond) & (cond < _COND_MAX)
+    w = np.full((N, 24), np.nan + 0j)
+    V = np.zeros((N, 24, 24), dtype=complex)
+    I12 = np.eye(12)
+    if np.any(good):
+        g = np.flatnonzero(good)
+        X = np.linalg.solve(A2[g], np.concatenate([A0[g], A1[g]], axis=2))
+        M = np.zeros((g.size, 24, 24))
+        M[:, :12, 12:] = I12
+        M[:, 12:, :12] = -X[:, :, :12]
+        M[:, 12:, 12:] = -X[:, :, 12:]
+        w[g], V[g] = np.linalg.eig(M)
+    for i in np.flatnonzero(~good):
+        a = np.zeros((24, 24))
+        b = np.eye(24)
+        a[:12, 12:] = I12
+        a[12:, :12] = -A0[i]
+        a[12:, 12:] = -A1[i]
+        b[12:, 12:] = A2[i]
+        wi, Vi = scipy.linalg.eig(a, b)
+        wi = np.where(np.isfinite(wi), wi, np.nan)
+        w[i], V[i] = wi, Vi
+    return w, V
+
+
+def _ratio(v: np.ndarray, axis: int) -> np.ndarray:
+    """Least-squares ratio x with ``v[.., i+1] = x v[.., i]`` along ``axis`` of v (.., 4, 3)."""
+    a = np.moveaxis(v, axis, -1)
+    lo, hi = a[..., :-1], a[..., 1:]
+    num = np.sum(hi * lo, axis=(-2, -1))
+    den = np.sum(lo * lo, axis=(-2, -1))
+    return num / np.where(den > 0, den, np.nan)
+
+
+def _angles_345(w: np.ndarray, V: np.ndarray):
+    """θ3, θ4, θ5 ``(N, 24)`` and a realness mask from the eigenpairs."""
+    real = np.isfinite(w) & (np.abs(w.imag) <= 1e-6 * (1.0 + np.abs(w)))
+    x3 = np.where(real, w.real, 0.0)
+    top = np.abs(x3) <= 1.0
+    v = np.where(top[:, None, :], V[:, :12, :], V[:, 12:, :])  # (N, 12, 24)
+    v = np.moveaxis(v, 1, 2)  # (N, 24, 12)
+    k = np.argmax(np.abs(v), axis=-1)
+    ph = np.take_along_axis(v, k[..., None], axis=-1)
+    v = (v * np.conj(ph) / np.abs(np.where(ph == 0, 1.0, ph))).real.reshape(v.shape[:2] + (4, 3))
+    x4 = _ratio(v, 2)
+    x5 = _ratio(v, 3)
+    ok = real & np.isfinite(x4) & np.isfinite(x5)
+    t3 = 2.0 * np.arctan(x3) + OFFSETS[0]
+    t4 = 2.0 * np.arctan(np.where(ok, x4, 0.0)) + OFFSETS[1]
+    t5 = 2.0 * np.arctan(np.where(ok, x5, 0.0)) + OFFSETS[2]
+    return t3, t4, t5, ok
+
+
+def _monomials(t: np.ndarray) -> np.ndarray:
+    return np.stack([np.ones_like(t), np.cos(t), np.sin(t)], axis=-1)
+
+
+def _angles_12(Lt, svd, t3, t4, t5):
+    """θ1, θ2 from ``Q S = Lt m(θ3, θ4, θ5)`` in least squares (Manocha–Canny eq. 9)."""
+    U, s, Vt = svd
+    m = np.einsum("nka,nkb,nkc->nkabc", _monomials(t3 - OFFSETS[0]), _monomials(t4 - OFFSETS[1]),
+                  _monomials(t5 - OFFSETS[2])).reshape(t3.shape + (27,))
+    rhs = np.einsum("nij,nkj->nki", Lt, m)  # (N, 24, 14)
+    inv_s = np.where(s > 1e-12 * s[:, :1], 1.0 / np.where(s > 0, s, 1.0), 0.0)
+    coef = np.einsum("nki,nij->nkj", rhs, U[:, :, :8]) * inv_s[:, None, :]
+    S = np.einsum("nkj,nji->nki", coef, Vt)  # (N, 24, 8): (a, b) ≠ (0, 0) of m(θ1) m(θ2)
+    t1 = np.arctan2(S[..., 5], S[..., 2])
+    t2 = np.arctan2(S[..., 1], S[..., 0])
+    return t1, t2
+
+
+def _theta6(M: list, q5: np.ndarray) -> np.ndarray:
+    """θ6 of the loop from ``Z6 = (Z1 M1 … Z5 M5)⁻¹ M6⁻¹``."""
+    G = np.broadcast_to(np.eye(4), q5.shape[:-1] + (4, 4)).copy()
+    for i in range(5):
+        c, s = np.cos(q5[..., i]), np.sin(q5[..., i])
+        Z = np.zeros(q5.shape[:-1] + (4, 4))
+        Z[..., 0, 0] = c
+        Z[..., 0, 1] = -s
+        Z[..., 1, 0] = s
+        Z[..., 1, 1] = c
+        Z[..., 2, 2] = Z[..., 3, 3] = 1.0
+        Mi = M[i] if M[i].ndim == 2 else M[i][:, None]
+        G = G @ Z @ Mi
+    Ts = _inv_rigid(M[5])
+    Ts = Ts if Ts.ndim == 2 else Ts[:, None]
+    R6 = np.swapaxes(G[..., :3, :3], -1, -2) @ Ts[..., :3, :3]
+    return np.arctan2(R6[..., 1, 0] - R6[..., 0, 1], R6[..., 0, 0] + R6[..., 1, 1])
+
+
+def candidates(model: ChainModel, T: np.ndarray, form: Formulation):
+    """Raw candidate solutions ``(N, 24, 6)`` with mask ``(N, 24)`` before polishing."""
+    N = T.shape[0]
+    M = form.links(np.asarray(model.constants), T)
+    A, Lt, svd, deficient = _pencil(M, N)
+    w, V = _eig(A)
+    t3, t4, t5, ok = _angles_345(w, V)
+    t1, t2 = _angles_12(Lt, svd, t3, t4, t5)
+    th5 = np.stack([t1, t2, t3, t4, t5], axis=-1)
+    th = np.concatenate([th5, _theta6(M, th5)[..., None]], axis=-1)
+    order, sign = form.joints()
+    q = np.empty_like(th)
+    q[..., list(order)] = sign * th
+    ok &= np.all(np.isfinite(q), axis=-1) & ~deficient[:, None]
+    return q, ok, deficient
+
+
+def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24) -> float:
+    """Fraction of random configurations found among a formulation's polished candidates."""
+    rng = np.random.default_rng(20261201)
+    lo = np.where(np.isfinite(model.lower), model.lower, -math.pi)
+    hi = np.where(np.isfinite(model.upper), model.upper, math.pi)
+    q0 = rng.uniform(lo, hi, (n, 6))
+    res = solve_general_6r(model, fk(model, q0), form=form)
+    d = np.abs(np.mod(res.q - q0[:, None, :] + math.pi, 2 * math.pi) - math.pi).max(-1)
+    return float(np.mean(np.any(np.where(res.valid, d, np.inf) < 1e-6, axis=1)))
+
+
+@lru_cache(maxsize=32)
+def formulation(model: ChainModel) -> tuple[Formulation, float]:
+    """The first formulation (of :data:`FORMULATIONS`) that finds every one of 24 random
+    configurations of ``model``, or the best one with its completeness fraction."""
+    check_general(model)
+    best = (FORMULATIONS[0], -1.0)
+    for form in FORMULATIONS:
+        frac = _raw_completeness(model, form)
+        if frac == 1.0:
+            return form, frac
+        if frac > best[1]:
+            best = (form, frac)
+    return best
+
+
+def _solve(model, T, form, tol, polish_iters) -> IKAllResult:
+    q, ok, deficient = candidates(model, T, form)
+    N, C, n = q.shape
+    flat = np.flatnonzero(ok.ravel())
+    Tc = np.repeat(T, C, axis=0)[flat]
+    qf = q.reshape(-1, n)
+    qf[flat] = newton_polish(model, qf[flat], Tc, polish_iters)
+    res = pack(model, qf.reshape(N, C, n), ok, T, MAX_SOLUTIONS, tol=tol,
+               method=_method_name(form), reason_none=_REASON_NONE)
+    if np.any(deficient):
+        r = res.reason.copy()
+        r[deficient & (res.n_solutions == 0)] = _REASON_DEFICIENT
+        object.__setattr__(res, "reason", r)
+    return res
+
+
+_PARALLEL_MIN = 32  # smaller batches run on one thread
+
+_REASON_NONE = ("no real solution: the pose is outside the workspace (no real root of the "
+                "Raghavan–Roth eigenproblem reproduces it)")
+_REASON_DEFICIENT = ("degenerate elimination: the θ1-θ2 coefficient matrix Q of Raghavan–Roth "
+                     "eq. 9 is rank deficient for this pose")
+
+
+@lru_cache(maxsize=64)
+def _compiled_data(model: ChainModel, form: Formulation):
+    """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5)."""
+    C = np.asarray(model.constants)
+    M = form.links(C, np.eye(4)[None])
+    L = rr.left_tensor(M[1], M[2], M[3], M[4], np.array(OFFSETS))[1:].reshape(14, 27)
+    order, sign = form.joints()
+    return (np.ascontiguousarray(C), np.ascontiguousarray(np.stack(M[1:5])),
+            np.ascontiguousarray(L), np.ascontiguousarray(_H3), np.array(OFFSETS),
+            np.array(order, dtype=np.int64), float(sign))
+
+
+def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
+    from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
+
+    C, links_fixed, L, H3, off, order, sign = _compiled_data(model, form)
+    M = form.links(C, T)
+    N = T.shape[0]
+    M1 = np.ascontiguousarray(np.broadcast_to(M[0], (N, 4, 4)))
+    Ts = np.ascontiguousarray(np.broadcast_to(_inv_rigid(M[5]), (N, 4, 4)))
+    q = np.full((N, MAX_SOLUTIONS, 6), np.nan)
+    valid = np.zeros((N, MAX_SOLUTIONS), dtype=bool)
+    pos = np.full((N, MAX_SOLUTIONS), np.nan)
+    rot = np.full((N, MAX_SOLUTIONS), np.nan)
+    flags = np.zeros(N, dtype=np.int64)
+    run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
+    run(C, np.ascontiguousarray(T), M1, Ts, links_fixed, L, H3, off, order, sign, tol,
+        polish_iters, 1e-6, q, valid, pos, rot, flags)
+    nsol = valid.sum(axis=1)
+    reason = np.where(nsol > 0, "", _REASON_NONE).astype(object)
+    reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
+    res = IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
+                      singular=np.zeros_like(valid), family_sign=np.zeros((N, MAX_SOLUTIONS)),
+                      family_value=np.full((N, MAX_SOLUTIONS), np.nan), family_joints=None,
+                      n_solutions=nsol, reason=reason, method=_method_name(form), tol=tol)
+    redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
+    if redo.size:  # the generalised eigenproblem (scipy) for these poses
+        sub = _solve(model, T[redo], form, tol, polish_iters)
+        for f in ("q", "valid", "position_error", "rotation_error", "n_solutions", "reason"):
+            getattr(res, f)[redo] = getattr(sub, f)
+    return res
+
+
+def _method_name(form: Formulation) -> str:
+    return f"raghavan-roth{'-reversed' if form.reverse else ''}-shift{form.shift}"
+
+
+def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
+                     polish_iters: int = 8, form: Formulation | None = None,
+                     backend: str = "numba") -> IKAllResult:
+    """All IK solutions of a 6R ``model`` for poses ``T (N, 4, 4)`` (Raghavan–Roth 1993).
+
+    Returns an :class:`IKAllResult` with ``K = 16`` slots. ``form`` defaults to the model's
+    :func:`formulation`; ``backend`` ``"numba"`` (compiled kernel, for formulations with shift
+    0 or 5) or ``"numpy"`` (the reference).
+    """
+    check_general(model)
+    if form is None:
+        form, _ = formulation(model)
+    if backend == "numba" and form.shift in (0, 5):
+        return _solve_compiled(model, T, form, tol, polish_iters)
+    return _solve(model, T, form, tol, polish_iters)

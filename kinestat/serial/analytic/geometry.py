@@ -1,0 +1,81 @@
+"""Which closed form a 6-joint chain admits, detected from its joint axes at q = 0.
+
+In product-of-exponentials form ``T(q) = e^{ξ̂1 q1} ⋯ e^{ξ̂6 q6} T(0)`` (MLS eq. 3.26), joint i's
+axis at q = 0 is the z axis of ``C0 C1 ⋯ C(i-1)``. Closed forms by subproblems need special
+axis geometry:
+
+- ``"pieper"``: axes 4, 5, 6 meet at one point (a spherical wrist, Pieper 1968) and axes 1, 2
+  meet (PUMA-type shoulders): subproblems 3, 2, 2, 1.
+- ``"three-parallel"``: axes 2, 3, 4 parallel and axes 5, 6 meeting (UR-type): subproblems 4,
+  4, 1, 1, 3, 1.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinestat.mechanism.chain import ChainModel
+
+__all__ = ["HomeAxes", "home_axes", "meet", "parallel", "classify"]
+
+
+@dataclass(frozen=True, eq=False)
+class HomeAxes:
+    """Joint axes at q = 0 in the base frame: directions ``w (n, 3)``, points ``r (n, 3)``, the
+    home pose ``T0`` and a length scale of the model."""
+
+    w: np.ndarray
+    r: np.ndarray
+    T0: np.ndarray
+    scale: float
+
+
+def home_axes(model: ChainModel) -> HomeAxes:
+    """The joint axes of ``model`` at q = 0 (``F1 = C0``, ``F(i+1) = Fi Ci``)."""
+    C = np.asarray(model.constants)
+    F = C[0].copy()
+    w, r = [], []
+    for i in range(model.n):
+        w.append(F[:3, 2].copy())
+        r.append(F[:3, 3].copy())
+        F = F @ C[i + 1]
+    scale = max(1.0, float(np.max(np.abs(C[:, :3, 3]))))
+    return HomeAxes(np.array(w), np.array(r), F, scale)
+
+
+def parallel(ax: HomeAxes, i: int, j: int, tol: float = 1e-9) -> bool:
+    """Axes i and j are parallel (or anti-parallel)."""
+    return float(np.linalg.norm(np.cross(ax.w[i], ax.w[j]))) <= tol
+
+
+def meet(ax: HomeAxes, i: int, j: int, tol: float = 1e-9):
+    """The point where non-parallel axes i and j meet, or None."""
+    wi, wj, d = ax.w[i], ax.w[j], ax.r[j] - ax.r[i]
+    n = np.cross(wi, wj)
+    nn = float(n @ n)
+    if nn <= tol ** 2:
+        return None
+    if abs(float(d @ n)) / np.sqrt(nn) > tol * ax.scale:
+        return None
+    # r_i + s wi = r_j + t wj  (least squares on the two-line system)
+    s = float(np.cross(d, wj) @ n) / nn
+    return ax.r[i] + s * wi
+
+
+def classify(model: ChainModel, tol: float = 1e-9) -> tuple[str, dict]:
+    """``("pieper" | "three-parallel" | "general", data)`` for a 6-joint revolute model."""
+    if model.n != 6 or any(j.kind != "revolute" for j in model.joints):
+        return "none", {}
+    ax = home_axes(model)
+    w = meet(ax, 3, 4, tol)
+    if w is not None and float(np.linalg.norm(np.cross(w - ax.r[5], ax.w[5]))) <= tol * ax.scale:
+        r12 = meet(ax, 0, 1, tol)
+        if r12 is not None:
+            return "pieper", {"axes": ax, "wrist": w, "shoulder": r12}
+    if parallel(ax, 1, 2, tol) and parallel(ax, 1, 3, tol):
+        p56 = meet(ax, 4, 5, tol)
+        if p56 is not None and not parallel(ax, 0, 1, tol) and not parallel(ax, 4, 1, tol):
+            return "three-parallel", {"axes": ax, "p56": p56}
+    return "general", {"axes": ax}

@@ -1,0 +1,135 @@
+"""``ik_all``: every inverse-kinematics solution of a 6-joint serial arm, batched.
+
+Dispatch (:func:`kinestat.serial.analytic.geometry.classify`): a closed form by subproblems when
+the geometry admits one (spherical wrist with meeting shoulder axes; three parallel axes with a
+meeting wrist pair), otherwise the general 6R eigenvalue method of Raghavan & Roth.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from kinestat.errors import ModelError
+from kinestat.mechanism.chain import ChainModel
+from kinestat.serial.analytic import closed_form, general6r
+from kinestat.serial.analytic._common import check_poses
+from kinestat.serial.analytic.geometry import classify
+from kinestat.serial.analytic.result import IKAllResult
+
+__all__ = ["ik_all", "METHODS", "BACKENDS", "method_for"]
+
+METHODS = ("auto", "pieper", "three-parallel", "raghavan-roth")
+BACKENDS = ("numba", "numpy")
+
+
+def _check_model(model: ChainModel) -> None:
+    if not isinstance(model, ChainModel):
+        raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
+    if model.n != 6:
+        raise ModelError(
+            f"ik_all: model {model.name!r} has {model.n} joints; all-solutions IK needs exactly "
+            f"6 (fewer: the pose is over-constrained, more: the solutions are not isolated)")
+    for i, j in enumerate(model.joints):
+        if j.kind != "revolute":
+            raise ModelError(
+                f"ik_all: joint {i + 1} of model {model.name!r} is {j.kind}; the all-solutions "
+                f"solvers handle revolute joints only (prismatic and screw joints are not "
+                f"supported yet — use kinestat.ik for a numerical solution)")
+
+
+@lru_cache(maxsize=64)
+def _classified(model: ChainModel):
+    return classify(model)
+
+
+def method_for(model: ChainModel) -> str:
+    """The method ``ik_all(model, T)`` uses with ``method="auto"``."""
+    _check_model(model)
+    kind, _ = _classified(model)
+    return "raghavan-roth" if kind == "general" else kind
+
+
+def _reshape(res: IKAllResult, shape: tuple[int, ...]) -> IKAllResult:
+    def r(a):
+        return a.reshape(shape + a.shape[1:])
+
+    return IKAllResult(
+        q=r(res.q), valid=r(res.valid), position_error=r(res.position_error),
+        rotation_error=r(res.rotation_error), singular=r(res.singular),
+        family_sign=r(res.family_sign), family_value=r(res.family_value),
+        family_joints=res.family_joints, n_solutions=r(res.n_solutions),
+        reason=r(res.reason), method=res.method, tol=res.tol,
+    )
+
+
+def _nearest_rigid(Tf: np.ndarray) -> np.ndarray:
+    """Project rotations that are orthonormal only to within the accepted 1e-6 (rounded input,
+    float32) onto the nearest rotation (SVD), so that an exact solution can exist."""
+    R = Tf[:, :3, :3]
+    err = np.abs(np.einsum("nij,nkj->nik", R, R) - np.eye(3)).max(axis=(1, 2))
+    bad = np.flatnonzero(err > 1e-13)
+    if bad.size:
+        Tf = Tf.copy()
+        U, _, Vt = np.linalg.svd(Tf[bad, :3, :3])
+        Tf[bad, :3, :3] = U @ Vt
+    return Tf
+
+
+def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
+           backend: str = "numba") -> IKAllResult:
+    """Every IK solution of the 6R ``model`` for poses ``T_base_flange (..., 4, 4)``.
+
+    Returns an :class:`~kinestat.serial.analytic.result.IKAllResult` (``q (..., K, 6)``,
+    ``valid (..., K)``, residuals, singular families); each valid solution reproduces its pose
+    by :func:`kinestat.fk` within ``tol`` (model length unit; radians). An unreachable pose
+    gives no valid slot and a ``reason``; a model that is not six revolute joints, or a pose
+    that is not a rigid transform, raises a :class:`~kinestat.errors.KinestatError`.
+    ``backend``: ``"numba"`` (compiled kernels, default) or ``"numpy"`` (the references).
+    A rotation accepted as orthonormal within 1e-6 but not to rounding (float32 or printed
+    poses) is first replaced by the nearest rotation; residuals refer to that pose.
+
+    >>> import kinestat, numpy as np
+    >>> m = kinestat.load("puma560")
+    >>> q = np.array([0.1, 0.5, -0.3, 0.4, 0.6, -0.2])
+    >>> res = kinestat.ik_all(m, kinestat.fk(m, q))
+    >>> res.method, int(res.n_solutions)
+    ('pieper', 8)
+    >>> bool(np.any(np.all(np.abs(res.solutions() - q) < 1e-9, axis=1)))
+    True
+    """
+    _check_model(model)
+    if method not in METHODS:
+        raise ModelError(f"ik_all: unknown method {method!r}; expected one of {METHODS}")
+    T = T_base_flange
+    if type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
+            T.shape[-2:] == (4, 4) and backend == "numba":
+        from kinestat.serial.analytic import _cf_kernels  # lazy: Numba start-up
+
+        Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
+        if _cf_kernels.first_non_rigid(Tf, 1e-6) >= 0:
+            check_poses(T)  # raises with the full message
+    else:
+        T = check_poses(T)
+        Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
+    shape = T.shape[:-2]
+    Tf = _nearest_rigid(Tf)
+    kind, data = _classified(model)
+    use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
+    if use in ("pieper", "three-parallel") and use != kind:
+        raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
+                         f"(its geometry is {kind!r})")
+    if backend not in BACKENDS:
+        raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
+    fast = backend == "numba"
+    if use == "pieper":
+        solver = closed_form.solve_pieper_compiled if fast else closed_form.solve_pieper
+        res = solver(model, Tf, data, tol=tol)
+    elif use == "three-parallel":
+        solver = (closed_form.solve_three_parallel_compiled if fast
+                  else closed_form.solve_three_parallel)
+        res = solver(model, Tf, data, tol=tol)
+    else:
+        res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend)
+    return _reshape(res, shape)

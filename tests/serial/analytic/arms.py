@@ -1,0 +1,97 @@
+"""Test arms for the all-solutions IK, built through the public ChainModel constructors, and an
+independent oracle: many-start damped Newton with de-duplication."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import kinestat
+from kinestat.mechanism.chain import from_standard_dh
+
+PI = math.pi
+
+
+def ur5():
+    """UR5 (DH: d1=0.089159, a2=-0.425, a3=-0.39225, d4=0.10915, d5=0.09465, d6=0.0823)."""
+    rows = np.column_stack([np.zeros(6), [0.089159, 0, 0, 0.10915, 0.09465, 0.0823],
+                            [0, -0.425, -0.39225, 0, 0, 0], [PI / 2, 0, 0, PI / 2, -PI / 2, 0]])
+    return from_standard_dh(rows, name="ur5", length_unit="m")
+
+
+def jaco6():
+    """Kinova Jaco2 6-DOF type: a non-spherical 60° wrist (Kinova's published classic DH)."""
+    aa = PI / 6
+    k = math.sin(aa) / math.sin(2 * aa)
+    D1, D2, D3, D4, D5, D6, e2 = 0.2755, 0.41, 0.2073, 0.0741, 0.0741, 0.16, 0.0098
+    rows = [[0, D1, 0, PI / 2], [-PI / 2, 0, D2, PI], [PI / 2, -e2, 0, PI / 2],
+            [0, -(D3 + k * D4), 0, 2 * aa], [PI, -(k * D4 + k * D5), 0, 2 * aa],
+            [-PI / 2, -(k * D5 + D6), 0, PI]]
+    return from_standard_dh(rows, name="jaco6", length_unit="m")
+
+
+def random_6r(seed: int):
+    """A random general 6R chain (standard DH, lengths in [-1, 1] m, angles uniform)."""
+    rng = np.random.default_rng(seed)
+    rows = np.column_stack([rng.uniform(-PI, PI, 6), rng.uniform(-1, 1, 6),
+                            rng.uniform(-1, 1, 6), rng.uniform(-PI, PI, 6)])
+    return from_standard_dh(rows, name=f"random6r-{seed}", length_unit="m")
+
+
+def arm(name: str):
+    if name == "ur5":
+        return ur5()
+    if name == "jaco6":
+        return jaco6()
+    if name.startswith("random"):
+        return random_6r(int(name[6:]))
+    return kinestat.load(name)
+
+
+def wrapped_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Max over joints of the 2π-wrapped difference."""
+    return np.max(np.abs(np.mod(a - b + PI, 2 * PI) - PI), axis=-1)
+
+
+def _twist_error(F, T):
+    dR = T[..., :3, :3] @ np.swapaxes(F[..., :3, :3], -1, -2)
+    ang = 0.5 * np.stack([dR[..., 2, 1] - dR[..., 1, 2], dR[..., 0, 2] - dR[..., 2, 0],
+                          dR[..., 1, 0] - dR[..., 0, 1]], -1)
+    p = F[..., :3, 3]
+    return np.concatenate([ang, T[..., :3, 3] - p - np.cross(ang, p)], -1)
+
+
+def newton_solutions(model, T: np.ndarray, starts: int = 400, iters: int = 60,
+                     seed: int = 0) -> list[np.ndarray]:
+    """Distinct IK solutions of each pose ``T (P, 4, 4)`` by damped Newton from many random
+    starts (Levenberg–Marquardt on the twist error), de-duplicated modulo 2π."""
+    rng = np.random.default_rng(seed)
+    P = T.shape[0]
+    q = rng.uniform(-PI, PI, (P, starts, 6))
+    Tt = np.broadcast_to(T[:, None], (P, starts, 4, 4))
+    lam = np.full((P, starts), 1e-2)
+    e = _twist_error(kinestat.fk(model, q), Tt)
+    en = np.linalg.norm(e, axis=-1)
+    for _ in range(iters):
+        J = kinestat.jacobian(model, q)
+        JT = np.swapaxes(J, -1, -2)
+        A = JT @ J + lam[..., None, None] * np.eye(6)
+        dq = np.linalg.solve(A, (JT @ e[..., None]))[..., 0]
+        qn = q + dq
+        en_new = _twist_error(kinestat.fk(model, qn), Tt)
+        nn = np.linalg.norm(en_new, axis=-1)
+        better = nn < en
+        q = np.where(better[..., None], qn, q)
+        e = np.where(better[..., None], en_new, e)
+        en = np.where(better, nn, en)
+        lam = np.where(better, np.maximum(lam / 10, 1e-12), lam * 10)
+    out = []
+    for i in range(P):
+        sols: list[np.ndarray] = []
+        for qi in q[i][en[i] < 1e-11]:
+            qi = np.mod(qi + PI, 2 * PI) - PI
+            if all(wrapped_distance(qi, s) > 1e-6 for s in sols):
+                sols.append(qi)
+        out.append(np.array(sols).reshape(-1, 6))
+    return out
