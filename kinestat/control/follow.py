@@ -29,8 +29,9 @@ line through the measured tip ``p``, the base (flange) is displaced by
   ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ).
 
 Step limits per cycle: ``Δs ≤ travel_step``; the compliance twist moves the tip by at most
-``max_correction``; S6 turns by at most ``max_turn_deg``. The target is solved by the PUMA's
-closed-form reverse analysis and rounded to counts with the press task's vernier; the envelope
+``max_correction`` along the normal (and ``TANGENTIAL_FACTOR`` times that in all); S6 turns
+by at most ``max_turn_deg``. The target is solved by the PUMA's closed-form reverse
+analysis and rounded to counts with the press task's vernier; the envelope
 (:mod:`kinestat.control.envelope`) checks every measurement and every command's worst-case
 prediction. Travel starts once ``|F_n − |F_req|| ≤ settle_tol`` and S6 is aligned.
 
@@ -95,10 +96,16 @@ CHORD_HISTORY = 12
 """Measured tips kept for the chord."""
 FRICTION_SMOOTHING = 0.2
 """Weight of a new sample in the friction ratio's running estimate."""
+TANGENTIAL_FACTOR = 4.0
+"""The compliance twist's whole tip motion may be this multiple of ``max_correction`` (its
+normal part is limited to ``max_correction``: a frictionless tip slides freely along the
+surface, the soft direction of a point contact on a long tool)."""
 SLIDE_FRACTION = 0.5
 """The tip slides when it advanced at least this fraction of the last travel step; otherwise
 it sticks and the normal estimate is kept (a sticking tip's force says nothing of the
 surface)."""
+MIN_SLIP = 0.05
+"""Smallest advance of the tip (mm) that counts as sliding."""
 TURN_DEADBAND_DEG = 0.3
 """Misalignments of S6 below this are not corrected (the normal estimate's noise)."""
 TRAVEL_TOL = 0.02
@@ -152,6 +159,11 @@ class FollowConfig:
         gain: fraction of the normal-force error corrected per cycle (0 < gain ≤ 1).
         settle_tol: normal-force error (N) below which travel starts.
         tilt_deg: S6 tilted from −n̂ towards the travel direction (degrees, 0: along −n̂).
+        auto_tilt: tilt S6 by ``atan(μ̂)`` (the estimated friction ratio) so that it stays
+            along the total force, plus ``max_turn_deg`` more for every cycle the tip sticks:
+            a point contact on the long tool is very soft tangentially (the top turns about
+            the tip), so friction carried across the tool axis turns the top beyond Table
+            3-1's range; along the axis the platform carries it.
         max_contact_lost: cycles without contact during travel before a safe stop.
         min_angle_deg: smallest angle between the travel direction and the approach direction
             or the measured normal.
@@ -166,6 +178,7 @@ class FollowConfig:
     gain: float = 0.8
     settle_tol: float = 0.2
     tilt_deg: float = 0.0
+    auto_tilt: bool = False
     max_contact_lost: int = 3
     min_angle_deg: float = 10.0
 
@@ -210,6 +223,9 @@ class FollowState(ControllerState):
         contact_lost: cycles without contact during travel.
         path: the last measured tips in contact during travel (the estimator's chords).
         step: the travel commanded by the last move (mm).
+        sticking: the tip did not follow the last travel step.
+        breakaway: the extra tilt of the automatic tilt, in units of ``max_turn_deg``
+            (grows while the tip sticks, halves while it slides).
         friction_ratio: running estimate of the tangential-to-normal force ratio along the
             slip (μ when sliding), from the force and the chord.
     """
@@ -224,6 +240,8 @@ class FollowState(ControllerState):
     path: tuple = ()
     friction_ratio: float = 0.0
     step: float = 0.0
+    sticking: bool = False
+    breakaway: float = 0.0
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -265,9 +283,10 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     v_O = R.T @ travel - np.cross(w, p)  # tip moves by `travel`, turning about the tip
     Tf = np.concatenate([w, v_O])
     Tc = compose_twist(K, W, np.zeros(6), -dlam * W)
-    move = float(np.linalg.norm(Tc[3:] + np.cross(Tc[:3], p)))
-    if move > max_correction:
-        Tc = Tc * (max_correction / move)
+    dp = Tc[3:] + np.cross(Tc[:3], p)  # the tip's motion under the compliance twist
+    scale = max(abs(float(dp @ n)) / max_correction,
+                float(np.linalg.norm(dp)) / (TANGENTIAL_FACTOR * max_correction), 1.0)
+    Tc = Tc / scale
     return compose_twist(K, W, Tf, np.zeros(6)) + Tc
 
 
@@ -298,16 +317,19 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     tip = meas.tip(config.base.model)
     if not contact:
         return st
-    if st.phase != "travel" or st.normal is None or st.tangent is None:
-        return replace(st, normal=estimate_normal(F), last_tip=tip,
-                       path_dir=None if st.phase != "travel" else st.path_dir)
+    if st.normal is None:  # first contact: the force's direction
+        return replace(st, normal=estimate_normal(F), last_tip=tip)
+    if st.phase != "travel":  # settling: kept (a sticking tip's force turns with the tool)
+        return replace(st, last_tip=tip)
     n0, s = st.normal, st.tangent
     b = np.cross(n0, s)
     advance = float((tip - st.last_tip) @ s)
     travel = st.travel + advance
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
-    if advance < SLIDE_FRACTION * st.step:  # sticking (or not asked to move): keep n0
-        return replace(st, travel=travel, last_tip=tip, path=path)
+    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP):  # sticking: keep n0
+        stuck = st.step > 0 or st.sticking
+        return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
+                       breakaway=st.breakaway + (1.0 if stuck else 0.0))
     fn = float(-(F @ n0))
     a_force, c_force = float(F @ s) / fn, float(F @ b) / fn
     mu = st.friction_ratio
@@ -318,7 +340,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         mu = min(max(mu, 0.0), 1.0)
     n = n0 + (mu - a_force) * s - c_force * b
     return replace(st, travel=travel, normal=n / np.linalg.norm(n), last_tip=tip, path=path,
-                   friction_ratio=mu, path_dir=None if c is None else c / np.linalg.norm(c))
+                   friction_ratio=mu, path_dir=None if c is None else c / np.linalg.norm(c),
+                   sticking=False, breakaway=0.5 * st.breakaway)
 
 
 def decide_follow(config: FollowConfig, state: ControllerState,
@@ -384,6 +407,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
                      f"{np.round(n, 4).tolist()}: it points into the surface", **kw)
     t /= np.linalg.norm(t)
     tilt = math.radians(config.tilt_deg)
+    if config.auto_tilt:  # S6 along the force's cone edge; tilt more while the tip sticks
+        tilt = math.atan(st.friction_ratio) + math.radians(config.max_turn_deg) * st.breakaway
     axis = -math.cos(tilt) * n + math.sin(tilt) * t
     mis = math.degrees(math.acos(max(-1.0, min(1.0, float(meas.s6 @ axis)))))
     kw["misalignment_deg"] = mis
@@ -396,12 +421,10 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     if phase == "travel" and remaining <= TRAVEL_TOL:
         return (Command(kind="done", label="e", reason=f"travelled {st.travel:.3f} mm along the "
                         "surface", **kw), replace(st, label="e", done=True))
-    if phase == "travel":
+    if phase == "travel" and not (config.auto_tilt and st.sticking):
         step = min(config.travel_step, remaining)
         travel_vec = step * t
-    # S6 is turned only while sliding: a sticking tip turns the force with the tool, and
-    # chasing it would walk the estimate round the friction cone
-    omega = (np.zeros(3) if phase != "travel" or mis < TURN_DEADBAND_DEG
+    omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
              else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
     dlam = config.gain * err
     try:
