@@ -104,8 +104,14 @@ SLIDE_FRACTION = 0.5
 """The tip slides when it advanced at least this fraction of the last travel step; otherwise
 it sticks and the normal estimate is kept (a sticking tip's force says nothing of the
 surface)."""
-MIN_SLIP = 0.05
+MIN_SLIP = 0.2
 """Smallest advance of the tip (mm) that counts as sliding."""
+LEARN_CHORDS = 3
+"""With the automatic tilt, chords needed before the friction ratio is trusted; until then the
+tilt reached at breakaway is kept and the travel steps are ``LEARN_STEP`` of the full step."""
+LEARN_STEP = 0.25
+AUTO_TILT_MARGIN_DEG = 1.0
+"""The automatic tilt's margin beyond the friction cone (keeps the tip sliding)."""
 TURN_DEADBAND_DEG = 0.3
 """Misalignments of S6 below this are not corrected (the normal estimate's noise)."""
 TRAVEL_TOL = 0.02
@@ -222,6 +228,7 @@ class FollowState(ControllerState):
             along the travel direction).
         contact_lost: cycles without contact during travel.
         path: the last measured tips in contact during travel (the estimator's chords).
+        friction_samples: chords that have measured the friction ratio so far.
         step: the travel commanded by the last move (mm).
         sticking: the tip did not follow the last travel step.
         breakaway: the extra tilt of the automatic tilt, in units of ``max_turn_deg``
@@ -239,6 +246,7 @@ class FollowState(ControllerState):
     contact_lost: int = 0
     path: tuple = ()
     friction_ratio: float = 0.0
+    friction_samples: int = 0
     step: float = 0.0
     sticking: bool = False
     breakaway: float = 0.0
@@ -332,16 +340,21 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
                        breakaway=st.breakaway + (1.0 if stuck else 0.0))
     fn = float(-(F @ n0))
     a_force, c_force = float(F @ s) / fn, float(F @ b) / fn
-    mu = st.friction_ratio
+    mu, samples = st.friction_ratio, st.friction_samples
     c = _chord(path, tip, CHORD_LENGTH)
+    n_s = 0.0  # the normal's change along s: kept until a chord has measured the friction
     if c is not None and float(c @ s) > 0.5 * float(np.linalg.norm(c)):
         n_s_geom = -float(c @ n0) / float(c @ s)  # the chord lies in the surface
-        mu = (1.0 - FRICTION_SMOOTHING) * mu + FRICTION_SMOOTHING * (a_force + n_s_geom)
-        mu = min(max(mu, 0.0), 1.0)
-    n = n0 + (mu - a_force) * s - c_force * b
+        w = 1.0 if samples == 0 else FRICTION_SMOOTHING
+        mu = min(max((1.0 - w) * mu + w * (a_force + n_s_geom), 0.0), 1.0)
+        samples += 1
+    if samples:
+        n_s = mu - a_force
+    n = n0 + n_s * s - c_force * b
     return replace(st, travel=travel, normal=n / np.linalg.norm(n), last_tip=tip, path=path,
-                   friction_ratio=mu, path_dir=None if c is None else c / np.linalg.norm(c),
-                   sticking=False, breakaway=0.5 * st.breakaway)
+                   friction_ratio=mu, friction_samples=samples,
+                   path_dir=None if c is None else c / np.linalg.norm(c),
+                   sticking=False, breakaway=st.breakaway if samples < LEARN_CHORDS else 0.0)
 
 
 def decide_follow(config: FollowConfig, state: ControllerState,
@@ -408,7 +421,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     t /= np.linalg.norm(t)
     tilt = math.radians(config.tilt_deg)
     if config.auto_tilt:  # S6 along the force's cone edge; tilt more while the tip sticks
-        tilt = math.atan(st.friction_ratio) + math.radians(config.max_turn_deg) * st.breakaway
+        tilt = max(math.atan(st.friction_ratio) + math.radians(AUTO_TILT_MARGIN_DEG),
+                   math.radians(config.max_turn_deg) * st.breakaway)
     axis = -math.cos(tilt) * n + math.sin(tilt) * t
     mis = math.degrees(math.acos(max(-1.0, min(1.0, float(meas.s6 @ axis)))))
     kw["misalignment_deg"] = mis
@@ -422,7 +436,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         return (Command(kind="done", label="e", reason=f"travelled {st.travel:.3f} mm along the "
                         "surface", **kw), replace(st, label="e", done=True))
     if phase == "travel" and not (config.auto_tilt and st.sticking):
-        step = min(config.travel_step, remaining)
+        learning = config.auto_tilt and st.friction_samples < LEARN_CHORDS
+        step = min(config.travel_step * (LEARN_STEP if learning else 1.0), remaining)
         travel_vec = step * t
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
              else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
