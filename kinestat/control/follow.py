@@ -290,12 +290,11 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     w = R.T @ omega
     v_O = R.T @ travel - np.cross(w, p)  # tip moves by `travel`, turning about the tip
     Tf = np.concatenate([w, v_O])
-    Tc = compose_twist(K, W, np.zeros(6), -dlam * W)
+    Tc = -dlam * np.linalg.solve(K, W)  # K⁻¹ δw with δw = −Δλ W (compose_twist's term)
     dp = Tc[3:] + np.cross(Tc[:3], p)  # the tip's motion under the compliance twist
     scale = max(abs(float(dp @ n)) / max_correction,
                 float(np.linalg.norm(dp)) / (TANGENTIAL_FACTOR * max_correction), 1.0)
-    Tc = Tc / scale
-    return compose_twist(K, W, Tf, np.zeros(6)) + Tc
+    return compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
 
 
 def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
@@ -445,7 +444,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     try:
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
                         config.max_correction)
-    except InputError as exc:
+    except (InputError, np.linalg.LinAlgError) as exc:
         return _stop(st, label, f"the contact basis is singular for the platform stiffness: "
                      f"{exc}", **kw)
     new = _target(model, meas, T)
