@@ -112,6 +112,8 @@ tilt reached at breakaway is kept and the travel steps are ``LEARN_STEP`` of the
 LEARN_STEP = 0.25
 AUTO_TILT_MARGIN_DEG = 1.0
 """The automatic tilt's margin beyond the friction cone (keeps the tip sliding)."""
+SETTLE_ALIGN_DEG = 2.0
+"""While settling, the force is raised only once S6 is within this of the normal estimate."""
 TURN_DEADBAND_DEG = 0.3
 """Misalignments of S6 below this are not corrected (the normal estimate's noise)."""
 TRAVEL_TOL = 0.02
@@ -441,6 +443,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
              else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
     dlam = config.gain * err
+    if phase == "settle" and mis > SETTLE_ALIGN_DEG:
+        dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
     try:
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
                         config.max_correction)
