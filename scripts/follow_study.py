@@ -4,10 +4,11 @@ Runs ``kinestat control --task follow`` (50 mm, |F_req| = 4 N, thesis calibratio
 sensor resolution) on the in-process simulated cell for 10 random planes (1.5-4 mm ahead of
 the start tool point, normal tilted 0-8° from −F_req in a random azimuth) and 10 random
 cylinders (radius 150-400 mm, axis within ~20° of the fixed z axis), the initial travel
-direction within ~11° of +y; then the default plane and the R = 200 mm cylinder with the ideal
-sensor. Prints one row per run (true figures from the simulator) and a summary.
+direction within ~11° of +y; then the acceptance runs (the default plane and the R = 200 mm
+cylinder, thesis and ideal sensor). Prints one row per run (true figures from the simulator)
+and a summary.
 
-    .venv/bin/python scripts/follow_study.py [N]
+    .venv/bin/python scripts/follow_study.py [N | --acceptance]
 """
 
 from __future__ import annotations
@@ -95,12 +96,20 @@ def main(n: int = 20) -> None:
              f"worst {max(r['true_normal_force_max_error'] for r in done):.3f} N; travel "
              f"{min(r['travel'] for r in done):.2f}-{max(r['travel'] for r in done):.2f} mm"
              if done else ""))
-    print("\nideal sensor:")
-    for name, cell in (("plane 5° (default)", SimulatedCell(ideal_sensor=True)),
-                       ("cylinder R 200", SimulatedCell(ideal_sensor=True, cylinder=CylinderSpec(
-                           radius=200.0, axis=np.array([0.0, 0.0, 1.0]))))):
-        print(_row(name, follow(cell, Y)))
+    print("\nacceptance runs (default plane and R = 200 mm cylinder):")
+    acceptance()
 
+
+def acceptance() -> None:
+    cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
+    for name, cell in (("plane 5°, thesis", SimulatedCell()),
+                       ("plane 5°, ideal", SimulatedCell(ideal_sensor=True)),
+                       ("cyl R 200, thesis", SimulatedCell(cylinder=cyl)),
+                       ("cyl R 200, ideal", SimulatedCell(ideal_sensor=True, cylinder=cyl))):
+        print(_row(name, follow(cell, Y)), flush=True)
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 20)
+    if sys.argv[1:] == ["--acceptance"]:
+        acceptance()
+    else:
+        main(int(sys.argv[1]) if len(sys.argv) > 1 else 20)

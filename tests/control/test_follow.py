@@ -193,3 +193,21 @@ def test_follow_config_rejects_a_finished_state(tmp_path):
     _, st = start(base, io_q)
     with pytest.raises(InputError, match="over"):
         decide_follow(fc, replace(st, done=True), None)
+
+
+def test_friction_without_tilt_stops_safely_on_the_motion_range(tmp_path):
+    # a sticking tip lags the flange; the top turns about it (Table 3-1's 4°) long before the
+    # platform carries mu * F_n across the tool axis: a safe stop with the reason
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.3))
+    assert not out["completed"]
+    assert "Table 3-1" in rep.stop_reason and "refused by the envelope" in rep.stop_reason
+    assert out["contact_lost"] == 0
+
+
+def test_auto_tilt_follows_with_light_friction_and_learns_mu(tmp_path):
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.1), auto_tilt=True)
+    assert out["completed"], rep.stop_reason
+    assert out["contact_lost"] == 0 and abs(out["travel"] - 50.0) <= 1.0
+    assert out["true_normal_force_max_error"] <= 1.0
+    # the friction ratio learnt from the chords is the simulator's mu
+    assert rep.cycles[-1]["friction_ratio"] == pytest.approx(0.1, abs=0.03)
