@@ -8,12 +8,19 @@ cycle's :class:`~kinestat.control.wrench.Measurement` and returns the next
 The start move is the press task's (:func:`kinestat.control.controller.start`).
 
 **Contact estimator** (the controller is not told the surface). The contact point is the
-measured deflected tool tip (:meth:`Measurement.tip`). The normal comes from the measured force
-``F`` (the point-contact fit) with its friction part removed: a sliding tip's friction acts
-along the slip, which is the direction ``ĉ`` of the last chord of the measured tip path (a
-chord of ≥ 0.1 mm; it lies in the surface to within chord/(2R) rad), so
-``n̂ = −(F − (F·ĉ) ĉ) / |F − (F·ĉ) ĉ|`` (the normal points out of the material; before the tip
-has slid, ``n̂ = −F/|F|``). The normal force is ``F_n = −F·n̂``.
+measured deflected tool tip (:meth:`Measurement.tip`). The normal (out of the material) is at
+first contact the measured force's direction, ``n̂ = −F/|F|`` (``F`` the point-contact fit of
+the force the tool applies), and is KEPT while the force settles: a sticking tip's force turns
+with the tool, chasing it would walk round the friction cone. During travel, on every cycle the
+tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``), it is updated in the frame
+of the previous normal ``n̂₀``, the travel direction ``ŝ`` and ``b̂ = n̂₀ × ŝ``:
+``n̂ ∝ n̂₀ + (μ̂ − F·ŝ/F_n) ŝ − (F·b̂/F_n) b̂`` — across the travel from the force (sliding
+friction has no component across the slip), along it from the force corrected by the friction
+ratio ``μ̂``, a running estimate of ``F·ŝ/F_n + n_s`` where ``n_s = −(c·n̂₀)/(c·ŝ)`` is the
+surface's slope along ``ŝ`` measured by the chord ``c`` (≥ ``CHORD_LENGTH``) of the measured
+tip path, which lies in the surface (until a chord exists the along component is kept).
+Frictionless, ``μ̂ ≈ 0`` and the normal is the force's direction. The normal force is
+``F_n = −F·n̂``.
 
 **Control law** (Griffis & Duffy's kinestatic decomposition,
 :func:`kinestat.parallel.kinestatic.compose_twist`). In the platform base frame, with ``K``
@@ -33,7 +40,8 @@ Step limits per cycle: ``Δs ≤ travel_step``; the compliance twist moves the t
 by at most ``max_turn_deg``. The target is solved by the PUMA's closed-form reverse
 analysis and rounded to counts with the press task's vernier; the envelope
 (:mod:`kinestat.control.envelope`) checks every measurement and every command's worst-case
-prediction. Travel starts once ``|F_n − |F_req|| ≤ settle_tol`` and S6 is aligned.
+prediction. While settling, the force is raised only once S6 is within ``SETTLE_ALIGN_DEG`` of
+the normal; travel starts once ``|F_n − |F_req|| ≤ settle_tol``.
 
 Phases (the ``label`` of each cycle): ``a`` approach along S6 (no contact), ``b`` first
 contact, ``d`` settling the normal force before travel, ``f`` following (travel), ``e`` done.
