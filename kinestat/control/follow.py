@@ -386,9 +386,11 @@ def decide_follow(config: FollowConfig, state: ControllerState,
     if contact and st.phase == "approach":
         label = "b"
     fn = float(-(F @ st.normal)) if (contact and st.normal is not None) else 0.0
+    ft = 0.0 if not contact else float(np.linalg.norm(F + fn * st.normal))
     err = base.force_target - fn
     info = {"phase": st.phase, "tip": meas.tip(model), "normal_estimate": st.normal,
-            "normal_force": fn, "travel": st.travel, "in_contact": contact,
+            "normal_force": fn, "tangential_force": ft, "travel": st.travel,
+            "in_contact": contact,
             "friction_ratio": st.friction_ratio}
     kw = {"force_error": err, "info": info}
     bad = check_measurement(env, model, meas)
