@@ -74,10 +74,11 @@ from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
 from kinestat.parallel.kinestatic import compose_twist
 from kinestat.parallel.legs import leg_lengths
+from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
 from kinestat.serial import puma762
 from kinestat.spatial.se3 import twist_exp
-from kinestat.spatial.transforms import apply, inv
+from kinestat.spatial.transforms import apply, inv, skew
 
 __all__ = [
     "FollowConfig",
@@ -120,6 +121,8 @@ tilt reached at breakaway is kept and the travel steps are ``LEARN_STEP`` of the
 LEARN_STEP = 0.25
 AUTO_TILT_MARGIN_DEG = 1.0
 """The automatic tilt's margin beyond the friction cone (keeps the tip sliding)."""
+CARRY_MARGIN = 1.0
+"""Newtons above the requested force the platform must carry (control overshoot)."""
 SETTLE_ALIGN_DEG = 2.0
 """While settling, the force is raised only once S6 is within this of the normal estimate."""
 TURN_DEADBAND_DEG = 0.3
@@ -136,24 +139,55 @@ def _unit3(v, name: str) -> np.ndarray:
     return a / np.linalg.norm(a)
 
 
+def _tip_load_pose(platform, tip_top: np.ndarray, f_ext: np.ndarray, steps: int = 8,
+                   max_iter: int = 30) -> np.ndarray | None:
+    """The top pose (base frame) at which the springs carry the force ``f_ext`` (base frame)
+    applied at the tool tip ``tip_top`` (top frame), the tip free to move (a frictionless
+    contact): Newton on ``spring_wrench(X) = [f; p(X) × f]``, the load raised in ``steps``;
+    None where no equilibrium exists (the platform stops carrying load)."""
+    X = platform.home_pose.copy()
+    for k in range(1, steps + 1):
+        f = f_ext * (k / steps)
+        for _ in range(max_iter):
+            p = apply(X, tip_top)
+            r = np.concatenate([f, np.cross(p, f)]) - spring_wrench(platform, X)
+            if float(np.linalg.norm(r)) <= 1e-8 * max(1.0, float(np.linalg.norm(f))):
+                break
+            G = np.zeros((6, 6))  # d[f; p × f]/d[δx; δφ]
+            G[3:, :3] = -skew(f)
+            G[3:, 3:] = skew(f) @ skew(p)
+            try:
+                d = np.linalg.solve(stiffness(platform, X) - G, r)
+            except np.linalg.LinAlgError:
+                return None
+            d /= max(1.0, float(np.linalg.norm(d[3:])) / 0.05,
+                     float(np.linalg.norm(d[:3])) / (0.05 * platform.scale))
+            X = twist_exp(np.concatenate([d[3:], d[:3]])) @ X
+        else:
+            return None
+    return X
+
+
 def carry_check(model: ControlModel, envelope: Envelope, force, s6, a67) -> list[str]:
     """Violations of the envelope by the platform carrying ``force`` (N, fixed frame, the tool's
-    force on the workpiece) at the tip with S6/a67 as given (first order at the unloaded pose):
-    Table 3-1's motion ranges and the legs' deflection limit. Empty when it can be carried."""
+    force on the workpiece; checked at ``|force| + CARRY_MARGIN`` N) at the tip with S6/a67 as
+    given: an equilibrium must exist (the loaded platform stops carrying load beyond a limit,
+    about 8 N along the thesis's direction with its calibrated legs), inside Table 3-1's motion
+    ranges and the legs' deflection limit. Empty when it can be carried."""
     R6 = np.column_stack([a67, np.cross(s6, a67), s6])
     RB = R6 @ model.mount[:3, :3]
     plat = model.platform
-    home = plat.home_pose
-    p = apply(home, model.tool_tip_top)
-    f_ext = -(RB.T @ np.asarray(force, dtype=float))
-    K = stiffness(plat, home, twist_order="axis")
-    D = np.linalg.solve(K, np.concatenate([f_ext, np.cross(p, f_ext)]))
-    top = twist_exp(D) @ home
-    out = check_motion(envelope, model, top, "at the requested force the")
+    F = np.asarray(force, dtype=float)
+    F = F * (1.0 + CARRY_MARGIN / float(np.linalg.norm(F)))
+    top = _tip_load_pose(plat, model.tool_tip_top, -(RB.T @ F))
+    if top is None:
+        return [f"the platform finds no equilibrium carrying {np.linalg.norm(F):.3g} N at the "
+                "tool tip (its load limit along this direction)"]
+    out = check_motion(envelope, model, top, f"at {np.linalg.norm(F):.3g} N the")
     defl = leg_lengths(plat, top) - plat.free_lengths
     k = int(np.argmax(np.abs(defl)))
     if abs(defl[k]) > envelope.max_deflection:
-        out.append(f"at the requested force leg {plat.leg_names[k]} would deflect "
+        out.append(f"at {np.linalg.norm(F):.3g} N leg {plat.leg_names[k]} would deflect "
                    f"{defl[k]:+.3f} mm, beyond ±{envelope.max_deflection:g} mm")
     return out
 

@@ -211,3 +211,14 @@ def test_auto_tilt_follows_with_light_friction_and_learns_mu(tmp_path):
     assert out["true_normal_force_max_error"] <= 1.0
     # the friction ratio learnt from the chords is the simulator's mu
     assert rep.cycles[-1]["friction_ratio"] == pytest.approx(0.1, abs=0.03)
+
+
+def test_the_carry_check_matches_what_the_simulated_cell_carries(tmp_path):
+    # the simulated cell (thesis legs) has no contact equilibrium at 10 N along F_req: refused
+    # before any motion; 7 N passes the check and the cell carries it while following
+    with pytest.raises(InputError, match="cannot be carried"):
+        FollowConfig(base=_base(tmp_path, force=10.0), travel=10.0, travel_dir=Y)
+    prep, rep, out = _follow(tmp_path, force=7.0, travel=10.0)
+    assert out["completed"], rep.stop_reason
+    trav = [c for c in rep.cycles if c["phase"] == "travel"]
+    assert max(abs(_true_normal_force(c) - 7.0) for c in trav) <= 0.5
