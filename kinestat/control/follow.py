@@ -466,8 +466,9 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     t /= np.linalg.norm(t)
     tilt = math.radians(config.tilt_deg)
     if config.auto_tilt:  # S6 along the force's cone edge; tilt more while the tip sticks
-        tilt = max(math.atan(st.friction_ratio) + math.radians(AUTO_TILT_MARGIN_DEG),
-                   math.radians(config.max_turn_deg) * st.breakaway)
+        tilt = ((math.atan(st.friction_ratio) + math.radians(AUTO_TILT_MARGIN_DEG)
+                 if st.friction_samples else 0.0)
+                + math.radians(config.max_turn_deg) * st.breakaway)
     axis = -math.cos(tilt) * n + math.sin(tilt) * t
     mis = math.degrees(math.acos(max(-1.0, min(1.0, float(meas.s6 @ axis)))))
     kw["misalignment_deg"] = mis
