@@ -10,9 +10,10 @@ the kinestatic loop (:func:`kinestat.control.loop.run`) on it.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -29,10 +30,12 @@ from kinestat.app.control_defaults import (
     DEFAULT_PLANE_DISTANCE,
     DEFAULT_PLANE_TILT_DEG,
     DEFAULT_START,
+    TASKS,
 )
 from kinestat.app.sim_cell import SimHarness, start_counts
 from kinestat.control.controller import MAX_ITERATIONS, ControllerConfig, Procedure, StepMethod
 from kinestat.control.envelope import Envelope, sent_command_guard
+from kinestat.control.follow import FollowConfig, decide_follow, follow_summary
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, run
 from kinestat.control.model import ControlModel
@@ -46,6 +49,7 @@ from kinestat.errors import InputError, SafetyStop
 from kinestat.parallel.platform import Platform
 from kinestat.sim.contact import Cell, make_cell
 from kinestat.sim.sensor import Sensor
+from kinestat.sim.surface import Cylinder, cylinder_ahead
 
 __all__ = [
     "MAX_ITERATIONS",
@@ -54,6 +58,8 @@ __all__ = [
     "DEFAULT_DIRECTION",
     "DEFAULT_PLANE_DISTANCE",
     "DEFAULT_PLANE_TILT_DEG",
+    "TASKS",
+    "CylinderSpec",
     "SimulatedCell",
     "RealDevices",
     "ControlRequest",
@@ -63,9 +69,14 @@ __all__ = [
     "simulated_cell",
     "device_model",
     "run_control",
+    "report_dict",
     "plot_run",
 ]
 
+FOLLOW_APPROACH_STEP = 0.25
+"""The follow task's default approach step (mm): its first contact force stays below 3 N."""
+FOLLOW_MAX_ITERATIONS = MAX_ITERATIONS
+"""The follow task's default cycle budget."""
 
 def default_plane(start_point: np.ndarray, direction: np.ndarray, distance: float,
                   tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
@@ -83,10 +94,22 @@ def default_plane(start_point: np.ndarray, direction: np.ndarray, distance: floa
 
 
 @dataclass(frozen=True)
+class CylinderSpec:
+    """A simulated cylindrical workpiece: ``radius`` (mm), ``axis`` direction and, optionally,
+    a ``point`` on its axis (default: its surface :data:`DEFAULT_PLANE_DISTANCE` mm ahead of
+    the start tool point along F_req, as the default plane)."""
+
+    radius: float
+    axis: np.ndarray
+    point: np.ndarray | None = None
+
+
+@dataclass(frozen=True)
 class SimulatedCell:
     """Settings of the simulated cell (``kinestat control`` without devices).
 
-    ``plane_point``/``plane_normal`` None: :func:`default_plane`. ``noise``: leg-length noise
+    ``cylinder`` None: a plane workpiece; ``plane_point``/``plane_normal`` None:
+    :func:`default_plane`. ``noise``: leg-length noise
     (mm, standard deviation); ``ideal_sensor``: 1 nm leg encoders; ``rate_hz``: packet rate.
     """
 
@@ -98,6 +121,7 @@ class SimulatedCell:
     rate_hz: float = 200.0
     seed: int = 0
     sim_legs: str = "thesis"
+    cylinder: CylinderSpec | None = None
 
 
 @dataclass(frozen=True)
@@ -121,15 +145,21 @@ class ControlRequest:
     align_tol_deg: float = 0.5
     method: StepMethod = "stiffness"
     step: float = 1.0
-    approach_step: float = 1.0
+    approach_step: float | None = None
     estimator: Estimator = "point"
     samples: int = 1
-    max_iterations: int = 60
+    max_iterations: int | None = None
     calibration: str = "thesis"
     platform: str | None = None
     procedure: Procedure = "kinestat"
     move_rule: MoveRule = "coordinated"
     assume_homed: bool = False
+    task: str = "press"
+    travel: float = 50.0
+    travel_dir: np.ndarray | None = None
+    travel_step: float = 1.0
+    tilt_deg: float = 0.0
+    auto_tilt: bool = False
 
 
 def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: np.ndarray,
@@ -152,6 +182,11 @@ def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: 
         pn = settings.plane_normal
     cell = make_cell(platform, plane_point=pp, plane_normal=pn, friction=settings.friction,
                      legs=truth.calibration)
+    cyl = settings.cylinder
+    if cyl is not None:
+        wp = (cylinder_ahead(start_point, direction, DEFAULT_PLANE_DISTANCE, cyl.radius, cyl.axis)
+              if cyl.point is None else Cylinder(cyl.point, cyl.axis, cyl.radius))
+        cell = replace(cell, workpiece=replace(wp, friction=settings.friction))
     return cell, sensor
 
 
@@ -167,8 +202,17 @@ def _config(req: ControlRequest, model: ControlModel) -> ControllerConfig:
     return ControllerConfig(
         model=model, force=req.force, start_tool_point=req.start_tool_point,
         force_tol=req.force_tol, align_tol_deg=req.align_tol_deg, method=req.method,
-        step=req.step, approach_step=req.approach_step, estimator=req.estimator,
-        max_iterations=req.max_iterations, envelope=Envelope(), procedure=req.procedure)
+        step=req.step, approach_step=_or(req.approach_step, FOLLOW_APPROACH_STEP, 1.0, req),
+        estimator=req.estimator,
+        max_iterations=_or(req.max_iterations, FOLLOW_MAX_ITERATIONS, 60, req),
+        envelope=Envelope(), procedure=req.procedure)
+
+
+def _or(value, follow_default, press_default, req: ControlRequest):
+    """``value``, or the task's default when it is None."""
+    if value is not None:
+        return value
+    return follow_default if req.task == "follow" else press_default
 
 
 @dataclass(frozen=True, eq=False)
@@ -181,10 +225,32 @@ class PreparedRun:
     header: dict
     cell: Cell | None = None
     sensor: Sensor | None = None
+    follow: FollowConfig | None = None
 
 
 def prepare_control(req: ControlRequest) -> PreparedRun:
-    """Assemble the cell and the controller of ``req`` (checks every setting; nothing starts)."""
+    """Assemble the cell and the controller of ``req`` (checks every setting; nothing starts).
+
+    The follow task's request is checked here too (:class:`~kinestat.control.follow.FollowConfig`:
+    a travel direction along the approach, a force the platform cannot carry inside the
+    envelope are refused before anything moves)."""
+    if req.task not in TASKS:
+        raise InputError(f"--task must be one of {', '.join(TASKS)}, got {req.task!r}")
+    prepared = _prepare_cell(req)
+    if req.task != "follow":
+        return prepared
+    if req.travel_dir is None:
+        raise InputError("the follow task needs a travel direction (--travel-dir x,y,z)")
+    follow = FollowConfig(base=prepared.config, travel=req.travel, travel_dir=req.travel_dir,
+                          travel_step=req.travel_step, tilt_deg=req.tilt_deg,
+                          auto_tilt=req.auto_tilt)
+    header = dict(prepared.header, task="follow", travel=req.travel,
+                  travel_dir=follow.travel_dir, tilt_deg=req.tilt_deg, auto_tilt=req.auto_tilt)
+    return replace(prepared, follow=follow, header=header)
+
+
+def _prepare_cell(req: ControlRequest) -> PreparedRun:
+    """The press task's assembly (the follow task adds its settings on top)."""
     if not (isinstance(req.samples, int) and 1 <= req.samples <= MAX_SAMPLES):
         raise InputError(f"samples (sensor packets averaged per measurement) must be in "
                          f"1..{MAX_SAMPLES}, got {req.samples!r}")
@@ -206,8 +272,11 @@ def prepare_control(req: ControlRequest) -> PreparedRun:
             cal = NamedCalibration(cal.name, fine)
         cell, sensor = simulated_cell(s, req.start_tool_point, direction, platform, truth)
         config = _config(req, calibrated_model(platform, cal))
-        header.update({"plane_point": cell.workpiece.point, "plane_normal": cell.workpiece.normal,
-                       "friction": s.friction, "ideal_sensor": s.ideal_sensor, "noise": s.noise,
+        wp = cell.workpiece
+        header.update({"plane_point": wp.point, "plane_normal": wp.normal} if s.cylinder is None
+                      else {"workpiece": {"kind": "cylinder", "radius": wp.radius,
+                                          "axis": wp.axis, "point": wp.point}})
+        header.update({"friction": s.friction, "ideal_sensor": s.ideal_sensor, "noise": s.noise,
                        "rate_hz": s.rate_hz, "sim_legs": truth.name})
         return PreparedRun(req, config, header, cell, sensor)
     d = req.cell
@@ -226,6 +295,8 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
     compensated) goes through the envelope (:func:`~kinestat.control.envelope.sent_command_guard`).
     """
     req, config, header = prepared.request, prepared.config, prepared.header
+    decide_fn = (None if prepared.follow is None
+                 else functools.partial(decide_follow, prepared.follow))
     safety = {"guard": sent_command_guard(config.envelope, config.model),
               "max_stream_faults": config.envelope.max_stream_faults,
               "move_rule": req.move_rule}
@@ -234,7 +305,8 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
                         rate_hz=req.cell.rate_hz, seed=req.cell.seed) as h:
             io = h.device_io(samples=req.samples, **safety)
             with CycleLog(log_path) as cycle_log:
-                return run(config, io, cycle_log, progress=progress, extra_header=header)
+                return run(config, io, cycle_log, progress=progress, extra_header=header,
+                           decide_fn=decide_fn)
     d = req.cell
     client = GalilClient(d.host, d.port).connect()
     try:
@@ -248,13 +320,33 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
         with EncoderReader(d.serial, fmt=d.serial_format) as reader:
             io = DeviceIO(client, reader, samples=req.samples, settle=0.1, **safety)
             with CycleLog(log_path) as cycle_log:
-                return run(config, io, cycle_log, progress=progress, extra_header=header)
+                return run(config, io, cycle_log, progress=progress, extra_header=header,
+                           decide_fn=decide_fn)
     finally:
         client.close()
 
 
-def plot_run(log_path: Path, plot_dir: Path) -> list[str]:
-    """Write the wrench-vs-state plot of a run's log (Vibhute Fig. 5-2's states)."""
-    from kinestat.viz.control_plots import write_plots  # lazy: matplotlib only when plotting
+def report_dict(prepared: PreparedRun, report: RunReport) -> dict:
+    """The run's JSON report: :meth:`RunReport.as_dict`, and for the follow task ``completed``,
+    ``travel`` (mm along the surface), ``normal_force_rms_error``/``normal_force_max_error``
+    (N, over the travel cycles), ``contact_lost`` (and the true errors when simulated)."""
+    out = report.as_dict()
+    if prepared.follow is not None:
+        out["task"] = "follow"
+        out["completed"] = report.converged
+        out.update(follow_summary(report.cycles, prepared.config.force_target,
+                                  prepared.follow.travel))
+    return out
 
-    return [str(p) for p in write_plots(read_log(log_path), plot_dir)]
+
+def plot_run(log_path: Path, plot_dir: Path) -> list[str]:
+    """Write the wrench-vs-state plot of a run's log (Vibhute Fig. 5-2's states), and for a
+    follow run the normal force against travel and the tool path."""
+    from kinestat.viz.control_plots import write_plots  # lazy: matplotlib only when plotting
+    from kinestat.viz.follow_plots import write_follow_plots  # lazy: as above
+
+    records = read_log(log_path)
+    paths = write_plots(records, plot_dir)
+    if any(r.get("type") == "cycle" and r.get("task") for r in records):
+        paths += write_follow_plots(records, plot_dir)
+    return [str(p) for p in paths]

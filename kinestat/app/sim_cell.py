@@ -36,11 +36,13 @@ from kinestat.hardware.puma762_axes import (
     counts_to_joint_rad,
 )
 from kinestat.serial import puma762
-from kinestat.sim.contact import Cell, Equilibrium, equilibrium, unloaded_tip
+from kinestat.sim.contact import Cell, Equilibrium, unloaded_tip
 from kinestat.sim.dmc import DmcSimulator, SimClock
 from kinestat.sim.encoder_emitter import EncoderEmitter
 from kinestat.sim.galil_server import GalilSimServer
 from kinestat.sim.sensor import Sensor
+from kinestat.sim.surface import solve as solve_contact
+from kinestat.sim.surface import surface_normal
 
 __all__ = ["CellState", "SimHarness", "InProcessIO", "control_model", "start_counts"]
 
@@ -90,7 +92,8 @@ class CellState:
                 return self._eq
             T = puma762.forward(q).pose
             try:
-                eq = equilibrium(self.cell, T, anchor=self._anchor, approach_from=self._free_tip)
+                eq = solve_contact(self.cell, T, anchor=self._anchor,
+                                   approach_from=self._free_tip)
             except KinestatError as exc:
                 self.error = exc
                 raise
@@ -123,6 +126,8 @@ class CellState:
             "tool_point": fwd.tool_point,
             "joints_deg": np.degrees(q),
             "residual": eq.residual,
+            "normal": (surface_normal(self.cell.workpiece, eq.tip) if eq.in_contact
+                       else None),
         }
 
 

@@ -21,6 +21,7 @@ from kinestat.app.control_defaults import (
     DEFAULT_PLANE_DISTANCE,
     DEFAULT_PLANE_TILT_DEG,
     DEFAULT_START,
+    TASKS,
 )
 from kinestat.app.signals import stop_on_signals
 from kinestat.cli._options import flag
@@ -58,8 +59,41 @@ def _run_dir(base: Path) -> Path:
     return d
 
 
+def _workpiece(text: str | None):
+    """``--workpiece``: "plane" (None) or "cylinder:radius=R,axis=x,y,z[,point=x,y,z]" (a
+    :class:`~kinestat.app.control_run.CylinderSpec`)."""
+    from kinestat.app.control_run import CylinderSpec  # lazy: start-up (numba)
+
+    if text is None or text.strip() == "plane":
+        return None
+    kind, sep, rest = text.partition(":")
+    if kind.strip() != "cylinder" or not sep:
+        raise InputError(f"--workpiece: expected 'plane' or 'cylinder:radius=R,axis=x,y,z"
+                         f"[,point=x,y,z]', got {text!r}")
+    fields: dict[str, list[str]] = {}
+    key = None
+    for tok in rest.split(","):
+        name, eq, val = tok.partition("=")
+        if eq:
+            key = name.strip()
+            if key not in ("radius", "axis", "point") or key in fields:
+                raise InputError(f"--workpiece: unknown or repeated field {key!r} in {text!r}")
+            fields[key] = [val]
+        elif key is None:
+            raise InputError(f"--workpiece: expected name=value after 'cylinder:', got {text!r}")
+        else:
+            fields[key].append(tok)
+    if "radius" not in fields or "axis" not in fields:
+        raise InputError(f"--workpiece: a cylinder needs radius= and axis=, got {text!r}")
+    radius = parse_floats(",".join(fields["radius"]), 1, "workpiece radius")[0]
+    axis = parse_floats(",".join(fields["axis"]), 3, "workpiece axis")
+    point = (parse_floats(",".join(fields["point"]), 3, "workpiece point")
+             if "point" in fields else None)
+    return CylinderSpec(radius=float(radius), axis=axis, point=point)
+
+
 def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise, friction,
-          rate, seed, sim_legs="thesis"):
+          rate, seed, sim_legs="thesis", workpiece=None):
     """The cell the options describe: simulated (no device options) or the real devices."""
     from kinestat.app.control_run import RealDevices, SimulatedCell  # lazy: start-up (numba)
 
@@ -67,10 +101,14 @@ def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor,
         raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
                          "neither to run the simulated cell")
     if galil is not None and (plane_point or plane_normal or ideal_sensor or noise or friction
-                              or sim_legs != "thesis"):
+                              or sim_legs != "thesis" or workpiece is not None):
         raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction/"
-                         "--sim-legs describe the simulated cell; they cannot be used with real "
-                         "devices")
+                         "--sim-legs/--workpiece describe the simulated cell; they cannot be used "
+                         "with real devices")
+    cylinder = _workpiece(workpiece)
+    if cylinder is not None and (plane_point or plane_normal):
+        raise InputError("--plane-point/--plane-normal describe a plane workpiece; with "
+                         "--workpiece cylinder:... give the cylinder's point= instead")
     if serial_format not in ("ks", "legacy"):
         raise InputError(f"--serial-format must be 'ks' or 'legacy', got {serial_format!r}")
     if ideal_sensor and noise:
@@ -83,7 +121,7 @@ def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor,
             plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
             plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
             friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed,
-            sim_legs=sim_legs)
+            sim_legs=sim_legs, cylinder=cylinder)
     host, port = _host_port(galil)
     return RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
 
@@ -99,6 +137,9 @@ def _print_progress(rec: dict) -> None:
     if c is not None and c["rotation_deg"]:
         extra += f" turn {c['rotation_deg']:.3f}°"
     fmag = float(np.linalg.norm(m["estimate"]))
+    task = rec.get("task")
+    if task:
+        extra += f"  F_n {task['normal_force']:7.4f} N  travel {task['travel']:7.3f} mm"
     err_console.print(f"cycle {rec['cycle']:3d}  state {rec['state']}  |F| {fmag:7.4f} N"
                       f"  -> {what}{extra}")
 
@@ -129,7 +170,8 @@ def control_command(
     step: float = typer.Option(
         1.0, "--step", help="Fixed step, and the largest stiffness step (mm)."),
     approach_step: float = typer.Option(
-        1.0, "--approach-step", help="Step along S6 while no contact is measured (mm)."),
+        None, "--approach-step", help="Step along S6 while no contact is measured (mm; default "
+        "1 for press, 0.25 for follow)."),
     estimator: str = typer.Option(
         "point", "--estimator",
         help="Force the controller acts on: 'point' (point-contact fit) or 'wrench' (the "
@@ -150,8 +192,9 @@ def control_command(
     rate: float = typer.Option(200.0, "--rate", help="Simulated encoder packet rate (Hz)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the simulated sensor noise."),
     max_iterations: int = typer.Option(
-        60, "--max-iterations",
-        help=f"Measurement cycles before giving up (1..{MAX_ITERATIONS})."),
+        None, "--max-iterations",
+        help=f"Measurement cycles before giving up (1..{MAX_ITERATIONS}; default 60 for press, "
+        f"{MAX_ITERATIONS} for follow)."),
     plot: Path = typer.Option(
         None, "--plot", help="Directory for the wrench-vs-state plot (default: the run "
         "directory)."),
@@ -186,6 +229,26 @@ def control_command(
         False, "--assume-homed",
         help="With --galil: move even if the controller does not report this session homed "
         "(`kinestat home`)."),
+    task: str = typer.Option(
+        "press", "--task", help=f"{' or '.join(TASKS)}: press the tool on the workpiece "
+        "(default), or slide it along the workpiece holding the normal force at --force."),
+    travel: float = typer.Option(50.0, "--travel",
+                                 help="follow: distance to travel along the surface (mm)."),
+    travel_dir: str = typer.Option(
+        None, "--travel-dir", help="follow: initial direction of travel x,y,z (fixed frame), "
+        "projected onto the tangent plane as the surface is discovered."),
+    travel_step: float = typer.Option(1.0, "--travel-step",
+                                      help="follow: largest travel per cycle (mm)."),
+    tilt_deg: float = typer.Option(
+        0.0, "--tilt-deg", help="follow: tool axis tilted from the measured normal towards "
+        "the travel direction (degrees)."),
+    auto_tilt: bool = typer.Option(
+        False, "--auto-tilt", help="follow: tilt the tool axis onto the friction cone's edge "
+        "(estimated), more while the tip sticks (experimental; docs/control.md)."),
+    workpiece: str = typer.Option(
+        None, "--workpiece", help="Simulated workpiece: 'plane' (default, --plane-point/"
+        "--plane-normal) or 'cylinder:radius=R,axis=x,y,z[,point=x,y,z]' (without point: its "
+        f"surface {DEFAULT_PLANE_DISTANCE} mm ahead of the start tool point along F_req)."),
     as_json: bool = typer.Option(False, "--json", help="Print the final report as JSON."),
 ) -> None:
     """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
@@ -197,7 +260,9 @@ def control_command(
 
     JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
     tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
-    torque_about_tool, torque_about_base (N·mm, fixed frame), procedure, calibration, cycles.
+    torque_about_tool, torque_about_base (N·mm, fixed frame), procedure, calibration, cycles;
+    with --task follow also task, completed, travel, normal_force_rms_error,
+    normal_force_max_error, contact_lost (and the true errors, simulated).
     """
     _check_counts(samples, max_iterations)
     _check_plot_dir(plot, no_plot)
@@ -220,19 +285,23 @@ def control_command(
         SimulatedCell,
         plot_run,
         prepare_control,
+        report_dict,
         run_control,
     )
     from kinestat.cli._compile import KERNELS, compiling_notice, is_cold, warm_kernels
 
     cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
-                 friction, rate, seed, sim_legs)
+                 friction, rate, seed, sim_legs, workpiece)
     simulated = isinstance(cell, SimulatedCell)
     req = ControlRequest(force=force * d, start_tool_point=p0, cell=cell, force_tol=force_tol,
                          align_tol_deg=align_tol_deg, method=method, step=step,
                          approach_step=approach_step, estimator=estimator, samples=samples,
                          max_iterations=max_iterations, calibration=calibration,
                          platform=platform, procedure=procedure, move_rule=move_rule,
-                         assume_homed=assume_homed)
+                         assume_homed=assume_homed, task=task, travel=travel,
+                         travel_dir=(None if travel_dir is None
+                                     else parse_floats(travel_dir, 3, "travel-dir")),
+                         travel_step=travel_step, tilt_deg=tilt_deg, auto_tilt=auto_tilt)
     cold = tuple(g for g in KERNELS if is_cold(g))
     if cold:  # compile before the run, so that its timing is the loop's own
         with compiling_notice(*cold):
@@ -251,7 +320,7 @@ def control_command(
         except KeyboardInterrupt as exc:  # before or after the loop: nothing was moving
             raise KinestatError(f"kinestat control: {exc or 'interrupted'} before the run "
                                 "started or after it ended") from exc
-        out = report.as_dict()
+        out = report_dict(prepared, report)
         plots: list[str] = []
         if plot_dir is not None:
             try:
@@ -268,15 +337,17 @@ def control_command(
 
         show_log(log_path)
     if not report.converged:
-        raise KinestatError(f"kinestatic control did not converge: {report.stop_reason}")
+        what = "the follow task did not complete" if task == "follow" else (
+            "kinestatic control did not converge")
+        raise KinestatError(f"{what}: {report.stop_reason}")
 
 
-def _check_counts(samples: int, max_iterations: int) -> None:
+def _check_counts(samples: int, max_iterations: int | None) -> None:
     """The documented ceilings of --samples and --max-iterations, before anything starts."""
     if not 1 <= samples <= MAX_SAMPLES:
         raise InputError(f"--samples must be in 1..{MAX_SAMPLES} (packets averaged per "
                          f"measurement), got {samples}")
-    if not 1 <= max_iterations <= MAX_ITERATIONS:
+    if max_iterations is not None and not 1 <= max_iterations <= MAX_ITERATIONS:
         raise InputError(f"--max-iterations must be in 1..{MAX_ITERATIONS}, got "
                          f"{max_iterations}")
 
@@ -296,6 +367,11 @@ def _print_report(out: dict) -> None:
                          else "none (stopped before the first cycle)"))
     if out["converged"]:  # a failed run's reason is the one error line on stderr
         out_console.print(f"  {literal(out['stop_reason'])}")
+    if out.get("task") == "follow":
+        rms, mx = out.get("normal_force_rms_error"), out.get("normal_force_max_error")
+        out_console.print(f"  travel {out['travel']:.3f} mm along the surface; normal force error "
+                          + ("n/a" if rms is None else f"RMS {rms:.4f} N, max {mx:.4f} N")
+                          + f"; contact lost {out['contact_lost']} cycles")
     rows = []
     for key, label in (("force", "force (N)"),
                        ("torque_about_tool", "torque about tool point (N·mm)"),

@@ -284,6 +284,9 @@ class Command:
         force_error: |F_req| − |F| (N); misalignment_deg: angle(S6, F).
         prediction: predicted force and deflections after the move.
         violations: envelope violations that caused a stop.
+        info: task-specific figures of the cycle for the report's ``cycles`` (the follow
+            task's phase, measured tip, normal estimate, normal force, travel); empty for the
+            press task.
     """
 
     kind: CommandKind
@@ -300,6 +303,7 @@ class Command:
     misalignment_deg: float | None = None
     prediction: Prediction | None = None
     violations: tuple[str, ...] = ()
+    info: dict = field(default_factory=dict)
 
 
 # -- joint-space helpers ------------------------------------------------------------------------

@@ -245,21 +245,32 @@ class _Run:
     converged: bool = False
     reason: str = ""
     cycles: list[dict] = field(default_factory=list)
+    decide_fn: DecideFn | None = None
 
     def t(self) -> float:
         return time.monotonic() - self.t0
 
 
+DecideFn = Callable[[ControllerState, Measurement], tuple[Command, ControllerState]]
+"""A task's pure decision function with its settings bound, e.g.
+``functools.partial(decide_follow, follow_config)``."""
+
+
 def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
         progress: Callable[[dict], None] | None = None,
-        extra_header: dict | None = None) -> RunReport:
+        extra_header: dict | None = None, decide_fn: DecideFn | None = None) -> RunReport:
     """Run the kinestatic procedure (Vibhute 2011 ch. 5, Fig. 5-2) on ``io`` until the goal, a
     stop or ``max_iterations``.
+
+    ``decide_fn`` replaces the press task's decision (:func:`decide` or the thesis's
+    procedure) by another task's, e.g. the follow task's
+    (:func:`kinestat.control.follow.decide_follow`); the start move, the measurement chain,
+    the log and the safe stop are the same.
 
     Never raises for a fault of the cell: the run ends with a safe stop and the report says
     why. Every cycle is written to ``log`` before its command is sent.
     """
-    r = _Run(t0=time.monotonic())
+    r = _Run(t0=time.monotonic(), decide_fn=decide_fn)
     header = {"type": "start", "time": time.strftime("%Y-%m-%dT%H:%M:%S"),
               "config": _config_record(config)}
     if extra_header:
@@ -328,8 +339,11 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
     meas = measure(config.model, q, sample.counts, r.state.top_pose, seq=sample.seq,
                    age=sample.age)
     r.last_meas = meas
-    decide_fn = decide_thesis if config.procedure == "thesis" else decide
-    cmd, r.state = decide_fn(config, r.state, meas)
+    if r.decide_fn is not None:
+        cmd, r.state = r.decide_fn(r.state, meas)
+    else:
+        decide_fn = decide_thesis if config.procedure == "thesis" else decide
+        cmd, r.state = decide_fn(config, r.state, meas)
     r.states.append(cmd.label)
     r.last_truth = io.truth()
     r.cycles.append(_cycle_summary(cmd, r.state, meas, r.last_truth))
@@ -339,6 +353,8 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
            "misalignment_deg": cmd.misalignment_deg,
            "measured": _meas_record(config, meas), "commanded": _cmd_record(cmd),
            "true": r.last_truth, "violations": list(cmd.violations)}
+    if cmd.info:
+        rec["task"] = cmd.info
     log.write(rec)
     if progress is not None:
         progress(rec)
@@ -363,10 +379,16 @@ def _cycle_summary(cmd: Command, state: ControllerState, meas: Measurement,
     t = cmd.target if cmd.target is not None else state.target
     tf = None if not truth or truth.get("tool_force") is None else np.asarray(
         truth["tool_force"], dtype=float)
-    return {"cycle": state.cycle, "state": cmd.label,
-            "action": cmd.action if cmd.kind in ("move", "measure") else cmd.kind,
-            "tool_point": t.tool_point.copy(), "s6": t.s6.copy(),
-            "force": meas.wrench[:3].copy(), "true_force": tf}
+    out = {"cycle": state.cycle, "state": cmd.label,
+           "action": cmd.action if cmd.kind in ("move", "measure") else cmd.kind,
+           "tool_point": t.tool_point.copy(), "s6": t.s6.copy(),
+           "force": meas.wrench[:3].copy(), "true_force": tf}
+    if cmd.info:  # a task's own figures (the follow task's), with the true normal and tip
+        out.update(cmd.info)
+        for key, src in (("true_normal", "normal"), ("true_tip", "tip")):
+            v = None if not truth else truth.get(src)
+            out[key] = None if v is None else np.asarray(v, dtype=float).copy()
+    return out
 
 
 def _fault_reason(exc: BaseException) -> str:

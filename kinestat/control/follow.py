@@ -1,0 +1,549 @@
+"""Force + motion: slide the tool along an unknown workpiece holding the normal force (issue 13).
+
+One call per cycle, :func:`decide_follow`, takes the :class:`FollowConfig`, the state and the
+cycle's :class:`~kinestat.control.wrench.Measurement` and returns the next
+:class:`~kinestat.control.controller.Command` — pure, no I/O, like
+:func:`kinestat.control.controller.decide`, and run by the same loop
+(:func:`kinestat.control.loop.run` with ``decide_fn``) on the simulated cell or real hardware.
+The start move is the press task's (:func:`kinestat.control.controller.start`).
+
+**Contact estimator** (the controller is not told the surface). The contact point is the
+measured deflected tool tip (:meth:`Measurement.tip`). The normal (out of the material) is at
+first contact the measured force's direction, ``n̂ = −F/|F|`` (``F`` the point-contact fit of
+the force the tool applies), and is KEPT while the force settles: a sticking tip's force turns
+with the tool, chasing it would walk round the friction cone. During travel, on every cycle the
+tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``), it is updated in the frame
+of the previous normal ``n̂₀``, the travel direction ``ŝ`` and ``b̂ = n̂₀ × ŝ``:
+``n̂ ∝ n̂₀ + (μ̂ − F·ŝ/F_n) ŝ − (F·b̂/F_n) b̂`` — across the travel from the force (sliding
+friction has no component across the slip), along it from the force corrected by the friction
+ratio ``μ̂``, a running estimate of ``F·ŝ/F_n + n_s`` where ``n_s = −(c·n̂₀)/(c·ŝ)`` is the
+surface's slope along ``ŝ`` measured by the chord ``c`` (≥ ``CHORD_LENGTH``) of the measured
+tip path, which lies in the surface (until a chord exists the along component is kept).
+Frictionless, ``μ̂ ≈ 0`` and the normal is the force's direction. The normal force is
+``F_n = −F·n̂``.
+
+**Control law** (Griffis & Duffy's kinestatic decomposition,
+:func:`kinestat.parallel.kinestatic.compose_twist`). In the platform base frame, with ``K``
+the platform stiffness at the measured top pose and ``W = [n̂; p × n̂]`` the contact's wrench
+line through the measured tip ``p``, the base (flange) is displaced by
+``T = T_f − K⁻¹ W Δλ``:
+
+* ``T_f``, a twist of freedom (reciprocal to W): the travel ``Δs t̂`` along the tangent
+  ``t̂`` (the requested direction carried onto the tangent plane, then transported from cycle
+  to cycle) plus a rotation about the tip turning S6 onto ``−n̂`` (or the commanded tilt
+  towards ``t̂``);
+* ``−K⁻¹ W Δλ``, the twist of compliance that raises the normal force by
+  ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ).
+
+Step limits per cycle: ``Δs ≤ travel_step``; the compliance twist moves the tip by at most
+``max_correction`` along the normal (and ``TANGENTIAL_FACTOR`` times that in all); S6 turns
+by at most ``max_turn_deg``. The target is solved by the PUMA's closed-form reverse
+analysis and rounded to counts with the press task's vernier; the envelope
+(:mod:`kinestat.control.envelope`) checks every measurement and every command's worst-case
+prediction. While settling, the force is raised only once S6 is within ``SETTLE_ALIGN_DEG`` of
+the normal; travel starts once ``|F_n − |F_req|| ≤ settle_tol``.
+
+Phases (the ``label`` of each cycle): ``a`` approach along S6 (no contact), ``b`` first
+contact, ``d`` settling the normal force before travel, ``f`` following (travel), ``e`` done.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from kinestat.control.controller import (
+    Command,
+    ControllerConfig,
+    ControllerState,
+    Target,
+    _solve_counts,
+    axis_counts_to_q,
+)
+from kinestat.control.envelope import (
+    Envelope,
+    check_command,
+    check_measurement,
+    check_motion,
+    predict,
+)
+from kinestat.control.model import ControlModel
+from kinestat.control.wrench import Measurement
+from kinestat.errors import InputError, JointLimitError, UnreachableError
+from kinestat.parallel.kinestatic import compose_twist
+from kinestat.parallel.legs import leg_lengths
+from kinestat.parallel.statics import spring_wrench
+from kinestat.parallel.stiffness import stiffness
+from kinestat.serial import puma762
+from kinestat.spatial.se3 import twist_exp
+from kinestat.spatial.transforms import apply, inv, skew
+
+__all__ = [
+    "FollowConfig",
+    "FollowState",
+    "FOLLOW_STATES",
+    "decide_follow",
+    "estimate_normal",
+    "carry_check",
+    "follow_summary",
+]
+
+FOLLOW_STATES = {
+    "a": "approach along S6, no contact",
+    "b": "first contact",
+    "d": "settling the normal force before travel",
+    "f": "following the surface: travel + force control",
+    "e": "requested travel done",
+}
+"""The labels of a follow run's cycles."""
+
+CHORD_LENGTH = 2.0
+"""Shortest measured tip chord (mm) the estimator takes as a line in the surface."""
+CHORD_HISTORY = 12
+"""Measured tips kept for the chord."""
+FRICTION_SMOOTHING = 0.2
+"""Weight of a new sample in the friction ratio's running estimate."""
+TANGENTIAL_FACTOR = 4.0
+"""The compliance twist's whole tip motion may be this multiple of ``max_correction`` (its
+normal part is limited to ``max_correction``: a frictionless tip slides freely along the
+surface, the soft direction of a point contact on a long tool)."""
+SLIDE_FRACTION = 0.5
+"""The tip slides when it advanced at least this fraction of the last travel step; otherwise
+it sticks and the normal estimate is kept (a sticking tip's force says nothing of the
+surface)."""
+MIN_SLIP = 0.2
+"""Smallest advance of the tip (mm) that counts as sliding."""
+LEARN_CHORDS = 3
+"""With the automatic tilt, chords needed before the friction ratio is trusted; until then the
+tilt reached at breakaway is kept and the travel steps are ``LEARN_STEP`` of the full step."""
+LEARN_STEP = 0.25
+AUTO_TILT_MARGIN_DEG = 1.0
+"""The automatic tilt's margin beyond the friction cone (keeps the tip sliding)."""
+CARRY_MARGIN = 1.0
+"""Newtons above the requested force the platform must carry (control overshoot)."""
+SETTLE_ALIGN_DEG = 2.0
+"""While settling, the force is raised only once S6 is within this of the normal estimate."""
+TURN_DEADBAND_DEG = 0.3
+"""Misalignments of S6 below this are not corrected (the normal estimate's noise)."""
+TRAVEL_TOL = 0.02
+"""Remaining travel (mm) at which the follow task is complete."""
+
+
+def _unit3(v, name: str) -> np.ndarray:
+    a = np.asarray(v, dtype=float)
+    if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) < 1e-12:
+        raise InputError(f"{name} must be 3 finite numbers, not all zero, got "
+                         f"{np.asarray(v).tolist()}")
+    return a / np.linalg.norm(a)
+
+
+def _tip_load_pose(platform, tip_top: np.ndarray, f_ext: np.ndarray, steps: int = 8,
+                   max_iter: int = 30) -> np.ndarray | None:
+    """The top pose (base frame) at which the springs carry the force ``f_ext`` (base frame)
+    applied at the tool tip ``tip_top`` (top frame), the tip free to move (a frictionless
+    contact): Newton on ``spring_wrench(X) = [f; p(X) × f]``, the load raised in ``steps``;
+    None where no equilibrium exists (the platform stops carrying load)."""
+    X = platform.home_pose.copy()
+    for k in range(1, steps + 1):
+        f = f_ext * (k / steps)
+        for _ in range(max_iter):
+            p = apply(X, tip_top)
+            r = np.concatenate([f, np.cross(p, f)]) - spring_wrench(platform, X)
+            if float(np.linalg.norm(r)) <= 1e-8 * max(1.0, float(np.linalg.norm(f))):
+                break
+            G = np.zeros((6, 6))  # d[f; p × f]/d[δx; δφ]
+            G[3:, :3] = -skew(f)
+            G[3:, 3:] = skew(f) @ skew(p)
+            try:
+                d = np.linalg.solve(stiffness(platform, X) - G, r)
+            except np.linalg.LinAlgError:
+                return None
+            d /= max(1.0, float(np.linalg.norm(d[3:])) / 0.05,
+                     float(np.linalg.norm(d[:3])) / (0.05 * platform.scale))
+            X = twist_exp(np.concatenate([d[3:], d[:3]])) @ X
+        else:
+            return None
+    return X
+
+
+def carry_check(model: ControlModel, envelope: Envelope, force, s6, a67) -> list[str]:
+    """Violations of the envelope by the platform carrying ``force`` (N, fixed frame, the tool's
+    force on the workpiece; checked at ``|force| + CARRY_MARGIN`` N) at the tip with S6/a67 as
+    given: an equilibrium must exist (the loaded platform stops carrying load beyond a limit,
+    about 8 N along the thesis's direction with its calibrated legs), inside Table 3-1's motion
+    ranges and the legs' deflection limit. Empty when it can be carried."""
+    R6 = np.column_stack([a67, np.cross(s6, a67), s6])
+    RB = R6 @ model.mount[:3, :3]
+    plat = model.platform
+    F = np.asarray(force, dtype=float)
+    F = F * (1.0 + CARRY_MARGIN / float(np.linalg.norm(F)))
+    top = _tip_load_pose(plat, model.tool_tip_top, -(RB.T @ F))
+    if top is None:
+        return [f"the platform finds no equilibrium carrying {np.linalg.norm(F):.3g} N at the "
+                "tool tip (its load limit along this direction)"]
+    out = check_motion(envelope, model, top, f"at {np.linalg.norm(F):.3g} N the")
+    defl = leg_lengths(plat, top) - plat.free_lengths
+    k = int(np.argmax(np.abs(defl)))
+    if abs(defl[k]) > envelope.max_deflection:
+        out.append(f"at {np.linalg.norm(F):.3g} N leg {plat.leg_names[k]} would deflect "
+                   f"{defl[k]:+.3f} mm, beyond ±{envelope.max_deflection:g} mm")
+    return out
+
+
+@dataclass(frozen=True, eq=False)
+class FollowConfig:
+    """Settings of one follow run (immutable; bad requests raise InputError here, before any
+    motion).
+
+    Attributes:
+        base: the press task's settings (model, F_req, start pose, approach step, contact
+            threshold, estimator, vernier, envelope, max_iterations).
+        travel: distance to travel along the surface (mm).
+        travel_dir: (3,) initial direction of travel (fixed frame), projected onto the
+            tangent plane as the surface is discovered.
+        travel_step: largest travel per cycle (mm).
+        max_correction: largest tip motion of the compliance twist per cycle (mm).
+        max_turn_deg: largest turn of S6 per cycle (degrees).
+        gain: fraction of the normal-force error corrected per cycle (0 < gain ≤ 1).
+        settle_tol: normal-force error (N) below which travel starts.
+        tilt_deg: S6 tilted from −n̂ towards the travel direction (degrees, 0: along −n̂).
+        auto_tilt: tilt S6 by ``atan(μ̂)`` (the estimated friction ratio) so that it stays
+            along the total force, plus ``max_turn_deg`` more for every cycle the tip sticks:
+            a point contact on the long tool is very soft tangentially (the top turns about
+            the tip), so friction carried across the tool axis turns the top beyond Table
+            3-1's range; along the axis the platform carries it.
+        max_contact_lost: cycles without contact during travel before a safe stop.
+        min_angle_deg: smallest angle between the travel direction and the approach direction
+            or the measured normal.
+    """
+
+    base: ControllerConfig
+    travel: float
+    travel_dir: np.ndarray
+    travel_step: float = 1.0
+    max_correction: float = 0.3
+    max_turn_deg: float = 1.0
+    gain: float = 0.8
+    settle_tol: float = 0.2
+    tilt_deg: float = 0.0
+    auto_tilt: bool = False
+    max_contact_lost: int = 3
+    min_angle_deg: float = 10.0
+
+    def __post_init__(self) -> None:
+        if not (math.isfinite(self.travel) and 0.0 < self.travel <= 1000.0):
+            raise InputError(f"travel must be in (0, 1000] mm, got {self.travel!r}")
+        t = _unit3(self.travel_dir, "travel direction")
+        object.__setattr__(self, "travel_dir", t)
+        for name in ("travel_step", "max_correction", "max_turn_deg", "settle_tol"):
+            v = float(getattr(self, name))
+            if not (math.isfinite(v) and v > 0):
+                raise InputError(f"{name} must be a positive number, got {v!r}")
+        if not 0.0 < self.gain <= 1.0:
+            raise InputError(f"gain must be in (0, 1], got {self.gain!r}")
+        if not (math.isfinite(self.tilt_deg) and abs(self.tilt_deg) < 45.0):
+            raise InputError(f"tilt must be within ±45°, got {self.tilt_deg!r}")
+        d = self.base.start_s6
+        ang = math.degrees(math.acos(min(1.0, abs(float(t @ d)))))
+        if ang < self.min_angle_deg:
+            raise InputError(f"travel direction {np.round(t, 4).tolist()} is {ang:.2f}° from the "
+                             f"approach direction (F_req): it must make at least "
+                             f"{self.min_angle_deg:g}° with it to travel along the surface")
+        bad = carry_check(self.base.model, self.base.envelope, self.base.force, d,
+                          self.base.start_a67)
+        if bad:
+            raise InputError(f"the requested force {self.base.force_target:g} N cannot be carried "
+                             "by the platform inside the safety envelope: " + "; ".join(bad))
+
+
+@dataclass(frozen=True, eq=False)
+class FollowState(ControllerState):
+    """The follow task's state: the press state plus the contact estimate and the travel.
+
+    Attributes:
+        phase: "approach", "settle" or "travel".
+        normal: (3,) the last normal estimate (out of the material), None before contact.
+        tangent: (3,) the travel direction on the tangent plane, None before contact.
+        path_dir: (3,) the last measured tip chord's direction, None before sliding.
+        last_tip: (3,) the last measured tip in contact.
+        travel: distance travelled along the surface (mm, the measured tip path's advance
+            along the travel direction).
+        contact_lost: cycles without contact during travel.
+        path: the last measured tips in contact during travel (the estimator's chords).
+        friction_samples: chords that have measured the friction ratio so far.
+        step: the travel commanded by the last move (mm).
+        sticking: the tip did not follow the last travel step.
+        breakaway: the extra tilt of the automatic tilt, in units of ``max_turn_deg``
+            (grows while the tip sticks, halves while it slides).
+        friction_ratio: running estimate of the tangential-to-normal force ratio along the
+            slip (μ when sliding), from the force and the chord.
+    """
+
+    phase: str = "approach"
+    normal: np.ndarray | None = None
+    tangent: np.ndarray | None = None
+    path_dir: np.ndarray | None = None
+    last_tip: np.ndarray | None = None
+    travel: float = 0.0
+    contact_lost: int = 0
+    path: tuple = ()
+    friction_ratio: float = 0.0
+    friction_samples: int = 0
+    step: float = 0.0
+    sticking: bool = False
+    breakaway: float = 0.0
+
+
+def estimate_normal(force, path_dir=None) -> np.ndarray:
+    """The contact normal (out of the material) from the tool's force on the workpiece and the
+    path's chord direction: ``−(F − (F·ĉ)ĉ)`` normalised (module docstring).
+
+    >>> estimate_normal([0.3, 0.0, -1.0], [1.0, 0.0, 0.0]).tolist()
+    [-0.0, -0.0, 1.0]
+    """
+    F = np.asarray(force, dtype=float)
+    if path_dir is not None:
+        c = np.asarray(path_dir, dtype=float)
+        F = F - (F @ c) * c
+    return -F / np.linalg.norm(F)
+
+
+def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
+    """Rotation vector turning ``s6`` towards ``axis`` by at most ``limit_rad``."""
+    c = np.cross(s6, axis)
+    s = float(np.linalg.norm(c))
+    if s < 1e-15:
+        return np.zeros(3)
+    ang = min(math.atan2(s, float(s6 @ axis)), limit_rad)
+    return c / s * ang
+
+
+def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal: np.ndarray,
+                omega: np.ndarray, travel: np.ndarray, dlam: float,
+                max_correction: float) -> np.ndarray:
+    """The base's twist T = T_f − K⁻¹ W Δλ (base frame, axis order [ω; v_O0]); the compliance
+    part scaled so that it moves the tip by at most ``max_correction``."""
+    TB = meas.base_pose
+    R = TB[:3, :3]
+    p = R.T @ (tip - TB[:3, 3])
+    n = R.T @ normal
+    W = np.concatenate([n, np.cross(p, n)])
+    K = stiffness(model.platform, meas.top_pose, twist_order="axis")
+    w = R.T @ omega
+    v_O = R.T @ travel - np.cross(w, p)  # tip moves by `travel`, turning about the tip
+    Tf = np.concatenate([w, v_O])
+    Tc = -dlam * np.linalg.solve(K, W)  # K⁻¹ δw with δw = −Δλ W (compose_twist's term)
+    dp = Tc[3:] + np.cross(Tc[:3], p)  # the tip's motion under the compliance twist
+    scale = max(abs(float(dp @ n)) / max_correction,
+                float(np.linalg.norm(dp)) / (TANGENTIAL_FACTOR * max_correction), 1.0)
+    return compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
+
+
+def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
+    TB_new = meas.base_pose @ twist_exp(T_base)
+    T6 = TB_new @ inv(model.mount)
+    return Target(apply(T6, model.tool_point_6), T6[:3, 2].copy(), T6[:3, 0].copy())
+
+
+def _stop(st: FollowState, label: str, reason: str, **kw) -> tuple[Command, FollowState]:
+    return Command(kind="stop", label=label, reason=reason, **kw), replace(st, label=label,
+                                                                           done=True)
+
+
+def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
+    """The chord from the latest earlier tip at least ``min_len`` mm away to ``tip``."""
+    for old in reversed(path):
+        c = tip - old
+        if float(np.linalg.norm(c)) >= min_len:
+            return c
+    return None
+
+
+def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.ndarray,
+             contact: bool) -> FollowState:
+    """Update the travel, the friction ratio and the normal estimate from this measurement
+    (the estimator of the module docstring)."""
+    tip = meas.tip(config.base.model)
+    if not contact:
+        return st
+    if st.normal is None:  # first contact: the force's direction
+        return replace(st, normal=estimate_normal(F), last_tip=tip)
+    if st.phase != "travel":  # settling: kept (a sticking tip's force turns with the tool)
+        return replace(st, last_tip=tip)
+    n0, s = st.normal, st.tangent
+    b = np.cross(n0, s)
+    advance = float((tip - st.last_tip) @ s)
+    travel = st.travel + advance
+    path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
+    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP):  # sticking: keep n0
+        stuck = st.step > 0 or st.sticking
+        return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
+                       breakaway=st.breakaway + (1.0 if stuck else 0.0))
+    fn = float(-(F @ n0))
+    a_force, c_force = float(F @ s) / fn, float(F @ b) / fn
+    mu, samples = st.friction_ratio, st.friction_samples
+    c = _chord(path, tip, CHORD_LENGTH)
+    n_s = 0.0  # the normal's change along s: kept until a chord has measured the friction
+    if c is not None and float(c @ s) > 0.5 * float(np.linalg.norm(c)):
+        n_s_geom = -float(c @ n0) / float(c @ s)  # the chord lies in the surface
+        w = 1.0 if samples == 0 else FRICTION_SMOOTHING
+        mu = min(max((1.0 - w) * mu + w * (a_force + n_s_geom), 0.0), 1.0)
+        samples += 1
+    if samples:
+        n_s = mu - a_force
+    n = n0 + n_s * s - c_force * b
+    return replace(st, travel=travel, normal=n / np.linalg.norm(n), last_tip=tip, path=path,
+                   friction_ratio=mu, friction_samples=samples,
+                   path_dir=None if c is None else c / np.linalg.norm(c),
+                   sticking=False, breakaway=st.breakaway if samples < LEARN_CHORDS else 0.0)
+
+
+def decide_follow(config: FollowConfig, state: ControllerState,
+                  meas: Measurement) -> tuple[Command, FollowState]:
+    """One cycle of the follow task: the next command and the new state (pure).
+
+    ``state`` is the press task's start state (:func:`~kinestat.control.controller.start`) on
+    the first cycle, then the :class:`FollowState` this function returned.
+    """
+    if state.done:
+        raise InputError("decide_follow: the run is over (state.done); start a new one")
+    base = config.base
+    model, env = base.model, base.envelope
+    st = state if isinstance(state, FollowState) else FollowState(**vars(state))
+    st = replace(st, cycle=st.cycle + 1, top_pose=meas.top_pose)
+    F = meas.estimate(base.estimator)
+    contact = float(np.linalg.norm(F)) >= base.contact_force
+    st = _observe(config, st, meas, F, contact)
+    label = {"approach": "a", "settle": "d", "travel": "f"}[st.phase]
+    if contact and st.phase == "approach":
+        label = "b"
+    fn = float(-(F @ st.normal)) if (contact and st.normal is not None) else 0.0
+    ft = 0.0 if not contact else float(np.linalg.norm(F + fn * st.normal))
+    err = base.force_target - fn
+    info = {"phase": st.phase, "tip": meas.tip(model), "normal_estimate": st.normal,
+            "normal_force": fn, "tangential_force": ft, "travel": st.travel,
+            "in_contact": contact,
+            "friction_ratio": st.friction_ratio}
+    kw = {"force_error": err, "info": info}
+    bad = check_measurement(env, model, meas)
+    if bad:
+        return _stop(st, label, "measurement outside the envelope: " + "; ".join(bad),
+                     violations=tuple(bad), **kw)
+    if st.cycle >= base.max_iterations:
+        return _stop(st, label, f"travel not completed after {st.cycle} cycles "
+                     f"({st.travel:.3f} of {config.travel:g} mm)", **kw)
+    return _act(config, st, meas, label, contact, err, kw)
+
+
+def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, contact: bool,
+         err: float, kw: dict) -> tuple[Command, FollowState]:
+    """Choose the motion of this cycle (after the measurement was accepted)."""
+    base = config.base
+    model = base.model
+    tgt = st.target
+    omega, step, travel_vec, dlam = np.zeros(3), 0.0, np.zeros(3), 0.0
+    if not contact:
+        if st.phase == "travel":
+            lost = st.contact_lost + 1
+            if lost > config.max_contact_lost:
+                return _stop(replace(st, contact_lost=lost), label,
+                             f"contact lost for {lost} cycles during travel", **kw)
+            st = replace(st, contact_lost=lost)
+            d = -st.normal  # regain contact along the last normal
+        else:
+            d = tgt.s6
+        new = Target(tgt.tool_point + base.approach_step * d, tgt.s6, tgt.a67)
+        return _command(config, st, meas, new, label, "approach", base.approach_step, 0.0, kw)
+    n = st.normal
+    t0 = st.tangent if st.tangent is not None else config.travel_dir
+    t = t0 - (t0 @ n) * n
+    if np.linalg.norm(t) < math.sin(math.radians(config.min_angle_deg)):
+        return _stop(st, label, f"the travel direction {np.round(t0, 4).tolist()} is within "
+                     f"{config.min_angle_deg:g}° of the measured normal "
+                     f"{np.round(n, 4).tolist()}: it points into the surface", **kw)
+    t /= np.linalg.norm(t)
+    tilt = math.radians(config.tilt_deg)
+    if config.auto_tilt:  # S6 along the force's cone edge; tilt more while the tip sticks
+        tilt = ((math.atan(st.friction_ratio) + math.radians(AUTO_TILT_MARGIN_DEG)
+                 if st.friction_samples else 0.0)
+                + math.radians(config.max_turn_deg) * st.breakaway)
+    axis = -math.cos(tilt) * n + math.sin(tilt) * t
+    mis = math.degrees(math.acos(max(-1.0, min(1.0, float(meas.s6 @ axis)))))
+    kw["misalignment_deg"] = mis
+    phase = "settle" if st.phase == "approach" else st.phase
+    if phase == "settle" and abs(err) <= config.settle_tol:
+        phase = "travel"
+    st = replace(st, phase=phase, tangent=t)
+    kw["info"]["phase"] = phase
+    remaining = config.travel - st.travel
+    if phase == "travel" and remaining <= TRAVEL_TOL:
+        return (Command(kind="done", label="e", reason=f"travelled {st.travel:.3f} mm along the "
+                        "surface", **kw), replace(st, label="e", done=True))
+    if phase == "travel" and not (config.auto_tilt and st.sticking):
+        learning = config.auto_tilt and st.friction_samples < LEARN_CHORDS
+        step = min(config.travel_step * (LEARN_STEP if learning else 1.0), remaining)
+        travel_vec = step * t
+    omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
+             else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
+    dlam = config.gain * err
+    if phase == "settle" and mis > SETTLE_ALIGN_DEG:
+        dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
+    try:
+        T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
+                        config.max_correction)
+    except (InputError, np.linalg.LinAlgError) as exc:
+        return _stop(st, label, f"the contact basis is singular for the platform stiffness: "
+                     f"{exc}", **kw)
+    new = _target(model, meas, T)
+    action = "follow" if phase == "travel" else "settle"
+    return _command(config, st, meas, new, label, action, step,
+                    math.degrees(float(np.linalg.norm(omega))), kw)
+
+
+def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Target, label: str,
+             action: str, step: float, rotation_deg: float,
+             kw: dict) -> tuple[Command, FollowState]:
+    """Solve ``new`` to counts, check it against the envelope, build the move."""
+    base = config.base
+    model = base.model
+    try:
+        counts, _ = _solve_counts(model, new, meas.q, st.axis_counts, base.vernier)
+    except (UnreachableError, JointLimitError) as exc:
+        return _stop(st, label, f"{action} target not reachable: {exc}", **kw)
+    axis_deg = counts * model.axis_deg_per_count
+    q_new = axis_counts_to_q(model, counts)
+    pred = predict(model, meas, puma762.forward(q_new).pose)
+    bad = check_command(base.envelope, model, axis_deg,
+                        st.axis_counts * model.axis_deg_per_count, pred)
+    if bad:
+        return _stop(st, label, f"{action} command refused by the envelope: " + "; ".join(bad),
+                     violations=tuple(bad), prediction=pred, **kw)
+    cmd = Command(kind="move", label=label, action=action, target=new, axis_counts=counts,
+                  axis_deg=axis_deg, q=q_new, step=step, rotation_deg=rotation_deg,
+                  prediction=pred, **kw)
+    return cmd, replace(st, label=label, last_action=action, target=new, axis_counts=counts,
+                        step=step if action == "follow" else 0.0)
+
+
+def follow_summary(cycles: list[dict], target_force: float, travel: float) -> dict:
+    """The follow report's figures from the loop's per-cycle summaries: ``travel`` (mm, the
+    measured path along the surface), the normal-force errors over the travel cycles (from the
+    first travel cycle on; measured, and true when simulated), ``contact_lost`` (travel cycles
+    without contact) and ``completed``."""
+    trav = [c for c in cycles if c.get("phase") == "travel"]
+    err = [abs(c["normal_force"] - target_force) for c in trav if c.get("in_contact")]
+    out = {"travel": float(cycles[-1]["travel"]) if cycles else 0.0,
+           "contact_lost": sum(1 for c in trav if not c.get("in_contact")),
+           "normal_force_rms_error": float(np.sqrt(np.mean(np.square(err)))) if err else None,
+           "normal_force_max_error": float(max(err)) if err else None}
+    true_err = []
+    for c in trav:
+        if c.get("true_normal") is not None and c.get("true_force") is not None:
+            fn = -float(np.asarray(c["true_force"]) @ np.asarray(c["true_normal"]))
+            true_err.append(abs(fn - target_force))
+    if true_err:
+        out["true_normal_force_rms_error"] = float(np.sqrt(np.mean(np.square(true_err))))
+        out["true_normal_force_max_error"] = float(max(true_err))
+    return out

@@ -1,0 +1,115 @@
+"""The follow task over 20 random workpieces (issue 13 item 5): figures for docs/control.md.
+
+Runs ``kinestat control --task follow`` (50 mm, |F_req| = 4 N, thesis calibration, legs and
+sensor resolution) on the in-process simulated cell for 10 random planes (1.5-4 mm ahead of
+the start tool point, normal tilted 0-8° from −F_req in a random azimuth) and 10 random
+cylinders (radius 150-400 mm, axis within ~20° of the fixed z axis), the initial travel
+direction within ~11° of +y; then the acceptance runs (the default plane and the R = 200 mm
+cylinder, thesis and ideal sensor). Prints one row per run (true figures from the simulator)
+and a summary.
+
+    .venv/bin/python scripts/follow_study.py [N | --acceptance]
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from kinestat.app.control_run import (  # noqa: E402
+    ControlRequest,
+    CylinderSpec,
+    SimulatedCell,
+    prepare_control,
+    report_dict,
+)
+from kinestat.app.sim_cell import InProcessIO, start_counts  # noqa: E402
+from kinestat.control.controller import THESIS_FORCE_DIRECTION  # noqa: E402
+from kinestat.control.follow import decide_follow  # noqa: E402
+from kinestat.control.log import CycleLog  # noqa: E402
+from kinestat.control.loop import run  # noqa: E402
+
+START = np.array([-400.0, 800.0, -100.0])
+F_HAT = np.asarray(THESIS_FORCE_DIRECTION)
+Y = np.array([0.0, 1.0, 0.0])
+
+
+def random_cell(rng: np.random.Generator, k: int) -> tuple[str, SimulatedCell]:
+    if k % 2 == 0:
+        tilt, az = math.radians(rng.uniform(0, 8)), rng.uniform(0, 2 * math.pi)
+        u = np.cross(F_HAT, Y)
+        u /= np.linalg.norm(u)
+        v = np.cross(F_HAT, u)
+        n = -(math.cos(tilt) * F_HAT + math.sin(tilt) * (math.cos(az) * u + math.sin(az) * v))
+        d = rng.uniform(1.5, 4.0)
+        return (f"plane {math.degrees(tilt):.1f}°",
+                SimulatedCell(plane_point=START + d * F_HAT, plane_normal=n))
+    r = rng.uniform(150, 400)
+    axis = np.array([rng.uniform(-0.3, 0.3), rng.uniform(-0.2, 0.2), 1.0])
+    return f"cylinder R {r:.0f}", SimulatedCell(cylinder=CylinderSpec(radius=r, axis=axis))
+
+
+def follow(cell: SimulatedCell, travel_dir, travel: float = 50.0) -> dict:
+    req = ControlRequest(force=4.0 * F_HAT, start_tool_point=START, cell=cell, task="follow",
+                         travel=travel, travel_dir=np.asarray(travel_dir, dtype=float))
+    prep = prepare_control(req)
+    io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp, CycleLog(Path(tmp) / "log.jsonl") as log:
+        rep = run(prep.config, io, log, decide_fn=functools.partial(decide_follow, prep.follow))
+    out = report_dict(prep, rep)
+    out["wall_s"] = time.perf_counter() - t0
+    return out
+
+
+def _row(name: str, out: dict) -> str:
+    def f(key, fmt):
+        v = out.get(key)
+        return "-" if v is None else format(v, fmt)
+    return (f"| {name:18s} | {'yes' if out['completed'] else 'NO':3s} | {out['travel']:6.2f} | "
+            f"{f('true_normal_force_rms_error', '.3f'):>6s} | "
+            f"{f('true_normal_force_max_error', '.3f'):>6s} | {out['contact_lost']} | "
+            f"{out['iterations']:3d} | {out['stop_reason'][:60]} |")
+
+
+def main(n: int = 20) -> None:
+    rng = np.random.default_rng(13)
+    print("| workpiece          | ok  | travel | RMS N  | max N  | lost | cycles | stop |")
+    rows = []
+    for k in range(n):
+        name, cell = random_cell(rng, k)
+        out = follow(cell, Y + rng.uniform(-0.2, 0.2, 3))
+        rows.append(out)
+        print(_row(name, out), flush=True)
+    done = [r for r in rows if r["completed"]]
+    print(f"\ncompleted {len(done)}/{n}; "
+          + (f"true normal-force RMS error median {np.median([r['true_normal_force_rms_error'] for r in done]):.3f} N, "  # noqa: E501
+             f"worst {max(r['true_normal_force_rms_error'] for r in done):.3f} N; max error "
+             f"worst {max(r['true_normal_force_max_error'] for r in done):.3f} N; travel "
+             f"{min(r['travel'] for r in done):.2f}-{max(r['travel'] for r in done):.2f} mm"
+             if done else ""))
+    print("\nacceptance runs (default plane and R = 200 mm cylinder):")
+    acceptance()
+
+
+def acceptance() -> None:
+    cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
+    for name, cell in (("plane 5°, thesis", SimulatedCell()),
+                       ("plane 5°, ideal", SimulatedCell(ideal_sensor=True)),
+                       ("cyl R 200, thesis", SimulatedCell(cylinder=cyl)),
+                       ("cyl R 200, ideal", SimulatedCell(ideal_sensor=True, cylinder=cyl))):
+        print(_row(name, follow(cell, Y)), flush=True)
+
+if __name__ == "__main__":
+    if sys.argv[1:] == ["--acceptance"]:
+        acceptance()
+    else:
+        main(int(sys.argv[1]) if len(sys.argv) > 1 else 20)

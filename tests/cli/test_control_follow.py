@@ -1,0 +1,67 @@
+"""``kinestat control --task follow``: options, JSON contract, plots, one-line errors."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from kinestat.cli.control import _workpiece
+from kinestat.cli.main import main
+from kinestat.devices.cell_io import MotionProfile
+from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
+from kinestat.errors import InputError
+
+FAST = MotionProfile(speed=tuple(20 * np.asarray(THESIS_SPEED_MAX)),
+                     accel=tuple(400 * np.asarray(THESIS_ACCEL)))
+
+
+@pytest.fixture(autouse=True)
+def fast_robot(monkeypatch):
+    monkeypatch.setattr(MotionProfile.__init__, "__defaults__", (FAST.speed, FAST.accel))
+
+
+def test_follow_cylinder_json_and_plots(tmp_path, capsys):
+    rc = main(["control", "--task", "follow", "--travel", "6", "--travel-dir", "0,1,0",
+               "--workpiece", "cylinder:radius=200,axis=0,0,1", "--json",
+               "--log", str(tmp_path / "log.jsonl"), "--plot", str(tmp_path / "plots")])
+    out = capsys.readouterr().out
+    rep = json.loads(out[out.index("{"):])
+    assert rc == 0 and rep["completed"] is True
+    assert rep["travel"] == pytest.approx(6.0, abs=1.0)
+    assert rep["contact_lost"] == 0
+    assert rep["normal_force_max_error"] <= 0.5
+    for key in ("converged", "force", "true_force", "stop_reason", "states", "cycles"):
+        assert key in rep
+    last = rep["cycles"][-1]
+    for key in ("tool_point", "force", "true_force", "normal_estimate", "true_normal", "travel"):
+        assert key in last
+    names = sorted(p.rsplit("/", 1)[-1] for p in rep["plots"])
+    assert names == ["normal-force-vs-travel.png", "tool-path.png", "wrench-vs-state.png"]
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--travel-dir", "0.9713,0,-0.2375"], "approach direction"),
+    (["--travel-dir", "0,1,0", "--force", "40"], "cannot be carried"),
+    ([], "travel direction"),
+    (["--travel-dir", "0,1,0", "--workpiece", "sphere:radius=3"], "--workpiece"),
+    (["--travel-dir", "0,1,0", "--task", "slide"], "--task"),
+])
+def test_bad_follow_requests_fail_before_any_motion(tmp_path, capsys, args, message):
+    argv = ["control", "--log", str(tmp_path / "log.jsonl"), "--no-plot"]
+    if "--task" not in args:
+        argv += ["--task", "follow"]
+    assert main(argv + args) != 0
+    assert message in capsys.readouterr().err.replace("\n", " ")
+    assert not (tmp_path / "log.jsonl").exists()
+
+
+def test_workpiece_option_parsing():
+    assert _workpiece(None) is None and _workpiece("plane") is None
+    c = _workpiece("cylinder:radius=150,axis=0,0,1,point=1,2,3")
+    assert c.radius == 150.0 and c.axis.tolist() == [0, 0, 1] and c.point.tolist() == [1, 2, 3]
+    for bad in ("cylinder:axis=0,0,1", "cylinder:radius=1,axis=0,1", "cylinder:radius=1,"
+                "axis=0,0,1,colour=3", "cylinder:radius=1,radius=2,axis=0,0,1", "cylinder"):
+        with pytest.raises(InputError):
+            _workpiece(bad)

@@ -1,0 +1,224 @@
+"""The follow task (issue 13 items 3-5): slide along an unknown plane or cylinder holding the
+normal force, on the in-process simulated cell (the thesis's calibrated cell)."""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from kinestat.app.control_run import (
+    DEFAULT_START,
+    ControlRequest,
+    CylinderSpec,
+    SimulatedCell,
+    prepare_control,
+    report_dict,
+)
+from kinestat.app.sim_cell import InProcessIO, start_counts
+from kinestat.control.controller import THESIS_FORCE_DIRECTION, start
+from kinestat.control.follow import FollowConfig, decide_follow, estimate_normal
+from kinestat.control.log import CycleLog
+from kinestat.control.loop import run
+from kinestat.control.wrench import measure
+from kinestat.errors import InputError
+from kinestat.sim.surface import Cylinder
+
+START = np.array([float(v) for v in DEFAULT_START.split(",")])
+F_HAT = np.asarray(THESIS_FORCE_DIRECTION)
+Y = np.array([0.0, 1.0, 0.0])
+
+
+def _follow(tmp_path, *, travel=50.0, travel_dir=Y, cell=None, force=4.0, **kw):
+    req = ControlRequest(force=force * F_HAT, start_tool_point=START,
+                         cell=cell or SimulatedCell(), task="follow", travel=travel,
+                         travel_dir=np.asarray(travel_dir, dtype=float), **kw)
+    prep = prepare_control(req)
+    io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
+    with CycleLog(tmp_path / "log.jsonl") as log:
+        rep = run(prep.config, io, log, decide_fn=functools.partial(decide_follow, prep.follow))
+    return prep, rep, report_dict(prep, rep)
+
+
+def _true_normal_force(c) -> float:
+    return -float(np.asarray(c["true_force"]) @ np.asarray(c["true_normal"]))
+
+
+def _true_arc(prep, cycles) -> float:
+    """The true tip's distance travelled on the surface, computed from the simulator's tips:
+    a straight line on a plane; on a cylinder the arc about the axis and the axial part."""
+    trav = [c for c in cycles if c["phase"] == "travel"]
+    a, b = trav[0]["true_tip"], trav[-1]["true_tip"]
+    wp = prep.cell.workpiece
+    if not isinstance(wp, Cylinder):
+        return float(np.linalg.norm(b - a))
+    ra, rb = wp._radial(a), wp._radial(b)
+    ang = math.atan2(np.linalg.norm(np.cross(ra, rb)), float(ra @ rb))
+    axial = float((b - a) @ wp.axis)
+    return math.hypot(wp.radius * ang, axial)
+
+
+def _check_acceptance(prep, rep, out, *, rms_limit: float, travel=50.0) -> None:
+    assert out["completed"] and rep.converged, rep.stop_reason
+    assert out["contact_lost"] == 0
+    trav = [c for c in rep.cycles if c["phase"] == "travel"]
+    err = np.array([_true_normal_force(c) - 4.0 for c in trav])
+    assert np.max(np.abs(err)) <= 0.5
+    assert math.sqrt(np.mean(err ** 2)) <= rms_limit
+    assert out["normal_force_rms_error"] <= rms_limit
+    assert abs(out["travel"] - travel) <= 1.0
+    assert abs(_true_arc(prep, rep.cycles) - travel) <= 1.0
+    # the normal estimate follows the true normal (friction-free: the force direction)
+    ang = [math.degrees(math.acos(min(1.0, float(c["normal_estimate"] @ c["true_normal"]))))
+           for c in trav]
+    assert max(ang) < 3.0
+
+
+@pytest.mark.parametrize("ideal, rms_limit", [(False, 0.2), (True, 0.05)])
+def test_follow_the_default_tilted_plane(tmp_path, ideal, rms_limit):
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(ideal_sensor=ideal))
+    _check_acceptance(prep, rep, out, rms_limit=rms_limit)
+    for key in ("tool_point", "force", "true_force", "normal_estimate", "true_normal",
+                "travel"):
+        assert key in out["cycles"][-1]
+
+
+@pytest.mark.parametrize("ideal, rms_limit", [(False, 0.2), (True, 0.05)])
+def test_follow_a_cylinder_of_radius_200(tmp_path, ideal, rms_limit):
+    cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(ideal_sensor=ideal, cylinder=cyl))
+    _check_acceptance(prep, rep, out, rms_limit=rms_limit)
+    # the path really curved: the true normal turned by about travel / radius
+    trav = [c for c in rep.cycles if c["phase"] == "travel"]
+    turn = math.degrees(math.acos(float(trav[0]["true_normal"] @ trav[-1]["true_normal"])))
+    assert turn == pytest.approx(math.degrees(50.0 / 200.0), abs=1.0)
+
+
+@pytest.mark.parametrize("seed", [3, 11])
+def test_follow_random_workpieces(tmp_path, seed):
+    rng = np.random.default_rng(seed)
+    if seed % 2:  # a plane: tilt 0-8° from -F_req in a random azimuth
+        tilt, az = math.radians(rng.uniform(0, 8)), rng.uniform(0, 2 * math.pi)
+        u = np.cross(F_HAT, Y)
+        u /= np.linalg.norm(u)
+        v = np.cross(F_HAT, u)
+        n = -(math.cos(tilt) * F_HAT + math.sin(tilt) * (math.cos(az) * u + math.sin(az) * v))
+        cell = SimulatedCell(plane_point=START + rng.uniform(1.5, 4.0) * F_HAT, plane_normal=n)
+    else:  # a cylinder, radius 150-400 mm, axis roughly across the travel
+        axis = np.array([rng.uniform(-0.3, 0.3), rng.uniform(-0.2, 0.2), 1.0])
+        cell = SimulatedCell(cylinder=CylinderSpec(radius=rng.uniform(150, 400), axis=axis))
+    travel_dir = Y + rng.uniform(-0.2, 0.2, 3)
+    prep, rep, out = _follow(tmp_path, cell=cell, travel=20.0, travel_dir=travel_dir)
+    _check_acceptance(prep, rep, out, rms_limit=0.2, travel=20.0)
+
+
+def test_estimate_normal_removes_friction_along_the_path():
+    rng = np.random.default_rng(0)
+    for _ in range(20):
+        n = rng.normal(size=3)
+        n /= np.linalg.norm(n)
+        t = np.cross(n, rng.normal(size=3))
+        t /= np.linalg.norm(t)
+        fn, mu = rng.uniform(1, 8), rng.uniform(0, 0.5)
+        F = -fn * n + mu * fn * t  # the tool drags the workpiece along t
+        np.testing.assert_allclose(estimate_normal(F, t), n, atol=1e-12)
+        np.testing.assert_allclose(estimate_normal(-fn * n), n, atol=1e-12)
+
+
+def _base(tmp_path, force=4.0, cell=None):
+    req = ControlRequest(force=force * F_HAT, start_tool_point=START, cell=cell or SimulatedCell())
+    return prepare_control(req).config
+
+
+def test_bad_requests_are_refused_before_any_motion(tmp_path):
+    base = _base(tmp_path)
+    with pytest.raises(InputError, match="approach direction"):
+        FollowConfig(base=base, travel=50.0, travel_dir=F_HAT + 0.05 * Y)
+    with pytest.raises(InputError, match="cannot be carried"):
+        FollowConfig(base=_base(tmp_path, force=30.0), travel=50.0, travel_dir=Y)
+    with pytest.raises(InputError, match="travel"):
+        FollowConfig(base=base, travel=-1.0, travel_dir=Y)
+    with pytest.raises(InputError, match="travel direction"):
+        FollowConfig(base=base, travel=10.0, travel_dir=[0.0, 0.0, 0.0])
+    with pytest.raises(InputError, match="travel direction"):
+        prepare_control(ControlRequest(force=4.0 * F_HAT, start_tool_point=START,
+                                       cell=SimulatedCell(), task="follow"))
+
+
+def test_travel_into_the_surface_stops_at_contact_with_a_reason(tmp_path):
+    # a plane tilted 20° from -F_req; the travel direction is (minus) its normal: 20° from the
+    # approach (accepted before contact), along the normal once it is measured
+    u = np.cross(F_HAT, Y)
+    u /= np.linalg.norm(u)
+    t = math.radians(20.0)
+    n = -(math.cos(t) * F_HAT + math.sin(t) * u)
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(plane_normal=n), travel_dir=-n)
+    assert not out["completed"]
+    assert "into the surface" in rep.stop_reason
+    assert out["travel"] == 0.0
+
+
+def test_decide_follow_is_pure(tmp_path):
+    req = ControlRequest(force=4.0 * F_HAT, start_tool_point=START, cell=SimulatedCell(),
+                         task="follow", travel_dir=Y)
+    prep = prepare_control(req)
+    io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
+    counts = io.robot_counts()
+    from kinestat.control.controller import axis_counts_to_q
+
+    q = axis_counts_to_q(prep.config.model, counts)
+    cmd0, st = start(prep.config, q, counts_now=counts)
+    io.move(cmd0.axis_counts)
+    for _ in range(20):  # approach until contact
+        m = measure(prep.config.model, axis_counts_to_q(prep.config.model, io.robot_counts()),
+                    io.sensor().counts, st.top_pose)
+        c1, s1 = decide_follow(prep.follow, st, m)
+        c2, s2 = decide_follow(prep.follow, st, m)
+        assert c1.kind == c2.kind and np.array_equal(c1.axis_counts, c2.axis_counts)
+        assert s1.phase == s2.phase and s1.cycle == s2.cycle == st.cycle + 1
+        st = s1
+        io.move(c1.axis_counts)
+        if s1.phase != "approach":
+            break
+    assert st.phase == "settle" and st.normal is not None
+
+
+def test_follow_config_rejects_a_finished_state(tmp_path):
+    base = _base(tmp_path)
+    fc = FollowConfig(base=base, travel=10.0, travel_dir=Y)
+    io_q = np.zeros(6)
+    _, st = start(base, io_q)
+    with pytest.raises(InputError, match="over"):
+        decide_follow(fc, replace(st, done=True), None)
+
+
+def test_friction_without_tilt_stops_safely_on_the_motion_range(tmp_path):
+    # a sticking tip lags the flange; the top turns about it (Table 3-1's 4°) long before the
+    # platform carries mu * F_n across the tool axis: a safe stop with the reason
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.3))
+    assert not out["completed"]
+    assert "Table 3-1" in rep.stop_reason and "refused by the envelope" in rep.stop_reason
+    assert out["contact_lost"] == 0
+
+
+def test_auto_tilt_follows_with_light_friction_and_learns_mu(tmp_path):
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.1), auto_tilt=True)
+    assert out["completed"], rep.stop_reason
+    assert out["contact_lost"] == 0 and abs(out["travel"] - 50.0) <= 1.0
+    assert out["true_normal_force_max_error"] <= 1.0
+    # the friction ratio learnt from the chords is the simulator's mu
+    assert rep.cycles[-1]["friction_ratio"] == pytest.approx(0.1, abs=0.03)
+
+
+def test_the_carry_check_matches_what_the_simulated_cell_carries(tmp_path):
+    # the simulated cell (thesis legs) has no contact equilibrium at 10 N along F_req: refused
+    # before any motion; 7 N passes the check and the cell carries it while following
+    with pytest.raises(InputError, match="cannot be carried"):
+        FollowConfig(base=_base(tmp_path, force=10.0), travel=10.0, travel_dir=Y)
+    prep, rep, out = _follow(tmp_path, force=7.0, travel=10.0)
+    assert out["completed"], rep.stop_reason
+    trav = [c for c in rep.cycles if c["phase"] == "travel"]
+    assert max(abs(_true_normal_force(c) - 7.0) for c in trav) <= 0.5

@@ -1,0 +1,100 @@
+"""The cylinder workpiece (kinestat.sim.surface): the tangent-plane fixed point lands on the
+surface, in equilibrium with the force along the true normal; a plane is unchanged."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from kinestat.errors import InputError
+from kinestat.parallel.platform import special_6_6
+from kinestat.parallel.statics import spring_wrench
+from kinestat.sim.contact import Workpiece, equilibrium, make_cell, unloaded_tip
+from kinestat.sim.surface import Cylinder, cylinder_ahead, solve, surface_normal
+from kinestat.spatial.transforms import apply_vector, inv
+
+PLATFORM = special_6_6()
+F_HAT = np.array([0.9713, 0.0, -0.2375]) / math.hypot(0.9713, 0.2375)
+
+
+def _flange(push: float, turn: float = 0.0) -> np.ndarray:
+    """A flange pose whose unloaded tip is at the origin + push along F_HAT, tool along F_HAT."""
+    z = F_HAT
+    x = np.cross([0.0, 1.0, 0.0], z)
+    x /= np.linalg.norm(x)
+    y = np.cross(z, x)
+    c, s = math.cos(turn), math.sin(turn)
+    R = np.column_stack([x, c * y + s * z, -s * y + c * z])
+    T = np.eye(4)
+    T[:3, :3] = R
+    cell = make_cell(PLATFORM, plane_point=[0, 0, 0], plane_normal=-F_HAT)
+    T[:3, 3] = push * F_HAT - (unloaded_tip(cell, T) - T[:3, 3])
+    return T
+
+
+def _cyl_cell(radius=200.0, axis=(0.0, 0.0, 1.0), friction=0.0, point_offset=2.0):
+    cell = make_cell(PLATFORM, plane_point=[0, 0, 0], plane_normal=-F_HAT)
+    cyl = cylinder_ahead(np.zeros(3), F_HAT, point_offset, radius, axis)
+    return replace(cell, workpiece=replace(cyl, friction=friction))
+
+
+def test_plane_goes_straight_to_the_plane_equilibrium():
+    cell = make_cell(PLATFORM, plane_point=2.0 * F_HAT, plane_normal=-F_HAT, friction=0.0)
+    T = _flange(2.4, 0.05)
+    a, b = solve(cell, T), equilibrium(cell, T)
+    assert np.array_equal(a.top_pose, b.top_pose) and np.array_equal(a.tool_force, b.tool_force)
+
+
+@pytest.mark.parametrize("radius, turn", [(200.0, 0.0), (200.0, 0.08), (80.0, -0.05)])
+def test_cylinder_contact_is_on_the_surface_along_the_true_normal(radius, turn):
+    cell = _cyl_cell(radius)
+    eq = solve(cell, _flange(2.5, turn))
+    wp = cell.workpiece
+    assert eq.in_contact
+    assert abs(float(wp.gap(eq.tip))) < 1e-8
+    n = wp.normal_at(eq.tip)
+    f = eq.contact_force
+    assert np.linalg.norm(f - (f @ n) * n) < 1e-8 * np.linalg.norm(f)
+    assert f @ n > 0  # the workpiece pushes the tool out
+    # the springs balance the contact force at the tip (base frame, independent of the solver)
+    TB = eq.base_pose
+    fB = apply_vector(inv(TB), f)
+    pB = (inv(TB) @ np.append(eq.tip, 1.0))[:3]
+    w = spring_wrench(cell.platform, eq.top_pose)
+    np.testing.assert_allclose(w, np.concatenate([fB, np.cross(pB, fB)]), atol=1e-7)
+
+
+def test_a_huge_cylinder_is_the_plane():
+    T = _flange(2.5, 0.04)
+    cyl = _cyl_cell(1e7)
+    n = surface_normal(cyl.workpiece, 2.0 * F_HAT)  # the axis is across F_HAT: n = -x
+    plane = replace(cyl, workpiece=Workpiece(2.0 * F_HAT, n))
+    a, b = solve(cyl, T), solve(plane, T)
+    np.testing.assert_allclose(a.tool_force, b.tool_force, atol=1e-5)
+
+
+def test_cylinder_with_friction_sticks_on_the_surface():
+    cell = _cyl_cell(200.0, friction=0.5)
+    eq = solve(cell, _flange(2.5, 0.03))
+    assert eq.in_contact and eq.anchor is not None
+    assert abs(float(cell.workpiece.gap(eq.anchor))) < 1e-8
+    n = cell.workpiece.normal_at(eq.tip)
+    f = eq.contact_force
+    assert np.linalg.norm(f - (f @ n) * n) <= 0.5 * (f @ n) * (1 + 1e-9)
+
+
+def test_out_of_contact_and_placement():
+    cell = _cyl_cell(200.0, point_offset=2.0)
+    assert not solve(cell, _flange(1.0)).in_contact
+    wp = cell.workpiece
+    assert float(wp.gap(2.0 * F_HAT)) == pytest.approx(0.0, abs=1e-9)
+    u = F_HAT - F_HAT[2] * np.array([0.0, 0.0, 1.0])  # F_HAT off the axis (z)
+    np.testing.assert_allclose(surface_normal(wp, 2.0 * F_HAT), -u / np.linalg.norm(u),
+                               atol=1e-12)
+    with pytest.raises(InputError):
+        Cylinder([0, 0, 0], [0, 0, 1], -1.0)
+    with pytest.raises(InputError, match="axis"):
+        cylinder_ahead(np.zeros(3), F_HAT, 2.0, 100.0, F_HAT)
