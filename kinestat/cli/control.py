@@ -23,7 +23,7 @@ from kinestat.app.control_defaults import (
     DEFAULT_START,
 )
 from kinestat.app.signals import stop_on_signals
-from kinestat.cli._options import flag
+from kinestat.cli._options import check_seed, flag
 from kinestat.cli._output import console as out_console
 from kinestat.cli._output import err_console, literal, parse_floats, print_json, table
 from kinestat.control.ceilings import MAX_ITERATIONS
@@ -200,6 +200,7 @@ def control_command(
     torque_about_tool, torque_about_base (N·mm, fixed frame), procedure, calibration, cycles.
     """
     _check_counts(samples, max_iterations)
+    check_seed(seed)
     _check_plot_dir(plot, no_plot)
     d = parse_floats(direction, 3, "direction")
     if np.linalg.norm(d) == 0:
