@@ -139,7 +139,8 @@ def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: 
     platform (default the prototype) with legs that follow ``truth`` (default
     ``settings.sim_legs``), the sensor reading counts through the truth's length maps."""
     platform = resolve_platform(None) if platform is None else platform
-    truth = resolve_calibration(settings.sim_legs, platform) if truth is None else truth
+    truth = (resolve_calibration(settings.sim_legs, platform, option="--sim-legs")
+             if truth is None else truth)
     legs = truth.calibration
     if settings.ideal_sensor:
         legs, = ideal_counts(legs)
@@ -200,7 +201,7 @@ def prepare_control(req: ControlRequest) -> PreparedRun:
     header["platform"] = req.platform or "prototype"
     if isinstance(req.cell, SimulatedCell):
         s = req.cell
-        truth = resolve_calibration(s.sim_legs, platform)
+        truth = resolve_calibration(s.sim_legs, platform, option="--sim-legs")
         if s.ideal_sensor:  # the controller reads the same fine counts
             _, fine = ideal_counts(truth.calibration, cal.calibration)
             cal = NamedCalibration(cal.name, fine)

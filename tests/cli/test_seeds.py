@@ -22,3 +22,4 @@ def test_a_negative_seed_is_one_usage_error(tmp_path, capsys, monkeypatch, argv)
 def test_a_seed_of_zero_still_runs_the_simulator(capsys):
     assert main(["sim", "galil", "--seed", "0", "--duration", "0", "--json"]) == 0
     assert '"port"' in capsys.readouterr().out
+
