@@ -34,7 +34,7 @@ from kinestat.app.sim_cell import SimHarness, start_counts
 from kinestat.control.controller import MAX_ITERATIONS, ControllerConfig, Procedure, StepMethod
 from kinestat.control.envelope import Envelope, sent_command_guard
 from kinestat.control.log import CycleLog, read_log
-from kinestat.control.loop import RunReport, run
+from kinestat.control.loop import RunReport, refuse, run
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Estimator
 from kinestat.devices.cell_io import MAX_SAMPLES, DeviceIO
@@ -42,7 +42,7 @@ from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import GalilClient
 from kinestat.devices.homing import is_homed
 from kinestat.devices.motion import MOVE_RULES, MoveRule
-from kinestat.errors import InputError, SafetyStop
+from kinestat.errors import InputError
 from kinestat.parallel.platform import Platform
 from kinestat.sim.contact import Cell, make_cell
 from kinestat.sim.sensor import Sensor
@@ -244,8 +244,7 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
                       "this controller session: run `kinestat home --galil "
                       f"{d.host}:{d.port}` first (or pass --assume-homed); nothing moved")
             with CycleLog(log_path) as cycle_log:
-                cycle_log.write({"type": "fault", "reason": reason, "action": "nothing sent"})
-            raise SafetyStop(reason)
+                return refuse(config, cycle_log, reason, extra_header=header)
         with EncoderReader(d.serial, fmt=d.serial_format) as reader:
             io = DeviceIO(client, reader, samples=req.samples, settle=0.1, **safety)
             with CycleLog(log_path) as cycle_log:

@@ -41,7 +41,7 @@ from kinestat.control.procedure import decide_thesis
 from kinestat.control.wrench import Estimator, Measurement, measure
 from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
 
-__all__ = ["SensorReading", "CellIO", "RunReport", "run"]
+__all__ = ["SensorReading", "CellIO", "RunReport", "refuse", "run"]
 
 
 class SensorReading(Protocol):
@@ -260,11 +260,7 @@ def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
     why. Every cycle is written to ``log`` before its command is sent.
     """
     r = _Run(t0=time.monotonic())
-    header = {"type": "start", "time": time.strftime("%Y-%m-%dT%H:%M:%S"),
-              "config": _config_record(config)}
-    if extra_header:
-        header.update(extra_header)
-    log.write(header)
+    log.write(_start_record(config, extra_header))
     try:
         _start_move(config, io, log, r)
         while not _cycle(config, io, log, r, progress):
@@ -276,6 +272,26 @@ def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
                               r.t0)
         _once_more_if_interrupted(_finish, config, r, log)
         raise
+    return _once_more_if_interrupted(_finish, config, r, log)
+
+
+def _start_record(config: ControllerConfig, extra_header: dict | None) -> dict:
+    header = {"type": "start", "time": time.strftime("%Y-%m-%dT%H:%M:%S"),
+              "config": _config_record(config)}
+    if extra_header:
+        header.update(extra_header)
+    return header
+
+
+def refuse(config: ControllerConfig, log: CycleLog, reason: str, *,
+           extra_header: dict | None = None) -> RunReport:
+    """A run refused before anything was sent (e.g. an unhomed robot): the log still gets its
+    ``start``, a ``fault`` (action "nothing sent") and the ``end`` record with the report."""
+    r = _Run(t0=time.monotonic())
+    log.write(_start_record(config, extra_header))
+    r.faults.append(reason)
+    log.write({"type": "fault", "t": r.t(), "reason": reason, "action": "nothing sent"})
+    r.reason = reason
     return _once_more_if_interrupted(_finish, config, r, log)
 
 
