@@ -197,7 +197,9 @@ def control_command(
 
     JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
     tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
-    torque_about_tool, torque_about_base (N·mm, fixed frame), procedure, calibration, cycles.
+    torque_about_tool, torque_about_base (N·mm, fixed frame), equivalent_force (the
+    equivalent wrench's force, N: base − tool torque = tool_point × it), procedure,
+    calibration, cycles.
     """
     _check_counts(samples, max_iterations)
     check_seed(seed)
@@ -298,9 +300,11 @@ def _print_report(out: dict) -> None:
     if out["converged"]:  # a failed run's reason is the one error line on stderr
         out_console.print(f"  {literal(out['stop_reason'])}")
     rows = []
-    for key, label in (("force", "force (N)"),
-                       ("torque_about_tool", "torque about tool point (N·mm)"),
-                       ("torque_about_base", "torque about robot base (N·mm)"),
+    # the equivalent wrench's force beside its torques: base − tool = tool_point × that force
+    for key, label in (("force", f"force, {out.get('estimator', 'point')} estimate (N)"),
+                       ("equivalent_force", "equivalent wrench: force (N)"),
+                       ("torque_about_tool", "  torque about tool point (N·mm)"),
+                       ("torque_about_base", "  torque about robot base (N·mm)"),
                        ("true_force", "true force (N)"), ("tool_axis", "tool axis S6"),
                        ("tool_point", "tool point (mm)")):
         if out.get(key) is not None:

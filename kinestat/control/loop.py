@@ -143,6 +143,8 @@ class RunReport:
             "faults": list(self.faults),
             "estimator": self.estimator,
             "equivalent_wrench": arr(self.equivalent_wrench),
+            "equivalent_force": (None if self.equivalent_wrench is None
+                                 else arr(self.equivalent_wrench[:3])),
             "torque_about_tool": arr(self.torque_about_tool),
             "torque_about_base": arr(self.torque_about_base),
             "procedure": self.procedure,
