@@ -42,7 +42,8 @@ from kinestat.sim.encoder_emitter import EncoderEmitter
 from kinestat.sim.galil_server import GalilSimServer
 from kinestat.sim.sensor import Sensor
 
-__all__ = ["CellState", "SimHarness", "InProcessIO", "control_model", "start_counts"]
+__all__ = ["CellState", "SimHarness", "SimCheckedReader", "InProcessIO", "control_model",
+           "simulator_fault", "start_counts"]
 
 
 def control_model(cell: Cell, sensor: Sensor, *, coupling: float = AXIS4_TO_5_COUPLING,
@@ -229,8 +230,61 @@ class SimHarness:
         """A :class:`DeviceIO` through the real client and reader, with the truth attached."""
         kw.setdefault("truth", self.truth)
         kw.setdefault("settle", 2.5 / self.emitter.rate_hz)
-        return DeviceIO(self.client(client_timeout), self.reader(**(reader_options or {})),
-                        **kw)
+        reader = SimCheckedReader(self.reader(**(reader_options or {})), self.emitter)
+        return DeviceIO(self.client(client_timeout), reader, **kw)
+
+
+#: what a failed contact solve means for the run (docs/control.md, *Safety envelope*)
+LOAD_LIMIT_HINT = ("the simulated platform cannot carry this load at this pose (with the "
+                   "thesis's calibrated legs and the 175 mm tool its force flattens at about "
+                   "7-8 N along the thesis's direction); ask for a smaller --force")
+
+
+def simulator_fault(err: BaseException) -> DeviceError:
+    """The error that stops the run when the simulated cell itself failed (e.g. no contact
+    equilibrium): the simulator's own reason, not the stale stream it leaves behind."""
+    hint = f"; {LOAD_LIMIT_HINT}" if "contact equilibrium" in str(err) else ""
+    return DeviceError(f"the simulated cell failed ({type(err).__name__}): {err}{hint}")
+
+
+class SimCheckedReader:
+    """An :class:`EncoderReader` on the emitter's pty that reports the emitter's error.
+
+    When the simulated cell raises inside the emitter's thread, the emitter keeps the error
+    and goes silent; the reader would see only stale data. Every read and poll checks the
+    emitter first (and again when the reader reports stale data) and raises
+    :func:`simulator_fault` with the real cause; the loop then stops the cell (ST, ``fault``
+    and ``end`` records). Everything else is the reader's.
+    """
+
+    def __init__(self, reader: EncoderReader, emitter: EncoderEmitter) -> None:
+        self._reader = reader
+        self._emitter = emitter
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._reader, name)
+
+    def _check(self) -> None:
+        err = self._emitter.error
+        if err is not None:
+            raise simulator_fault(err) from err
+
+    def _checked(self, fn, *args: Any, **kw: Any) -> Any:
+        self._check()
+        try:
+            return fn(*args, **kw)
+        except DeviceError:
+            self._check()
+            raise
+
+    def read(self, *args: Any, **kw: Any) -> Any:
+        return self._checked(self._reader.read, *args, **kw)
+
+    def poll(self) -> Any:
+        return self._checked(self._reader.poll)
+
+    def latest(self, *args: Any, **kw: Any) -> Any:
+        return self._checked(self._reader.latest, *args, **kw)
 
 
 class InProcessIO:
