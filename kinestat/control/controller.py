@@ -45,6 +45,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from kinestat.control.approach import approach_waypoints, check_approach
 from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.control.envelope import (
     Envelope,
@@ -284,6 +285,8 @@ class Command:
         force_error: |F_req| − |F| (N); misalignment_deg: angle(S6, F).
         prediction: predicted force and deflections after the move.
         violations: envelope violations that caused a stop.
+        waypoints: for the start move, the intermediate axis counts commanded before
+            ``axis_counts`` (:func:`kinestat.control.approach.approach_waypoints`).
     """
 
     kind: CommandKind
@@ -300,6 +303,7 @@ class Command:
     misalignment_deg: float | None = None
     prediction: Prediction | None = None
     violations: tuple[str, ...] = ()
+    waypoints: tuple[np.ndarray, ...] = ()
 
 
 # -- joint-space helpers ------------------------------------------------------------------------
@@ -387,13 +391,15 @@ def start(config: ControllerConfig, q_now, *, counts_now=None) -> tuple[Command,
         msg = f"the start pose cannot be commanded: {exc}"
         return Command(kind="stop", label="", reason=msg), replace(state, done=True)
     axis_deg = counts * model.axis_deg_per_count
-    now_deg = counts_now * model.axis_deg_per_count
-    bad = check_command(config.envelope, model, axis_deg, now_deg, None)
+    # a long move goes as a sequence of commands, each within the per-command step
+    wps = approach_waypoints(config.envelope, model, counts_now, counts)
+    bad = check_approach(config.envelope, model, counts_now, wps)
     if bad:
         return (Command(kind="stop", label="", reason="start move: " + "; ".join(bad),
                         violations=tuple(bad)), replace(state, done=True))
     cmd = Command(kind="move", label="", action="start", target=target, axis_counts=counts,
-                  axis_deg=axis_deg, q=axis_counts_to_q(model, counts))
+                  axis_deg=axis_deg, q=axis_counts_to_q(model, counts),
+                  waypoints=tuple(wps[:-1]))
     return cmd, replace(state, axis_counts=counts, history=(target.key(),))
 
 

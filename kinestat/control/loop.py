@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 import numpy as np
@@ -315,6 +315,12 @@ def _start_move(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run) ->
                "reason": cmd.reason, "commanded": _cmd_record(cmd)})
     if cmd.kind == "stop":
         raise SafetyStop(cmd.reason)
+    n = len(cmd.waypoints) + 1
+    for k, wp in enumerate(cmd.waypoints, 1):  # a long start move, one command at a time
+        log.write({"type": "approach", "cycle": 0, "t": r.t(), "waypoint": k, "of": n,
+                   "axis_counts": np.asarray(wp).tolist(),
+                   "axis_deg": (np.asarray(wp) * config.model.axis_deg_per_count).tolist()})
+        _move(io, log, replace(cmd, axis_counts=np.asarray(wp)), 0, r)
     _move(io, log, cmd, 0, r)
 
 
