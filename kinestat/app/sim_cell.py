@@ -28,7 +28,7 @@ from kinestat.devices.cell_io import DeviceIO, SensorSample
 from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.devices.motion import coordinated_move_plan
-from kinestat.errors import DeviceError, KinestatError
+from kinestat.errors import DeviceError, KinestatError, UnreachableError
 from kinestat.hardware.puma762_axes import (
     AXIS4_TO_5_COUPLING,
     AXIS_DEG_PER_COUNT,
@@ -91,7 +91,10 @@ class CellState:
                 return self._eq
             T = puma762.forward(q).pose
             try:
-                eq = equilibrium(self.cell, T, anchor=self._anchor, approach_from=self._free_tip)
+                guess = (self._eq.top_pose if self._eq is not None and self._eq.in_contact
+                         else None)  # continuation along the robot's motion
+                eq = equilibrium(self.cell, T, anchor=self._anchor, approach_from=self._free_tip,
+                                 top_pose_guess=guess)
             except KinestatError as exc:
                 self.error = exc
                 raise
@@ -234,16 +237,16 @@ class SimHarness:
         return DeviceIO(self.client(client_timeout), reader, **kw)
 
 
-#: what a failed contact solve means for the run (docs/control.md, *Safety envelope*)
-LOAD_LIMIT_HINT = ("the simulated platform cannot carry this load at this pose (with the "
-                   "thesis's calibrated legs and the 175 mm tool its force flattens at about "
-                   "7-8 N along the thesis's direction); ask for a smaller --force")
+#: what a failed contact solve means for the run (docs/control.md, *The simulated cell*)
+LOAD_LIMIT_HINT = ("the tool was pushed beyond what the simulated platform can carry at this "
+                   "pose; ask for a smaller --force")
 
 
 def simulator_fault(err: BaseException) -> DeviceError:
     """The error that stops the run when the simulated cell itself failed (e.g. no contact
-    equilibrium): the simulator's own reason, not the stale stream it leaves behind."""
-    hint = f"; {LOAD_LIMIT_HINT}" if "contact equilibrium" in str(err) else ""
+    equilibrium, a leg beyond its stroke): the simulator's own reason, not the stale stream it
+    leaves behind."""
+    hint = f"; {LOAD_LIMIT_HINT}" if isinstance(err, UnreachableError) else ""
     return DeviceError(f"the simulated cell failed ({type(err).__name__}): {err}{hint}")
 
 
