@@ -87,3 +87,30 @@ def test_control_from_the_home_position_reaches_the_start_pose(tmp_path, capsys)
     cyc = [r for r in recs if r["type"] == "cycle"]
     assert cyc, (code, report["stop_reason"])
     np.testing.assert_allclose(cyc[0]["measured"]["tool_point"], cfg.start_tool_point, atol=0.5)
+
+
+def test_home_then_control_on_one_simulated_controller(tmp_path, capsys):
+    """`kinestat home` on a robot at an unknown position, then `kinestat control --galil` on
+    the same simulated controller (the harness's DMC replaced by an unhomed one)."""
+    from kinestat.sim.dmc import DmcSimulator, SimClock
+    from kinestat.sim.galil_server import GalilSimServer
+
+    cell, cfg = _cell(1000.0)
+    h = SimHarness(cell, Sensor())
+    # simulated time (0.05 s per command), as the homing tests: the coarse move takes seconds
+    h.controller = DmcSimulator.unknown_start(4, clock=SimClock(step_per_command=0.05))
+    h.server = GalilSimServer(controller=h.controller)
+    with h:
+        host, port = h.galil_address
+        addr = f"{host}:{port}"
+        assert main(["home", "--galil", addr, "--json", "--log", str(tmp_path / "h.jsonl")]) == 0
+        capsys.readouterr()
+        main(["control", "--galil", addr, "--serial", h.serial_path, "--no-plot", "--json",
+              "--log", str(tmp_path / "c.jsonl"), "--max-iterations", "1"])
+    out = capsys.readouterr().out
+    report = json.loads(out[out.index("{"):])
+    recs = read_log(tmp_path / "c.jsonl")
+    assert any(r["type"] == "approach" for r in recs), report["stop_reason"]
+    cyc = [r for r in recs if r["type"] == "cycle"]
+    assert cyc, report["stop_reason"]
+    np.testing.assert_allclose(cyc[0]["measured"]["tool_point"], cfg.start_tool_point, atol=0.5)
