@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import os
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -27,7 +28,7 @@ from kinestat.errors import InputError
 from kinestat.hardware.leg_calibration import LegCalibration
 from kinestat.hardware.leg_law import calibrated_platform, nominal_calibration, rescale_counts
 from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, THESIS_TOOL_POINT_6
-from kinestat.io.library import load_calibration
+from kinestat.io.library import list_calibrations, load_calibration
 from kinestat.io.platform_toml import read_platform
 from kinestat.parallel.platform import Platform, special_6_6
 from kinestat.sim.contact import centred_mount
@@ -51,10 +52,21 @@ def resolve_platform(path: str | os.PathLike | None) -> Platform:
     return special_6_6() if path is None else read_platform(path)
 
 
-def resolve_calibration(spec: str | os.PathLike, platform: Platform) -> NamedCalibration:
+CALIBRATION_NAMES = ("thesis", "nominal")
+"""The names ``--calibration`` and ``--sim-legs`` accept besides the embedded calibrations
+(:func:`kinestat.io.library.list_calibrations`) and TOML file paths."""
+
+
+def resolve_calibration(spec: str | os.PathLike, platform: Platform, *,
+                        option: str = "--calibration") -> NamedCalibration:
     """``"thesis"``, ``"nominal"`` (the platform's design springs on the thesis's length maps)
-    or a calibration file / embedded name."""
+    or a calibration file / embedded name; an unknown name is refused naming ``option`` and
+    every accepted name."""
     s = os.fspath(spec)
+    known = (*CALIBRATION_NAMES, *list_calibrations())
+    if s not in known and Path(s).suffix != ".toml" and not Path(s).exists():
+        raise InputError(f"{option}: unknown calibration {s!r}: expected one of "
+                         f"{', '.join(known)} or a TOML calibration file path")
     thesis = load_calibration("thesis")
     if s == "nominal":
         return NamedCalibration("nominal", nominal_calibration(platform, thesis.calibration))

@@ -37,7 +37,7 @@ from kinestat.control.controller import MAX_ITERATIONS, ControllerConfig, Proced
 from kinestat.control.envelope import Envelope, sent_command_guard
 from kinestat.control.follow import FollowConfig, decide_follow, follow_summary
 from kinestat.control.log import CycleLog, read_log
-from kinestat.control.loop import RunReport, run
+from kinestat.control.loop import RunReport, refuse, run
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Estimator
 from kinestat.devices.cell_io import MAX_SAMPLES, DeviceIO
@@ -45,7 +45,7 @@ from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import GalilClient
 from kinestat.devices.homing import is_homed
 from kinestat.devices.motion import MOVE_RULES, MoveRule
-from kinestat.errors import InputError, SafetyStop
+from kinestat.errors import InputError
 from kinestat.parallel.platform import Platform
 from kinestat.sim.contact import Cell, make_cell
 from kinestat.sim.sensor import Sensor
@@ -169,7 +169,8 @@ def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: 
     platform (default the prototype) with legs that follow ``truth`` (default
     ``settings.sim_legs``), the sensor reading counts through the truth's length maps."""
     platform = resolve_platform(None) if platform is None else platform
-    truth = resolve_calibration(settings.sim_legs, platform) if truth is None else truth
+    truth = (resolve_calibration(settings.sim_legs, platform, option="--sim-legs")
+             if truth is None else truth)
     legs = truth.calibration
     if settings.ideal_sensor:
         legs, = ideal_counts(legs)
@@ -266,7 +267,7 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
     header["platform"] = req.platform or "prototype"
     if isinstance(req.cell, SimulatedCell):
         s = req.cell
-        truth = resolve_calibration(s.sim_legs, platform)
+        truth = resolve_calibration(s.sim_legs, platform, option="--sim-legs")
         if s.ideal_sensor:  # the controller reads the same fine counts
             _, fine = ideal_counts(truth.calibration, cal.calibration)
             cal = NamedCalibration(cal.name, fine)
@@ -315,8 +316,7 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
                       "this controller session: run `kinestat home --galil "
                       f"{d.host}:{d.port}` first (or pass --assume-homed); nothing moved")
             with CycleLog(log_path) as cycle_log:
-                cycle_log.write({"type": "fault", "reason": reason, "action": "nothing sent"})
-            raise SafetyStop(reason)
+                return refuse(config, cycle_log, reason, extra_header=header)
         with EncoderReader(d.serial, fmt=d.serial_format) as reader:
             io = DeviceIO(client, reader, samples=req.samples, settle=0.1, **safety)
             with CycleLog(log_path) as cycle_log:

@@ -27,9 +27,11 @@ def run_home(host: str, port: int, log_path: Path, *, samples: int = 100,
         try:
             try:
                 client.connect()
-            except DeviceError as exc:
-                log.write({"type": "fault", "reason": str(exc), "action": "nothing sent"})
-                rep = HomingReport(False, f"device fault: {exc} (nothing sent)")
+            except (DeviceError, KeyboardInterrupt) as exc:  # incl. SIGTERM/SIGHUP (StopRequested)
+                why = (f"device fault: {exc}" if isinstance(exc, DeviceError) else
+                       f"stopped by {getattr(exc, 'signal_name', 'the user')} while connecting")
+                log.write({"type": "fault", "reason": why, "action": "nothing sent"})
+                rep = HomingReport(False, f"{why} (nothing sent)")
             else:
                 rep = home(client, samples=samples, motion_timeout=motion_timeout,
                            record=log.write)

@@ -28,7 +28,7 @@ from kinestat.devices.cell_io import DeviceIO, SensorSample
 from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.devices.motion import coordinated_move_plan
-from kinestat.errors import DeviceError, KinestatError
+from kinestat.errors import DeviceError, KinestatError, UnreachableError
 from kinestat.hardware.puma762_axes import (
     AXIS4_TO_5_COUPLING,
     AXIS_DEG_PER_COUNT,
@@ -44,7 +44,8 @@ from kinestat.sim.sensor import Sensor
 from kinestat.sim.surface import solve as solve_contact
 from kinestat.sim.surface import surface_normal
 
-__all__ = ["CellState", "SimHarness", "InProcessIO", "control_model", "start_counts"]
+__all__ = ["CellState", "SimHarness", "SimCheckedReader", "InProcessIO", "control_model",
+           "simulator_fault", "start_counts"]
 
 
 def control_model(cell: Cell, sensor: Sensor, *, coupling: float = AXIS4_TO_5_COUPLING,
@@ -92,8 +93,10 @@ class CellState:
                 return self._eq
             T = puma762.forward(q).pose
             try:
+                guess = (self._eq.top_pose if self._eq is not None and self._eq.in_contact
+                         else None)  # continuation along the robot's motion
                 eq = solve_contact(self.cell, T, anchor=self._anchor,
-                                   approach_from=self._free_tip)
+                                   approach_from=self._free_tip, top_pose_guess=guess)
             except KinestatError as exc:
                 self.error = exc
                 raise
@@ -234,8 +237,61 @@ class SimHarness:
         """A :class:`DeviceIO` through the real client and reader, with the truth attached."""
         kw.setdefault("truth", self.truth)
         kw.setdefault("settle", 2.5 / self.emitter.rate_hz)
-        return DeviceIO(self.client(client_timeout), self.reader(**(reader_options or {})),
-                        **kw)
+        reader = SimCheckedReader(self.reader(**(reader_options or {})), self.emitter)
+        return DeviceIO(self.client(client_timeout), reader, **kw)
+
+
+#: what a failed contact solve means for the run (docs/control.md, *The simulated cell*)
+LOAD_LIMIT_HINT = ("the tool was pushed beyond what the simulated platform can carry at this "
+                   "pose; ask for a smaller --force")
+
+
+def simulator_fault(err: BaseException) -> DeviceError:
+    """The error that stops the run when the simulated cell itself failed (e.g. no contact
+    equilibrium, a leg beyond its stroke): the simulator's own reason, not the stale stream it
+    leaves behind."""
+    hint = f"; {LOAD_LIMIT_HINT}" if isinstance(err, UnreachableError) else ""
+    return DeviceError(f"the simulated cell failed ({type(err).__name__}): {err}{hint}")
+
+
+class SimCheckedReader:
+    """An :class:`EncoderReader` on the emitter's pty that reports the emitter's error.
+
+    When the simulated cell raises inside the emitter's thread, the emitter keeps the error
+    and goes silent; the reader would see only stale data. Every read and poll checks the
+    emitter first (and again when the reader reports stale data) and raises
+    :func:`simulator_fault` with the real cause; the loop then stops the cell (ST, ``fault``
+    and ``end`` records). Everything else is the reader's.
+    """
+
+    def __init__(self, reader: EncoderReader, emitter: EncoderEmitter) -> None:
+        self._reader = reader
+        self._emitter = emitter
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._reader, name)
+
+    def _check(self) -> None:
+        err = self._emitter.error
+        if err is not None:
+            raise simulator_fault(err) from err
+
+    def _checked(self, fn, *args: Any, **kw: Any) -> Any:
+        self._check()
+        try:
+            return fn(*args, **kw)
+        except DeviceError:
+            self._check()
+            raise
+
+    def read(self, *args: Any, **kw: Any) -> Any:
+        return self._checked(self._reader.read, *args, **kw)
+
+    def poll(self) -> Any:
+        return self._checked(self._reader.poll)
+
+    def latest(self, *args: Any, **kw: Any) -> Any:
+        return self._checked(self._reader.latest, *args, **kw)
 
 
 class InProcessIO:

@@ -16,6 +16,8 @@ from typing import Any
 import typer
 from rich.markup import escape
 
+from kinestat.errors import InputError
+
 #: metavars: what a comma-separated option expects
 Q_METAVAR = "A,B,C,..."
 XYZ_METAVAR = "X,Y,Z"
@@ -74,3 +76,13 @@ def units(length: str | None = None, force: str | None = None) -> dict[str, str]
     if force is not None:
         out["force"] = force
     return {**out, "angle": "rad", "angle_deg_keys": "deg"}
+
+
+def check_seed(seed: int | None, option: str = "--seed") -> None:
+    """A random seed is a non-negative integer (NumPy's generators refuse others with a
+    ``ValueError``): refuse it as one usage error, before anything starts.
+
+    >>> check_seed(0); check_seed(None)
+    """
+    if seed is not None and seed < 0:
+        raise InputError(f"{option} must be a non-negative integer, got {seed}")

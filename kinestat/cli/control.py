@@ -24,7 +24,7 @@ from kinestat.app.control_defaults import (
     TASKS,
 )
 from kinestat.app.signals import stop_on_signals
-from kinestat.cli._options import flag
+from kinestat.cli._options import check_seed, flag
 from kinestat.cli._output import console as out_console
 from kinestat.cli._output import err_console, literal, parse_floats, print_json, table
 from kinestat.control.ceilings import MAX_ITERATIONS
@@ -260,11 +260,14 @@ def control_command(
 
     JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
     tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
-    torque_about_tool, torque_about_base (N·mm, fixed frame), procedure, calibration, cycles;
-    with --task follow also task, completed, travel, normal_force_rms_error,
-    normal_force_max_error, contact_lost (and the true errors, simulated).
+    torque_about_tool, torque_about_base (N·mm, fixed frame), equivalent_force (the
+    equivalent wrench's force, N: base − tool torque = tool_point × it), procedure,
+    calibration, cycles; with --task follow also task, completed, travel,
+    normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
+    simulated).
     """
     _check_counts(samples, max_iterations)
+    check_seed(seed)
     _check_plot_dir(plot, no_plot)
     d = parse_floats(direction, 3, "direction")
     if np.linalg.norm(d) == 0:
@@ -373,9 +376,11 @@ def _print_report(out: dict) -> None:
                           + ("n/a" if rms is None else f"RMS {rms:.4f} N, max {mx:.4f} N")
                           + f"; contact lost {out['contact_lost']} cycles")
     rows = []
-    for key, label in (("force", "force (N)"),
-                       ("torque_about_tool", "torque about tool point (N·mm)"),
-                       ("torque_about_base", "torque about robot base (N·mm)"),
+    # the equivalent wrench's force beside its torques: base − tool = tool_point × that force
+    for key, label in (("force", f"force, {out.get('estimator', 'point')} estimate (N)"),
+                       ("equivalent_force", "equivalent wrench: force (N)"),
+                       ("torque_about_tool", "  torque about tool point (N·mm)"),
+                       ("torque_about_base", "  torque about robot base (N·mm)"),
                        ("true_force", "true force (N)"), ("tool_axis", "tool axis S6"),
                        ("tool_point", "tool point (mm)")):
         if out.get(key) is not None:

@@ -12,9 +12,13 @@ from pathlib import Path
 import typer
 
 from kinestat.app.homing_run import run_home
+from kinestat.app.signals import stop_on_signals
 from kinestat.cli._options import flag
-from kinestat.cli._output import console, err_console, print_json
+from kinestat.cli._output import console, print_json
 from kinestat.errors import InputError, KinestatError
+
+MAX_SAMPLES = 1000
+"""Ceiling of ``--samples`` (pot readings averaged per axis), as ``kinestat control``'s."""
 
 
 def register(app: typer.Typer) -> None:
@@ -31,8 +35,8 @@ def _host_port(text: str) -> tuple[str, int]:
 def home_command(
     galil: str = typer.Option(..., "--galil", help="Galil controller HOST:PORT (a real DMC "
                               "or `kinestat sim galil`).", metavar="HOST:PORT"),
-    samples: int = typer.Option(100, "--samples", help="Pot readings averaged per axis.",
-                                metavar="N"),
+    samples: int = typer.Option(100, "--samples", help=f"Pot readings averaged per axis, "
+                                f"1..{MAX_SAMPLES}.", metavar="N"),
     log: Path = typer.Option(None, "--log", help="Step log, JSON lines (default: "
                              "./kinestat-runs/home-<timestamp>.jsonl).", metavar="FILE"),
     as_json: bool = flag(False, "--json", help="Print the report as JSON."),
@@ -43,17 +47,18 @@ def home_command(
     JSON keys: homed, axes, stop_reason, elapsed_s, log.
     """
     host, port = _host_port(galil)
-    if samples < 1:
-        raise InputError(f"--samples must be at least 1, got {samples}")
+    if not 1 <= samples <= MAX_SAMPLES:
+        raise InputError(f"--samples must be in 1..{MAX_SAMPLES}, got {samples}")
     log_path = log or Path("kinestat-runs") / f"home-{time.strftime('%Y%m%d-%H%M%S')}.jsonl"
-    rep = run_home(host, port, log_path, samples=samples)
+    with stop_on_signals():  # SIGTERM and SIGHUP stop the robot (ST, MO) as Ctrl-C does
+        rep = run_home(host, port, log_path, samples=samples)
     out = rep.as_dict()
     out["log"] = str(log_path)
     if as_json:
         print_json(out)
     else:
-        ok = "[green]homed[/]" if rep.homed else "[red]not homed[/]"
-        console.print(f"PUMA {ok}: {rep.stop_reason}")
+        if rep.homed:  # a failure's reason is printed once, as the error line below
+            console.print(f"PUMA [green]homed[/]: {rep.stop_reason}")
         for ax in rep.axes:
             if "pot_volts" in ax:
                 console.print(f"  axis {ax['axis']}: pot {ax['pot_volts']:.4f} V, coarse move "
@@ -61,5 +66,4 @@ def home_command(
                               + (f", now {ax['position']}" if "position" in ax else ""))
         console.print(f"log: {log_path}")
     if not rep.homed:
-        err_console.print(f"[red]not homed[/]: {rep.stop_reason}")
         raise KinestatError(f"not homed: {rep.stop_reason}")

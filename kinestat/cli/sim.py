@@ -11,6 +11,7 @@ import numpy as np
 import typer
 
 from kinestat.app.signals import stop_on_signals
+from kinestat.cli._options import check_seed
 from kinestat.cli._output import console, literal, parse_floats, print_json
 from kinestat.errors import InputError
 from kinestat.hardware.encoder_packets import (
@@ -91,6 +92,7 @@ def galil(
 ) -> None:
     """Run a simulated Galil DMC (six axes, trapezoidal profiles) until Ctrl-C."""
     _check_duration(duration)
+    check_seed(seed)
     c0 = _int_counts(initial_counts, "initial-counts")
     kw = {"coupling": 0.0} if no_coupling else {}
     if seed is not None:

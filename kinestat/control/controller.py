@@ -45,6 +45,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from kinestat.control.approach import approach_waypoints, check_approach
 from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.control.envelope import (
     Envelope,
@@ -287,6 +288,8 @@ class Command:
         info: task-specific figures of the cycle for the report's ``cycles`` (the follow
             task's phase, measured tip, normal estimate, normal force, travel); empty for the
             press task.
+        waypoints: for the start move, the intermediate axis counts commanded before
+            ``axis_counts`` (:func:`kinestat.control.approach.approach_waypoints`).
     """
 
     kind: CommandKind
@@ -304,6 +307,7 @@ class Command:
     prediction: Prediction | None = None
     violations: tuple[str, ...] = ()
     info: dict = field(default_factory=dict)
+    waypoints: tuple[np.ndarray, ...] = ()
 
 
 # -- joint-space helpers ------------------------------------------------------------------------
@@ -391,13 +395,15 @@ def start(config: ControllerConfig, q_now, *, counts_now=None) -> tuple[Command,
         msg = f"the start pose cannot be commanded: {exc}"
         return Command(kind="stop", label="", reason=msg), replace(state, done=True)
     axis_deg = counts * model.axis_deg_per_count
-    now_deg = counts_now * model.axis_deg_per_count
-    bad = check_command(config.envelope, model, axis_deg, now_deg, None)
+    # a long move goes as a sequence of commands, each within the per-command step
+    wps = approach_waypoints(config.envelope, model, counts_now, counts)
+    bad = check_approach(config.envelope, model, counts_now, wps)
     if bad:
         return (Command(kind="stop", label="", reason="start move: " + "; ".join(bad),
                         violations=tuple(bad)), replace(state, done=True))
     cmd = Command(kind="move", label="", action="start", target=target, axis_counts=counts,
-                  axis_deg=axis_deg, q=axis_counts_to_q(model, counts))
+                  axis_deg=axis_deg, q=axis_counts_to_q(model, counts),
+                  waypoints=tuple(wps[:-1]))
     return cmd, replace(state, axis_counts=counts, history=(target.key(),))
 
 

@@ -20,7 +20,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Protocol
 
 import numpy as np
@@ -41,7 +41,7 @@ from kinestat.control.procedure import decide_thesis
 from kinestat.control.wrench import Estimator, Measurement, measure
 from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
 
-__all__ = ["SensorReading", "CellIO", "RunReport", "run"]
+__all__ = ["SensorReading", "CellIO", "RunReport", "refuse", "run"]
 
 
 class SensorReading(Protocol):
@@ -143,6 +143,8 @@ class RunReport:
             "faults": list(self.faults),
             "estimator": self.estimator,
             "equivalent_wrench": arr(self.equivalent_wrench),
+            "equivalent_force": (None if self.equivalent_wrench is None
+                                 else arr(self.equivalent_wrench[:3])),
             "torque_about_tool": arr(self.torque_about_tool),
             "torque_about_base": arr(self.torque_about_base),
             "procedure": self.procedure,
@@ -271,11 +273,7 @@ def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
     why. Every cycle is written to ``log`` before its command is sent.
     """
     r = _Run(t0=time.monotonic(), decide_fn=decide_fn)
-    header = {"type": "start", "time": time.strftime("%Y-%m-%dT%H:%M:%S"),
-              "config": _config_record(config)}
-    if extra_header:
-        header.update(extra_header)
-    log.write(header)
+    log.write(_start_record(config, extra_header))
     try:
         _start_move(config, io, log, r)
         while not _cycle(config, io, log, r, progress):
@@ -287,6 +285,26 @@ def run(config: ControllerConfig, io: CellIO, log: CycleLog, *,
                               r.t0)
         _once_more_if_interrupted(_finish, config, r, log)
         raise
+    return _once_more_if_interrupted(_finish, config, r, log)
+
+
+def _start_record(config: ControllerConfig, extra_header: dict | None) -> dict:
+    header = {"type": "start", "time": time.strftime("%Y-%m-%dT%H:%M:%S"),
+              "config": _config_record(config)}
+    if extra_header:
+        header.update(extra_header)
+    return header
+
+
+def refuse(config: ControllerConfig, log: CycleLog, reason: str, *,
+           extra_header: dict | None = None) -> RunReport:
+    """A run refused before anything was sent (e.g. an unhomed robot): the log still gets its
+    ``start``, a ``fault`` (action "nothing sent") and the ``end`` record with the report."""
+    r = _Run(t0=time.monotonic())
+    log.write(_start_record(config, extra_header))
+    r.faults.append(reason)
+    log.write({"type": "fault", "t": r.t(), "reason": reason, "action": "nothing sent"})
+    r.reason = reason
     return _once_more_if_interrupted(_finish, config, r, log)
 
 
@@ -308,6 +326,12 @@ def _start_move(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run) ->
                "reason": cmd.reason, "commanded": _cmd_record(cmd)})
     if cmd.kind == "stop":
         raise SafetyStop(cmd.reason)
+    n = len(cmd.waypoints) + 1
+    for k, wp in enumerate(cmd.waypoints, 1):  # a long start move, one command at a time
+        log.write({"type": "approach", "cycle": 0, "t": r.t(), "waypoint": k, "of": n,
+                   "axis_counts": np.asarray(wp).tolist(),
+                   "axis_deg": (np.asarray(wp) * config.model.axis_deg_per_count).tolist()})
+        _move(io, log, replace(cmd, axis_counts=np.asarray(wp)), 0, r)
     _move(io, log, cmd, 0, r)
 
 

@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kinestat.devices.galil import GalilClient, GalilCommandError
-from kinestat.errors import DeviceError, KinestatError, SafetyStop
+from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
 from kinestat.hardware.puma762_axes import AXES
 from kinestat.hardware.puma762_homing import (
     COARSE_ACCEL,
@@ -194,7 +194,8 @@ def home(client: GalilClient, *, samples: int = 100, max_coarse: float = 60000.0
         rec({"type": "homed", "positions": tp.tolist()})
         return HomingReport(True, reason, axes, time.monotonic() - t0)
     except (KinestatError, KeyboardInterrupt) as exc:
-        why = ("interrupted by the user" if isinstance(exc, KeyboardInterrupt) else
+        why = (f"stopped by {exc.signal_name}" if isinstance(exc, StopRequested) else
+               "interrupted by the user" if isinstance(exc, KeyboardInterrupt) else
                str(exc) if isinstance(exc, SafetyStop) else
                f"{'device fault' if isinstance(exc, DeviceError) else type(exc).__name__}: {exc}")
         done = _amplifiers_off(client)

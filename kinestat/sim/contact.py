@@ -394,6 +394,7 @@ def equilibrium(
     approach_from=None,
     tol: float = 1e-9,
     max_iter: int = 30,
+    top_pose_guess=None,
 ) -> Equilibrium:
     """Solve the contact equilibrium of the top platform at ``flange_pose`` (``F_6T``).
 
@@ -401,6 +402,12 @@ def equilibrium(
     contact before). ``approach_from`` is the previous unloaded tip position (fixed frame):
     when the tip first touches, the anchor is where the segment from it to the current
     unloaded tip crosses the plane (else the projection of the unloaded tip onto the plane).
+
+    ``top_pose_guess`` (the previous solution's ``top_pose``, base frame) is a second start
+    for the frictionless Newton when the one from the unloaded pose fails: continuation
+    along the robot's motion. Far from the unloaded pose (e.g. 16 mm into the workpiece along
+    the thesis's direction, where the force flattens as the top turns) Newton from the
+    unloaded pose misses equilibria that exist.
 
     Raises:
         UnreachableError: no equilibrium (Newton failed), or one that needs a leg deflection
@@ -445,6 +452,10 @@ def equilibrium(
         # the sticking solution would pull: contact released, fall back to frictionless
     X, lam, res, gap, it = _solve_frictionless(cell, nB, cB, home, tol, max_iter)
     iters += it
+    if not (res <= tol and gap <= tol) and top_pose_guess is not None:
+        guess = np.asarray(top_pose_guess, dtype=float)
+        X, lam, res, gap, it = _solve_frictionless(cell, nB, cB, guess, tol, max_iter)
+        iters += it
     if not (res <= tol and gap <= tol):
         raise UnreachableError(
             f"simulated cell: no frictionless contact equilibrium found (wrench residual "

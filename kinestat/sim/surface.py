@@ -126,23 +126,26 @@ def surface_normal(workpiece, point) -> np.ndarray:
     return workpiece.normal_at(point)
 
 
-def solve(cell: Cell, flange_pose, *, anchor=None, approach_from=None) -> Equilibrium:
+def solve(cell: Cell, flange_pose, *, anchor=None, approach_from=None,
+          top_pose_guess=None) -> Equilibrium:
     """Contact equilibrium of ``cell`` at ``flange_pose`` for a plane or a cylinder workpiece.
 
     A plane: :func:`kinestat.sim.contact.equilibrium` itself. A cylinder: the plane's
     equilibrium on the tangent plane at the contact point, repeated until the tip lies on the
-    cylinder (module docstring). ``anchor``/``approach_from`` as for the plane.
+    cylinder (module docstring). ``anchor``/``approach_from``/``top_pose_guess`` (the previous
+    solution, for continuation along the robot's motion) as for the plane.
     """
     wp = cell.workpiece
     if isinstance(wp, Workpiece):
-        return equilibrium(cell, flange_pose, anchor=anchor, approach_from=approach_from)
+        return equilibrium(cell, flange_pose, anchor=anchor, approach_from=approach_from,
+                           top_pose_guess=top_pose_guess)
     q = unloaded_tip(cell, flange_pose) if anchor is None else np.asarray(anchor, dtype=float)
     hist: list[float] = []
     prev = None
     for _ in range(_FIXED_POINT_ITER):
         plane = wp.tangent_plane(q)
         eq = equilibrium(replace(cell, workpiece=plane), flange_pose, anchor=anchor,
-                         approach_from=approach_from)
+                         approach_from=approach_from, top_pose_guess=top_pose_guess)
         if not eq.in_contact:
             return eq
         hist.append(float(np.linalg.norm(wp.project(eq.tip) - plane.point)))

@@ -103,3 +103,21 @@ def test_cli_home_and_control_refuses_an_unhomed_robot(tmp_path, capsys):
                      str(tmp_path / "h2.jsonl")])
         out = _json(capsys)
         assert code == 2 and out["homed"] is False and "input 3" in out["stop_reason"]
+
+
+def test_the_unhomed_refusal_logs_start_fault_end_and_prints_json(tmp_path, capsys):
+    sim = _sim(13, record=True)
+    log = tmp_path / "c.jsonl"
+    with GalilSimServer(controller=sim) as srv:
+        code = main(["control", "--galil", f"127.0.0.1:{srv.port}", "--serial", "/dev/null",
+                     "--no-plot", "--json", "--log", str(log)])
+    cap = capsys.readouterr()
+    assert code == 2 and "not homed" in cap.err
+    out = json.loads(cap.out[cap.out.index("{"):])
+    assert out["converged"] is False and "not homed" in out["stop_reason"]
+    assert out["iterations"] == 0 and out["moves"] == 0
+    recs = read_log(log)
+    assert [r["type"] for r in recs] == ["start", "fault", "end"]
+    assert recs[1]["action"] == "nothing sent" and "not homed" in recs[1]["reason"]
+    assert recs[2]["report"]["stop_reason"] == out["stop_reason"]
+    assert not any(c.startswith(("BG", "PA", "PR")) for c in sim.commands)
