@@ -55,8 +55,25 @@ def register(app: typer.Typer) -> None:
     app.add_typer(sweep_app, name="sweep")
 
 
-def _run(study_name: str, spec: dict, *, output, scheduler, workers, threads, timeout,
-         max_chunks, no_plots, quiet, as_json) -> None:
+#: the options every study command takes for running it (see :func:`_run`)
+_RUN_OPTIONS = ("output", "scheduler", "workers", "threads", "timeout", "max_chunks",
+                "no_plots", "quiet", "as_json")
+
+
+def _run(study_name: str, spec: dict, options: dict) -> None:
+    """Run the study and print its summary; ``options`` holds the command's parameters (its
+    ``locals()``), of which the run options :data:`_RUN_OPTIONS` are used."""
+    _run_study(study_name, spec, **{k: options[k] for k in _RUN_OPTIONS})
+
+
+def _ranges(range_mm: str, range_deg: str) -> dict:
+    """``--range-mm`` and ``--range-deg`` as the spec builders' ``range_mm``/``range_deg``."""
+    return {"range_mm": parse_floats(range_mm, 3, "range-mm"),
+            "range_deg": parse_floats(range_deg, 3, "range-deg")}
+
+
+def _run_study(study_name: str, spec: dict, *, output, scheduler, workers, threads, timeout,
+               max_chunks, no_plots, quiet, as_json) -> None:
     from kinestat.studies.base import build_study  # lazy: start-up (the studies load Dask)
     from kinestat.studies.engine import run_study  # lazy: start-up (the studies load Dask)
 
@@ -123,9 +140,7 @@ def workspace_command(
     spec = workspace_spec(model, grid=grid, samples=_samples_default(grid, samples, 100_000),
                           seed=seed, chunk_size=chunk_size or DEFAULT_CHUNK, task=task,
                           arrays=not no_arrays)
-    _run("workspace", spec, output=output, scheduler=scheduler, workers=workers,
-         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
-         quiet=quiet, as_json=as_json)
+    _run("workspace", spec, locals())
 
 
 @sweep_app.command("platform-range")
@@ -154,12 +169,10 @@ def platform_range_command(
 
     spec = platform_range_spec(
         platform, grid=grid, samples=_samples_default(grid, samples, 20_000), seed=seed,
-        range_mm=parse_floats(range_mm, 3, "range-mm"),
-        range_deg=parse_floats(range_deg, 3, "range-deg"), max_deflection=max_deflection,
-        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays)
-    _run("platform-range", spec, output=output, scheduler=scheduler, workers=workers,
-         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
-         quiet=quiet, as_json=as_json)
+        max_deflection=max_deflection, max_load=max_load,
+        chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays,
+        **_ranges(range_mm, range_deg))
+    _run("platform-range", spec, locals())
 
 
 @sweep_app.command("platform-design")
@@ -201,12 +214,10 @@ def platform_design_command(
              "stiffness": stiffness}
     spec = platform_design_spec(
         platform, values={k: v for k, v in given.items() if v is not None}, grid=grid,
-        samples=samples, seed=seed, poses=poses, range_mm=parse_floats(range_mm, 3, "range-mm"),
-        range_deg=parse_floats(range_deg, 3, "range-deg"), max_deflection=max_deflection,
-        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays)
-    _run("platform-design", spec, output=output, scheduler=scheduler, workers=workers,
-         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
-         quiet=quiet, as_json=as_json)
+        samples=samples, seed=seed, poses=poses, max_deflection=max_deflection,
+        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays,
+        **_ranges(range_mm, range_deg))
+    _run("platform-design", spec, locals())
 
 
 @sweep_app.command("tolerance")
@@ -237,9 +248,6 @@ def tolerance_command(
 
     spec = tolerance_spec(platform, samples=samples, seed=seed, sigma_mount=sigma_mount,
                           sigma_k=sigma_k, sigma_offset=sigma_offset,
-                          range_mm=parse_floats(range_mm, 3, "range-mm"),
-                          range_deg=parse_floats(range_deg, 3, "range-deg"),
-                          chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays)
-    _run("tolerance", spec, output=output, scheduler=scheduler, workers=workers,
-         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
-         quiet=quiet, as_json=as_json)
+                          chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays,
+                          **_ranges(range_mm, range_deg))
+    _run("tolerance", spec, locals())
