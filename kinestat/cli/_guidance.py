@@ -8,6 +8,7 @@ import math
 from typing import TYPE_CHECKING
 
 import numpy as np
+import typer
 from rich.console import Console
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn
 
@@ -55,9 +56,21 @@ def singular_mode(text: str, damped: bool) -> str:
 @contextlib.contextmanager
 def progress_reporter(enabled: bool = True, console_err: Console | None = None):
     """A ``progress(done, total)`` callback drawing a rich progress bar on stderr when stderr
-    is a terminal (None otherwise)."""
+    is a terminal (None otherwise). Ctrl-C inside ends the command with one line saying where
+    the run was (``kinestat: interrupted: …``) and status 130, no traceback."""
     con = err_console if console_err is None else console_err
-    if not (enabled and con.is_terminal):
+    try:
+        with _bar(enabled and con.is_terminal, con) as update:
+            yield update
+    except KeyboardInterrupt as exc:  # Typer would turn it into a silent exit 130
+        where = " ".join(str(exc).split())
+        typer.echo(f"kinestat: interrupted{': ' + where if where else ''}", err=True)
+        raise typer.Exit(130) from None
+
+
+@contextlib.contextmanager
+def _bar(enabled: bool, con: Console):
+    if not enabled:
         yield None
         return
     with Progress(TextColumn("guidance"), BarColumn(), MofNCompleteColumn(),

@@ -245,12 +245,13 @@ def _print_closed_form(out: dict, res, has_current: bool) -> None:
 def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits,
                as_json) -> None:
     import kinestat  # lazy: pulls in numba and scipy; keeps `kinestat --help` fast
-    from kinestat.serial.ik import ik  # lazy: as above
+    from kinestat.serial.ik import MAX_ITER, MAX_RESTARTS, ik  # lazy: as above
 
-    if restarts < 0:
-        raise InputError(f"--restarts must be 0 or more, got {restarts}")
-    if max_iter < 1:
-        raise InputError(f"--max-iter must be at least 1, got {max_iter}")
+    if not 0 <= restarts <= MAX_RESTARTS:
+        raise InputError(f"--restarts must be 0 or more and at most {MAX_RESTARTS}, got {restarts}")
+    if not 1 <= max_iter <= MAX_ITER:
+        shown = max_iter if len(str(max_iter)) <= 40 else f"{len(str(max_iter))} digits"
+        raise InputError(f"--max-iter must be at least 1 and at most {MAX_ITER}, got {shown}")
     m = kinestat.load(model_name)
     T = _read_poses(pose)
     q0 = None

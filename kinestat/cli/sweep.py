@@ -11,6 +11,10 @@ docs/sweeps.md.
 
 from __future__ import annotations
 
+import functools
+import inspect
+from collections.abc import Callable
+
 import typer
 
 from kinestat.cli._options import XYZ_METAVAR, flag
@@ -55,6 +59,47 @@ def register(app: typer.Typer) -> None:
     app.add_typer(sweep_app, name="sweep")
 
 
+#: the options every study command takes after its own, with their types (Typer has no shared
+#: option groups: :func:`_study_command` adds them to each command's signature)
+_COMMON = (("chunk_size", int, CHUNK), ("output", str, OUTPUT), ("scheduler", str, SCHEDULER),
+           ("workers", int, WORKERS), ("threads", bool, THREADS), ("timeout", float, TIMEOUT),
+           ("max_chunks", int, MAX_CHUNKS), ("no_arrays", bool, NO_ARRAYS),
+           ("no_plots", bool, NO_PLOTS), ("quiet", bool, QUIET), ("as_json", bool, JSON))
+#: the common options that say how to run the study (the others shape its spec)
+_RUN_OPTIONS = ("output", "scheduler", "workers", "threads", "timeout", "max_chunks",
+                "no_plots", "quiet", "as_json")
+
+
+def _study_command(name: str):
+    """Register ``build`` as ``kinestat sweep NAME``: ``build`` takes the command's own options
+    plus ``chunk_size`` (None: the study's default) and ``arrays``, and returns the study's
+    spec; the command also takes the common options (:data:`_COMMON`) and runs the spec."""
+
+    def register_build(build: Callable[..., dict]):
+        own = [p for p in inspect.signature(build, eval_str=True).parameters.values()
+               if p.name not in ("chunk_size", "arrays")]
+        common = [inspect.Parameter(n, inspect.Parameter.KEYWORD_ONLY, default=d, annotation=t)
+                  for n, t, d in _COMMON]
+
+        @functools.wraps(build)
+        def command(**options) -> None:
+            run = {k: options.pop(k) for k in _RUN_OPTIONS}
+            arrays = not options.pop("no_arrays")
+            _run(name, build(**options, arrays=arrays), **run)
+
+        command.__signature__ = inspect.Signature([*own, *common], return_annotation=None)
+        command.__annotations__ = {p.name: p.annotation for p in (*own, *common)}
+        return sweep_app.command(name)(command)
+
+    return register_build
+
+
+def _ranges(range_mm: str, range_deg: str) -> dict:
+    """``--range-mm`` and ``--range-deg`` as the spec builders' ``range_mm``/``range_deg``."""
+    return {"range_mm": parse_floats(range_mm, 3, "range-mm"),
+            "range_deg": parse_floats(range_deg, 3, "range-deg")}
+
+
 def _run(study_name: str, spec: dict, *, output, scheduler, workers, threads, timeout,
          max_chunks, no_plots, quiet, as_json) -> None:
     from kinestat.studies.base import build_study  # lazy: start-up (the studies load Dask)
@@ -96,7 +141,7 @@ def _samples_default(grid, samples, default):
     return default if grid is None and samples is None else samples
 
 
-@sweep_app.command("workspace")
+@_study_command("workspace")
 def workspace_command(
     model: str = typer.Option("puma762", "--model", help="Embedded model name or TOML file."),
     grid: int = typer.Option(None, "--grid", help="N values per joint over its limits."),
@@ -105,11 +150,8 @@ def workspace_command(
     seed: int = SEED,
     task: str = typer.Option("auto", "--task", help="Jacobian rows for manipulability/"
                              "condition: auto, full, position, planar."),
-    chunk_size: int = CHUNK, output: str = OUTPUT, scheduler: str = SCHEDULER,
-    workers: int = WORKERS, threads: bool = THREADS, timeout: float = TIMEOUT,
-    max_chunks: int = MAX_CHUNKS, no_arrays: bool = NO_ARRAYS, no_plots: bool = NO_PLOTS,
-    quiet: bool = QUIET, as_json: bool = JSON,
-) -> None:
+    chunk_size: int | None = None, arrays: bool = True,
+) -> dict:
     """Workspace and dexterity of an arm: reach, Yoshikawa manipulability, condition number.
 
     Summary: points, reach_max, reach_min (distance of the end point from the base origin),
@@ -120,15 +162,12 @@ def workspace_command(
         workspace_spec,
     )
 
-    spec = workspace_spec(model, grid=grid, samples=_samples_default(grid, samples, 100_000),
+    return workspace_spec(model, grid=grid, samples=_samples_default(grid, samples, 100_000),
                           seed=seed, chunk_size=chunk_size or DEFAULT_CHUNK, task=task,
-                          arrays=not no_arrays)
-    _run("workspace", spec, output=output, scheduler=scheduler, workers=workers,
-         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
-         quiet=quiet, as_json=as_json)
+                          arrays=arrays)
 
 
-@sweep_app.command("platform-range")
+@_study_command("platform-range")
 def platform_range_command(
     platform: str = PLATFORM,
     grid: int = typer.Option(None, "--grid", help="N values per axis over the motion range."),
@@ -136,11 +175,8 @@ def platform_range_command(
                                 "--grid)."),
     seed: int = SEED, range_mm: str = RANGE_MM, range_deg: str = RANGE_DEG,
     max_deflection: float = MAX_DEFL, max_load: float = MAX_LOAD,
-    chunk_size: int = CHUNK, output: str = OUTPUT, scheduler: str = SCHEDULER,
-    workers: int = WORKERS, threads: bool = THREADS, timeout: float = TIMEOUT,
-    max_chunks: int = MAX_CHUNKS, no_arrays: bool = NO_ARRAYS, no_plots: bool = NO_PLOTS,
-    quiet: bool = QUIET, as_json: bool = JSON,
-) -> None:
+    chunk_size: int | None = None, arrays: bool = True,
+) -> dict:
     """The platform over its working range: leg deflections/forces, load, stiffness, singularity.
 
     Summary: poses, within_deflection, within_load, within_both, fraction_within, statistics of
@@ -152,17 +188,14 @@ def platform_range_command(
         platform_range_spec,
     )
 
-    spec = platform_range_spec(
+    return platform_range_spec(
         platform, grid=grid, samples=_samples_default(grid, samples, 20_000), seed=seed,
-        range_mm=parse_floats(range_mm, 3, "range-mm"),
-        range_deg=parse_floats(range_deg, 3, "range-deg"), max_deflection=max_deflection,
-        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays)
-    _run("platform-range", spec, output=output, scheduler=scheduler, workers=workers,
-         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
-         quiet=quiet, as_json=as_json)
+        max_deflection=max_deflection, max_load=max_load,
+        chunk_size=chunk_size or DEFAULT_CHUNK, arrays=arrays,
+        **_ranges(range_mm, range_deg))
 
 
-@sweep_app.command("platform-design")
+@_study_command("platform-design")
 def platform_design_command(
     platform: str = PLATFORM,
     base_side: str = typer.Option(None, "--base-side", help="Base triangle side(s): v, "
@@ -180,11 +213,8 @@ def platform_design_command(
     poses: int = typer.Option(256, "--poses", help="Random poses in the range per design."),
     range_mm: str = RANGE_MM, range_deg: str = RANGE_DEG,
     max_deflection: float = MAX_DEFL, max_load: float = MAX_LOAD,
-    chunk_size: int = CHUNK, output: str = OUTPUT, scheduler: str = SCHEDULER,
-    workers: int = WORKERS, threads: bool = THREADS, timeout: float = TIMEOUT,
-    max_chunks: int = MAX_CHUNKS, no_arrays: bool = NO_ARRAYS, no_plots: bool = NO_PLOTS,
-    quiet: bool = QUIET, as_json: bool = JSON,
-) -> None:
+    chunk_size: int | None = None, arrays: bool = True,
+) -> dict:
     """Special 6-6 designs scored on Vibhute Table 3-1 (unswept parameters: the --platform's).
 
     Summary: designs, valid, meets_spec, fraction_within {min, mean, max}, min_singularity,
@@ -199,17 +229,14 @@ def platform_design_command(
     given = {"base_side": base_side, "top_side": top_side, "base_offset": base_offset,
              "top_offset": top_offset, "height": height, "twist_deg": twist_deg,
              "stiffness": stiffness}
-    spec = platform_design_spec(
+    return platform_design_spec(
         platform, values={k: v for k, v in given.items() if v is not None}, grid=grid,
-        samples=samples, seed=seed, poses=poses, range_mm=parse_floats(range_mm, 3, "range-mm"),
-        range_deg=parse_floats(range_deg, 3, "range-deg"), max_deflection=max_deflection,
-        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays)
-    _run("platform-design", spec, output=output, scheduler=scheduler, workers=workers,
-         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
-         quiet=quiet, as_json=as_json)
+        samples=samples, seed=seed, poses=poses, max_deflection=max_deflection,
+        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=arrays,
+        **_ranges(range_mm, range_deg))
 
 
-@sweep_app.command("tolerance")
+@_study_command("tolerance")
 def tolerance_command(
     platform: str = PLATFORM,
     samples: int = typer.Option(10_000, "--samples", help="Monte-Carlo samples."),
@@ -220,11 +247,8 @@ def tolerance_command(
     sigma_offset: float = typer.Option(0.01, "--sigma-offset", help="Encoder zero error per "
                                        "leg (length unit)."),
     range_mm: str = RANGE_MM, range_deg: str = RANGE_DEG,
-    chunk_size: int = CHUNK, output: str = OUTPUT, scheduler: str = SCHEDULER,
-    workers: int = WORKERS, threads: bool = THREADS, timeout: float = TIMEOUT,
-    max_chunks: int = MAX_CHUNKS, no_arrays: bool = NO_ARRAYS, no_plots: bool = NO_PLOTS,
-    quiet: bool = QUIET, as_json: bool = JSON,
-) -> None:
+    chunk_size: int | None = None, arrays: bool = True,
+) -> dict:
     """Monte-Carlo of mounting and calibration errors -> error of the measured wrench.
 
     Summary: samples, failed, force_error and torque_error {mean, rms, max} (torque about the
@@ -235,11 +259,7 @@ def tolerance_command(
         tolerance_spec,
     )
 
-    spec = tolerance_spec(platform, samples=samples, seed=seed, sigma_mount=sigma_mount,
+    return tolerance_spec(platform, samples=samples, seed=seed, sigma_mount=sigma_mount,
                           sigma_k=sigma_k, sigma_offset=sigma_offset,
-                          range_mm=parse_floats(range_mm, 3, "range-mm"),
-                          range_deg=parse_floats(range_deg, 3, "range-deg"),
-                          chunk_size=chunk_size or DEFAULT_CHUNK, arrays=not no_arrays)
-    _run("tolerance", spec, output=output, scheduler=scheduler, workers=workers,
-         threads=threads, timeout=timeout, max_chunks=max_chunks, no_plots=no_plots,
-         quiet=quiet, as_json=as_json)
+                          chunk_size=chunk_size or DEFAULT_CHUNK, arrays=arrays,
+                          **_ranges(range_mm, range_deg))

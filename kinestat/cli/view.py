@@ -44,16 +44,21 @@ def register(app: typer.Typer) -> None:
 class _Out:
     """The output options every view command takes."""
 
-    def __init__(self, html: Path | None, serve: bool, host: str, port: int, no_open: bool):
+    def __init__(self, html: Path | None, serve: bool, host: str, port: int, no_open: bool,
+                 allow_remote: bool = False):
         self.html, self.serve, self.host, self.port, self.no_open = html, serve, host, port, no_open
+        self.allow_remote = allow_remote
 
 
-def _out_options(html: Path | None, serve: bool, host: str, port: int, no_open: bool) -> _Out:
+def _out_options(html: Path | None, serve: bool, host: str, port: int, no_open: bool,
+                 allow_remote: bool = False) -> _Out:
     if html is not None and serve:
         raise InputError("give either --html FILE or --serve, not both")
     if not 0 <= port <= 65535:
         raise InputError(f"--port must be 0..65535, got {port}")
-    return _Out(html, serve, host, port, no_open)
+    if allow_remote and not serve:
+        raise InputError("--allow-remote goes with --serve")
+    return _Out(html, serve, host, port, no_open, allow_remote)
 
 
 def _emit(scene: dict, out: _Out, model=None) -> None:
@@ -64,7 +69,8 @@ def _emit(scene: dict, out: _Out, model=None) -> None:
         # lazy: the HTTP server and IK only with --serve
         from kinestat.viz.serve import make_server
 
-        srv = make_server(scene, host=out.host, port=out.port, model=model)
+        srv = make_server(scene, host=out.host, port=out.port, model=model,
+                          allow_remote=out.allow_remote)
         host, port = srv.server_address[:2]
         url = f"http://{host}:{port}/"
         console.print(f"kinestat view: serving {url} (Ctrl-C stops)")
@@ -110,6 +116,11 @@ def _host_opt():
                         metavar="HOST")
 
 
+def _allow_remote_opt():
+    return flag(False, "--allow-remote", help="With --serve: allow a non-loopback --host (the "
+                "server answers IK to anyone who can reach it).")
+
+
 def _port_opt():
     return typer.Option(0, "--port", help="Port to serve on (0: a free one, printed).",
                         metavar="PORT")
@@ -125,19 +136,20 @@ def view_root(
     log: Path = typer.Option(None, "--log", help="Replay a control run's cycle log "
                              "(same as `kinestat view log FILE`).", metavar="FILE"),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
-    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+    allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),
+    no_open: bool = _no_open_opt(),
 ) -> None:
     """3D views in the browser (three.js): model, platform, screw, disp, log."""
     if ctx.invoked_subcommand is not None:
         if log is not None or html is not None or serve or port != 0 or no_open \
-                or host != "127.0.0.1":
+                or host != "127.0.0.1" or allow_remote:
             raise InputError(f"put the options after the view's name, e.g. kinestat view "
                              f"{ctx.invoked_subcommand} … --html FILE (--log goes alone)")
         return
     if log is None:
         raise InputError("give a view (model, platform, screw, disp, log) or --log FILE; "
                          "see kinestat view --help")
-    view_log(log, None, html, serve, host, port, no_open)
+    view_log(log, None, html, serve, host, allow_remote, port, no_open)
 
 
 @view_app.command("model")
@@ -149,12 +161,13 @@ def view_model(
                               metavar=Q_METAVAR),
     frames: bool = flag(False, "--frames", help="Show every joint frame."),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
-    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+    allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),
+    no_open: bool = _no_open_opt(),
 ) -> None:
     """A serial model with joint sliders (FK in the page); IK of a target with --serve."""
     from kinestat.viz.scene import model_scene  # lazy: scenes load only for a view
 
-    out = _out_options(html, serve, host, port, no_open)
+    out = _out_options(html, serve, host, port, no_open, allow_remote)
     m = _load_model(model)
     if q is not None and q_deg is not None:
         raise InputError("give at most one of --q and --q-deg")
@@ -179,13 +192,14 @@ def view_platform(
     platform: str = typer.Option(None, "--platform", help="TOML platform file (default: the "
                                  "embedded 2011 prototype).", metavar="FILE"),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
-    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+    allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),
+    no_open: bool = _no_open_opt(),
 ) -> None:
     """The platform: plates, legs coloured by force (red tension, blue compression), the
     wrench and its axis; with --legs every assembly mode side by side, the physical one marked."""
     from kinestat.viz.scene import platform_scene  # lazy: scenes load only for a view
 
-    out = _out_options(html, serve, host, port, no_open)
+    out = _out_options(html, serve, host, port, no_open, allow_remote)
     p, poses, L = _platform_poses(legs, pose, platform)
     w = None if wrench is None else parse_floats(wrench, 6, "wrench")
     _emit(platform_scene(p, poses, legs=L, wrench=w), out)
@@ -224,14 +238,15 @@ def view_screw(
     pose2: str = typer.Option(None, "--pose2", help="Second pose, as --pose1.",
                               metavar=POSE_FILE_METAVAR),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
-    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+    allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),
+    no_open: bool = _no_open_opt(),
 ) -> None:
     """Both body positions, the screw axis, the rotation about and translation along it."""
     # lazy: scenes load only for a view
     from kinestat.spatial.displacement import frame_from_triple
     from kinestat.viz.scene import screw_scene
 
-    out = _out_options(html, serve, host, port, no_open)
+    out = _out_options(html, serve, host, port, no_open, allow_remote)
     by_points = points1 is not None or points2 is not None
     if by_points == (pose1 is not None or pose2 is not None):
         raise InputError("give either --points1 and --points2, or --pose1 and --pose2")
@@ -256,12 +271,13 @@ def view_disp(
                               metavar=STEPS_METAVAR),
     disp_1977: bool = flag(False, "--disp-1977", help="The 1977 program's step rule."),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
-    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+    allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),
+    no_open: bool = _no_open_opt(),
 ) -> None:
     """Animate a DISP deck's guidance run: the arm step by step, the hand path, events."""
     from kinestat.viz.scene import guidance_scene  # lazy: scenes load only for a view
 
-    out = _out_options(html, serve, host, port, no_open)
+    out = _out_options(html, serve, host, port, no_open, allow_remote)
     result, title = disp_result(deck, steps, disp_1977)
     _emit(guidance_scene(result, title=title), out)
 
@@ -294,13 +310,14 @@ def view_log(
     platform: str = typer.Option(None, "--platform", help="TOML platform file of the run "
                                  "(default: the embedded 2011 prototype).", metavar="FILE"),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
-    port: int = _port_opt(), no_open: bool = _no_open_opt(),
+    allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),
+    no_open: bool = _no_open_opt(),
 ) -> None:
     """Replay a control run: robot, platform, tool, workpiece, measured and true forces, the
     state a–e per cycle, with a timeline slider."""
     from kinestat.viz.cell_scene import cell_scene, read_cycle_log  # lazy: only for this view
 
-    out = _out_options(html, serve, host, port, no_open)
+    out = _out_options(html, serve, host, port, no_open, allow_remote)
     p = None
     if platform is not None:
         from kinestat.io.platform_toml import read_platform  # lazy: only with --platform

@@ -134,6 +134,22 @@ def _seed_key(seed) -> np.uint64:
         raise InputError(f"seed must be a non-negative integer or None, got {seed!r}") from exc
 
 
+#: Ceilings of one IK call's effort (docs/reliability.md, "Limits and ceilings"): an attempt that
+#: has not converged in 10^5 Levenberg–Marquardt iterations will not (it converges in tens), and
+#: 10^4 random restarts is far past the point where another start finds a new solution.
+MAX_ITER = 100_000
+MAX_RESTARTS = 10_000
+
+
+def _check_effort(max_iter, restarts) -> None:
+    """``max_iter`` in 1..MAX_ITER and ``restarts`` in 0..MAX_RESTARTS, whole numbers."""
+    for name, v, lo, hi in (("max_iter", max_iter, 1, MAX_ITER),
+                            ("restarts", restarts, 0, MAX_RESTARTS)):
+        if isinstance(v, bool) or not isinstance(v, (int, np.integer)) or not lo <= v <= hi:
+            shown = repr(v) if len(repr(v)) <= 40 else f"an integer of {len(str(v))} digits"
+            raise InputError(f"{name} must be a whole number from {lo} to {hi}, got {shown}")
+
+
 def ik(
     model: ChainModel,
     poses,
@@ -187,8 +203,7 @@ def ik(
     Tt = _check_poses(poses) if backend == "numpy" else _poses_compiled(poses)
     shape = Tt.shape[:-2]
     n = model.n
-    if max_iter < 1 or restarts < 0:
-        raise InputError("max_iter must be at least 1 and restarts non-negative")
+    _check_effort(max_iter, restarts)
     d = _model_data(model)
     L = d.scale
     if pos_tol is None:
@@ -284,8 +299,7 @@ def _ik_chunk(model: ChainModel, T: np.ndarray, q0, key: np.uint64, offset: int,
               backend: str = "numba") -> IKResult:
     """One chunk of :func:`iter_ik` (compiled path, random streams offset by ``offset``)."""
     Tt = _poses_compiled(T)
-    if max_iter < 1 or restarts < 0:
-        raise InputError("max_iter must be at least 1 and restarts non-negative")
+    _check_effort(max_iter, restarts)
     d = _model_data(model)
     L, lo, hi = d.scale, d.lower, d.upper
     if pos_tol is None:

@@ -10,7 +10,6 @@ bound).
 from __future__ import annotations
 
 import contextlib
-import ipaddress
 import re
 import socket
 import threading
@@ -18,45 +17,10 @@ import threading
 import numpy as np
 
 from kinestat.errors import DeviceError, InputError
+from kinestat.io.netbind import check_bind_address, resolve_bind_address  # re-exported
 from kinestat.sim.dmc import DmcSimulator
 
 __all__ = ["resolve_bind_address", "check_bind_address", "GalilSimServer"]
-
-
-def resolve_bind_address(host: str, port: int, allow_remote: bool
-                         ) -> tuple[socket.AddressFamily, tuple]:
-    """Resolve ``host`` ONCE and check the address that will be bound: ``(family, sockaddr)``.
-
-    A non-loopback address (``0.0.0.0``, ``::``, ``""``, a LAN address, a name resolving to
-    one) is refused unless ``allow_remote`` is the bool True: anyone who can reach the
-    simulator could command motion. ``allow_remote`` must be a real bool (``"false"`` is
-    refused, not taken as true). The server binds exactly the ``sockaddr`` returned.
-    """
-    if not isinstance(allow_remote, bool):
-        raise InputError(f"allow_remote must be True or False, got {allow_remote!r} "
-                         f"({type(allow_remote).__name__})")
-    if not isinstance(host, str):
-        raise InputError(f"simulator bind address must be a string, got {host!r}")
-    try:
-        infos = socket.getaddrinfo(host or None, port, type=socket.SOCK_STREAM,
-                                   proto=socket.IPPROTO_TCP, flags=socket.AI_PASSIVE)
-    except (socket.gaierror, UnicodeError) as exc:
-        raise InputError(f"cannot resolve simulator bind address {host!r}: {exc}") from exc
-    family, _, _, _, sockaddr = infos[0]
-    addr = str(sockaddr[0])
-    if not allow_remote and not ipaddress.ip_address(addr.split("%")[0]).is_loopback:
-        shown = host or "all interfaces"
-        raise InputError(f"refusing to bind the Galil simulator to {shown!r} ({addr}): not a "
-                         "loopback address, and it accepts motion commands from anyone who "
-                         "can reach it. Use 127.0.0.1, or pass allow_remote=True / "
-                         "--allow-remote deliberately")
-    return family, sockaddr
-
-
-def check_bind_address(host: str, allow_remote: bool) -> None:
-    """Refuse a non-loopback bind address unless ``allow_remote`` (raises InputError); see
-    :func:`resolve_bind_address`, which also returns what to bind."""
-    resolve_bind_address(host, 0, allow_remote)
 
 
 class GalilSimServer:

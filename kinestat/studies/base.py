@@ -20,7 +20,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-__all__ = ["Study", "spec_hash", "spec_json", "build_study", "STUDIES"]
+from kinestat.errors import InputError
+from kinestat.studies import grids
+
+__all__ = ["Study", "ChunkedStudy", "spec_hash", "spec_json", "build_study", "STUDIES"]
 
 #: name -> "module:class" of the known studies (imported on first use)
 STUDIES: dict[str, str] = {
@@ -74,6 +77,50 @@ class Study(ABC):
     def describe(self) -> dict[str, Any]:
         """The inputs to echo in the summary (spec without bulky texts)."""
         return {k: v for k, v in self.spec.items() if not k.endswith("_text")}
+
+
+class ChunkedStudy(Study):
+    """A study of ``total`` evaluations in chunks of ``spec["chunk_size"]`` (set by
+    :meth:`_set_items` in ``__init__``), with the inputs of a box for ``mode`` grid or samples.
+    """
+
+    total: int = 0
+    chunk: int = 1
+
+    def _set_items(self, total: int, what: str = "evaluations") -> None:
+        if total > grids.MAX_POINTS:
+            raise InputError(f"{total:.3e} {what} is too many (at most {grids.MAX_POINTS:.3e})")
+        self.total = int(total)
+        self.chunk = int(self.spec["chunk_size"])
+        self._chunks = grids.chunk_count(self.total, self.chunk)
+
+    @property
+    def n_chunks(self) -> int:
+        return self._chunks
+
+    @property
+    def n_items(self) -> int:
+        return self.total
+
+    def chunk_rows(self, i: int) -> tuple[int, int]:
+        """Flat index range ``[start, stop)`` of chunk ``i``."""
+        return grids.chunk_range(i, self.total, self.chunk)
+
+    def uniform_inputs(self, i: int, lower, upper) -> np.ndarray:
+        """Chunk ``i``'s random inputs ``(rows, n)``, uniform in the box ``[lower, upper]``
+        (the chunk's own stream of ``spec["seed"]``)."""
+        start, stop = self.chunk_rows(i)
+        lo = np.asarray(lower, dtype=float)
+        return grids.chunk_rng(self.spec["seed"], i).uniform(lo, upper, size=(stop - start,
+                                                                                 lo.size))
+
+    def box_inputs(self, i: int, lower, upper) -> np.ndarray:
+        """Chunk ``i``'s inputs ``(rows, n)`` in the box: the tensor grid of ``spec["grid"]``
+        values per axis, or uniform samples (``spec["mode"]``)."""
+        if self.spec["mode"] == "grid":
+            start, stop = self.chunk_rows(i)
+            return grids.grid_points(start, stop, lower, upper, self.spec["grid"])
+        return self.uniform_inputs(i, lower, upper)
 
 
 def _load_class(name: str) -> type[Study]:

@@ -12,8 +12,9 @@ import numpy as np
 
 from kinestat.errors import InputError
 
-__all__ = ["MAX_POINTS", "check_grid", "chunk_count", "chunk_range", "grid_points",
-           "chunk_rng", "parse_values"]
+__all__ = ["MAX_POINTS", "check_grid", "check_grid_count", "check_samples", "check_seed",
+           "sampling", "chunk_count", "chunk_range", "grid_points", "chunk_rng",
+           "parse_values"]
 
 #: the largest grid or sample count accepted (indices stay exact in int64)
 MAX_POINTS = 1 << 62
@@ -23,11 +24,58 @@ STREAM_INPUTS = 0
 STREAM_POSES = 1
 
 
-def check_grid(n_per_axis: int, n_axes: int, what: str = "--grid") -> int:
-    """Total points ``n_per_axis ** n_axes`` of a full tensor grid (both ends included)."""
-    if n_per_axis < 2:
+def _whole(v) -> bool:
+    return isinstance(v, (int, np.integer)) and not isinstance(v, bool)
+
+
+def check_grid_count(n_per_axis: int, what: str = "--grid") -> int:
+    """A grid's values per axis: a whole number ≥ 2 (both ends of each range are included)."""
+    if not _whole(n_per_axis) or n_per_axis < 2:
         raise InputError(f"{what} {n_per_axis}: a grid needs at least 2 values per axis (both "
                          "ends of each range are included)")
+    return int(n_per_axis)
+
+
+def check_samples(samples: int, what: str = "--samples") -> int:
+    """A sample count: a whole number from 1 to :data:`MAX_POINTS`."""
+    if not _whole(samples) or not 1 <= samples <= MAX_POINTS:
+        raise InputError(f"{what} must be at least 1 (and at most {MAX_POINTS:.3e}), "
+                         f"got {samples}")
+    return int(samples)
+
+
+def check_seed(seed: int) -> int:
+    """A seed of the random inputs: a whole number ≥ 0 (NumPy's ``SeedSequence`` entropy).
+
+    >>> check_seed(7)
+    7
+    """
+    if not _whole(seed) or seed < 0:
+        raise InputError(f"--seed must be a whole number ≥ 0, got {seed}")
+    return int(seed)
+
+
+def sampling(grid: int | None, samples: int | None, seed: int, n_axes: int) -> dict:
+    """The spec entries of a study over a box: ``{"mode": "grid", "grid": N}`` (a full tensor
+    grid, N values per axis) or ``{"mode": "samples", "samples": N}``, with ``"seed"``.
+
+    >>> sampling(None, 10, 3, 2)
+    {'seed': 3, 'mode': 'samples', 'samples': 10}
+    """
+    if (grid is None) == (samples is None):
+        raise InputError("give exactly one of --grid N and --samples N")
+    out: dict = {"seed": check_seed(seed)}
+    if grid is not None:
+        check_grid(grid, n_axes)
+        out.update(mode="grid", grid=int(grid))
+    else:
+        out.update(mode="samples", samples=check_samples(samples))
+    return out
+
+
+def check_grid(n_per_axis: int, n_axes: int, what: str = "--grid") -> int:
+    """Total points ``n_per_axis ** n_axes`` of a full tensor grid (both ends included)."""
+    check_grid_count(n_per_axis, what)
     total = int(n_per_axis) ** int(n_axes)
     if total > MAX_POINTS:
         raise InputError(f"{what} {n_per_axis} over {n_axes} axes makes {total:.3e} points, "

@@ -26,7 +26,7 @@ from kinestat.io.textfile import read_text_file
 from kinestat.parallel import leg_lengths, singularity_measure, spring_wrench, stiffness
 from kinestat.parallel.legs import top_points_in_base
 
-__all__ = ["TABLE_3_1", "platform_text", "load_platform", "displaced_poses",
+__all__ = ["TABLE_3_1", "platform_text", "load_platform", "platform_spec", "displaced_poses",
            "evaluate_poses", "axis_check", "range_box"]
 
 #: Vibhute 2011 Table 3-1 (mm, N, degrees)
@@ -49,6 +49,17 @@ def load_platform(label: str, text: str):
     """The platform described by TOML ``text`` (``label`` names it in errors)."""
 
     return loads_platform(text, source=label)
+
+
+def platform_spec(study: str, source: tuple[str, str], *, range_mm, range_deg,
+                  chunk_size: int, arrays: bool, **entries) -> dict:
+    """The spec entries every platform study has — ``study``, ``platform`` and
+    ``platform_text`` (``source``: :func:`platform_text`), the motion range, ``chunk_size``,
+    ``arrays`` — plus ``entries``."""
+    label, text = source
+    return {"study": study, "platform": label, "platform_text": text,
+            "range_mm": [float(x) for x in range_mm], "range_deg": [float(x) for x in range_deg],
+            "chunk_size": int(chunk_size), "arrays": bool(arrays), **entries}
 
 
 def range_box(range_mm, range_deg) -> np.ndarray:

@@ -30,7 +30,7 @@ from kinestat.parallel import singularity_measure, special_6_6
 from kinestat.studies import grids
 from kinestat.studies import platform_common as pc
 from kinestat.studies import reduce as red
-from kinestat.studies.base import Study
+from kinestat.studies.base import ChunkedStudy
 
 __all__ = ["PlatformDesignStudy", "platform_design_spec", "PARAMETERS"]
 
@@ -78,27 +78,31 @@ def platform_design_spec(platform: str | None = None, *, values: dict[str, str] 
     unknown = set(values) - set(PARAMETERS)
     if unknown:
         raise InputError(f"unknown design parameters {sorted(unknown)}; known: {PARAMETERS}")
+    if grid is not None:
+        if samples is not None:
+            raise InputError("give --grid N (values per lo:hi range) or --samples N, not both")
+        grids.check_grid_count(grid)
+        if not any(":" in values[k] and values[k].count(":") == 1 for k in values):
+            raise InputError(f"--grid {grid}: no parameter is given as a range lo:hi to take "
+                             "the grid's values from (e.g. --base-side 100:140)")
+    inputs = {"seed": grids.check_seed(seed)}
+    inputs.update({"mode": "grid"} if samples is None else
+                  {"mode": "samples", "samples": grids.check_samples(samples)})
     lists = {k: (grids.parse_values(values[k], k.replace("_", "-"), grid if samples is None
                                     else 2) if k in values else [base[k]])
              for k in PARAMETERS}
     if poses < 1:
         raise InputError(f"--poses must be at least 1, got {poses}")
-    spec = {"study": "platform-design", "platform": label, "platform_text": text,
-            "values": lists, "reference": base, "poses": int(poses),
-            "range_mm": [float(x) for x in range_mm], "range_deg": [float(x) for x in range_deg],
-            "max_deflection": float(max_deflection), "max_load": float(max_load),
-            "chunk_size": int(chunk_size), "arrays": bool(arrays), "seed": int(seed)}
-    if samples is not None:
-        if samples < 1:
-            raise InputError(f"--samples must be at least 1, got {samples}")
-        spec.update(mode="samples", samples=int(samples))
-    else:
-        spec.update(mode="grid")
+    spec = pc.platform_spec("platform-design", (label, text),
+                            range_mm=range_mm, range_deg=range_deg, chunk_size=chunk_size,
+                            arrays=arrays, values=lists, reference=base,
+                            poses=int(poses), max_deflection=float(max_deflection),
+                            max_load=float(max_load), **inputs)
     PlatformDesignStudy(spec)
     return spec
 
 
-class PlatformDesignStudy(Study):
+class PlatformDesignStudy(ChunkedStudy):
     """Special 6-6 designs scored on Table 3-1."""
 
     name = "platform-design"
@@ -108,33 +112,19 @@ class PlatformDesignStudy(Study):
         self.box = pc.range_box(spec["range_mm"], spec["range_deg"])
         self.lists = {k: np.asarray(spec["values"][k], float) for k in PARAMETERS}
         sizes = [len(v) for v in self.lists.values()]
-        self.total = math.prod(sizes) if spec["mode"] == "grid" else spec["samples"]
-        if self.total > grids.MAX_POINTS:
-            raise InputError(f"{self.total:.3e} designs is too many")
-        self.chunk = int(spec["chunk_size"])
-        self._chunks = grids.chunk_count(self.total, self.chunk)
+        self._set_items(math.prod(sizes) if spec["mode"] == "grid" else spec["samples"],
+                        "designs")
         base = pc.load_platform(spec["platform"], spec["platform_text"])
         self.names = (base.name, base.length_unit, base.force_unit)
         rng = grids.chunk_rng(spec["seed"], 0, grids.STREAM_POSES)
         self.displacements = rng.uniform(-self.box, self.box, size=(spec["poses"], 6))
 
-    @property
-    def n_chunks(self) -> int:
-        return self._chunks
-
-    @property
-    def n_items(self) -> int:
-        return self.total
-
     def designs(self, i: int) -> np.ndarray:
         """Design parameters ``(rows, 7)`` (order :data:`PARAMETERS`) of chunk ``i``."""
-        start, stop = grids.chunk_range(i, self.total, self.chunk)
         vals = list(self.lists.values())
         if self.spec["mode"] == "samples":
-            rng = grids.chunk_rng(self.spec["seed"], i)
-            lo = np.array([v.min() for v in vals])
-            hi = np.array([v.max() for v in vals])
-            return rng.uniform(lo, hi, size=(stop - start, len(vals)))
+            return self.uniform_inputs(i, [v.min() for v in vals], [v.max() for v in vals])
+        start, stop = self.chunk_rows(i)
         idx = np.arange(start, stop, dtype=np.int64)
         out = np.empty((idx.size, len(vals)))
         for j in range(len(vals) - 1, -1, -1):

@@ -19,7 +19,7 @@ from kinestat.parallel import stiffness
 from kinestat.studies import grids
 from kinestat.studies import platform_common as pc
 from kinestat.studies import reduce as red
-from kinestat.studies.base import Study
+from kinestat.studies.base import ChunkedStudy
 
 __all__ = ["PlatformRangeStudy", "platform_range_spec"]
 
@@ -37,27 +37,16 @@ def platform_range_spec(platform: str | None = None, *, grid: int | None = None,
                         max_load: float = pc.TABLE_3_1["max_load"],
                         chunk_size: int = DEFAULT_CHUNK, arrays: bool = True) -> dict:
     """Check the inputs and build the spec of a platform-range study."""
-    label, text = pc.platform_text(platform)
-    if (grid is None) == (samples is None):
-        raise InputError("give exactly one of --grid N and --samples N")
-    spec = {"study": "platform-range", "platform": label, "platform_text": text,
-            "range_mm": [float(x) for x in range_mm], "range_deg": [float(x) for x in range_deg],
-            "max_deflection": float(max_deflection), "max_load": float(max_load),
-            "chunk_size": int(chunk_size), "arrays": bool(arrays), "seed": int(seed)}
-    if grid is not None:
-        grids.check_grid(grid, 6)
-        spec.update(mode="grid", grid=int(grid))
-    else:
-        if samples < 1:
-            raise InputError(f"--samples must be at least 1, got {samples}")
-        spec.update(mode="samples", samples=int(samples))
+    spec = pc.platform_spec("platform-range", pc.platform_text(platform),
+                            range_mm=range_mm, range_deg=range_deg, chunk_size=chunk_size,
+                            arrays=arrays,
+                            max_deflection=float(max_deflection), max_load=float(max_load),
+                            **grids.sampling(grid, samples, seed, 6))
     PlatformRangeStudy(spec)
     return spec
 
 
-
-
-class PlatformRangeStudy(Study):
+class PlatformRangeStudy(ChunkedStudy):
     """Deflection, load, stiffness and singularity of the platform over its motion range."""
 
     name = "platform-range"
@@ -69,29 +58,15 @@ class PlatformRangeStudy(Study):
         for key in ("max_deflection", "max_load"):
             if not spec[key] > 0:
                 raise InputError(f"--{key.replace('_', '-')} must be positive, got {spec[key]}")
-        self.chunk = int(spec["chunk_size"])
-        self.total = spec["grid"] ** 6 if spec["mode"] == "grid" else spec["samples"]
-        self._chunks = grids.chunk_count(self.total, self.chunk)
+        self._set_items(spec["grid"] ** 6 if spec["mode"] == "grid" else spec["samples"], "poses")
         lim_d, lim_f = spec["max_deflection"], spec["max_load"]
         self.edges = {"max_deflection": np.linspace(0.0, 2 * lim_d, _BINS + 1),
                       "force_z": np.linspace(0.0, 2 * lim_f, _BINS + 1),
                       "singularity": np.linspace(0.0, 1.0, _BINS + 1)}
 
-    @property
-    def n_chunks(self) -> int:
-        return self._chunks
-
-    @property
-    def n_items(self) -> int:
-        return self.total
-
     def displacements(self, i: int) -> np.ndarray:
         """Displacements ``(rows, 6)`` (x, y, z, rx, ry, rz; radians) of chunk ``i``."""
-        start, stop = grids.chunk_range(i, self.total, self.chunk)
-        if self.spec["mode"] == "grid":
-            return grids.grid_points(start, stop, -self.box, self.box, self.spec["grid"])
-        return grids.chunk_rng(self.spec["seed"], i).uniform(-self.box, self.box,
-                                                             size=(stop - start, 6))
+        return self.box_inputs(i, -self.box, self.box)
 
     def compute_chunk(self, i: int):
         d = self.displacements(i)

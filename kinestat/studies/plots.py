@@ -18,6 +18,19 @@ def _plt():
     return plt
 
 
+def _save(plt, fig, ax, path: Path, xlabel: str, ylabel: str, title: str) -> str:
+    """Label the axes, title the plot, write ``path`` (its folder created) and close the
+    figure; returns the file name."""
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=9)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path.name
+
+
 def histogram_png(hist: dict, path: Path, xlabel: str, title: str, log_x: bool = False) -> str:
     """A bar histogram of reduced counts (:func:`kinestat.studies.reduce.histogram`)."""
     plt = _plt()
@@ -27,16 +40,9 @@ def histogram_png(hist: dict, path: Path, xlabel: str, title: str, log_x: bool =
     ax.stairs(c, e, fill=True, alpha=0.7)
     if log_x:
         ax.set_xscale("log")
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel("count")
     extra = f" (below {hist['below']}, above {hist['above']})" if hist["below"] or \
         hist["above"] else ""
-    ax.set_title(title + extra, fontsize=9)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path.name
+    return _save(plt, fig, ax, path, xlabel, "count", title + extra)
 
 
 def slice_png(counts, edges_x, edges_y, path: Path, xlabel: str, ylabel: str,
@@ -52,14 +58,7 @@ def slice_png(counts, edges_x, edges_y, path: Path, xlabel: str, ylabel: str,
     m = ax.pcolormesh(edges_x, edges_y, masked.T, norm=LogNorm(vmin=1, vmax=vmax))
     fig.colorbar(m, ax=ax, label="points")
     ax.set_aspect("equal")
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=9)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path.name
+    return _save(plt, fig, ax, path, xlabel, ylabel, title)
 
 
 def scatter_png(x, y, path: Path, xlabel: str, ylabel: str, title: str, mark=None) -> str:
@@ -70,11 +69,4 @@ def scatter_png(x, y, path: Path, xlabel: str, ylabel: str, title: str, mark=Non
     ax.scatter(x, y, s=8, alpha=0.6)
     if mark is not None and np.any(mark):
         ax.scatter(x[mark], y[mark], s=40, facecolors="none", edgecolors="red")
-    ax.set_xlabel(xlabel)
-    ax.set_ylabel(ylabel)
-    ax.set_title(title, fontsize=9)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
-    fig.savefig(path, dpi=100)
-    plt.close(fig)
-    return path.name
+    return _save(plt, fig, ax, path, xlabel, ylabel, title)

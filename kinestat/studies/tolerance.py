@@ -24,7 +24,7 @@ from kinestat.parallel.legs import top_points_in_base
 from kinestat.studies import grids
 from kinestat.studies import platform_common as pc
 from kinestat.studies import reduce as red
-from kinestat.studies.base import Study
+from kinestat.studies.base import ChunkedStudy
 
 __all__ = ["ToleranceStudy", "tolerance_spec"]
 
@@ -43,23 +43,21 @@ def tolerance_spec(platform: str | None = None, *, samples: int = 10000, seed: i
     Defaults: 0.05 mm mounting error, 5 % spring constant error (the springs' linearity,
     Vibhute §3.1.3), 0.01 mm encoder zero error (the position resolution of Table 3-1).
     """
-    label, text = pc.platform_text(platform)
-    if samples < 1:
-        raise InputError(f"--samples must be at least 1, got {samples}")
+    samples, seed = grids.check_samples(samples), grids.check_seed(seed)
     for name, v in (("sigma-mount", sigma_mount), ("sigma-k", sigma_k),
                     ("sigma-offset", sigma_offset)):
         if not (np.isfinite(v) and v >= 0):
             raise InputError(f"--{name} must be a non-negative number, got {v}")
-    spec = {"study": "tolerance", "platform": label, "platform_text": text, "mode": "samples",
-            "samples": int(samples), "seed": int(seed), "sigma_mount": float(sigma_mount),
-            "sigma_k": float(sigma_k), "sigma_offset": float(sigma_offset),
-            "range_mm": [float(x) for x in range_mm], "range_deg": [float(x) for x in range_deg],
-            "chunk_size": int(chunk_size), "arrays": bool(arrays)}
+    spec = pc.platform_spec("tolerance", pc.platform_text(platform),
+                            range_mm=range_mm, range_deg=range_deg, chunk_size=chunk_size,
+                            arrays=arrays, mode="samples",
+                            samples=samples, seed=seed, sigma_mount=float(sigma_mount),
+                            sigma_k=float(sigma_k), sigma_offset=float(sigma_offset))
     ToleranceStudy(spec)
     return spec
 
 
-class ToleranceStudy(Study):
+class ToleranceStudy(ChunkedStudy):
     """Monte-Carlo of the wrench error due to mounting and calibration errors."""
 
     name = "tolerance"
@@ -68,27 +66,16 @@ class ToleranceStudy(Study):
         super().__init__(spec)
         self.platform = pc.load_platform(spec["platform"], spec["platform_text"])
         self.box = pc.range_box(spec["range_mm"], spec["range_deg"])
-        self.total = spec["samples"]
-        self.chunk = int(spec["chunk_size"])
-        self._chunks = grids.chunk_count(self.total, self.chunk)
-
+        self._set_items(spec["samples"], "samples")
         p = self.platform
         self.centre = top_points_in_base(p, p.home_pose).mean(axis=0)
         self.force_edges = np.linspace(0.0, 10.0 * max(spec["sigma_k"], 1e-3) * 50.0 + 1.0,
                                        _BINS + 1)
         self.torque_edges = self.force_edges * p.scale
 
-    @property
-    def n_chunks(self) -> int:
-        return self._chunks
-
-    @property
-    def n_items(self) -> int:
-        return self.total
-
     def draws(self, i: int) -> dict[str, np.ndarray]:
         """The random inputs of chunk ``i`` (one stream per chunk, drawn in a fixed order)."""
-        start, stop = grids.chunk_range(i, self.total, self.chunk)
+        start, stop = self.chunk_rows(i)
         m, s = stop - start, self.spec
         rng = grids.chunk_rng(s["seed"], i)
         return {"d": rng.uniform(-self.box, self.box, size=(m, 6)),

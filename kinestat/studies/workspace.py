@@ -30,7 +30,7 @@ from kinestat.errors import InputError
 from kinestat.io.model_toml import loads_model
 from kinestat.studies import grids
 from kinestat.studies import reduce as red
-from kinestat.studies.base import Study
+from kinestat.studies.base import ChunkedStudy
 
 __all__ = ["WorkspaceStudy", "workspace_spec", "TASKS", "task_jacobian"]
 
@@ -63,19 +63,11 @@ def workspace_spec(model: str, *, grid: int | None = None, samples: int | None =
     text = None
     if model not in kinestat.list_models():
         text = Path(model).read_text(encoding="utf-8")
-    if (grid is None) == (samples is None):
-        raise InputError("give exactly one of --grid N and --samples N")
+    inputs = grids.sampling(grid, samples, seed, m.n)
     if task not in TASKS:
         raise InputError(f"--task must be one of {list(TASKS)}, got {task!r}")
     spec = {"study": "workspace", "model": str(model), "model_text": text,
-            "chunk_size": int(chunk_size), "task": task, "arrays": bool(arrays), "seed": int(seed)}
-    if grid is not None:
-        grids.check_grid(grid, m.n)
-        spec.update(mode="grid", grid=int(grid))
-    else:
-        if samples < 1:
-            raise InputError(f"--samples must be at least 1, got {samples}")
-        spec.update(mode="samples", samples=int(samples))
+            "chunk_size": int(chunk_size), "task": task, "arrays": bool(arrays), **inputs}
     WorkspaceStudy(spec)  # limits, task/joint count and chunk size are checked here
     return spec
 
@@ -95,7 +87,7 @@ def task_jacobian(J: np.ndarray, p: np.ndarray, task: str) -> np.ndarray:
     return vp if task == "position" else vp[..., :2, :]
 
 
-class WorkspaceStudy(Study):
+class WorkspaceStudy(ChunkedStudy):
     """Reach, manipulability and condition number of an arm over joint grids or samples."""
 
     name = "workspace"
@@ -119,23 +111,14 @@ class WorkspaceStudy(Study):
                              f"many joints, model {m.name!r} has {m.n}; choose a smaller task "
                              "(position, planar)")
         self.task = task
-        self.chunk = int(spec["chunk_size"])
-        self.total = (spec["grid"] ** m.n if spec["mode"] == "grid" else spec["samples"])
-        self._chunks = grids.chunk_count(self.total, self.chunk)
+        self._set_items(spec["grid"] ** m.n if spec["mode"] == "grid" else spec["samples"],
+                        "configurations")
         self.bound = self.reach_bound()
         b = self.bound
         self.reach_edges = np.linspace(0.0, b, _BINS + 1)
         self.xy_edges = np.linspace(-b, b, _BINS + 1)
         self.manip_edges = red.log_edges(-8, 16)
         self.cond_edges = red.log_edges(0, 16)
-
-    @property
-    def n_chunks(self) -> int:
-        return self._chunks
-
-    @property
-    def n_items(self) -> int:
-        return self.total
 
     def reach_bound(self) -> float:
         """An upper bound on the reach: the sum of the constant offsets |t(C_i)| plus the
@@ -152,11 +135,7 @@ class WorkspaceStudy(Study):
 
     def configurations(self, i: int) -> np.ndarray:
         """Joint values ``(rows, n)`` of chunk ``i``."""
-        start, stop = grids.chunk_range(i, self.total, self.chunk)
-        if self.spec["mode"] == "grid":
-            return grids.grid_points(start, stop, self.lower, self.upper, self.spec["grid"])
-        rng = grids.chunk_rng(self.spec["seed"], i)
-        return rng.uniform(self.lower, self.upper, size=(stop - start, self.model.n))
+        return self.box_inputs(i, self.lower, self.upper)
 
     def evaluate(self, q: np.ndarray) -> dict[str, np.ndarray]:
         """End points, reach, manipulability and condition number at configurations ``q``."""

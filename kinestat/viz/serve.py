@@ -20,6 +20,7 @@ import numpy as np
 
 import kinestat
 from kinestat.errors import InputError, KinestatError
+from kinestat.io.netbind import resolve_bind_address
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import puma762
 from kinestat.viz.html import render_html, scene_json
@@ -98,18 +99,29 @@ def _handler(page: bytes, scene_bytes: bytes, model: ChainModel | None):
 
 
 def make_server(scene: dict, *, host: str = "127.0.0.1", port: int = 0,
-                model: ChainModel | None = None) -> ThreadingHTTPServer:
+                model: ChainModel | None = None,
+                allow_remote: bool = False) -> ThreadingHTTPServer:
     """A bound (not yet serving) HTTP server for ``scene``; ``port`` 0 picks a free port.
 
+    Loopback only unless ``allow_remote`` is the bool True (the server answers IK and shows the
+    scene to whoever connects): the host is resolved once and exactly the checked address is
+    bound (:func:`kinestat.io.netbind.resolve_bind_address`).
+
     Raises:
-        InputError: the port is in use or the address cannot be bound.
+        InputError: a non-loopback host without ``allow_remote``, the port is in use or the
+            address cannot be bound.
     """
+    if not (isinstance(port, int) and not isinstance(port, bool) and 0 <= port <= 65535):
+        raise InputError(f"port must be an integer in 0..65535, got {port!r}")
+    family, sockaddr = resolve_bind_address(
+        host, port, allow_remote, what="the viewer",
+        exposure="it shows the scene and answers IK to anyone who can reach it")
     if model is not None and scene.get("robot") and scene["robot"].get("live"):
         scene = {**scene, "ik_url": "/ik"}
     page = render_html(scene).encode("utf-8")
-    try:
-        return ThreadingHTTPServer((host, port), _handler(page, scene_json(scene).encode(),
-                                                          model))
+    server_class = type("_ViewerServer", (ThreadingHTTPServer,), {"address_family": family})
+    try:  # exactly the address resolve_bind_address checked
+        return server_class(sockaddr, _handler(page, scene_json(scene).encode(), model))
     except OSError as exc:
         if exc.errno == errno.EADDRINUSE:
             raise InputError(f"port {port} on {host} is in use; choose another with --port "

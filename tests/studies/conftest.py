@@ -16,30 +16,15 @@ ROOT = Path(__file__).resolve().parents[2]
 
 L1, L2 = 1.0, 0.5
 
-PLANAR_TOML = f"""
-name = "planar2"
-notation = "standard_dh"
-length_unit = "m"
-angle_unit = "deg"
 
-[[joints]]
-name = "1"
-type = "revolute"
-theta = 0.0
-d = 0.0
-a = {L1}
-alpha = 0.0
-limits = [-180.0, 180.0]
 
-[[joints]]
-name = "2"
-type = "revolute"
-theta = 0.0
-d = 0.0
-a = {L2}
-alpha = 0.0
-limits = [-180.0, 180.0]
-"""
+def _revolute(name: str, a: float) -> str:
+    return (f'\n[[joints]]\nname = "{name}"\ntype = "revolute"\ntheta = 0.0\nd = 0.0\n'
+            f"a = {a}\nalpha = 0.0\nlimits = [-180.0, 180.0]\n")
+
+
+PLANAR_TOML = ('name = "planar2"\nnotation = "standard_dh"\nlength_unit = "m"\n'
+               'angle_unit = "deg"\n' + _revolute("1", L1) + _revolute("2", L2))
 
 
 @pytest.fixture

@@ -16,6 +16,8 @@ kind                   event
 ``not_converged``      :class:`NotConverged` — the closed-loop correction failed: stopped
 ``settle``             :class:`SettleStep` — a correction step straight at the stage target
 ``target_not_reached`` :class:`TargetNotReached` — settling failed: stopped
+``numerical``          :class:`NumericalFailure` — a step's numbers failed (an SVD that did
+                       not converge, joints that are not finite): stopped
 =====================  ==================================================================
 """
 
@@ -42,6 +44,7 @@ __all__ = [
     "NotConverged",
     "SettleStep",
     "TargetNotReached",
+    "NumericalFailure",
 ]
 
 
@@ -178,3 +181,14 @@ class TargetNotReached(_Unreached):
     position_error: float = 0.0
     angle_error_deg: float = 0.0
     action: str = "stopped"
+
+
+@dataclass(frozen=True, eq=False)
+class NumericalFailure(GuidanceEvent):
+    """A step's numerics failed (``reason``: e.g. the SVD did not converge, the joints are not
+    finite): the run stops with the configuration of the step before."""
+
+    kind: ClassVar[str] = "numerical"
+    stops: ClassVar[bool] = True
+
+    reason: str = ""

@@ -365,8 +365,9 @@ def command_path(start, direction, distance: float, angle: float,
 def path_extent(path, samples: int = 256) -> tuple[float, float]:
     """``(rotation in rad, length)`` travelled by the hand frame / origin along the ideal path,
     summed over ``samples`` equal parts (exact for screw and general paths in the limit)."""
-    P = path.pose_at(np.linspace(0.0, 1.0, samples + 1))
-    dp, ang = pose_error(P[1:], P[:-1])
+    with np.errstate(over="ignore", invalid="ignore"):  # huge motions: inf, checked by callers
+        P = path.pose_at(np.linspace(0.0, 1.0, samples + 1))
+        dp, ang = pose_error(P[1:], P[:-1])
     return float(np.sum(ang)), float(np.sum(dp))
 
 
@@ -383,6 +384,10 @@ def auto_steps(path, length: float, *, max_step_deg: float = 1.0,
     30
     """
     rot, dist = path_extent(path)
+    if not (math.isfinite(rot) and math.isfinite(dist) and math.isfinite(length)):
+        raise InputError(
+            f"the motion is not finite (rotation {rot:.4g} rad, distance {dist:.4g}): a "
+            "distance, angle or target too large to guide")
     k = max(1, math.ceil(math.degrees(rot) / max_step_deg - 1e-9),
             math.ceil(dist / (max_step_fraction * length) - 1e-9))
     if k > max_steps:

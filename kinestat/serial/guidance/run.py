@@ -36,6 +36,7 @@ from kinestat.serial.guidance.events import (
     JointLimitStop,
     LeastSquaresStep,
     NotConverged,
+    NumericalFailure,
     SettleStep,
     Singularity,
     TargetNotReached,
@@ -44,6 +45,7 @@ from kinestat.serial.guidance.planners import (
     Path,
     StageSpec,
     auto_steps,
+    path_extent,
     pose_error,
     resolve_stage,
     twist_between,
@@ -71,7 +73,23 @@ __all__ = [
     "run_guidance",
     "joint_display",
     "SINGULAR_MODES",
+    "MAX_RUN_STEPS",
+    "GuidanceInterrupted",
 ]
+
+#: Ceiling on the path steps of one run, the per-stage counts summed (explicit and automatic
+#: alike; correction and sub-steps come on top, each bounded by its own option). 10^5 steps take
+#: a minute or two and ~120 MB of rows; see docs/reliability.md, "Limits and ceilings".
+MAX_RUN_STEPS = 100_000
+
+
+class GuidanceInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a guidance run: a ``KeyboardInterrupt`` (nothing swallows it) that says
+    where the run was: ``step`` of ``planned`` path steps."""
+
+    def __init__(self, step: int, planned: int) -> None:
+        self.step, self.planned = int(step), int(planned)
+        super().__init__(f"the guidance run was stopped at step {step} of {planned} planned")
 
 
 @dataclass(frozen=True, eq=False)
@@ -163,17 +181,36 @@ def _unit(model: ChainModel, i: int) -> str:
     return model.length_unit if model.prismatic[i] else "deg"
 
 
+def _step_count(s) -> int | None:
+    """One stage's step count: a whole number ≥ 0 (0/None: automatic), else InputError."""
+    if s is None:
+        return None
+    if isinstance(s, bool) or not isinstance(s, (int, np.integer, float, np.floating)):
+        raise InputError(f"a step count must be a whole number, got {s!r}")
+    if isinstance(s, (float, np.floating)) and not (math.isfinite(s) and float(s).is_integer()):
+        raise InputError(f"a step count must be a whole number, got {s!r}")
+    if s < 0:
+        raise InputError("step counts must be positive integers (0 means automatic)")
+    if s > MAX_RUN_STEPS:
+        raise InputError(f"a step count of {int(s)} is over the ceiling of {MAX_RUN_STEPS} "
+                         "steps per run")
+    return int(s) or None
+
+
 def _per_stage_steps(steps, n_stages: int) -> list[int | None]:
-    if steps is None or isinstance(steps, (int, np.integer)):
-        per_stage: list[int | None] = [None if not steps else int(steps)] * n_stages
+    if steps is None or isinstance(steps, (int, np.integer, float, np.floating)):
+        per_stage: list[int | None] = [_step_count(steps)] * n_stages
     else:
-        per_stage = [None if not s else int(s) for s in steps]
+        per_stage = [_step_count(s) for s in steps]
         if len(per_stage) != n_stages:
             raise InputError(
                 f"{len(per_stage)} step counts given for {n_stages} stages; give one count "
                 "for all or one per stage")
-    if any(s is not None and s < 1 for s in per_stage):
-        raise InputError("step counts must be positive integers (0 means automatic)")
+    total = sum(s for s in per_stage if s is not None)
+    if total > MAX_RUN_STEPS:
+        raise InputError(
+            f"{total} steps over {n_stages} stages is over the ceiling of {MAX_RUN_STEPS} steps "
+            "per run: give fewer steps or split the motion into several runs")
     return per_stage
 
 
@@ -261,22 +298,29 @@ class _Run:
         path = resolve_stage(spec, self.H)
         refine = None
         k = k_given
+        left = MAX_RUN_STEPS - self.total_planned
         if k is None:
             refine = self.opt.max_joint_step_deg
             k = auto_steps(path, self.L, max_step_deg=self.opt.max_step_deg,
-                           max_step_fraction=self.opt.max_step_fraction)
+                           max_step_fraction=self.opt.max_step_fraction, max_steps=left)
+        elif not all(map(math.isfinite, path_extent(path, samples=8))):
+            raise InputError(f"stage {si + 1}: the motion is not finite (a distance, angle or "
+                             "target too large to guide)")
         self.planned.append(k)
         self.total_planned += k
         self.targets.append(np.asarray(path.end, dtype=float))
         stage = _Stage(si, path, k, refine)
-        for j in range(1, k + 1):
-            self.gstep += 1
-            if not self.step(stage, j):
-                break
-            if self.progress is not None:
-                self.progress(self.gstep, self.total_planned)
-        if self.stop_event is None and self.opt.settle:
-            self.settle(si)
+        try:
+            for j in range(1, k + 1):
+                self.gstep += 1
+                if not self.step(stage, j):
+                    break
+                if self.progress is not None:
+                    self.progress(self.gstep, self.total_planned)
+            if self.stop_event is None and self.opt.settle:
+                self.settle(si)
+        except np.linalg.LinAlgError as exc:  # e.g. "SVD did not converge" on extreme numbers
+            self.numerical_stop(stage, f"the linear algebra of the step failed ({exc})")
         if isinstance(self.stop_event, (Singularity, NotConverged)):
             dp, _ = pose_error(self.H, self.targets[-1])
             if dp > 1e-6 * max(1.0, self.L):
@@ -297,6 +341,8 @@ class _Run:
         s0, s1 = st.fractions(j)
         inc = self.increment(st, s0, s1, J, damping)
         q_new = self.q + inc
+        if not np.all(np.isfinite(q_new)):
+            return self.numerical_stop(st, "the joint increments are not finite")
         ideal = st.path.pose_at(s1)
         if self.opt.closed_loop:
             q_new = self.newton(st, ideal, q_new)
@@ -306,6 +352,14 @@ class _Run:
             return False
         self.accept(q_new, ideal, st.index)
         return True
+
+    def numerical_stop(self, st: _Stage, reason: str) -> bool:
+        """Stop with a :class:`NumericalFailure` at the current step; returns False."""
+        self.stop(NumericalFailure(self.gstep, st.index + 1, reason=reason),
+                  f"step {self.gstep}: {reason}; stopped with the configuration of step "
+                  f"{self.gstep - 1} (the motion is too large or passes a degenerate "
+                  "configuration)")
+        return False
 
     def increment(self, st: _Stage, s0: float, s1: float, J, damping) -> np.ndarray:
         """Joint increments of the step from the step rule; for automatic step counts a step
@@ -491,10 +545,15 @@ def run_guidance(
     run = _Run(model, q, opt, L, progress, rule)
     if run.limit_stop(q, None):
         return run.result(notes)
-    for si, spec in enumerate(stages):
-        run.run_stage(si, spec, per_stage[si])
-        if run.stop_event is not None:
-            break
+    try:
+        for si, spec in enumerate(stages):
+            run.run_stage(si, spec, per_stage[si])
+            if run.stop_event is not None:
+                break
+    except KeyboardInterrupt as exc:
+        if isinstance(exc, GuidanceInterrupted):
+            raise
+        raise GuidanceInterrupted(run.gstep, run.total_planned) from None
     return run.result(notes)
 
 
