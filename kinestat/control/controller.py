@@ -411,6 +411,37 @@ def _stop(state: ControllerState, label: str, reason: str, **kw) -> tuple[Comman
     return Command(kind="stop", label=label, reason=reason, **kw), replace(state, done=True)
 
 
+@dataclass(frozen=True)
+class Refusal:
+    """Why a move was not commanded: ``reason`` and the extra fields of the stop command."""
+
+    reason: str
+    extra: dict
+
+
+def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target,
+                 counts_now, *, label: str, action: str, step: float, rotation_deg: float,
+                 info: dict) -> Command | Refusal:
+    """The move onto target ``new``: its axis counts by the closed form (Vibhute App. C, with
+    the vernier when asked), checked against the envelope's joint limits, per-command step and
+    predicted platform state (:func:`~kinestat.control.envelope.check_command`); or the
+    :class:`Refusal` that stops the run. One path for every task and procedure."""
+    try:
+        counts, _ = _solve_counts(model, new, meas.q, counts_now, vernier)
+    except (UnreachableError, JointLimitError) as exc:
+        return Refusal(f"{action} target not reachable: {exc}", {})
+    axis_deg = counts * model.axis_deg_per_count
+    q_new = axis_counts_to_q(model, counts)
+    pred = predict(model, meas, puma762.forward(q_new).pose)
+    bad = check_command(envelope, model, axis_deg, counts_now * model.axis_deg_per_count, pred)
+    if bad:
+        return Refusal(f"{action} command refused by the envelope: " + "; ".join(bad),
+                       {"violations": tuple(bad), "prediction": pred})
+    return Command(kind="move", label=label, action=action, target=new, axis_counts=counts,
+                   axis_deg=axis_deg, q=q_new, step=step, rotation_deg=rotation_deg,
+                   prediction=pred, **info)
+
+
 def decide(config: ControllerConfig, state: ControllerState,
            meas: Measurement) -> tuple[Command, ControllerState]:
     """One cycle of the kinestatic procedure: the next command and the new state.
@@ -485,22 +516,10 @@ def decide(config: ControllerConfig, state: ControllerState,
                      + (f"; the fixed {config.step:g} mm step is too coarse for this stiffness "
                         "— use method 'stiffness' or a smaller step"
                         if config.method == "fixed" else ""), **info)
-    try:
-        counts, _ = _solve_counts(model, new, meas.q, state.axis_counts, config.vernier)
-    except (UnreachableError, JointLimitError) as exc:
-        return _stop(replace(st, label=label), label, f"{action} target not reachable: {exc}",
-                     **info)
-    axis_deg = counts * model.axis_deg_per_count
-    q_new = axis_counts_to_q(model, counts)
-    pred = predict(model, meas, puma762.forward(q_new).pose)
-    bad = check_command(env, model, axis_deg, state.axis_counts * model.axis_deg_per_count, pred)
-    if bad:
-        return _stop(replace(st, label=label), label, f"{action} command refused by the "
-                     "envelope: " + "; ".join(bad), violations=tuple(bad), prediction=pred,
-                     **info)
-    cmd = Command(kind="move", label=label, action=action, target=new, axis_counts=counts,
-                  axis_deg=axis_deg, q=q_new, step=step, rotation_deg=rotation, prediction=pred,
-                  **info)
-    new_state = replace(st, label=label, last_action=action, target=new, axis_counts=counts,
-                        history=state.history + (key,))
+    cmd = move_command(model, env, config.vernier, meas, new, state.axis_counts, label=label,
+                       action=action, step=step, rotation_deg=rotation, info=info)
+    if isinstance(cmd, Refusal):
+        return _stop(replace(st, label=label), label, cmd.reason, **cmd.extra, **info)
+    new_state = replace(st, label=label, last_action=action, target=new,
+                        axis_counts=cmd.axis_counts, history=state.history + (key,))
     return cmd, new_state

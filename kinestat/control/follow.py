@@ -58,25 +58,22 @@ from kinestat.control.controller import (
     Command,
     ControllerConfig,
     ControllerState,
+    Refusal,
     Target,
-    _solve_counts,
-    axis_counts_to_q,
+    move_command,
 )
 from kinestat.control.envelope import (
     Envelope,
-    check_command,
     check_measurement,
     check_motion,
-    predict,
 )
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
-from kinestat.errors import InputError, JointLimitError, UnreachableError
+from kinestat.errors import InputError
 from kinestat.parallel.kinestatic import compose_twist
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
-from kinestat.serial import puma762
 from kinestat.spatial.se3 import twist_exp
 from kinestat.spatial.transforms import apply, inv, skew
 
@@ -505,26 +502,14 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
 def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Target, label: str,
              action: str, step: float, rotation_deg: float,
              kw: dict) -> tuple[Command, FollowState]:
-    """Solve ``new`` to counts, check it against the envelope, build the move."""
+    """Command ``new`` through the shared move path (or stop)."""
     base = config.base
-    model = base.model
-    try:
-        counts, _ = _solve_counts(model, new, meas.q, st.axis_counts, base.vernier)
-    except (UnreachableError, JointLimitError) as exc:
-        return _stop(st, label, f"{action} target not reachable: {exc}", **kw)
-    axis_deg = counts * model.axis_deg_per_count
-    q_new = axis_counts_to_q(model, counts)
-    pred = predict(model, meas, puma762.forward(q_new).pose)
-    bad = check_command(base.envelope, model, axis_deg,
-                        st.axis_counts * model.axis_deg_per_count, pred)
-    if bad:
-        return _stop(st, label, f"{action} command refused by the envelope: " + "; ".join(bad),
-                     violations=tuple(bad), prediction=pred, **kw)
-    cmd = Command(kind="move", label=label, action=action, target=new, axis_counts=counts,
-                  axis_deg=axis_deg, q=q_new, step=step, rotation_deg=rotation_deg,
-                  prediction=pred, **kw)
-    return cmd, replace(st, label=label, last_action=action, target=new, axis_counts=counts,
-                        step=step if action == "follow" else 0.0)
+    cmd = move_command(base.model, base.envelope, base.vernier, meas, new, st.axis_counts,
+                       label=label, action=action, step=step, rotation_deg=rotation_deg, info=kw)
+    if isinstance(cmd, Refusal):
+        return _stop(st, label, cmd.reason, **cmd.extra, **kw)
+    return cmd, replace(st, label=label, last_action=action, target=new,
+                        axis_counts=cmd.axis_counts, step=step if action == "follow" else 0.0)
 
 
 def follow_summary(cycles: list[dict], target_force: float, travel: float) -> dict:

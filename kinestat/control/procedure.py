@@ -45,15 +45,14 @@ from kinestat.control.controller import (
     Command,
     ControllerConfig,
     ControllerState,
+    Refusal,
     Target,
-    _solve_counts,
     _stop,
-    axis_counts_to_q,
+    move_command,
 )
-from kinestat.control.envelope import check_command, check_measurement, predict
+from kinestat.control.envelope import check_measurement
 from kinestat.control.wrench import Measurement
-from kinestat.errors import InputError, JointLimitError, UnreachableError
-from kinestat.serial import puma762
+from kinestat.errors import InputError
 
 __all__ = ["decide_thesis"]
 
@@ -124,25 +123,13 @@ def decide_thesis(config: ControllerConfig, state: ControllerState,
 
 
 def _move(config, state, st, label, action, new, meas, step, rotation, contact, info):
-    """Solve, check against the envelope and command ``new`` (or stop)."""
-    model = config.model
-    try:
-        counts, _ = _solve_counts(model, new, meas.q, state.axis_counts, config.vernier)
-    except (UnreachableError, JointLimitError) as exc:
-        return _stop(replace(st, label=label), label, f"{action} target not reachable: {exc}",
-                     **info)
-    axis_deg = counts * model.axis_deg_per_count
-    q_new = axis_counts_to_q(model, counts)
-    pred = predict(model, meas, puma762.forward(q_new).pose)
-    bad = check_command(config.envelope, model, axis_deg,
-                        state.axis_counts * model.axis_deg_per_count, pred)
-    if bad:
-        return _stop(replace(st, label=label), label, f"{action} command refused by the "
-                     "envelope: " + "; ".join(bad), violations=tuple(bad), prediction=pred,
-                     **info)
-    cmd = Command(kind="move", label=label, action=action, target=new, axis_counts=counts,
-                  axis_deg=axis_deg, q=q_new, step=step, rotation_deg=rotation, prediction=pred,
-                  **info)
+    """Command ``new`` through the shared move path (or stop)."""
+    cmd = move_command(config.model, config.envelope, config.vernier, meas, new,
+                       state.axis_counts, label=label, action=action, step=step,
+                       rotation_deg=rotation, info=info)
+    if isinstance(cmd, Refusal):
+        return _stop(replace(st, label=label), label, cmd.reason, **cmd.extra, **info)
     reoriented = state.reoriented or action == "reorient" or contact
-    return cmd, replace(st, label=label, last_action=action, target=new, axis_counts=counts,
-                        history=state.history + (new.key(),), reoriented=reoriented)
+    return cmd, replace(st, label=label, last_action=action, target=new,
+                        axis_counts=cmd.axis_counts, history=state.history + (new.key(),),
+                        reoriented=reoriented)
