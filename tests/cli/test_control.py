@@ -11,26 +11,20 @@ from kinestat.app import sim_cell as harness_mod
 from kinestat.app.control_run import DEFAULT_START, default_plane
 from kinestat.cli.main import main
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
-from kinestat.devices.cell_io import MotionProfile
-from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
 from kinestat.hardware.leg_calibration import THESIS_CALIBRATION
 from kinestat.parallel.platform import special_6_6
 from kinestat.sim.contact import make_cell
 from kinestat.sim.sensor import Sensor
-
-FAST = MotionProfile(speed=tuple(20 * np.asarray(THESIS_SPEED_MAX)),
-                     accel=tuple(400 * np.asarray(THESIS_ACCEL)))
+from tests.cli._cell_helpers import json_of, use_fast_moves
 
 
 @pytest.fixture(autouse=True)
 def fast_robot(monkeypatch):
     """Command fast moves (a few ms each) by default, to keep the tests short."""
-    monkeypatch.setattr(MotionProfile.__init__, "__defaults__", (FAST.speed, FAST.accel))
+    use_fast_moves(monkeypatch)
 
 
-def _json(capsys) -> dict:
-    out = capsys.readouterr().out
-    return json.loads(out[out.index("{"):])
+_json = json_of
 
 
 def test_default_run_reports_and_plots(tmp_path, capsys, monkeypatch):

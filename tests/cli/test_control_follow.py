@@ -4,22 +4,17 @@ from __future__ import annotations
 
 import json
 
-import numpy as np
 import pytest
 
 from kinestat.cli.control import _workpiece
 from kinestat.cli.main import main
-from kinestat.devices.cell_io import MotionProfile
-from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
 from kinestat.errors import InputError
-
-FAST = MotionProfile(speed=tuple(20 * np.asarray(THESIS_SPEED_MAX)),
-                     accel=tuple(400 * np.asarray(THESIS_ACCEL)))
+from tests.cli._cell_helpers import use_fast_moves
 
 
 @pytest.fixture(autouse=True)
 def fast_robot(monkeypatch):
-    monkeypatch.setattr(MotionProfile.__init__, "__defaults__", (FAST.speed, FAST.accel))
+    use_fast_moves(monkeypatch)
 
 
 def test_follow_cylinder_json_and_plots(tmp_path, capsys):

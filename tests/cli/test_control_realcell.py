@@ -9,21 +9,15 @@ import numpy as np
 import pytest
 
 from kinestat.cli.main import main
-from kinestat.devices.cell_io import MotionProfile
-from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
-
-FAST = MotionProfile(speed=tuple(20 * np.asarray(THESIS_SPEED_MAX)),
-                     accel=tuple(400 * np.asarray(THESIS_ACCEL)))
+from tests.cli._cell_helpers import json_of, use_fast_moves
 
 
 @pytest.fixture(autouse=True)
 def fast_robot(monkeypatch):
-    monkeypatch.setattr(MotionProfile.__init__, "__defaults__", (FAST.speed, FAST.accel))
+    use_fast_moves(monkeypatch)
 
 
-def _json(capsys) -> dict:
-    out = capsys.readouterr().out
-    return json.loads(out[out.index("{"):])
+_json = json_of
 
 
 def test_files_thesis_procedure_and_the_new_report_keys(tmp_path, capsys):

@@ -30,6 +30,7 @@ from kinestat.parallel.platform import special_6_6
 from kinestat.serial.puma762 import AXIS_LIMITS_DEG
 from kinestat.sim.contact import make_cell
 from kinestat.sim.sensor import Sensor
+from tests.cli._cell_helpers import wait_until
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -40,12 +41,7 @@ def _cli(*args: str, cwd: Path) -> subprocess.Popen:
                             env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
 
 
-def _wait(pred, timeout: float, what: str) -> None:
-    t_end = time.monotonic() + timeout
-    while not pred():
-        if time.monotonic() > t_end:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.005)
+_wait = wait_until
 
 
 def _json_head(proc: subprocess.Popen) -> dict:

@@ -20,16 +20,12 @@ import pytest
 from kinestat.control.log import read_log
 from kinestat.sim.dmc import DmcSimulator
 from kinestat.sim.galil_server import GalilSimServer
+from tests.cli._cell_helpers import wait_until
 
 ROOT = Path(__file__).resolve().parents[2]
 
 
-def _wait(pred, timeout: float, what: str) -> None:
-    t_end = time.monotonic() + timeout
-    while not pred():
-        if time.monotonic() > t_end:
-            raise AssertionError(f"timed out waiting for {what}")
-        time.sleep(0.005)
+_wait = wait_until
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
