@@ -34,8 +34,6 @@ from kinestat.hardware.puma762_axes import (
     joint_rad_to_counts,
     round_half_away,
 )
-from kinestat.sim.dmc import DmcSimulator, SimClock
-from kinestat.sim.galil_server import GalilSimServer
 
 counts6 = st.lists(st.integers(-10_000_000, 10_000_000), min_size=6, max_size=6)
 
@@ -132,18 +130,6 @@ def test_parse_numbers():
 # ----------------------------------------------------------------------------- client
 
 
-@pytest.fixture
-def sim():
-    clock = SimClock(step_per_command=0.002)
-    ctrl = DmcSimulator(clock=clock, record=True)
-    with GalilSimServer(controller=ctrl) as server:
-        yield server
-
-
-@pytest.fixture
-def client(sim):
-    with GalilClient("127.0.0.1", sim.port, timeout=1.0) as g:
-        yield g
 
 
 def test_move_completes_with_trapezoidal_profile(sim, client):

@@ -13,21 +13,8 @@ from kinestat.devices.galil_replies import expects_data, match_reply, split_repl
 from kinestat.devices.motion_check import check_arrival
 from kinestat.devices.safe_stop import send_stop
 from kinestat.errors import DeviceError, ProtocolError
-from kinestat.sim.dmc import DmcSimulator, SimClock
+from kinestat.sim.dmc import DmcSimulator
 from kinestat.sim.galil_server import GalilSimServer
-
-
-@pytest.fixture
-def sim():
-    ctrl = DmcSimulator(clock=SimClock(step_per_command=0.002), record=True)
-    with GalilSimServer(controller=ctrl) as server:
-        yield server
-
-
-@pytest.fixture
-def client(sim):
-    with GalilClient("127.0.0.1", sim.port, timeout=1.0) as g:
-        yield g
 
 
 def _wait_for_bytes(client: GalilClient, timeout: float = 1.0) -> None:
