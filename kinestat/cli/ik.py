@@ -8,6 +8,13 @@ import numpy as np
 import typer
 
 from kinestat.cli._compile import compiling_notice
+from kinestat.cli._model import (
+    base_option,
+    length_unit_option,
+    load_model,
+    scale_option,
+    tip_option,
+)
 from kinestat.cli._options import (
     POSE_FILE_METAVAR,
     Q_METAVAR,
@@ -41,8 +48,8 @@ def _deg(x) -> list[float]:
 
 def ik_command(
     model: str = typer.Argument(
-        ..., help="puma762 (closed form with --tool-point/--s6/--a67) or any model name or TOML "
-        "file (numerical, with --pose)."
+        ..., help="puma762 (closed form with --tool-point/--s6/--a67) or any model name, TOML "
+        "or URDF file (numerical, or every analytic solution with --all, with --pose)."
     ),
     tool_point: str = typer.Option(
         None, "--tool-point", help="PUMA 762: P_tool_F, the tool point in the fixed frame, x,y,z "
@@ -88,6 +95,10 @@ def ik_command(
     ignore_limits: bool = flag(
         False, "--ignore-limits", help="Numerical IK: ignore the model's joint limits."
     ),
+    tip: str = tip_option(),
+    base: str = base_option(),
+    scale: float = scale_option(),
+    length_unit: str = length_unit_option(),
     as_json: bool = json_option(),
 ) -> None:
     """Joint angles that reach a pose.
@@ -110,7 +121,8 @@ def ik_command(
     if pose is None:
         raise InputError("give the target: --pose for any model, or --tool-point, --s6 and "
                          "--a67 for the PUMA 762 closed form")
-    _numerical(model, pose, q0_deg, restarts, max_iter, seed, ignore_limits, as_json)
+    m = load_model(model, tip, base, scale, length_unit)
+    _numerical(m, pose, q0_deg, restarts, max_iter, seed, ignore_limits, as_json)
 
 
 def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_axis_deg,

@@ -60,9 +60,9 @@ def test_q0_and_moves_and_joint_rates(capsys):
 
 
 def test_joint_limit_stop_prints_the_table_and_exits_2(capsys, tmp_path):
-    from kinestat.io.library import _models_dir
+    from kinestat.io.library import embedded_text
 
-    text = (_models_dir() / "nadkarni-config2.toml").read_text()
+    text = embedded_text("models", "nadkarni-config2.toml")
     text = text.replace('name = "4"\ntype = "revolute"', 'name = "4"\ntype = "revolute"\n'
                         'limits = [-180.0, 30.0]')
     assert "limits" in text
