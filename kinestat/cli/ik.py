@@ -113,7 +113,7 @@ def ik_command(
     "singular_families": [...], "selected" (with --current-deg)}.
 
     Any model, numerically (--pose): JSON {"q", "q_deg", "success", "position_error",
-    "rotation_error", "iterations", "attempts"}.
+    "rotation_error", "iterations", "attempts", "joint_names"}.
 
     Any 6R arm, every solution (--pose --all): JSON {"solutions": [{"q", "q_deg", "residual",
     "within_limits", "singular"}], "singular_families", "selected", "reason", "method",
@@ -290,6 +290,7 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
         "model": m.name,
         "method": "numerical",
         "length_unit": m.length_unit,
+        "joint_names": [j.name for j in m.joints],
         "q": r.q,
         "q_deg": q_deg,
         "success": r.success,

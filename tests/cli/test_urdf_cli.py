@@ -80,3 +80,12 @@ def test_urdf_errors_are_one_line(capsys, args, msg):
 def test_urdf_options_on_a_toml_model_are_refused(capsys):
     assert main(["fk", "puma560", "--tip", "x", "--q-deg", "0,0,0,0,0,0"]) == 2
     assert "not a .urdf file" in capsys.readouterr().err
+
+
+def test_numerical_ik_json_names_the_joints(capsys):
+    path = arm_path("ur5")
+    m = kinestat.load(path, tip="tool0")
+    T = kinestat.fk(m, [0.1, -1.0, 1.2, -0.3, 0.9, 0.4])
+    pose = ",".join(f"{v:.17g}" for v in T.ravel())
+    out = _json(capsys, "ik", path, "--tip", "tool0", "--pose", pose)
+    assert out["joint_names"] == [j.name for j in m.joints]
