@@ -89,7 +89,7 @@ def ik_command(
         None, "--q0-deg", help="Numerical IK start: joint values, rotating joints in degrees.",
         metavar=Q_METAVAR
     ),
-    restarts: int = typer.Option(20, "--restarts", help="Numerical IK: random restarts."),
+    restarts: int = typer.Option(100, "--restarts", help="Numerical IK: random restarts."),
     max_iter: int = typer.Option(100, "--max-iter", help="Numerical IK: iterations per attempt."),
     seed: int = typer.Option(0, "--seed", help="Numerical IK: seed of the random restarts."),
     ignore_limits: bool = flag(
