@@ -89,3 +89,11 @@ def test_numerical_ik_json_names_the_joints(capsys):
     pose = ",".join(f"{v:.17g}" for v in T.ravel())
     out = _json(capsys, "ik", path, "--tip", "tool0", "--pose", pose)
     assert out["joint_names"] == [j.name for j in m.joints]
+
+
+def test_view_model_of_a_urdf(tmp_path, capsys):
+    out = tmp_path / "ur5.html"
+    assert main(["view", "model", str(arm_path("ur5")), "--tip", "tool0", "--q-deg",
+                 "0,-90,90,0,90,0", "--html", str(out)]) == 0
+    text = out.read_text(encoding="utf-8")
+    assert "shoulder_pan_joint" in text and "wrist_3_joint" in text
