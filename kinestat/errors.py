@@ -102,3 +102,8 @@ class StopRequested(KeyboardInterrupt):
 
 class ClusterError(KinestatError):
     """A study's compute cluster failed: the Dask scheduler unreachable, no workers joined."""
+
+
+class KinestatWarning(UserWarning):
+    """Something kinestat did that may not be what was meant (e.g. a URDF whose lengths look
+    like millimetres); the CLI prints it as one line on stderr."""

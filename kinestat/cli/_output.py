@@ -145,7 +145,11 @@ def parse_pose(value: str, option: str = "pose", *, allow_batch: bool = False) -
     """A pose option's value: a pose file (JSON, TOML or numbers; :mod:`kinestat.io.posefile`)
     or 16 comma-separated numbers (a 4x4 matrix, row by row)."""
     p = Path(value)
-    if p.is_file() or p.suffix.lower() in (".json", ".toml"):
+    try:
+        is_file = p.is_file()
+    except OSError:  # e.g. 16 numbers written in full are too long for a file name
+        is_file = False
+    if is_file or p.suffix.lower() in (".json", ".toml"):
         if not p.exists():
             raise InputError(f"--{option}: file {value!r} does not exist")
         return read_pose_file(p, allow_batch=allow_batch)

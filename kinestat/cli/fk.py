@@ -7,6 +7,14 @@ from __future__ import annotations
 import numpy as np
 import typer
 
+from kinestat.cli._model import (
+    MODEL_HELP,
+    base_option,
+    length_unit_option,
+    load_model,
+    scale_option,
+    tip_option,
+)
 from kinestat.cli._options import Q_METAVAR, XYZ_METAVAR, command_help, flag, json_option, units
 from kinestat.cli._output import console, literal, parse_floats, print_json, table
 from kinestat.errors import InputError
@@ -20,7 +28,7 @@ def register(app: typer.Typer) -> None:
 
 
 def fk_command(
-    model: str = typer.Argument(..., help="Embedded model name (e.g. puma762) or a TOML file."),
+    model: str = typer.Argument(..., help=MODEL_HELP),
     q: str = typer.Option(None, "--q", help="Joint values, comma-separated (radians / length).",
                           metavar=Q_METAVAR),
     q_deg: str = typer.Option(
@@ -36,6 +44,10 @@ def fk_command(
         "zyx extrinsic).", metavar="SEQ"
     ),
     frames: bool = flag(False, "--frames", help="Also report every link frame."),
+    tip: str = tip_option(),
+    base: str = base_option(),
+    scale: float = scale_option(),
+    length_unit: str = length_unit_option(),
     as_json: bool = json_option(),
 ) -> None:
     """Pose of the end frame T_base_end and the tool point; for the PUMA 762 also P_tool_F,
@@ -46,11 +58,10 @@ def fk_command(
     "s6" and "a67" for the puma762 model, "z_base_end" and "x_base_end" for any other model
     (+ "frames" with --frames, "warning" outside the joint limits).
     """
-    import kinestat  # lazy: pulls in numba and scipy; keeps `kinestat --help` fast
     from kinestat.serial.fk import fk_frames  # lazy: as above
     from kinestat.spatial.euler import euler_from_matrix  # lazy: scipy
 
-    m = kinestat.load(model)
+    m = load_model(model, tip, base, scale, length_unit)
     if (q is None) == (q_deg is None):
         raise InputError("give the joint values with exactly one of --q or --q-deg")
     vals = parse_floats(q if q is not None else q_deg, m.n, "q" if q is not None else "q-deg")

@@ -21,6 +21,13 @@ from kinestat.cli._guidance import (
     progress_reporter,
     singular_mode,
 )
+from kinestat.cli._model import (
+    base_option,
+    length_unit_option,
+    load_model,
+    scale_option,
+    tip_option,
+)
 from kinestat.cli._options import (
     POINTS3_METAVAR,
     POSE_FILE_METAVAR,
@@ -157,8 +164,8 @@ def _rates(result, speed: float) -> tuple[np.ndarray, list[int]]:
 
 
 def guide(
-    model: str = typer.Argument(..., help="A TOML model file or an embedded model name "
-                                "(nadkarni-config1, nadkarni-config2, puma762, …)."),
+    model: str = typer.Argument(..., help="A TOML model file, a URDF file or an embedded "
+                                "model name (nadkarni-config1, nadkarni-config2, puma762, …)."),
     to_pose: list[str] = typer.Option(None, "--to-pose", metavar=POSE_FILE_METAVAR,
                                       help="Target hand pose T_base_hand: a pose file or 16 "
                                       "comma-separated numbers (row by row); repeatable. "
@@ -197,6 +204,10 @@ def guide(
                                 "(Nadkarni suggestion 1): deg/s of rotation, or length/s for a "
                                 "pure translation."),
     view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
+    tip: str = tip_option(),
+    base: str = base_option(),
+    scale: float = scale_option(),
+    length_unit: str = length_unit_option(),
     as_json: bool = json_option(),
     plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png here.",
                               metavar="DIR"),
@@ -210,14 +221,13 @@ def guide(
     table up to that point is printed first.
     """
     from kinestat.disp import result_record  # lazy: start-up (numba)
-    from kinestat.io.library import load  # lazy: start-up (`kinestat --help`)
     from kinestat.serial.guidance.rules import GuidanceOptions  # lazy: start-up (numba)
     from kinestat.serial.guidance.run import run_guidance  # lazy: start-up (numba)
     from kinestat.serial.guidance.stages import PATH_TYPES  # lazy: start-up (numba)
 
     if kind not in PATH_TYPES:
         raise InputError(f"--type must be one of {', '.join(PATH_TYPES)}, got {kind!r}")
-    m = load(model)
+    m = load_model(model, tip, base, scale, length_unit)
     if q0_deg is None:
         q0 = np.array(m.q_home, dtype=float)
     else:

@@ -8,6 +8,13 @@ import numpy as np
 import typer
 
 from kinestat.cli._compile import compiling_notice
+from kinestat.cli._model import (
+    base_option,
+    length_unit_option,
+    load_model,
+    scale_option,
+    tip_option,
+)
 from kinestat.cli._options import (
     POSE_FILE_METAVAR,
     Q_METAVAR,
@@ -41,8 +48,8 @@ def _deg(x) -> list[float]:
 
 def ik_command(
     model: str = typer.Argument(
-        ..., help="puma762 (closed form with --tool-point/--s6/--a67) or any model name or TOML "
-        "file (numerical, with --pose)."
+        ..., help="puma762 (closed form with --tool-point/--s6/--a67) or any model name, TOML "
+        "or URDF file (numerical, or every analytic solution with --all, with --pose)."
     ),
     tool_point: str = typer.Option(
         None, "--tool-point", help="PUMA 762: P_tool_F, the tool point in the fixed frame, x,y,z "
@@ -82,12 +89,21 @@ def ik_command(
         None, "--q0-deg", help="Numerical IK start: joint values, rotating joints in degrees.",
         metavar=Q_METAVAR
     ),
-    restarts: int = typer.Option(20, "--restarts", help="Numerical IK: random restarts."),
+    restarts: int = typer.Option(100, "--restarts", help="Numerical IK: random restarts."),
     max_iter: int = typer.Option(100, "--max-iter", help="Numerical IK: iterations per attempt."),
     seed: int = typer.Option(0, "--seed", help="Numerical IK: seed of the random restarts."),
     ignore_limits: bool = flag(
         False, "--ignore-limits", help="Numerical IK: ignore the model's joint limits."
     ),
+    all_solutions: bool = flag(
+        False, "--all", help="With --pose: every analytic solution of a 6R arm (kinestat.ik_all) "
+        "and the one nearest --current-deg (or --q0-deg; default the model's home) within the "
+        "limits."
+    ),
+    tip: str = tip_option(),
+    base: str = base_option(),
+    scale: float = scale_option(),
+    length_unit: str = length_unit_option(),
     as_json: bool = json_option(),
 ) -> None:
     """Joint angles that reach a pose.
@@ -97,9 +113,17 @@ def ik_command(
     "singular_families": [...], "selected" (with --current-deg)}.
 
     Any model, numerically (--pose): JSON {"q", "q_deg", "success", "position_error",
-    "rotation_error", "iterations", "attempts"}.
+    "rotation_error", "iterations", "attempts", "joint_names"}.
+
+    Any 6R arm, every solution (--pose --all): JSON {"solutions": [{"q", "q_deg", "residual",
+    "within_limits", "singular"}], "singular_families", "selected", "reason", "method",
+    "units"}; an unreachable pose gives no solution, the reason, and exit status 0.
     """
     closed = any(v is not None for v in (tool_point, s6, a67))
+    if all_solutions:
+        _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg,
+                     (tip, base, scale, length_unit), as_json)
+        return
     if closed and pose is not None:
         raise InputError("give either --pose (numerical IK) or --tool-point/--s6/--a67 "
                          "(PUMA 762 closed form), not both")
@@ -110,7 +134,8 @@ def ik_command(
     if pose is None:
         raise InputError("give the target: --pose for any model, or --tool-point, --s6 and "
                          "--a67 for the PUMA 762 closed form")
-    _numerical(model, pose, q0_deg, restarts, max_iter, seed, ignore_limits, as_json)
+    m = load_model(model, tip, base, scale, length_unit)
+    _numerical(m, pose, q0_deg, restarts, max_iter, seed, ignore_limits, as_json)
 
 
 def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_axis_deg,
@@ -266,6 +291,7 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
         "model": m.name,
         "method": "numerical",
         "length_unit": m.length_unit,
+        "joint_names": [j.name for j in m.joints],
         "q": r.q,
         "q_deg": q_deg,
         "success": r.success,
@@ -295,3 +321,107 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
             "reported above); try another --q0-deg, more --restarts, or check that the pose "
             "is reachable within the joint limits"
         )
+
+
+def _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg, urdf,
+                 as_json) -> None:
+    """``kinestat ik MODEL --pose ... --all``: every analytic solution (docs/ik-all.md)."""
+    from kinestat.serial.analytic import ik_all, select_nearest  # lazy: numba kernels
+
+    if closed or current_axis_deg is not None:
+        raise InputError("--all goes with --pose (--tool-point/--s6/--a67 and "
+                         "--current-axis-deg are the PUMA 762 closed form's options)")
+    if pose is None:
+        raise InputError("--all needs the target pose: --pose")
+    if current_deg is not None and q0_deg is not None:
+        raise InputError("give the reference configuration once: --current-deg or --q0-deg")
+    m = load_model(model, *urdf)
+    T = _read_poses(pose)
+    ref_text, ref_name = (current_deg, "current-deg") if current_deg is not None else \
+        (q0_deg, "q0-deg")
+    ref = m.q_home
+    if ref_text is not None:
+        v = parse_floats(ref_text, m.n, ref_name)
+        ref = np.where(m.prismatic, v, np.radians(v))
+    res = ik_all(m, T)
+    sel = select_nearest(m, res, ref)
+    records = [_all_record(m, res, sel, i, ref) for i in np.ndindex(res.shape)]
+    head = {"model": m.name, "method": res.method, "length_unit": m.length_unit,
+            "joint_names": [j.name for j in m.joints]}
+    if as_json:
+        body = records[0] if T.ndim == 2 else {"targets": records}
+        print_json({**head, **body, "units": units(m.length_unit)})
+        return
+    for k, rec in enumerate(records):
+        _print_all(m, rec, res.method, None if T.ndim == 2 else k)
+
+
+def _all_record(m, res, sel, i: tuple, ref: np.ndarray) -> dict:
+    """The JSON record of one pose's solutions (``i`` indexes the batch)."""
+    from kinestat.serial.analytic import wrap_to_limits  # lazy: numba kernels
+
+    rot = ~m.prismatic
+    names = [f"joint {j.name}" if j.name.isdigit() else j.name for j in m.joints]
+    out: dict = {"solutions": [], "singular_families": [], "n_solutions": int(res.n_solutions[i]),
+                 "reference_q_deg": _q_deg(m, ref)}
+    for k in np.flatnonzero(res.valid[i]):
+        q = res.q[i][k]
+        _, ok = wrap_to_limits(q, ref, m.lower, m.upper, rot)
+        out["solutions"].append({
+            "q": q, "q_deg": _q_deg(m, q),
+            "residual": {"position": float(res.position_error[i][k]),
+                         "rotation": float(res.rotation_error[i][k])},
+            "within_limits": bool(np.all(ok)), "singular": bool(res.singular[i][k]),
+        })
+        if res.singular[i][k]:
+            a, b = res.family_joints
+            sign = int(res.family_sign[i][k])
+            value = float(res.family_value[i][k])
+            out["singular_families"].append({
+                "solution": len(out["solutions"]) - 1, "joints": [names[a], names[b]],
+                "sign": sign, "value": value, "value_deg": float(np.degrees(value)),
+                "relation": f"{names[a]} {'+' if sign > 0 else '-'} {names[b]} = value "
+                            "(one free parameter; q holds the member with "
+                            f"{names[a]} = 0)",
+            })
+    out["reason"] = str(res.reason[i])  # "" when some solution exists
+    if bool(sel.ok[i]):
+        out["selected"] = {"index": int(np.flatnonzero(res.valid[i]).tolist().index(
+            int(sel.index[i]))), "q": sel.q[i], "q_deg": _q_deg(m, sel.q[i]),
+            "motion": float(sel.motion[i])}
+    else:
+        out["selected"] = None
+        out["selection_error"] = ("no solution" if not out["solutions"] else
+                                  "no solution lies within the joint limits")
+    return out
+
+
+def _q_deg(m, q) -> list[float]:
+    """Joint values with rotating joints in degrees (prismatic: length)."""
+    return [float(v) for v in np.where(m.prismatic, q, np.degrees(np.asarray(q, dtype=float)))]
+
+
+def _print_all(m, rec: dict, method: str, k: int | None) -> None:
+    """The table of ``ik --all`` for one pose (without --json)."""
+    names = [j.name or f"q{i + 1}" for i, j in enumerate(m.joints)]
+    title = (f"{m.name}: every IK solution ({method}; degrees, lengths in {m.length_unit})"
+             + ("" if k is None else f", target {k}"))
+    rows = [[n, *s["q_deg"], f"{s['residual']['position']:.1e}",
+             f"{s['residual']['rotation']:.1e}", "yes" if s["within_limits"] else "no",
+             "family" if s["singular"] else ""] for n, s in enumerate(rec["solutions"])]
+    if rows:
+        console.print(table(title, ["#", *names, "pos err", "rot err", "limits ok", "family"], rows,
+                            fmt="{:.3f}"))
+    else:
+        console.print(f"[bold]{literal(title)}[/]: no solution")
+    for f in rec["singular_families"]:
+        console.print(f"solution {f['solution']} is a family: {literal(f['relation'])}, value "
+                      f"{f['value_deg']:.4f}°")
+    if rec["reason"]:
+        console.print(f"[yellow]unreachable:[/] {literal(rec['reason'])}")
+    sel = rec["selected"]
+    if sel is not None:
+        console.print(f"selected #{sel['index']} (nearest the reference, within limits): "
+                      + ", ".join(f"{v:.4f}" for v in sel["q_deg"]))
+    elif rec["solutions"]:
+        console.print("[red]no solution lies within the joint limits[/]")

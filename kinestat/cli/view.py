@@ -13,6 +13,14 @@ from pathlib import Path
 import numpy as np
 import typer
 
+from kinestat.cli._model import (
+    MODEL_HELP,
+    base_option,
+    length_unit_option,
+    load_model,
+    scale_option,
+    tip_option,
+)
 from kinestat.cli._options import (
     LEGS_METAVAR,
     POINTS3_METAVAR,
@@ -91,17 +99,6 @@ def _emit(scene: dict, out: _Out, model=None) -> None:
     console.print(f"wrote {out.html}")
 
 
-def _load_model(spec: str):
-    import kinestat  # lazy: model loading only for this view
-
-    p = Path(spec)
-    if p.suffix.lower() == ".urdf":
-        from kinestat.io.urdf import read_urdf  # lazy: URDF only for .urdf files
-
-        return read_urdf(p)
-    return kinestat.load(spec)
-
-
 # The output options, repeated on every command (Typer has no shared option groups).
 def _html_opt():
     return typer.Option(None, "--html", help=HTML_HELP, metavar="FILE")
@@ -154,12 +151,16 @@ def view_root(
 
 @view_app.command("model")
 def view_model(
-    model: str = typer.Argument(..., help="Embedded model name, a TOML model or a URDF file."),
+    model: str = typer.Argument(..., help=MODEL_HELP),
     q: str = typer.Option(None, "--q", help="Joint values shown first (radians / length).",
                          metavar=Q_METAVAR),
     q_deg: str = typer.Option(None, "--q-deg", help="Joint values, rotating joints in degrees.",
                               metavar=Q_METAVAR),
     frames: bool = flag(False, "--frames", help="Show every joint frame."),
+    tip: str = tip_option(),
+    base: str = base_option(),
+    scale: float = scale_option(),
+    length_unit: str = length_unit_option(),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),
     no_open: bool = _no_open_opt(),
@@ -168,7 +169,7 @@ def view_model(
     from kinestat.viz.scene import model_scene  # lazy: scenes load only for a view
 
     out = _out_options(html, serve, host, port, no_open, allow_remote)
-    m = _load_model(model)
+    m = load_model(model, tip, base, scale, length_unit)
     if q is not None and q_deg is not None:
         raise InputError("give at most one of --q and --q-deg")
     vals = None

@@ -74,23 +74,45 @@ def list_models() -> list[str]:
     return _embedded_names("models")
 
 
-def load(name_or_path: str | os.PathLike | ChainModel) -> ChainModel:
-    """An embedded model by name (``"puma762"``, ``"puma560"``, ``"nadkarni-config1"``, ...)
-    or a TOML model file by path; a :class:`ChainModel` is returned as it is.
+def load(name_or_path: str | os.PathLike | ChainModel, *, tip: str | None = None,
+         base: str | None = None, scale: float | None = None,
+         length_unit: str | None = None) -> ChainModel:
+    """An embedded model by name (``"puma762"``, ``"puma560"``, ``"nadkarni-config1"``, ...),
+    a TOML model file or a URDF file (``.urdf``) by path; a :class:`ChainModel` is returned as
+    it is.
+
+    For a URDF (docs/urdf.md): the chain from link ``base`` (default: the root) to link ``tip``
+    (default: the only chain's end), lengths in ``length_unit`` (default metres, URDF's unit)
+    or the file's numbers times ``scale`` (see :func:`kinestat.io.urdf.from_urdf`). These
+    options belong to URDF files; with another model they are an InputError.
 
     >>> m = load("puma560")
     >>> m.n, m.length_unit
     (6, 'm')
     """
+    urdf_opts = {"tip": tip, "base": base, "scale": scale, "length_unit": length_unit}
     if isinstance(name_or_path, ChainModel):
+        s = None
+    else:
+        s = os.fspath(name_or_path)
+        if Path(s).suffix.lower() == ".urdf":
+            from kinestat.io.urdf import read_urdf  # lazy: XML and scipy only for URDF files
+
+            if not Path(s).exists():
+                raise InputError(f"URDF file {s!r} does not exist")
+            return read_urdf(s, **urdf_opts)
+    given = [k for k, v in urdf_opts.items() if v is not None]
+    if given:
+        raise InputError(f"{', '.join(given)}: options of URDF models, but {s or 'the model'!r} "
+                         "is not a .urdf file")
+    if s is None:
         return name_or_path
-    s = os.fspath(name_or_path)
     model = _embedded_or_file(s, "model", "models", loads_model, read_model)
     if model is not None:
         return model
     raise InputError(
         f"unknown model {s!r}: not an embedded model ({', '.join(list_models())}) "
-        "and not a TOML file path"
+        "and not a TOML or URDF file path"
     )
 
 

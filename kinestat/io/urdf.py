@@ -4,8 +4,14 @@ Export writes the chain ``C0 · Z(q1) · C1 · … · Z(qn) · Cn`` as links ``b
 ``link<n>`` → ``tool``: joint i has origin ``C_{i-1}`` and axis +z; a fixed joint carries ``Cn``.
 Import follows the chain from the root link to a tip link; a joint whose axis is not +z is
 rotated onto z (``A`` with ``A·z = axis``) so that the model stays in kinestat's canonical form.
-URDF lengths are metres: ``scale`` converts (e.g. ``scale=1e-3`` exports a millimetre model).
-Screw joints have no URDF form and are refused.
+Units: URDF lengths are metres and angles radians, by the format. Export converts the model's
+lengths to metres from its ``length_unit`` (mm, cm, m, in, ft; another unit is refused unless
+``scale`` is given). Import gives metres, or the ``length_unit`` asked for (converted); ``scale``
+multiplies the file's numbers instead (a file written in millimetres: ``scale=1e-3``). A file
+whose joint offsets look like millimetres (one longer than 10 m) raises a
+:class:`~kinestat.errors.KinestatWarning` when no ``scale`` is given.
+A ``<mimic>`` joint on the chain is refused (kinestat has no coupled joints); so are floating and
+planar joints (no single axis). Screw joints have no URDF form and are refused on export.
 """
 
 from __future__ import annotations
@@ -19,12 +25,32 @@ from pathlib import Path
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from kinestat.errors import InputError, ModelError, ParseError
+from kinestat.errors import InputError, KinestatWarning, ModelError, ParseError
 from kinestat.io.textfile import read_text_file
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import Joint
 
-__all__ = ["to_urdf", "from_urdf", "read_urdf"]
+__all__ = ["to_urdf", "from_urdf", "read_urdf", "METRES_PER_UNIT", "metres_per_unit"]
+
+#: metres in one unit of each length unit a model may use
+METRES_PER_UNIT = {"mm": 1e-3, "cm": 1e-2, "m": 1.0, "in": 0.0254, "ft": 0.3048}
+
+#: a joint offset longer than this (file numbers, metres by the format) looks like millimetres
+_MM_SUSPECT = 10.0
+
+
+def metres_per_unit(unit: str, what: str = "length unit") -> float:
+    """Metres in one ``unit`` (mm, cm, m, in, ft); another unit is an InputError.
+
+    >>> metres_per_unit("mm"), metres_per_unit("in")
+    (0.001, 0.0254)
+    """
+    try:
+        return METRES_PER_UNIT[unit]
+    except KeyError:
+        raise InputError(f"{what} {unit!r} cannot be converted to metres: kinestat knows "
+                         f"{', '.join(METRES_PER_UNIT)}; give scale= (--scale) "
+                         "explicitly") from None
 
 
 def _origin(T: np.ndarray, scale: float) -> str:
@@ -36,10 +62,19 @@ def _origin(T: np.ndarray, scale: float) -> str:
     return f'<origin xyz="{xyz}" rpy="{rpy}"/>'
 
 
-def to_urdf(model: ChainModel, *, scale: float = 1.0, name: str | None = None) -> str:
-    """URDF text of a serial chain (lengths multiplied by ``scale``)."""
+def to_urdf(model: ChainModel, *, scale: float | None = None, name: str | None = None) -> str:
+    """URDF text of a serial chain, lengths in metres: converted from ``model.length_unit``
+    (mm, cm, m, in, ft), or multiplied by ``scale`` when it is given (for any other unit).
+
+    >>> from kinestat.mechanism.chain import from_standard_dh
+    >>> arm = from_standard_dh([[0.0, 0.0, 650.0, 0.0]], length_unit="mm")
+    >>> 'xyz="0.65 0 0"' in to_urdf(arm)
+    True
+    """
     if any(j.kind == "screw" for j in model.joints):
         raise ModelError(f"model {model.name!r} has a screw joint, which URDF cannot express")
+    if scale is None:
+        scale = metres_per_unit(model.length_unit, f"model {model.name!r}: length unit")
     lines = [f'<robot name="{name or model.name}">', '  <link name="base"/>']
     C = model.constants
     for i, j in enumerate(model.joints, start=1):
@@ -93,8 +128,43 @@ def _limit(text: str | None, default: float, where: str, source: str) -> float:
     return v
 
 
-def _path_to_tip(root: ET.Element, tip: str | None, source: str) -> list[ET.Element]:
-    """The joints from the root link to ``tip`` (default: the only leaf), root first.
+def _check_joint(j: ET.Element, where: str, source: str) -> None:
+    """A joint kinestat can put on a serial chain, or a ParseError naming it and why not."""
+    jtype = j.get("type")
+    if jtype in ("floating", "planar"):
+        dof = "6 degrees of freedom" if jtype == "floating" else "3 degrees of freedom"
+        raise ParseError(f"{where} is {jtype} ({dof}, no single axis): a serial chain has "
+                         "revolute, continuous, prismatic and fixed joints only; start the "
+                         "chain below it (base=, --base)", file=source)
+    if jtype not in ("revolute", "continuous", "prismatic", "fixed"):
+        raise ParseError(f"{where}: joint type {jtype!r} is not supported in a serial chain",
+                         file=source)
+    mimic = j.find("mimic")
+    if mimic is not None:
+        raise ParseError(f"{where} mimics joint {mimic.get('joint')!r} (<mimic>): kinestat "
+                         "models independent joints only, so coupled joints are refused; end "
+                         "the chain before it (tip=, --tip)", file=source)
+
+
+def _leaves_below(start: str, children: dict[str, list[str]]) -> list[str]:
+    """Leaf links below ``start`` (itself if it has no child), depth first, linear time."""
+    leaves, stack, seen = [], [start], set()
+    while stack:
+        link = stack.pop()
+        if link in seen:
+            continue
+        seen.add(link)
+        kids = children.get(link, [])
+        if not kids:
+            leaves.append(link)
+        stack.extend(reversed(kids))
+    return leaves
+
+
+def _path_to_tip(root: ET.Element, tip: str | None, source: str,
+                 base: str | None = None) -> list[ET.Element]:
+    """The joints from ``base`` (default: the root link) to ``tip`` (default: the only leaf
+    below ``base`` that a moving joint leads to), base first.
 
     Linear in the number of joints. A link that is the child of two joints, or a cycle of
     joints, is a ParseError naming the joint.
@@ -113,22 +183,25 @@ def _path_to_tip(root: ET.Element, tip: str | None, source: str) -> list[ET.Elem
         joint_to[c] = j
         parents_of[c] = parent.get("link")
     links = [lk.get("name") for lk in root.findall("link")]
-    roots = [lk for lk in links if lk not in joint_to]
-    if len(roots) != 1:
-        raise ParseError(f"expected one root link, found {roots[:10]}", file=source)
-    has_child = set(parents_of.values())
-    leaves = [lk for lk in links if lk not in has_child]
+    link_set = set(links)
+    if base is None:
+        roots = [lk for lk in links if lk not in joint_to]
+        if len(roots) != 1:
+            raise ParseError(f"expected one root link, found {roots[:10]}", file=source)
+        base = roots[0]
+    elif base not in link_set:
+        raise ParseError(f"no link named {base!r} (base)", file=source)
     if tip is None:
-        if len(leaves) != 1:
-            raise ParseError(f"several leaf links {leaves[:10]}: choose one with tip=",
-                             file=source)
-        tip = leaves[0]
-    if tip not in set(links):
-        raise ParseError(f"no link named {tip!r}", file=source)
+        tip = _only_leaf(base, joint_to, parents_of, source)
+    if tip not in link_set:
+        raise ParseError(f"no link named {tip!r} (tip)", file=source)
     path: list[ET.Element] = []
     seen: set[str] = set()
     link = tip
-    while link in joint_to:
+    while link != base:
+        if link not in joint_to:
+            raise ParseError(f"link {tip!r} (tip) is not below link {base!r} (base)",
+                             file=source)
         if link in seen:
             raise ParseError(f"joint {joint_to[link].get('name')!r} closes a cycle of joints "
                              f"through link {link!r}; a serial chain has none", file=source)
@@ -137,6 +210,30 @@ def _path_to_tip(root: ET.Element, tip: str | None, source: str) -> list[ET.Elem
         link = parents_of[link]
     path.reverse()
     return path
+
+
+def _only_leaf(base: str, joint_to: dict, parents_of: dict, source: str) -> str:
+    """The one leaf link below ``base`` reached through at least one moving joint; several
+    (or none) is a ParseError listing them."""
+    children: dict[str, list[str]] = {}
+    for child, parent in parents_of.items():
+        children.setdefault(parent, []).append(child)
+    leaves = _leaves_below(base, children)
+
+    def moves(leaf: str) -> bool:
+        link = leaf
+        while link != base and link in joint_to:
+            if joint_to[link].get("type") != "fixed":
+                return True
+            link = parents_of[link]
+        return False
+
+    chains = [lk for lk in leaves if moves(lk)]
+    if len(chains) != 1:
+        raise ParseError(f"{len(chains)} chains below link {base!r}, ending at "
+                         f"{chains[:10] or leaves[:10]}: choose the end link with tip= (--tip)",
+                         file=source)
+    return chains[0]
 
 
 def _pose(xyz: np.ndarray, rpy: np.ndarray) -> np.ndarray:
@@ -177,29 +274,44 @@ def from_urdf(
     text: str,
     *,
     tip: str | None = None,
-    scale: float = 1.0,
+    base: str | None = None,
+    scale: float | None = None,
     name: str | None = None,
-    length_unit: str = "m",
+    length_unit: str | None = None,
     source: str = "<urdf>",
 ) -> ChainModel:
-    """Serial chain from URDF text, from the root link to ``tip`` (default: the only leaf).
+    """Serial chain from URDF text, from link ``base`` (default: the root link) to link ``tip``
+    (default: the only leaf below ``base`` reached through a moving joint).
 
-    Lengths are multiplied by ``scale`` (``scale=1000`` gives millimetres).
+    Units: the model's lengths are in ``length_unit`` (default ``"m"``, URDF's own unit),
+    converted from metres; or the file's numbers times ``scale`` when it is given (a file
+    written in millimetres: ``scale=1e-3``; the model's unit is then ``length_unit`` or "m").
+    Without ``scale``, a joint offset longer than 10 (file numbers) warns that the file looks
+    like millimetres. Angles are radians. A ``<mimic>``, floating or planar joint on the chain
+    is a ParseError naming it.
     """
+    explicit_scale = scale is not None
+    if scale is None:
+        scale = 1.0 / metres_per_unit(length_unit or "m")
+    length_unit = length_unit or "m"
     try:
         root = ET.fromstring(text)
     except ET.ParseError as exc:
         raise ParseError(f"not valid XML: {exc}", file=source) from exc
     if root.tag != "robot":
         raise ParseError("the root element must be <robot>", file=source)
-    path = _path_to_tip(root, tip, source)
+    path = _path_to_tip(root, tip, source, base)
     consts = [np.eye(4)]
     kinds: list[Joint] = []
+    longest = (0.0, "")
     for j in path:
         where = f"joint {j.get('name')!r}"
+        _check_joint(j, where, source)
         o = j.find("origin")
         xyz = _floats(o.get("xyz") if o is not None else None, 3, where + " origin xyz", source)
         rpy = _floats(o.get("rpy") if o is not None else None, 3, where + " origin rpy", source)
+        if float(np.abs(xyz).max()) > longest[0]:
+            longest = (float(np.abs(xyz).max()), str(j.get("name")))
         with np.errstate(over="ignore", invalid="ignore"):
             xyz = xyz * scale
         if not np.all(np.isfinite(xyz)):
@@ -210,9 +322,6 @@ def from_urdf(
         if jtype == "fixed":
             consts[-1] = consts[-1] @ Tj
             continue
-        if jtype not in ("revolute", "continuous", "prismatic"):
-            raise ParseError(f"{where}: joint type {jtype!r} is not supported in a serial chain",
-                             file=source)
         ax = j.find("axis")
         axis = _floats(ax.get("xyz") if ax is not None else "1 0 0", 3, where + " axis", source)
         nrm = np.linalg.norm(axis)
@@ -233,7 +342,12 @@ def from_urdf(
         except InputError as exc:  # limits that are not an interval
             raise ParseError(str(exc), file=source, field=where + " limit") from exc
     if not kinds:
-        raise ModelError(f"{source}: no moving joint between the root and {tip!r}")
+        raise ModelError(f"{source}: no moving joint between {base or 'the root'!r} and {tip!r}")
+    if not explicit_scale and longest[0] > _MM_SUSPECT:
+        warnings.warn(f"{source}: lengths look like millimetres (joint {longest[1]!r} is "
+                      f"{longest[0]:g} from its parent link, URDF lengths are metres); if the "
+                      "file is in millimetres load it with scale=0.001 (--scale 0.001)",
+                      KinestatWarning, stacklevel=2)
     try:
         return ChainModel(name=name or str(root.get("name", "urdf")), joints=tuple(kinds),
                           constants=np.array(consts), length_unit=length_unit)

@@ -59,6 +59,12 @@ __all__ = [
 ]
 
 
+#: default number of random restarts after a stalled attempt. 100 (was 20): on 10^4 random
+#: reachable targets per arm the success rate with 20 was 99.34-100 % (PUMA 560 99.80 %, PUMA 762
+#: 99.72 %, Panda 99.50 %, SO-100 99.34 %), with 100 it is 99.95-100 % (docs/ik.md); restarts
+#: run only after a stall, so a reachable target costs the same, an unreachable one ~5x more.
+DEFAULT_RESTARTS = 100
+
 #: the SO(3) logarithm, :func:`kinestat.spatial.se3.so3_log` (old name)
 rotation_log = so3_log
 
@@ -158,7 +164,7 @@ def ik(
     pos_tol: float | None = None,
     rot_tol: float = 1e-9,
     max_iter: int = 100,
-    restarts: int = 20,
+    restarts: int = DEFAULT_RESTARTS,
     seed: int | None = 0,
     respect_limits: bool = True,
     backend: Backend = "numba",
@@ -295,7 +301,7 @@ def iter_ik(model: ChainModel, poses, q0=None, *, chunk_rows: int = CHUNK_ROWS,
 
 def _ik_chunk(model: ChainModel, T: np.ndarray, q0, key: np.uint64, offset: int, *,
               pos_tol: float | None = None, rot_tol: float = 1e-9, max_iter: int = 100,
-              restarts: int = 20, respect_limits: bool = True,
+              restarts: int = DEFAULT_RESTARTS, respect_limits: bool = True,
               backend: str = "numba") -> IKResult:
     """One chunk of :func:`iter_ik` (compiled path, random streams offset by ``offset``)."""
     Tt = _poses_compiled(T)

@@ -9,9 +9,11 @@ commands cannot run here; each is listed in ``SKIP`` with the reason.
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import re
 import shlex
+from importlib.metadata import PackageNotFoundError, distribution
 from pathlib import Path
 
 import pytest
@@ -82,6 +84,17 @@ def _toml_blocks(path: Path) -> list[str]:
                                                            False) if lang == "toml"]
 
 
+@functools.cache
+def _erd_urdfs() -> dict[str, Path]:
+    """The URDF files of the example-robot-data test dependency, by file name."""
+    try:
+        robots = Path(str(distribution("example-robot-data").locate_file(
+            "cmeel.prefix/share/example-robot-data/robots")))
+    except PackageNotFoundError:
+        return {}
+    return {p.name: p for p in robots.rglob("*.urdf")}
+
+
 FILES = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
 CASES = [(p, n, c) for p in FILES for n, c in _commands(p)]
 
@@ -111,6 +124,9 @@ def test_every_documented_command_runs(doc, tmp_path, monkeypatch):
         if ">" in args:
             k = args.index(">")
             args, target = args[:k], args[k + 1]
+        for a in args:  # a real arm's URDF file that docs/urdf.md copies from example-robot-data
+            if a.endswith(".urdf") and not Path(a).exists() and a in _erd_urdfs():
+                Path(a).write_bytes(_erd_urdfs()[a].read_bytes())
         for a in args:  # a model file written in the same document's ```toml block
             if a.endswith(".toml") and not Path(a).exists():
                 stem = Path(a).stem

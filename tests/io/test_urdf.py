@@ -12,7 +12,7 @@ from kinestat.mechanism.chain import from_standard_dh
 @pytest.mark.parametrize("name", ["puma560", "puma762", "nadkarni-config2"])
 def test_round_trip(name, rng):
     m = kinestat.load(name)
-    m2 = from_urdf(to_urdf(m))
+    m2 = from_urdf(to_urdf(m), length_unit=m.length_unit)  # URDF is metres: convert back
     q = m.q_home + rng.uniform(-1, 1, (20, m.n))
     np.testing.assert_allclose(kinestat.fk(m2, q), kinestat.fk(m, q), atol=1e-9)
     assert [j.kind for j in m2.joints] == [j.kind for j in m.joints]
