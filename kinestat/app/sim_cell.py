@@ -66,10 +66,6 @@ def start_counts(config: ControllerConfig, current_counts=(0, 0, 0, 0, 0, 0)) ->
     return axis_deg_to_counts(np.degrees(sel.axis))
 
 
-
-SOLVE_RETRIES = 4
-"""Most contact solves per emitted packet while the robot moves (:meth:`SimHarness.counts_now`)."""
-
 class CellState:
     """The evolving state of a simulated cell (thread-safe): friction anchor, last solution.
 
@@ -209,21 +205,8 @@ class SimHarness:
         return counts_to_joint_rad(self.server.true_axis_counts())
 
     def counts_now(self) -> np.ndarray:
-        """Leg counts for the emitter: the cell at the robot's true pose, through the sensor.
-
-        The contact solve takes time (more on a loaded machine); if the robot moved meanwhile
-        the packet would describe a pose that is already gone — and one written just after a
-        move ends would pass for a fresh measurement of the new pose. So the pose is read again
-        after the solve and the solve repeated (at most :data:`SOLVE_RETRIES` times) until it
-        did not change: a packet always describes the pose of its own time."""
-        q = self.true_q()
-        for _ in range(SOLVE_RETRIES):
-            counts = self.state.counts(q)
-            q_after = self.true_q()
-            if np.array_equal(q_after, q):
-                break
-            q = q_after
-        return counts
+        """Leg counts for the emitter: the cell at the robot's true pose, through the sensor."""
+        return self.state.counts(self.true_q())
 
     def truth(self) -> dict:
         """The true state now (what the controller cannot see)."""
