@@ -66,6 +66,10 @@ def start_counts(config: ControllerConfig, current_counts=(0, 0, 0, 0, 0, 0)) ->
     return axis_deg_to_counts(np.degrees(sel.axis))
 
 
+
+SIM_STALE_AFTER = 1.0
+"""Staleness limit (s) of the reader on the simulated encoder stream (:meth:`SimHarness.reader`)."""
+
 class CellState:
     """The evolving state of a simulated cell (thread-safe): friction anchor, last solution.
 
@@ -225,9 +229,13 @@ class SimHarness:
         return c
 
     def reader(self, **kw: Any) -> EncoderReader:
-        """An open encoder reader on the emitter's pty (closed with the harness)."""
+        """An open encoder reader on the emitter's pty (closed with the harness).
+
+        Its staleness limit defaults to :data:`SIM_STALE_AFTER`: the simulated encoder box is
+        a thread of this Python process and shares it with the contact solver, so on a loaded
+        machine its packets can be late by more than real hardware's would."""
         kw.setdefault("fmt", self.fmt)
-        kw.setdefault("stale_after", 0.5)
+        kw.setdefault("stale_after", SIM_STALE_AFTER)
         r = EncoderReader(self.serial_path, **kw).open()
         self._opened.append(r)
         return r

@@ -83,6 +83,12 @@ The simulated hardware tolerates a little more so that the envelope, not the sim
 what stops an excessive command."""
 
 
+SLIDE_TOL = 1e-4
+"""Largest force residual (N) accepted for a sliding contact's equilibrium: far below the
+simulated sensor's force resolution (about 0.01 N), so a solve that stops a little short of its
+1e-10 N target near the stick-slip boundary is accepted instead of failing the cell."""
+
+
 def _unit(v, name: str) -> np.ndarray:
     a = as_array(v, shape_tail=(3,), name=name)
     if a.shape != (3,):
@@ -572,7 +578,7 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
     if fns < 0.0:
         return None
     ft_s = fFs - fns * nF
-    if not (np.max(np.abs(r)) <= 1e-8 and np.linalg.norm(ft_s) <= mu * fns * (1.0 + 1e-6)):
+    if not (np.max(np.abs(r)) <= SLIDE_TOL and np.linalg.norm(ft_s) <= mu * fns * (1.0 + 1e-6)):
         raise UnreachableError(
             f"simulated cell: the sliding contact did not settle (friction residual "
             f"{np.max(np.abs(r)):.3g} N)")
