@@ -83,10 +83,11 @@ The simulated hardware tolerates a little more so that the envelope, not the sim
 what stops an excessive command."""
 
 
-SLIDE_TOL = 1e-4
-"""Largest force residual (N) accepted for a sliding contact's equilibrium: far below the
-simulated sensor's force resolution (about 0.01 N), so a solve that stops a little short of its
-1e-10 N target near the stick-slip boundary is accepted instead of failing the cell."""
+SLIDE_TOL = 1e-3
+"""Largest force residual (N) accepted for a sliding contact's equilibrium. One count of a leg
+sensor is about 0.03 N (0.0254 mm at about 1.1 N/mm), so 1e-3 N is invisible in the counts; a
+solve that stops short of its 1e-10 N target near the stick-slip boundary (residuals of 2e-5 and
+2e-4 N were seen) is accepted instead of failing the cell."""
 
 
 def _unit(v, name: str) -> np.ndarray:
