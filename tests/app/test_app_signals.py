@@ -6,10 +6,29 @@ import os
 import signal
 import threading
 
+import numpy as np
 import pytest
 
 from kinestat.app.signals import stop_on_signals
+from kinestat.app.sim_cell import InProcessIO, control_model, start_counts
 from kinestat.errors import StopRequested
+
+
+def _thesis_cell():
+    """The thesis's experiment on the in-process cell: the plate 2.5 mm ahead of the start tool
+    point along F_req, 4 N requested; returns (cell, sensor, controller config)."""
+    from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
+    from kinestat.parallel.platform import special_6_6
+    from kinestat.sim.contact import make_cell
+    from kinestat.sim.sensor import Sensor
+
+    f = np.asarray(THESIS_FORCE_DIRECTION)
+    p0 = np.array([-400.0, 800.0, -100.0])
+    cell = make_cell(special_6_6(), plane_point=p0 + 2.5 * f, plane_normal=-f)
+    sensor = Sensor()
+    cfg = ControllerConfig(model=control_model(cell, sensor, coupling=0.0), force=4.0 * f,
+                           start_tool_point=p0)
+    return cell, sensor, cfg
 
 
 @pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGHUP])
@@ -56,22 +75,10 @@ def test_outside_the_main_thread_nothing_is_installed():
 def test_a_signal_mid_run_stops_the_in_process_cell_with_a_complete_log(tmp_path, sig):
     """The loop over the in-process cell (InProcessIO): the signal arrives while the cell
     moves (here: from inside a move), the run ends in a safe stop."""
-    import numpy as np
-
-    from kinestat.app.sim_cell import InProcessIO, control_model, start_counts
-    from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
     from kinestat.control.log import CycleLog, read_log
     from kinestat.control.loop import run
-    from kinestat.parallel.platform import special_6_6
-    from kinestat.sim.contact import make_cell
-    from kinestat.sim.sensor import Sensor
 
-    f = np.asarray(THESIS_FORCE_DIRECTION)
-    p0 = np.array([-400.0, 800.0, -100.0])
-    cell = make_cell(special_6_6(), plane_point=p0 + 2.5 * f, plane_normal=-f)
-    sensor = Sensor()
-    cfg = ControllerConfig(model=control_model(cell, sensor, coupling=0.0), force=4.0 * f,
-                           start_tool_point=p0)
+    cell, sensor, cfg = _thesis_cell()
     io = InProcessIO(cell, sensor, start_counts=start_counts(cfg))
     real_move = io.move
     moves = []
@@ -96,23 +103,12 @@ def test_a_signal_mid_run_stops_the_in_process_cell_with_a_complete_log(tmp_path
 def test_a_signal_during_the_stop_of_a_fault_does_not_cut_it_short(tmp_path):
     """A device fault starts a safe stop; SIGTERM arrives while ST is being sent (e.g. during
     the reconnection): ST is sent again, the fault and the end are logged."""
-    import numpy as np
 
-    from kinestat.app.sim_cell import InProcessIO, control_model, start_counts
-    from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
     from kinestat.control.log import CycleLog, read_log
     from kinestat.control.loop import run
     from kinestat.errors import DeviceError
-    from kinestat.parallel.platform import special_6_6
-    from kinestat.sim.contact import make_cell
-    from kinestat.sim.sensor import Sensor
 
-    f = np.asarray(THESIS_FORCE_DIRECTION)
-    p0 = np.array([-400.0, 800.0, -100.0])
-    cell = make_cell(special_6_6(), plane_point=p0 + 2.5 * f, plane_normal=-f)
-    sensor = Sensor()
-    cfg = ControllerConfig(model=control_model(cell, sensor, coupling=0.0), force=4.0 * f,
-                           start_tool_point=p0)
+    cell, sensor, cfg = _thesis_cell()
 
     class FaultyIO(InProcessIO):
         stops = 0
