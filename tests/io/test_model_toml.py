@@ -31,6 +31,15 @@ def test_radians_file():
                                kinestat.fk(kinestat.load("puma762"), np.ones(6)))
 
 
+
+def _refused_naming(text: str, where: str | None) -> None:
+    """``text`` is refused with a ParseError naming the file and, when given, ``where``."""
+    with pytest.raises(ParseError) as exc:
+        loads_model(text, source="bad.toml")
+    assert "bad.toml" in str(exc.value)
+    if where:
+        assert where in str(exc.value)
+
 @pytest.mark.parametrize("text,where", [
     ("notation = 'xyz'\n[[joints]]\n", "notation"),
     ("notation = 'standard_dh'\n"
@@ -56,11 +65,7 @@ def test_radians_file():
      "[[joints]]\nd = [\n", None),
 ])
 def test_errors_name_the_field(text, where):
-    with pytest.raises(ParseError) as exc:
-        loads_model(text, source="bad.toml")
-    assert "bad.toml" in str(exc.value)
-    if where:
-        assert where in str(exc.value)
+    _refused_naming(text, where)
 
 
 def test_unknown_model_name():
@@ -120,11 +125,7 @@ _NAD = ("notation = 'nadkarni'\n"
      "[[joints]]\nr = 0\nalpha = 0\na = 1\ntheta = 0\n", None),
 ])
 def test_misplaced_or_malformed_keys_are_refused(text, where):
-    with pytest.raises(ParseError) as exc:
-        loads_model(text, source="bad.toml")
-    assert "bad.toml" in str(exc.value)
-    if where:
-        assert where in str(exc.value)
+    _refused_naming(text, where)
 
 
 def test_screw_joint_with_pitch_still_reads():
