@@ -11,7 +11,6 @@ import time
 import numpy as np
 import pytest
 
-import kinestat
 from kinestat.cli.main import main
 from kinestat.disp import run_deck
 from kinestat.errors import InputError
@@ -19,8 +18,7 @@ from kinestat.io.disp_deck import embedded_deck
 from kinestat.serial.guidance.planners import command_path
 from kinestat.serial.guidance.rules import FirstOrder, GuidanceOptions
 from kinestat.serial.guidance.run import MAX_RUN_STEPS, GuidanceInterrupted, run_guidance
-
-C2 = kinestat.load("nadkarni-config2")
+from tests.serial.guidance._models import C2
 
 
 def _cmd(d: float, angle: float = 0.0):

@@ -10,7 +10,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import kinestat
 from kinestat.errors import InputError, JointLimitError, KinestatError
 from kinestat.mechanism.chain import from_nadkarni
 from kinestat.mechanism.nadkarni import hand_points
@@ -26,10 +25,8 @@ from kinestat.serial.guidance.run import GuidanceOptions, joint_display, run_gui
 from kinestat.serial.guidance.velocity import joint_rates
 from kinestat.spatial.displacement import frame_from_triple, screw_from_poses
 from kinestat.spatial.transforms import make_pose
+from tests.serial.guidance._models import C1, C2, PUMA
 
-C1 = kinestat.load("nadkarni-config1")
-C2 = kinestat.load("nadkarni-config2")
-PUMA = kinestat.load("puma560")
 Q_REG = np.radians([40.0, 70.0, 60.0, 30.0, 50.0, 20.0])  # a regular pose of configuration 1
 OPEN = GuidanceOptions(settle=False)
 CLOSED = GuidanceOptions(closed_loop=True, settle=False)

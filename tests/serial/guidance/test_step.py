@@ -10,7 +10,6 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-import kinestat
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import from_nadkarni, from_standard_dh
 from kinestat.serial.fk import fk
@@ -27,10 +26,7 @@ from kinestat.serial.guidance.step import (
     solve_step,
 )
 from kinestat.serial.jacobian import jacobian
-
-PUMA = kinestat.load("puma560")
-C1 = kinestat.load("nadkarni-config1")
-C2 = kinestat.load("nadkarni-config2")
+from tests.serial.guidance._models import C1, C2, PUMA
 
 
 def test_exact_solve_matches_numpy_and_is_batched(rng):
