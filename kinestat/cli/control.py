@@ -176,7 +176,7 @@ def control_command(
         "point", "--estimator",
         help="Force the controller acts on: 'point' (point-contact fit) or 'wrench' (the "
         "equivalent wrench's force, as the thesis)."),
-    ideal_sensor: bool = typer.Option(
+    ideal_sensor: bool = flag(
         False, "--ideal-sensor", help="Simulated leg encoders without quantisation (1 nm)."),
     noise: float = typer.Option(
         0.0, "--noise", help="Simulated leg-length noise, standard deviation (mm)."),
@@ -198,7 +198,7 @@ def control_command(
     plot: Path = typer.Option(
         None, "--plot", help="Directory for the wrench-vs-state plot (default: the run "
         "directory)."),
-    no_plot: bool = typer.Option(False, "--no-plot", help="Do not write the plot."),
+    no_plot: bool = flag(False, "--no-plot", help="Do not write the plot."),
     log: Path = typer.Option(
         None, "--log", help="Cycle log file, JSON lines (default: "
         "./kinestat-runs/<timestamp>/log.jsonl)."),
@@ -242,14 +242,14 @@ def control_command(
     tilt_deg: float = typer.Option(
         0.0, "--tilt-deg", help="follow: tool axis tilted from the measured normal towards "
         "the travel direction (degrees)."),
-    auto_tilt: bool = typer.Option(
+    auto_tilt: bool = flag(
         False, "--auto-tilt", help="follow: tilt the tool axis onto the friction cone's edge "
         "(estimated), more while the tip sticks (experimental; docs/control.md)."),
     workpiece: str = typer.Option(
         None, "--workpiece", help="Simulated workpiece: 'plane' (default, --plane-point/"
         "--plane-normal) or 'cylinder:radius=R,axis=x,y,z[,point=x,y,z]' (without point: its "
         f"surface {DEFAULT_PLANE_DISTANCE} mm ahead of the start tool point along F_req)."),
-    as_json: bool = typer.Option(False, "--json", help="Print the final report as JSON."),
+    as_json: bool = flag(False, "--json", help="Print the final report as JSON."),
 ) -> None:
     """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
 

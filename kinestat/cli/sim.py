@@ -11,7 +11,7 @@ import numpy as np
 import typer
 
 from kinestat.app.signals import stop_on_signals
-from kinestat.cli._options import check_seed
+from kinestat.cli._options import check_seed, flag
 from kinestat.cli._output import console, literal, parse_floats, print_json
 from kinestat.errors import InputError
 from kinestat.hardware.encoder_packets import (
@@ -77,18 +77,18 @@ def galil(
                              "controller uses 23)."),
     host: str = typer.Option("127.0.0.1", "--host", help="Address to bind (loopback only, "
                              "unless --allow-remote)."),
-    allow_remote: bool = typer.Option(False, "--allow-remote", help="Allow a non-loopback "
+    allow_remote: bool = flag(False, "--allow-remote", help="Allow a non-loopback "
                                       "address: anyone who can reach it can command motion."),
     initial_counts: str = typer.Option("0,0,0,0,0,0", "--initial-counts",
                                        help="Encoder counts of axes A..F at start."),
-    no_coupling: bool = typer.Option(False, "--no-coupling", help="Disable the axis 4 -> 5 "
+    no_coupling: bool = flag(False, "--no-coupling", help="Disable the axis 4 -> 5 "
                                      "coupling of the thesis's PUMA."),
     duration: float = typer.Option(None, "--duration", help="Stop after this many seconds "
                                    "(default: run until Ctrl-C)."),
     seed: int = typer.Option(None, "--seed", help="Start the robot at an arbitrary, unknown "
                              "position drawn with this seed (encoders read 0 at power-up; "
                              "home it with `kinestat home`)."),
-    as_json: bool = typer.Option(False, "--json", help="Print the address as JSON."),
+    as_json: bool = flag(False, "--json", help="Print the address as JSON."),
 ) -> None:
     """Run a simulated Galil DMC (six axes, trapezoidal profiles) until Ctrl-C."""
     _check_duration(duration)
@@ -122,7 +122,7 @@ def encoders(
                             "(the thesis's 23-byte line)."),
     duration: float = typer.Option(None, "--duration", help="Stop after this many seconds "
                                    "(default: run until Ctrl-C)."),
-    as_json: bool = typer.Option(False, "--json", help="Print the pty path as JSON."),
+    as_json: bool = flag(False, "--json", help="Print the pty path as JSON."),
 ) -> None:
     """Stream encoder packets onto a pseudo-terminal and print its path until Ctrl-C."""
     _check_duration(duration)

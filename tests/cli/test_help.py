@@ -52,8 +52,6 @@ def test_every_bracket_in_a_help_text_is_shown(capsys, monkeypatch, path, cmd):
 
 @pytest.mark.parametrize("path, cmd", COMMANDS, ids=[" ".join(p) for p, _ in COMMANDS])
 def test_flags_show_no_value_placeholder(capsys, monkeypatch, path, cmd):
-    if path[0] in ("control", "sim"):
-        pytest.skip("cli/control.py and cli/sim.py belong to the cell's helpers (issue 16 report)")
     out = _help(capsys, monkeypatch, path)
     flags = [o for p in cmd.params if getattr(p, "is_flag", False) for o in p.opts]
     for line in out.splitlines():
