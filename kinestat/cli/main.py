@@ -1,7 +1,11 @@
 """The ``kinestat`` command.
 
 Each command group lives in its own module ``kinestat.cli.<name>`` exposing
-``register(app: typer.Typer) -> None``; the modules are listed in ``COMMAND_MODULES``.
+``register(app: typer.Typer) -> None``. The commands are listed in :data:`COMMANDS` (name,
+module, the summary ``kinestat --help`` shows) and a module is imported only when one of its
+commands runs or shows its own help (:mod:`kinestat.cli._lazy`): ``kinestat --help`` and
+``kinestat --version`` import neither NumPy nor any command module (issue 16, start-up).
+A test checks :data:`COMMANDS` against what the modules register, so it cannot drift.
 Errors derived from :class:`kinestat.errors.KinestatError`, and usage errors (an unknown option,
 a missing argument, a bad choice), are printed as one line ``kinestat: error: ...`` on stderr (no
 traceback, no box) and exit with status 2.
@@ -9,7 +13,6 @@ traceback, no box) and exit with status 2.
 
 from __future__ import annotations
 
-import importlib
 import sys
 
 import typer
@@ -19,26 +22,52 @@ import typer
 from typer._click.exceptions import ClickException, NoArgsIsHelpError, UsageError
 
 import kinestat
+from kinestat.cli._lazy import CommandEntry, LazyGroup
 from kinestat.errors import KinestatError
 
-# Order is the order of the help listing.
-COMMAND_MODULES: list[str] = [
-    "fk",
-    "demo",
-    "screw",
-    "disp",
-    "guide",
-    "ik",
-    "sim",
-    "dh_from_axes",
-    "platform",
-    "control",
-    "view",
-    "home",
-    "sweep",
-]
+# Order is the order of the help listing; ``summary`` is the first paragraph of the command's
+# help as its module writes it (tests/cli/test_lazy_commands.py checks every row).
+COMMANDS: tuple[CommandEntry, ...] = (
+    CommandEntry("fk", "fk", "Pose of the end frame T_base_end and the tool point; for the PUMA "
+                 "762 also P_tool_F, S6_F and a67_F in the thesis's words (Vibhute eq. 2-34)."),
+    CommandEntry("demo", "demo", "Run the thesis illustrations on the embedded data and print "
+                 "their results."),
+    CommandEntry("warmup", "demo", "Compile kinestat's kernels now (first run only; later runs "
+                 "load them from the cache).", hidden=True),
+    CommandEntry("screw", "screw", "Screw axis of the displacement between two positions of a "
+                 "body (Nadkarni ch. III)."),
+    CommandEntry("disp", "disp", "Run a DISP deck (Nadkarni 1977): MS 1 screw axes, 2 mechanism "
+                 "data, 3 both, 0/4/5/6 guidance of types II/III/IV/I."),
+    CommandEntry("guide", "guide", "Guide a manipulator's hand to targets, along commands or moves "
+                 "(Nadkarni ch. IV)."),
+    CommandEntry("ik", "ik", "Joint angles that reach a pose."),
+    CommandEntry("dh-from-axes", "dh_from_axes", "Standard DH table (θ, d, a, α) from the joint "
+                 "axes, by the lecture notes' frame assignment."),
+    CommandEntry("control", "control", "Kinestatic control: press the tool on the workpiece with "
+                 "|F_req| along the force."),
+    CommandEntry("home", "home", "Power-on checks, pot-based coarse positioning, index search and "
+                 "home definition\n(startup_initialize.m). Refuses (amplifiers off via MO) when a "
+                 "check fails."),
+    CommandEntry("sim", "sim", "Simulated hardware: the Galil DMC controller and the platform's "
+                 "encoder stream."),
+    CommandEntry("platform", "platform", "The compliant special 6-6 platform: info, fk, ik, "
+                 "statics, stiffness."),
+    CommandEntry("view", "view", "3D views in the browser: model, platform, screw, disp, log (or "
+                 "--log FILE)."),
+    CommandEntry("sweep", "sweep", "Studies at scale on Dask: workspace, platform-range, "
+                 "platform-design, tolerance."),
+)
+#: the command modules, in the order of :data:`COMMANDS`
+COMMAND_MODULES: list[str] = list(dict.fromkeys(e.module for e in COMMANDS))
+
+
+class _KinestatGroup(LazyGroup):
+    entries = COMMANDS
+    package = "kinestat.cli"
+
 
 app = typer.Typer(
+    cls=_KinestatGroup,
     name="kinestat",
     help="Kinematics and statics of robot manipulators (kinestat).",
     no_args_is_help=True,
@@ -71,10 +100,6 @@ def _usage_error(exc: UsageError) -> str:
     msg = _one_line(exc.format_message())
     path = exc.ctx.command_path if exc.ctx is not None else "kinestat"
     return f"kinestat: error: {msg} (see '{path} --help')"
-
-
-for _name in COMMAND_MODULES:
-    importlib.import_module(f"kinestat.cli.{_name}").register(app)
 
 
 def main(argv: list[str] | None = None) -> int:
