@@ -1,9 +1,11 @@
 """Start-up time of kinestat, side by side (issue 16): what a user waits for before any work.
 
-`kinestat fk` runs NumPy only (no compiled kernel), so its cold row differs from the warm one
-only by noise; `kinestat ik` with --tool-point runs the PUMA 762's compiled closed form. Each
-row is a fresh Python process (median of ``--repeat`` runs; the cold-cache row is one run
-per repeat, each with an empty ``NUMBA_CACHE_DIR``, so every kernel it uses compiles):
+`kinestat --help` and `--version` import no command module (kinestat/cli/_lazy.py); a
+command's own help imports that command's module, and with it NumPy. `kinestat fk` runs NumPy
+only (no compiled kernel), so its cold row differs from the warm one only by noise;
+`kinestat ik` with --tool-point runs the PUMA 762's compiled closed form. Each row is a fresh
+Python process (median of ``--repeat`` runs; the cold-cache row is one run per repeat, each
+with an empty ``NUMBA_CACHE_DIR``, so every kernel it uses compiles):
 
     python benchmarks/startup.py            # a table
     python benchmarks/startup.py --json     # the same as JSON
@@ -33,6 +35,8 @@ ROWS: list[tuple[str, list[str], bool]] = [
     ('python -c "import numpy"', ["-c", "import numpy"], False),
     ('python -c "import kinestat"', ["-c", "import kinestat"], False),
     ("kinestat --help", ["-c", CLI, "--help"], False),
+    ("kinestat --version", ["-c", CLI, "--version"], False),
+    ("kinestat fk --help (a command's help)", ["-c", CLI, "fk", "--help"], False),
     ("kinestat fk puma762 --q-deg 0,0,0,0,0,0 (warm kernel cache)", ["-c", CLI, *FK], False),
     ("kinestat fk puma762 --q-deg 0,0,0,0,0,0 (cold kernel cache)", ["-c", CLI, *FK], True),
     ("kinestat ik puma762 --tool-point ... (closed form; warm)", ["-c", CLI, *IK], False),

@@ -17,19 +17,20 @@ from __future__ import annotations
 
 import json
 import os
+import sys
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
 from rich.console import Console, ConsoleDimensions
 from rich.markup import escape
 from rich.table import Table
 from rich.text import Text
 
 from kinestat.errors import InputError
-from kinestat.io.jsonable import to_jsonable
-from kinestat.io.posefile import read_pose_file
+
+if TYPE_CHECKING:
+    import numpy as np
 
 #: the width of human output going to a file or pipe when ``COLUMNS`` is not set
 PIPE_WIDTH = 160
@@ -63,6 +64,14 @@ console = _Console()
 err_console = _Console(stderr=True)
 
 
+def to_jsonable(obj: Any) -> Any:
+    """``obj`` with NumPy arrays and scalars as lists and numbers
+    (:func:`kinestat.io.jsonable.to_jsonable`)."""
+    from kinestat.io.jsonable import to_jsonable as convert  # lazy: NumPy only when printing
+
+    return convert(obj)
+
+
 def print_json(obj: Any) -> None:
     """Print ``obj`` as JSON on stdout (no rich markup, no wrapping)."""
     print(json.dumps(to_jsonable(obj), indent=2))
@@ -78,7 +87,9 @@ def literal(value: Any) -> str:
 
 
 def _cell(v: Any, fmt: str) -> str:
-    return fmt.format(v) if isinstance(v, float | np.floating) else str(v)
+    np = sys.modules.get("numpy")  # a NumPy scalar implies NumPy is loaded: no import here
+    is_float = isinstance(v, float) or (np is not None and isinstance(v, np.floating))
+    return fmt.format(v) if is_float else str(v)
 
 
 def _plain_len(cell: str) -> int:
@@ -135,6 +146,8 @@ def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.nda
         raise InputError(f"--{name}: cannot read {text!r} as comma-separated numbers") from exc
     if n is not None and len(vals) != n:
         raise InputError(f"--{name}: expected {n} comma-separated numbers, got {len(vals)}")
+    import numpy as np  # lazy: a command's --help needs no NumPy
+
     arr = np.asarray(vals)
     if not np.all(np.isfinite(arr)):
         raise InputError(f"--{name}: values must be finite, got {text!r}")
@@ -152,6 +165,8 @@ def parse_pose(value: str, option: str = "pose", *, allow_batch: bool = False) -
     if is_file or p.suffix.lower() in (".json", ".toml"):
         if not p.exists():
             raise InputError(f"--{option}: file {value!r} does not exist")
+        from kinestat.io.posefile import read_pose_file  # lazy: NumPy only when parsing
+
         return read_pose_file(p, allow_batch=allow_batch)
     if "," not in value:
         raise InputError(f"--{option}: {value!r} is neither a file nor 16 comma-separated "
