@@ -4,8 +4,8 @@
 command's own help imports that command's module, and with it NumPy. `kinestat fk` runs NumPy
 only (no compiled kernel), so its cold row differs from the warm one only by noise;
 `kinestat ik` with --tool-point runs the PUMA 762's compiled closed form. Each row is a fresh
-Python process (median of ``--repeat`` runs; the cold-cache row is one run per repeat, each
-with an empty ``NUMBA_CACHE_DIR``, so every kernel it uses compiles):
+Python process (median of ``--repeat`` runs, the rows taking turns; a cold-cache row runs half
+as often, each time with an empty ``NUMBA_CACHE_DIR``, so every kernel it uses compiles):
 
     python benchmarks/startup.py            # a table
     python benchmarks/startup.py --json     # the same as JSON
@@ -60,14 +60,17 @@ def _once(args: list[str], cold: bool) -> float:
 
 def measure(repeat: int = 5) -> list[dict]:
     """Median wall time (s) of each row over ``repeat`` fresh processes, and its ratio to
-    ``import numpy``."""
+    ``import numpy``. The rows take turns (round ``k`` runs every row once), so a change in the
+    machine's load during the run reaches every row alike and the ratios stay fair."""
     for _, args, _cold in ROWS:  # the warm rows need a warm cache: compile once, untimed
         _once(args, False)
-    rows = []
-    for label, args, cold in ROWS:
-        times = [_once(args, cold) for _ in range(repeat if not cold else max(1, repeat // 2))]
-        rows.append({"command": label, "median_s": statistics.median(times),
-                     "min_s": min(times), "runs": len(times)})
+    times: list[list[float]] = [[] for _ in ROWS]
+    for k in range(repeat):
+        for i, (_, args, cold) in enumerate(ROWS):
+            if not cold or k < max(1, repeat // 2):
+                times[i].append(_once(args, cold))
+    rows = [{"command": label, "median_s": statistics.median(t), "min_s": min(t), "runs": len(t)}
+            for (label, _, _), t in zip(ROWS, times, strict=True)]
     base = rows[0]["median_s"]
     for r in rows:
         r["ratio_to_numpy"] = r["median_s"] / base
