@@ -7,6 +7,10 @@ commands from a table of :class:`CommandEntry` (name, module, summary) instead, 
 module the first time one of its commands is resolved to run (``kinestat fk ...``,
 ``kinestat fk --help``) or looked up in :attr:`LazyGroup.commands`.
 
+The group also gives ``--help`` flags the default ``False`` (Typer leaves ``None``, and coercing
+that ``None`` imports pydantic): ``kinestat fk --help`` then costs NumPy's import plus Typer's,
+not pydantic's as well.
+
 The table is written by hand in :mod:`kinestat.cli.main`; tests/cli/test_lazy_commands.py checks
 it against what the modules register (names, order, summaries, hidden flags) and the rendered
 help against an eagerly built app, so it cannot drift.
@@ -19,7 +23,7 @@ from collections.abc import Iterator, MutableMapping, Sequence
 from typing import Any, NamedTuple
 
 import typer
-from typer._click.core import Command, Context
+from typer._click.core import Command, Context, Parameter
 from typer.core import TyperCommand, TyperGroup
 
 
@@ -93,6 +97,18 @@ class _LazyCommands(MutableMapping):
         return name in self._entries or name in self._loaded
 
 
+def _help_defaults_to_false(option: Parameter | None) -> Parameter | None:
+    """``option`` (a ``--help`` flag) with the default ``False`` instead of Typer's ``None``.
+
+    Typer coerces a flag's value unless it is already a bool, and its first coercion imports
+    pydantic and builds a validator: a group's ``--help``, absent (``None``) whenever a
+    subcommand is given, cost ``kinestat fk --help`` as much again as importing NumPy.
+    """
+    if option is not None and option.default is None:
+        option.default = False
+    return option
+
+
 class LazyGroup(TyperGroup):
     """A Typer group whose commands come from :attr:`entries` (set by a subclass) and load on
     demand. ``get_command`` (what help listings call) returns a help-only stand-in for a command
@@ -105,6 +121,9 @@ class LazyGroup(TyperGroup):
     def __init__(self, **attrs: Any) -> None:
         super().__init__(**attrs)
         self.commands = _LazyCommands(self.entries, self.package, self.commands)
+
+    def get_help_option(self, ctx: Context) -> Parameter | None:
+        return _help_defaults_to_false(super().get_help_option(ctx))
 
     def list_commands(self, ctx: Context) -> list[str]:
         return list(self.commands)  # the names only (Typer's own walks the items)
@@ -120,4 +139,6 @@ class LazyGroup(TyperGroup):
         name, cmd, rest = super().resolve_command(ctx, args)
         if name is not None and name in self.commands:
             cmd = self.commands[name]
+            if isinstance(cmd, TyperGroup):  # its context inherits this one's help option names
+                _help_defaults_to_false(cmd.get_help_option(ctx))
         return name, cmd, rest

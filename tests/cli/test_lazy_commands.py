@@ -56,8 +56,9 @@ def test_each_row_matches_its_command(entry):
 @pytest.mark.parametrize("path", list(_paths(EAGER)), ids=lambda p: " ".join(p) or "kinestat")
 @pytest.mark.parametrize("columns", ["80", "250"])
 def test_help_reads_as_the_eager_apps(capsys, monkeypatch, path, columns):
+    # COLUMNS only: typer reads TERMINAL_WIDTH once, when its help renderer is first imported,
+    # and keeps it for the session (an 80 here would narrow test_help.py's wide help)
     monkeypatch.setenv("COLUMNS", columns)
-    monkeypatch.setenv("TERMINAL_WIDTH", columns)
     EAGER.main([*path, "--help"], prog_name="kinestat", standalone_mode=False)
     eager_out = capsys.readouterr().out
     assert main([*path, "--help"]) == 0
@@ -79,7 +80,7 @@ def _modules_after(argv: list[str]) -> dict:
             "from kinestat.cli.main import main\n"
             f"status = main({argv!r})\n"
             "print(json.dumps({'status': status, 'modules': sorted(m for m in sys.modules if "
-            "m == 'numpy' or m.startswith('kinestat.cli.'))}), file=sys.stderr)\n")
+            "m in ('numpy', 'pydantic') or m.startswith('kinestat.cli.'))}), file=sys.stderr)\n")
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          timeout=120)
     return json.loads(run.stderr.strip().splitlines()[-1])
@@ -94,13 +95,18 @@ def test_the_top_level_imports_no_command_module_and_no_numpy(argv):
     got = _modules_after(argv)
     assert got["status"] == (0 if argv in (["--help"], ["--version"]) else 2)
     assert "numpy" not in got["modules"]
+    assert "pydantic" not in got["modules"]
     assert not COMMAND_MODULE_NAMES & set(got["modules"])
 
 
-def test_a_command_imports_only_its_own_module():
-    got = _modules_after(["screw", "--help"])
+@pytest.mark.parametrize("argv, module", [(["screw", "--help"], "screw"),
+                                          (["platform", "stiffness", "--help"], "platform")])
+def test_a_commands_help_imports_only_its_own_module(argv, module):
+    got = _modules_after(argv)
     assert got["status"] == 0
-    assert COMMAND_MODULE_NAMES & set(got["modules"]) == {"kinestat.cli.screw"}
+    assert COMMAND_MODULE_NAMES & set(got["modules"]) == {f"kinestat.cli.{module}"}
+    # the groups' absent --help flags are not coerced (Typer's first coercion loads pydantic)
+    assert "pydantic" not in got["modules"]
 
 
 def test_a_typo_still_suggests_the_command(capsys):
