@@ -7,9 +7,9 @@ commands from a table of :class:`CommandEntry` (name, module, summary) instead, 
 module the first time one of its commands is resolved to run (``kinestat fk ...``,
 ``kinestat fk --help``) or looked up in :attr:`LazyGroup.commands`.
 
-The group also gives ``--help`` flags the default ``False`` (Typer leaves ``None``, and coercing
-that ``None`` imports pydantic): ``kinestat fk --help`` then costs NumPy's import plus Typer's,
-not pydantic's as well.
+The group also tidies every ``--help`` flag (:func:`tidy_help_option`): no ``<bool>`` value
+placeholder, and the default ``False`` (Typer leaves ``None``, and coercing that ``None`` imports
+pydantic): ``kinestat fk --help`` then costs NumPy's import plus Typer's, not pydantic's too.
 
 The table is written by hand in :mod:`kinestat.cli.main`; tests/cli/test_lazy_commands.py checks
 it against what the modules register (names, order, summaries, hidden flags) and the rendered
@@ -97,16 +97,28 @@ class _LazyCommands(MutableMapping):
         return name in self._entries or name in self._loaded
 
 
-def _help_defaults_to_false(option: Parameter | None) -> Parameter | None:
-    """``option`` (a ``--help`` flag) with the default ``False`` instead of Typer's ``None``.
+def tidy_help_option(option: Parameter | None) -> Parameter | None:
+    """``option`` (a ``--help`` flag) shown without a value placeholder (no ``<bool>``: it is a
+    flag) and defaulting to ``False`` instead of Typer's ``None``.
 
     Typer coerces a flag's value unless it is already a bool, and its first coercion imports
     pydantic and builds a validator: a group's ``--help``, absent (``None``) whenever a
     subcommand is given, cost ``kinestat fk --help`` as much again as importing NumPy.
     """
-    if option is not None and option.default is None:
-        option.default = False
+    if option is not None:
+        if option.default is None:
+            option.default = False
+        if option.metavar is None:
+            option.metavar = ""
     return option
+
+
+def tidy_help_options(cmd: Command, ctx: Context) -> None:
+    """:func:`tidy_help_option` on the ``--help`` of ``cmd`` and of every command under it
+    (their contexts inherit ``ctx``'s help option names)."""
+    tidy_help_option(cmd.get_help_option(ctx))
+    for sub in getattr(cmd, "commands", {}).values():
+        tidy_help_options(sub, ctx)
 
 
 class LazyGroup(TyperGroup):
@@ -123,7 +135,7 @@ class LazyGroup(TyperGroup):
         self.commands = _LazyCommands(self.entries, self.package, self.commands)
 
     def get_help_option(self, ctx: Context) -> Parameter | None:
-        return _help_defaults_to_false(super().get_help_option(ctx))
+        return tidy_help_option(super().get_help_option(ctx))
 
     def list_commands(self, ctx: Context) -> list[str]:
         return list(self.commands)  # the names only (Typer's own walks the items)
@@ -139,6 +151,5 @@ class LazyGroup(TyperGroup):
         name, cmd, rest = super().resolve_command(ctx, args)
         if name is not None and name in self.commands:
             cmd = self.commands[name]
-            if isinstance(cmd, TyperGroup):  # its context inherits this one's help option names
-                _help_defaults_to_false(cmd.get_help_option(ctx))
+            tidy_help_options(cmd, ctx)
         return name, cmd, rest

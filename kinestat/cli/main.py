@@ -85,7 +85,7 @@ def _print_version(value: bool) -> None:
 @app.callback()
 def _root(
     version: bool = typer.Option(False, "--version", help="Print the version and exit.",
-                                 callback=_print_version, is_eager=True),
+                                 callback=_print_version, is_eager=True, metavar=""),
 ) -> None:
     """Kinematics and statics of robot manipulators."""
 
