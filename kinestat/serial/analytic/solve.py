@@ -108,13 +108,15 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         from kinestat.serial.analytic import _cf_kernels  # lazy: Numba start-up
 
         Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
-        if _cf_kernels.first_non_rigid(Tf, 1e-6) >= 0:
+        bad, n_project = _cf_kernels.check_rigid(Tf, 1e-6)
+        if bad >= 0:
             check_poses(T)  # raises with the full message
+        if n_project:
+            Tf = _nearest_rigid(Tf)
     else:
         T = check_poses(T)
-        Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
+        Tf = _nearest_rigid(np.ascontiguousarray(T.reshape(-1, 4, 4)))
     shape = T.shape[:-2]
-    Tf = _nearest_rigid(Tf)
     kind, data = _classified(model)
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
     if use in ("pieper", "three-parallel") and use != kind:
