@@ -292,32 +292,37 @@ _REASON_DEFICIENT = ("degenerate elimination: the θ1-θ2 coefficient matrix Q o
 
 @lru_cache(maxsize=64)
 def _compiled_data(model: ChainModel, form: Formulation):
-    """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5)."""
-    C = np.asarray(model.constants)
+    """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5,
+    whose pose link is M1 or M6): ``form (4, 4, 4)`` = C0⁻¹, C6⁻¹, constant M1, constant Ts;
+    the constant links M2..M5; ``L H3``, ``H3[0]``, L; the joint order with the pose-link
+    codes of M1 and Ts appended (0 constant, 1 ``C0⁻¹ T C6⁻¹``, 2 its inverse)."""
+    C = np.ascontiguousarray(model.constants)
     M = form.links(C, np.eye(4)[None])
+    M = [m[0] if m.ndim == 3 else m for m in M]
     L = rr.left_tensor(M[1], M[2], M[3], M[4], np.array(OFFSETS))[1:].reshape(14, 27)
     order, sign = form.joints()
-    return (np.ascontiguousarray(C), np.ascontiguousarray(np.stack(M[1:5])),
-            np.ascontiguousarray(L), np.ascontiguousarray(_H3), np.array(OFFSETS),
-            np.array(order, dtype=np.int64), float(sign))
+    # the pose link is C6 T⁻¹ C0 (= G⁻¹) forwards and its inverse G when reversed
+    at0 = 0 if form.shift == 0 else (2 if not form.reverse else 1)
+    at5 = 0 if form.shift == 5 else (1 if not form.reverse else 2)
+    consts = np.stack([_inv_rigid(C[0]), _inv_rigid(C[6]), M[0], _inv_rigid(M[5])])
+    return (C, np.ascontiguousarray(consts), np.ascontiguousarray(np.stack(M[1:5])),
+            np.ascontiguousarray(L @ _H3), np.ascontiguousarray(_H3[0]), np.ascontiguousarray(L),
+            np.array(OFFSETS), np.array(list(order) + [at0, at5], dtype=np.int64), float(sign))
 
 
 def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
     from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
 
-    C, links_fixed, L, H3, off, order, sign = _compiled_data(model, form)
-    M = form.links(C, T)
+    C, consts, links, LH, h0, L, off, order, sign = _compiled_data(model, form)
     N = T.shape[0]
-    M1 = np.ascontiguousarray(np.broadcast_to(M[0], (N, 4, 4)))
-    Ts = np.ascontiguousarray(np.broadcast_to(_inv_rigid(M[5]), (N, 4, 4)))
     q = np.full((N, MAX_SOLUTIONS, 6), np.nan)
     valid = np.zeros((N, MAX_SOLUTIONS), dtype=bool)
     pos = np.full((N, MAX_SOLUTIONS), np.nan)
     rot = np.full((N, MAX_SOLUTIONS), np.nan)
     flags = np.zeros(N, dtype=np.int64)
     run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
-    run(C, np.ascontiguousarray(T), M1, Ts, links_fixed, L, H3, off, order, sign, tol,
-        polish_iters, 1e-6, q, valid, pos, rot, flags)
+    run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6, q, valid,
+        pos, rot, flags)
     nsol = valid.sum(axis=1)
     reason = np.where(nsol > 0, "", _REASON_NONE).astype(object)
     reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
@@ -350,5 +355,5 @@ def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     if form is None:
         form, _ = formulation(model)
     if backend == "numba" and form.shift in (0, 5):
-        return _solve_compiled(model, T, form, tol, polish_iters)
+        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters)
     return _solve(model, T, form, tol, polish_iters)
