@@ -22,6 +22,7 @@ Raghavan & Roth (1993), in the numerically stable form of Manocha & Canny (1994)
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -31,7 +32,7 @@ import scipy.linalg
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _rr_algebra as rr
-from kinestat.serial.analytic._common import newton_polish, pack
+from kinestat.serial.analytic._common import nan_array, newton_polish, pack, reasons
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.fk import fk
 
@@ -311,24 +312,33 @@ def _compiled_data(model: ChainModel, form: Formulation):
 
 
 def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
-    from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
+    K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
+    if K is None:
+        from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
 
     C, consts, links, LH, h0, L, off, order, sign = _compiled_data(model, form)
     N = T.shape[0]
-    q = np.full((N, MAX_SOLUTIONS, 6), np.nan)
-    valid = np.zeros((N, MAX_SOLUTIONS), dtype=bool)
-    pos = np.full((N, MAX_SOLUTIONS), np.nan)
-    rot = np.full((N, MAX_SOLUTIONS), np.nan)
+    K16 = MAX_SOLUTIONS
+    q = nan_array((N, K16, 6))
+    valid = np.zeros((N, K16), dtype=bool)
+    pos = nan_array((N, K16))
+    rot = nan_array((N, K16))
     flags = np.zeros(N, dtype=np.int64)
     run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
     run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6, q, valid,
         pos, rot, flags)
-    nsol = valid.sum(axis=1)
-    reason = np.where(nsol > 0, "", _REASON_NONE).astype(object)
+    nsol = np.count_nonzero(valid, axis=1)
+    reason = reasons(nsol, _REASON_NONE)
+    if not flags.any():
+        return IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
+                           singular=np.zeros((N, K16), dtype=bool),
+                           family_sign=np.zeros((N, K16)), family_value=nan_array((N, K16)),
+                           family_joints=None, n_solutions=nsol, reason=reason,
+                           method=_method_name(form), tol=tol)
     reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
     res = IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
-                      singular=np.zeros_like(valid), family_sign=np.zeros((N, MAX_SOLUTIONS)),
-                      family_value=np.full((N, MAX_SOLUTIONS), np.nan), family_joints=None,
+                      singular=np.zeros((N, K16), dtype=bool), family_sign=np.zeros((N, K16)),
+                      family_value=nan_array((N, K16)), family_joints=None,
                       n_solutions=nsol, reason=reason, method=_method_name(form), tol=tol)
     redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
     if redo.size:  # the generalised eigenproblem (scipy) for these poses
