@@ -3,13 +3,14 @@
 poses the kernel flags), one pose at a time, batches split over the cores with ``prange``.
 
 Per pose: the pose link ``C0⁻¹ T C6⁻¹`` (or its inverse) of the formulation, the right side of
-RR eq. 4 (15x15 rigid action), the SVD of Q, the 12x12 matrix quadratic, the eigenvalues of its
+RR eq. 4 (15x15 rigid action), a pivoted Householder QR of Q (its left null space; the
+least-squares back-substitution), the 12x12 matrix quadratic, the eigenvalues of its
 24x24 companion (LAPACK dgeev), the power-product vector of each real root by inverse
 iteration, back-substitution, θ6 (the serial FK kernel's scalar steps), Newton polishing
 against FK, verification and de-duplication
 (:mod:`kinestat.serial.analytic._solution_kernels`). Every work array is allocated once per
-chunk of poses (:func:`_scratch`), not per root or per step; only the SVD and dgeev allocate
-their own results and workspace. Flags: 0 solved, 1 Q rank deficient, 2 A2 ill-conditioned
+chunk of poses (:func:`_scratch`), not per root or per step; only dgeev allocates its
+workspace. Flags: 0 solved, 1 Q rank deficient, 2 A2 ill-conditioned
 (the caller reruns the pose with the generalised eigenproblem).
 """
 
@@ -197,20 +198,83 @@ def _right_side(M1, Ts, Rh, MA, f, u, o, w):
 
 
 @nb.njit(**_OPTS)
-def _pencil(LH, h0, Rh, A, E):
+def _qr_pivoted(Rh, H, R, piv, Vr, Aw):
+    """Householder QR with column pivoting of ``Q = Rh[1:, 1:] (14, 8)``:
+    ``Q[:, piv] = H[:, :8] R`` with ``H (14, 14)`` orthogonal (its last 6 columns span the left
+    null space of Q) and ``R (8, 8)`` upper triangular, |R[k, k]| non-increasing. Vr (8, 14),
+    Aw (14, 8): scratch (the reflectors and the working copy)."""
+    for i in range(14):
+        for j in range(8):
+            Aw[i, j] = Rh[i + 1, j + 1]
+    for j in range(8):
+        piv[j] = j
+    for k in range(8):
+        best, jb = -1.0, k
+        for j in range(k, 8):
+            nj = 0.0
+            for i in range(k, 14):
+                nj += Aw[i, j] * Aw[i, j]
+            if nj > best:
+                best, jb = nj, j
+        if jb != k:
+            for i in range(14):
+                Aw[i, k], Aw[i, jb] = Aw[i, jb], Aw[i, k]
+            piv[k], piv[jb] = piv[jb], piv[k]
+        alpha = math.sqrt(best)
+        if Aw[k, k] > 0.0:
+            alpha = -alpha
+        vv = 0.0
+        for i in range(14):
+            Vr[k, i] = Aw[i, k] if i >= k else 0.0
+        Vr[k, k] -= alpha
+        for i in range(k, 14):
+            vv += Vr[k, i] * Vr[k, i]
+        if vv > 0.0:
+            for j in range(k, 8):
+                d = 0.0
+                for i in range(k, 14):
+                    d += Vr[k, i] * Aw[i, j]
+                d *= 2.0 / vv
+                for i in range(k, 14):
+                    Aw[i, j] -= d * Vr[k, i]
+            for i in range(k, 14):
+                Vr[k, i] /= math.sqrt(vv / 2.0)  # now H_k = I − v vᵀ
+        else:
+            for i in range(14):
+                Vr[k, i] = 0.0
+    for i in range(8):
+        for j in range(8):
+            R[i, j] = Aw[i, j] if j >= i else 0.0
+    # H = H_1 H_2 … H_8, applied to the identity from the left in reverse order
+    for i in range(14):
+        for j in range(14):
+            H[i, j] = 1.0 if i == j else 0.0
+    for k in range(7, -1, -1):
+        for j in range(14):
+            d = 0.0
+            for i in range(k, 14):
+                d += Vr[k, i] * H[i, j]
+            if d != 0.0:
+                for i in range(k, 14):
+                    H[i, j] -= d * Vr[k, i]
+
+
+@nb.njit(**_OPTS)
+def _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw):
     """Fill ``A (3, 12, 12)`` from ``E = Nᵀ (L H3 − r0 h0ᵀ)`` (N the left null space of Q,
-    r0 = Rh[1:, 0]); returns (U, s, Vt, flag) of Q's SVD."""
-    U, s, Vt = np.linalg.svd(np.ascontiguousarray(Rh[1:, 1:]))
-    if s[7] <= 1e-10 * s[0]:
-        return U, s, Vt, FLAG_DEFICIENT
+    r0 = Rh[1:, 0]) and the pivoted QR of Q into H, R, piv; returns the flag (Q rank
+    deficient: |R[7, 7]| ≤ 1e-10 |R[0, 0]|)."""
+    _qr_pivoted(Rh, H, R, piv, Vr, Aw)
+    if not abs(R[7, 7]) > 1e-10 * abs(R[0, 0]):
+        return FLAG_DEFICIENT
     for e in range(6):
         nr = 0.0
         for i in range(14):
-            nr += U[i, 8 + e] * Rh[i + 1, 0]
+            nr += H[i, 8 + e] * Rh[i + 1, 0]
         for c in range(27):
             acc = -nr * h0[c]
             for i in range(14):
-                acc += U[i, 8 + e] * LH[i, c]
+                acc += H[i, 8 + e] * LH[i, c]
             E[e, c] = acc
     A[:, :, :] = 0.0
     for k in range(3):
@@ -218,7 +282,7 @@ def _pencil(LH, h0, Rh, A, E):
             for m in range(9):
                 A[k, e, m] = E[e, k * 9 + m]
                 A[k, 6 + e, 3 + m] = E[e, k * 9 + m]
-    return U, s, Vt, FLAG_OK
+    return FLAG_OK
 
 
 @nb.njit(**_OPTS)
@@ -264,22 +328,72 @@ def _companion_eigvals(A, X, A2, Mc, wr, wi, dummy):
 
 
 @nb.njit(**_OPTS)
-def _null_vector(A, x, S, v):
+def _lu(A, perm):
+    """LU factors of ``A (n, n)`` in place with partial pivoting (row order in perm); pivots
+    below 1e-17 of the largest |entry| are replaced by that size so solves stay finite
+    (inverse iteration on a singular matrix relies on it)."""
+    n = A.shape[0]
+    big = 0.0
+    for i in range(n):
+        perm[i] = i
+        for j in range(n):
+            big = max(big, abs(A[i, j]))
+    tiny = 1e-17 * big if big > 0.0 else 1e-300
+    for k in range(n):
+        p = k
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > abs(A[p, k]):
+                p = i
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+            perm[k], perm[p] = perm[p], perm[k]
+        piv = A[k, k]
+        if abs(piv) < tiny:
+            piv = tiny if piv >= 0.0 else -tiny
+            A[k, k] = piv
+        for i in range(k + 1, n):
+            f = A[i, k] / piv
+            A[i, k] = f
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    A[i, j] -= f * A[k, j]
+
+
+@nb.njit(**_OPTS)
+def _lu_solve(A, perm, b, y):
+    """``b ← A⁻¹ b`` with the factors of :func:`_lu`; y (n,) scratch."""
+    n = A.shape[0]
+    for i in range(n):
+        acc = b[perm[i], 0]
+        for j in range(i):
+            acc -= A[i, j] * y[j]
+        y[i] = acc
+    for i in range(n - 1, -1, -1):
+        acc = y[i]
+        for j in range(i + 1, n):
+            acc -= A[i, j] * b[j, 0]
+        b[i, 0] = acc / A[i, i]
+
+
+@nb.njit(**_OPTS)
+def _null_vector(A, x, S, v, perm, y):
     """The power-product vector ``v (12, 1)``: a null vector of ``A2 x² + A1 x + A0`` by two
-    steps of inverse iteration (the matrix is singular at an eigenvalue); S (12, 12) scratch.
-    For |x| > 1 the matrix is divided by x² (better scaled)."""
+    steps of inverse iteration on one LU factorisation (the matrix is singular at an
+    eigenvalue); S (12, 12), perm (12,), y (12,) scratch. For |x| > 1 the matrix is divided by
+    x² (better scaled)."""
     for i in range(12):
         v[i, 0] = _B0[i]
     if abs(x) <= 1.0:
         c0, c1, c2 = 1.0, x, x * x
     else:
-        y = 1.0 / x
-        c0, c1, c2 = y * y, y, 1.0
+        c0, c1, c2 = 1.0 / (x * x), 1.0 / x, 1.0
+    for i in range(12):
+        for j in range(12):
+            S[i, j] = c0 * A[0, i, j] + c1 * A[1, i, j] + c2 * A[2, i, j]
+    _lu(S, perm)
     for _ in range(2):
-        for i in range(12):
-            for j in range(12):
-                S[i, j] = c0 * A[0, i, j] + c1 * A[1, i, j] + c2 * A[2, i, j]
-        _gauss(S, v)
+        _lu_solve(S, perm, v, y)
         nv = 0.0
         for i in range(12):
             nv += v[i, 0] * v[i, 0]
@@ -308,7 +422,7 @@ def _ratio(v, axis):
 
 
 @nb.njit(**_OPTS)
-def _angles(x3, v, off, L, Rh, U, s, Vt, M1, links, Ts, th, m, coef):
+def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     """θ (6,) of the loop from a real root x3 and its power products ``v (12, 1)``; False if
     not usable. m (27,), coef (8,) scratch; ``links (4, 4, 4)`` the constant M2..M5."""
     x4 = _ratio(v, 0)
@@ -325,7 +439,7 @@ def _angles(x3, v, off, L, Rh, U, s, Vt, M1, links, Ts, th, m, coef):
         for b in range(3):
             for c in range(3):
                 m[a * 9 + b * 3 + c] = m3[a] * m4[b] * m5[c]
-    # coef = Σ⁺ Uᵀ (L m − r0): the least-squares (c1, s1, c2, s2) products (Manocha–Canny eq. 9)
+    # (c1, s1, c2, s2) products in least squares (Manocha–Canny eq. 9): R x = H₈ᵀ (L m − r0)
     for j in range(8):
         coef[j] = 0.0
     for i in range(14):
@@ -333,15 +447,22 @@ def _angles(x3, v, off, L, Rh, U, s, Vt, M1, links, Ts, th, m, coef):
         for c in range(27):
             r += L[i, c] * m[c]
         for j in range(8):
-            coef[j] += U[i, j] * r
-    for j in range(8):
-        coef[j] = coef[j] / s[j] if s[j] > 1e-12 * s[0] else 0.0
+            coef[j] += H[i, j] * r
+    for k in range(7, -1, -1):
+        acc = coef[k]
+        for j in range(k + 1, 8):
+            acc -= R[k, j] * coef[j]
+        coef[k] = acc / R[k, k]
     S0 = S1 = S2 = S5 = 0.0
     for j in range(8):
-        S0 += Vt[j, 0] * coef[j]
-        S1 += Vt[j, 1] * coef[j]
-        S2 += Vt[j, 2] * coef[j]
-        S5 += Vt[j, 5] * coef[j]
+        if piv[j] == 0:
+            S0 = coef[j]
+        elif piv[j] == 1:
+            S1 = coef[j]
+        elif piv[j] == 2:
+            S2 = coef[j]
+        elif piv[j] == 5:
+            S5 = coef[j]
     th[0] = math.atan2(S5, S2)
     th[1] = math.atan2(S1, S0)
     th[2] = ph3 + off[0]
@@ -367,7 +488,9 @@ def _scratch():
     return (np.empty((3, 4, 4)), np.empty((15, 9)), np.empty((15, 15)), np.empty((5, 15)),
             np.empty((3, 12, 12)), np.empty((6, 27)), np.empty((12, 24)), np.empty((12, 12)),
             np.empty((24, 24)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
-            np.empty(8), np.empty((3, 6, 6)), np.empty((4, 6)), np.empty(6), np.empty(6))
+            np.empty(8), np.empty((3, 6, 6)), np.empty((4, 6)), np.empty(6), np.empty(6),
+            np.empty((14, 14)), np.empty((8, 8)), np.empty(8, dtype=np.int64), np.empty((8, 14)),
+            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12))
 
 
 @nb.njit(**_OPTS)
@@ -376,7 +499,8 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
     """All solutions of pose n. ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant M1 / Ts of the
     formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0 constant, 1
     ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``)."""
-    Gs, Rh, MA, V15, A, E, X, A2, Mc, W24, v, m, coef, Ms, Vs, th, q = S
+    Gs, Rh, MA, V15, A, E, X, A2, Mc, W24, v, m, coef, Ms, Vs, th, q, H, R, piv, Vr, Aw, \
+        perm, y12 = S
     _rigid_product(form[0], T[n], form[1], Gs[1])
     _rigid_inverse(Gs[1], Gs[2])
     Gs[0] = form[2]
@@ -386,7 +510,7 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
     else:
         Ts = Gs[order[7]]
     _right_side(M1, Ts, Rh, MA, V15[0], V15[1], V15[2], V15[3])
-    U, s, Vt, flag = _pencil(LH, h0, Rh, A, E)
+    flag = _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw)
     if flag != FLAG_OK:
         flags[n] = flag
         return
@@ -398,8 +522,8 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
     for k in range(24):
         if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
             continue
-        _null_vector(A, wr[k], A2, v)
-        if not _angles(wr[k], v, off, L, Rh, U, s, Vt, M1, links, Ts, th, m, coef):
+        _null_vector(A, wr[k], A2, v, perm, y12)
+        if not _angles(wr[k], v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
             continue
         for i in range(6):
             q[order[i]] = sign * th[i]
