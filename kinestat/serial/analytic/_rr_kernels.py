@@ -36,6 +36,12 @@ FLAG_OK = 0
 FLAG_DEFICIENT = 1
 FLAG_ILL_CONDITIONED = 2
 _CHUNK = 16  # poses per scratch allocation in the parallel loop
+#: A2's smallest relative pivot below which the variable is changed (:func:`_companion_eigvals`):
+#: the companion's spurious eigenvalues ±i are defective (4-fold), so an ill-conditioned A2 can
+#: move even the real roots by percent (a Jaco2 pose at 5e-8 lost two of its three solutions)
+_A2_PIVOT_MIN = 1e-5
+#: the Möbius parameters tried in turn (0: the plain variable)
+_MOBIUS = (0.0, 0.7, -1.3, 2.9)
 _B0 = (0.31, -0.72, 0.55, 0.13, -0.94, 0.67, -0.28, 0.81, -0.46, 0.19, 0.73, -0.35)
 
 
@@ -288,25 +294,38 @@ def _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw):
 @nb.njit(**_OPTS)
 def _companion_eigvals(A, X, A2, Mc, wr, wi, dummy):
     """Eigenvalues (into wr, wi) of ``A2 x² + A1 x + A0`` (A normalised in place) through the
-    24x24 companion with ``A2⁻¹`` (LAPACK dgeev, eigenvalues only); False when A2 is
-    ill-conditioned. X (12, 24), A2 (12, 12), Mc (24, 24): scratch."""
+    24x24 companion with the inverse leading coefficient (LAPACK dgeev, eigenvalues only).
+
+    When A2 is ill-conditioned (smallest relative pivot below ``_A2_PIVOT_MIN``) the variable
+    is changed by the Möbius map ``x = (y + t)/(1 − t y)`` (a shift of the half-angle by
+    atan t): ``B(y) = (1 − t y)² A(x)`` has the leading coefficient ``A0 t² − A1 t + A2``,
+    regular unless −1/t is itself a root. False when no tried t gives a regular one. X (12, 24),
+    A2 (12, 12), Mc (24, 24): scratch."""
     sc = 0.0
     for k in range(3):
         for i in range(12):
             for j in range(12):
                 sc = max(sc, abs(A[k, i, j]))
-    big = 0.0
     for k in range(3):
         for i in range(12):
             for j in range(12):
                 A[k, i, j] /= sc
-    for i in range(12):
-        for j in range(12):
-            X[i, j] = A[0, i, j]
-            X[i, 12 + j] = A[1, i, j]
-            A2[i, j] = A[2, i, j]
-    if _gauss(A2, X) < 1e-10:
+    t = 0.0
+    regular = False
+    for t in _MOBIUS:
+        tt = t * t
+        for i in range(12):
+            for j in range(12):
+                a0, a1, a2 = A[0, i, j], A[1, i, j], A[2, i, j]
+                X[i, j] = a0 + t * a1 + tt * a2
+                X[i, 12 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
+                A2[i, j] = tt * a0 - t * a1 + a2
+        if _gauss(A2, X) >= _A2_PIVOT_MIN:
+            regular = True
+            break
+    if not regular:
         return False
+    big = 0.0
     for i in range(12):
         for j in range(24):
             if not math.isfinite(X[i, j]):
@@ -324,6 +343,11 @@ def _companion_eigvals(A, X, A2, Mc, wr, wi, dummy):
             Mc[j, 12 + i] = -X[i, j]
     info = _rgeev(ord("d"), ord("N"), ord("N"), 24, Mc.ctypes, 24, wr.ctypes, wi.ctypes,
                   dummy.ctypes, 1, dummy.ctypes, 1)
+    if t != 0.0:  # back to x = (y + t) / (1 − t y)
+        for k in range(24):
+            x = (complex(wr[k], wi[k]) + t) / (1.0 - t * complex(wr[k], wi[k]))
+            wr[k] = x.real
+            wi[k] = x.imag
     return info == 0
 
 
