@@ -7,6 +7,8 @@ axes), PUMA 560 (spherical wrist, embedded), PUMA 762 (embedded, Crane–Duffy f
 Jaco2-type 6R with a 60° wrist (non-Pieper) and a random general 6R. For every solver and arm:
 single-call time per pose (one pose per call, median over ``--single`` poses), batched poses/s
 (kinestat: one call on ``--n`` poses; peers have no batch call, so their figure is 1/single),
+each with the CPU time of this process per pose beside it (``cpu µs``: all threads; robust to
+other jobs on a shared machine, where wall time is not),
 completeness (the generating configuration is among the returned solutions, wrapped distance
 < 1e-6), the mean number of solutions (kinestat: over ``--n`` poses; peers: over the
 ``--single`` poses), the worst pose residual of the returned solutions, every one recomputed
@@ -32,7 +34,9 @@ import warnings
 import numpy as np
 
 warnings.filterwarnings("ignore")
-sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests", "serial", "analytic"))
+_ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..")
+sys.path.insert(0, os.path.join(_ROOT, "tests", "serial", "analytic"))
+sys.path.insert(0, _ROOT)  # this checkout's kinestat, not an installed one
 
 from arms import arm  # noqa: E402  (test arms, public constructors)
 
@@ -78,15 +82,22 @@ def _agreement(mine, sols_per_pose):
     return same / len(mine), extra
 
 
+_CPU: dict[int, float] = {}
+
+
 def _single(call, poses):
-    """Median seconds per call over the poses (after one warm-up)."""
+    """Median seconds per call over the poses (after one warm-up); the median CPU seconds of
+    this process per call go to ``_CPU[id(call)]`` (less sensitive to other jobs' load)."""
     call(poses[0])
-    times, out = [], []
+    times, cpu, out = [], [], []
     for T in poses:
+        c = time.process_time()
         t = time.perf_counter()
         r = call(T)
         times.append(time.perf_counter() - t)
+        cpu.append(time.process_time() - c)
         out.append(r)
+    _CPU[id(call)] = float(np.median(cpu))
     return float(np.median(times)), out
 
 
@@ -178,16 +189,20 @@ def run(n: int, n_single: int) -> dict:
         model = arm(name)
         q = rng.uniform(-PI, PI, (n, 6))
         T = kinestat.fk(model, q)
-        ik_all(model, T[:64])  # compile / load the kernels
+        ik_all(model, T[:512])  # compile / load the kernels (serial and parallel paths)
+        c = time.process_time()
         t = time.perf_counter()
         res = ik_all(model, T)
         dt = time.perf_counter() - t
+        cpu_batch = (time.process_time() - c) / n
         d = _wrapdist(res.q, q[:, None, :])
         complete = float(np.mean(np.any(np.where(res.valid, d, np.inf) < 1e-6, axis=1)))
         worst = float(np.nanmax(np.maximum(res.position_error, res.rotation_error)))
-        single, _ = _single(lambda x, m=model: ik_all(m, x), T[:n_single])
+        mine = lambda x, m=model: ik_all(m, x)  # noqa: E731
+        single, _ = _single(mine, T[:n_single])
         r = {"kinestat": {"method": res.method, "batched_poses_per_s": n / dt,
-                          "single_us": single * 1e6, "complete": complete,
+                          "batched_cpu_us": cpu_batch * 1e6, "single_us": single * 1e6,
+                          "single_cpu_us": _CPU[id(mine)] * 1e6, "complete": complete,
                           "mean_solutions": float(res.n_solutions.mean()),
                           "worst_residual": worst}}
         kind = res.method if res.method in ("pieper", "three-parallel") else "general"
@@ -205,6 +220,8 @@ def run(n: int, n_single: int) -> dict:
                         for qq, ss in zip(q[:n_single], sols, strict=True)]
                 agree, extra = _agreement([res.solutions((i,)) for i in range(n_single)], good)
                 r[peer] = {"single_us": single * 1e6, "batched_poses_per_s": 1.0 / single,
+                           "single_cpu_us": _CPU[id(call)] * 1e6,
+                           "batched_cpu_us": _CPU[id(call)] * 1e6,
                            "complete": c, "mean_solutions": mean, "worst_residual": w,
                            "count_agrees_with_kinestat": agree,
                            "peer_solutions_kinestat_lacks": extra}
@@ -231,9 +248,9 @@ def main(argv=None) -> int:
         print(json.dumps({"meta": meta, "rows": rows}, indent=1))
         return 0
     print(f"# ik_all benchmark  n={a.n}  single={a.single}  {meta}")
-    print(f"{'arm':9} {'solver':12} {'method':24} {'single µs':>10} {'poses/s':>10} "
-          f"{'complete':>8} {'mean #':>7} {'worst res':>10} {'same # as ks':>12} "
-          f"{'ks lacks':>8}")
+    print(f"{'arm':9} {'solver':12} {'method':24} {'single µs':>10} {'cpu µs':>7} "
+          f"{'poses/s':>10} {'cpu µs':>7} {'complete':>8} {'mean #':>7} {'worst res':>10} "
+          f"{'same # as ks':>12} {'ks lacks':>8}")
     for name, r in rows.items():
         for solver, v in r.items():
             if v is None:
@@ -243,7 +260,8 @@ def main(argv=None) -> int:
                 print(f"{name:9} {solver:12} failed: {v['error']}")
                 continue
             print(f"{name:9} {solver:12} {v.get('method', ''):24} "
-                  f"{_fmt(v['single_us'], '10.1f')} {_fmt(v['batched_poses_per_s'], '10.0f')} "
+                  f"{_fmt(v['single_us'], '10.1f')} {_fmt(v['single_cpu_us'], '7.1f')} "
+                  f"{_fmt(v['batched_poses_per_s'], '10.0f')} {_fmt(v['batched_cpu_us'], '7.2f')} "
                   f"{_fmt(v['complete'], '8.4f')} {_fmt(v['mean_solutions'], '7.2f')} "
                   f"{_fmt(v['worst_residual'], '10.1e')} "
                   f"{_fmt(v.get('count_agrees_with_kinestat'), '12.4f')} "

@@ -27,6 +27,11 @@ KERNELS: dict[str, str] = {
     "puma762": "kinestat.serial.puma762._kernels",
     "platform": "kinestat.parallel._fk_kernels",
 }
+#: kernel groups compiled on demand by the command that uses them (not by ``kinestat warmup``)
+ON_DEMAND: dict[str, str] = {
+    "ik_all_closed": "kinestat.serial.analytic._cf_kernels",
+    "ik_all_general": "kinestat.serial.analytic._rr_kernels",
+}
 NOTICE = "compiling kernels (first run only)…"
 
 
@@ -46,7 +51,7 @@ def _index_paths(module_name: str) -> list[str]:
 
 def is_cold(group: str) -> bool:
     """True when no public kernel of ``group`` has a cache index on disk (it will compile)."""
-    paths = _index_paths(KERNELS[group])
+    paths = _index_paths(KERNELS.get(group) or ON_DEMAND[group])
     return bool(paths) and not any(os.path.exists(p) for p in paths)
 
 

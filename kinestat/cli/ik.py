@@ -326,7 +326,7 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
 def _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg, urdf,
                  as_json) -> None:
     """``kinestat ik MODEL --pose ... --all``: every analytic solution (docs/ik-all.md)."""
-    from kinestat.serial.analytic import ik_all, select_nearest  # lazy: numba kernels
+    from kinestat.serial.analytic import ik_all, method_for, select_nearest  # lazy: numba
 
     if closed or current_axis_deg is not None:
         raise InputError("--all goes with --pose (--tool-point/--s6/--a67 and "
@@ -343,7 +343,10 @@ def _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg, urd
     if ref_text is not None:
         v = parse_floats(ref_text, m.n, ref_name)
         ref = np.where(m.prismatic, v, np.radians(v))
-    res = ik_all(m, T)
+    groups = ("ik_all_closed",) if method_for(m) != "raghavan-roth" else \
+        ("ik_all_closed", "ik_all_general")
+    with compiling_notice(*groups):
+        res = ik_all(m, T)
     sel = select_nearest(m, res, ref)
     records = [_all_record(m, res, sel, i, ref) for i in np.ndindex(res.shape)]
     head = {"model": m.name, "method": res.method, "length_unit": m.length_unit,

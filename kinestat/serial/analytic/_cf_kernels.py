@@ -1,6 +1,13 @@
 """Compiled (Numba) kernels of the closed forms (:mod:`kinestat.serial.analytic.closed_form`
-is the NumPy reference): Paden–Kahan subproblems on 3-vectors, one pose per ``prange``
-iteration, FK verification and de-duplication in the kernel."""
+is the NumPy reference): Paden–Kahan subproblems, one pose per ``prange`` iteration, FK
+verification and de-duplication in the kernel.
+
+Allocation-free: 3-vectors are 3-tuples and rotations 9-tuples (row-major) held in registers;
+the verification runs the serial FK kernel's scalar steps (through
+:mod:`kinestat.serial.analytic._solution_kernels`) and writes straight into the caller's output
+arrays. Only the rare pose whose candidate misses
+the tolerance (rounding next to a singular set) allocates, for two Newton steps.
+"""
 
 from __future__ import annotations
 
@@ -9,9 +16,32 @@ import math
 import numba as nb
 import numpy as np
 
-from kinestat.serial.analytic._rr_kernels import _mm, _mtm, _mtv, _mv, _polish, _wrap
+from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial.analytic._solution_kernels import fk6, polish, pose_errors, scratch, store
+from kinestat.serial.analytic._solution_kernels import wrap as _wrap
 
-_OPTS = {"cache": True, "nogil": True, "error_model": "numpy"}
+_Z3 = (0.0, 0.0, 0.0)
+
+
+# -- 3-vectors and rotations as tuples ----------------------------------------------------------
+@nb.njit(inline="always", **_OPTS)
+def _row(A, i):
+    return (A[i, 0], A[i, 1], A[i, 2])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _add(a, b):
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _sub(a, b):
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _scale(a, s):
+    return (a[0] * s, a[1] * s, a[2] * s)
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -21,50 +51,104 @@ def _dot(a, b):
 
 @nb.njit(inline="always", **_OPTS)
 def _cross(a, b):
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2],
-                     a[0] * b[1] - a[1] * b[0]])
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _norm(a):
+    return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
 @nb.njit(inline="always", **_OPTS)
 def _rot(w, th):
-    """Rodrigues' rotation matrix (MLS eq. 2.14)."""
+    """Rodrigues' rotation matrix (MLS eq. 2.14) as a row-major 9-tuple."""
     c = math.cos(th)
     s = math.sin(th)
     v = 1.0 - c
     x, y, z = w[0], w[1], w[2]
-    R = np.empty((3, 3))
-    R[0, 0] = c + x * x * v
-    R[0, 1] = x * y * v - z * s
-    R[0, 2] = x * z * v + y * s
-    R[1, 0] = y * x * v + z * s
-    R[1, 1] = c + y * y * v
-    R[1, 2] = y * z * v - x * s
-    R[2, 0] = z * x * v - y * s
-    R[2, 1] = z * y * v + x * s
-    R[2, 2] = c + z * z * v
-    return R
+    return (c + x * x * v, x * y * v - z * s, x * z * v + y * s,
+            y * x * v + z * s, c + y * y * v, y * z * v - x * s,
+            z * x * v - y * s, z * y * v + x * s, c + z * z * v)
+
+
+@nb.njit(inline="always", **_OPTS)
+def _mv(R, x):
+    return (R[0] * x[0] + R[1] * x[1] + R[2] * x[2],
+            R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
+            R[6] * x[0] + R[7] * x[1] + R[8] * x[2])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _mtv(R, x):
+    """``Rᵀ x``."""
+    return (R[0] * x[0] + R[3] * x[1] + R[6] * x[2],
+            R[1] * x[0] + R[4] * x[1] + R[7] * x[2],
+            R[2] * x[0] + R[5] * x[1] + R[8] * x[2])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _mm(A, B):
+    return (A[0] * B[0] + A[1] * B[3] + A[2] * B[6], A[0] * B[1] + A[1] * B[4] + A[2] * B[7],
+            A[0] * B[2] + A[1] * B[5] + A[2] * B[8],
+            A[3] * B[0] + A[4] * B[3] + A[5] * B[6], A[3] * B[1] + A[4] * B[4] + A[5] * B[7],
+            A[3] * B[2] + A[4] * B[5] + A[5] * B[8],
+            A[6] * B[0] + A[7] * B[3] + A[8] * B[6], A[6] * B[1] + A[7] * B[4] + A[8] * B[7],
+            A[6] * B[2] + A[7] * B[5] + A[8] * B[8])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _mtm(A, B):
+    """``Aᵀ B``."""
+    return (A[0] * B[0] + A[3] * B[3] + A[6] * B[6], A[0] * B[1] + A[3] * B[4] + A[6] * B[7],
+            A[0] * B[2] + A[3] * B[5] + A[6] * B[8],
+            A[1] * B[0] + A[4] * B[3] + A[7] * B[6], A[1] * B[1] + A[4] * B[4] + A[7] * B[7],
+            A[1] * B[2] + A[4] * B[5] + A[7] * B[8],
+            A[2] * B[0] + A[5] * B[3] + A[8] * B[6], A[2] * B[1] + A[5] * B[4] + A[8] * B[7],
+            A[2] * B[2] + A[5] * B[5] + A[8] * B[8])
+
+
+@nb.njit(inline="always", **_OPTS)
+def _mmt(A, B):
+    """``A Bᵀ``."""
+    return (A[0] * B[0] + A[1] * B[1] + A[2] * B[2], A[0] * B[3] + A[1] * B[4] + A[2] * B[5],
+            A[0] * B[6] + A[1] * B[7] + A[2] * B[8],
+            A[3] * B[0] + A[4] * B[1] + A[5] * B[2], A[3] * B[3] + A[4] * B[4] + A[5] * B[5],
+            A[3] * B[6] + A[4] * B[7] + A[5] * B[8],
+            A[6] * B[0] + A[7] * B[1] + A[8] * B[2], A[6] * B[3] + A[7] * B[4] + A[8] * B[5],
+            A[6] * B[6] + A[7] * B[7] + A[8] * B[8])
 
 
 @nb.njit(inline="always", **_OPTS)
 def _rotate(w, r, th, x):
-    return r + _mv(_rot(w, th), x - r)
+    """The point x turned by θ about the axis (ω, r)."""
+    return _add(r, _mv(_rot(w, th), _sub(x, r)))
 
 
 @nb.njit(inline="always", **_OPTS)
+def _pose_times(T, A):
+    """Rotation (9-tuple) and translation (3-tuple) of ``T · A`` for 4x4 rigid arrays."""
+    R = (T[0, 0], T[0, 1], T[0, 2], T[1, 0], T[1, 1], T[1, 2], T[2, 0], T[2, 1], T[2, 2])
+    Ra = (A[0, 0], A[0, 1], A[0, 2], A[1, 0], A[1, 1], A[1, 2], A[2, 0], A[2, 1], A[2, 2])
+    t = _add(_mv(R, (A[0, 3], A[1, 3], A[2, 3])), (T[0, 3], T[1, 3], T[2, 3]))
+    return _mm(R, Ra), t
+
+
+# -- Paden–Kahan subproblems (the NumPy references are in subproblems.py) -----------------------
+@nb.njit(inline="always", **_OPTS)
 def _sp1(w, r, p, q):
-    """Subproblem 1: the angle of p → q about (ω, r); returns (θ, |u'|)."""
-    u = p - r
-    v = q - r
-    up = u - _dot(u, w) * w
-    vp = v - _dot(v, w) * w
-    return math.atan2(_dot(w, _cross(up, vp)), _dot(up, vp)), math.sqrt(_dot(up, up))
+    """Subproblem 1: the angle of p → q about (ω, r)."""
+    u = _sub(p, r)
+    v = _sub(q, r)
+    up = _sub(u, _scale(w, _dot(u, w)))
+    vp = _sub(v, _scale(w, _dot(v, w)))
+    return math.atan2(_dot(w, _cross(up, vp)), _dot(up, vp))
 
 
-@nb.njit(**_OPTS)
-def _sp2(w1, w2, r, p, q, out, tol):
-    """Subproblem 2 (axes meeting at r): out[k] = (θ1, θ2) for k = 0, 1; returns existence."""
-    u = p - r
-    v = q - r
+@nb.njit(inline="always", **_OPTS)
+def _sp2(w1, w2, r, p, q, tol):
+    """Subproblem 2 (axes meeting at r): ``(exists, θ1, θ2, θ1', θ2')``."""
+    u = _sub(p, r)
+    v = _sub(q, r)
     c12 = _dot(w1, w2)
     den = c12 * c12 - 1.0
     a = (c12 * _dot(w2, u) - _dot(w1, v)) / den
@@ -73,173 +157,118 @@ def _sp2(w1, w2, r, p, q, out, tol):
     uu = _dot(u, u)
     g2 = (uu - a * a - b * b - 2.0 * a * b * c12) / _dot(x, x)
     if g2 < -tol * (1.0 + uu) or abs(uu - _dot(v, v)) > tol * (1.0 + uu):
-        return False
+        return False, 0.0, 0.0, 0.0, 0.0
     g = math.sqrt(max(g2, 0.0))
-    for k in range(2):
-        c = r + a * w1 + b * w2 + (g if k == 0 else -g) * x
-        out[k, 1], _ = _sp1(w2, r, p, c)
-        out[k, 0], _ = _sp1(w1, r, c, q)
-    return True
+    base = _add(r, _add(_scale(w1, a), _scale(w2, b)))
+    c = _add(base, _scale(x, g))
+    d = _sub(base, _scale(x, g))
+    return True, _sp1(w1, r, c, q), _sp1(w2, r, p, c), _sp1(w1, r, d, q), _sp1(w2, r, p, d)
 
 
-@nb.njit(**_OPTS)
-def _sp3(w, r, p, q, delta, out, tol):
-    """Subproblem 3: out[0:2] = θ with |e^{ξ̂θ} p − q| = δ; returns existence."""
-    u = p - r
-    v = q - r
-    up = u - _dot(u, w) * w
-    vp = v - _dot(v, w) * w
+@nb.njit(inline="always", **_OPTS)
+def _sp3(w, r, p, q, delta, tol):
+    """Subproblem 3: ``(exists, θ, θ')`` with ``|e^{ξ̂θ} p − q| = δ``."""
+    u = _sub(p, r)
+    v = _sub(q, r)
+    up = _sub(u, _scale(w, _dot(u, w)))
+    vp = _sub(v, _scale(w, _dot(v, w)))
     t0 = math.atan2(_dot(w, _cross(up, vp)), _dot(up, vp))
-    h = _dot(w, p - q)
+    h = _dot(w, _sub(p, q))
     d2 = delta * delta - h * h
-    nu = math.sqrt(_dot(up, up))
-    nv = math.sqrt(_dot(vp, vp))
+    nu = _norm(up)
+    nv = _norm(vp)
     if nu * nv == 0.0:
-        return False
+        return False, 0.0, 0.0
     c = (nu * nu + nv * nv - d2) / (2.0 * nu * nv)
     if abs(c) > 1.0 + tol:
-        return False
+        return False, 0.0, 0.0
     a = math.acos(min(max(c, -1.0), 1.0))
-    out[0] = t0 - a
-    out[1] = t0 + a
-    return True
+    return True, t0 - a, t0 + a
 
 
-@nb.njit(**_OPTS)
-def _sp4(h, w, p, d, out, tol):
-    """Subproblem 4 (one axis): out[0:2] = θ with hᵀ R(ω, θ) p = d; returns existence."""
-    par = _dot(w, p) * w
-    A = _dot(h, p - par)
+@nb.njit(inline="always", **_OPTS)
+def _sp4(h, w, p, d, tol):
+    """Subproblem 4 (one axis): ``(exists, θ, θ')`` with ``hᵀ R(ω, θ) p = d``."""
+    par = _scale(w, _dot(w, p))
+    A = _dot(h, _sub(p, par))
     B = _dot(h, _cross(w, p))
     C = d - _dot(h, par)
     n = math.hypot(A, B)
     if n <= tol:
-        return False
+        return False, 0.0, 0.0
     c = C / n
     if abs(c) > 1.0 + tol:
-        return False
+        return False, 0.0, 0.0
     phi = math.atan2(B, A)
     a = math.acos(min(max(c, -1.0), 1.0))
-    out[0] = phi - a
-    out[1] = phi + a
-    return True
+    return True, phi - a, phi + a
 
 
+# -- verification, de-duplication, storage ------------------------------------------------------
 @nb.njit(**_OPTS)
-def _fk(C, q):
-    """``C0 Rz(q1) C1 … Rz(q6) C6`` with the running transform in scalars (no temporaries)."""
-    F = np.empty((4, 4))
-    r00, r01, r02, p0 = C[0, 0, 0], C[0, 0, 1], C[0, 0, 2], C[0, 0, 3]
-    r10, r11, r12, p1 = C[0, 1, 0], C[0, 1, 1], C[0, 1, 2], C[0, 1, 3]
-    r20, r21, r22, p2 = C[0, 2, 0], C[0, 2, 1], C[0, 2, 2], C[0, 2, 3]
-    for i in range(6):
-        c = math.cos(q[i])
-        s = math.sin(q[i])
-        a0 = c * r00 + s * r01
-        a1 = c * r10 + s * r11
-        a2 = c * r20 + s * r21
-        r01 = c * r01 - s * r00
-        r11 = c * r11 - s * r10
-        r21 = c * r21 - s * r20
-        r00, r10, r20 = a0, a1, a2
-        M = C[i + 1]
-        n00 = r00 * M[0, 0] + r01 * M[1, 0] + r02 * M[2, 0]
-        n01 = r00 * M[0, 1] + r01 * M[1, 1] + r02 * M[2, 1]
-        n02 = r00 * M[0, 2] + r01 * M[1, 2] + r02 * M[2, 2]
-        p0 = r00 * M[0, 3] + r01 * M[1, 3] + r02 * M[2, 3] + p0
-        n10 = r10 * M[0, 0] + r11 * M[1, 0] + r12 * M[2, 0]
-        n11 = r10 * M[0, 1] + r11 * M[1, 1] + r12 * M[2, 1]
-        n12 = r10 * M[0, 2] + r11 * M[1, 2] + r12 * M[2, 2]
-        p1 = r10 * M[0, 3] + r11 * M[1, 3] + r12 * M[2, 3] + p1
-        n20 = r20 * M[0, 0] + r21 * M[1, 0] + r22 * M[2, 0]
-        n21 = r20 * M[0, 1] + r21 * M[1, 1] + r22 * M[2, 1]
-        n22 = r20 * M[0, 2] + r21 * M[1, 2] + r22 * M[2, 2]
-        p2 = r20 * M[0, 3] + r21 * M[1, 3] + r22 * M[2, 3] + p2
-        r00, r01, r02, r10, r11, r12, r20, r21, r22 = n00, n01, n02, n10, n11, n12, n20, n21, n22
-    F[0, 0], F[0, 1], F[0, 2], F[0, 3] = r00, r01, r02, p0
-    F[1, 0], F[1, 1], F[1, 2], F[1, 3] = r10, r11, r12, p1
-    F[2, 0], F[2, 1], F[2, 2], F[2, 3] = r20, r21, r22, p2
-    F[3, 0], F[3, 1], F[3, 2], F[3, 3] = 0.0, 0.0, 0.0, 1.0
-    return F
-
-
-@nb.njit(**_OPTS)
-def _store(n, C, T, q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
-    """Verify q by FK against T and store it unless it repeats a stored one; new count."""
-    F = _fk(C, q)
-    pos = math.sqrt((F[0, 3] - T[0, 3]) ** 2 + (F[1, 3] - T[1, 3]) ** 2
-                    + (F[2, 3] - T[2, 3]) ** 2)
-    d = math.sqrt(np.sum((F[:3, :3] - T[:3, :3]) ** 2))
-    rot = 2.0 * math.asin(min(d / (2.0 * math.sqrt(2.0)), 1.0))
+def _store(n, C, Tn, q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
+    """Verify q (6-tuple) by FK against Tn and store it unless it repeats a stored one; returns
+    the new count."""
+    pos, rot = pose_errors(fk6(C, q), Tn)
     if not (pos <= tol and rot <= tol):  # rounding near a singular set: two Newton steps
-        pos, rot = _polish(C, T, q, 2)
+        qa = np.empty(6)
+        for i in range(6):
+            qa[i] = q[i]
+        Ms, Vs = scratch()
+        pos, rot = polish(C, Tn, qa, 2, Ms, Vs)
         if not (pos <= tol and rot <= tol):
             return cnt
-    for i in range(6):
-        q[i] = _wrap(q[i])
-    for j in range(cnt):
-        dmax = 0.0
-        for i in range(6):
-            dmax = max(dmax, abs(_wrap(q[i] - out_q[n, j, i])))
-        if dmax < dedup:
-            return cnt
-    if cnt >= out_q.shape[1]:
-        return cnt
-    out_q[n, cnt] = q
-    out_valid[n, cnt] = True
-    out_pos[n, cnt] = pos
-    out_rot[n, cnt] = rot
-    return cnt + 1
+        q = (qa[0], qa[1], qa[2], qa[3], qa[4], qa[5])
+    return store(n, q, pos, rot, dedup, out_q, out_valid, out_pos, out_rot, cnt)
 
 
+# -- spherical wrist, shoulder axes meeting (Pieper) --------------------------------------------
 @nb.njit(**_OPTS)
 def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
                  out_pos, out_rot, out_sing, out_sign, out_fam):
-    g = _mm(T[n], T0inv)
-    Rg = np.ascontiguousarray(g[:3, :3])
-    pw = _mv(Rg, w) + g[:3, 3]
-    t3 = np.empty(2)
-    if not _sp3(W[2], P[2], w, s, math.sqrt(_dot(pw - s, pw - s)), t3, tol):
+    Rg, tg = _pose_times(T[n], T0inv)
+    W0, W1, W2, W3, W4, W5 = _row(W, 0), _row(W, 1), _row(W, 2), _row(W, 3), _row(W, 4), _row(W, 5)
+    P2 = _row(P, 2)
+    wc = (w[0], w[1], w[2])
+    sc = (s[0], s[1], s[2])
+    xs = (x6[0], x6[1], x6[2])
+    pw = _add(_mv(Rg, wc), tg)
+    ok3, t3a, t3b = _sp3(W2, P2, wc, sc, _norm(_sub(pw, sc)), tol)
+    if not ok3:
         return
-    t12 = np.empty((2, 2))
-    t45 = np.empty((2, 2))
-    z = np.zeros(3)
-    q = np.empty(6)
     cnt = 0
     for i3 in range(2):
-        w3 = _rotate(W[2], P[2], t3[i3], w)
-        if not _sp2(W[0], W[1], s, w3, pw, t12, tol):
+        t3 = t3a if i3 == 0 else t3b
+        w3 = _rotate(W2, P2, t3, wc)
+        ok12, t1a, t2a, t1b, t2b = _sp2(W0, W1, sc, w3, pw, tol)
+        if not ok12:
             continue
-        R3 = _rot(W[2], t3[i3])
+        R3 = _rot(W2, t3)
         for i12 in range(2):
-            R123 = _mm(_mm(_rot(W[0], t12[i12, 0]), _rot(W[1], t12[i12, 1])), R3)
-            Rp = _mtm(R123, Rg)
-            target = _mv(Rp, W[5])
-            cr = _cross(W[3], target)
-            sing = math.sqrt(_dot(cr, cr)) < wrist_tol
+            t1 = t1a if i12 == 0 else t1b
+            t2 = t2a if i12 == 0 else t2b
+            Rp = _mtm(_mm(_mm(_rot(W0, t1), _rot(W1, t2)), R3), Rg)
+            target = _mv(Rp, W5)
+            sing = _norm(_cross(W3, target)) < wrist_tol
             if sing:  # θ4 free: θ4 = 0, align ω6 with θ5 alone
-                t45[0, 0] = 0.0
-                t45[0, 1], _ = _sp1(W[4], z, W[5], target)
-                t45[1, 0] = t45[0, 0]
-                t45[1, 1] = t45[0, 1]
-            elif not _sp2(W[3], W[4], z, W[5], target, t45, tol):
-                continue
+                t4a = t4b = 0.0
+                t5a = t5b = _sp1(W4, _Z3, W5, target)
+            else:
+                ok45, t4a, t5a, t4b, t5b = _sp2(W3, W4, _Z3, W5, target, tol)
+                if not ok45:
+                    continue
             for i45 in range(2):
-                R5 = _rot(W[4], t45[i45, 1])
-                R45 = _mm(_rot(W[3], t45[i45, 0]), R5)
-                t6, _ = _sp1(W[5], z, x6, _mtv(R45, _mv(Rp, x6)))
-                q[0] = t12[i12, 0]
-                q[1] = t12[i12, 1]
-                q[2] = t3[i3]
-                q[3] = t45[i45, 0]
-                q[4] = t45[i45, 1]
-                q[5] = t6
+                t4 = t4a if i45 == 0 else t4b
+                t5 = t5a if i45 == 0 else t5b
+                R5 = _rot(W4, t5)
+                t6 = _sp1(W5, _Z3, xs, _mtv(_mm(_rot(W3, t4), R5), _mv(Rp, xs)))
+                q = (t1, t2, t3, t4, t5, t6)
                 new = _store(n, C, T[n], q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
                 if new > cnt and sing:
-                    sig = 1.0 if _dot(W[3], _mv(R5, W[5])) >= 0.0 else -1.0
+                    sig = 1.0 if _dot(W3, _mv(R5, W5)) >= 0.0 else -1.0
                     out_sing[n, cnt] = True
                     out_sign[n, cnt] = sig
-                    out_fam[n, cnt] = _wrap(q[3] + sig * q[5])
+                    out_fam[n, cnt] = _wrap(out_q[n, cnt, 3] + sig * out_q[n, cnt, 5])
                 cnt = new
 
 
@@ -253,47 +282,54 @@ def pieper_batch(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_
 
 
 @nb.njit(**_OPTS)
+def pieper_serial(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
+                  out_pos, out_rot, out_sing, out_sign, out_fam):
+    """:func:`pieper_batch` on one thread (small batches: no thread start-up)."""
+    for n in range(T.shape[0]):
+        _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
+                     out_pos, out_rot, out_sing, out_sign, out_fam)
+
+
+# -- three parallel axes, wrist pair meeting (UR type) ------------------------------------------
+@nb.njit(**_OPTS)
 def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
                          out_valid, out_pos, out_rot):
-    g = _mm(T[n], T0inv)
-    Rg = np.ascontiguousarray(g[:3, :3])
-    tg = np.ascontiguousarray(g[:3, 3])
-    h = W[1]
-    q56 = _mv(Rg, p56) + tg
-    psi = np.empty(2)
-    if not _sp4(h, W[0], q56 - P[0], _dot(h, p56 - P[0]), psi, tol):
+    Rg, tg = _pose_times(T[n], T0inv)
+    W0, W1, W2, W4, W5 = _row(W, 0), _row(W, 1), _row(W, 2), _row(W, 4), _row(W, 5)
+    P0, P1, P2, P3, P4, P5 = _row(P, 0), _row(P, 1), _row(P, 2), _row(P, 3), _row(P, 4), _row(P, 5)
+    h = W1
+    pc = (p56[0], p56[1], p56[2])
+    xc = (xh[0], xh[1], xh[2])
+    q56 = _add(_mv(Rg, pc), tg)
+    ok1, psi_a, psi_b = _sp4(h, W0, _sub(q56, P0), _dot(h, _sub(pc, P0)), tol)
+    if not ok1:
         return
-    t5 = np.empty(2)
-    t3 = np.empty(2)
-    z = np.zeros(3)
-    q = np.empty(6)
     cnt = 0
     for i1 in range(2):
-        Rr = _mm(_rot(W[0], psi[i1]), Rg)
-        if not _sp4(h, W[4], W[5], _dot(h, _mv(Rr, W[5])), t5, tol):
+        psi = psi_a if i1 == 0 else psi_b
+        Rr = _mm(_rot(W0, psi), Rg)
+        ok5, t5a, t5b = _sp4(h, W4, W5, _dot(h, _mv(Rr, W5)), tol)
+        if not ok5:
             continue
         hr = _mtv(Rr, h)
-        cr = _cross(hr, W[5])
-        if math.sqrt(_dot(cr, cr)) < wrist_tol:
+        if _norm(_cross(hr, W5)) < wrist_tol:
             continue  # wrist-singular: axis 6 parallel to axes 2-4 (not reported)
         for i5 in range(2):
-            R5 = _rot(W[4], t5[i5])
-            t6, _ = _sp1(W[5], z, hr, _mtv(R5, h))
-            R6 = _rot(W[5], t6)
-            R234 = _mm(Rr, _mm(R5, R6).T)
-            phi, _ = _sp1(h, z, xh, _mv(R234, xh))
-            y = _rotate(W[5], P[5], -t6, _rotate(W[4], P[4], -t5[i5], P[3]))
-            y = _rotate(W[0], P[0], psi[i1], _mv(Rg, y) + tg)
-            if not _sp3(W[2], P[2], P[3], P[1], math.sqrt(_dot(y - P[1], y - P[1])), t3, tol):
+            t5 = t5a if i5 == 0 else t5b
+            R5 = _rot(W4, t5)
+            t6 = _sp1(W5, _Z3, hr, _mtv(R5, h))
+            R234 = _mmt(Rr, _mm(R5, _rot(W5, t6)))
+            phi = _sp1(h, _Z3, xc, _mv(R234, xc))
+            y = _rotate(W5, P5, -t6, _rotate(W4, P4, -t5, P3))
+            y = _rotate(W0, P0, psi, _add(_mv(Rg, y), tg))
+            ok3, t3a, t3b = _sp3(W2, P2, P3, P1, _norm(_sub(y, P1)), tol)
+            if not ok3:
                 continue
             for i3 in range(2):
-                t2, _ = _sp1(W[1], P[1], _rotate(W[2], P[2], t3[i3], P[3]), y)
-                q[0] = -psi[i1]
-                q[1] = t2
-                q[2] = t3[i3]
-                q[3] = sg[2] * (phi - sg[0] * t2 - sg[1] * t3[i3])
-                q[4] = t5[i5]
-                q[5] = t6
+                t3 = t3a if i3 == 0 else t3b
+                t2 = _sp1(W1, P1, _rotate(W2, P2, t3, P3), y)
+                t4 = sg[2] * (phi - sg[0] * t2 - sg[1] * t3)
+                q = (-psi, t2, t3, t4, t5, t6)
                 cnt = _store(n, C, T[n], q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
 
 
@@ -307,15 +343,6 @@ def three_parallel_batch(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, 
 
 
 @nb.njit(**_OPTS)
-def pieper_serial(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
-                  out_pos, out_rot, out_sing, out_sign, out_fam):
-    """:func:`pieper_batch` on one thread (small batches: no thread start-up)."""
-    for n in range(T.shape[0]):
-        _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
-                     out_pos, out_rot, out_sing, out_sign, out_fam)
-
-
-@nb.njit(**_OPTS)
 def three_parallel_serial(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
                           out_valid, out_pos, out_rot):
     """:func:`three_parallel_batch` on one thread."""
@@ -324,27 +351,43 @@ def three_parallel_serial(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup,
                              out_valid, out_pos, out_rot)
 
 
+# -- pose checks ------------------------------------------------------------------------------
+@nb.njit(inline="always", **_OPTS)
+def _pose_status(T, n, tol):
+    """0: a rotation orthonormal to rounding (1e-13); 1: within tol only (to be projected);
+    2: not a finite rigid transform."""
+    for i in range(4):
+        for j in range(4):
+            if not math.isfinite(T[n, i, j]):
+                return 2
+    if T[n, 3, 0] != 0.0 or T[n, 3, 1] != 0.0 or T[n, 3, 2] != 0.0 or T[n, 3, 3] != 1.0:
+        return 2
+    worst = 0.0
+    for i in range(3):
+        for j in range(3):
+            d = T[n, i, 0] * T[n, j, 0] + T[n, i, 1] * T[n, j, 1] + T[n, i, 2] * T[n, j, 2]
+            worst = max(worst, abs(d - (1.0 if i == j else 0.0)))
+    if worst > tol:
+        return 2
+    det = (T[n, 0, 0] * (T[n, 1, 1] * T[n, 2, 2] - T[n, 1, 2] * T[n, 2, 1])
+           - T[n, 0, 1] * (T[n, 1, 0] * T[n, 2, 2] - T[n, 1, 2] * T[n, 2, 0])
+           + T[n, 0, 2] * (T[n, 1, 0] * T[n, 2, 1] - T[n, 1, 1] * T[n, 2, 0]))
+    if abs(det - 1.0) > tol:
+        return 2
+    return 1 if worst > 1e-13 else 0
+
+
 @nb.njit(**_OPTS)
-def first_non_rigid(T, tol):
-    """Index of the first pose of ``T (N, 4, 4)`` that is not a finite rigid transform (rotation
-    orthonormal with det +1 within tol, last row [0, 0, 0, 1]), or −1."""
+def check_rigid(T, tol):
+    """``(first, n_project)``: the index of the first pose of ``T (N, 4, 4)`` that is not a
+    finite rigid transform (rotation orthonormal with det +1 within tol, last row
+    [0, 0, 0, 1]) or −1, and how many poses are orthonormal within tol but not to rounding
+    (1e-13: the caller projects them onto the nearest rotation)."""
+    n_project = 0
     for n in range(T.shape[0]):
-        bad = False
-        for i in range(4):
-            for j in range(4):
-                if not math.isfinite(T[n, i, j]):
-                    bad = True
-        if bad or T[n, 3, 0] != 0.0 or T[n, 3, 1] != 0.0 or T[n, 3, 2] != 0.0 or \
-                T[n, 3, 3] != 1.0:
-            return n
-        for i in range(3):
-            for j in range(3):
-                d = T[n, i, 0] * T[n, j, 0] + T[n, i, 1] * T[n, j, 1] + T[n, i, 2] * T[n, j, 2]
-                if abs(d - (1.0 if i == j else 0.0)) > tol:
-                    return n
-        det = (T[n, 0, 0] * (T[n, 1, 1] * T[n, 2, 2] - T[n, 1, 2] * T[n, 2, 1])
-               - T[n, 0, 1] * (T[n, 1, 0] * T[n, 2, 2] - T[n, 1, 2] * T[n, 2, 0])
-               + T[n, 0, 2] * (T[n, 1, 0] * T[n, 2, 1] - T[n, 1, 1] * T[n, 2, 0]))
-        if abs(det - 1.0) > tol:
-            return n
-    return -1
+        st = _pose_status(T, n, tol)
+        if st == 2:
+            return n, n_project
+        n_project += st
+    return -1, n_project
+

@@ -13,7 +13,23 @@ from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.fk import fk
 from kinestat.serial.jacobian import fk_and_jacobian
 
-__all__ = ["check_poses", "pose_residuals", "newton_polish", "wrap_angles", "pack"]
+__all__ = ["check_poses", "pose_residuals", "newton_polish", "wrap_angles", "pack", "nan_array",
+           "reasons"]
+
+
+def nan_array(shape: tuple[int, ...]) -> np.ndarray:
+    """A float array of NaN (output slots the kernels fill)."""
+    a = np.empty(shape)
+    a.fill(np.nan)
+    return a
+
+
+def reasons(n_solutions: np.ndarray, why_none: str) -> np.ndarray:
+    """Object array: ``""`` where a pose has solutions, ``why_none`` where it has none."""
+    r = np.empty(n_solutions.shape, dtype=object)
+    r.fill("")
+    r[n_solutions == 0] = why_none
+    return r
 
 
 def wrap_angles(q: np.ndarray, rotates: np.ndarray) -> np.ndarray:

@@ -1,12 +1,17 @@
-"""Compiled (Numba) kernel of the Raghavan–Roth general 6R solver: one pose per iteration of a
-``prange`` loop, the same steps as :mod:`kinestat.serial.analytic.general6r` (which stays the
-NumPy reference and the fallback for poses the kernel flags).
+"""Compiled (Numba) kernel of the Raghavan–Roth general 6R solver: the same steps as
+:mod:`kinestat.serial.analytic.general6r` (which stays the NumPy reference and the fallback for
+poses the kernel flags), one pose at a time, batches split over the cores with ``prange``.
 
-Per pose: the right side of RR eq. 4 from the pose link (15x15 rigid action), the SVD of Q, the
-12x12 matrix quadratic, the eigenvalues of its 24x24 companion (LAPACK dgeev), the power-product
-vector of each real root by inverse iteration, back-substitution, θ6, Newton polishing against
-FK and verification. Flags: 0 solved, 1 Q rank deficient, 2 A2 ill-conditioned (the caller
-reruns the pose with the generalised eigenproblem).
+Per pose: the pose link ``C0⁻¹ T C6⁻¹`` (or its inverse) of the formulation, the right side of
+RR eq. 4 (15x15 rigid action), a pivoted Householder QR of Q (its left null space; the
+least-squares back-substitution), the 12x12 matrix quadratic, the eigenvalues of its
+24x24 companion (LAPACK dgeev), the power-product vector of each real root by inverse
+iteration, back-substitution, θ6 (the serial FK kernel's scalar steps), Newton polishing
+against FK, verification and de-duplication
+(:mod:`kinestat.serial.analytic._solution_kernels`). Every work array is allocated once per
+chunk of poses (:func:`_scratch`), not per root or per step; only dgeev allocates its
+workspace. Flags: 0 solved, 1 Q rank deficient, 2 A2 ill-conditioned
+(the caller reruns the pose with the generalised eigenproblem).
 """
 
 from __future__ import annotations
@@ -18,67 +23,26 @@ import numpy as np
 from numba import types
 from numba.np.linalg import _LAPACK
 
+from kinestat.mechanism.joints import JointKind
+from kinestat.serial._kernels import _step
+from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial.analytic._solution_kernels import polish, store
+
 # LAPACK dgeev through Numba's own binding (cacheable, unlike a ctypes pointer)
 _rgeev = _LAPACK().numba_ez_rgeev(types.float64)
 
-_OPTS = {"cache": True, "nogil": True, "error_model": "numpy"}
-
+REVOLUTE = int(JointKind.REVOLUTE)
 FLAG_OK = 0
 FLAG_DEFICIENT = 1
 FLAG_ILL_CONDITIONED = 2
-
-
-@nb.njit(inline="always", **_OPTS)
-def _mm(A, B):
-    """Matrix product by loops (tiny matrices: BLAS calls cost more than the arithmetic)."""
-    n, k = A.shape
-    m = B.shape[1]
-    out = np.zeros((n, m))
-    for i in range(n):
-        for t in range(k):
-            a = A[i, t]
-            if a != 0.0:
-                for j in range(m):
-                    out[i, j] += a * B[t, j]
-    return out
-
-
-@nb.njit(inline="always", **_OPTS)
-def _mv(A, x):
-    """Matrix-vector product by loops."""
-    n, k = A.shape
-    out = np.zeros(n)
-    for i in range(n):
-        acc = 0.0
-        for t in range(k):
-            acc += A[i, t] * x[t]
-        out[i] = acc
-    return out
-
-
-@nb.njit(inline="always", **_OPTS)
-def _mtm(A, B):
-    """``Aᵀ B`` by loops."""
-    k, n = A.shape
-    m = B.shape[1]
-    out = np.zeros((n, m))
-    for t in range(k):
-        for i in range(n):
-            a = A[t, i]
-            for j in range(m):
-                out[i, j] += a * B[t, j]
-    return out
-
-
-@nb.njit(inline="always", **_OPTS)
-def _mtv(A, x):
-    """``Aᵀ x`` by loops."""
-    k, n = A.shape
-    out = np.zeros(n)
-    for t in range(k):
-        for i in range(n):
-            out[i] += A[t, i] * x[t]
-    return out
+_CHUNK = 16  # poses per scratch allocation in the parallel loop
+#: A2's smallest relative pivot below which the variable is changed (:func:`_companion_eigvals`):
+#: the companion's spurious eigenvalues ±i are defective (4-fold), so an ill-conditioned A2 can
+#: move even the real roots by percent (a Jaco2 pose at 5e-8 lost two of its three solutions)
+_A2_PIVOT_MIN = 1e-5
+#: the Möbius parameters tried in turn (0: the plain variable)
+_MOBIUS = (0.0, 0.7, -1.3, 2.9)
+_B0 = (0.31, -0.72, 0.55, 0.13, -0.94, 0.67, -0.28, 0.81, -0.46, 0.19, 0.73, -0.35)
 
 
 @nb.njit(**_OPTS)
@@ -126,40 +90,68 @@ def _gauss(A, B):
     return small
 
 
+@nb.njit(inline="always", **_OPTS)
+def _rigid_product(A, B, C, out):
+    """``out = A B C`` for rigid 4x4 arrays (bottom row [0, 0, 0, 1])."""
+    for i in range(3):
+        ab0 = A[i, 0] * B[0, 0] + A[i, 1] * B[1, 0] + A[i, 2] * B[2, 0]
+        ab1 = A[i, 0] * B[0, 1] + A[i, 1] * B[1, 1] + A[i, 2] * B[2, 1]
+        ab2 = A[i, 0] * B[0, 2] + A[i, 1] * B[1, 2] + A[i, 2] * B[2, 2]
+        ab3 = A[i, 0] * B[0, 3] + A[i, 1] * B[1, 3] + A[i, 2] * B[2, 3] + A[i, 3]
+        for j in range(4):
+            out[i, j] = ab0 * C[0, j] + ab1 * C[1, j] + ab2 * C[2, j]
+        out[i, 3] += ab3
+    out[3, 0] = 0.0
+    out[3, 1] = 0.0
+    out[3, 2] = 0.0
+    out[3, 3] = 1.0
+
+
+@nb.njit(inline="always", **_OPTS)
+def _rigid_inverse(T, out):
+    """``out = T⁻¹`` for a rigid 4x4 array."""
+    for i in range(3):
+        for j in range(3):
+            out[i, j] = T[j, i]
+        out[i, 3] = -(T[0, i] * T[0, 3] + T[1, i] * T[1, 3] + T[2, i] * T[2, 3])
+        out[3, i] = 0.0
+    out[3, 3] = 1.0
+
+
 @nb.njit(**_OPTS)
 def _rigid_action_inv(T, M):
     """``M = rigid_action(T⁻¹)`` (see ``_rr_algebra.rigid_action``), T rigid 4x4."""
     M[:, :] = 0.0
-    R = np.empty((3, 3))
-    t = np.empty(3)
-    for i in range(3):
-        for j in range(3):
-            R[i, j] = T[j, i]
-    for i in range(3):
-        t[i] = -(R[i, 0] * T[0, 3] + R[i, 1] * T[1, 3] + R[i, 2] * T[2, 3])
-    tt = t[0] * t[0] + t[1] * t[1] + t[2] * t[2]
-    tx = np.array([[0.0, -t[2], t[1]], [t[2], 0.0, -t[0]], [-t[1], t[0], 0.0]])
-    txR = _mm(tx, R)
-    tR = np.empty(3)
-    for j in range(3):
-        tR[j] = t[0] * R[0, j] + t[1] * R[1, j] + t[2] * R[2, j]
+    R = (T[0, 0], T[1, 0], T[2, 0], T[0, 1], T[1, 1], T[2, 1], T[0, 2], T[1, 2], T[2, 2])
+    t0 = -(R[0] * T[0, 3] + R[1] * T[1, 3] + R[2] * T[2, 3])
+    t1 = -(R[3] * T[0, 3] + R[4] * T[1, 3] + R[5] * T[2, 3])
+    t2 = -(R[6] * T[0, 3] + R[7] * T[1, 3] + R[8] * T[2, 3])
+    t = (t0, t1, t2)
+    tt = t0 * t0 + t1 * t1 + t2 * t2
     M[0, 0] = 1.0
     M[7, 7] = 1.0
     M[8, 8] = 1.0
     M[7, 0] = tt
+    for j in range(3):
+        tRj = t0 * R[j] + t1 * R[3 + j] + t2 * R[6 + j]
+        M[7, 1 + j] = 2.0 * tRj
+        M[8, 4 + j] = tRj
+        for i in range(3):
+            Rij = R[3 * i + j]
+            # ([t]x R)_ij = (t x R[:, j])_i
+            i1 = (i + 1) % 3
+            i2 = (i + 2) % 3
+            txR = t[i1] * R[3 * i2 + j] - t[i2] * R[3 * i1 + j]
+            M[1 + i, 1 + j] = Rij
+            M[4 + i, 4 + j] = Rij
+            M[9 + i, 9 + j] = Rij
+            M[12 + i, 12 + j] = Rij
+            M[9 + i, 4 + j] = txR
+            M[12 + i, 9 + j] = -2.0 * txR
+            M[12 + i, 4 + j] = tt * Rij - 2.0 * t[i] * tRj
     for i in range(3):
         M[1 + i, 0] = t[i]
-        M[7, 1 + i] = 2.0 * tR[i]
-        M[8, 4 + i] = tR[i]
         M[12 + i, 8] = -2.0 * t[i]
-        for j in range(3):
-            M[1 + i, 1 + j] = R[i, j]
-            M[4 + i, 4 + j] = R[i, j]
-            M[9 + i, 9 + j] = R[i, j]
-            M[12 + i, 12 + j] = R[i, j]
-            M[9 + i, 4 + j] = txR[i, j]
-            M[12 + i, 9 + j] = -2.0 * txR[i, j]
-            M[12 + i, 4 + j] = tt * R[i, j] - 2.0 * t[i] * tR[j]
 
 
 @nb.njit(**_OPTS)
@@ -183,213 +175,280 @@ def _apply_d(a, sign, v, out):
 
 
 @nb.njit(**_OPTS)
-def _zc(th, C, G):
-    """``G ← G · Rz(th) · C``."""
-    c = math.cos(th)
-    s = math.sin(th)
-    Z = np.zeros((4, 4))
-    Z[0, 0] = c
-    Z[0, 1] = -s
-    Z[1, 0] = s
-    Z[1, 1] = c
-    Z[2, 2] = 1.0
-    Z[3, 3] = 1.0
-    return _mm(_mm(G, Z), C)
-
-
-@nb.njit(**_OPTS)
-def _fk_jac(C, q, J):
-    """FK ``T`` of the revolute chain ``C0 Z1 C1 … Z6 C6`` and its space Jacobian into J."""
-    G = C[0].copy()
-    for i in range(6):
-        w0, w1, w2 = G[0, 2], G[1, 2], G[2, 2]
-        r0, r1, r2 = G[0, 3], G[1, 3], G[2, 3]
-        J[0, i] = w0
-        J[1, i] = w1
-        J[2, i] = w2
-        J[3, i] = -(w1 * r2 - w2 * r1)
-        J[4, i] = -(w2 * r0 - w0 * r2)
-        J[5, i] = -(w0 * r1 - w1 * r0)
-        G = _zc(q[i], C[i + 1], G)
-    return G
-
-
-@nb.njit(**_OPTS)
-def _twist_err(F, T, e):
-    """First-order spatial twist from F to T; returns its norm."""
-    dR = _mm(T[:3, :3], F[:3, :3].T)
-    w0 = 0.5 * (dR[2, 1] - dR[1, 2])
-    w1 = 0.5 * (dR[0, 2] - dR[2, 0])
-    w2 = 0.5 * (dR[1, 0] - dR[0, 1])
-    p0, p1, p2 = F[0, 3], F[1, 3], F[2, 3]
-    e[0] = w0
-    e[1] = w1
-    e[2] = w2
-    e[3] = T[0, 3] - p0 - (w1 * p2 - w2 * p1)
-    e[4] = T[1, 3] - p1 - (w2 * p0 - w0 * p2)
-    e[5] = T[2, 3] - p2 - (w0 * p1 - w1 * p0)
-    return math.sqrt(np.sum(e * e))
-
-
-@nb.njit(**_OPTS)
-def _polish(C, T, q, iters):
-    """Newton steps ``J δq = ξ`` with backtracking (halved until the error drops); returns the
-    (position, rotation) errors of the final q (updated in place)."""
-    J = np.empty((6, 6))
-    e = np.empty(6)
-    F = _fk_jac(C, q, J)
-    en = _twist_err(F, T, e)
-    Jn = np.empty((6, 6))
-    en_v = np.empty(6)
-    for _ in range(iters):
-        if en < 1e-15:
-            break
-        Jc = J.copy()
-        dq = e.copy().reshape((6, 1))
-        if _gauss(Jc, dq) < 1e-14:
-            break
-        step = 1.0
-        moved = False
-        for _half in range(6):  # backtracking: full Newton step, then halves
-            qn = q + step * dq[:, 0]
-            Fn = _fk_jac(C, qn, Jn)
-            nn = _twist_err(Fn, T, en_v)
-            if nn < en:
-                moved = True
-                break
-            step *= 0.5
-        if not moved:
-            break
-        q[:] = qn
-        J[:, :] = Jn
-        e[:] = en_v
-        en = nn
-        F = Fn
-    pos = math.sqrt((F[0, 3] - T[0, 3]) ** 2 + (F[1, 3] - T[1, 3]) ** 2
-                    + (F[2, 3] - T[2, 3]) ** 2)
-    d = math.sqrt(np.sum((F[:3, :3] - T[:3, :3]) ** 2))
-    rot = 2.0 * math.asin(min(d / (2.0 * math.sqrt(2.0)), 1.0))
-    return pos, rot
-
-
-@nb.njit(**_OPTS)
-def _right_side(M1, Ts, Rh):
+def _right_side(M1, Ts, Rh, MA, f, u, o, w):
     """``Rh (15, 9)``: invariants of ``Z2⁻¹ M1⁻¹ Z1⁻¹ (p, l)`` of the target Ts, column a*3+b
-    multiplying ``m_a(θ1) m_b(θ2)``."""
-    MA = np.empty((15, 15))
+    multiplying ``m_a(θ1) m_b(θ2)``; MA (15, 15), f, u, o, w (15,) are scratch."""
     _rigid_action_inv(M1, MA)
-    p = Ts[:3, 3]
-    l = Ts[:3, 2]  # noqa: E741
-    pp = p[0] * p[0] + p[1] * p[1] + p[2] * p[2]
-    pl = p[0] * l[0] + p[1] * l[1] + p[2] * l[2]
-    f = np.empty(15)
+    p0, p1, p2 = Ts[0, 3], Ts[1, 3], Ts[2, 3]
+    l0, l1, l2 = Ts[0, 2], Ts[1, 2], Ts[2, 2]
+    pp = p0 * p0 + p1 * p1 + p2 * p2
+    pl = p0 * l0 + p1 * l1 + p2 * l2
     f[0] = 1.0
+    f[1], f[2], f[3] = p0, p1, p2
+    f[4], f[5], f[6] = l0, l1, l2
     f[7] = pp
     f[8] = pl
-    x = np.array([p[1] * l[2] - p[2] * l[1], p[2] * l[0] - p[0] * l[2],
-                  p[0] * l[1] - p[1] * l[0]])
-    for i in range(3):
-        f[1 + i] = p[i]
-        f[4 + i] = l[i]
-        f[9 + i] = x[i]
-        f[12 + i] = pp * l[i] - 2.0 * pl * p[i]
-    u = np.empty(15)
-    o = np.empty(15)
+    f[9], f[10], f[11] = p1 * l2 - p2 * l1, p2 * l0 - p0 * l2, p0 * l1 - p1 * l0
+    f[12], f[13], f[14] = pp * l0 - 2.0 * pl * p0, pp * l1 - 2.0 * pl * p1, pp * l2 - 2.0 * pl * p2
     for a in range(3):
         _apply_d(a, -1.0, f, u)
-        w = _mv(MA, u)
+        for i in range(15):
+            acc = 0.0
+            for j in range(15):
+                acc += MA[i, j] * u[j]
+            w[i] = acc
         for b in range(3):
             _apply_d(b, -1.0, w, o)
-            Rh[:, a * 3 + b] = o
+            for i in range(15):
+                Rh[i, a * 3 + b] = o[i]
 
 
 @nb.njit(**_OPTS)
-def _pencil(L, H3, Rh, A, Lt):
-    """Fill ``A (3, 12, 12)`` and ``Lt (14, 27)``; returns (U, s, Vt, flag)."""
-    Lt[:, :] = L
+def _qr_pivoted(Rh, H, R, piv, Vr, Aw):
+    """Householder QR with column pivoting of ``Q = Rh[1:, 1:] (14, 8)``:
+    ``Q[:, piv] = H[:, :8] R`` with ``H (14, 14)`` orthogonal (its last 6 columns span the left
+    null space of Q) and ``R (8, 8)`` upper triangular, |R[k, k]| non-increasing. Vr (8, 14),
+    Aw (14, 8): scratch (the reflectors and the working copy)."""
     for i in range(14):
-        Lt[i, 0] -= Rh[i + 1, 0]
-    Q = np.ascontiguousarray(Rh[1:, 1:])
-    U, s, Vt = np.linalg.svd(Q)
-    if s[7] <= 1e-10 * s[0]:
-        return U, s, Vt, FLAG_DEFICIENT
-    E = np.ascontiguousarray(U[:, 8:].T) @ Lt @ H3  # (6, 27)
+        for j in range(8):
+            Aw[i, j] = Rh[i + 1, j + 1]
+    for j in range(8):
+        piv[j] = j
+    for k in range(8):
+        best, jb = -1.0, k
+        for j in range(k, 8):
+            nj = 0.0
+            for i in range(k, 14):
+                nj += Aw[i, j] * Aw[i, j]
+            if nj > best:
+                best, jb = nj, j
+        if jb != k:
+            for i in range(14):
+                Aw[i, k], Aw[i, jb] = Aw[i, jb], Aw[i, k]
+            piv[k], piv[jb] = piv[jb], piv[k]
+        alpha = math.sqrt(best)
+        if Aw[k, k] > 0.0:
+            alpha = -alpha
+        vv = 0.0
+        for i in range(14):
+            Vr[k, i] = Aw[i, k] if i >= k else 0.0
+        Vr[k, k] -= alpha
+        for i in range(k, 14):
+            vv += Vr[k, i] * Vr[k, i]
+        if vv > 0.0:
+            for j in range(k, 8):
+                d = 0.0
+                for i in range(k, 14):
+                    d += Vr[k, i] * Aw[i, j]
+                d *= 2.0 / vv
+                for i in range(k, 14):
+                    Aw[i, j] -= d * Vr[k, i]
+            for i in range(k, 14):
+                Vr[k, i] /= math.sqrt(vv / 2.0)  # now H_k = I − v vᵀ
+        else:
+            for i in range(14):
+                Vr[k, i] = 0.0
+    for i in range(8):
+        for j in range(8):
+            R[i, j] = Aw[i, j] if j >= i else 0.0
+    # H = H_1 H_2 … H_8, applied to the identity from the left in reverse order
+    for i in range(14):
+        for j in range(14):
+            H[i, j] = 1.0 if i == j else 0.0
+    for k in range(7, -1, -1):
+        for j in range(14):
+            d = 0.0
+            for i in range(k, 14):
+                d += Vr[k, i] * H[i, j]
+            if d != 0.0:
+                for i in range(k, 14):
+                    H[i, j] -= d * Vr[k, i]
+
+
+@nb.njit(**_OPTS)
+def _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw):
+    """Fill ``A (3, 12, 12)`` from ``E = Nᵀ (L H3 − r0 h0ᵀ)`` (N the left null space of Q,
+    r0 = Rh[1:, 0]) and the pivoted QR of Q into H, R, piv; returns the flag (Q rank
+    deficient: |R[7, 7]| ≤ 1e-10 |R[0, 0]|)."""
+    _qr_pivoted(Rh, H, R, piv, Vr, Aw)
+    if not abs(R[7, 7]) > 1e-10 * abs(R[0, 0]):
+        return FLAG_DEFICIENT
+    for e in range(6):
+        nr = 0.0
+        for i in range(14):
+            nr += H[i, 8 + e] * Rh[i + 1, 0]
+        for c in range(27):
+            acc = -nr * h0[c]
+            for i in range(14):
+                acc += H[i, 8 + e] * LH[i, c]
+            E[e, c] = acc
     A[:, :, :] = 0.0
     for k in range(3):
         for e in range(6):
             for m in range(9):
                 A[k, e, m] = E[e, k * 9 + m]
                 A[k, 6 + e, 3 + m] = E[e, k * 9 + m]
-    return U, s, Vt, FLAG_OK
+    return FLAG_OK
 
 
 @nb.njit(**_OPTS)
-def _companion_eigvals(A):
-    """Eigenvalues of ``A2 x² + A1 x + A0`` (A normalised in place) through the 24x24 companion
-    with ``A2⁻¹`` (LAPACK dgeev, eigenvalues only); ``ok`` False when A2 is ill-conditioned."""
-    sc = np.max(np.abs(A))
-    A /= sc
-    X = np.concatenate((A[0], A[1]), axis=1)
-    wr = np.empty(24)
-    wi = np.empty(24)
-    if _gauss(A[2].copy(), X) < 1e-10 or not np.all(np.isfinite(X)) or np.max(np.abs(X)) > 1e10:
-        return wr, wi, False
-    Mc = np.zeros((24, 24))  # stored transposed (LAPACK is column-major): same eigenvalues
+def _companion_eigvals(A, X, A2, Mc, wr, wi, dummy):
+    """Eigenvalues (into wr, wi) of ``A2 x² + A1 x + A0`` (A normalised in place) through the
+    24x24 companion with the inverse leading coefficient (LAPACK dgeev, eigenvalues only).
+
+    When A2 is ill-conditioned (smallest relative pivot below ``_A2_PIVOT_MIN``) the variable
+    is changed by the Möbius map ``x = (y + t)/(1 − t y)`` (a shift of the half-angle by
+    atan t): ``B(y) = (1 − t y)² A(x)`` has the leading coefficient ``A0 t² − A1 t + A2``,
+    regular unless −1/t is itself a root. False when no tried t gives a regular one. X (12, 24),
+    A2 (12, 12), Mc (24, 24): scratch."""
+    sc = 0.0
+    for k in range(3):
+        for i in range(12):
+            for j in range(12):
+                sc = max(sc, abs(A[k, i, j]))
+    for k in range(3):
+        for i in range(12):
+            for j in range(12):
+                A[k, i, j] /= sc
+    t = 0.0
+    regular = False
+    for t in _MOBIUS:
+        tt = t * t
+        for i in range(12):
+            for j in range(12):
+                a0, a1, a2 = A[0, i, j], A[1, i, j], A[2, i, j]
+                X[i, j] = a0 + t * a1 + tt * a2
+                X[i, 12 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
+                A2[i, j] = tt * a0 - t * a1 + a2
+        if _gauss(A2, X) >= _A2_PIVOT_MIN:
+            regular = True
+            break
+    if not regular:
+        return False
+    big = 0.0
+    for i in range(12):
+        for j in range(24):
+            if not math.isfinite(X[i, j]):
+                return False
+            big = max(big, abs(X[i, j]))
+    if big > 1e10:
+        return False
+    # stored transposed (LAPACK is column-major): same eigenvalues
+    for i in range(24):
+        for j in range(12):
+            Mc[i, j] = 0.0
     for i in range(12):
         Mc[12 + i, i] = 1.0
         for j in range(24):
             Mc[j, 12 + i] = -X[i, j]
-    dummy = np.empty(1)
     info = _rgeev(ord("d"), ord("N"), ord("N"), 24, Mc.ctypes, 24, wr.ctypes, wi.ctypes,
                   dummy.ctypes, 1, dummy.ctypes, 1)
-    return wr, wi, info == 0
-
-
-_B0 = np.array([0.31, -0.72, 0.55, 0.13, -0.94, 0.67, -0.28, 0.81, -0.46, 0.19, 0.73, -0.35])
+    if t != 0.0:  # back to x = (y + t) / (1 − t y)
+        for k in range(24):
+            x = (complex(wr[k], wi[k]) + t) / (1.0 - t * complex(wr[k], wi[k]))
+            wr[k] = x.real
+            wi[k] = x.imag
+    return info == 0
 
 
 @nb.njit(**_OPTS)
-def _sigma(A, x):
-    """``A2 x² + A1 x + A0`` (or, for |x| > 1, the same divided by x², better scaled)."""
+def _lu(A, perm):
+    """LU factors of ``A (n, n)`` in place with partial pivoting (row order in perm); pivots
+    below 1e-17 of the largest |entry| are replaced by that size so solves stay finite
+    (inverse iteration on a singular matrix relies on it)."""
+    n = A.shape[0]
+    big = 0.0
+    for i in range(n):
+        perm[i] = i
+        for j in range(n):
+            big = max(big, abs(A[i, j]))
+    tiny = 1e-17 * big if big > 0.0 else 1e-300
+    for k in range(n):
+        p = k
+        for i in range(k + 1, n):
+            if abs(A[i, k]) > abs(A[p, k]):
+                p = i
+        if p != k:
+            for j in range(n):
+                A[k, j], A[p, j] = A[p, j], A[k, j]
+            perm[k], perm[p] = perm[p], perm[k]
+        piv = A[k, k]
+        if abs(piv) < tiny:
+            piv = tiny if piv >= 0.0 else -tiny
+            A[k, k] = piv
+        for i in range(k + 1, n):
+            f = A[i, k] / piv
+            A[i, k] = f
+            if f != 0.0:
+                for j in range(k + 1, n):
+                    A[i, j] -= f * A[k, j]
+
+
+@nb.njit(**_OPTS)
+def _lu_solve(A, perm, b, y):
+    """``b ← A⁻¹ b`` with the factors of :func:`_lu`; y (n,) scratch."""
+    n = A.shape[0]
+    for i in range(n):
+        acc = b[perm[i], 0]
+        for j in range(i):
+            acc -= A[i, j] * y[j]
+        y[i] = acc
+    for i in range(n - 1, -1, -1):
+        acc = y[i]
+        for j in range(i + 1, n):
+            acc -= A[i, j] * b[j, 0]
+        b[i, 0] = acc / A[i, i]
+
+
+@nb.njit(**_OPTS)
+def _null_vector(A, x, S, v, perm, y):
+    """The power-product vector ``v (12, 1)``: a null vector of ``A2 x² + A1 x + A0`` by two
+    steps of inverse iteration on one LU factorisation (the matrix is singular at an
+    eigenvalue); S (12, 12), perm (12,), y (12,) scratch. For |x| > 1 the matrix is divided by
+    x² (better scaled)."""
+    for i in range(12):
+        v[i, 0] = _B0[i]
     if abs(x) <= 1.0:
-        return A[0] + x * A[1] + (x * x) * A[2]
-    y = 1.0 / x
-    return A[2] + y * A[1] + (y * y) * A[0]
-
-
-@nb.njit(**_OPTS)
-def _null_vector(A, x):
-    """The power-product vector: a null vector of ``A2 x² + A1 x + A0`` by two steps of
-    inverse iteration (the matrix is singular at an eigenvalue)."""
-    v = _B0.copy().reshape((12, 1))
+        c0, c1, c2 = 1.0, x, x * x
+    else:
+        c0, c1, c2 = 1.0 / (x * x), 1.0 / x, 1.0
+    for i in range(12):
+        for j in range(12):
+            S[i, j] = c0 * A[0, i, j] + c1 * A[1, i, j] + c2 * A[2, i, j]
+    _lu(S, perm)
     for _ in range(2):
-        _gauss(_sigma(A, x), v)
-        v /= math.sqrt(np.sum(v * v))
-    return np.ascontiguousarray(v[:, 0])
+        _lu_solve(S, perm, v, y)
+        nv = 0.0
+        for i in range(12):
+            nv += v[i, 0] * v[i, 0]
+        nv = math.sqrt(nv)
+        for i in range(12):
+            v[i, 0] /= nv
 
 
-@nb.njit(**_OPTS)
+@nb.njit(inline="always", **_OPTS)
 def _ratio(v, axis):
-    """Least-squares ratio along ``axis`` (0: x4, 1: x5) of the power products v (4, 3)."""
+    """Least-squares ratio along ``axis`` (0: x4, 1: x5) of the power products ``v[3i + j]``
+    (i: power of x4, j: power of x5)."""
     num = 0.0
     den = 0.0
     if axis == 0:
         for i in range(3):
             for j in range(3):
-                num += v[i + 1, j] * v[i, j]
-                den += v[i, j] * v[i, j]
+                num += v[3 * (i + 1) + j, 0] * v[3 * i + j, 0]
+                den += v[3 * i + j, 0] * v[3 * i + j, 0]
     else:
         for i in range(4):
             for j in range(2):
-                num += v[i, j + 1] * v[i, j]
-                den += v[i, j] * v[i, j]
+                num += v[3 * i + j + 1, 0] * v[3 * i + j, 0]
+                den += v[3 * i + j, 0] * v[3 * i + j, 0]
     return num / den if den > 0 else np.nan
 
 
 @nb.njit(**_OPTS)
-def _angles(x3, vec, off, L, Lt, U, s, Vt, links, Ts, th):
-    """θ (6,) of the loop from a real root x3 and its power products; False if not usable."""
-    v = vec.reshape((4, 3))
+def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
+    """θ (6,) of the loop from a real root x3 and its power products ``v (12, 1)``; False if
+    not usable. m (27,), coef (8,) scratch; ``links (4, 4, 4)`` the constant M2..M5."""
     x4 = _ratio(v, 0)
     x5 = _ratio(v, 1)
     if not (np.isfinite(x4) and np.isfinite(x5)):
@@ -397,107 +456,127 @@ def _angles(x3, vec, off, L, Lt, U, s, Vt, links, Ts, th):
     ph3 = 2.0 * math.atan(x3)
     ph4 = 2.0 * math.atan(x4)
     ph5 = 2.0 * math.atan(x5)
-    m = np.empty(27)
-    c3, s3 = math.cos(ph3), math.sin(ph3)
-    c4, s4 = math.cos(ph4), math.sin(ph4)
-    c5, s5 = math.cos(ph5), math.sin(ph5)
-    m3 = (1.0, c3, s3)
-    m4 = (1.0, c4, s4)
-    m5 = (1.0, c5, s5)
+    m3 = (1.0, math.cos(ph3), math.sin(ph3))
+    m4 = (1.0, math.cos(ph4), math.sin(ph4))
+    m5 = (1.0, math.cos(ph5), math.sin(ph5))
     for a in range(3):
         for b in range(3):
             for c in range(3):
                 m[a * 9 + b * 3 + c] = m3[a] * m4[b] * m5[c]
-    rhs = _mv(Lt, m)
-    coef = _mtv(U[:, :8], rhs)
+    # (c1, s1, c2, s2) products in least squares (Manocha–Canny eq. 9): R x = H₈ᵀ (L m − r0)
     for j in range(8):
-        coef[j] = coef[j] / s[j] if s[j] > 1e-12 * s[0] else 0.0
-    S = _mtv(Vt, coef)
-    th[0] = math.atan2(S[5], S[2])
-    th[1] = math.atan2(S[1], S[0])
+        coef[j] = 0.0
+    for i in range(14):
+        r = -Rh[i + 1, 0]
+        for c in range(27):
+            r += L[i, c] * m[c]
+        for j in range(8):
+            coef[j] += H[i, j] * r
+    for k in range(7, -1, -1):
+        acc = coef[k]
+        for j in range(k + 1, 8):
+            acc -= R[k, j] * coef[j]
+        coef[k] = acc / R[k, k]
+    S0 = S1 = S2 = S5 = 0.0
+    for j in range(8):
+        if piv[j] == 0:
+            S0 = coef[j]
+        elif piv[j] == 1:
+            S1 = coef[j]
+        elif piv[j] == 2:
+            S2 = coef[j]
+        elif piv[j] == 5:
+            S5 = coef[j]
+    th[0] = math.atan2(S5, S2)
+    th[1] = math.atan2(S1, S0)
     th[2] = ph3 + off[0]
     th[3] = ph4 + off[1]
     th[4] = ph5 + off[2]
-    G = np.eye(4)
-    for i in range(5):
-        G = _zc(th[i], links[i], G)
-    R6 = _mtm(G[:3, :3], Ts[:3, :3])
-    th[5] = math.atan2(R6[1, 0] - R6[0, 1], R6[0, 0] + R6[1, 1])
+    # θ6 from Z6 = (Z1 M1 … Z5 M5)⁻¹ Ts
+    t = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    t = _step(M1, REVOLUTE, 0.0, th[0], t)
+    for i in range(4):
+        t = _step(links[i], REVOLUTE, 0.0, th[i + 1], t)
+    # R6 = G_Rᵀ Ts_R: entries (0, 0), (0, 1), (1, 0), (1, 1)
+    r00 = t[0] * Ts[0, 0] + t[4] * Ts[1, 0] + t[8] * Ts[2, 0]
+    r01 = t[0] * Ts[0, 1] + t[4] * Ts[1, 1] + t[8] * Ts[2, 1]
+    r10 = t[1] * Ts[0, 0] + t[5] * Ts[1, 0] + t[9] * Ts[2, 0]
+    r11 = t[1] * Ts[0, 1] + t[5] * Ts[1, 1] + t[9] * Ts[2, 1]
+    th[5] = math.atan2(r10 - r01, r00 + r11)
     return True
 
 
 @nb.njit(**_OPTS)
-def _wrap(x):
-    return (x + math.pi) % (2.0 * math.pi) - math.pi
+def _scratch():
+    """Work arrays of :func:`_solve_pose` (one set per chunk of poses)."""
+    return (np.empty((3, 4, 4)), np.empty((15, 9)), np.empty((15, 15)), np.empty((5, 15)),
+            np.empty((3, 12, 12)), np.empty((6, 27)), np.empty((12, 24)), np.empty((12, 12)),
+            np.empty((24, 24)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
+            np.empty(8), np.empty((3, 6, 6)), np.empty((4, 6)), np.empty(6), np.empty(6),
+            np.empty((14, 14)), np.empty((8, 8)), np.empty(8, dtype=np.int64), np.empty((8, 14)),
+            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12))
 
 
 @nb.njit(**_OPTS)
-def _solve_pose(n, C, T, M1, Ts, links_fixed, L, H3, off, order, sign, tol, iters, dedup,
-                out_q, out_valid, out_pos, out_rot, flags):
-    Rh = np.empty((15, 9))
-    _right_side(M1[n], Ts[n], Rh)
-    A = np.empty((3, 12, 12))
-    Lt = np.empty((14, 27))
-    U, s, Vt, flag = _pencil(L, H3, Rh, A, Lt)
+def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
+                out_q, out_valid, out_pos, out_rot, flags, S):
+    """All solutions of pose n. ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant M1 / Ts of the
+    formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0 constant, 1
+    ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``)."""
+    Gs, Rh, MA, V15, A, E, X, A2, Mc, W24, v, m, coef, Ms, Vs, th, q, H, R, piv, Vr, Aw, \
+        perm, y12 = S
+    _rigid_product(form[0], T[n], form[1], Gs[1])
+    _rigid_inverse(Gs[1], Gs[2])
+    Gs[0] = form[2]
+    M1 = Gs[order[6]]
+    if order[7] == 0:
+        Ts = form[3]
+    else:
+        Ts = Gs[order[7]]
+    _right_side(M1, Ts, Rh, MA, V15[0], V15[1], V15[2], V15[3])
+    flag = _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw)
     if flag != FLAG_OK:
         flags[n] = flag
         return
-    wr, wi, ok = _companion_eigvals(A)
-    if not ok:
+    wr, wi = W24[0], W24[1]
+    if not _companion_eigvals(A, X, A2, Mc, wr, wi, W24[2]):
         flags[n] = FLAG_ILL_CONDITIONED
         return
-    links = np.empty((5, 4, 4))
-    links[0] = M1[n]
-    links[1:] = links_fixed
-    th = np.empty(6)
-    q = np.empty(6)
     cnt = 0
-    K = out_q.shape[1]
     for k in range(24):
         if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
             continue
-        vec = _null_vector(A, wr[k])
-        if not _angles(wr[k], vec, off, L, Lt, U, s, Vt, links, Ts[n], th):
+        _null_vector(A, wr[k], A2, v, perm, y12)
+        if not _angles(wr[k], v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
             continue
         for i in range(6):
             q[order[i]] = sign * th[i]
-        pos, rot = _polish(C, T[n], q, iters)
+        pos, rot = polish(C, T[n], q, iters, Ms, Vs)
         if not (pos <= tol and rot <= tol):
             continue
-        for i in range(6):
-            q[i] = _wrap(q[i])
-        dup = False
-        for j in range(min(cnt, K)):
-            dmax = 0.0
-            for i in range(6):
-                dmax = max(dmax, abs(_wrap(q[i] - out_q[n, j, i])))
-            if dmax < dedup:
-                dup = True
-                break
-        if dup or cnt >= K:
-            continue
-        out_q[n, cnt] = q
-        out_valid[n, cnt] = True
-        out_pos[n, cnt] = pos
-        out_rot[n, cnt] = rot
-        cnt += 1
+        cnt = store(n, (q[0], q[1], q[2], q[3], q[4], q[5]), pos, rot, dedup, out_q, out_valid,
+                    out_pos, out_rot, cnt)
     flags[n] = FLAG_OK
 
 
 @nb.njit(parallel=True, **_OPTS)
-def solve_batch(C, T, M1, Ts, links_fixed, L, H3, off, order, sign, tol, iters, dedup,
+def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
                 out_q, out_valid, out_pos, out_rot, flags):
     """All solutions of N poses (see the module docstring); outputs pre-filled by the caller
     (q NaN, valid False, errors NaN)."""
-    for n in nb.prange(T.shape[0]):
-        _solve_pose(n, C, T, M1, Ts, links_fixed, L, H3, off, order, sign, tol, iters, dedup,
-                    out_q, out_valid, out_pos, out_rot, flags)
+    N = T.shape[0]
+    for c in nb.prange((N + _CHUNK - 1) // _CHUNK):
+        S = _scratch()
+        for n in range(c * _CHUNK, min(N, (c + 1) * _CHUNK)):
+            _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
+                        out_q, out_valid, out_pos, out_rot, flags, S)
 
 
 @nb.njit(**_OPTS)
-def solve_serial(C, T, M1, Ts, links_fixed, L, H3, off, order, sign, tol, iters, dedup,
+def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
                  out_q, out_valid, out_pos, out_rot, flags):
     """:func:`solve_batch` on one thread (small batches: no thread start-up)."""
+    S = _scratch()
     for n in range(T.shape[0]):
-        _solve_pose(n, C, T, M1, Ts, links_fixed, L, H3, off, order, sign, tol, iters, dedup,
-                    out_q, out_valid, out_pos, out_rot, flags)
+        _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
+                    out_q, out_valid, out_pos, out_rot, flags, S)

@@ -18,11 +18,12 @@ Product-of-exponentials form ``g = T T(0)⁻¹ = e^{ξ̂1θ1} ⋯ e^{ξ̂6θ6}``
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic._common import pack
+from kinestat.serial.analytic._common import nan_array, pack, reasons
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
 
@@ -30,7 +31,7 @@ __all__ = ["solve_pieper", "solve_three_parallel", "solve_pieper_compiled",
            "solve_three_parallel_compiled"]
 
 _WRIST_TOL = 1e-10
-_PARALLEL_MIN = 32  # smaller batches run on one thread
+_PARALLEL_MIN = 256  # smaller batches run on one thread (a pose costs a few µs)
 
 
 def _apply(T: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -152,30 +153,29 @@ _REASON_3P = ("no real solution: the pose is out of reach (subproblem 4 for θ1 
 
 
 def _outputs(N: int, K: int):
-    return (np.full((N, K, 6), np.nan), np.zeros((N, K), dtype=bool), np.full((N, K), np.nan),
-            np.full((N, K), np.nan))
+    return nan_array((N, K, 6)), np.zeros((N, K), dtype=bool), nan_array((N, K)), nan_array((N, K))
 
 
 def _result(q, valid, pos, rot, sing, sign, fam, joints, reason, method, tol) -> IKAllResult:
-    nsol = valid.sum(axis=1)
+    nsol = np.count_nonzero(valid, axis=1)
     return IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot, singular=sing,
                        family_sign=sign, family_value=fam, family_joints=joints,
-                       n_solutions=nsol,
-                       reason=np.where(nsol > 0, "", reason).astype(object), method=method,
-                       tol=tol)
+                       n_solutions=nsol, reason=reasons(nsol, reason), method=method, tol=tol)
 
 
 def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
                           wrist_tol: float = _WRIST_TOL) -> IKAllResult:
     """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first)."""
-    from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
+    K = sys.modules.get("kinestat.serial.analytic._cf_kernels")
+    if K is None:
+        from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
 
     ax = data["axes"]
     N = T.shape[0]
     q, valid, pos, rot = _outputs(N, 8)
     sing = np.zeros((N, 8), dtype=bool)
     sign = np.zeros((N, 8))
-    fam = np.full((N, 8), np.nan)
+    fam = nan_array((N, 8))
     run = K.pieper_batch if N >= _PARALLEL_MIN else K.pieper_serial
     if "kernel_args" not in data:  # pose-independent, kept with the model's cached geometry
         data["kernel_args"] = (np.asarray(model.constants), np.linalg.inv(ax.T0), ax.w, ax.r,
@@ -191,7 +191,9 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
                                   tol: float = 1e-9,
                                   wrist_tol: float = _WRIST_TOL) -> IKAllResult:
     """:func:`solve_three_parallel` by the compiled kernel."""
-    from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
+    K = sys.modules.get("kinestat.serial.analytic._cf_kernels")
+    if K is None:
+        from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
 
     ax = data["axes"]
     N = T.shape[0]
@@ -206,4 +208,4 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
     run(C, np.ascontiguousarray(T), T0inv, W, P, p56, xh, sg, tol, wrist_tol, 1e-6, q, valid,
         pos, rot)
     return _result(q, valid, pos, rot, np.zeros((N, 8), dtype=bool), np.zeros((N, 8)),
-                   np.full((N, 8), np.nan), None, _REASON_3P, "three-parallel", tol)
+                   nan_array((N, 8)), None, _REASON_3P, "three-parallel", tol)

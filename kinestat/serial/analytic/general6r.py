@@ -22,6 +22,7 @@ Raghavan & Roth (1993), in the numerically stable form of Manocha & Canny (1994)
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -31,7 +32,7 @@ import scipy.linalg
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _rr_algebra as rr
-from kinestat.serial.analytic._common import newton_polish, pack
+from kinestat.serial.analytic._common import nan_array, newton_polish, pack, reasons
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.fk import fk
 
@@ -292,38 +293,52 @@ _REASON_DEFICIENT = ("degenerate elimination: the θ1-θ2 coefficient matrix Q o
 
 @lru_cache(maxsize=64)
 def _compiled_data(model: ChainModel, form: Formulation):
-    """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5)."""
-    C = np.asarray(model.constants)
+    """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5,
+    whose pose link is M1 or M6): ``form (4, 4, 4)`` = C0⁻¹, C6⁻¹, constant M1, constant Ts;
+    the constant links M2..M5; ``L H3``, ``H3[0]``, L; the joint order with the pose-link
+    codes of M1 and Ts appended (0 constant, 1 ``C0⁻¹ T C6⁻¹``, 2 its inverse)."""
+    C = np.ascontiguousarray(model.constants)
     M = form.links(C, np.eye(4)[None])
+    M = [m[0] if m.ndim == 3 else m for m in M]
     L = rr.left_tensor(M[1], M[2], M[3], M[4], np.array(OFFSETS))[1:].reshape(14, 27)
     order, sign = form.joints()
-    return (np.ascontiguousarray(C), np.ascontiguousarray(np.stack(M[1:5])),
-            np.ascontiguousarray(L), np.ascontiguousarray(_H3), np.array(OFFSETS),
-            np.array(order, dtype=np.int64), float(sign))
+    # the pose link is C6 T⁻¹ C0 (= G⁻¹) forwards and its inverse G when reversed
+    at0 = 0 if form.shift == 0 else (2 if not form.reverse else 1)
+    at5 = 0 if form.shift == 5 else (1 if not form.reverse else 2)
+    consts = np.stack([_inv_rigid(C[0]), _inv_rigid(C[6]), M[0], _inv_rigid(M[5])])
+    return (C, np.ascontiguousarray(consts), np.ascontiguousarray(np.stack(M[1:5])),
+            np.ascontiguousarray(L @ _H3), np.ascontiguousarray(_H3[0]), np.ascontiguousarray(L),
+            np.array(OFFSETS), np.array(list(order) + [at0, at5], dtype=np.int64), float(sign))
 
 
 def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
-    from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
+    K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
+    if K is None:
+        from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
 
-    C, links_fixed, L, H3, off, order, sign = _compiled_data(model, form)
-    M = form.links(C, T)
+    C, consts, links, LH, h0, L, off, order, sign = _compiled_data(model, form)
     N = T.shape[0]
-    M1 = np.ascontiguousarray(np.broadcast_to(M[0], (N, 4, 4)))
-    Ts = np.ascontiguousarray(np.broadcast_to(_inv_rigid(M[5]), (N, 4, 4)))
-    q = np.full((N, MAX_SOLUTIONS, 6), np.nan)
-    valid = np.zeros((N, MAX_SOLUTIONS), dtype=bool)
-    pos = np.full((N, MAX_SOLUTIONS), np.nan)
-    rot = np.full((N, MAX_SOLUTIONS), np.nan)
+    K16 = MAX_SOLUTIONS
+    q = nan_array((N, K16, 6))
+    valid = np.zeros((N, K16), dtype=bool)
+    pos = nan_array((N, K16))
+    rot = nan_array((N, K16))
     flags = np.zeros(N, dtype=np.int64)
     run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
-    run(C, np.ascontiguousarray(T), M1, Ts, links_fixed, L, H3, off, order, sign, tol,
-        polish_iters, 1e-6, q, valid, pos, rot, flags)
-    nsol = valid.sum(axis=1)
-    reason = np.where(nsol > 0, "", _REASON_NONE).astype(object)
+    run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6, q, valid,
+        pos, rot, flags)
+    nsol = np.count_nonzero(valid, axis=1)
+    reason = reasons(nsol, _REASON_NONE)
+    if not flags.any():
+        return IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
+                           singular=np.zeros((N, K16), dtype=bool),
+                           family_sign=np.zeros((N, K16)), family_value=nan_array((N, K16)),
+                           family_joints=None, n_solutions=nsol, reason=reason,
+                           method=_method_name(form), tol=tol)
     reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
     res = IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
-                      singular=np.zeros_like(valid), family_sign=np.zeros((N, MAX_SOLUTIONS)),
-                      family_value=np.full((N, MAX_SOLUTIONS), np.nan), family_joints=None,
+                      singular=np.zeros((N, K16), dtype=bool), family_sign=np.zeros((N, K16)),
+                      family_value=nan_array((N, K16)), family_joints=None,
                       n_solutions=nsol, reason=reason, method=_method_name(form), tol=tol)
     redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
     if redo.size:  # the generalised eigenproblem (scipy) for these poses
@@ -350,5 +365,5 @@ def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     if form is None:
         form, _ = formulation(model)
     if backend == "numba" and form.shift in (0, 5):
-        return _solve_compiled(model, T, form, tol, polish_iters)
+        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters)
     return _solve(model, T, form, tol, polish_iters)

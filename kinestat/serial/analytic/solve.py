@@ -7,6 +7,7 @@ meeting wrist pair), otherwise the general 6R eigenvalue method of Raghavan & Ro
 
 from __future__ import annotations
 
+import sys
 from functools import lru_cache
 
 import numpy as np
@@ -27,6 +28,12 @@ BACKENDS = ("numba", "numpy")
 def _check_model(model: ChainModel) -> None:
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
+    _check_chain(model)
+
+
+@lru_cache(maxsize=64)
+def _check_chain(model: ChainModel) -> None:
+    """The model checks (cached per model: a failing model raises every time)."""
     if model.n != 6:
         raise ModelError(
             f"ik_all: model {model.name!r} has {model.n} joints; all-solutions IK needs exactly "
@@ -52,6 +59,9 @@ def method_for(model: ChainModel) -> str:
 
 
 def _reshape(res: IKAllResult, shape: tuple[int, ...]) -> IKAllResult:
+    if len(shape) == 1:
+        return res
+
     def r(a):
         return a.reshape(shape + a.shape[1:])
 
@@ -75,6 +85,14 @@ def _nearest_rigid(Tf: np.ndarray) -> np.ndarray:
         U, _, Vt = np.linalg.svd(Tf[bad, :3, :3])
         Tf[bad, :3, :3] = U @ Vt
     return Tf
+
+
+def _kernels():
+    """The closed-form kernel module (imported on first use: Numba start-up)."""
+    mod = sys.modules.get("kinestat.serial.analytic._cf_kernels")
+    if mod is None:
+        from kinestat.serial.analytic import _cf_kernels as mod  # lazy: Numba start-up
+    return mod
 
 
 def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
@@ -105,16 +123,16 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     T = T_base_flange
     if type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
             T.shape[-2:] == (4, 4) and backend == "numba":
-        from kinestat.serial.analytic import _cf_kernels  # lazy: Numba start-up
-
         Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
-        if _cf_kernels.first_non_rigid(Tf, 1e-6) >= 0:
+        bad, n_project = _kernels().check_rigid(Tf, 1e-6)
+        if bad >= 0:
             check_poses(T)  # raises with the full message
+        if n_project:
+            Tf = _nearest_rigid(Tf)
     else:
         T = check_poses(T)
-        Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
+        Tf = _nearest_rigid(np.ascontiguousarray(T.reshape(-1, 4, 4)))
     shape = T.shape[:-2]
-    Tf = _nearest_rigid(Tf)
     kind, data = _classified(model)
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
     if use in ("pieper", "three-parallel") and use != kind:
