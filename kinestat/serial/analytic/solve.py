@@ -3,6 +3,8 @@
 Dispatch (:func:`kinestat.serial.analytic.geometry.classify`): a closed form by subproblems when
 the geometry admits one (spherical wrist with meeting shoulder axes; three parallel axes with a
 meeting wrist pair), otherwise the general 6R eigenvalue method of Raghavan & Roth.
+``method="puma762"`` runs the thesis's PUMA 762 closed form
+(:mod:`kinestat.serial.analytic.thesis_puma762`) on a model with the PUMA 762's geometry.
 """
 
 from __future__ import annotations
@@ -13,14 +15,14 @@ import numpy as np
 
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic import closed_form, general6r
+from kinestat.serial.analytic import closed_form, general6r, thesis_puma762
 from kinestat.serial.analytic._common import check_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["ik_all", "METHODS", "BACKENDS", "method_for"]
 
-METHODS = ("auto", "pieper", "three-parallel", "raghavan-roth")
+METHODS = ("auto", "pieper", "three-parallel", "raghavan-roth", "puma762")
 BACKENDS = ("numba", "numpy")
 
 
@@ -123,7 +125,12 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if backend not in BACKENDS:
         raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
     fast = backend == "numba"
-    if use == "pieper":
+    if use == thesis_puma762.METHOD:
+        if not thesis_puma762.is_puma762(model):
+            raise ModelError(f"ik_all: method 'puma762' applies only to the PUMA 762's geometry "
+                             f"(millimetres, Vibhute Table 2-2); model {model.name!r} differs")
+        res = thesis_puma762.solve_puma762(model, Tf, tol=tol, backend=backend)
+    elif use == "pieper":
         solver = closed_form.solve_pieper_compiled if fast else closed_form.solve_pieper
         res = solver(model, Tf, data, tol=tol)
     elif use == "three-parallel":
