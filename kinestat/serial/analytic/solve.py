@@ -15,7 +15,7 @@ import numpy as np
 
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic import closed_form, general6r, thesis_puma762
+from kinestat.serial.analytic import closed_form, families, general6r, thesis_puma762
 from kinestat.serial.analytic._common import check_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
@@ -62,7 +62,7 @@ def _reshape(res: IKAllResult, shape: tuple[int, ...]) -> IKAllResult:
         rotation_error=r(res.rotation_error), singular=r(res.singular),
         family_sign=r(res.family_sign), family_value=r(res.family_value),
         family_joints=res.family_joints, n_solutions=r(res.n_solutions),
-        reason=r(res.reason), method=res.method, tol=res.tol,
+        reason=r(res.reason), method=res.method, tol=res.tol, family_curve=res.family_curve,
     )
 
 
@@ -136,7 +136,7 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     elif use == "three-parallel":
         solver = (closed_form.solve_three_parallel_compiled if fast
                   else closed_form.solve_three_parallel)
-        res = solver(model, Tf, data, tol=tol)
+        res = families.add_wrist_families(model, Tf, data, solver(model, Tf, data, tol=tol))
     else:
         res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend)
     return _reshape(res, shape)
