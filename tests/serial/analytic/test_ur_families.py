@@ -98,3 +98,50 @@ def test_cli_all_json_reports_the_family(capsys):
         np.testing.assert_allclose(kinestat.fk(model, np.asarray(s["q"])), T, atol=1e-9)
     assert main(["ik", str(arm_path("ur10")), "--tip", "tool0", "--pose", pose, "--all"]) == 0
     assert "is a family" in capsys.readouterr().out
+
+
+def _shoulder_singular_configs(model, n, seed):
+    """Configurations whose wrist point (axes 5 and 6 meet) lies in the plane of axis 1 and
+    axis 2's normal: θ2 by root finding on the signed distance from that plane."""
+    from scipy.optimize import brentq
+
+    from kinestat.serial.analytic.geometry import classify
+    from kinestat.serial.analytic.subproblems import rotation_matrix
+
+    _, data = classify(model)
+    ax = data["axes"]
+    T0inv = np.linalg.inv(ax.T0)
+
+    def signed(q):
+        g = kinestat.fk(model, q) @ T0inv
+        v = g[:3, :3] @ data["p56"] + g[:3, 3] - ax.r[0]
+        return float(v @ np.cross(ax.w[0], rotation_matrix(ax.w[0], q[0]) @ ax.w[1]))
+
+    rng = np.random.default_rng(seed)
+    out = []
+    while len(out) < n:
+        q = rng.uniform(-3, 3, 6)
+        ts = np.linspace(-3, 3, 61)
+        f = [signed(np.r_[q[0], t, q[2:]]) for t in ts]
+        k = next((i for i in range(60) if f[i] * f[i + 1] < 0), None)
+        if k is not None:
+            t = brentq(lambda t, q=q: signed(np.r_[q[0], t, q[2:]]), ts[k], ts[k + 1],
+                       xtol=1e-15)
+            out.append(np.r_[q[0], t, q[2:]])
+    return np.array(out)
+
+
+def test_ur_shoulder_singularity_is_a_double_root_not_a_family():
+    """The UR's shoulder singularity (wrist point on the cylinder of radius |d| about axis 1,
+    d the shoulder offset ≠ 0) merges the two θ1 branches: a finite set, no self-motion."""
+    model = ur5()
+    q = _shoulder_singular_configs(model, 8, seed=1)
+    s = np.linalg.svd(kinestat.jacobian(model, q), compute_uv=False)
+    assert np.all(s[:, -1] < 1e-12 * s[:, 0])
+    T = kinestat.fk(model, q)
+    res = ik_all(model, T)
+    assert not res.singular.any()
+    d = np.where(res.valid, wrapped_distance(res.q, q[:, None]), np.inf).min(axis=1)
+    assert np.all(d < 1e-6)  # a double root: about sqrt(eps) accurate
+    F = kinestat.fk(model, np.where(res.valid[..., None], res.q, 0.0))
+    assert np.max(np.where(res.valid[..., None, None], np.abs(F - T[:, None]), 0)) < 1e-9
