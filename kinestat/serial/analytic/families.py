@@ -112,11 +112,20 @@ def add_wrist_families(model: ChainModel, T: np.ndarray, data: dict, res: IKAllR
     ax = data["axes"]
     W, P = ax.w, ax.r
     h = W[1]
-    T0inv = np.linalg.inv(ax.T0)
-    g = T @ T0inv
+    if "family_args" not in data:  # pose-independent, kept with the model's cached geometry
+        T0inv = np.linalg.inv(ax.T0)
+        data["family_args"] = (T0inv, T0inv[:3, :3] @ W[5], float(W[0] @ h))
+    T0inv, w6, w0h = data["family_args"]
+    # necessary (cheap) test: a rotation about axis 1 keeps the component along it, so axis 6
+    # (g ω6) can be parallel to h only where ω1ᵀ g ω6 = ±ω1ᵀ h
+    c = T[:, :3, :3] @ w6 @ W[0]
+    near = np.flatnonzero(np.minimum(np.abs(c - w0h), np.abs(c + w0h)) < 1e-6)
+    if near.size == 0:
+        return res
+    g = T[near] @ T0inv
     q56 = np.einsum("nij,j->ni", g[:, :3, :3], data["p56"]) + g[:, :3, 3]
-    psi, e1 = sp4(h, W[0], q56 - P[0], float(h @ (data["p56"] - P[0])))  # (N, 2)
-    Rr = rotation_matrix(W[0], psi) @ g[:, None, :3, :3]  # (N, 2, 3, 3)
+    psi, e1 = sp4(h, W[0], q56 - P[0], float(h @ (data["p56"] - P[0])))  # (M, 2)
+    Rr = rotation_matrix(W[0], psi) @ g[:, None, :3, :3]  # (M, 2, 3, 3)
     hr = np.einsum("...ji,j->...i", Rr, h)
     sing = e1[:, None] & (np.linalg.norm(np.cross(hr, W[5]), axis=-1) < wrist_tol)
     N, K = res.valid.shape
@@ -130,9 +139,10 @@ def add_wrist_families(model: ChainModel, T: np.ndarray, data: dict, res: IKAllR
     pos, rot = res.position_error.copy(), res.rotation_error.copy()
     singular = res.singular.copy()
     scan = np.linspace(-math.pi, math.pi, _SCAN, endpoint=False)
-    for n, b in zip(*np.nonzero(sing), strict=True):
-        t1 = float(-psi[n, b])
-        t5, _, _ = sp1(W[4], np.zeros(3), W[5], Rr[n, b] @ W[5])
+    for i, b in zip(*np.nonzero(sing), strict=True):
+        n = int(near[i])
+        t1 = float(-psi[i, b])
+        t5, _, _ = sp1(W[4], np.zeros(3), W[5], Rr[i, b] @ W[5])
         t5 = float(t5)
         qm, ok, margin = _members(curve, n, t1, t5, scan)
         best = int(np.argmax(np.where(ok.any(1), margin, -np.inf)))
