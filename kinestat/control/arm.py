@@ -23,18 +23,18 @@ an arm without it).
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
 import numpy as np
 
 from kinestat.errors import JointLimitError, ModelError, UnreachableError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import puma762
-from kinestat.serial.analytic import IKAllResult, ik_all, select_nearest, wrap_to_limits
-from kinestat.serial.analytic.thesis_puma762 import METHOD as _PUMA_METHOD
-from kinestat.serial.analytic.thesis_puma762 import puma762_chain
 from kinestat.serial.fk import fk
 from kinestat.spatial.validate import frozen
+
+if TYPE_CHECKING:
+    from kinestat.serial.analytic import IKAllResult
 
 __all__ = ["Arm", "ToolFrame", "Puma762Arm", "ChainArm", "THESIS_ARM"]
 
@@ -91,8 +91,15 @@ class Puma762Arm:
     np.float64(180.0)
     """
 
-    model: ChainModel = field(default_factory=puma762_chain)
     limits_deg: np.ndarray = field(default_factory=lambda: puma762.AXIS_LIMITS_DEG)
+
+    @property
+    def model(self) -> ChainModel:
+        """The PUMA 762 as a chain (equal to ``kinestat.load("puma762")``)."""
+        # the thesis path (reverse, select, forward) does not need the all-solutions package
+        from kinestat.serial.analytic.thesis_puma762 import puma762_chain  # lazy: scipy.linalg
+
+        return puma762_chain()
 
     def q_from_axis(self, axis) -> np.ndarray:
         return puma762.from_axis_angles(axis)
@@ -104,7 +111,9 @@ class Puma762Arm:
         return puma762.forward(q, tool_point_6)
 
     def ik_all(self, T_base_end) -> IKAllResult:
-        return ik_all(self.model, T_base_end, method=_PUMA_METHOD)
+        from kinestat.serial.analytic import ik_all  # lazy: scipy.linalg, ~0.3 s at import
+
+        return ik_all(self.model, T_base_end, method="puma762")
 
     def solve_axis(self, tool_point, s6, a67, tool_point_6, q_now, limits_deg) -> np.ndarray:
         res = puma762.reverse(tool_point, s6, a67, tool_point_6)
@@ -160,7 +169,7 @@ class ChainArm:
         else:
             lim = np.asarray(self.limits_deg, dtype=float)
         object.__setattr__(self, "limits_deg", frozen(lim, float))
-        ik_all(self.model, np.eye(4))  # refuses a model no analytic solver handles
+        self.ik_all(np.eye(4))  # refuses a model no analytic solver handles
 
     def q_from_axis(self, axis) -> np.ndarray:
         return np.asarray(axis, dtype=float) - self.axis_offset
@@ -175,9 +184,16 @@ class ChainArm:
                          a67=T[..., :3, 0].copy(), pose=T)
 
     def ik_all(self, T_base_end) -> IKAllResult:
+        from kinestat.serial.analytic import ik_all  # lazy: scipy.linalg, ~0.3 s at import
+
         return ik_all(self.model, T_base_end)
 
     def solve_axis(self, tool_point, s6, a67, tool_point_6, q_now, limits_deg) -> np.ndarray:
+        from kinestat.serial.analytic import (  # lazy: scipy.linalg, ~0.3 s at import
+            select_nearest,
+            wrap_to_limits,
+        )
+
         res = self.ik_all(_frame_from_tool(tool_point, s6, a67, tool_point_6))
         if int(res.n_solutions) == 0:
             raise UnreachableError(f"{self.model.name}: no inverse-kinematics solution "

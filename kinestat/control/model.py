@@ -26,6 +26,8 @@ from kinestat.spatial.validate import frozen
 
 __all__ = ["ControlModel", "ForceSource"]
 
+_ARM_METHODS = ("q_from_axis", "axis_from_q", "forward", "solve_axis", "ik_all")
+
 ForceSource = Literal["springs", "calibration"]
 """Where the leg forces come from: the platform's linear springs ``k (l − l0)`` at the measured
 lengths, or the calibration's count → force maps (the thesis's eq_wrench.m ``legf``)."""
@@ -65,7 +67,7 @@ class ControlModel:
     arm: Arm = THESIS_ARM
 
     def __post_init__(self) -> None:
-        if not isinstance(self.arm, Arm):
+        if not all(callable(getattr(type(self.arm), n, None)) for n in _ARM_METHODS):
             raise ModelError(f"arm must provide kinestat.control.arm.Arm, got "
                              f"{type(self.arm).__name__}")
         if self.force_source not in get_args(ForceSource):
