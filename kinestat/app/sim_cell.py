@@ -60,10 +60,9 @@ def start_counts(config: ControllerConfig, current_counts=(0, 0, 0, 0, 0, 0)) ->
     simulated robot is placed before the run so that the first move is short."""
     model = config.model
     c = np.asarray(current_counts, dtype=np.int64)
-    res = puma762.reverse(config.start_tool_point, config.start_s6, config.start_a67,
-                          model.tool_point_6)
-    sel = puma762.select(res, axis_counts_to_q(model, c), model.limits_deg)
-    return axis_deg_to_counts(np.degrees(sel.axis))
+    axis = model.arm.solve_axis(config.start_tool_point, config.start_s6, config.start_a67,
+                                model.tool_point_6, axis_counts_to_q(model, c), model.limits_deg)
+    return axis_deg_to_counts(np.degrees(axis))
 
 
 

@@ -376,7 +376,15 @@ def _all_record(m, res, sel, i: tuple, ref: np.ndarray) -> dict:
                          "rotation": float(res.rotation_error[i][k])},
             "within_limits": bool(np.all(ok)), "singular": bool(res.singular[i][k]),
         })
-        if res.singular[i][k]:
+        if res.singular[i][k] and res.family_joints is None:  # a curve: four joints move
+            curve = res.family_curve
+            out["singular_families"].append({
+                "solution": len(out["solutions"]) - 1,
+                "joints": [names[j] for j in curve.joints],
+                "free_joint": names[curve.free_joint], "sign": None, "value": None,
+                "value_deg": None, "relation": f"{curve.description} (one free parameter; q "
+                                               "holds one member)"})
+        elif res.singular[i][k]:
             a, b = res.family_joints
             sign = int(res.family_sign[i][k])
             value = float(res.family_value[i][k])
@@ -418,8 +426,8 @@ def _print_all(m, rec: dict, method: str, k: int | None) -> None:
     else:
         console.print(f"[bold]{literal(title)}[/]: no solution")
     for f in rec["singular_families"]:
-        console.print(f"solution {f['solution']} is a family: {literal(f['relation'])}, value "
-                      f"{f['value_deg']:.4f}°")
+        value = "" if f["value_deg"] is None else f", value {f['value_deg']:.4f}°"
+        console.print(f"solution {f['solution']} is a family: {literal(f['relation'])}{value}")
     if rec["reason"]:
         console.print(f"[yellow]unreachable:[/] {literal(rec['reason'])}")
     sel = rec["selected"]

@@ -13,12 +13,22 @@ from __future__ import annotations
 
 import functools
 import inspect
+import warnings
 from collections.abc import Callable
 
 import typer
 
+from kinestat.cli._model import (
+    MODEL_HELP,
+    base_option,
+    length_unit_option,
+    load_model,
+    scale_option,
+    tip_option,
+)
 from kinestat.cli._options import XYZ_METAVAR, flag
 from kinestat.cli._output import console, parse_floats, print_json, table
+from kinestat.errors import KinestatWarning
 
 sweep_app = typer.Typer(
     name="sweep",
@@ -143,13 +153,15 @@ def _samples_default(grid, samples, default):
 
 @_study_command("workspace")
 def workspace_command(
-    model: str = typer.Option("puma762", "--model", help="Embedded model name or TOML file."),
+    model: str = typer.Option("puma762", "--model", help=MODEL_HELP),
     grid: int = typer.Option(None, "--grid", help="N values per joint over its limits."),
     samples: int = typer.Option(None, "--samples", help="Random configurations (default "
                                 "100000 if no --grid)."),
     seed: int = SEED,
     task: str = typer.Option("auto", "--task", help="Jacobian rows for manipulability/"
                              "condition: auto, full, position, planar."),
+    tip: str | None = tip_option(), base: str | None = base_option(),
+    scale: float | None = scale_option(), length_unit: str | None = length_unit_option(),
     chunk_size: int | None = None, arrays: bool = True,
 ) -> dict:
     """Workspace and dexterity of an arm: reach, Yoshikawa manipulability, condition number.
@@ -162,9 +174,13 @@ def workspace_command(
         workspace_spec,
     )
 
-    return workspace_spec(model, grid=grid, samples=_samples_default(grid, samples, 100_000),
-                          seed=seed, chunk_size=chunk_size or DEFAULT_CHUNK, task=task,
-                          arrays=arrays)
+    load_model(model, tip, base, scale, length_unit)  # the loader's warnings, one line each
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", KinestatWarning)
+        return workspace_spec(model, grid=grid, samples=_samples_default(grid, samples, 100_000),
+                              seed=seed, chunk_size=chunk_size or DEFAULT_CHUNK, task=task,
+                              arrays=arrays, tip=tip, base=base, scale=scale,
+                              length_unit=length_unit)
 
 
 @_study_command("platform-range")

@@ -1,6 +1,8 @@
 """Kinestatic control (Vibhute 2011 ch. 4-5): decide from measured wrenches, never leave the
 safety envelope, log every cycle.
 
+- :mod:`kinestat.control.arm` — the robot arm (any 6R arm with an analytic solver; the
+  thesis's PUMA 762 is the default instance).
 - :mod:`kinestat.control.model` — what the controller knows about the cell.
 - :mod:`kinestat.control.wrench` — the measurement chain (counts → wrench, fixed frame).
 - :mod:`kinestat.control.controller` — pure decision logic, ``decide(config, state, meas)``.
@@ -21,6 +23,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submodules=None,
     submod_attrs={
+        'arm': ['Arm', 'ChainArm', 'Puma762Arm', 'THESIS_ARM'],
         'controller': [
             'Command', 'ControllerConfig', 'ControllerState', 'STATES', 'THESIS_FORCE_DIRECTION',
             'Target', 'decide', 'start',

@@ -60,7 +60,6 @@ from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Estimator, Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
 from kinestat.hardware.puma762_axes import round_half_away
-from kinestat.serial import puma762
 
 __all__ = [
     "THESIS_FORCE_DIRECTION",
@@ -314,7 +313,7 @@ class Command:
 def axis_counts_to_q(model: ControlModel, counts) -> np.ndarray:
     """Joint angles (radians) from robot axis counts (``axis = counts · resolution``)."""
     deg = np.asarray(counts, dtype=float) * model.axis_deg_per_count
-    return puma762.from_axis_angles(np.radians(deg))
+    return model.arm.q_from_axis(np.radians(deg))
 
 
 def _q_to_axis_counts(model: ControlModel, axis_rad) -> np.ndarray:
@@ -340,13 +339,13 @@ def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
 
     Returns (counts, residual along S6 in mm of the chosen counts). Raises UnreachableError or
     JointLimitError."""
-    res = puma762.reverse(target.tool_point, target.s6, target.a67, model.tool_point_6)
-    sel = puma762.select(res, q_now, model.limits_deg)
-    c0 = _q_to_axis_counts(model, sel.axis)
+    axis = model.arm.solve_axis(target.tool_point, target.s6, target.a67, model.tool_point_6,
+                                q_now, model.limits_deg)
+    c0 = _q_to_axis_counts(model, axis)
     cand = c0 + _OFFSETS if vernier else c0[None, :]
     phys = cand.astype(float)
     phys[:, 4] += _axis5_residual(model, cand, counts_now)
-    fwd = puma762.forward(axis_counts_to_q(model, phys), model.tool_point_6)
+    fwd = model.arm.forward(axis_counts_to_q(model, phys), model.tool_point_6)
     d = fwd.tool_point - target.tool_point
     along = d @ target.s6
     lateral = np.linalg.norm(d - along[:, None] * target.s6, axis=1)
@@ -380,7 +379,7 @@ def start(config: ControllerConfig, q_now, *, counts_now=None) -> tuple[Command,
     model = config.model
     q_now = np.asarray(q_now, dtype=float)
     if counts_now is None:
-        counts_now = _q_to_axis_counts(model, puma762.to_axis_angles(q_now))
+        counts_now = _q_to_axis_counts(model, model.arm.axis_from_q(q_now))
     counts_now = np.asarray(counts_now, dtype=np.int64)
     target = Target(config.start_tool_point, config.start_s6, config.start_a67)
     state = ControllerState(cycle=0, label="", last_action="start", target=target,
@@ -432,7 +431,7 @@ def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target
         return Refusal(f"{action} target not reachable: {exc}", {})
     axis_deg = counts * model.axis_deg_per_count
     q_new = axis_counts_to_q(model, counts)
-    pred = predict(model, meas, puma762.forward(q_new).pose)
+    pred = predict(model, meas, model.arm.forward(q_new).pose)
     bad = check_command(envelope, model, axis_deg, counts_now * model.axis_deg_per_count, pred)
     if bad:
         return Refusal(f"{action} command refused by the envelope: " + "; ".join(bad),

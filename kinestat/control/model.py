@@ -1,7 +1,8 @@
 """What the kinestatic controller knows about the cell (immutable).
 
-The robot (the PUMA 762 in closed form, its axis limits, its encoder resolution and the axis
-4 → 5 coupling its motion controller compensates), the compliant platform, how the platform is
+The robot (an :class:`~kinestat.control.arm.Arm`: by default the PUMA 762 in closed form; its
+axis limits, its encoder resolution and the axis 4 → 5 coupling its motion controller
+compensates), the compliant platform, how the platform is
 mounted on the flange, where the unloaded tool tip is (``P_tool_6``, Vibhute App. D.1) and how
 the leg encoders are calibrated. Nothing here changes while the controller runs; per-cycle
 values live in :class:`kinestat.control.controller.ControllerState`.
@@ -15,15 +16,17 @@ from typing import Literal, get_args
 
 import numpy as np
 
+from kinestat.control.arm import THESIS_ARM, Arm
 from kinestat.errors import ModelError
 from kinestat.hardware.leg_calibration import THESIS_CALIBRATION, LegCalibration
 from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, AXIS_DEG_PER_COUNT
 from kinestat.parallel.platform import Platform
-from kinestat.serial import puma762
 from kinestat.spatial.transforms import apply, as_array, inv
 from kinestat.spatial.validate import frozen
 
 __all__ = ["ControlModel", "ForceSource"]
+
+_ARM_METHODS = ("q_from_axis", "axis_from_q", "forward", "solve_axis", "ik_all")
 
 ForceSource = Literal["springs", "calibration"]
 """Where the leg forces come from: the platform's linear springs ``k (l − l0)`` at the measured
@@ -39,7 +42,8 @@ class ControlModel:
         mount: (4, 4) the platform's base frame in frame 6 (``6_BT``).
         tool_point_6: (3,) the unloaded tool tip in frame 6, mm (``P_tool_6``).
         calibration: encoder counts → leg lengths (sensor legs 1..6).
-        limits_deg: (6, 2) robot axis limits, degrees (default the MATLAB code's).
+        limits_deg: (6, 2) robot axis limits, degrees (default the arm's: for the PUMA 762
+            the MATLAB code's).
         axis_deg_per_count: (6,) robot encoder resolution, degrees per count.
         coupling: axis-5 counts turned per axis-4 count, compensated by the motion controller
             (:func:`kinestat.hardware.puma762_axes.axis45_compensation`); 0 when there is none.
@@ -47,19 +51,25 @@ class ControlModel:
             calibration's force maps; give the platform its calibrated springs,
             :func:`kinestat.hardware.leg_law.calibrated_platform`, for the predictions).
         calibration_name: a label for reports ("thesis-2011", "nominal", a file name).
+        arm: the robot (:class:`kinestat.control.arm.Arm`: axis angles, forward analysis with
+            the tool, analytic reverse analysis with selection); default the thesis's PUMA 762.
     """
 
     platform: Platform
     mount: np.ndarray
     tool_point_6: np.ndarray
     calibration: LegCalibration = THESIS_CALIBRATION
-    limits_deg: np.ndarray = field(default_factory=lambda: puma762.AXIS_LIMITS_DEG)
+    limits_deg: np.ndarray | None = None
     axis_deg_per_count: np.ndarray = field(default_factory=lambda: AXIS_DEG_PER_COUNT)
     coupling: float = AXIS4_TO_5_COUPLING
     force_source: ForceSource = "springs"
     calibration_name: str = ""
+    arm: Arm = THESIS_ARM
 
     def __post_init__(self) -> None:
+        if not all(callable(getattr(type(self.arm), n, None)) for n in _ARM_METHODS):
+            raise ModelError(f"arm must provide kinestat.control.arm.Arm, got "
+                             f"{type(self.arm).__name__}")
         if self.force_source not in get_args(ForceSource):
             raise ModelError(f"force_source must be one of {get_args(ForceSource)}, got "
                              f"{self.force_source!r}")
@@ -71,7 +81,8 @@ class ControlModel:
         if p6.shape != (3,):
             raise ModelError(f"tool_point_6 must be 3 numbers, got shape {p6.shape}")
         object.__setattr__(self, "tool_point_6", frozen(p6, float))
-        L = as_array(self.limits_deg, shape_tail=(2,), name="axis limits")
+        L = as_array(self.arm.limits_deg if self.limits_deg is None else self.limits_deg,
+                     shape_tail=(2,), name="axis limits")
         if L.shape != (6, 2) or np.any(L[:, 0] >= L[:, 1]):
             raise ModelError(f"axis limits must be 6 (lower, upper) pairs in degrees with "
                              f"lower < upper, got {L.tolist()}")

@@ -37,7 +37,6 @@ from kinestat.control.model import ControlModel
 from kinestat.errors import InputError
 from kinestat.hardware.leg_calibration import counts_to_forces, counts_to_lengths
 from kinestat.parallel.statics import line_jacobian, spring_forces, wrench_from_leg_lengths
-from kinestat.serial import puma762
 from kinestat.spatial.screws import transform_wrench
 from kinestat.spatial.transforms import apply, skew
 
@@ -118,7 +117,7 @@ class Measurement:
 
 def tool_frame(q, model: ControlModel):
     """Forward analysis of the robot with the model's tool: ``(P_tool_F, S6_F, a67_F, F_6T)``."""
-    r = puma762.forward(q, model.tool_point_6)
+    r = model.arm.forward(q, model.tool_point_6)
     return r.tool_point, r.s6, r.a67, r.pose
 
 

@@ -21,12 +21,13 @@ Revolute joints without limits range over [−π, π]; prismatic joints need lim
 from __future__ import annotations
 
 import math
+import warnings
 from pathlib import Path
 
 import numpy as np
 
 import kinestat
-from kinestat.errors import InputError
+from kinestat.errors import InputError, KinestatWarning
 from kinestat.io.model_toml import loads_model
 from kinestat.studies import grids
 from kinestat.studies import reduce as red
@@ -46,20 +47,30 @@ def _load_model(spec: dict):
 
         return kinestat.load(spec["model"])
 
+    if "urdf" in spec:  # the loader's warnings were given when the spec was built
+        from kinestat.io.urdf import from_urdf  # lazy: XML and scipy only for URDF models
+
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", KinestatWarning)
+            return from_urdf(spec["model_text"], source=spec["model"], **spec["urdf"])
     return loads_model(spec["model_text"], source=spec["model"])
 
 
 def workspace_spec(model: str, *, grid: int | None = None, samples: int | None = None,
                    seed: int = 0, chunk_size: int = DEFAULT_CHUNK, task: str = "auto",
-                   arrays: bool = True) -> dict:
+                   arrays: bool = True, tip: str | None = None, base: str | None = None,
+                   scale: float | None = None, length_unit: str | None = None) -> dict:
     """Check the inputs and build the spec of a workspace study.
 
-    ``model`` is an embedded model name or a TOML file (its text goes into the spec). Exactly
-    one of ``grid`` (values per joint, both limits included) and ``samples`` (uniform within the
-    limits, seeded) is given.
+    ``model`` is an embedded model name, a TOML file or a URDF file (its text goes into the
+    spec; a URDF's chain is chosen by ``tip``/``base`` and its lengths by ``scale``/
+    ``length_unit``, as :func:`kinestat.load`). Exactly one of ``grid`` (values per joint, both
+    limits included) and ``samples`` (uniform within the limits, seeded) is given.
     """
-
-    m = kinestat.load(model)  # unknown names and bad files fail here, before any output
+    urdf = {k: v for k, v in (("tip", tip), ("base", base), ("scale", scale),
+                              ("length_unit", length_unit)) if v is not None}
+    # unknown names and bad files fail here, before any output
+    m = kinestat.load(model, **urdf)
     text = None
     if model not in kinestat.list_models():
         text = Path(model).read_text(encoding="utf-8")
@@ -68,6 +79,8 @@ def workspace_spec(model: str, *, grid: int | None = None, samples: int | None =
         raise InputError(f"--task must be one of {list(TASKS)}, got {task!r}")
     spec = {"study": "workspace", "model": str(model), "model_text": text,
             "chunk_size": int(chunk_size), "task": task, "arrays": bool(arrays), **inputs}
+    if Path(str(model)).suffix.lower() == ".urdf":
+        spec["urdf"] = urdf  # only for URDF models: the specs of other runs stay as they were
     WorkspaceStudy(spec)  # limits, task/joint count and chunk size are checked here
     return spec
 

@@ -47,6 +47,10 @@ class IKAllResult:
         method: the solver that produced the result (``"pieper"``, ``"raghavan-roth"``...).
         tol: the residual tolerance a valid slot meets (position in the model's length unit
             and rotation in radians).
+        family_curve: for families that are not a relation between two joints (the
+            wrist-singular families of arms with three parallel axes: four joints move), the
+            generator of their members (:class:`kinestat.serial.analytic.families.WristCurve`);
+            None otherwise. See :meth:`family_members`.
     """
 
     q: np.ndarray
@@ -61,6 +65,7 @@ class IKAllResult:
     reason: np.ndarray
     method: str
     tol: float
+    family_curve: object | None = None
 
     @property
     def shape(self) -> tuple[int, ...]:
@@ -70,6 +75,23 @@ class IKAllResult:
     def solutions(self, index: tuple[int, ...] = ()) -> np.ndarray:
         """The valid solutions ``(m, n)`` of one pose (``index`` into the batch shape)."""
         return self.q[index][self.valid[index]]
+
+    def family_members(self, index: tuple[int, ...], k: int, t) -> np.ndarray:
+        """Members ``(m, n)`` of the singular family in slot ``k`` of pose ``index`` for free
+        parameter values ``t (m,)``: for a two-joint family ``q[j] + σ q[k]`` fixed, ``q[j]``
+        moves by ``t`` from the slot's member; for a :attr:`family_curve`, ``t`` is the value of
+        its free joint (NaN rows where no member exists)."""
+        t = np.atleast_1d(np.asarray(t, dtype=float))
+        if not self.singular[index][k]:
+            raise InputError(f"slot {k} of pose {index} is not a singular family")
+        if self.family_joints is not None:
+            j, kk = self.family_joints
+            q = np.repeat(self.q[index][k][None, :], t.size, axis=0)
+            q[:, j] += t
+            q[:, kk] -= self.family_sign[index][k] * t
+            return q
+        flat = int(np.ravel_multi_index(index, self.shape)) if self.shape else 0
+        return self.family_curve.members(flat, k, t)[0]
 
 
 def wrap_to_limits(q, current, lower, upper, rotates) -> tuple[np.ndarray, np.ndarray]:

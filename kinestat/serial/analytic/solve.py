@@ -3,6 +3,8 @@
 Dispatch (:func:`kinestat.serial.analytic.geometry.classify`): a closed form by subproblems when
 the geometry admits one (spherical wrist with meeting shoulder axes; three parallel axes with a
 meeting wrist pair), otherwise the general 6R eigenvalue method of Raghavan & Roth.
+``method="puma762"`` runs the thesis's PUMA 762 closed form
+(:mod:`kinestat.serial.analytic.thesis_puma762`) on a model with the PUMA 762's geometry.
 """
 
 from __future__ import annotations
@@ -14,14 +16,14 @@ import numpy as np
 
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic import closed_form, general6r
+from kinestat.serial.analytic import closed_form, families, general6r, thesis_puma762
 from kinestat.serial.analytic._common import check_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["ik_all", "METHODS", "BACKENDS", "method_for"]
 
-METHODS = ("auto", "pieper", "three-parallel", "raghavan-roth")
+METHODS = ("auto", "pieper", "three-parallel", "raghavan-roth", "puma762")
 BACKENDS = ("numba", "numpy")
 
 
@@ -70,7 +72,7 @@ def _reshape(res: IKAllResult, shape: tuple[int, ...]) -> IKAllResult:
         rotation_error=r(res.rotation_error), singular=r(res.singular),
         family_sign=r(res.family_sign), family_value=r(res.family_value),
         family_joints=res.family_joints, n_solutions=r(res.n_solutions),
-        reason=r(res.reason), method=res.method, tol=res.tol,
+        reason=r(res.reason), method=res.method, tol=res.tol, family_curve=res.family_curve,
     )
 
 
@@ -141,13 +143,18 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if backend not in BACKENDS:
         raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
     fast = backend == "numba"
-    if use == "pieper":
+    if use == thesis_puma762.METHOD:
+        if not thesis_puma762.is_puma762(model):
+            raise ModelError(f"ik_all: method 'puma762' applies only to the PUMA 762's geometry "
+                             f"(millimetres, Vibhute Table 2-2); model {model.name!r} differs")
+        res = thesis_puma762.solve_puma762(model, Tf, tol=tol, backend=backend)
+    elif use == "pieper":
         solver = closed_form.solve_pieper_compiled if fast else closed_form.solve_pieper
         res = solver(model, Tf, data, tol=tol)
     elif use == "three-parallel":
         solver = (closed_form.solve_three_parallel_compiled if fast
                   else closed_form.solve_three_parallel)
-        res = solver(model, Tf, data, tol=tol)
+        res = families.add_wrist_families(model, Tf, data, solver(model, Tf, data, tol=tol))
     else:
         res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend)
     return _reshape(res, shape)
