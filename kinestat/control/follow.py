@@ -54,6 +54,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from kinestat.control.contact_estimate import cone_normal, friction_sample, update_friction
 from kinestat.control.controller import (
     Command,
     ControllerConfig,
@@ -100,8 +101,8 @@ CHORD_LENGTH = 2.0
 """Shortest measured tip chord (mm) the estimator takes as a line in the surface."""
 CHORD_HISTORY = 12
 """Measured tips kept for the chord."""
-FRICTION_SMOOTHING = 0.2
-"""Weight of a new sample in the friction ratio's running estimate."""
+MAX_FRICTION = 1.0
+"""Largest friction coefficient the estimate takes."""
 TANGENTIAL_FACTOR = 4.0
 """The compliance twist's whole tip motion may be this multiple of ``max_correction`` (its
 normal part is limited to ``max_correction``: a frictionless tip slides freely along the
@@ -319,9 +320,14 @@ def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
 
 def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal: np.ndarray,
                 omega: np.ndarray, travel: np.ndarray, dlam: float,
-                max_correction: float) -> np.ndarray:
-    """The base's twist T = T_f − K⁻¹ W Δλ (base frame, axis order [ω; v_O0]); the compliance
-    part scaled so that it moves the tip by at most ``max_correction``."""
+                max_correction: float, friction: float = 0.0,
+                slip: np.ndarray | None = None) -> np.ndarray:
+    """The base's twist T = T_f − K⁻¹ W_c Δλ (base frame, axis order [ω; v_O0]); the compliance
+    part scaled so that it moves the tip by at most ``max_correction``. ``W_c`` is the contact
+    normal's line W, or, for a tip sliding along ``slip`` with the friction ratio
+    ``friction``, the friction cone's edge ``[n − μ ŝ; p × (n − μ ŝ)]``: a sliding contact's
+    force changes along the edge, so the normal force changes by Δλ and the tip keeps
+    sliding."""
     TB = meas.base_pose
     R = TB[:3, :3]
     p = R.T @ (tip - TB[:3, 3])
@@ -331,11 +337,18 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     w = R.T @ omega
     v_O = R.T @ travel - np.cross(w, p)  # tip moves by `travel`, turning about the tip
     Tf = np.concatenate([w, v_O])
-    Tc = -dlam * np.linalg.solve(K, W)  # K⁻¹ δw with δw = −Δλ W (compose_twist's term)
+    Wt = np.zeros(6)
+    if friction > 0.0 and slip is not None:
+        s = R.T @ slip
+        Wt = np.concatenate([s, np.cross(p, s)])
+    Tc = -dlam * np.linalg.solve(K, W - friction * Wt)  # K⁻¹ δw, δw = −Δλ W_c
     dp = Tc[3:] + np.cross(Tc[:3], p)  # the tip's motion under the compliance twist
     scale = max(abs(float(dp @ n)) / max_correction,
                 float(np.linalg.norm(dp)) / (TANGENTIAL_FACTOR * max_correction), 1.0)
-    return compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
+    T = compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
+    if friction > 0.0 and slip is not None:
+        T = T + (dlam / scale) * friction * np.linalg.solve(K, Wt)
+    return T
 
 
 def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
@@ -370,7 +383,6 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if st.phase != "travel":  # settling: kept (a sticking tip's force turns with the tool)
         return replace(st, last_tip=tip)
     n0, s = st.normal, st.tangent
-    b = np.cross(n0, s)
     advance = float((tip - st.last_tip) @ s)
     travel = st.travel + advance
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
@@ -378,19 +390,16 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         stuck = st.step > 0 or st.sticking
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
                        breakaway=st.breakaway + (1.0 if stuck else 0.0))
-    fn = float(-(F @ n0))
-    a_force, c_force = float(F @ s) / fn, float(F @ b) / fn
+    u = -F / float(np.linalg.norm(F))  # the force on the tool's direction
     mu, samples = st.friction_ratio, st.friction_samples
     c = _chord(path, tip, CHORD_LENGTH)
-    n_s = 0.0  # the normal's change along s: kept until a chord has measured the friction
+    n = n0  # kept until a chord has measured the friction
     if c is not None and float(c @ s) > 0.5 * float(np.linalg.norm(c)):
-        n_s_geom = -float(c @ n0) / float(c @ s)  # the chord lies in the surface
-        w = 1.0 if samples == 0 else FRICTION_SMOOTHING
-        mu = min(max((1.0 - w) * mu + w * (a_force + n_s_geom), 0.0), 1.0)
-        samples += 1
-    if samples:
-        n_s = mu - a_force
-    n = n0 + n_s * s - c_force * b
+        mu, samples = update_friction(mu, samples, friction_sample(u, c))
+        mu = min(mu, MAX_FRICTION)
+        n = cone_normal(u, c, mu)
+    elif samples:
+        n = cone_normal(u, s, mu)
     return replace(st, travel=travel, normal=n / np.linalg.norm(n), last_tip=tip, path=path,
                    friction_ratio=mu, friction_samples=samples,
                    path_dir=None if c is None else c / np.linalg.norm(c),
@@ -488,8 +497,9 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
         dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
     try:
+        sliding = phase == "travel" and st.friction_samples > 0
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
-                        config.max_correction)
+                        config.max_correction, st.friction_ratio if sliding else 0.0, t)
     except (InputError, np.linalg.LinAlgError) as exc:
         return _stop(st, label, f"the contact basis is singular for the platform stiffness: "
                      f"{exc}", **kw)
