@@ -389,7 +389,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP):  # sticking: keep n0
         stuck = st.step > 0 or st.sticking
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
-                       breakaway=st.breakaway + (1.0 if stuck else 0.0))
+                       breakaway=st.breakaway + (
+                           1.0 if stuck and st.friction_samples < LEARN_CHORDS else 0.0))
     u = -F / float(np.linalg.norm(F))  # the force on the tool's direction
     mu, samples = st.friction_ratio, st.friction_samples
     c = _chord(path, tip, CHORD_LENGTH)
@@ -487,7 +488,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     if phase == "travel" and remaining <= TRAVEL_TOL:
         return (Command(kind="done", label="e", reason=f"travelled {st.travel:.3f} mm along the "
                         "surface", **kw), replace(st, label="e", done=True))
-    if phase == "travel" and not (config.auto_tilt and st.sticking):
+    if phase == "travel" and not (config.auto_tilt and st.sticking
+                                  and st.friction_samples < LEARN_CHORDS):
         learning = config.auto_tilt and st.friction_samples < LEARN_CHORDS
         step = min(config.travel_step * (LEARN_STEP if learning else 1.0), remaining)
         travel_vec = step * t
