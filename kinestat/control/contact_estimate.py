@@ -10,7 +10,7 @@ chord of its measured tip path, which lies in the surface), so the bias can be r
 * ``û = f/|f|`` and ``ĝ``, the slip direction made perpendicular to ``û``, span the plane of
   ``n̂`` and ``ŝ``; in it ``n̂ = cos α û + sin α ĝ`` (:func:`cone_normal`). An error of the
   chord within that plane (its elevation out of the surface: noise, a curved path) does not
-  change ``ĝ``; an error across it turns ``n̂`` by only ``sin α`` times that error.
+  change ``ĝ``; an error across it turns ``n̂`` by only ``μ`` times that error.
 * ``sin α = −û·ŝ`` for a chord in the surface (:func:`friction_sample`): one sample of μ per
   sliding cycle; μ is a property of the contact, so its running mean
   (:func:`update_friction`) is far less noisy than one chord.

@@ -528,13 +528,18 @@ def follow_summary(cycles: list[dict], target_force: float, travel: float) -> di
     """The follow report's figures from the loop's per-cycle summaries: ``travel`` (mm, the
     measured path along the surface), the normal-force errors over the travel cycles (from the
     first travel cycle on; measured, and true when simulated), ``contact_lost`` (travel cycles
-    without contact) and ``completed``."""
+    without contact), and once the tip slid with friction ``friction_estimate`` (μ̂) and
+    ``friction_force_mean`` (N, the tangential force over those cycles)."""
     trav = [c for c in cycles if c.get("phase") == "travel"]
     err = [abs(c["normal_force"] - target_force) for c in trav if c.get("in_contact")]
     out = {"travel": float(cycles[-1]["travel"]) if cycles else 0.0,
            "contact_lost": sum(1 for c in trav if not c.get("in_contact")),
            "normal_force_rms_error": float(np.sqrt(np.mean(np.square(err)))) if err else None,
            "normal_force_max_error": float(max(err)) if err else None}
+    slid = [c for c in trav if c.get("in_contact") and c.get("friction_ratio")]
+    if slid:  # the friction measured, not fought: mu estimate and mean friction force
+        out["friction_estimate"] = float(slid[-1]["friction_ratio"])
+        out["friction_force_mean"] = float(np.mean([c["tangential_force"] for c in slid]))
     true_err = []
     for c in trav:
         if c.get("true_normal") is not None and c.get("true_force") is not None:
