@@ -117,6 +117,11 @@ LEARN_CHORDS = 3
 """With the automatic tilt, chords needed before the friction ratio is trusted; until then the
 tilt reached at breakaway is kept and the travel steps are ``LEARN_STEP`` of the full step."""
 LEARN_STEP = 0.25
+BREAKAWAY_DECAY = 0.25
+"""Once the friction is measured, the breakaway tilt decays by this many ``max_turn_deg`` per
+sliding cycle (turning a pushed tool back onto the cone at once jams the tip)."""
+LEARN_CHORD_LENGTH = 0.6
+"""Shortest chord (mm) for the first ``LEARN_CHORDS`` friction samples (a slow first slip)."""
 AUTO_TILT_MARGIN_DEG = 1.0
 """The automatic tilt's margin beyond the friction cone (keeps the tip sliding)."""
 CARRY_MARGIN = 1.0
@@ -371,6 +376,15 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
     return None
 
 
+def _breakaway_step(st: FollowState) -> float:
+    """The automatic tilt's growth (units of ``max_turn_deg``) for a cycle the tip stuck: a
+    full turn until the first slip measured the friction, then :data:`BREAKAWAY_DECAY` while
+    learning (the tilt is near the cone: beyond it a pushed tip runs ahead), none after."""
+    if not st.friction_samples:
+        return 1.0
+    return BREAKAWAY_DECAY if st.friction_samples < LEARN_CHORDS else 0.0
+
+
 def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.ndarray,
              contact: bool) -> FollowState:
     """Update the travel, the friction ratio and the normal estimate from this measurement
@@ -389,11 +403,11 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP):  # sticking: keep n0
         stuck = st.step > 0 or st.sticking
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
-                       breakaway=st.breakaway + (
-                           1.0 if stuck and st.friction_samples < LEARN_CHORDS else 0.0))
+                       breakaway=st.breakaway + (_breakaway_step(st) if stuck else 0.0))
     u = -F / float(np.linalg.norm(F))  # the force on the tool's direction
     mu, samples = st.friction_ratio, st.friction_samples
-    c = _chord(path, tip, CHORD_LENGTH)
+    c = _chord(path, tip, CHORD_LENGTH if st.friction_samples >= LEARN_CHORDS
+               else LEARN_CHORD_LENGTH)
     n = n0  # kept until a chord has measured the friction
     if c is not None and float(c @ s) > 0.5 * float(np.linalg.norm(c)):
         mu, samples = update_friction(mu, samples, friction_sample(u, c))
@@ -401,10 +415,16 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         n = cone_normal(u, c, mu)
     elif samples:
         n = cone_normal(u, s, mu)
-    return replace(st, travel=travel, normal=n / np.linalg.norm(n), last_tip=tip, path=path,
+    n = n / np.linalg.norm(n)
+    brk = max(st.breakaway - BREAKAWAY_DECAY, 0.0)
+    if samples and not st.friction_samples:  # first slip measured: keep the tool's tilt
+        tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ n)))))
+        brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
+        brk /= config.max_turn_deg
+    return replace(st, travel=travel, normal=n, last_tip=tip, path=path,
                    friction_ratio=mu, friction_samples=samples,
                    path_dir=None if c is None else c / np.linalg.norm(c),
-                   sticking=False, breakaway=st.breakaway if samples < LEARN_CHORDS else 0.0)
+                   sticking=False, breakaway=brk)
 
 
 def decide_follow(config: FollowConfig, state: ControllerState,
