@@ -64,14 +64,15 @@ def cone_normal(force_on_tool, slip, mu) -> np.ndarray:
 def friction_sample(force_on_tool, chord) -> float:
     """One sample of the friction coefficient, ``tan α`` with ``sin α = −û·ĉ``: the force on a
     sliding tip leans from the normal by α against the slip ``ĉ`` (a chord of the tip path,
-    which lies in the surface). Clipped to α ≥ 0.
+    which lies in the surface). Signed: noise makes it negative at times, and a running mean of
+    signed samples is unbiased where a clipped one is not (frictionless contacts).
 
     >>> round(friction_sample([-0.3, 0.0, 1.0], [2.0, 0.0, 0.0]), 12)
     0.3
     """
     u = _unit(force_on_tool)
     c = _unit(chord)
-    s = min(max(-float(u @ c), 0.0), 0.99)
+    s = min(max(-float(u @ c), -0.99), 0.99)
     return s / math.sqrt(1.0 - s * s)
 
 

@@ -280,6 +280,8 @@ class FollowState(ControllerState):
         sticking: the tip did not follow the last travel step.
         breakaway: the extra tilt of the automatic tilt, in units of ``max_turn_deg``
             (grows while the tip sticks, halves while it slides).
+        friction_mean: the running mean of the signed friction samples
+            (:func:`~kinestat.control.contact_estimate.update_friction`).
         friction_ratio: running estimate of the tangential-to-normal force ratio along the
             slip (μ when sliding), from the force and the chord.
     """
@@ -293,6 +295,7 @@ class FollowState(ControllerState):
     contact_lost: int = 0
     path: tuple = ()
     friction_ratio: float = 0.0
+    friction_mean: float = 0.0
     friction_samples: int = 0
     step: float = 0.0
     sticking: bool = False
@@ -405,13 +408,13 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
                        breakaway=st.breakaway + (_breakaway_step(st) if stuck else 0.0))
     u = -F / float(np.linalg.norm(F))  # the force on the tool's direction
-    mu, samples = st.friction_ratio, st.friction_samples
+    mu, raw, samples = st.friction_ratio, st.friction_mean, st.friction_samples
     c = _chord(path, tip, CHORD_LENGTH if st.friction_samples >= LEARN_CHORDS
                else LEARN_CHORD_LENGTH)
     n = n0  # kept until a chord has measured the friction
     if c is not None and float(c @ s) > 0.5 * float(np.linalg.norm(c)):
-        mu, samples = update_friction(mu, samples, friction_sample(u, c))
-        mu = min(mu, MAX_FRICTION)
+        raw, samples = update_friction(raw, samples, friction_sample(u, c))
+        mu = min(max(raw, 0.0), MAX_FRICTION)
         n = cone_normal(u, c, mu)
     elif samples:
         n = cone_normal(u, s, mu)
@@ -422,7 +425,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
         brk /= config.max_turn_deg
     return replace(st, travel=travel, normal=n, last_tip=tip, path=path,
-                   friction_ratio=mu, friction_samples=samples,
+                   friction_ratio=mu, friction_mean=raw, friction_samples=samples,
                    path_dir=None if c is None else c / np.linalg.norm(c),
                    sticking=False, breakaway=brk)
 
