@@ -117,10 +117,11 @@ LEARN_CHORDS = 3
 """With the automatic tilt, chords needed before the friction ratio is trusted; until then the
 tilt reached at breakaway is kept and the travel steps are ``LEARN_STEP`` of the full step."""
 LEARN_STEP = 0.25
-BREAKAWAY_DECAY = 0.25
+BREAKAWAY_DECAY = 0.1
+BREAKAWAY_FIRST = 0.25
 """Once the friction is measured, the breakaway tilt decays by this many ``max_turn_deg`` per
 sliding cycle (turning a pushed tool back onto the cone at once jams the tip)."""
-LEARN_CHORD_LENGTH = 0.6
+LEARN_CHORD_LENGTH = 0.4
 """Shortest chord (mm) for the first ``LEARN_CHORDS`` friction samples (a slow first slip)."""
 AUTO_TILT_MARGIN_DEG = 1.0
 """The automatic tilt's margin beyond the friction cone (keeps the tip sliding)."""
@@ -379,13 +380,22 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
     return None
 
 
+def _creeping(st: FollowState, path: tuple, tip: np.ndarray) -> bool:
+    """While μ is learnt, a tip that crept :data:`LEARN_CHORD_LENGTH` along the travel over
+    the last cycles slides (the breakaway tilt slips it slowly, below ``MIN_SLIP`` a cycle)."""
+    if st.friction_samples >= LEARN_CHORDS:
+        return False
+    c = _chord(path, tip, LEARN_CHORD_LENGTH)
+    return c is not None and float(c @ st.tangent) > 0.5 * float(np.linalg.norm(c))
+
+
 def _breakaway_step(st: FollowState) -> float:
     """The automatic tilt's growth (units of ``max_turn_deg``) for a cycle the tip stuck: a
     full turn until the first slip measured the friction, then :data:`BREAKAWAY_DECAY` while
     learning (the tilt is near the cone: beyond it a pushed tip runs ahead), none after."""
     if not st.friction_samples:
-        return 1.0
-    return BREAKAWAY_DECAY if st.friction_samples < LEARN_CHORDS else 0.0
+        return BREAKAWAY_FIRST
+    return BREAKAWAY_DECAY
 
 
 def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.ndarray,
@@ -403,7 +413,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     advance = float((tip - st.last_tip) @ s)
     travel = st.travel + advance
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
-    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP):  # sticking: keep n0
+    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip):
         stuck = st.step > 0 or st.sticking
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
                        breakaway=st.breakaway + (_breakaway_step(st) if stuck else 0.0))
@@ -511,8 +521,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     if phase == "travel" and remaining <= TRAVEL_TOL:
         return (Command(kind="done", label="e", reason=f"travelled {st.travel:.3f} mm along the "
                         "surface", **kw), replace(st, label="e", done=True))
-    if phase == "travel" and not (config.auto_tilt and st.sticking
-                                  and st.friction_samples < LEARN_CHORDS):
+    if phase == "travel" and not (config.auto_tilt and st.sticking):
         learning = config.auto_tilt and st.friction_samples < LEARN_CHORDS
         step = min(config.travel_step * (LEARN_STEP if learning else 1.0), remaining)
         travel_vec = step * t
