@@ -12,15 +12,15 @@ measured deflected tool tip (:meth:`Measurement.tip`). The normal (out of the ma
 first contact the measured force's direction, ``n̂ = −F/|F|`` (``F`` the point-contact fit of
 the force the tool applies), and is KEPT while the force settles: a sticking tip's force turns
 with the tool, chasing it would walk round the friction cone. During travel, on every cycle the
-tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``), it is updated in the frame
-of the previous normal ``n̂₀``, the travel direction ``ŝ`` and ``b̂ = n̂₀ × ŝ``:
-``n̂ ∝ n̂₀ + (μ̂ − F·ŝ/F_n) ŝ − (F·b̂/F_n) b̂`` — across the travel from the force (sliding
-friction has no component across the slip), along it from the force corrected by the friction
-ratio ``μ̂``, a running estimate of ``F·ŝ/F_n + n_s`` where ``n_s = −(c·n̂₀)/(c·ŝ)`` is the
-surface's slope along ``ŝ`` measured by the chord ``c`` (≥ ``CHORD_LENGTH``) of the measured
-tip path, which lies in the surface (until a chord exists the along component is kept).
-Frictionless, ``μ̂ ≈ 0`` and the normal is the force's direction. The normal force is
-``F_n = −F·n̂``.
+tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``, or, while μ is learnt,
+crept ``LEARN_CHORD_LENGTH``), it is the sliding contact's normal of Coulomb's law
+(:mod:`kinestat.control.contact_estimate`): the force on the tool ``û = −F/|F|`` leans from the
+normal by ``atan μ̂`` against the slip, measured by the chord ``c`` (≥ ``CHORD_LENGTH``,
+``LEARN_CHORD_LENGTH`` for the first ``LEARN_CHORDS`` samples) of the measured tip path, which
+lies in the surface: ``n̂ = cos α̂ û + sin α̂ ĝ`` (``ĝ`` the chord made ⊥ û, ``α̂ = atan μ̂``),
+μ̂ the running mean of the samples ``tan α``, ``sin α = −û·ĉ``. Until a chord exists the
+normal is kept. Frictionless, ``μ̂ ≈ 0`` and the normal is the force's direction. The normal
+force is ``F_n = −F·n̂``; the friction force ``F + F_n n̂`` is reported, not fought.
 
 **Control law** (Griffis & Duffy's kinestatic decomposition,
 :func:`kinestat.parallel.kinestatic.compose_twist`). In the platform base frame, with ``K``
@@ -33,7 +33,9 @@ line through the measured tip ``p``, the base (flange) is displaced by
   to cycle) plus a rotation about the tip turning S6 onto ``−n̂`` (or the commanded tilt
   towards ``t̂``);
 * ``−K⁻¹ W Δλ``, the twist of compliance that raises the normal force by
-  ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ).
+  ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ);
+  once μ̂ is measured, along the friction cone's edge ``W_c = [n̂ − μ̂ t̂; p × (n̂ − μ̂ t̂)]``
+  instead (a sliding contact's force changes only along the edge).
 
 Step limits per cycle: ``Δs ≤ travel_step``; the compliance twist moves the tip by at most
 ``max_correction`` along the normal (and ``TANGENTIAL_FACTOR`` times that in all); S6 turns
@@ -118,9 +120,14 @@ LEARN_CHORDS = 3
 tilt reached at breakaway is kept and the travel steps are ``LEARN_STEP`` of the full step."""
 LEARN_STEP = 0.25
 BREAKAWAY_DECAY = 0.1
-BREAKAWAY_FIRST = 0.25
 """Once the friction is measured, the breakaway tilt decays by this many ``max_turn_deg`` per
-sliding cycle (turning a pushed tool back onto the cone at once jams the tip)."""
+sliding cycle (turning a pushed tool back onto the cone at once jams the tip), and grows by as
+much per cycle the tip sticks."""
+BREAKAWAY_FIRST = 0.25
+"""Growth of the breakaway tilt (``max_turn_deg``) per sticking cycle before the first slip:
+every degree the tool is tilted past the friction cone lets the pushed tip run ahead ~1.5 mm
+and drops the normal force ~1.7 N (the soft mode against the axial spring), so the tilt
+creeps up to the slip."""
 LEARN_CHORD_LENGTH = 0.4
 """Shortest chord (mm) for the first ``LEARN_CHORDS`` friction samples (a slow first slip)."""
 AUTO_TILT_MARGIN_DEG = 1.0
@@ -214,7 +221,9 @@ class FollowConfig:
         settle_tol: normal-force error (N) below which travel starts.
         tilt_deg: S6 tilted from −n̂ towards the travel direction (degrees, 0: along −n̂).
         auto_tilt: tilt S6 by ``atan(μ̂)`` (the estimated friction ratio) so that it stays
-            along the total force, plus ``max_turn_deg`` more for every cycle the tip sticks:
+            along the total force (plus ``AUTO_TILT_MARGIN_DEG``), plus the breakaway tilt
+            that grows while the tip sticks (``BREAKAWAY_FIRST`` × ``max_turn_deg`` a cycle
+            before the first slip, ``BREAKAWAY_DECAY`` after) and decays while it slides:
             a point contact on the long tool is very soft tangentially (the top turns about
             the tip), so friction carried across the tool axis turns the top beyond Table
             3-1's range; along the axis the platform carries it.
@@ -280,7 +289,7 @@ class FollowState(ControllerState):
         step: the travel commanded by the last move (mm).
         sticking: the tip did not follow the last travel step.
         breakaway: the extra tilt of the automatic tilt, in units of ``max_turn_deg``
-            (grows while the tip sticks, halves while it slides).
+            (grows while the tip sticks, decays while it slides).
         friction_mean: the running mean of the signed friction samples
             (:func:`~kinestat.control.contact_estimate.update_friction`).
         friction_ratio: running estimate of the tangential-to-normal force ratio along the
