@@ -12,15 +12,15 @@ measured deflected tool tip (:meth:`Measurement.tip`). The normal (out of the ma
 first contact the measured force's direction, ``n̂ = −F/|F|`` (``F`` the point-contact fit of
 the force the tool applies), and is KEPT while the force settles: a sticking tip's force turns
 with the tool, chasing it would walk round the friction cone. During travel, on every cycle the
-tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``), it is updated in the frame
-of the previous normal ``n̂₀``, the travel direction ``ŝ`` and ``b̂ = n̂₀ × ŝ``:
-``n̂ ∝ n̂₀ + (μ̂ − F·ŝ/F_n) ŝ − (F·b̂/F_n) b̂`` — across the travel from the force (sliding
-friction has no component across the slip), along it from the force corrected by the friction
-ratio ``μ̂``, a running estimate of ``F·ŝ/F_n + n_s`` where ``n_s = −(c·n̂₀)/(c·ŝ)`` is the
-surface's slope along ``ŝ`` measured by the chord ``c`` (≥ ``CHORD_LENGTH``) of the measured
-tip path, which lies in the surface (until a chord exists the along component is kept).
-Frictionless, ``μ̂ ≈ 0`` and the normal is the force's direction. The normal force is
-``F_n = −F·n̂``.
+tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``, or, while μ is learnt,
+crept ``LEARN_CHORD_LENGTH``), it is the sliding contact's normal of Coulomb's law
+(:mod:`kinestat.control.contact_estimate`): the force on the tool ``û = −F/|F|`` leans from the
+normal by ``atan μ̂`` against the slip, measured by the chord ``c`` (≥ ``CHORD_LENGTH``,
+``LEARN_CHORD_LENGTH`` for the first ``LEARN_CHORDS`` samples) of the measured tip path, which
+lies in the surface: ``n̂ = cos α̂ û + sin α̂ ĝ`` (``ĝ`` the chord made ⊥ û, ``α̂ = atan μ̂``),
+μ̂ the running mean of the samples ``tan α``, ``sin α = −û·ĉ``. Until a chord exists the
+normal is kept. Frictionless, ``μ̂ ≈ 0`` and the normal is the force's direction. The normal
+force is ``F_n = −F·n̂``; the friction force ``F + F_n n̂`` is reported, not fought.
 
 **Control law** (Griffis & Duffy's kinestatic decomposition,
 :func:`kinestat.parallel.kinestatic.compose_twist`). In the platform base frame, with ``K``
@@ -33,7 +33,9 @@ line through the measured tip ``p``, the base (flange) is displaced by
   to cycle) plus a rotation about the tip turning S6 onto ``−n̂`` (or the commanded tilt
   towards ``t̂``);
 * ``−K⁻¹ W Δλ``, the twist of compliance that raises the normal force by
-  ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ).
+  ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ);
+  once μ̂ is measured, along the friction cone's edge ``W_c = [n̂ − μ̂ t̂; p × (n̂ − μ̂ t̂)]``
+  instead (a sliding contact's force changes only along the edge).
 
 Step limits per cycle: ``Δs ≤ travel_step``; the compliance twist moves the tip by at most
 ``max_correction`` along the normal (and ``TANGENTIAL_FACTOR`` times that in all); S6 turns
@@ -54,6 +56,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from kinestat.control.contact_estimate import cone_normal, friction_sample, update_friction
 from kinestat.control.controller import (
     Command,
     ControllerConfig,
@@ -100,8 +103,8 @@ CHORD_LENGTH = 2.0
 """Shortest measured tip chord (mm) the estimator takes as a line in the surface."""
 CHORD_HISTORY = 12
 """Measured tips kept for the chord."""
-FRICTION_SMOOTHING = 0.2
-"""Weight of a new sample in the friction ratio's running estimate."""
+MAX_FRICTION = 1.0
+"""Largest friction coefficient the estimate takes."""
 TANGENTIAL_FACTOR = 4.0
 """The compliance twist's whole tip motion may be this multiple of ``max_correction`` (its
 normal part is limited to ``max_correction``: a frictionless tip slides freely along the
@@ -116,6 +119,17 @@ LEARN_CHORDS = 3
 """With the automatic tilt, chords needed before the friction ratio is trusted; until then the
 tilt reached at breakaway is kept and the travel steps are ``LEARN_STEP`` of the full step."""
 LEARN_STEP = 0.25
+BREAKAWAY_DECAY = 0.1
+"""Once the friction is measured, the breakaway tilt decays by this many ``max_turn_deg`` per
+sliding cycle (turning a pushed tool back onto the cone at once jams the tip), and grows by as
+much per cycle the tip sticks."""
+BREAKAWAY_FIRST = 0.25
+"""Growth of the breakaway tilt (``max_turn_deg``) per sticking cycle before the first slip:
+every degree the tool is tilted past the friction cone lets the pushed tip run ahead ~1.5 mm
+and drops the normal force ~1.7 N (the soft mode against the axial spring), so the tilt
+creeps up to the slip."""
+LEARN_CHORD_LENGTH = 0.4
+"""Shortest chord (mm) for the first ``LEARN_CHORDS`` friction samples (a slow first slip)."""
 AUTO_TILT_MARGIN_DEG = 1.0
 """The automatic tilt's margin beyond the friction cone (keeps the tip sliding)."""
 CARRY_MARGIN = 1.0
@@ -207,7 +221,9 @@ class FollowConfig:
         settle_tol: normal-force error (N) below which travel starts.
         tilt_deg: S6 tilted from −n̂ towards the travel direction (degrees, 0: along −n̂).
         auto_tilt: tilt S6 by ``atan(μ̂)`` (the estimated friction ratio) so that it stays
-            along the total force, plus ``max_turn_deg`` more for every cycle the tip sticks:
+            along the total force (plus ``AUTO_TILT_MARGIN_DEG``), plus the breakaway tilt
+            that grows while the tip sticks (``BREAKAWAY_FIRST`` × ``max_turn_deg`` a cycle
+            before the first slip, ``BREAKAWAY_DECAY`` after) and decays while it slides:
             a point contact on the long tool is very soft tangentially (the top turns about
             the tip), so friction carried across the tool axis turns the top beyond Table
             3-1's range; along the axis the platform carries it.
@@ -273,7 +289,9 @@ class FollowState(ControllerState):
         step: the travel commanded by the last move (mm).
         sticking: the tip did not follow the last travel step.
         breakaway: the extra tilt of the automatic tilt, in units of ``max_turn_deg``
-            (grows while the tip sticks, halves while it slides).
+            (grows while the tip sticks, decays while it slides).
+        friction_mean: the running mean of the signed friction samples
+            (:func:`~kinestat.control.contact_estimate.update_friction`).
         friction_ratio: running estimate of the tangential-to-normal force ratio along the
             slip (μ when sliding), from the force and the chord.
     """
@@ -287,6 +305,7 @@ class FollowState(ControllerState):
     contact_lost: int = 0
     path: tuple = ()
     friction_ratio: float = 0.0
+    friction_mean: float = 0.0
     friction_samples: int = 0
     step: float = 0.0
     sticking: bool = False
@@ -319,9 +338,14 @@ def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
 
 def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal: np.ndarray,
                 omega: np.ndarray, travel: np.ndarray, dlam: float,
-                max_correction: float) -> np.ndarray:
-    """The base's twist T = T_f − K⁻¹ W Δλ (base frame, axis order [ω; v_O0]); the compliance
-    part scaled so that it moves the tip by at most ``max_correction``."""
+                max_correction: float, friction: float = 0.0,
+                slip: np.ndarray | None = None) -> np.ndarray:
+    """The base's twist T = T_f − K⁻¹ W_c Δλ (base frame, axis order [ω; v_O0]); the compliance
+    part scaled so that it moves the tip by at most ``max_correction``. ``W_c`` is the contact
+    normal's line W, or, for a tip sliding along ``slip`` with the friction ratio
+    ``friction``, the friction cone's edge ``[n − μ ŝ; p × (n − μ ŝ)]``: a sliding contact's
+    force changes along the edge, so the normal force changes by Δλ and the tip keeps
+    sliding."""
     TB = meas.base_pose
     R = TB[:3, :3]
     p = R.T @ (tip - TB[:3, 3])
@@ -331,11 +355,18 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     w = R.T @ omega
     v_O = R.T @ travel - np.cross(w, p)  # tip moves by `travel`, turning about the tip
     Tf = np.concatenate([w, v_O])
-    Tc = -dlam * np.linalg.solve(K, W)  # K⁻¹ δw with δw = −Δλ W (compose_twist's term)
+    Wt = np.zeros(6)
+    if friction > 0.0 and slip is not None:
+        s = R.T @ slip
+        Wt = np.concatenate([s, np.cross(p, s)])
+    Tc = -dlam * np.linalg.solve(K, W - friction * Wt)  # K⁻¹ δw, δw = −Δλ W_c
     dp = Tc[3:] + np.cross(Tc[:3], p)  # the tip's motion under the compliance twist
     scale = max(abs(float(dp @ n)) / max_correction,
                 float(np.linalg.norm(dp)) / (TANGENTIAL_FACTOR * max_correction), 1.0)
-    return compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
+    T = compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
+    if friction > 0.0 and slip is not None:
+        T = T + (dlam / scale) * friction * np.linalg.solve(K, Wt)
+    return T
 
 
 def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
@@ -358,6 +389,24 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
     return None
 
 
+def _creeping(st: FollowState, path: tuple, tip: np.ndarray) -> bool:
+    """While μ is learnt, a tip that crept :data:`LEARN_CHORD_LENGTH` along the travel over
+    the last cycles slides (the breakaway tilt slips it slowly, below ``MIN_SLIP`` a cycle)."""
+    if st.friction_samples >= LEARN_CHORDS:
+        return False
+    c = _chord(path, tip, LEARN_CHORD_LENGTH)
+    return c is not None and float(c @ st.tangent) > 0.5 * float(np.linalg.norm(c))
+
+
+def _breakaway_step(st: FollowState) -> float:
+    """The automatic tilt's growth (units of ``max_turn_deg``) for a cycle the tip stuck: a
+    full turn until the first slip measured the friction, then :data:`BREAKAWAY_DECAY` while
+    learning (the tilt is near the cone: beyond it a pushed tip runs ahead), none after."""
+    if not st.friction_samples:
+        return BREAKAWAY_FIRST
+    return BREAKAWAY_DECAY
+
+
 def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.ndarray,
              contact: bool) -> FollowState:
     """Update the travel, the friction ratio and the normal estimate from this measurement
@@ -370,31 +419,34 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if st.phase != "travel":  # settling: kept (a sticking tip's force turns with the tool)
         return replace(st, last_tip=tip)
     n0, s = st.normal, st.tangent
-    b = np.cross(n0, s)
     advance = float((tip - st.last_tip) @ s)
     travel = st.travel + advance
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
-    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP):  # sticking: keep n0
+    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip):
         stuck = st.step > 0 or st.sticking
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
-                       breakaway=st.breakaway + (1.0 if stuck else 0.0))
-    fn = float(-(F @ n0))
-    a_force, c_force = float(F @ s) / fn, float(F @ b) / fn
-    mu, samples = st.friction_ratio, st.friction_samples
-    c = _chord(path, tip, CHORD_LENGTH)
-    n_s = 0.0  # the normal's change along s: kept until a chord has measured the friction
+                       breakaway=st.breakaway + (_breakaway_step(st) if stuck else 0.0))
+    u = -F / float(np.linalg.norm(F))  # the force on the tool's direction
+    mu, raw, samples = st.friction_ratio, st.friction_mean, st.friction_samples
+    c = _chord(path, tip, CHORD_LENGTH if st.friction_samples >= LEARN_CHORDS
+               else LEARN_CHORD_LENGTH)
+    n = n0  # kept until a chord has measured the friction
     if c is not None and float(c @ s) > 0.5 * float(np.linalg.norm(c)):
-        n_s_geom = -float(c @ n0) / float(c @ s)  # the chord lies in the surface
-        w = 1.0 if samples == 0 else FRICTION_SMOOTHING
-        mu = min(max((1.0 - w) * mu + w * (a_force + n_s_geom), 0.0), 1.0)
-        samples += 1
-    if samples:
-        n_s = mu - a_force
-    n = n0 + n_s * s - c_force * b
-    return replace(st, travel=travel, normal=n / np.linalg.norm(n), last_tip=tip, path=path,
-                   friction_ratio=mu, friction_samples=samples,
+        raw, samples = update_friction(raw, samples, friction_sample(u, c))
+        mu = min(max(raw, 0.0), MAX_FRICTION)
+        n = cone_normal(u, c, mu)
+    elif samples:
+        n = cone_normal(u, s, mu)
+    n = n / np.linalg.norm(n)
+    brk = max(st.breakaway - BREAKAWAY_DECAY, 0.0)
+    if samples and not st.friction_samples:  # first slip measured: keep the tool's tilt
+        tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ n)))))
+        brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
+        brk /= config.max_turn_deg
+    return replace(st, travel=travel, normal=n, last_tip=tip, path=path,
+                   friction_ratio=mu, friction_mean=raw, friction_samples=samples,
                    path_dir=None if c is None else c / np.linalg.norm(c),
-                   sticking=False, breakaway=st.breakaway if samples < LEARN_CHORDS else 0.0)
+                   sticking=False, breakaway=brk)
 
 
 def decide_follow(config: FollowConfig, state: ControllerState,
@@ -488,8 +540,9 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
         dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
     try:
+        sliding = phase == "travel" and st.friction_samples > 0
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
-                        config.max_correction)
+                        config.max_correction, st.friction_ratio if sliding else 0.0, t)
     except (InputError, np.linalg.LinAlgError) as exc:
         return _stop(st, label, f"the contact basis is singular for the platform stiffness: "
                      f"{exc}", **kw)
@@ -516,13 +569,18 @@ def follow_summary(cycles: list[dict], target_force: float, travel: float) -> di
     """The follow report's figures from the loop's per-cycle summaries: ``travel`` (mm, the
     measured path along the surface), the normal-force errors over the travel cycles (from the
     first travel cycle on; measured, and true when simulated), ``contact_lost`` (travel cycles
-    without contact) and ``completed``."""
+    without contact), and once the tip slid with friction ``friction_estimate`` (μ̂) and
+    ``friction_force_mean`` (N, the tangential force over those cycles)."""
     trav = [c for c in cycles if c.get("phase") == "travel"]
     err = [abs(c["normal_force"] - target_force) for c in trav if c.get("in_contact")]
     out = {"travel": float(cycles[-1]["travel"]) if cycles else 0.0,
            "contact_lost": sum(1 for c in trav if not c.get("in_contact")),
            "normal_force_rms_error": float(np.sqrt(np.mean(np.square(err)))) if err else None,
            "normal_force_max_error": float(max(err)) if err else None}
+    slid = [c for c in trav if c.get("in_contact") and c.get("friction_ratio")]
+    if slid:  # the friction measured, not fought: mu estimate and mean friction force
+        out["friction_estimate"] = float(slid[-1]["friction_ratio"])
+        out["friction_force_mean"] = float(np.mean([c["tangential_force"] for c in slid]))
     true_err = []
     for c in trav:
         if c.get("true_normal") is not None and c.get("true_force") is not None:
