@@ -61,6 +61,7 @@ from kinestat.control.wrench import Estimator, Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
 from kinestat.hardware.puma762_axes import round_half_away
 from kinestat.serial import puma762
+from kinestat.serial.puma762._grid_kernels import grid_nearest
 
 __all__ = [
     "THESIS_FORCE_DIRECTION",
@@ -332,6 +333,53 @@ def _axis5_residual(model: ControlModel, counts: np.ndarray, counts_now: np.ndar
 # turns the tool about its own axis).
 _OFFSETS = np.array([(a, b, c, d, e, 0) for a, b, c in itertools.product(range(-4, 5), repeat=3)
                      for d, e in itertools.product((-1, 0, 1), repeat=2)], dtype=np.int64)
+#: the same grid per axis (axes 1-3, 4, 5; axis 6 as is), in the order of _OFFSETS' rows
+_AXIS_OFFSETS = (np.arange(-4, 5), np.arange(-4, 5), np.arange(-4, 5), np.arange(-1, 2),
+                 np.arange(-1, 2))
+_ZERO_OFFSETS = tuple(np.zeros(1, dtype=np.int64) for _ in range(5))
+#: the vernier's cost scales: 1 µm along S6, 0.05 mm across it, 0.01° of tilt
+_VERNIER_SCALES = (1e-3, 0.05, math.radians(0.01))
+
+
+def _vernier_tables(model: ControlModel, c0: np.ndarray, counts_now, offsets) -> tuple:
+    """cos/sin of the joint angles of the vernier's grid around the counts ``c0`` (axes 1-3,
+    4; axis 5 for each axis-4 value, with the axis-5 rounding the 4 → 5 compensation leaves;
+    axis 6 as is), computed as :func:`axis_counts_to_q` computes them for the whole grid."""
+    n4, n5 = len(offsets[3]), len(offsets[4])
+    rows = max(len(o) for o in offsets[:3]) + n4 * n5
+    cand = np.repeat(c0[None, :], rows, axis=0)
+    for j in range(3):
+        cand[:len(offsets[j]), j] += offsets[j]
+    wrist = np.repeat(c0[None, :], n4 * n5, axis=0)
+    wrist[:, 3] += np.repeat(offsets[3], n5)
+    wrist[:, 4] += np.tile(offsets[4], n4)
+    cand[rows - n4 * n5:] = wrist
+    phys = cand.astype(float)
+    phys[:, 4] += _axis5_residual(model, cand, np.asarray(counts_now))
+    q = axis_counts_to_q(model, phys)
+    cs = np.stack([np.cos(q), np.sin(q)], axis=-1)  # (rows, 6, 2)
+    w = cs[rows - n4 * n5:]
+    return (np.ascontiguousarray(cs[:len(offsets[0]), 0]),
+            np.ascontiguousarray(cs[:len(offsets[1]), 1]),
+            np.ascontiguousarray(cs[:len(offsets[2]), 2]),
+            np.ascontiguousarray(w[::n5, 3]),
+            np.ascontiguousarray(w[:, 4].reshape(n4, n5, 2)),
+            np.ascontiguousarray(cs[0, 5]))
+
+
+def _vernier_pick(model: ControlModel, target: Target, c0: np.ndarray, counts_now,
+                  offsets) -> tuple[int, float]:
+    """The index (in the grid ``offsets``' row order, :data:`_OFFSETS` for the full grid) of
+    the count vector whose tool point best realises ``target`` and its offset along S6 (mm):
+    the compiled grid search :func:`kinestat.serial.puma762._grid_kernels.grid_nearest`."""
+    sizes = [len(o) for o in offsets]
+    centre = 0
+    for o, n in zip(offsets, sizes, strict=True):
+        centre = centre * n + int(np.flatnonzero(o == 0)[0])
+    k, along, _ = grid_nearest(*_vernier_tables(model, c0, counts_now, offsets),
+                               model.tool_point_6, target.tool_point, target.s6,
+                               *_VERNIER_SCALES, centre)
+    return int(k), float(along)
 
 
 def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
@@ -339,21 +387,16 @@ def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
     """Reverse analysis, selection within limits, rounding to counts (with the vernier).
 
     Returns (counts, residual along S6 in mm of the chosen counts). Raises UnreachableError or
-    JointLimitError."""
+    JointLimitError. The vernier's search runs compiled (:func:`_vernier_pick`); the NumPy
+    formulation it reproduces is :func:`kinestat.control._reference.solve_counts_reference`."""
     res = puma762.reverse(target.tool_point, target.s6, target.a67, model.tool_point_6)
     sel = puma762.select(res, q_now, model.limits_deg)
     c0 = _q_to_axis_counts(model, sel.axis)
-    cand = c0 + _OFFSETS if vernier else c0[None, :]
-    phys = cand.astype(float)
-    phys[:, 4] += _axis5_residual(model, cand, counts_now)
-    fwd = puma762.forward(axis_counts_to_q(model, phys), model.tool_point_6)
-    d = fwd.tool_point - target.tool_point
-    along = d @ target.s6
-    lateral = np.linalg.norm(d - along[:, None] * target.s6, axis=1)
-    tilt = np.arccos(np.clip(fwd.s6 @ target.s6, -1.0, 1.0))
-    cost = (along / 1e-3) ** 2 + (lateral / 0.05) ** 2 + (tilt / math.radians(0.01)) ** 2
-    k = int(np.argmin(cost))
-    return cand[k], float(along[k])
+    if not vernier:
+        k, along = _vernier_pick(model, target, c0, counts_now, _ZERO_OFFSETS)
+        return c0, along
+    k, along = _vernier_pick(model, target, c0, counts_now, _AXIS_OFFSETS)
+    return c0 + _OFFSETS[k], along
 
 
 def _rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:

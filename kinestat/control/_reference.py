@@ -1,0 +1,56 @@
+"""The unoptimised per-cycle computations the compiled fast path replaced, kept as the
+reference: the tests replay recorded cycles through both and require the same commands
+(tests/control/test_cycle_fast.py), and ``benchmarks/control_cycle.py`` times both side by side.
+
+:func:`solve_counts_reference` is the vernier as first written: the forward analysis of all
+9·9·9·3·3 = 6561 count vectors with NumPy and ``argmin`` of the cost. The fast path
+(:func:`kinestat.control.controller._solve_counts`) searches the same grid with the same cost
+in a compiled kernel; both pick the same count vector unless two candidates' costs agree to
+the last few bits (the two formulations round differently, ~1e-13 mm).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from kinestat.control.controller import (
+    _OFFSETS,
+    Target,
+    _axis5_residual,
+    _q_to_axis_counts,
+    axis_counts_to_q,
+)
+from kinestat.control.model import ControlModel
+from kinestat.serial import puma762
+
+__all__ = ["solve_counts_reference", "vernier_costs_reference"]
+
+
+def vernier_costs_reference(model: ControlModel, target: Target, c0, counts_now,
+                            vernier: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The candidates ``c0 + _OFFSETS`` (or ``c0`` alone), their cost and offset along S6."""
+    c0 = np.asarray(c0)
+    cand = c0 + _OFFSETS if vernier else c0[None, :]
+    phys = cand.astype(float)
+    phys[:, 4] += _axis5_residual(model, cand, counts_now)
+    fwd = puma762.forward(axis_counts_to_q(model, phys), model.tool_point_6)
+    d = fwd.tool_point - target.tool_point
+    along = d @ target.s6
+    lateral = np.linalg.norm(d - along[:, None] * target.s6, axis=1)
+    tilt = np.arccos(np.clip(fwd.s6 @ target.s6, -1.0, 1.0))
+    cost = (along / 1e-3) ** 2 + (lateral / 0.05) ** 2 + (tilt / math.radians(0.01)) ** 2
+    return cand, cost, along
+
+
+def solve_counts_reference(model: ControlModel, target: Target, q_now, counts_now,
+                           vernier: bool) -> tuple[np.ndarray, float]:
+    """:func:`kinestat.control.controller._solve_counts` as first written (NumPy, all
+    candidates): (counts, residual along S6 in mm)."""
+    res = puma762.reverse(target.tool_point, target.s6, target.a67, model.tool_point_6)
+    sel = puma762.select(res, q_now, model.limits_deg)
+    c0 = _q_to_axis_counts(model, sel.axis)
+    cand, cost, along = vernier_costs_reference(model, target, c0, counts_now, vernier)
+    k = int(np.argmin(cost))
+    return cand[k], float(along[k])
