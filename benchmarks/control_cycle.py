@@ -14,6 +14,7 @@ decisions without the vernier. Figures are medians over cycles of the median of 
 from __future__ import annotations
 
 import argparse
+import copy
 import functools
 import json
 import statistics
@@ -33,7 +34,7 @@ from kinestat.control.controller import THESIS_FORCE_DIRECTION, _solve_counts, d
 from kinestat.control.follow import decide_follow  # noqa: E402
 from kinestat.control.log import CycleLog  # noqa: E402
 from kinestat.control.loop import run  # noqa: E402
-from kinestat.control.wrench import measure  # noqa: E402
+from kinestat.control.wrench import Measurement, measure  # noqa: E402
 
 START = np.array([-400.0, 800.0, -100.0])
 
@@ -58,14 +59,21 @@ def _record(task: str) -> tuple:
     return prep, pairs, rep
 
 
+def _fresh(args: tuple) -> tuple:
+    """The call's arguments with a new Measurement object (same values), so that no per-cycle
+    data cached for the measurement (:func:`kinestat.control.cycle.cycle_data`) is reused."""
+    return tuple(copy.copy(a) if isinstance(a, Measurement) else a for a in args)
+
+
 def _median_per_call(fn, pairs, repeat: int = 5) -> float:
     per = []
     for p in pairs:
-        fn(*p)  # warm-up
+        fn(*_fresh(p))  # warm-up (compiles on the very first call)
         ts = []
         for _ in range(repeat):
+            args = _fresh(p)
             t0 = time.perf_counter()
-            fn(*p)
+            fn(*args)
             ts.append(time.perf_counter() - t0)
         per.append(statistics.median(ts))
     return statistics.median(per)

@@ -36,12 +36,11 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from kinestat.control.cycle import cycle_data
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
 from kinestat.hardware.platform_spec import MAX_DEFLECTION, MAX_LOAD, MOTION_RANGE
-from kinestat.parallel.statics import leg_directions
-from kinestat.parallel.stiffness import stiffness
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
 from kinestat.parallel.stiffness import tip_stiffness as platform_tip_stiffness
 from kinestat.spatial.transforms import apply, inv, skew
@@ -139,8 +138,9 @@ def tip_stiffness(model: ControlModel, meas: Measurement) -> np.ndarray:
     (:func:`kinestat.parallel.stiffness.tip_stiffness`): moving the flange by ``δ`` (at the
     tip) with the tip held changes the tool's force by ``K_tip δ``.
     """
-    return platform_tip_stiffness(model.platform, meas.top_pose, _tip_base(model, meas),
-                                  meas.base_pose[:3, :3])
+    d = cycle_data(model, meas)
+    return platform_tip_stiffness(model.platform, meas.top_pose, d.tip_base,
+                                  meas.base_pose[:3, :3], stiffness_axis=d.K)
 
 
 def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Prediction:
@@ -156,19 +156,20 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     """
     Tn = np.asarray(flange_pose_new, dtype=float)
     TB_new = Tn @ model.mount
-    tip_F = meas.tip(model)
-    p = _tip_base(model, meas)
+    data = cycle_data(model, meas)  # K, the tip and C_tip at the measured pose, made once
+    tip_F = data.tip_fixed
+    p = data.tip_base
     u = apply(inv(TB_new), tip_F) - p
     R = meas.base_pose[:3, :3]
     F = -(R.T @ meas.estimate("point"))  # external force on the tip, base frame
-    K = stiffness(model.platform, meas.top_pose, twist_order="axis")
+    K = data.K
     A = np.vstack([np.eye(3), skew(p)])
     B = np.hstack([-skew(p), np.eye(3)])
-    C_tip = platform_tip_compliance(model.platform, meas.top_pose, p)
+    C_tip = data.C_tip
     b = np.concatenate([np.zeros(3), np.cross(u, F)])
     dF = np.linalg.solve(C_tip, u - B @ np.linalg.solve(K, b))
     D = np.linalg.solve(K, A @ dF + b)  # top twist [δφ; δx_O] relative to the base
-    S, _ = leg_directions(model.platform, meas.top_pose)
+    S, _ = data.leg_directions
     Bp = model.platform.base_points
     dl = np.cross(Bp, S) @ D[:3] + S @ D[3:]
     force = -(TB_new[:3, :3] @ (F + dF))

@@ -62,6 +62,7 @@ from kinestat.control.controller import (
     Target,
     move_command,
 )
+from kinestat.control.cycle import cycle_data
 from kinestat.control.envelope import (
     Envelope,
     check_measurement,
@@ -327,7 +328,7 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     p = R.T @ (tip - TB[:3, 3])
     n = R.T @ normal
     W = np.concatenate([n, np.cross(p, n)])
-    K = stiffness(model.platform, meas.top_pose, twist_order="axis")
+    K = cycle_data(model, meas).K  # the measured pose's stiffness, computed once per cycle
     w = R.T @ omega
     v_O = R.T @ travel - np.cross(w, p)  # tip moves by `travel`, turning about the tip
     Tf = np.concatenate([w, v_O])

@@ -95,13 +95,14 @@ def stiffness(platform: Platform, pose, forces=None, *, twist_order: str = "ray"
     return K if twist_order == "ray" else _swap(K)
 
 
-def tip_compliance(platform: Platform, pose, tip) -> np.ndarray:
+def tip_compliance(platform: Platform, pose, tip, *, stiffness_axis=None) -> np.ndarray:
     """Translational compliance (..., 3, 3) of a point ``tip`` of the top, base frame, mm/N.
 
     A force ``δF`` applied at the tip (the top free to rotate) moves the tip by ``C_tip δF``:
     ``C_tip = [−[p]×, I] K⁻¹ [I; [p]×]``, K the platform's stiffness at ``pose`` (Vibhute
     eq. 2-16/2-17, axis order ``[δφ; δx_O]``) and ``p`` (..., 3) the tip in base coordinates.
-    Batched over a leading shape shared by ``pose`` and ``tip``.
+    Batched over a leading shape shared by ``pose`` and ``tip``. ``stiffness_axis``: K at
+    ``pose`` in axis order when the caller already has it (not recomputed).
 
     >>> from kinestat.parallel.platform import special_6_6
     >>> pf = special_6_6()
@@ -109,7 +110,8 @@ def tip_compliance(platform: Platform, pose, tip) -> np.ndarray:
     >>> bool(np.allclose(C, C.T)) and bool(np.all(np.linalg.eigvalsh(C) > 0))
     True
     """
-    K = stiffness(platform, pose, twist_order="axis")
+    K = (stiffness(platform, pose, twist_order="axis") if stiffness_axis is None
+         else stiffness_axis)
     p = as_array(tip, shape_tail=(3,), name="tip")
     P = skew(p)
     eye = np.broadcast_to(np.eye(3), P.shape)
@@ -118,7 +120,8 @@ def tip_compliance(platform: Platform, pose, tip) -> np.ndarray:
     return B @ np.linalg.solve(K, A)
 
 
-def tip_stiffness(platform: Platform, pose, tip, rotation=None) -> np.ndarray:
+def tip_stiffness(platform: Platform, pose, tip, rotation=None, *,
+                  stiffness_axis=None) -> np.ndarray:
     """Point stiffness (..., 3, 3) of the platform at ``tip``, N/mm: ``C_tip⁻¹``
     (:func:`tip_compliance`), in the base frame, or rotated by ``rotation`` (..., 3, 3, the
     base frame's orientation in another frame) into that frame: ``R C_tip⁻¹ Rᵀ``.
@@ -126,7 +129,7 @@ def tip_stiffness(platform: Platform, pose, tip, rotation=None) -> np.ndarray:
     Moving the base by ``δ`` at the tip with the tip held changes the tip force by
     ``K_tip δ`` (Vibhute eq. 2-16 reduced to the tip's translation).
     """
-    Kb = np.linalg.inv(tip_compliance(platform, pose, tip))
+    Kb = np.linalg.inv(tip_compliance(platform, pose, tip, stiffness_axis=stiffness_axis))
     if rotation is None:
         return Kb
     R = np.asarray(rotation, dtype=float)
