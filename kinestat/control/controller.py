@@ -61,7 +61,7 @@ from kinestat.control.wrench import Estimator, Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
 from kinestat.hardware.puma762_axes import round_half_away
 from kinestat.serial import puma762
-from kinestat.serial.puma762._grid_kernels import grid_nearest
+from kinestat.serial.puma762._cycle_kernels import grid_nearest
 
 __all__ = [
     "THESIS_FORCE_DIRECTION",
@@ -371,13 +371,14 @@ def _vernier_pick(model: ControlModel, target: Target, c0: np.ndarray, counts_no
                   offsets) -> tuple[int, float]:
     """The index (in the grid ``offsets``' row order, :data:`_OFFSETS` for the full grid) of
     the count vector whose tool point best realises ``target`` and its offset along S6 (mm):
-    the compiled grid search :func:`kinestat.serial.puma762._grid_kernels.grid_nearest`."""
+    the compiled grid search :func:`kinestat.serial.puma762._cycle_kernels.grid_nearest`."""
     sizes = [len(o) for o in offsets]
     centre = 0
     for o, n in zip(offsets, sizes, strict=True):
         centre = centre * n + int(np.flatnonzero(o == 0)[0])
-    k, along, _ = grid_nearest(*_vernier_tables(model, c0, counts_now, offsets),
-                               model.tool_point_6, target.tool_point, target.s6,
+    p6, tp, ts = (np.array(v, dtype=float) for v in (model.tool_point_6, target.tool_point,
+                                                      target.s6))  # writeable, C order
+    k, along, _ = grid_nearest(*_vernier_tables(model, c0, counts_now, offsets), p6, tp, ts,
                                *_VERNIER_SCALES, centre)
     return int(k), float(along)
 
@@ -389,9 +390,10 @@ def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
     Returns (counts, residual along S6 in mm of the chosen counts). Raises UnreachableError or
     JointLimitError. The vernier's search runs compiled (:func:`_vernier_pick`); the NumPy
     formulation it reproduces is :func:`kinestat.control._reference.solve_counts_reference`."""
-    res = puma762.reverse(target.tool_point, target.s6, target.a67, model.tool_point_6)
-    sel = puma762.select(res, q_now, model.limits_deg)
-    c0 = _q_to_axis_counts(model, sel.axis)
+    axis = puma762.select_axis_one(target.tool_point, target.s6, target.a67,
+                                   model.tool_point_6, np.asarray(q_now, dtype=float),
+                                   model.limits_deg)
+    c0 = _q_to_axis_counts(model, axis)
     if not vernier:
         k, along = _vernier_pick(model, target, c0, counts_now, _ZERO_OFFSETS)
         return c0, along
@@ -475,7 +477,7 @@ def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target
         return Refusal(f"{action} target not reachable: {exc}", {})
     axis_deg = counts * model.axis_deg_per_count
     q_new = axis_counts_to_q(model, counts)
-    pred = predict(model, meas, puma762.forward(q_new).pose)
+    pred = predict(model, meas, puma762.pose_one(q_new))  # = forward(q_new).pose, compiled
     bad = check_command(envelope, model, axis_deg, counts_now * model.axis_deg_per_count, pred)
     if bad:
         return Refusal(f"{action} command refused by the envelope: " + "; ".join(bad),

@@ -189,10 +189,26 @@ def top_motion(model: ControlModel, top_pose) -> np.ndarray:
     rotation vector of ``R_top R_home⁻¹``."""
     T = np.asarray(top_pose, dtype=float)
     H = model.platform.home_pose
-    c = model.platform.top_points.mean(axis=0)
-    d = (T[:3, :3] @ c + T[:3, 3]) - (H[:3, :3] @ c + H[:3, 3])
     r = Rotation.from_matrix(T[:3, :3] @ H[:3, :3].T).as_rotvec(degrees=True)
-    return np.concatenate([d, r])
+    return np.concatenate([_top_translation(model, T), r])
+
+
+def _top_translation(model: ControlModel, T: np.ndarray) -> np.ndarray:
+    """:func:`top_motion`'s ``[dx, dy, dz]``: the top centroid's displacement from home (mm)."""
+    H = model.platform.home_pose
+    c = model.platform.top_points.mean(axis=0)
+    return (T[:3, :3] @ c + T[:3, 3]) - (H[:3, :3] @ c + H[:3, 3])
+
+
+def _rotation_clear(envelope: Envelope, model: ControlModel, T: np.ndarray) -> bool:
+    """True when the top's rotation from home is so small that no component of
+    :func:`top_motion`'s rotation vector can exceed its range: its angle (from the trace,
+    ``cos θ = (tr R − 1) / 2``), which bounds every component, is below the smallest rotation
+    range by 1e-6° (more than the two computations' rounding apart). :func:`check_motion`
+    then needs no rotation vector — the same verdicts, without SciPy's conversion."""
+    c = (float(np.trace(T[:3, :3] @ model.platform.home_pose[:3, :3].T)) - 1.0) / 2.0
+    angle = math.degrees(math.acos(min(1.0, max(-1.0, c))))
+    return angle + 1e-6 < min(envelope.motion_range[3:])
 
 
 _MOTION_NAMES = ("x", "y", "z", "about x", "about y", "about z")
@@ -201,7 +217,11 @@ _MOTION_NAMES = ("x", "y", "z", "about x", "about y", "about z")
 def check_motion(envelope: Envelope, model: ControlModel, top_pose, what: str) -> list[str]:
     """Violations of Table 3-1's motion ranges by the top at ``top_pose`` (``what``: "measured"
     or "predicted")."""
-    m = top_motion(model, top_pose)
+    T = np.asarray(top_pose, dtype=float)
+    if _rotation_clear(envelope, model, T):  # no rotation component can be out of range
+        m = np.concatenate([_top_translation(model, T), np.zeros(3)])
+    else:
+        m = top_motion(model, T)
     out = []
     for k, (v, lim) in enumerate(zip(m, envelope.motion_range, strict=True)):
         if abs(v) > lim:

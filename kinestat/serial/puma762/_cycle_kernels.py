@@ -26,10 +26,11 @@ import numba as nb
 import numpy as np
 
 from kinestat.serial._numba_options import OPTS as _OPTS
-from kinestat.serial.puma762._kernels import _link
+from kinestat.serial._numba_options import TWO_PI as _TWO_PI
+from kinestat.serial.puma762._kernels import _link, _wrap
 from kinestat.serial.puma762.params import _A, _CA, _S, _SA
 
-__all__ = ["grid_nearest"]
+__all__ = ["grid_nearest", "select_one", "pose_one"]
 
 
 @nb.njit(**_OPTS)
@@ -129,3 +130,78 @@ def grid_nearest(cs1, cs2, cs3, cs4, cs5, cs6, p6, tp, ts, w_along, w_lat, w_til
                             if cost < best or (cost == best and k < best_k):
                                 best, best_k, best_along = cost, k, along
     return best_k, best_along, best
+
+
+@nb.njit(**_OPTS)
+def _wrap_near(a, c, lo, hi):
+    """``wrap_into_limits`` for one angle: ``a`` shifted by whole turns to the value nearest
+    ``c`` inside ``[lo, hi]`` (1e-12 slack); ``(value, ok)``, the plain wrap when none is."""
+    base = c + _wrap(a - c)
+    best = base
+    best_d = np.inf
+    for m in range(-2, 3):
+        cand = base + float(m) * _TWO_PI
+        if cand >= lo - 1e-12 and cand <= hi + 1e-12:
+            d = abs(cand - c)
+            if d < best_d:
+                best_d = d
+                best = cand
+    return best, best_d < np.inf
+
+
+@nb.njit(**_OPTS)
+def select_one(q, valid, sing, fsum, fval, q_now, offset, lo, hi, axis):
+    """The least-motion selection of one pose's eight branches (``select_batch`` with
+    ``current_q``, one pose): the chosen axis angles into ``axis (6,)``; returns whether any
+    branch lies within the limits. ``offset`` is the axis − joint angle offset (6,), ``lo``,
+    ``hi`` the axis limits (radians). Wrist-singular branches split the free motion between
+    axes 4 and 6."""
+    cur = np.empty(6)
+    for j in range(6):
+        cur[j] = q_now[j] + offset[j]
+    cur[0], _ = _wrap_near(cur[0], cur[0], lo[0], hi[0])
+    c4, c6 = cur[3], cur[5]
+    best_motion = np.inf
+    found = False
+    a = np.empty(6)
+    w = np.empty(6)
+    for k in range(q.shape[0]):
+        if not valid[k]:
+            continue
+        for j in range(6):
+            a[j] = q[k, j] + offset[j]
+        if sing[k]:
+            e_sum = _wrap(fval[k] - (c4 + c6))
+            e_dif = _wrap(fval[k] - (c6 - c4))
+            if fsum[k]:
+                a[3], a[5] = c4 + e_sum / 2, c6 + e_sum / 2
+            else:
+                a[3], a[5] = c4 - e_dif / 2, c6 + e_dif / 2
+        ok = True
+        motion = 0.0
+        for j in range(6):
+            w[j], ok_j = _wrap_near(a[j], cur[j], lo[j], hi[j])
+            ok = ok and ok_j
+            motion += abs(w[j] - cur[j])
+        if ok and motion < best_motion:
+            best_motion = motion
+            found = True
+            for j in range(6):
+                axis[j] = w[j]
+    return found
+
+
+@nb.njit(**_OPTS)
+def pose_one(cs, T):
+    """``F_6T`` (eq. 2-33) into ``T (4, 4)`` from the cos and sin ``cs (6, 2)`` of the joint
+    angles: the link product of ``forward._frame_columns``, the same operations in the same
+    order."""
+    c1, s1 = cs[0, 0], cs[0, 1]
+    f = (c1, s1, 0.0, -s1, c1, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0)
+    for k in range(5):
+        f = _link(_CA[k], _SA[k], _A[k], _S[k], cs[k + 1, 0], cs[k + 1, 1], f)
+    x0, x1, x2, y0, y1, y2, z0, z1, z2, p0, p1, p2 = f
+    T[0, 0], T[0, 1], T[0, 2], T[0, 3] = x0, y0, z0, p0
+    T[1, 0], T[1, 1], T[1, 2], T[1, 3] = x1, y1, z1, p1
+    T[2, 0], T[2, 1], T[2, 2], T[2, 3] = x2, y2, z2, p2
+    T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0
