@@ -11,10 +11,13 @@ the last few bits (the two formulations round differently, ~1e-13 mm).
 
 from __future__ import annotations
 
+import contextlib
 import math
+from collections.abc import Iterator
 
 import numpy as np
 
+from kinestat.control import controller, cycle, envelope, follow
 from kinestat.control.controller import (
     _OFFSETS,
     Target,
@@ -23,9 +26,11 @@ from kinestat.control.controller import (
     axis_counts_to_q,
 )
 from kinestat.control.model import ControlModel
+from kinestat.parallel.stiffness import stiffness
 from kinestat.serial import puma762
 
-__all__ = ["solve_counts_reference", "vernier_costs_reference"]
+__all__ = ["solve_counts_reference", "vernier_costs_reference", "UncachedCycleData",
+           "reference_cycle"]
 
 
 def vernier_costs_reference(model: ControlModel, target: Target, c0, counts_now,
@@ -54,3 +59,35 @@ def solve_counts_reference(model: ControlModel, target: Target, q_now, counts_no
     cand, cost, along = vernier_costs_reference(model, target, c0, counts_now, vernier)
     k = int(np.argmin(cost))
     return cand[k], float(along[k])
+
+
+class UncachedCycleData(cycle.CycleData):
+    """:class:`~kinestat.control.cycle.CycleData` that recomputes the stiffness on every use
+    (as the decision did before the per-cycle data: once for ``tip_stiffness``, twice in the
+    envelope's prediction, once in the follow law)."""
+
+    @property
+    def K(self) -> np.ndarray:  # type: ignore[override]
+        return stiffness(self.model.platform, self.meas.top_pose, twist_order="axis")
+
+
+@contextlib.contextmanager
+def reference_cycle() -> Iterator[None]:
+    """Run :func:`~kinestat.control.controller.decide` and
+    :func:`~kinestat.control.follow.decide_follow` on the unoptimised path inside the block:
+    the NumPy vernier and selection (:func:`solve_counts_reference`), the NumPy forward
+    analysis for the flange pose, the stiffness recomputed on every use, and SciPy's
+    rotation vector on every motion check. Not thread-safe (it swaps module attributes)."""
+    saved = [(controller, "_solve_counts", solve_counts_reference),
+             (controller, "_flange_pose", lambda q: puma762.forward(q).pose),
+             (envelope, "cycle_data", UncachedCycleData),
+             (follow, "cycle_data", UncachedCycleData),
+             (envelope, "_rotation_clear", lambda *a: False)]
+    old = [(mod, name, getattr(mod, name)) for mod, name, _ in saved]
+    try:
+        for mod, name, new in saved:
+            setattr(mod, name, new)
+        yield
+    finally:
+        for mod, name, value in old:
+            setattr(mod, name, value)

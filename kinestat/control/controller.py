@@ -401,6 +401,11 @@ def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
     return c0 + _OFFSETS[k], along
 
 
+def _flange_pose(q) -> np.ndarray:
+    """``F_6T`` of the joint angles ``q``: :func:`puma762.forward`'s pose, compiled."""
+    return puma762.pose_one(q)
+
+
 def _rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Rotate ``v`` by the smallest rotation taking unit ``a`` onto unit ``b``."""
     axis = np.cross(a, b)
@@ -477,7 +482,7 @@ def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target
         return Refusal(f"{action} target not reachable: {exc}", {})
     axis_deg = counts * model.axis_deg_per_count
     q_new = axis_counts_to_q(model, counts)
-    pred = predict(model, meas, puma762.pose_one(q_new))  # = forward(q_new).pose, compiled
+    pred = predict(model, meas, _flange_pose(q_new))
     bad = check_command(envelope, model, axis_deg, counts_now * model.axis_deg_per_count, pred)
     if bad:
         return Refusal(f"{action} command refused by the envelope: " + "; ".join(bad),
