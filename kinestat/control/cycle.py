@@ -20,8 +20,8 @@ import numpy as np
 
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
-from kinestat.parallel.statics import leg_directions
-from kinestat.parallel.stiffness import stiffness, tip_compliance
+from kinestat.parallel.legs import leg_directions_trusted
+from kinestat.parallel.stiffness import stiffness_axis_trusted, tip_compliance
 from kinestat.spatial.transforms import apply
 
 __all__ = ["CycleData", "cycle_data"]
@@ -41,14 +41,16 @@ class CycleData:
     def __init__(self, model: ControlModel, meas: Measurement) -> None:
         self.model = model
         self.meas = meas
+        # the platform's forward kinematics made this pose (checked there): used unchecked
+        self.top_pose = np.asarray(meas.top_pose, dtype=float)
 
     @cached_property
     def K(self) -> np.ndarray:
-        return stiffness(self.model.platform, self.meas.top_pose, twist_order="axis")
+        return stiffness_axis_trusted(self.model.platform, self.top_pose)
 
     @cached_property
     def tip_base(self) -> np.ndarray:
-        return apply(self.meas.top_pose, self.model.tool_tip_top)
+        return apply(self.top_pose, self.model.tool_tip_top)
 
     @cached_property
     def tip_fixed(self) -> np.ndarray:
@@ -61,7 +63,7 @@ class CycleData:
 
     @cached_property
     def leg_directions(self) -> tuple[np.ndarray, np.ndarray]:
-        return leg_directions(self.model.platform, self.meas.top_pose)
+        return leg_directions_trusted(self.model.platform, self.top_pose)
 
 
 _DATA: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

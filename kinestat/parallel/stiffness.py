@@ -36,12 +36,13 @@ import numpy as np
 
 from kinestat.errors import InputError, UnreachableError
 from kinestat.parallel._refine import apply_twist
-from kinestat.parallel.legs import as_pose
+from kinestat.parallel.legs import as_pose, leg_directions_trusted
 from kinestat.parallel.platform import Platform
-from kinestat.parallel.statics import leg_directions, spring_wrench
+from kinestat.parallel.statics import spring_wrench
 from kinestat.spatial.transforms import as_array, skew
 
-__all__ = ["stiffness", "stiffness_terms", "load_asymmetry", "equilibrium_pose",
+__all__ = ["stiffness", "stiffness_axis_trusted", "stiffness_terms", "load_asymmetry",
+           "equilibrium_pose",
            "tip_compliance", "tip_stiffness", "TWIST_ORDERS"]
 
 TWIST_ORDERS = ("ray", "axis")
@@ -56,8 +57,12 @@ def stiffness_terms(platform: Platform, pose, forces=None) -> dict[str, np.ndarr
 
     ``forces`` (..., 6) are the leg tensions; default the springs' ``k (l − l0)`` at ``pose``.
     """
-    T = as_pose(pose)
-    S, l = leg_directions(platform, T)
+    return _terms(platform, as_pose(pose), forces)
+
+
+def _terms(platform: Platform, T: np.ndarray, forces=None) -> dict[str, np.ndarray]:
+    """:func:`stiffness_terms` at checked poses ``T``."""
+    S, l = leg_directions_trusted(platform, T)
     f = platform.stiffness * (l - platform.free_lengths) if forces is None else as_array(
         forces, shape_tail=(6,), name="leg forces")
     B = platform.base_points
@@ -93,6 +98,14 @@ def stiffness(platform: Platform, pose, forces=None, *, twist_order: str = "ray"
     parts = stiffness_terms(platform, pose, forces)
     K = parts["elastic"] + parts["geometric"] + parts["load"]
     return K if twist_order == "ray" else _swap(K)
+
+
+def stiffness_axis_trusted(platform: Platform, T: np.ndarray) -> np.ndarray:
+    """``stiffness(platform, T, twist_order="axis")`` (the springs' own tensions) at a pose
+    ``T`` (4, 4) the caller has checked: no validation, the same values (the hot path of a
+    control cycle)."""
+    parts = _terms(platform, T)
+    return _swap(parts["elastic"] + parts["geometric"] + parts["load"])
 
 
 def tip_compliance(platform: Platform, pose, tip, *, stiffness_axis=None) -> np.ndarray:
