@@ -47,6 +47,7 @@ import numpy as np
 
 from kinestat.control.approach import approach_waypoints, check_approach
 from kinestat.control.ceilings import MAX_ITERATIONS
+from kinestat.control.cycle import cross3
 from kinestat.control.envelope import (
     Envelope,
     Prediction,
@@ -408,14 +409,14 @@ def _flange_pose(q) -> np.ndarray:
 
 def _rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Rotate ``v`` by the smallest rotation taking unit ``a`` onto unit ``b``."""
-    axis = np.cross(a, b)
+    axis = cross3(a, b)
     s = float(np.linalg.norm(axis))
     c = float(a @ b)
     if s < 1e-15:
         return v.copy()
     k = axis / s
     ang = math.atan2(s, c)
-    return (v * math.cos(ang) + np.cross(k, v) * math.sin(ang)
+    return (v * math.cos(ang) + cross3(k, v) * math.sin(ang)
             + k * (k @ v) * (1.0 - math.cos(ang)))
 
 

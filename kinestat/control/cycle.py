@@ -24,7 +24,15 @@ from kinestat.parallel.legs import leg_directions_trusted
 from kinestat.parallel.stiffness import stiffness_axis_trusted, tip_compliance
 from kinestat.spatial.transforms import apply
 
-__all__ = ["CycleData", "cycle_data"]
+__all__ = ["CycleData", "cycle_data", "cross3"]
+
+
+def cross3(a, b) -> np.ndarray:
+    """``a × b`` of two 3-vectors: :func:`numpy.cross`'s products and differences, the same
+    values, without its broadcasting set-up (~1 µs instead of ~8 µs)."""
+    a0, a1, a2 = np.asarray(a, dtype=float).tolist()
+    b0, b1, b2 = np.asarray(b, dtype=float).tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 class CycleData:

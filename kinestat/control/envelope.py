@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from kinestat.control.cycle import cycle_data
+from kinestat.control.cycle import cross3, cycle_data
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
@@ -166,7 +166,7 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     A = np.vstack([np.eye(3), skew(p)])
     B = np.hstack([-skew(p), np.eye(3)])
     C_tip = data.C_tip
-    b = np.concatenate([np.zeros(3), np.cross(u, F)])
+    b = np.concatenate([np.zeros(3), cross3(u, F)])
     dF = np.linalg.solve(C_tip, u - B @ np.linalg.solve(K, b))
     D = np.linalg.solve(K, A @ dF + b)  # top twist [δφ; δx_O] relative to the base
     S, _ = data.leg_directions

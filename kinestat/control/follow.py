@@ -62,7 +62,7 @@ from kinestat.control.controller import (
     Target,
     move_command,
 )
-from kinestat.control.cycle import cycle_data
+from kinestat.control.cycle import cross3, cycle_data
 from kinestat.control.envelope import (
     Envelope,
     check_measurement,
@@ -310,7 +310,7 @@ def estimate_normal(force, path_dir=None) -> np.ndarray:
 
 def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
     """Rotation vector turning ``s6`` towards ``axis`` by at most ``limit_rad``."""
-    c = np.cross(s6, axis)
+    c = cross3(s6, axis)
     s = float(np.linalg.norm(c))
     if s < 1e-15:
         return np.zeros(3)
@@ -327,13 +327,13 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     R = TB[:3, :3]
     p = R.T @ (tip - TB[:3, 3])
     n = R.T @ normal
-    W = np.concatenate([n, np.cross(p, n)])
+    W = np.concatenate([n, cross3(p, n)])
     K = cycle_data(model, meas).K  # the measured pose's stiffness, computed once per cycle
     w = R.T @ omega
-    v_O = R.T @ travel - np.cross(w, p)  # tip moves by `travel`, turning about the tip
+    v_O = R.T @ travel - cross3(w, p)  # tip moves by `travel`, turning about the tip
     Tf = np.concatenate([w, v_O])
     Tc = -dlam * np.linalg.solve(K, W)  # K⁻¹ δw with δw = −Δλ W (compose_twist's term)
-    dp = Tc[3:] + np.cross(Tc[:3], p)  # the tip's motion under the compliance twist
+    dp = Tc[3:] + cross3(Tc[:3], p)  # the tip's motion under the compliance twist
     scale = max(abs(float(dp @ n)) / max_correction,
                 float(np.linalg.norm(dp)) / (TANGENTIAL_FACTOR * max_correction), 1.0)
     return compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
