@@ -26,6 +26,7 @@ KERNELS: dict[str, str] = {
     "ik": "kinestat.serial._ik_kernels",
     "puma762": "kinestat.serial.puma762._kernels",
     "cycle": "kinestat.serial.puma762._cycle_kernels",
+    "stiffness": "kinestat.parallel._stiffness_kernels",
     "platform": "kinestat.parallel._fk_kernels",
 }
 NOTICE = "compiling kernels (first run only)…"
@@ -107,6 +108,14 @@ def _warm_cycle() -> None:
                  np.array([0.0, 0.0, 1.0]), 1e-3, 0.05, 1e-4, 0)
 
 
+def _warm_stiffness() -> None:
+    from kinestat.io.library import prototype  # lazy: start-up
+    from kinestat.parallel.stiffness import stiffness_axis_trusted  # lazy: start-up (numba)
+
+    p = prototype()
+    stiffness_axis_trusted(p, p.home_pose)
+
+
 def _warm_platform() -> None:
     from kinestat.io.library import prototype  # lazy: start-up
     from kinestat.parallel.fk import fk_list  # lazy: start-up (numba)
@@ -117,7 +126,7 @@ def _warm_platform() -> None:
 
 
 _WARM = {"serial": _warm_serial, "ik": _warm_ik, "puma762": _warm_puma762,
-         "cycle": _warm_cycle, "platform": _warm_platform}
+         "cycle": _warm_cycle, "stiffness": _warm_stiffness, "platform": _warm_platform}
 
 
 def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:

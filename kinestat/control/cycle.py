@@ -6,7 +6,9 @@ needs more than once at the measured pose — the platform's loaded stiffness ``
 ``[δφ; δx_O]``, Vibhute eq. 2-17), the tool tip in the base and fixed frames, the tip's
 translational compliance ``C_tip`` (eq. 2-16/2-17) and the leg directions — each computed on
 first use by the same functions the callers used before (so the values are the same, bit for
-bit). :func:`cycle_data` finds a measurement's data (a weak map keyed by the measurement, so
+bit), except K: compiled for the one pose
+(:func:`kinestat.parallel.stiffness.stiffness_axis_trusted`), equal to the NumPy formulation
+to rounding. :func:`cycle_data` finds a measurement's data (a weak map keyed by the measurement, so
 that :func:`~kinestat.control.controller.decide`, the envelope's prediction and the follow
 task's control law share it without passing it around, and it goes with the measurement).
 """

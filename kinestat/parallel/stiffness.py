@@ -32,9 +32,12 @@ so K is symmetric exactly when the platform is unloaded. Finite differences of
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from kinestat.errors import InputError, UnreachableError
+from kinestat.parallel import _stiffness_kernels as _sk
 from kinestat.parallel._refine import apply_twist
 from kinestat.parallel.legs import as_pose, leg_directions_trusted
 from kinestat.parallel.platform import Platform
@@ -101,11 +104,30 @@ def stiffness(platform: Platform, pose, forces=None, *, twist_order: str = "ray"
 
 
 def stiffness_axis_trusted(platform: Platform, T: np.ndarray) -> np.ndarray:
-    """``stiffness(platform, T, twist_order="axis")`` (the springs' own tensions) at a pose
-    ``T`` (4, 4) the caller has checked: no validation, the same values (the hot path of a
-    control cycle)."""
-    parts = _terms(platform, T)
-    return _swap(parts["elastic"] + parts["geometric"] + parts["load"])
+    """``stiffness(platform, T, twist_order="axis")`` (the springs' own tensions) at one pose
+    ``T`` (4, 4) the caller has checked, compiled
+    (:func:`kinestat.parallel._stiffness_kernels.stiffness_axis_one`, the hot path of a control
+    cycle): no validation; equal to :func:`stiffness` to rounding (~1e-15 relative)."""
+    K = np.empty((6, 6))
+    if _sk.stiffness_axis_one(*_platform_arrays(platform), np.array(T, dtype=float), K):
+        return K
+    parts = _terms(platform, np.asarray(T, dtype=float))  # raises: a leg of zero length
+    return _swap(parts["elastic"] + parts["geometric"] + parts["load"])  # pragma: no cover
+
+
+_ARRAYS: dict[int, tuple] = {}
+
+
+def _platform_arrays(platform: Platform) -> tuple:
+    """The platform's base points, top points, springs and free lengths as writeable C arrays
+    (the kernel compiles for one array type), made once per platform."""
+    a = _ARRAYS.get(id(platform))
+    if a is None:
+        a = _ARRAYS[id(platform)] = tuple(
+            np.array(v, dtype=float) for v in (platform.base_points, platform.top_points,
+                                               platform.stiffness, platform.free_lengths))
+        weakref.finalize(platform, _ARRAYS.pop, id(platform), None)
+    return a
 
 
 def tip_compliance(platform: Platform, pose, tip, *, stiffness_axis=None) -> np.ndarray:

@@ -68,13 +68,15 @@ def _same_command(a, b) -> None:
     if a.axis_counts is None:
         assert b.axis_counts is None
         return
-    assert np.array_equal(a.axis_counts, b.axis_counts)
+    assert np.array_equal(a.axis_counts, b.axis_counts)  # the command sent: identical
     assert np.array_equal(a.q, b.q)
+    # the stiffness is compiled on the fast path (equal to rounding), and so are what follows
+    # from it: the target (through the Newton step / the twist of compliance), the prediction
     for x, y in ((a.target.tool_point, b.target.tool_point), (a.target.s6, b.target.s6),
                  (a.prediction.force, b.prediction.force),
                  (a.prediction.deflections, b.prediction.deflections),
                  (a.prediction.top_pose, b.prediction.top_pose)):
-        np.testing.assert_array_equal(x, y)
+        np.testing.assert_allclose(x, y, rtol=1e-9, atol=1e-9)
 
 
 @pytest.mark.parametrize("name", list(SCENARIOS))
@@ -146,6 +148,29 @@ def test_selection_matches_select_including_wrist_singular_poses(model_and_count
         fast = puma762.select_axis_one(f.tool_point, f.s6, f.a67, model.tool_point_6, q_now,
                                        model.limits_deg)
         np.testing.assert_array_equal(fast, ref)
+
+
+def test_cross3_is_numpy_cross_bit_for_bit():
+    from kinestat.control.cycle import cross3
+
+    rng = np.random.default_rng(5)
+    for _ in range(2000):
+        a, b = rng.normal(size=(2, 3)) * 10.0 ** rng.uniform(-6, 6, (2, 1))
+        np.testing.assert_array_equal(cross3(a, b), np.cross(a, b))
+
+
+def test_compiled_stiffness_equals_the_numpy_formulation(model_and_counts):
+    from kinestat.parallel.stiffness import stiffness, stiffness_axis_trusted
+    from kinestat.spatial.se3 import twist_exp
+
+    model, rng = model_and_counts
+    plat = model.platform
+    for _ in range(200):
+        T = twist_exp(np.concatenate([rng.normal(0, 0.03, 3), rng.normal(0, 2, 3)])) \
+            @ plat.home_pose
+        K = stiffness(plat, T, twist_order="axis")
+        np.testing.assert_allclose(stiffness_axis_trusted(plat, T), K, rtol=0,
+                                   atol=1e-13 * np.max(np.abs(K)))
 
 
 def test_flange_pose_is_the_forward_analysis_bit_for_bit():
