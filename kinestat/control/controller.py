@@ -342,24 +342,41 @@ _ZERO_OFFSETS = tuple(np.zeros(1, dtype=np.int64) for _ in range(5))
 _VERNIER_SCALES = (1e-3, 0.05, math.radians(0.01))
 
 
+def _grid_rows(offsets) -> tuple[np.ndarray, int]:
+    """The count offsets of :func:`_vernier_tables`' rows (axes 1-3's values in the first
+    rows, the wrist's n4·n5 combinations in the last) and the grid's centre index; made once
+    per offsets tuple."""
+    got = _GRID_ROWS.get(id(offsets))
+    if got is None:
+        n4, n5 = len(offsets[3]), len(offsets[4])
+        rows = max(len(o) for o in offsets[:3]) + n4 * n5
+        off = np.zeros((rows, 6), dtype=np.int64)
+        for j in range(3):
+            off[:len(offsets[j]), j] = offsets[j]
+        off[rows - n4 * n5:, 3] = np.repeat(offsets[3], n5)
+        off[rows - n4 * n5:, 4] = np.tile(offsets[4], n4)
+        centre = 0
+        for o in offsets:
+            centre = centre * len(o) + int(np.flatnonzero(o == 0)[0])
+        got = _GRID_ROWS[id(offsets)] = (off, centre)
+    return got
+
+
+_GRID_ROWS: dict[int, tuple[np.ndarray, int]] = {}
+
+
 def _vernier_tables(model: ControlModel, c0: np.ndarray, counts_now, offsets) -> tuple:
     """cos/sin of the joint angles of the vernier's grid around the counts ``c0`` (axes 1-3,
     4; axis 5 for each axis-4 value, with the axis-5 rounding the 4 → 5 compensation leaves;
     axis 6 as is), computed as :func:`axis_counts_to_q` computes them for the whole grid."""
     n4, n5 = len(offsets[3]), len(offsets[4])
-    rows = max(len(o) for o in offsets[:3]) + n4 * n5
-    cand = np.repeat(c0[None, :], rows, axis=0)
-    for j in range(3):
-        cand[:len(offsets[j]), j] += offsets[j]
-    wrist = np.repeat(c0[None, :], n4 * n5, axis=0)
-    wrist[:, 3] += np.repeat(offsets[3], n5)
-    wrist[:, 4] += np.tile(offsets[4], n4)
-    cand[rows - n4 * n5:] = wrist
+    off, _ = _grid_rows(offsets)
+    cand = c0 + off
     phys = cand.astype(float)
     phys[:, 4] += _axis5_residual(model, cand, np.asarray(counts_now))
     q = axis_counts_to_q(model, phys)
     cs = np.stack([np.cos(q), np.sin(q)], axis=-1)  # (rows, 6, 2)
-    w = cs[rows - n4 * n5:]
+    w = cs[len(off) - n4 * n5:]
     return (np.ascontiguousarray(cs[:len(offsets[0]), 0]),
             np.ascontiguousarray(cs[:len(offsets[1]), 1]),
             np.ascontiguousarray(cs[:len(offsets[2]), 2]),
@@ -373,10 +390,7 @@ def _vernier_pick(model: ControlModel, target: Target, c0: np.ndarray, counts_no
     """The index (in the grid ``offsets``' row order, :data:`_OFFSETS` for the full grid) of
     the count vector whose tool point best realises ``target`` and its offset along S6 (mm):
     the compiled grid search :func:`kinestat.serial.puma762._cycle_kernels.grid_nearest`."""
-    sizes = [len(o) for o in offsets]
-    centre = 0
-    for o, n in zip(offsets, sizes, strict=True):
-        centre = centre * n + int(np.flatnonzero(o == 0)[0])
+    _, centre = _grid_rows(offsets)
     p6, tp, ts = (np.array(v, dtype=float) for v in (model.tool_point_6, target.tool_point,
                                                       target.s6))  # writeable, C order
     k, along, _ = grid_nearest(*_vernier_tables(model, c0, counts_now, offsets), p6, tp, ts,

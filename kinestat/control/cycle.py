@@ -26,7 +26,7 @@ from kinestat.parallel.legs import leg_directions_trusted
 from kinestat.parallel.stiffness import stiffness_axis_trusted, tip_compliance
 from kinestat.spatial.transforms import apply
 
-__all__ = ["CycleData", "cycle_data", "cross3"]
+__all__ = ["CycleData", "cycle_data", "cross3", "cross_rows"]
 
 
 def cross3(a, b) -> np.ndarray:
@@ -35,6 +35,18 @@ def cross3(a, b) -> np.ndarray:
     a0, a1, a2 = np.asarray(a, dtype=float).tolist()
     b0, b1, b2 = np.asarray(b, dtype=float).tolist()
     return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
+def cross_rows(a, b) -> np.ndarray:
+    """Row-wise ``a × b`` of two (n, 3) arrays: :func:`numpy.cross`'s products and
+    differences, the same values, without its broadcasting set-up."""
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    out = np.empty(a.shape)
+    out[:, 0] = a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1]
+    out[:, 1] = a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2]
+    out[:, 2] = a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0]
+    return out
 
 
 class CycleData:

@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from kinestat.control.cycle import cross3, cycle_data
+from kinestat.control.cycle import cross3, cross_rows, cycle_data
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
@@ -171,7 +171,7 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     D = np.linalg.solve(K, A @ dF + b)  # top twist [δφ; δx_O] relative to the base
     S, _ = data.leg_directions
     Bp = model.platform.base_points
-    dl = np.cross(Bp, S) @ D[:3] + S @ D[3:]
+    dl = cross_rows(Bp, S) @ D[:3] + S @ D[3:]
     force = -(TB_new[:3, :3] @ (F + dF))
     defl = meas.deflections(model) + dl
     top = np.eye(4)

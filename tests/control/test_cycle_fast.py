@@ -150,13 +150,16 @@ def test_selection_matches_select_including_wrist_singular_poses(model_and_count
         np.testing.assert_array_equal(fast, ref)
 
 
-def test_cross3_is_numpy_cross_bit_for_bit():
-    from kinestat.control.cycle import cross3
+def test_cross_helpers_are_numpy_cross_bit_for_bit():
+    from kinestat.control.cycle import cross3, cross_rows
 
     rng = np.random.default_rng(5)
     for _ in range(2000):
         a, b = rng.normal(size=(2, 3)) * 10.0 ** rng.uniform(-6, 6, (2, 1))
         np.testing.assert_array_equal(cross3(a, b), np.cross(a, b))
+    for _ in range(200):
+        a, b = rng.normal(size=(2, 6, 3)) * 10.0 ** rng.uniform(-6, 6, (2, 6, 1))
+        np.testing.assert_array_equal(cross_rows(a, b), np.cross(a, b))
 
 
 def test_compiled_stiffness_equals_the_numpy_formulation(model_and_counts):
