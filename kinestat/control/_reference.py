@@ -26,6 +26,7 @@ from kinestat.control.controller import (
     axis_counts_to_q,
 )
 from kinestat.control.model import ControlModel
+from kinestat.parallel.kinestatic import compose_twist
 from kinestat.parallel.stiffness import stiffness
 from kinestat.serial import puma762
 
@@ -76,12 +77,14 @@ def reference_cycle() -> Iterator[None]:
     """Run :func:`~kinestat.control.controller.decide` and
     :func:`~kinestat.control.follow.decide_follow` on the unoptimised path inside the block:
     the NumPy vernier and selection (:func:`solve_counts_reference`), the NumPy forward
-    analysis for the flange pose, the stiffness recomputed on every use, and SciPy's
-    rotation vector on every motion check. Not thread-safe (it swaps module attributes)."""
+    analysis for the flange pose, the NumPy stiffness recomputed on every use, the batched
+    ``compose_twist`` in the follow law and SciPy's rotation vector on every motion check.
+    Not thread-safe (it swaps module attributes)."""
     saved = [(controller, "_solve_counts", solve_counts_reference),
              (controller, "_flange_pose", lambda q: puma762.forward(q).pose),
              (envelope, "cycle_data", UncachedCycleData),
              (follow, "cycle_data", UncachedCycleData),
+             (follow, "compose_twist_line", compose_twist),
              (envelope, "_rotation_clear", lambda *a: False)]
     old = [(mod, name, getattr(mod, name)) for mod, name, _ in saved]
     try:

@@ -71,7 +71,7 @@ from kinestat.control.envelope import (
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
-from kinestat.parallel.kinestatic import compose_twist
+from kinestat.parallel.kinestatic import compose_twist_line
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
@@ -336,7 +336,7 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     dp = Tc[3:] + cross3(Tc[:3], p)  # the tip's motion under the compliance twist
     scale = max(abs(float(dp @ n)) / max_correction,
                 float(np.linalg.norm(dp)) / (TANGENTIAL_FACTOR * max_correction), 1.0)
-    return compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
+    return compose_twist_line(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked
 
 
 def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:

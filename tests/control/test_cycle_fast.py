@@ -176,6 +176,32 @@ def test_compiled_stiffness_equals_the_numpy_formulation(model_and_counts):
                                    atol=1e-13 * np.max(np.abs(K)))
 
 
+def test_compose_twist_line_is_compose_twist_for_one_contact(model_and_counts):
+    from kinestat.errors import KinestatError
+    from kinestat.parallel.kinestatic import DELTA, compose_twist, compose_twist_line
+
+    model, rng = model_and_counts
+    from kinestat.parallel.stiffness import stiffness
+
+    K = stiffness(model.platform, model.platform.home_pose, twist_order="axis")
+    for i in range(300):
+        n = rng.normal(size=3)
+        n /= np.linalg.norm(n)
+        p = rng.normal(0.0, 50.0, 3)
+        w = np.concatenate([n, np.cross(p, n)])
+        T = rng.normal(size=6)
+        X = np.concatenate([np.zeros(3), n])  # w·ΔX = n·n = 1
+        Tf = T - float(w @ (T @ DELTA)) * X if i % 4 else T  # reciprocal to w, or not
+        dw = rng.normal() * w if i % 5 else rng.normal(size=6)
+        try:
+            ref = compose_twist(K, w, Tf, dw)
+        except KinestatError as exc:
+            with pytest.raises(type(exc)):
+                compose_twist_line(K, w, Tf, dw)
+            continue
+        np.testing.assert_array_equal(compose_twist_line(K, w, Tf, dw), ref)
+
+
 def test_flange_pose_is_the_forward_analysis_bit_for_bit():
     rng = np.random.default_rng(3)
     for _ in range(500):
