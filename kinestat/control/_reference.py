@@ -16,6 +16,7 @@ import math
 from collections.abc import Iterator
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from kinestat.control import controller, cycle, envelope, follow
 from kinestat.control.controller import (
@@ -29,6 +30,7 @@ from kinestat.control.model import ControlModel
 from kinestat.parallel.kinestatic import compose_twist
 from kinestat.parallel.stiffness import stiffness
 from kinestat.serial import puma762
+from kinestat.spatial.se3 import twist_exp
 
 __all__ = ["solve_counts_reference", "vernier_costs_reference", "UncachedCycleData",
            "reference_cycle"]
@@ -78,13 +80,17 @@ def reference_cycle() -> Iterator[None]:
     :func:`~kinestat.control.follow.decide_follow` on the unoptimised path inside the block:
     the NumPy vernier and selection (:func:`solve_counts_reference`), the NumPy forward
     analysis for the flange pose, the NumPy stiffness recomputed on every use, the batched
-    ``compose_twist`` in the follow law and SciPy's rotation vector on every motion check.
+    ``compose_twist`` and ``twist_exp`` in the follow law, SciPy's rotations in the prediction
+    and SciPy's rotation vector on every motion check.
     Not thread-safe (it swaps module attributes)."""
     saved = [(controller, "_solve_counts", solve_counts_reference),
              (controller, "_flange_pose", lambda q: puma762.forward(q).pose),
              (envelope, "cycle_data", UncachedCycleData),
              (follow, "cycle_data", UncachedCycleData),
              (follow, "compose_twist_line", compose_twist),
+             (follow, "twist_exp_one", twist_exp),
+             (envelope, "rotvec_matrix_one",
+              lambda r: Rotation.from_rotvec(r).as_matrix()),
              (envelope, "_rotation_clear", lambda *a: False)]
     old = [(mod, name, getattr(mod, name)) for mod, name, _ in saved]
     try:

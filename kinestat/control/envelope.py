@@ -43,6 +43,7 @@ from kinestat.errors import InputError, SafetyStop
 from kinestat.hardware.platform_spec import MAX_DEFLECTION, MAX_LOAD, MOTION_RANGE
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
 from kinestat.parallel.stiffness import tip_stiffness as platform_tip_stiffness
+from kinestat.spatial.se3 import rotvec_matrix_one
 from kinestat.spatial.transforms import apply, inv, skew
 
 __all__ = [
@@ -175,7 +176,7 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     force = -(TB_new[:3, :3] @ (F + dF))
     defl = meas.deflections(model) + dl
     top = np.eye(4)
-    Rd = Rotation.from_rotvec(D[:3]).as_matrix()
+    Rd = rotvec_matrix_one(D[:3])  # Rotation.from_rotvec(·).as_matrix(), to rounding
     top[:3, :3] = Rd @ meas.top_pose[:3, :3]
     top[:3, 3] = Rd @ meas.top_pose[:3, 3] + D[3:]
     return Prediction(force=force, deflections=defl, tip_motion=apply(Tn @ inv(meas.flange_pose),

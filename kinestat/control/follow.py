@@ -75,7 +75,7 @@ from kinestat.parallel.kinestatic import compose_twist_line
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
-from kinestat.spatial.se3 import twist_exp
+from kinestat.spatial.se3 import twist_exp, twist_exp_one
 from kinestat.spatial.transforms import apply, inv, skew
 
 __all__ = [
@@ -340,7 +340,7 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
 
 
 def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
-    TB_new = meas.base_pose @ twist_exp(T_base)
+    TB_new = meas.base_pose @ twist_exp_one(T_base)
     T6 = TB_new @ inv(model.mount)
     return Target(apply(T6, model.tool_point_6), T6[:3, 2].copy(), T6[:3, 0].copy())
 

@@ -202,6 +202,21 @@ def test_compose_twist_line_is_compose_twist_for_one_contact(model_and_counts):
         np.testing.assert_array_equal(compose_twist_line(K, w, Tf, dw), ref)
 
 
+def test_single_twist_and_rotation_vector_agree_with_the_batched_ones():
+    from scipy.spatial.transform import Rotation
+
+    from kinestat.spatial.se3 import rotvec_matrix_one, twist_exp, twist_exp_one
+
+    rng = np.random.default_rng(7)
+    for i in range(3000):
+        w = rng.normal(size=3) * 10.0 ** rng.uniform(-9, 0.5) if i % 10 else np.zeros(3)
+        V = np.concatenate([w, rng.normal(size=3) * 10.0 ** rng.uniform(-3, 3)])
+        scale = max(1.0, float(np.max(np.abs(V[3:]))))
+        np.testing.assert_allclose(twist_exp_one(V), twist_exp(V), rtol=0, atol=4e-15 * scale)
+        np.testing.assert_allclose(rotvec_matrix_one(w), Rotation.from_rotvec(w).as_matrix(),
+                                   rtol=0, atol=4e-15)
+
+
 def test_flange_pose_is_the_forward_analysis_bit_for_bit():
     rng = np.random.default_rng(3)
     for _ in range(500):
