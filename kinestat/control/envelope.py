@@ -42,7 +42,6 @@ from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
 from kinestat.hardware.platform_spec import MAX_DEFLECTION, MAX_LOAD, MOTION_RANGE
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
-from kinestat.parallel.stiffness import tip_stiffness as platform_tip_stiffness
 from kinestat.spatial.se3 import rotvec_matrix_one
 from kinestat.spatial.transforms import apply, inv, skew
 
@@ -139,9 +138,9 @@ def tip_stiffness(model: ControlModel, meas: Measurement) -> np.ndarray:
     (:func:`kinestat.parallel.stiffness.tip_stiffness`): moving the flange by ``δ`` (at the
     tip) with the tip held changes the tool's force by ``K_tip δ``.
     """
-    d = cycle_data(model, meas)
-    return platform_tip_stiffness(model.platform, meas.top_pose, d.tip_base,
-                                  meas.base_pose[:3, :3], stiffness_axis=d.K)
+    R = np.asarray(meas.base_pose, dtype=float)[:3, :3]
+    # platform_tip_stiffness's R C_tip⁻¹ Rᵀ, with the cycle's C_tip (shared with predict)
+    return R @ np.linalg.inv(cycle_data(model, meas).C_tip) @ np.swapaxes(R, -1, -2)
 
 
 def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Prediction:
