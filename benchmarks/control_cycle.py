@@ -14,7 +14,7 @@ over the moving cycles of the median of repeats; every call gets a fresh copy of
 Measurement (no per-cycle data is reused between calls). The kernels are compiled (or loaded
 from the cache) before anything is timed; that first load is reported on its own.
 
-    .venv/bin/python benchmarks/control_cycle.py [--json] [--repeat N]
+    .venv/bin/python benchmarks/control_cycle.py [--json] [--repeat N] [--clock wall|cpu]
 """
 
 from __future__ import annotations
@@ -83,11 +83,15 @@ def _fresh(args: tuple) -> tuple:
     return tuple(copy.copy(a) if isinstance(a, Measurement) else a for a in args)
 
 
+CLOCKS = {"wall": time.perf_counter, "cpu": time.thread_time}
+_clock = CLOCKS["wall"]
+
+
 def _once(fn, args) -> float:
     args = _fresh(args)
-    t0 = time.perf_counter()
+    t0 = _clock()
     fn(*args)
-    return time.perf_counter() - t0
+    return _clock() - t0
 
 
 def _paired(fast, ref, pairs, repeat: int) -> tuple[float, float, float, float]:
@@ -162,19 +166,25 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--repeat", type=int, default=5, help="calls per cycle (median)")
+    ap.add_argument("--clock", choices=tuple(CLOCKS), default="wall",
+                    help="wall time (default) or this thread's CPU time (leaves out the time "
+                         "other processes hold the CPU on a shared machine)")
     args = ap.parse_args(argv)
+    global _clock
+    _clock = CLOCKS[args.clock]
     t0 = time.perf_counter()
     warm_kernels()  # compile (first run) or load from the cache: never part of a cycle's time
     first_load_s = time.perf_counter() - t0
     rows = [_task_row(task, args.repeat) for task in ("press", "follow")]
     meta = {"date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
             "machine": f"{platform.machine()}, {os.cpu_count()} cores",
-            "python": platform.python_version(), "kernel_load_s": first_load_s}
+            "python": platform.python_version(), "kernel_load_s": first_load_s,
+            "clock": args.clock, "load_average": os.getloadavg()[0]}
     if args.json:
         print(json.dumps({"meta": meta, "tasks": rows}, indent=2))
         return 0
-    print(f"{meta['date']}, {meta['machine']}; kernels compiled/loaded first in "
-          f"{first_load_s:.1f} s (not timed)")
+    print(f"{meta['date']}, {meta['machine']}, load average {meta['load_average']:.1f}, "
+          f"{args.clock} clock; kernels compiled/loaded first in {first_load_s:.1f} s (not timed)")
     print("µs per cycle (median over the moving cycles), fast path vs reference path "
           "(same run, alternating)")
     print(f"{'task':7s} {'cycles':>6s} {'decide+IK':>10s} {'reference':>10s} {'×':>5s} "
