@@ -4,23 +4,33 @@ Records every (state, measurement) pair of a run on the in-process simulated cel
 default thesis cell: 5° tilted plane, thesis calibration and sensor), then times the decision
 function on each recorded pair (``decide`` for the press task, ``decide_follow`` for a 50 mm
 follow run; both include the closed-form reverse analysis, the vernier's rounding to counts and
-the envelope's prediction). Also times the parts: the reverse analysis + vernier alone
-(``_solve_counts``), the measurement chain (``measure``, not part of the decision), and the
-decisions without the vernier. Figures are medians over cycles of the median of repeats.
+the envelope's prediction), on the fast path and — side by side, alternating, in the same run —
+on the unoptimised reference path (:func:`kinestat.control._reference.reference_cycle`: the
+NumPy vernier and selection, the stiffness recomputed on every use, SciPy's rotation vector in
+every motion check). Also times the parts: the reverse analysis + selection + vernier
+(``_solve_counts``), the envelope's prediction (``predict``), the decision without the
+vernier, and the measurement chain (``measure``, not part of the decision). Figures are medians
+over the moving cycles of the median of repeats; every call gets a fresh copy of its
+Measurement (no per-cycle data is reused between calls). The kernels are compiled (or loaded
+from the cache) before anything is timed; that first load is reported on its own.
 
-    .venv/bin/python benchmarks/control_cycle.py [--json]
+    .venv/bin/python benchmarks/control_cycle.py [--json] [--repeat N] [--clock wall|cpu]
 """
 
 from __future__ import annotations
 
 import argparse
+import copy
 import functools
 import json
+import os
+import platform
 import statistics
 import sys
 import tempfile
 import time
 from dataclasses import replace
+from datetime import UTC, datetime
 from pathlib import Path
 
 import numpy as np
@@ -29,13 +39,22 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from kinestat.app.control_run import ControlRequest, SimulatedCell, prepare_control  # noqa: E402
 from kinestat.app.sim_cell import InProcessIO, start_counts  # noqa: E402
-from kinestat.control.controller import THESIS_FORCE_DIRECTION, _solve_counts, decide  # noqa: E402
+from kinestat.cli._compile import warm_kernels  # noqa: E402
+from kinestat.control._reference import reference_cycle, solve_counts_reference  # noqa: E402
+from kinestat.control.controller import (  # noqa: E402
+    THESIS_FORCE_DIRECTION,
+    _flange_pose,
+    _solve_counts,
+    decide,
+)
+from kinestat.control.envelope import predict  # noqa: E402
 from kinestat.control.follow import decide_follow  # noqa: E402
 from kinestat.control.log import CycleLog  # noqa: E402
 from kinestat.control.loop import run  # noqa: E402
-from kinestat.control.wrench import measure  # noqa: E402
+from kinestat.control.wrench import Measurement, measure  # noqa: E402
 
 START = np.array([-400.0, 800.0, -100.0])
+GOAL_US = 200.0
 
 
 def _record(task: str) -> tuple:
@@ -58,56 +77,129 @@ def _record(task: str) -> tuple:
     return prep, pairs, rep
 
 
-def _median_per_call(fn, pairs, repeat: int = 5) -> float:
+def _fresh(args: tuple) -> tuple:
+    """The call's arguments with a new Measurement object (same values), so that no per-cycle
+    data cached for the measurement (:func:`kinestat.control.cycle.cycle_data`) is reused."""
+    return tuple(copy.copy(a) if isinstance(a, Measurement) else a for a in args)
+
+
+CLOCKS = {"wall": time.perf_counter, "cpu": time.thread_time}
+_clock = CLOCKS["wall"]
+
+
+def _once(fn, args) -> float:
+    args = _fresh(args)
+    t0 = _clock()
+    fn(*args)
+    return _clock() - t0
+
+
+def _paired(fast, ref, pairs, repeat: int) -> tuple[float, float, float, float]:
+    """Median over ``pairs`` of the median of ``repeat`` calls, for ``fast`` and, alternating
+    with it (the same machine load), ``ref`` on the reference path; then the same with the
+    best (least) of the repeats instead of their median (less sensitive to other processes on
+    a shared machine); seconds."""
+    per_fast, per_ref, best_fast, best_ref = [], [], [], []
+    for p in pairs:
+        _once(fast, p)
+        with reference_cycle():
+            _once(ref, p)
+        tf, tr = [], []
+        for _ in range(repeat):
+            tf.append(_once(fast, p))
+            with reference_cycle():
+                tr.append(_once(ref, p))
+        per_fast.append(statistics.median(tf))
+        per_ref.append(statistics.median(tr))
+        best_fast.append(min(tf))
+        best_ref.append(min(tr))
+    return (statistics.median(per_fast), statistics.median(per_ref),
+            statistics.median(best_fast), statistics.median(best_ref))
+
+
+def _single(fn, pairs, repeat: int) -> float:
     per = []
     for p in pairs:
-        fn(*p)  # warm-up
-        ts = []
-        for _ in range(repeat):
-            t0 = time.perf_counter()
-            fn(*p)
-            ts.append(time.perf_counter() - t0)
-        per.append(statistics.median(ts))
+        _once(fn, p)
+        per.append(statistics.median(_once(fn, p) for _ in range(repeat)))
     return statistics.median(per)
+
+
+def _task_row(task: str, repeat: int) -> dict:
+    prep, pairs, rep = _record(task)
+    model = prep.config.model
+    if task == "follow":
+        fc = prep.follow
+        full = functools.partial(decide_follow, fc)
+        plain = functools.partial(decide_follow, replace(fc, base=replace(fc.base, vernier=False)))
+    else:
+        full = functools.partial(decide, prep.config)
+        plain = functools.partial(decide, replace(prep.config, vernier=False))
+    moving = []
+    for s, m in pairs:
+        cmd = full(s, m)[0]
+        if cmd.kind == "move":
+            moving.append((s, m, cmd))
+    decisions = [(s, m) for s, m, _ in moving]
+    targets = [(c.target, m.q, s.axis_counts) for s, m, c in moving]
+    poses = [(m, _flange_pose(c.q)) for s, m, c in moving]
+    t_full, t_full_ref, b_full, b_full_ref = _paired(full, full, decisions, repeat)
+    t_ik, t_ik_ref, *_ = _paired(lambda t, q, c: _solve_counts(model, t, q, c, True),
+                             lambda t, q, c: solve_counts_reference(model, t, q, c, True),
+                             targets, repeat)
+    t_pred, t_pred_ref, *_ = _paired(lambda m, T: predict(model, m, T),
+                                 lambda m, T: predict(model, m, T), poses, repeat)
+    t_plain = _single(plain, decisions, repeat)
+    t_meas = _single(lambda s, m: measure(model, m.q, m.counts, s.top_pose), decisions, repeat)
+    return {"task": task, "cycles": len(pairs), "moves_timed": len(moving),
+            "decide_us": 1e6 * t_full, "reference_decide_us": 1e6 * t_full_ref,
+            "speedup": t_full_ref / t_full,
+            "decide_best_us": 1e6 * b_full, "reference_decide_best_us": 1e6 * b_full_ref,
+            "ik_vernier_us": 1e6 * t_ik, "reference_ik_vernier_us": 1e6 * t_ik_ref,
+            "predict_us": 1e6 * t_pred, "reference_predict_us": 1e6 * t_pred_ref,
+            "rest_us": 1e6 * max(t_full - t_ik - t_pred, 0.0),
+            "decide_no_vernier_us": 1e6 * t_plain, "measure_us": 1e6 * t_meas,
+            "goal_us": GOAL_US, "converged": rep.converged}
 
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--json", action="store_true")
+    ap.add_argument("--repeat", type=int, default=5, help="calls per cycle (median)")
+    ap.add_argument("--clock", choices=tuple(CLOCKS), default="wall",
+                    help="wall time (default) or this thread's CPU time (leaves out the time "
+                         "other processes hold the CPU on a shared machine)")
     args = ap.parse_args(argv)
-    rows = []
-    for task in ("press", "follow"):
-        prep, pairs, rep = _record(task)
-        model = prep.config.model
-        if task == "follow":
-            fc = prep.follow
-            nov = replace(fc, base=replace(fc.base, vernier=False))
-            full = functools.partial(decide_follow, fc)
-            plain = functools.partial(decide_follow, nov)
-        else:
-            full = functools.partial(decide, prep.config)
-            plain = functools.partial(decide, replace(prep.config, vernier=False))
-        moving = [(s, m) for s, m in pairs if full(s, m)[0].kind == "move"]
-        targets = [(full(s, m)[0].target, m.q, s.axis_counts) for s, m in moving]
-        t_full = _median_per_call(full, moving)
-        t_plain = _median_per_call(plain, moving)
-        t_ik = _median_per_call(
-            lambda t, q, c, model=model: _solve_counts(model, t, q, c, True), targets)
-        t_meas = _median_per_call(
-            lambda s, m, model=model: measure(model, m.q, m.counts, s.top_pose), moving)
-        rows.append({"task": task, "cycles": len(pairs), "moves_timed": len(moving),
-                     "decide_us": 1e6 * t_full, "decide_no_vernier_us": 1e6 * t_plain,
-                     "ik_vernier_us": 1e6 * t_ik, "measure_us": 1e6 * t_meas,
-                     "converged": rep.converged})
+    global _clock
+    _clock = CLOCKS[args.clock]
+    t0 = time.perf_counter()
+    warm_kernels()  # compile (first run) or load from the cache: never part of a cycle's time
+    first_load_s = time.perf_counter() - t0
+    rows = [_task_row(task, args.repeat) for task in ("press", "follow")]
+    meta = {"date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
+            "machine": f"{platform.machine()}, {os.cpu_count()} cores",
+            "python": platform.python_version(), "kernel_load_s": first_load_s,
+            "clock": args.clock, "load_average": os.getloadavg()[0]}
     if args.json:
-        print(json.dumps(rows, indent=2))
+        print(json.dumps({"meta": meta, "tasks": rows}, indent=2))
         return 0
-    print(f"{'task':8s} {'cycles':>6s} {'decide+IK':>11s} {'no vernier':>11s} "
-          f"{'IK+vernier':>11s} {'measure':>9s}   (µs per cycle, median)")
+    print(f"{meta['date']}, {meta['machine']}, load average {meta['load_average']:.1f}, "
+          f"{args.clock} clock; kernels compiled/loaded first in {first_load_s:.1f} s (not timed)")
+    print("µs per cycle (median over the moving cycles), fast path vs reference path "
+          "(same run, alternating)")
+    print(f"{'task':7s} {'cycles':>6s} {'decide+IK':>10s} {'reference':>10s} {'×':>5s} "
+          f"{'best-of':>8s} {'(ref)':>7s} "
+          f"{'IK+vernier':>11s} {'(ref)':>7s} {'prediction':>11s} {'(ref)':>7s} {'rest':>6s} "
+          f"{'no vernier':>11s} {'measure':>8s}")
     for r in rows:
-        print(f"{r['task']:8s} {r['cycles']:6d} {r['decide_us']:11.0f} "
-              f"{r['decide_no_vernier_us']:11.0f} {r['ik_vernier_us']:11.0f} "
-              f"{r['measure_us']:9.0f}")
+        print(f"{r['task']:7s} {r['cycles']:6d} {r['decide_us']:10.0f} "
+              f"{r['reference_decide_us']:10.0f} {r['speedup']:5.1f} {r['decide_best_us']:8.0f} "
+              f"{r['reference_decide_best_us']:7.0f} {r['ik_vernier_us']:11.0f} "
+              f"{r['reference_ik_vernier_us']:7.0f} {r['predict_us']:11.0f} "
+              f"{r['reference_predict_us']:7.0f} {r['rest_us']:6.0f} "
+              f"{r['decide_no_vernier_us']:11.0f} {r['measure_us']:8.0f}")
+    print(f"goal: {GOAL_US:.0f} µs per cycle (decide + IK); best-of: the least of the repeats "
+          "per cycle (median over cycles)")
     return 0
 
 

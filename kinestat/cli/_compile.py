@@ -25,6 +25,8 @@ KERNELS: dict[str, str] = {
     "serial": "kinestat.serial._kernels",
     "ik": "kinestat.serial._ik_kernels",
     "puma762": "kinestat.serial.puma762._kernels",
+    "cycle": "kinestat.serial.puma762._cycle_kernels",
+    "stiffness": "kinestat.parallel._stiffness_kernels",
     "platform": "kinestat.parallel._fk_kernels",
 }
 #: kernel groups compiled on demand by the command that uses them (not by ``kinestat warmup``)
@@ -95,6 +97,30 @@ def _warm_puma762() -> None:
     puma762.reverse([725.0, 190.0, 650.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
 
 
+def _warm_cycle() -> None:
+    """The control cycle's single-pose kernels, with the argument types the controller passes
+    (kinestat.control.controller._solve_counts and move_command)."""
+    from kinestat.serial import puma762  # lazy: start-up (numba)
+    from kinestat.serial.puma762._cycle_kernels import grid_nearest  # lazy: start-up (numba)
+
+    q = np.full(6, 0.3)
+    p6 = np.array([0.0, 0.0, 235.0])
+    f = puma762.forward(q, p6)
+    puma762.select_axis_one(f.tool_point, f.s6, f.a67, p6, q, puma762.AXIS_LIMITS_DEG)
+    puma762.pose_one(q)
+    cs = np.zeros((1, 2))  # cos/sin tables (vernier.vernier_tables' layouts)
+    grid_nearest(cs, cs, cs, cs, np.zeros((1, 1, 2)), np.zeros(2), p6.copy(), p6.copy(),
+                 np.array([0.0, 0.0, 1.0]), 1e-3, 0.05, 1e-4, 0)
+
+
+def _warm_stiffness() -> None:
+    from kinestat.io.library import prototype  # lazy: start-up
+    from kinestat.parallel.stiffness import stiffness_axis_trusted  # lazy: start-up (numba)
+
+    p = prototype()
+    stiffness_axis_trusted(p, p.home_pose)
+
+
 def _warm_platform() -> None:
     from kinestat.io.library import prototype  # lazy: start-up
     from kinestat.parallel.fk import fk_list  # lazy: start-up (numba)
@@ -105,7 +131,7 @@ def _warm_platform() -> None:
 
 
 _WARM = {"serial": _warm_serial, "ik": _warm_ik, "puma762": _warm_puma762,
-         "platform": _warm_platform}
+         "cycle": _warm_cycle, "stiffness": _warm_stiffness, "platform": _warm_platform}
 
 
 def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:

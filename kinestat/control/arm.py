@@ -72,6 +72,11 @@ class Arm(Protocol):
         """The :class:`ToolFrame`-like forward analysis (``tool_point, s6, a67, pose``)."""
         ...
 
+    def flange_pose(self, q) -> np.ndarray:
+        """The end frame's pose ``(4, 4)`` of one joint vector ``(6,)`` (the envelope's
+        prediction)."""
+        ...
+
     def ik_all(self, T_base_end) -> IKAllResult:
         """Every solution for poses of the end frame ``(…, 4, 4)``."""
         ...
@@ -115,9 +120,16 @@ class Puma762Arm:
 
         return ik_all(self.model, T_base_end, method="puma762")
 
+    def flange_pose(self, q) -> np.ndarray:
+        """``F_6T`` (4, 4) of one joint vector, compiled (bit-identical to ``forward``'s)."""
+        return puma762.pose_one(q)
+
     def solve_axis(self, tool_point, s6, a67, tool_point_6, q_now, limits_deg) -> np.ndarray:
-        res = puma762.reverse(tool_point, s6, a67, tool_point_6)
-        return puma762.select(res, q_now, limits_deg).axis
+        # reverse analysis + least-motion selection in one compiled pass (equal to
+        # puma762.select(puma762.reverse(...), q_now, limits_deg).axis; tests/control/
+        # test_cycle_fast.py replays recorded runs through both)
+        return puma762.select_axis_one(tool_point, s6, a67, tool_point_6,
+                                       np.asarray(q_now, dtype=float), limits_deg)
 
 
 THESIS_ARM = Puma762Arm()
@@ -182,6 +194,9 @@ class ChainArm:
         p = np.einsum("...ij,j->...i", T[..., :3, :3], np.asarray(tool_point_6, float))
         return ToolFrame(tool_point=p + T[..., :3, 3], s6=T[..., :3, 2].copy(),
                          a67=T[..., :3, 0].copy(), pose=T)
+
+    def flange_pose(self, q) -> np.ndarray:
+        return fk(self.model, np.asarray(q, dtype=float))
 
     def ik_all(self, T_base_end) -> IKAllResult:
         from kinestat.serial.analytic import ik_all  # lazy: scipy.linalg, ~0.3 s at import

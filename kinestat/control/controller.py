@@ -38,7 +38,6 @@ towards the target force makes it precise).
 
 from __future__ import annotations
 
-import itertools
 import math
 from dataclasses import dataclass, field, replace
 from typing import Literal, get_args
@@ -46,7 +45,9 @@ from typing import Literal, get_args
 import numpy as np
 
 from kinestat.control.approach import approach_waypoints, check_approach
+from kinestat.control.arm import Puma762Arm
 from kinestat.control.ceilings import MAX_ITERATIONS
+from kinestat.control.cycle import cross3
 from kinestat.control.envelope import (
     Envelope,
     Prediction,
@@ -57,9 +58,21 @@ from kinestat.control.envelope import (
     tip_stiffness,
 )
 from kinestat.control.model import ControlModel
+from kinestat.control.vernier import (
+    AXIS_OFFSETS,
+    OFFSETS,
+    ZERO_OFFSETS,
+    axis5_residual,
+    axis_counts_to_q,
+    q_to_axis_counts,
+    vernier_generic,
+    vernier_pick,
+)
 from kinestat.control.wrench import Estimator, Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
-from kinestat.hardware.puma762_axes import round_half_away
+
+# names this module had before the vernier moved out (used by tests and the reference path)
+_OFFSETS, _axis5_residual, _q_to_axis_counts = OFFSETS, axis5_residual, q_to_axis_counts
 
 __all__ = [
     "THESIS_FORCE_DIRECTION",
@@ -309,62 +322,43 @@ class Command:
     waypoints: tuple[np.ndarray, ...] = ()
 
 
-# -- joint-space helpers ------------------------------------------------------------------------
-def axis_counts_to_q(model: ControlModel, counts) -> np.ndarray:
-    """Joint angles (radians) from robot axis counts (``axis = counts · resolution``)."""
-    deg = np.asarray(counts, dtype=float) * model.axis_deg_per_count
-    return model.arm.q_from_axis(np.radians(deg))
-
-
-def _q_to_axis_counts(model: ControlModel, axis_rad) -> np.ndarray:
-    return round_half_away(np.degrees(axis_rad) / model.axis_deg_per_count)
-
-
-def _axis5_residual(model: ControlModel, counts: np.ndarray, counts_now: np.ndarray) -> np.ndarray:
-    """Axis-5 counts left over by the 4 → 5 compensation (physical − commanded target)."""
-    kappa = model.coupling * (counts[..., 3] - counts_now[3])
-    return round_half_away(-kappa) + kappa
-
-
-# Vernier candidates: ±4 counts on axes 1-3 (they move the tool point along S6 by ~1-15 µm per
-# count, so their combinations resolve ~0.1 µm), ±1 on the wrist axes 4-5, axis 6 as is (it
-# turns the tool about its own axis).
-_OFFSETS = np.array([(a, b, c, d, e, 0) for a, b, c in itertools.product(range(-4, 5), repeat=3)
-                     for d, e in itertools.product((-1, 0, 1), repeat=2)], dtype=np.int64)
-
-
+# -- joint-space helpers: kinestat.control.vernier --------------------------------------------
 def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
                   vernier: bool) -> tuple[np.ndarray, float]:
     """Reverse analysis, selection within limits, rounding to counts (with the vernier).
 
     Returns (counts, residual along S6 in mm of the chosen counts). Raises UnreachableError or
-    JointLimitError."""
+    JointLimitError. For the thesis's PUMA 762 the vernier's search runs compiled
+    (:func:`vernier_pick`; the NumPy formulation it reproduces is
+    :func:`kinestat.control._reference.solve_counts_reference`); any other arm takes the same
+    search in NumPy (:func:`vernier_generic`)."""
     axis = model.arm.solve_axis(target.tool_point, target.s6, target.a67, model.tool_point_6,
-                                q_now, model.limits_deg)
-    c0 = _q_to_axis_counts(model, axis)
-    cand = c0 + _OFFSETS if vernier else c0[None, :]
-    phys = cand.astype(float)
-    phys[:, 4] += _axis5_residual(model, cand, counts_now)
-    fwd = model.arm.forward(axis_counts_to_q(model, phys), model.tool_point_6)
-    d = fwd.tool_point - target.tool_point
-    along = d @ target.s6
-    lateral = np.linalg.norm(d - along[:, None] * target.s6, axis=1)
-    tilt = np.arccos(np.clip(fwd.s6 @ target.s6, -1.0, 1.0))
-    cost = (along / 1e-3) ** 2 + (lateral / 0.05) ** 2 + (tilt / math.radians(0.01)) ** 2
-    k = int(np.argmin(cost))
-    return cand[k], float(along[k])
+                                np.asarray(q_now, dtype=float), model.limits_deg)
+    c0 = q_to_axis_counts(model, axis)
+    if not isinstance(model.arm, Puma762Arm):
+        return vernier_generic(model, target, c0, counts_now, vernier)
+    if not vernier:
+        k, along = vernier_pick(model, target, c0, counts_now, ZERO_OFFSETS)
+        return c0, along
+    k, along = vernier_pick(model, target, c0, counts_now, AXIS_OFFSETS)
+    return c0 + OFFSETS[k], along
+
+
+def _flange_pose(model: ControlModel, q) -> np.ndarray:
+    """``F_6T`` of the joint angles ``q``: the arm's flange pose (compiled for the PUMA 762)."""
+    return model.arm.flange_pose(q)
 
 
 def _rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Rotate ``v`` by the smallest rotation taking unit ``a`` onto unit ``b``."""
-    axis = np.cross(a, b)
+    axis = cross3(a, b)
     s = float(np.linalg.norm(axis))
     c = float(a @ b)
     if s < 1e-15:
         return v.copy()
     k = axis / s
     ang = math.atan2(s, c)
-    return (v * math.cos(ang) + np.cross(k, v) * math.sin(ang)
+    return (v * math.cos(ang) + cross3(k, v) * math.sin(ang)
             + k * (k @ v) * (1.0 - math.cos(ang)))
 
 
@@ -431,7 +425,7 @@ def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target
         return Refusal(f"{action} target not reachable: {exc}", {})
     axis_deg = counts * model.axis_deg_per_count
     q_new = axis_counts_to_q(model, counts)
-    pred = predict(model, meas, model.arm.forward(q_new).pose)
+    pred = predict(model, meas, _flange_pose(model, q_new))
     bad = check_command(envelope, model, axis_deg, counts_now * model.axis_deg_per_count, pred)
     if bad:
         return Refusal(f"{action} command refused by the envelope: " + "; ".join(bad),

@@ -36,14 +36,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from kinestat.control.cycle import cross3, cross_rows, cycle_data
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
 from kinestat.hardware.platform_spec import MAX_DEFLECTION, MAX_LOAD, MOTION_RANGE
-from kinestat.parallel.statics import leg_directions
-from kinestat.parallel.stiffness import stiffness
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
-from kinestat.parallel.stiffness import tip_stiffness as platform_tip_stiffness
+from kinestat.spatial.se3 import rotvec_matrix_one
 from kinestat.spatial.transforms import apply, inv, skew
 
 __all__ = [
@@ -139,8 +138,9 @@ def tip_stiffness(model: ControlModel, meas: Measurement) -> np.ndarray:
     (:func:`kinestat.parallel.stiffness.tip_stiffness`): moving the flange by ``δ`` (at the
     tip) with the tip held changes the tool's force by ``K_tip δ``.
     """
-    return platform_tip_stiffness(model.platform, meas.top_pose, _tip_base(model, meas),
-                                  meas.base_pose[:3, :3])
+    R = np.asarray(meas.base_pose, dtype=float)[:3, :3]
+    # platform_tip_stiffness's R C_tip⁻¹ Rᵀ, with the cycle's C_tip (shared with predict)
+    return R @ np.linalg.inv(cycle_data(model, meas).C_tip) @ np.swapaxes(R, -1, -2)
 
 
 def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Prediction:
@@ -156,25 +156,26 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     """
     Tn = np.asarray(flange_pose_new, dtype=float)
     TB_new = Tn @ model.mount
-    tip_F = meas.tip(model)
-    p = _tip_base(model, meas)
+    data = cycle_data(model, meas)  # K, the tip and C_tip at the measured pose, made once
+    tip_F = data.tip_fixed
+    p = data.tip_base
     u = apply(inv(TB_new), tip_F) - p
     R = meas.base_pose[:3, :3]
     F = -(R.T @ meas.estimate("point"))  # external force on the tip, base frame
-    K = stiffness(model.platform, meas.top_pose, twist_order="axis")
+    K = data.K
     A = np.vstack([np.eye(3), skew(p)])
     B = np.hstack([-skew(p), np.eye(3)])
-    C_tip = platform_tip_compliance(model.platform, meas.top_pose, p)
-    b = np.concatenate([np.zeros(3), np.cross(u, F)])
+    C_tip = data.C_tip
+    b = np.concatenate([np.zeros(3), cross3(u, F)])
     dF = np.linalg.solve(C_tip, u - B @ np.linalg.solve(K, b))
     D = np.linalg.solve(K, A @ dF + b)  # top twist [δφ; δx_O] relative to the base
-    S, _ = leg_directions(model.platform, meas.top_pose)
+    S, _ = data.leg_directions
     Bp = model.platform.base_points
-    dl = np.cross(Bp, S) @ D[:3] + S @ D[3:]
+    dl = cross_rows(Bp, S) @ D[:3] + S @ D[3:]
     force = -(TB_new[:3, :3] @ (F + dF))
     defl = meas.deflections(model) + dl
     top = np.eye(4)
-    Rd = Rotation.from_rotvec(D[:3]).as_matrix()
+    Rd = rotvec_matrix_one(D[:3])  # Rotation.from_rotvec(·).as_matrix(), to rounding
     top[:3, :3] = Rd @ meas.top_pose[:3, :3]
     top[:3, 3] = Rd @ meas.top_pose[:3, 3] + D[3:]
     return Prediction(force=force, deflections=defl, tip_motion=apply(Tn @ inv(meas.flange_pose),
@@ -188,10 +189,26 @@ def top_motion(model: ControlModel, top_pose) -> np.ndarray:
     rotation vector of ``R_top R_home⁻¹``."""
     T = np.asarray(top_pose, dtype=float)
     H = model.platform.home_pose
-    c = model.platform.top_points.mean(axis=0)
-    d = (T[:3, :3] @ c + T[:3, 3]) - (H[:3, :3] @ c + H[:3, 3])
     r = Rotation.from_matrix(T[:3, :3] @ H[:3, :3].T).as_rotvec(degrees=True)
-    return np.concatenate([d, r])
+    return np.concatenate([_top_translation(model, T), r])
+
+
+def _top_translation(model: ControlModel, T: np.ndarray) -> np.ndarray:
+    """:func:`top_motion`'s ``[dx, dy, dz]``: the top centroid's displacement from home (mm)."""
+    H = model.platform.home_pose
+    c = model.platform.top_points.mean(axis=0)
+    return (T[:3, :3] @ c + T[:3, 3]) - (H[:3, :3] @ c + H[:3, 3])
+
+
+def _rotation_clear(envelope: Envelope, model: ControlModel, T: np.ndarray) -> bool:
+    """True when the top's rotation from home is so small that no component of
+    :func:`top_motion`'s rotation vector can exceed its range: its angle (from the trace,
+    ``cos θ = (tr R − 1) / 2``), which bounds every component, is below the smallest rotation
+    range by 1e-6° (more than the two computations' rounding apart). :func:`check_motion`
+    then needs no rotation vector — the same verdicts, without SciPy's conversion."""
+    c = (float(np.trace(T[:3, :3] @ model.platform.home_pose[:3, :3].T)) - 1.0) / 2.0
+    angle = math.degrees(math.acos(min(1.0, max(-1.0, c))))
+    return angle + 1e-6 < min(envelope.motion_range[3:])
 
 
 _MOTION_NAMES = ("x", "y", "z", "about x", "about y", "about z")
@@ -200,7 +217,11 @@ _MOTION_NAMES = ("x", "y", "z", "about x", "about y", "about z")
 def check_motion(envelope: Envelope, model: ControlModel, top_pose, what: str) -> list[str]:
     """Violations of Table 3-1's motion ranges by the top at ``top_pose`` (``what``: "measured"
     or "predicted")."""
-    m = top_motion(model, top_pose)
+    T = np.asarray(top_pose, dtype=float)
+    if _rotation_clear(envelope, model, T):  # no rotation component can be out of range
+        m = np.concatenate([_top_translation(model, T), np.zeros(3)])
+    else:
+        m = top_motion(model, T)
     out = []
     for k, (v, lim) in enumerate(zip(m, envelope.motion_range, strict=True)):
         if abs(v) > lim:

@@ -65,6 +65,7 @@ from kinestat.control.controller import (
     Target,
     move_command,
 )
+from kinestat.control.cycle import cross3, cycle_data
 from kinestat.control.envelope import (
     Envelope,
     check_measurement,
@@ -73,11 +74,11 @@ from kinestat.control.envelope import (
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
-from kinestat.parallel.kinestatic import compose_twist
+from kinestat.parallel.kinestatic import compose_twist_line
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
-from kinestat.spatial.se3 import twist_exp
+from kinestat.spatial.se3 import twist_exp, twist_exp_one
 from kinestat.spatial.transforms import apply, inv, skew
 
 __all__ = [
@@ -328,7 +329,7 @@ def estimate_normal(force, path_dir=None) -> np.ndarray:
 
 def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
     """Rotation vector turning ``s6`` towards ``axis`` by at most ``limit_rad``."""
-    c = np.cross(s6, axis)
+    c = cross3(s6, axis)
     s = float(np.linalg.norm(c))
     if s < 1e-15:
         return np.zeros(3)
@@ -350,27 +351,27 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     R = TB[:3, :3]
     p = R.T @ (tip - TB[:3, 3])
     n = R.T @ normal
-    W = np.concatenate([n, np.cross(p, n)])
-    K = stiffness(model.platform, meas.top_pose, twist_order="axis")
+    W = np.concatenate([n, cross3(p, n)])
+    K = cycle_data(model, meas).K  # the measured pose's stiffness, computed once per cycle
     w = R.T @ omega
-    v_O = R.T @ travel - np.cross(w, p)  # tip moves by `travel`, turning about the tip
+    v_O = R.T @ travel - cross3(w, p)  # tip moves by `travel`, turning about the tip
     Tf = np.concatenate([w, v_O])
     Wt = np.zeros(6)
     if friction > 0.0 and slip is not None:
         s = R.T @ slip
-        Wt = np.concatenate([s, np.cross(p, s)])
+        Wt = np.concatenate([s, cross3(p, s)])
     Tc = -dlam * np.linalg.solve(K, W - friction * Wt)  # K⁻¹ δw, δw = −Δλ W_c
-    dp = Tc[3:] + np.cross(Tc[:3], p)  # the tip's motion under the compliance twist
+    dp = Tc[3:] + cross3(Tc[:3], p)  # the tip's motion under the compliance twist
     scale = max(abs(float(dp @ n)) / max_correction,
                 float(np.linalg.norm(dp)) / (TANGENTIAL_FACTOR * max_correction), 1.0)
-    T = compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
+    T = compose_twist_line(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
     if friction > 0.0 and slip is not None:
         T = T + (dlam / scale) * friction * np.linalg.solve(K, Wt)
     return T
 
 
 def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
-    TB_new = meas.base_pose @ twist_exp(T_base)
+    TB_new = meas.base_pose @ twist_exp_one(T_base)
     T6 = TB_new @ inv(model.mount)
     return Target(apply(T6, model.tool_point_6), T6[:3, 2].copy(), T6[:3, 0].copy())
 

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Literal, get_args
 
 import numpy as np
@@ -98,10 +99,11 @@ class ControlModel:
         # the platform's legs must match the calibration's
         self.calibration.platform_order(self.platform.leg_names)
 
-    @property
+    @cached_property
     def tool_tip_top(self) -> np.ndarray:
-        """The tool tip in the top frame (where ``P_tool_6`` sits when the platform is at home)."""
-        return apply(inv(self.mount @ self.platform.home_pose), self.tool_point_6)
+        """The tool tip in the top frame (where ``P_tool_6`` sits when the platform is at home;
+        computed once, read-only)."""
+        return frozen(apply(inv(self.mount @ self.platform.home_pose), self.tool_point_6), float)
 
     @property
     def limits_rad(self) -> np.ndarray:

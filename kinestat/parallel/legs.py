@@ -22,7 +22,7 @@ if TYPE_CHECKING:  # the platform module imports this one (its design check)
 _LAST_ROW_TOL = 1e-12  # poses computed here carry rounding in their last row at most
 
 __all__ = ["as_pose", "top_points_in_base", "leg_vectors", "leg_lengths", "leg_directions",
-           "leg_lines", "line_jacobian"]
+           "leg_directions_trusted", "leg_lines", "line_jacobian"]
 
 
 def as_pose(pose, name: str = "pose") -> np.ndarray:
@@ -58,7 +58,13 @@ def leg_lengths(platform: Platform, pose) -> np.ndarray:
 
 def leg_directions(platform: Platform, pose) -> tuple[np.ndarray, np.ndarray]:
     """Unit leg directions S_i (base → top) (..., 6, 3) and leg lengths (..., 6)."""
-    d = leg_vectors(platform, pose)
+    return leg_directions_trusted(platform, as_pose(pose))
+
+
+def leg_directions_trusted(platform: Platform, T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`leg_directions` of poses ``T`` (..., 4, 4) the caller has checked (float arrays,
+    rigid): no validation, the same values (the hot path of a control cycle)."""
+    d = apply(T[..., None, :, :], platform.top_points) - platform.base_points
     l = np.linalg.norm(d, axis=-1)
     if np.any(l <= 0):
         raise SingularityError("a leg has zero length at this pose: its line is undefined")

@@ -32,16 +32,20 @@ so K is symmetric exactly when the platform is unloaded. Finite differences of
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from kinestat.errors import InputError, UnreachableError
+from kinestat.parallel import _stiffness_kernels as _sk
 from kinestat.parallel._refine import apply_twist
-from kinestat.parallel.legs import as_pose
+from kinestat.parallel.legs import as_pose, leg_directions_trusted
 from kinestat.parallel.platform import Platform
-from kinestat.parallel.statics import leg_directions, spring_wrench
+from kinestat.parallel.statics import spring_wrench
 from kinestat.spatial.transforms import as_array, skew
 
-__all__ = ["stiffness", "stiffness_terms", "load_asymmetry", "equilibrium_pose",
+__all__ = ["stiffness", "stiffness_axis_trusted", "stiffness_terms", "load_asymmetry",
+           "equilibrium_pose",
            "tip_compliance", "tip_stiffness", "TWIST_ORDERS"]
 
 TWIST_ORDERS = ("ray", "axis")
@@ -56,8 +60,12 @@ def stiffness_terms(platform: Platform, pose, forces=None) -> dict[str, np.ndarr
 
     ``forces`` (..., 6) are the leg tensions; default the springs' ``k (l − l0)`` at ``pose``.
     """
-    T = as_pose(pose)
-    S, l = leg_directions(platform, T)
+    return _terms(platform, as_pose(pose), forces)
+
+
+def _terms(platform: Platform, T: np.ndarray, forces=None) -> dict[str, np.ndarray]:
+    """:func:`stiffness_terms` at checked poses ``T``."""
+    S, l = leg_directions_trusted(platform, T)
     f = platform.stiffness * (l - platform.free_lengths) if forces is None else as_array(
         forces, shape_tail=(6,), name="leg forces")
     B = platform.base_points
@@ -95,13 +103,41 @@ def stiffness(platform: Platform, pose, forces=None, *, twist_order: str = "ray"
     return K if twist_order == "ray" else _swap(K)
 
 
-def tip_compliance(platform: Platform, pose, tip) -> np.ndarray:
+def stiffness_axis_trusted(platform: Platform, T: np.ndarray) -> np.ndarray:
+    """``stiffness(platform, T, twist_order="axis")`` (the springs' own tensions) at one pose
+    ``T`` (4, 4) the caller has checked, compiled
+    (:func:`kinestat.parallel._stiffness_kernels.stiffness_axis_one`, the hot path of a control
+    cycle): no validation; equal to :func:`stiffness` to rounding (~1e-15 relative)."""
+    K = np.empty((6, 6))
+    if _sk.stiffness_axis_one(*_platform_arrays(platform), np.array(T, dtype=float), K):
+        return K
+    parts = _terms(platform, np.asarray(T, dtype=float))  # raises: a leg of zero length
+    return _swap(parts["elastic"] + parts["geometric"] + parts["load"])  # pragma: no cover
+
+
+_ARRAYS: dict[int, tuple] = {}
+
+
+def _platform_arrays(platform: Platform) -> tuple:
+    """The platform's base points, top points, springs and free lengths as writeable C arrays
+    (the kernel compiles for one array type), made once per platform."""
+    a = _ARRAYS.get(id(platform))
+    if a is None:
+        a = _ARRAYS[id(platform)] = tuple(
+            np.array(v, dtype=float) for v in (platform.base_points, platform.top_points,
+                                               platform.stiffness, platform.free_lengths))
+        weakref.finalize(platform, _ARRAYS.pop, id(platform), None)
+    return a
+
+
+def tip_compliance(platform: Platform, pose, tip, *, stiffness_axis=None) -> np.ndarray:
     """Translational compliance (..., 3, 3) of a point ``tip`` of the top, base frame, mm/N.
 
     A force ``δF`` applied at the tip (the top free to rotate) moves the tip by ``C_tip δF``:
     ``C_tip = [−[p]×, I] K⁻¹ [I; [p]×]``, K the platform's stiffness at ``pose`` (Vibhute
     eq. 2-16/2-17, axis order ``[δφ; δx_O]``) and ``p`` (..., 3) the tip in base coordinates.
-    Batched over a leading shape shared by ``pose`` and ``tip``.
+    Batched over a leading shape shared by ``pose`` and ``tip``. ``stiffness_axis``: K at
+    ``pose`` in axis order when the caller already has it (not recomputed).
 
     >>> from kinestat.parallel.platform import special_6_6
     >>> pf = special_6_6()
@@ -109,7 +145,8 @@ def tip_compliance(platform: Platform, pose, tip) -> np.ndarray:
     >>> bool(np.allclose(C, C.T)) and bool(np.all(np.linalg.eigvalsh(C) > 0))
     True
     """
-    K = stiffness(platform, pose, twist_order="axis")
+    K = (stiffness(platform, pose, twist_order="axis") if stiffness_axis is None
+         else stiffness_axis)
     p = as_array(tip, shape_tail=(3,), name="tip")
     P = skew(p)
     eye = np.broadcast_to(np.eye(3), P.shape)
@@ -118,7 +155,8 @@ def tip_compliance(platform: Platform, pose, tip) -> np.ndarray:
     return B @ np.linalg.solve(K, A)
 
 
-def tip_stiffness(platform: Platform, pose, tip, rotation=None) -> np.ndarray:
+def tip_stiffness(platform: Platform, pose, tip, rotation=None, *,
+                  stiffness_axis=None) -> np.ndarray:
     """Point stiffness (..., 3, 3) of the platform at ``tip``, N/mm: ``C_tip⁻¹``
     (:func:`tip_compliance`), in the base frame, or rotated by ``rotation`` (..., 3, 3, the
     base frame's orientation in another frame) into that frame: ``R C_tip⁻¹ Rᵀ``.
@@ -126,7 +164,7 @@ def tip_stiffness(platform: Platform, pose, tip, rotation=None) -> np.ndarray:
     Moving the base by ``δ`` at the tip with the tip held changes the tip force by
     ``K_tip δ`` (Vibhute eq. 2-16 reduced to the tip's translation).
     """
-    Kb = np.linalg.inv(tip_compliance(platform, pose, tip))
+    Kb = np.linalg.inv(tip_compliance(platform, pose, tip, stiffness_axis=stiffness_axis))
     if rotation is None:
         return Kb
     R = np.asarray(rotation, dtype=float)

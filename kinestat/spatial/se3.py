@@ -14,7 +14,8 @@ import numpy as np
 from kinestat.spatial.displacement import pose_from_screw
 from kinestat.spatial.transforms import as_array, trans
 
-__all__ = ["so3_exp", "so3_log", "twist_exp", "pose_error"]
+__all__ = ["so3_exp", "so3_log", "twist_exp", "twist_exp_one", "rotvec_matrix_one",
+           "pose_error"]
 
 
 def so3_exp(w) -> np.ndarray:
@@ -76,6 +77,58 @@ def twist_exp(V) -> np.ndarray:
     point = np.where(rot[..., None], np.cross(w, v) / (ths**2)[..., None], 0.0)
     D = pose_from_screw(u, point, np.where(rot, th, 0.0), np.where(rot, d, 0.0))
     return np.where(rot[..., None, None], D, trans(v))
+
+
+def _rodrigues(u0: float, u1: float, u2: float, s: float, h2: float) -> list[list[float]]:
+    """``I + s [u]x + h2 [u]x²`` for a unit axis u (Rodrigues; h2 = 1 − cos θ)."""
+    return [[1.0 - h2 * (u1 * u1 + u2 * u2), -s * u2 + h2 * u0 * u1, s * u1 + h2 * u0 * u2],
+            [s * u2 + h2 * u0 * u1, 1.0 - h2 * (u0 * u0 + u2 * u2), -s * u0 + h2 * u1 * u2],
+            [-s * u1 + h2 * u0 * u2, s * u0 + h2 * u1 * u2, 1.0 - h2 * (u0 * u0 + u1 * u1)]]
+
+
+def twist_exp_one(V) -> np.ndarray:
+    """:func:`twist_exp` of ONE finite twist ``V = [ω; v_O]`` (6,), in scalars: the same screw
+    (θ = |ω|, u = ω/θ, d = u·v, the axis through ω×v/θ²) and Rodrigues' formula, without the
+    batched validation (a control cycle's hot path); equal to :func:`twist_exp` to rounding.
+
+    >>> bool(np.allclose(twist_exp_one([0.1, -0.2, 0.3, 1.0, 2.0, 3.0]),
+    ...                  twist_exp([0.1, -0.2, 0.3, 1.0, 2.0, 3.0]), rtol=0, atol=1e-14))
+    True
+    """
+    w0, w1, w2, v0, v1, v2 = np.asarray(V, dtype=float).tolist()
+    th = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    out = np.eye(4)
+    if not th > 1e-15:
+        out[:3, 3] = (v0, v1, v2)
+        return out
+    u0, u1, u2 = w0 / th, w1 / th, w2 / th
+    d = u0 * v0 + u1 * v1 + u2 * v2
+    t2 = th * th
+    c0, c1, c2 = (w1 * v2 - w2 * v1) / t2, (w2 * v0 - w0 * v2) / t2, (w0 * v1 - w1 * v0) / t2
+    cu = c0 * u0 + c1 * u1 + c2 * u2
+    c0, c1, c2 = c0 - cu * u0, c1 - cu * u1, c2 - cu * u2  # the axis point normal to u
+    s, h2 = math.sin(th), 2.0 * math.sin(0.5 * th) ** 2
+    out[:3, :3] = _rodrigues(u0, u1, u2, s, h2)
+    out[:3, 3] = (h2 * c0 - s * (u1 * c2 - u2 * c1) + d * u0,
+                  h2 * c1 - s * (u2 * c0 - u0 * c2) + d * u1,
+                  h2 * c2 - s * (u0 * c1 - u1 * c0) + d * u2)
+    return out
+
+
+def rotvec_matrix_one(r) -> np.ndarray:
+    """The rotation matrix (3, 3) of ONE rotation vector ``r`` (3,) (radians): Rodrigues'
+    formula in scalars, equal to SciPy's ``Rotation.from_rotvec(r).as_matrix()`` to rounding.
+
+    >>> bool(np.allclose(rotvec_matrix_one([0.0, 0.0, np.pi / 2]),
+    ...                  [[0, -1, 0], [1, 0, 0], [0, 0, 1]], atol=1e-15))
+    True
+    """
+    r0, r1, r2 = np.asarray(r, dtype=float).tolist()
+    th = math.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
+    if not th > 0.0:
+        return np.eye(3)
+    s, h2 = math.sin(th), 2.0 * math.sin(0.5 * th) ** 2
+    return np.array(_rodrigues(r0 / th, r1 / th, r2 / th, s, h2))
 
 
 _SQRT8 = 2.0 * math.sqrt(2.0)

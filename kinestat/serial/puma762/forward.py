@@ -9,12 +9,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinestat.errors import InputError
+from kinestat.serial.puma762 import _cycle_kernels as _ck
 from kinestat.serial.puma762 import _kernels as _pk
 from kinestat.serial.puma762.params import _A, _CA, _S, _SA, S6
 from kinestat.spatial.se3 import pose_error
 from kinestat.spatial.validate import as_vector3
 
-__all__ = ["link_transform", "ForwardResult", "forward", "frame6", "wrist_center",
+__all__ = ["link_transform", "ForwardResult", "forward", "pose_one", "frame6", "wrist_center",
            "pose_residuals"]
 
 def link_transform(cos_alpha, sin_alpha, a, theta, s) -> np.ndarray:
@@ -141,6 +142,20 @@ def forward(q, tool_point_6=(0.0, 0.0, 0.0)) -> ForwardResult:
     tool = np.einsum("...ij,...j->...i", T[..., :3, :3], p6) + T[..., :3, 3]
     return ForwardResult(tool_point=tool, s6=T[..., :3, 2].copy(), a67=T[..., :3, 0].copy(),
                          pose=T)
+
+
+def pose_one(q) -> np.ndarray:
+    """``F_6T`` (4, 4) of one configuration ``q`` (6,) (eq. 2-33), compiled: the pose
+    :func:`forward` returns, the same operations in the same order (the single-pose path of
+    a control cycle; ``q`` finite, checked by the caller).
+
+    >>> bool(np.array_equal(pose_one(np.full(6, 0.3)), forward(np.full(6, 0.3)).pose))
+    True
+    """
+    q = np.asarray(q, dtype=float)
+    T = np.empty((4, 4))
+    _ck.pose_one(np.stack([np.cos(q), np.sin(q)], axis=-1), T)
+    return T
 
 
 # -- the end effector as a frame ----------------------------------------------------------------

@@ -8,12 +8,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinestat.errors import InputError, JointLimitError
+from kinestat.serial.puma762 import _cycle_kernels as _ck
+from kinestat.serial.puma762 import _kernels as _pk
 from kinestat.serial.puma762.forward import _check_q
 from kinestat.serial.puma762.params import _TWO_PI, AXIS_LIMITS_DEG, AXIS_OFFSET, _wrap
-from kinestat.serial.puma762.reverse import ReverseBatch, ReverseResult
+from kinestat.serial.puma762.reverse import ReverseBatch, ReverseResult, reverse
 
 __all__ = ["to_axis_angles", "from_axis_angles", "wrap_into_limits", "within_limits",
-           "Selection", "select_batch", "select"]
+           "Selection", "select_batch", "select", "select_axis_one"]
 
 
 def to_axis_angles(q) -> np.ndarray:
@@ -219,3 +221,29 @@ def select(result: ReverseResult, current_q=None, limits_deg=None, *,
             joint=joint,
         )
     return sel
+
+
+_AXIS_OFFSET = np.array(AXIS_OFFSET)  # writeable: the kernels compile for one array type
+
+
+def select_axis_one(tool_point, s6, a67, tool_point_6, current_q, limits_deg) -> np.ndarray:
+    """The axis angles (6,) (radians) of :func:`select` ``(reverse(tool_point, s6, a67,
+    tool_point_6), current_q, limits_deg).axis`` for one pose, in one compiled pass (the
+    reverse analysis's kernel and :func:`~kinestat.serial.puma762._cycle_kernels.select_one`):
+    the single-pose path of a control cycle. Inputs are (3,), (3,), (3,), (3,), (6,) float
+    arrays and (6, 2) limits in degrees, checked by the caller; an unreachable pose or one
+    outside the limits raises what :func:`reverse` and :func:`select` raise (they are run for
+    the message).
+    """
+    p, z, x, p6, cur = (np.array(v, dtype=float) for v in (tool_point, s6, a67, tool_point_6,
+                                                             current_q))  # writeable, C order
+    out = _pk.reverse_vectors_one(p, z, x, p6, 1e-6, 1e-9, 1e-10)
+    err, status, q, valid, sing, fsum, fval = out[0], out[2], out[4], out[5], out[6], out[7], \
+        out[8]
+    axis = np.empty(6)
+    if not err and not status and valid.any():
+        lo, hi = _limits_rad(limits_deg)
+        if _ck.select_one(q, valid, sing, fsum, fval, cur, _AXIS_OFFSET, lo, hi, axis):
+            return axis
+    sel = select(reverse(p, z, x, p6), cur, limits_deg)
+    return sel.axis  # pragma: no cover - select raises when no branch is within the limits

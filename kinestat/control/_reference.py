@@ -1,0 +1,88 @@
+"""The unoptimised per-cycle computations the compiled fast path replaced, kept as the
+reference: the tests replay recorded cycles through both and require the same commands
+(tests/control/test_cycle_fast.py), and ``benchmarks/control_cycle.py`` times both side by side.
+
+:func:`solve_counts_reference` is the vernier as first written: the forward analysis of all
+9·9·9·3·3 = 6561 count vectors with NumPy and ``argmin`` of the cost. The fast path
+(:func:`kinestat.control.controller._solve_counts`) searches the same grid with the same cost
+in a compiled kernel; both pick the same count vector unless two candidates' costs agree to
+the last few bits (the two formulations round differently, ~1e-13 mm).
+"""
+
+from __future__ import annotations
+
+import contextlib
+from collections.abc import Iterator
+
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from kinestat.control import controller, cycle, envelope, follow
+from kinestat.control.controller import Target
+from kinestat.control.model import ControlModel
+from kinestat.control.vernier import q_to_axis_counts, vernier_costs
+from kinestat.parallel.kinestatic import compose_twist
+from kinestat.parallel.stiffness import stiffness
+from kinestat.serial import puma762
+from kinestat.spatial.se3 import twist_exp
+
+__all__ = ["solve_counts_reference", "vernier_costs_reference", "UncachedCycleData",
+           "reference_cycle"]
+
+
+def vernier_costs_reference(model: ControlModel, target: Target, c0, counts_now,
+                            vernier: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The candidates ``c0 + OFFSETS`` (or ``c0`` alone), their cost and offset along S6: every
+    candidate through the NumPy forward analysis (:func:`kinestat.control.vernier.vernier_costs`,
+    the formulation the compiled search reproduces)."""
+    return vernier_costs(model, target, c0, counts_now, vernier)
+
+
+def solve_counts_reference(model: ControlModel, target: Target, q_now, counts_now,
+                           vernier: bool) -> tuple[np.ndarray, float]:
+    """:func:`kinestat.control.controller._solve_counts` as first written (NumPy, all
+    candidates): (counts, residual along S6 in mm)."""
+    res = puma762.reverse(target.tool_point, target.s6, target.a67, model.tool_point_6)
+    sel = puma762.select(res, q_now, model.limits_deg)
+    c0 = q_to_axis_counts(model, sel.axis)
+    cand, cost, along = vernier_costs_reference(model, target, c0, counts_now, vernier)
+    k = int(np.argmin(cost))
+    return cand[k], float(along[k])
+
+
+class UncachedCycleData(cycle.CycleData):
+    """:class:`~kinestat.control.cycle.CycleData` that recomputes the stiffness on every use
+    (as the decision did before the per-cycle data: once for ``tip_stiffness``, twice in the
+    envelope's prediction, once in the follow law)."""
+
+    @property
+    def K(self) -> np.ndarray:  # type: ignore[override]
+        return stiffness(self.model.platform, self.meas.top_pose, twist_order="axis")
+
+
+@contextlib.contextmanager
+def reference_cycle() -> Iterator[None]:
+    """Run :func:`~kinestat.control.controller.decide` and
+    :func:`~kinestat.control.follow.decide_follow` on the unoptimised path inside the block:
+    the NumPy vernier and selection (:func:`solve_counts_reference`), the NumPy forward
+    analysis for the flange pose, the NumPy stiffness recomputed on every use, the batched
+    ``compose_twist`` and ``twist_exp`` in the follow law, SciPy's rotations in the prediction
+    and SciPy's rotation vector on every motion check.
+    Not thread-safe (it swaps module attributes)."""
+    saved = [(controller, "_solve_counts", solve_counts_reference),
+             (controller, "_flange_pose", lambda model, q: puma762.forward(q).pose),
+             (envelope, "cycle_data", UncachedCycleData),
+             (follow, "cycle_data", UncachedCycleData),
+             (follow, "compose_twist_line", compose_twist),
+             (follow, "twist_exp_one", twist_exp),
+             (envelope, "rotvec_matrix_one",
+              lambda r: Rotation.from_rotvec(r).as_matrix()),
+             (envelope, "_rotation_clear", lambda *a: False)]
+    old = [(mod, name, getattr(mod, name)) for mod, name, _ in saved]
+    try:
+        for mod, name, new in saved:
+            setattr(mod, name, new)
+        yield
+    finally:
+        for mod, name, value in old:
+            setattr(mod, name, value)
