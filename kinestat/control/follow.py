@@ -141,6 +141,8 @@ TURN_DEADBAND_DEG = 0.3
 """Misalignments of S6 below this are not corrected (the normal estimate's noise)."""
 TRAVEL_TOL = 0.02
 """Remaining travel (mm) at which the follow task is complete."""
+END_STEP = 0.25
+"""Smallest travel step (mm) while the end is approached in halving steps."""
 
 
 def _unit3(v, name: str) -> np.ndarray:
@@ -533,7 +535,12 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
                         "surface", **kw), replace(st, label="e", done=True))
     if phase == "travel" and not (config.auto_tilt and st.sticking):
         learning = config.auto_tilt and st.friction_samples < LEARN_CHORDS
-        step = min(config.travel_step * (LEARN_STEP if learning else 1.0), remaining)
+        # half the remaining travel at most (but not below END_STEP, ~10 robot counts at the
+        # tool): the tip slides on the surface by up to ~2 mm a cycle as the tool turns (its
+        # tangential stiffness is low), so the end is approached in shrinking steps instead of
+        # overshot by a full one
+        step = min(config.travel_step * (LEARN_STEP if learning else 1.0),
+                   max(0.5 * remaining, min(END_STEP, remaining)))
         travel_vec = step * t
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
              else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
