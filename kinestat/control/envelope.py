@@ -41,6 +41,7 @@ from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
 from kinestat.hardware.platform_spec import MAX_DEFLECTION, MAX_LOAD, MOTION_RANGE
+from kinestat.parallel.stiffness import pinned_tip_step
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
 from kinestat.spatial.se3 import rotvec_matrix_one
 from kinestat.spatial.transforms import apply, inv, skew
@@ -155,6 +156,9 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     force on the workpiece, fixed frame, is ``−R' (F + δF)``.
     """
     Tn = np.asarray(flange_pose_new, dtype=float)
+    fast = _predict_fast(model, meas, Tn)
+    if fast is not None:
+        return fast
     TB_new = Tn @ model.mount
     data = cycle_data(model, meas)  # K, the tip and C_tip at the measured pose, made once
     tip_F = data.tip_fixed
@@ -181,6 +185,34 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     return Prediction(force=force, deflections=defl, tip_motion=apply(Tn @ inv(meas.flange_pose),
                                                                       tip_F) - tip_F,
                       top_pose=top)
+
+
+def _predict_compiled(model: ControlModel, meas: Measurement, Tn: np.ndarray) -> Prediction | None:
+    """:func:`predict`'s formulation with its linear algebra compiled for the one pose
+    (:func:`kinestat.parallel.stiffness.pinned_tip_step`: one elimination of K instead of
+    three solves, the legs and the Rodrigues rotation in scalars); equal to the NumPy
+    formulation to rounding. None when the kernel meets a singular matrix (the NumPy
+    formulation then runs and raises)."""
+    TB_new = Tn @ model.mount
+    data = cycle_data(model, meas)
+    tip_F = data.tip_fixed
+    p = data.tip_base
+    R_new, t_new = TB_new[:3, :3], TB_new[:3, 3]
+    u = (tip_F - t_new) @ R_new - p  # inv(TB_new) tip_F − p
+    F = -(meas.estimate("point") @ meas.base_pose[:3, :3])  # −Rᵀ F: external force, base frame
+    out = pinned_tip_step(model.platform, data.top_pose, data.K, p, u, F)
+    if out is None:
+        return None
+    dF, _, dl, top = out
+    Tf = meas.flange_pose
+    local = (tip_F - Tf[:3, 3]) @ Tf[:3, :3]  # the tip in the measured flange frame
+    tip_motion = Tn[:3, :3] @ local + Tn[:3, 3] - tip_F
+    return Prediction(force=-(R_new @ (F + dF)), deflections=meas.deflections(model) + dl,
+                      tip_motion=tip_motion, top_pose=top)
+
+
+#: the prediction's compiled path (None on the reference path: the NumPy formulation only)
+_predict_fast = _predict_compiled
 
 
 def top_motion(model: ControlModel, top_pose) -> np.ndarray:
