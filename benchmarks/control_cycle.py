@@ -20,7 +20,6 @@ from the cache) before anything is timed; that first load is reported on its own
 from __future__ import annotations
 
 import argparse
-import copy
 import functools
 import json
 import os
@@ -78,9 +77,10 @@ def _record(task: str) -> tuple:
 
 
 def _fresh(args: tuple) -> tuple:
-    """The call's arguments with a new Measurement object (same values), so that no per-cycle
-    data cached for the measurement (:func:`kinestat.control.cycle.cycle_data`) is reused."""
-    return tuple(copy.copy(a) if isinstance(a, Measurement) else a for a in args)
+    """The call's arguments with a new Measurement object (same values, made anew: no cache
+    of :meth:`Measurement.tip`), so that no per-cycle data cached for the measurement
+    (:func:`kinestat.control.cycle.cycle_data`) is reused."""
+    return tuple(replace(a) if isinstance(a, Measurement) else a for a in args)
 
 
 CLOCKS = {"wall": time.perf_counter, "cpu": time.thread_time}
