@@ -115,10 +115,17 @@ def _warm_cycle() -> None:
 
 def _warm_stiffness() -> None:
     from kinestat.io.library import prototype  # lazy: start-up
-    from kinestat.parallel.stiffness import stiffness_axis_trusted  # lazy: start-up (numba)
+    from kinestat.parallel.stiffness import (  # lazy: start-up (numba)
+        pinned_tip_step,
+        stiffness_axis_trusted,
+        tip_compliance_one,
+    )
 
     p = prototype()
-    stiffness_axis_trusted(p, p.home_pose)
+    K = stiffness_axis_trusted(p, p.home_pose)
+    tip = np.array([0.0, 0.0, 100.0])
+    tip_compliance_one(K, tip)
+    pinned_tip_step(p, p.home_pose, K, tip, np.full(3, 0.01), np.ones(3))
 
 
 def _warm_platform() -> None:

@@ -22,7 +22,7 @@ from kinestat.control.controller import Target
 from kinestat.control.model import ControlModel
 from kinestat.control.vernier import q_to_axis_counts, vernier_costs
 from kinestat.parallel.kinestatic import compose_twist
-from kinestat.parallel.stiffness import stiffness
+from kinestat.parallel.stiffness import stiffness, tip_compliance
 from kinestat.serial import puma762
 from kinestat.spatial.se3 import twist_exp
 
@@ -59,6 +59,11 @@ class UncachedCycleData(cycle.CycleData):
     def K(self) -> np.ndarray:  # type: ignore[override]
         return stiffness(self.model.platform, self.meas.top_pose, twist_order="axis")
 
+    @property
+    def C_tip(self) -> np.ndarray:  # type: ignore[override]
+        return tip_compliance(self.model.platform, self.meas.top_pose, self.tip_base,
+                              stiffness_axis=self.K)
+
 
 @contextlib.contextmanager
 def reference_cycle() -> Iterator[None]:
@@ -66,8 +71,8 @@ def reference_cycle() -> Iterator[None]:
     :func:`~kinestat.control.follow.decide_follow` on the unoptimised path inside the block:
     the NumPy vernier and selection (:func:`solve_counts_reference`), the NumPy forward
     analysis for the flange pose, the NumPy stiffness recomputed on every use, the batched
-    ``compose_twist`` and ``twist_exp`` in the follow law, SciPy's rotations in the prediction
-    and SciPy's rotation vector on every motion check.
+    ``compose_twist`` and ``twist_exp`` in the follow law, NumPy's solves and SciPy's rotations
+    in the prediction, NumPy's tip compliance and SciPy's rotation vector on every motion check.
     Not thread-safe (it swaps module attributes)."""
     saved = [(controller, "_solve_counts", solve_counts_reference),
              (controller, "_flange_pose", lambda model, q: puma762.forward(q).pose),
@@ -77,7 +82,8 @@ def reference_cycle() -> Iterator[None]:
              (follow, "twist_exp_one", twist_exp),
              (envelope, "rotvec_matrix_one",
               lambda r: Rotation.from_rotvec(r).as_matrix()),
-             (envelope, "_rotation_clear", lambda *a: False)]
+             (envelope, "_rotation_clear", lambda *a: False),
+             (envelope, "_predict_fast", lambda *a: None)]
     old = [(mod, name, getattr(mod, name)) for mod, name, _ in saved]
     try:
         for mod, name, new in saved:

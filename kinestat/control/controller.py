@@ -447,7 +447,10 @@ def decide(config: ControllerConfig, state: ControllerState,
     model = config.model
     env = config.envelope
     cycle = state.cycle + 1
-    st = replace(state, cycle=cycle, top_pose=meas.top_pose)
+
+    def st(**kw) -> ControllerState:  # the new state: one replace per cycle
+        return replace(state, cycle=cycle, top_pose=meas.top_pose, **kw)
+
     F = meas.estimate(config.estimator)
     Fmag = float(np.linalg.norm(F))
     contact = Fmag >= config.contact_force
@@ -465,13 +468,13 @@ def decide(config: ControllerConfig, state: ControllerState,
     info = {"force_error": err, "misalignment_deg": mis}
     bad = check_measurement(env, model, meas)
     if bad:
-        return _stop(replace(st, label=label), label, "measurement outside the envelope: "
+        return _stop(st(label=label), label, "measurement outside the envelope: "
                      + "; ".join(bad), violations=tuple(bad), **info)
     if contact and abs(err) <= config.force_tol and mis <= config.align_tol_deg:
         return (Command(kind="done", label="e", reason="goal attained", **info),
-                replace(st, label="e", done=True))
+                st(label="e", done=True))
     if cycle >= config.max_iterations:
-        return _stop(replace(st, label=label), label,
+        return _stop(st(label=label), label,
                      f"not converged after {cycle} cycles (|F| = {Fmag:.4g} N, error "
                      f"{err:+.4g} N" + (f", misalignment {mis:.3g}°)" if mis is not None else ")"),
                      **info)
@@ -503,7 +506,7 @@ def decide(config: ControllerConfig, state: ControllerState,
         new = Target(tgt.tool_point + step * axis, axis, a67)
     key = new.key()
     if state.history.count(key) + 1 >= config.repeat_limit:
-        return _stop(replace(st, label=label), label,
+        return _stop(st(label=label), label,
                      f"limit cycle: the same target has now been commanded {config.repeat_limit} "
                      f"times without reaching the goal (|F| = {Fmag:.4g} N, error {err:+.4g} N)"
                      + (f"; the fixed {config.step:g} mm step is too coarse for this stiffness "
@@ -512,7 +515,7 @@ def decide(config: ControllerConfig, state: ControllerState,
     cmd = move_command(model, env, config.vernier, meas, new, state.axis_counts, label=label,
                        action=action, step=step, rotation_deg=rotation, info=info)
     if isinstance(cmd, Refusal):
-        return _stop(replace(st, label=label), label, cmd.reason, **cmd.extra, **info)
-    new_state = replace(st, label=label, last_action=action, target=new,
+        return _stop(st(label=label), label, cmd.reason, **cmd.extra, **info)
+    new_state = st(label=label, last_action=action, target=new,
                         axis_counts=cmd.axis_counts, history=state.history + (key,))
     return cmd, new_state

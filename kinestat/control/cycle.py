@@ -6,9 +6,10 @@ needs more than once at the measured pose — the platform's loaded stiffness ``
 ``[δφ; δx_O]``, Vibhute eq. 2-17), the tool tip in the base and fixed frames, the tip's
 translational compliance ``C_tip`` (eq. 2-16/2-17) and the leg directions — each computed on
 first use by the same functions the callers used before (so the values are the same, bit for
-bit), except K: compiled for the one pose
-(:func:`kinestat.parallel.stiffness.stiffness_axis_trusted`), equal to the NumPy formulation
-to rounding. :func:`cycle_data` finds a measurement's data (a weak map keyed by the measurement, so
+bit), except K and C_tip: compiled for the one pose
+(:func:`kinestat.parallel.stiffness.stiffness_axis_trusted`,
+:func:`~kinestat.parallel.stiffness.tip_compliance_one`), equal to the NumPy formulations to
+rounding. :func:`cycle_data` finds a measurement's data (a weak map keyed by the measurement, so
 that :func:`~kinestat.control.controller.decide`, the envelope's prediction and the follow
 task's control law share it without passing it around, and it goes with the measurement).
 """
@@ -23,7 +24,7 @@ import numpy as np
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.parallel.legs import leg_directions_trusted
-from kinestat.parallel.stiffness import stiffness_axis_trusted, tip_compliance
+from kinestat.parallel.stiffness import stiffness_axis_trusted, tip_compliance_one
 from kinestat.spatial.transforms import apply
 
 __all__ = ["CycleData", "cycle_data", "cross3", "cross_rows"]
@@ -80,8 +81,7 @@ class CycleData:
 
     @cached_property
     def C_tip(self) -> np.ndarray:
-        return tip_compliance(self.model.platform, self.meas.top_pose, self.tip_base,
-                              stiffness_axis=self.K)
+        return tip_compliance_one(self.K, self.tip_base)
 
     @cached_property
     def leg_directions(self) -> tuple[np.ndarray, np.ndarray]:

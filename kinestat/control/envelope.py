@@ -31,6 +31,7 @@ Every check returns a list of violations (empty: safe); :func:`require` turns th
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -41,6 +42,7 @@ from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
 from kinestat.hardware.platform_spec import MAX_DEFLECTION, MAX_LOAD, MOTION_RANGE
+from kinestat.parallel.stiffness import pinned_tip_step
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
 from kinestat.spatial.se3 import rotvec_matrix_one
 from kinestat.spatial.transforms import apply, inv, skew
@@ -118,7 +120,7 @@ class Prediction:
 
     @property
     def force_magnitude(self) -> float:
-        return float(np.linalg.norm(self.force))
+        return _norm3(self.force)
 
 
 def _tip_base(model: ControlModel, meas: Measurement) -> np.ndarray:
@@ -155,6 +157,9 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     force on the workpiece, fixed frame, is ``−R' (F + δF)``.
     """
     Tn = np.asarray(flange_pose_new, dtype=float)
+    fast = _predict_fast(model, meas, Tn)
+    if fast is not None:
+        return fast
     TB_new = Tn @ model.mount
     data = cycle_data(model, meas)  # K, the tip and C_tip at the measured pose, made once
     tip_F = data.tip_fixed
@@ -183,6 +188,34 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
                       top_pose=top)
 
 
+def _predict_compiled(model: ControlModel, meas: Measurement, Tn: np.ndarray) -> Prediction | None:
+    """:func:`predict`'s formulation with its linear algebra compiled for the one pose
+    (:func:`kinestat.parallel.stiffness.pinned_tip_step`: one elimination of K instead of
+    three solves, the legs and the Rodrigues rotation in scalars); equal to the NumPy
+    formulation to rounding. None when the kernel meets a singular matrix (the NumPy
+    formulation then runs and raises)."""
+    TB_new = Tn @ model.mount
+    data = cycle_data(model, meas)
+    tip_F = data.tip_fixed
+    p = data.tip_base
+    R_new, t_new = TB_new[:3, :3], TB_new[:3, 3]
+    u = (tip_F - t_new) @ R_new - p  # inv(TB_new) tip_F − p
+    F = -(meas.estimate("point") @ meas.base_pose[:3, :3])  # −Rᵀ F: external force, base frame
+    out = pinned_tip_step(model.platform, data.top_pose, data.K, p, u, F)
+    if out is None:
+        return None
+    dF, _, dl, top = out
+    Tf = meas.flange_pose
+    local = (tip_F - Tf[:3, 3]) @ Tf[:3, :3]  # the tip in the measured flange frame
+    tip_motion = Tn[:3, :3] @ local + Tn[:3, 3] - tip_F
+    return Prediction(force=-(R_new @ (F + dF)), deflections=meas.deflections(model) + dl,
+                      tip_motion=tip_motion, top_pose=top)
+
+
+#: the prediction's compiled path (None on the reference path: the NumPy formulation only)
+_predict_fast = _predict_compiled
+
+
 def top_motion(model: ControlModel, top_pose) -> np.ndarray:
     """The top's motion from its unloaded pose (Table 3-1's quantities), base frame: (6,)
     ``[dx, dy, dz]`` (mm) of the top triangle's centroid and ``[rx, ry, rz]`` (degrees), the
@@ -193,20 +226,60 @@ def top_motion(model: ControlModel, top_pose) -> np.ndarray:
     return np.concatenate([_top_translation(model, T), r])
 
 
+class _Consts:
+    """A model's constants of the checks as Python floats, made once per model (the checks run
+    several times a cycle; their scalar arithmetic beats NumPy's per-call set-up on 3-vectors)."""
+
+    def __init__(self, model: ControlModel) -> None:
+        H = model.platform.home_pose
+        c = model.platform.top_points.mean(axis=0)
+        self.H_rot = H[:3, :3].tolist()
+        self.centroid = c.tolist()
+        self.home_centroid = (H[:3, :3] @ c + H[:3, 3]).tolist()
+        self.lo = model.limits_deg[:, 0].tolist()
+        self.hi = model.limits_deg[:, 1].tolist()
+        self.free_lengths = model.platform.free_lengths.tolist()
+
+
+_CONSTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _consts(model: ControlModel) -> _Consts:
+    k = _CONSTS.get(model)
+    if k is None:
+        k = _CONSTS[model] = _Consts(model)
+    return k
+
+
+def _translation_list(model: ControlModel, T: np.ndarray) -> list[float]:
+    """:func:`top_motion`'s ``[dx, dy, dz]``: the top centroid's displacement from home (mm),
+    ``(R c + t) − (R_home c + t_home)`` in scalars."""
+    k = _consts(model)
+    (r0, r1, r2, t0), (r3, r4, r5, t1), (r6, r7, r8, t2) = T[:3].tolist()
+    c0, c1, c2 = k.centroid
+    h0, h1, h2 = k.home_centroid
+    return [(r0 * c0 + r1 * c1 + r2 * c2 + t0) - h0,
+            (r3 * c0 + r4 * c1 + r5 * c2 + t1) - h1,
+            (r6 * c0 + r7 * c1 + r8 * c2 + t2) - h2]
+
+
 def _top_translation(model: ControlModel, T: np.ndarray) -> np.ndarray:
-    """:func:`top_motion`'s ``[dx, dy, dz]``: the top centroid's displacement from home (mm)."""
-    H = model.platform.home_pose
-    c = model.platform.top_points.mean(axis=0)
-    return (T[:3, :3] @ c + T[:3, 3]) - (H[:3, :3] @ c + H[:3, 3])
+    """:func:`top_motion`'s ``[dx, dy, dz]`` as an array (:func:`_translation_list`)."""
+    return np.array(_translation_list(model, np.asarray(T, dtype=float)))
 
 
 def _rotation_clear(envelope: Envelope, model: ControlModel, T: np.ndarray) -> bool:
     """True when the top's rotation from home is so small that no component of
     :func:`top_motion`'s rotation vector can exceed its range: its angle (from the trace,
-    ``cos θ = (tr R − 1) / 2``), which bounds every component, is below the smallest rotation
-    range by 1e-6° (more than the two computations' rounding apart). :func:`check_motion`
-    then needs no rotation vector — the same verdicts, without SciPy's conversion."""
-    c = (float(np.trace(T[:3, :3] @ model.platform.home_pose[:3, :3].T)) - 1.0) / 2.0
+    ``cos θ = (tr R − 1) / 2``, ``tr(R R_homeᵀ) = Σ R_ij R_home,ij``), which bounds every
+    component, is below the smallest rotation range by 1e-6° (more than the two computations'
+    rounding apart). :func:`check_motion` then needs no rotation vector — the same verdicts,
+    without SciPy's conversion."""
+    H = _consts(model).H_rot
+    tr = 0.0
+    for row, hrow in zip(T[:3, :3].tolist(), H, strict=True):
+        tr += row[0] * hrow[0] + row[1] * hrow[1] + row[2] * hrow[2]
+    c = (tr - 1.0) / 2.0
     angle = math.degrees(math.acos(min(1.0, max(-1.0, c))))
     return angle + 1e-6 < min(envelope.motion_range[3:])
 
@@ -219,9 +292,9 @@ def check_motion(envelope: Envelope, model: ControlModel, top_pose, what: str) -
     or "predicted")."""
     T = np.asarray(top_pose, dtype=float)
     if _rotation_clear(envelope, model, T):  # no rotation component can be out of range
-        m = np.concatenate([_top_translation(model, T), np.zeros(3)])
+        m = _translation_list(model, T) + [0.0, 0.0, 0.0]
     else:
-        m = top_motion(model, T)
+        m = top_motion(model, T).tolist()
     out = []
     for k, (v, lim) in enumerate(zip(m, envelope.motion_range, strict=True)):
         if abs(v) > lim:
@@ -229,6 +302,21 @@ def check_motion(envelope: Envelope, model: ControlModel, top_pose, what: str) -
             out.append(f"{what} top motion {_MOTION_NAMES[k]} {v:+.3f} {unit} is beyond the "
                        f"±{lim:g} {unit} range (Vibhute Table 3-1)")
     return out
+
+
+def _norm3(v) -> float:
+    """``|v|`` of a 3-vector in scalars."""
+    a, b, c = v.tolist()
+    return math.sqrt(a * a + b * b + c * c)
+
+
+def _largest(values: list[float]) -> int:
+    """Index of the largest ``|v|`` (the first of equals, as :func:`numpy.argmax`)."""
+    k, best = 0, abs(values[0])
+    for i in range(1, len(values)):
+        if abs(values[i]) > best:
+            k, best = i, abs(values[i])
+    return k
 
 
 def check_target(envelope: Envelope, force_target) -> list[str]:
@@ -245,13 +333,15 @@ def check_target(envelope: Envelope, force_target) -> list[str]:
 def check_measurement(envelope: Envelope, model: ControlModel, meas: Measurement) -> list[str]:
     """Violations in a measurement: load and leg deflections beyond the envelope."""
     out = []
-    if not (np.all(np.isfinite(meas.wrench)) and np.all(np.isfinite(meas.leg_lengths))):
+    w = np.asarray(meas.wrench, dtype=float).tolist()
+    lengths = np.asarray(meas.leg_lengths, dtype=float).tolist()
+    if not all(map(math.isfinite, w + lengths)):
         return ["the measurement contains NaN or infinity"]
-    F = meas.force_magnitude
+    F = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
     if F > envelope.max_load:
         out.append(f"measured load {F:.3g} N exceeds the limit {envelope.max_load:g} N")
-    defl = meas.deflections(model)
-    k = int(np.argmax(np.abs(defl)))
+    defl = [x - x0 for x, x0 in zip(lengths, _consts(model).free_lengths, strict=True)]
+    k = _largest(defl)
     if abs(defl[k]) > envelope.max_deflection:
         out.append(f"leg {model.platform.leg_names[k]} is deflected {defl[k]:+.3f} mm, beyond "
                    f"±{envelope.max_deflection:g} mm")
@@ -264,33 +354,38 @@ def check_command(envelope: Envelope, model: ControlModel, axis_deg_new, axis_de
     """Violations of a command: axis limits, axis step, predicted load and deflections.
 
     ``axis_deg_new`` are the absolute axis angles that will be commanded (degrees, after
-    rounding to counts); ``axis_deg_now`` the current ones.
+    rounding to counts); ``axis_deg_now`` the current ones. (Scalar arithmetic on Python
+    floats: the checks run on every command.)
     """
     out = []
-    a = np.asarray(axis_deg_new, dtype=float)
-    if a.shape != (6,) or not np.all(np.isfinite(a)):
-        return [f"commanded axis angles are not 6 finite numbers: {a.tolist()}"]
-    lo, hi = model.limits_deg[:, 0], model.limits_deg[:, 1]
+    arr = np.asarray(axis_deg_new, dtype=float)
+    a = arr.tolist()
+    if arr.shape != (6,) or not all(map(math.isfinite, a)):
+        return [f"commanded axis angles are not 6 finite numbers: {a}"]
+    k = _consts(model)
     for j in range(6):
-        if not lo[j] <= a[j] <= hi[j]:
+        if not k.lo[j] <= a[j] <= k.hi[j]:
             out.append(f"axis {j + 1} command {a[j]:.4f}° is outside its limits "
-                       f"[{lo[j]:g}°, {hi[j]:g}°]")
+                       f"[{k.lo[j]:g}°, {k.hi[j]:g}°]")
     if axis_deg_now is not None:
-        step = np.abs(a - np.asarray(axis_deg_now, dtype=float))
-        j = int(np.argmax(step))
+        now = np.asarray(axis_deg_now, dtype=float).tolist()
+        step = [abs(x - y) for x, y in zip(a, now, strict=True)]
+        j = _largest(step)
         if step[j] > envelope.max_joint_step_deg:
             out.append(f"axis {j + 1} would move {step[j]:.3f}° in one command, more than "
                        f"{envelope.max_joint_step_deg:g}°")
     if prediction is not None:
+        defl = prediction.deflections.tolist()
+        if not all(map(math.isfinite, prediction.force.tolist() + defl)):
+            return out + ["the predicted force or leg deflections are not finite"]
         F = prediction.force_magnitude
         if F > envelope.max_load:
             out.append(f"predicted load {F:.3g} N after the move exceeds the limit "
                        f"{envelope.max_load:g} N")
-        k = int(np.argmax(np.abs(prediction.deflections)))
-        dk = prediction.deflections[k]
-        if abs(dk) > envelope.max_deflection:
-            out.append(f"leg {model.platform.leg_names[k]} would deflect {dk:+.3f} mm after the "
-                       f"move, beyond ±{envelope.max_deflection:g} mm")
+        j = _largest(defl)
+        if abs(defl[j]) > envelope.max_deflection:
+            out.append(f"leg {model.platform.leg_names[j]} would deflect {defl[j]:+.3f} mm "
+                       f"after the move, beyond ±{envelope.max_deflection:g} mm")
         if prediction.top_pose is not None:
             out += check_motion(envelope, model, prediction.top_pose, "predicted")
     return out

@@ -111,8 +111,15 @@ class Measurement:
         return self.leg_lengths - model.platform.free_lengths
 
     def tip(self, model: ControlModel) -> np.ndarray:
-        """The measured (deflected) tool tip, fixed frame."""
-        return apply(self.base_pose @ self.top_pose, model.tool_tip_top)
+        """The measured (deflected) tool tip, fixed frame (read-only; computed once per model:
+        a cycle asks for it several times)."""
+        got = self.__dict__.get("_tip")
+        if got is not None and got[0] is model:
+            return got[1]
+        p = apply(self.base_pose @ self.top_pose, model.tool_tip_top)
+        p.setflags(write=False)
+        self.__dict__["_tip"] = (model, p)  # a cache, not a field: the instance stays frozen
+        return p
 
 
 def tool_frame(q, model: ControlModel):

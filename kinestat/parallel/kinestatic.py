@@ -53,6 +53,7 @@ wrenches, a twist of freedom that is not reciprocal, a wrench change outside spa
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -86,6 +87,7 @@ _K_TOL = 1e-12  # K is singular when s_min / s_max ≤ this
 _W_TOL = 1e-9  # contact wrenches dependent when s_min / s_max of the unit columns ≤ this
 _G_TOL = 1e-10  # Wᵀ Δ K⁻¹ W singular when s_min ≤ this × |K⁻¹| (unit columns of W)
 _IN_TOL = 1e-9  # relative tolerance of the input checks of compose_twist
+_TINY = float(np.finfo(float).tiny)
 
 
 class TwistSplit(NamedTuple):
@@ -288,31 +290,40 @@ def compose_twist_line(K, w, freedom, delta_wrench) -> np.ndarray:
     the same checks in the same order with the same messages (singular K, zero wrench, a
     wrench change not along ``w``, a twist of freedom not reciprocal to ``w``) and the same
     value ``T_f + K⁻¹ δw``, without the batched machinery (the control cycle's hot path).
-    The span check projects on ``w`` directly instead of through a pseudo-inverse; the two
-    agree to rounding, far inside the 1e-9 tolerance.
+    The span check projects on ``w`` directly instead of through a pseudo-inverse, and the
+    vector checks run in scalar arithmetic; they agree with the batched ones to rounding, far
+    inside the 1e-9 tolerance.
 
     >>> K = np.diag([10.0, 10.0, 10.0, 1.0, 1.0, 1.0]) @ DELTA
     >>> compose_twist_line(K, np.array([0, 0, 1.0, 0, 0, 0]), np.array([0, 0, 0, 1.0, 0, 0]),
     ...                    np.array([0, 0, 20.0, 0, 0, 0]))
     array([0., 0., 0., 1., 0., 2.])
     """
-    K, _ = _check_stiffness(K)
+    K = np.asarray(K, dtype=float)
     w = np.asarray(w, dtype=float)
     Tf = np.asarray(freedom, dtype=float)
     dw = np.asarray(delta_wrench, dtype=float)
+    ok = K.shape == (6, 6) and all(map(math.isfinite, K.ravel().tolist()))
+    s = np.linalg.svd(K, compute_uv=False) if ok else None
+    if s is None or s[-1] <= _K_TOL * s[0]:
+        K, _ = _check_stiffness(K)  # raises its message: a bad shape, not finite, singular
+    vals = []
     for v, name in ((w, "contact wrenches W"), (Tf, "twist of freedom"), (dw, "wrench change")):
-        if v.shape != (6,) or not np.all(np.isfinite(v)):
-            raise InputError(f"{name} must be 6 finite numbers, got {v.tolist()}")
-    wn = float(np.linalg.norm(w))
+        x = v.tolist()
+        if v.shape != (6,) or not all(map(math.isfinite, x)):
+            raise InputError(f"{name} must be 6 finite numbers, got {x}")
+        vals.append(x)
+    wl, tl, dl = vals
+    wn = math.sqrt(sum(a * a for a in wl))
     if wn == 0.0:
         raise InputError("contact wrench 1 is zero")
-    tiny = np.finfo(float).tiny
-    res = dw - w * (float(w @ dw) / (wn * wn))
-    if float(np.linalg.norm(res)) > _IN_TOL * max(float(np.linalg.norm(dw)), tiny):
+    c = sum(a * b for a, b in zip(wl, dl, strict=True)) / (wn * wn)
+    res = math.sqrt(sum((b - a * c) ** 2 for a, b in zip(wl, dl, strict=True)))
+    if res > _IN_TOL * max(math.sqrt(sum(b * b for b in dl)), _TINY):
         raise InputError("the wrench change is not one the contact can exert: it is not a "
                          "combination of the contact wrenches W")
-    r = float(w @ (Tf @ DELTA))
-    scale = max(wn * float(np.linalg.norm(Tf)), tiny)
+    r = sum(wl[i] * tl[(i + 3) % 6] for i in range(6))  # w · (T_f Δ), Δ swaps the halves
+    scale = max(wn * math.sqrt(sum(a * a for a in tl)), _TINY)
     if abs(r) > _IN_TOL * scale:
         raise InputError(f"the twist of freedom is not reciprocal to the contact wrenches "
                          f"(relative |Wᵀ Δ T_f| = {abs(r) / scale:.3g}): it would push "

@@ -46,7 +46,8 @@ from kinestat.spatial.transforms import as_array, skew
 
 __all__ = ["stiffness", "stiffness_axis_trusted", "stiffness_terms", "load_asymmetry",
            "equilibrium_pose",
-           "tip_compliance", "tip_stiffness", "TWIST_ORDERS"]
+           "tip_compliance", "tip_compliance_one", "pinned_tip_step", "tip_stiffness",
+           "TWIST_ORDERS"]
 
 TWIST_ORDERS = ("ray", "axis")
 
@@ -113,6 +114,41 @@ def stiffness_axis_trusted(platform: Platform, T: np.ndarray) -> np.ndarray:
         return K
     parts = _terms(platform, np.asarray(T, dtype=float))  # raises: a leg of zero length
     return _swap(parts["elastic"] + parts["geometric"] + parts["load"])  # pragma: no cover
+
+
+def tip_compliance_one(K: np.ndarray, tip) -> np.ndarray:
+    """:func:`tip_compliance` (3, 3) of ONE tip ``tip`` (3,) given the stiffness ``K`` (6, 6,
+    axis order) at the pose, compiled (:func:`~kinestat.parallel._stiffness_kernels.
+    tip_compliance_one`): no validation; equal to :func:`tip_compliance` to rounding.
+
+    Raises:
+        numpy.linalg.LinAlgError: ``K`` is singular (as :func:`tip_compliance`).
+    """
+    C = np.empty((3, 3))
+    p = np.array(tip, dtype=float)
+    if not _sk.tip_compliance_one(np.ascontiguousarray(K, dtype=float), p, C):
+        return tip_compliance(None, None, p, stiffness_axis=K)  # raises LinAlgError
+    return C
+
+
+def pinned_tip_step(platform: Platform, T: np.ndarray, K: np.ndarray, tip, u,
+                    force) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """The platform's first-order response at the pose ``T`` (4, 4; stiffness ``K`` (6, 6),
+    axis order) when the base moves so that the tip ``tip`` (3,), pinned in space, sits at
+    ``tip + u`` in the base frame, ``force`` (3,) the external force on the tip (base frame):
+    ``(δF, D, δl, T')`` — the change of the tip force (3,), the top's twist ``[δφ; δx_O]``
+    (6,), the legs' length changes ``jᵀ D`` (6,) and the moved top pose (4, 4), from
+    ``K D = [δF; p × δF + u × F]`` and ``[−[p]×, I] D = u`` (Vibhute eq. 2-16/2-17 to first
+    order), compiled (:func:`~kinestat.parallel._stiffness_kernels.pinned_tip_step_one`); None
+    when ``K`` or the tip compliance is singular or a leg has zero length (the caller falls
+    back to its NumPy formulation, which raises)."""
+    B, P_top, _, _ = _platform_arrays(platform)
+    dF, D, dl, top = np.empty(3), np.empty(6), np.empty(6), np.empty((4, 4))
+    ok = _sk.pinned_tip_step_one(B, P_top, np.ascontiguousarray(T, dtype=float),
+                                 np.ascontiguousarray(K, dtype=float),
+                                 np.array(tip, dtype=float), np.array(u, dtype=float),
+                                 np.array(force, dtype=float), dF, D, dl, top)
+    return (dF, D, dl, top) if ok else None
 
 
 _ARRAYS: dict[int, tuple] = {}
