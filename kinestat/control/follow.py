@@ -56,7 +56,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from kinestat.control.contact_estimate import cone_normal, friction_sample, update_friction
+from kinestat.control.contact_estimate import (
+    cone_normal,
+    friction_sample,
+    path_curvature,
+    update_friction,
+)
 from kinestat.control.controller import (
     Command,
     ControllerConfig,
@@ -139,6 +144,9 @@ SETTLE_ALIGN_DEG = 2.0
 """While settling, the force is raised only once S6 is within this of the normal estimate."""
 TURN_DEADBAND_DEG = 0.3
 """Misalignments of S6 below this are not corrected (the normal estimate's noise)."""
+CURVATURE_SPAN = 4.0
+"""Shortest span (mm) of the measured tip path along the travel over which its curvature is
+fitted (below it the path counts as straight)."""
 TRAVEL_TOL = 0.02
 """Remaining travel (mm) at which the follow task is complete."""
 
@@ -311,6 +319,7 @@ class FollowState(ControllerState):
     step: float = 0.0
     sticking: bool = False
     breakaway: float = 0.0
+    curvature: float = 0.0
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -390,10 +399,12 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
     return None
 
 
-def _creeping(st: FollowState, path: tuple, tip: np.ndarray) -> bool:
+def _creeping(st: FollowState, path: tuple, tip: np.ndarray, advance: float) -> bool:
     """While μ is learnt, a tip that crept :data:`LEARN_CHORD_LENGTH` along the travel over
-    the last cycles slides (the breakaway tilt slips it slowly, below ``MIN_SLIP`` a cycle)."""
-    if st.friction_samples >= LEARN_CHORDS:
+    the last cycles, and forward in this one, slides (the breakaway tilt slips it slowly,
+    below ``MIN_SLIP`` a cycle); a tip that stopped or went back sticks (its force is inside
+    the friction cone and says nothing of the normal or μ)."""
+    if st.friction_samples >= LEARN_CHORDS or advance <= 0.0:
         return False
     c = _chord(path, tip, LEARN_CHORD_LENGTH)
     return c is not None and float(c @ st.tangent) > 0.5 * float(np.linalg.norm(c))
@@ -423,7 +434,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     advance = float((tip - st.last_tip) @ s)
     travel = st.travel + advance
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
-    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip):
+    slid = advance >= max(SLIDE_FRACTION * st.step, MIN_SLIP)
+    if not slid and not _creeping(st, path, tip, advance):
         stuck = st.step > 0 or st.sticking
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
                        breakaway=st.breakaway + (_breakaway_step(st) if stuck else 0.0))
@@ -444,7 +456,9 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ n)))))
         brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
         brk /= config.max_turn_deg
-    return replace(st, travel=travel, normal=n, last_tip=tip, path=path,
+    t = s - (s @ n) * n
+    kappa = path_curvature(np.asarray(path), tip, n, t / np.linalg.norm(t), CURVATURE_SPAN)
+    return replace(st, travel=travel, normal=n, last_tip=tip, path=path, curvature=kappa,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
                    path_dir=None if c is None else c / np.linalg.norm(c),
                    sticking=False, breakaway=brk)
@@ -475,7 +489,7 @@ def decide_follow(config: FollowConfig, state: ControllerState,
     info = {"phase": st.phase, "tip": meas.tip(model), "normal_estimate": st.normal,
             "normal_force": fn, "tangential_force": ft, "travel": st.travel,
             "in_contact": contact,
-            "friction_ratio": st.friction_ratio}
+            "friction_ratio": st.friction_ratio, "curvature": st.curvature}
     kw = {"force_error": err, "info": info}
     bad = check_measurement(env, model, meas)
     if bad:
@@ -537,6 +551,9 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         travel_vec = step * t
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
              else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
+    if step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs under the step
+        omega = _curvature_feedforward(n, t, st.curvature * step, omega,
+                                       math.radians(config.max_turn_deg))
     dlam = config.gain * err
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
         dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
@@ -551,6 +568,20 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     action = "follow" if phase == "travel" else "settle"
     return _command(config, st, meas, new, label, action, step,
                     math.degrees(float(np.linalg.norm(omega))), kw)
+
+
+def _curvature_feedforward(n: np.ndarray, t: np.ndarray, angle: float, omega: np.ndarray,
+                           limit_rad: float) -> np.ndarray:
+    """Feed the surface's turn forward: the normal at the end of the step is turned by
+    ``angle = κ Δs`` towards the travel (:func:`turn_by_curvature`), so S6 turns by it about
+    ``n̂ × t̂`` on top of the feedback turn ``omega`` (together at most ``limit_rad``). The
+    travel stays along the tangent (a twist of freedom; the chord's sag ``κ Δs²/2`` is left
+    to the force control)."""
+    w = omega + angle * cross3(n, t)
+    a = float(np.linalg.norm(w))
+    if a > limit_rad:
+        w *= limit_rad / a
+    return w
 
 
 def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Target, label: str,
