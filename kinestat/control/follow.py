@@ -31,7 +31,10 @@ line through the measured tip ``p``, the base (flange) is displaced by
 * ``T_f``, a twist of freedom (reciprocal to W): the travel ``Δs t̂`` along the tangent
   ``t̂`` (the requested direction carried onto the tangent plane, then transported from cycle
   to cycle) plus a rotation about the tip turning S6 onto ``−n̂`` (or the commanded tilt
-  towards ``t̂``);
+  towards ``t̂``), plus, on a curved path, the surface's own turn under the step,
+  ``κ̂ Δs`` about ``n̂ × t̂`` (``κ̂`` the normal curvature of a circle fitted to the measured
+  tips, :func:`~kinestat.control.contact_estimate.path_curvature`): without it S6 lags the
+  turning normal by a step and the dead band, and a tip with friction sticks;
 * ``−K⁻¹ W Δλ``, the twist of compliance that raises the normal force by
   ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ);
   once μ̂ is measured, along the friction cone's edge ``W_c = [n̂ − μ̂ t̂; p × (n̂ − μ̂ t̂)]``
@@ -44,6 +47,11 @@ analysis and rounded to counts with the press task's vernier; the envelope
 (:mod:`kinestat.control.envelope`) checks every measurement and every command's worst-case
 prediction. While settling, the force is raised only once S6 is within ``SETTLE_ALIGN_DEG`` of
 the normal; travel starts once ``|F_n − |F_req|| ≤ settle_tol``.
+
+This module is over 600 lines for a reason: the estimator (:func:`_observe`) and the law
+(:func:`_act`) share :class:`FollowState` and its constants, and splitting them would put
+one task's state machine across modules; the reusable pieces already live in
+:mod:`kinestat.control.contact_estimate`.
 
 Phases (the ``label`` of each cycle): ``a`` approach along S6 (no contact), ``b`` first
 contact, ``d`` settling the normal force before travel, ``f`` following (travel), ``e`` done.
