@@ -33,8 +33,11 @@ line through the measured tip ``p``, the base (flange) is displaced by
   to cycle) plus a rotation about the tip turning S6 onto ``−n̂`` (or the commanded tilt
   towards ``t̂``), plus, on a curved path, the surface's own turn under the step,
   ``κ̂ Δs`` about ``n̂ × t̂`` (``κ̂`` the normal curvature of a circle fitted to the measured
-  tips, :func:`~kinestat.control.contact_estimate.path_curvature`): without it S6 lags the
-  turning normal by a step and the dead band, and a tip with friction sticks;
+  tips, :func:`~kinestat.control.contact_estimate.path_curvature`) when the tool is tilted
+  onto the friction cone (``auto_tilt``): without it S6 lags the turning normal by a step
+  and the dead band, falls inside the cone and the tip sticks. Along the normal
+  (frictionless) the lag costs nothing, and turning ahead of the estimate about a free tip
+  excites the soft mode (the tip runs ahead), so the feedback alone turns S6 there;
 * ``−K⁻¹ W Δλ``, the twist of compliance that raises the normal force by
   ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ);
   once μ̂ is measured, along the friction cone's edge ``W_c = [n̂ − μ̂ t̂; p × (n̂ − μ̂ t̂)]``
@@ -563,7 +566,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         travel_vec = step * t
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
              else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
-    if step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs under the step
+    if config.auto_tilt and step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs
         omega = _curvature_feedforward(n, t, st.curvature * step, omega,
                                        math.radians(config.max_turn_deg))
     dlam = config.gain * err
