@@ -132,9 +132,6 @@ it sticks and the normal estimate is kept (a sticking tip's force says nothing o
 surface)."""
 MIN_SLIP = 0.2
 """Smallest advance of the tip (mm) that counts as sliding."""
-MIN_CREEP = 0.1
-"""Smallest advance of the tip (mm) in one cycle that counts as creeping while μ is learnt:
-above the measured tip's cycle-to-cycle noise (about ±0.05 mm with the thesis's encoders)."""
 LEARN_CHORDS = 3
 """With the automatic tilt, chords needed before the friction ratio is trusted; until then the
 tilt reached at breakaway is kept and the travel steps are ``LEARN_STEP`` of the full step."""
@@ -415,11 +412,12 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
 
 def _creeping(st: FollowState, path: tuple, tip: np.ndarray, advance: float) -> bool:
     """While μ is learnt, a tip that crept :data:`LEARN_CHORD_LENGTH` along the travel over
-    the last cycles, and at least :data:`MIN_CREEP` in this one, slides (the breakaway tilt
-    slips it slowly, below ``MIN_SLIP`` a cycle); a tip that stopped (its advance within the
-    measured tip's noise) or went back sticks: its force is inside the friction cone and says
-    nothing of the normal or μ."""
-    if st.friction_samples >= LEARN_CHORDS or advance < MIN_CREEP:
+    the last cycles, and forward in this one, slides (the breakaway tilt slips it slowly,
+    below ``MIN_SLIP`` a cycle); a tip that went back sticks: its force is inside the
+    friction cone and says nothing of the normal or μ. (A threshold above the tip's noise,
+    0.1 mm, was tried: it also takes the slow creep of the breakaway for sticking, the tilt
+    grows on, and the default plane stops on the 4° range.)"""
+    if st.friction_samples >= LEARN_CHORDS or advance <= 0.0:
         return False
     c = _chord(path, tip, LEARN_CHORD_LENGTH)
     return c is not None and float(c @ st.tangent) > 0.5 * float(np.linalg.norm(c))
