@@ -140,7 +140,8 @@ def path_curvature(points, tip, normal, tangent, min_span: float) -> float:
     inside the material, on the −``normal`` side) of the tip path along ``tangent``: the
     points (and ``tip``) in the plane of ``tangent`` and ``normal`` through ``tip``, a circle
     fitted (:func:`fit_circle`), ``κ = −2A / sqrt(B² + 1 − 4AD)`` (the signed inverse radius).
-    0 when the points span less than ``min_span`` mm along the tangent or are fewer than 4.
+    0 when the points span less than ``min_span`` mm along the tangent, are fewer than 4, or
+    when the arc's sagitta ``|κ| span²/8`` is below twice the fit's RMS residual (noise).
 
     Shapes: points (N, 3), tip/normal/tangent (3,) (unit, perpendicular).
 
@@ -158,7 +159,14 @@ def path_curvature(points, tip, normal, tangent, min_span: float) -> float:
         return 0.0
     y = np.concatenate([P @ normal, [0.0]])
     A, B, D = fit_circle(x, y)
-    return float(-2.0 * A / math.sqrt(max(B * B + 1.0 - 4.0 * A * D, 1e-12)))
+    kappa = float(-2.0 * A / math.sqrt(max(B * B + 1.0 - 4.0 * A * D, 1e-12)))
+    # significance: the arc's sagitta over the span must exceed twice the fit's residual
+    # (the measured tips' noise); a noisy straight path fits a spurious curvature
+    resid = y - (A * (x * x + y * y) + B * x + D)
+    span = float(x.max() - x.min())
+    if abs(kappa) * span * span / 8.0 < 2.0 * float(np.sqrt(np.mean(resid * resid))):
+        return 0.0
+    return kappa
 
 
 def turn_by_curvature(normal, tangent, angle: float) -> tuple[np.ndarray, np.ndarray]:

@@ -185,3 +185,20 @@ def test_turn_by_curvature_follows_the_circle():
                              [-math.sin(th0), math.cos(th0), 0.0], ds / R)
     assert np.allclose(n, [math.cos(th1), math.sin(th1), 0.0], atol=1e-14)
     assert np.allclose(t, [-math.sin(th1), math.cos(th1), 0.0], atol=1e-14)
+
+
+def test_path_curvature_ignores_noise_on_a_straight_path_and_keeps_a_real_arc():
+    """Tips with 0.02 mm noise along the normal: on a straight path any fitted curvature is
+    not significant (0); on an R = 200 mm arc over 11 mm (sagitta 0.076 mm) it is kept, near
+    1/R."""
+    rng = np.random.default_rng(7)
+    n, t = _frame(rng)
+    s = np.linspace(-11.0, 0.0, 12)
+    zeros = 0
+    for _ in range(50):
+        P = np.outer(s, t) + np.outer(rng.normal(0.0, 0.02, 12), n)
+        zeros += path_curvature(P[:-1], P[-1], n, t, 4.0) == 0.0
+    assert zeros >= 45
+    P2, n2, t2 = _cylinder_path(rng, 200.0, 11.0, 12)
+    P2 = P2 + np.outer(rng.normal(0.0, 0.005, 12), n2)
+    assert path_curvature(P2[:-1], P2[-1], n2, t2, 4.0) == pytest.approx(1 / 200.0, rel=0.5)
