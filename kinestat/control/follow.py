@@ -410,14 +410,10 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
     return None
 
 
-def _creeping(st: FollowState, path: tuple, tip: np.ndarray, advance: float) -> bool:
+def _creeping(st: FollowState, path: tuple, tip: np.ndarray) -> bool:
     """While μ is learnt, a tip that crept :data:`LEARN_CHORD_LENGTH` along the travel over
-    the last cycles, and forward in this one, slides (the breakaway tilt slips it slowly,
-    below ``MIN_SLIP`` a cycle); a tip that went back sticks: its force is inside the
-    friction cone and says nothing of the normal or μ. (A threshold above the tip's noise,
-    0.1 mm, was tried: it also takes the slow creep of the breakaway for sticking, the tilt
-    grows on, and the default plane stops on the 4° range.)"""
-    if st.friction_samples >= LEARN_CHORDS or advance <= 0.0:
+    the last cycles slides (the breakaway tilt slips it slowly, below ``MIN_SLIP`` a cycle)."""
+    if st.friction_samples >= LEARN_CHORDS:
         return False
     c = _chord(path, tip, LEARN_CHORD_LENGTH)
     return c is not None and float(c @ st.tangent) > 0.5 * float(np.linalg.norm(c))
@@ -447,8 +443,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     advance = float((tip - st.last_tip) @ s)
     travel = st.travel + advance
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
-    slid = advance >= max(SLIDE_FRACTION * st.step, MIN_SLIP)
-    if not slid and not _creeping(st, path, tip, advance):
+    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip):
         stuck = st.step > 0 or st.sticking
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
                        breakaway=st.breakaway + (_breakaway_step(st) if stuck else 0.0))
