@@ -273,8 +273,9 @@ def test_friction_03_cylinder_no_stick_slip_after_the_breakaway(tmp_path):
     assert float(np.max(np.abs(err))) <= 0.15
 
 
-@pytest.mark.xfail(strict=True, reason="issue 13 open: on the cylinder, stick-slip events swing "
-                   "the normal force by up to ~1.3 N (docs/control.md, Limits)")
+@pytest.mark.xfail(strict=True, reason="issue 13 open: on the cylinder, the breakaway's stick-slip "
+                   "(first 10 mm) swings the normal force by up to ~1.3 N (docs/control.md, "
+                   "Curvature feed-forward)")
 def test_friction_03_cylinder_meets_the_acceptance(tmp_path):
     cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
     prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.3, cylinder=cyl),
