@@ -18,6 +18,13 @@ chord of its measured tip path, which lies in the surface), so the bias can be r
   (:func:`normal_and_friction`): the friction is measured and reported, not fought.
 
 The controller is not told the surface or μ. Frictionless, ``μ̂ = 0`` and ``n̂ = û``.
+
+**Curvature of the path.** The normal of a curved surface turns as the tip travels: by
+``κ Δs`` over a step ``Δs`` (``κ`` the normal curvature along the travel, positive convex).
+The measured tips lie in the surface, so a circle fitted to the recent tips in the plane of
+the normal and the travel (:func:`fit_circle`, :func:`path_curvature`) measures κ, and the
+normal at the next point is predicted by turning the estimate by ``κ Δs`` towards the travel
+(:func:`turn_by_curvature`) instead of lagging the surface by a step.
 """
 
 from __future__ import annotations
@@ -32,6 +39,10 @@ __all__ = [
     "update_friction",
     "normal_and_friction",
     "MIN_FRICTION_WEIGHT",
+    "fit_circle",
+    "circle_centre_radius",
+    "path_curvature",
+    "turn_by_curvature",
 ]
 
 MIN_FRICTION_WEIGHT = 0.05
@@ -91,3 +102,83 @@ def normal_and_friction(force_on_tool, normal) -> tuple[float, np.ndarray]:
     n = np.asarray(normal, dtype=float)
     fn = float(f @ n)
     return fn, f - fn * n
+
+
+def fit_circle(x, y) -> np.ndarray:
+    """The algebraic circle ``A (x² + y²) + B x − y + D = 0`` fitted to points (x, y) by linear
+    least squares in the residual of ``y`` (a Kåsa fit normalised on the ``y`` coefficient, so
+    a straight line ``y = B x + D`` is the case ``A = 0``: well conditioned for flat paths;
+    exact for exact points on any circle not centred on the x axis — with x along the path
+    and y along its normal, the centre is off it).
+
+    Shapes: x, y (N,) with N ≥ 3 → (3,) ``[A, B, D]``.
+
+    >>> (np.round(fit_circle([-0.6, 0.0, 0.6], [-0.2, 0.0, -0.2]), 12) + 0.0).tolist()
+    [-0.5, 0.0, 0.0]
+    """
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    M = np.column_stack([x * x + y * y, x, np.ones_like(x)])
+    coef, *_ = np.linalg.lstsq(M, y, rcond=None)
+    return coef
+
+
+def circle_centre_radius(coef) -> tuple[np.ndarray, float]:
+    """Centre (2,) and radius of the circle ``A (x² + y²) + B x − y + D = 0`` (``A ≠ 0``):
+    centre ``(−B, 1)/(2A)``, radius ``sqrt(B² + 1 − 4AD)/(2|A|)``.
+
+    >>> c, r = circle_centre_radius([-0.5, 0.0, 0.0])
+    >>> np.round(c, 12).tolist(), r
+    ([0.0, -1.0], 1.0)
+    """
+    A, B, D = (float(v) for v in coef)
+    return np.array([-B, 1.0]) / (2.0 * A), math.sqrt(B * B + 1.0 - 4.0 * A * D) / (2 * abs(A))
+
+
+def path_curvature(points, tip, normal, tangent, min_span: float) -> float:
+    """The normal curvature (1/mm, positive where the surface is convex: the circle's centre
+    inside the material, on the −``normal`` side) of the tip path along ``tangent``: the
+    points (and ``tip``) in the plane of ``tangent`` and ``normal`` through ``tip``, a circle
+    fitted (:func:`fit_circle`), ``κ = −2A / sqrt(B² + 1 − 4AD)`` (the signed inverse radius).
+    0 when the points span less than ``min_span`` mm along the tangent, are fewer than 4, or
+    when the arc's sagitta ``|κ| span²/8`` is below twice the fit's RMS residual (noise).
+
+    Shapes: points (N, 3), tip/normal/tangent (3,) (unit, perpendicular).
+
+    >>> a = np.linspace(0.0, 0.05, 6)
+    >>> pts = np.column_stack([100 * np.sin(a), 100 * np.cos(a) - 100, 0 * a])
+    >>> round(path_curvature(pts[:-1], pts[-1], pts[-1] / 100 + [0, 1, 0],
+    ...                      [math.cos(0.05), -math.sin(0.05), 0.0], 1.0), 12)
+    0.01
+    """
+    P = np.asarray(points, dtype=float) - np.asarray(tip, dtype=float)
+    if len(P) < 3:
+        return 0.0
+    x = np.concatenate([P @ tangent, [0.0]])
+    if float(x.max() - x.min()) < min_span:
+        return 0.0
+    y = np.concatenate([P @ normal, [0.0]])
+    A, B, D = fit_circle(x, y)
+    kappa = float(-2.0 * A / math.sqrt(max(B * B + 1.0 - 4.0 * A * D, 1e-12)))
+    # significance: the arc's sagitta over the span must exceed twice the fit's residual
+    # (the measured tips' noise); a noisy straight path fits a spurious curvature
+    resid = y - (A * (x * x + y * y) + B * x + D)
+    span = float(x.max() - x.min())
+    if abs(kappa) * span * span / 8.0 < 2.0 * float(np.sqrt(np.mean(resid * resid))):
+        return 0.0
+    return kappa
+
+
+def turn_by_curvature(normal, tangent, angle: float) -> tuple[np.ndarray, np.ndarray]:
+    """The normal and tangent a step further along a path whose normal turns by ``angle``
+    (rad, ``κ Δs``; positive turns the normal towards the travel, a convex surface):
+    ``n' = cos θ n̂ + sin θ t̂``, ``t' = cos θ t̂ − sin θ n̂``.
+
+    >>> n, t = turn_by_curvature([0.0, 0.0, 1.0], [1.0, 0.0, 0.0], math.pi / 2)
+    >>> np.round(n, 12).tolist(), np.round(t, 12).tolist()
+    ([1.0, 0.0, 0.0], [0.0, 0.0, -1.0])
+    """
+    n = np.asarray(normal, dtype=float)
+    t = np.asarray(tangent, dtype=float)
+    c, s = math.cos(angle), math.sin(angle)
+    return c * n + s * t, c * t - s * n

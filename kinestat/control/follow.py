@@ -31,7 +31,13 @@ line through the measured tip ``p``, the base (flange) is displaced by
 * ``T_f``, a twist of freedom (reciprocal to W): the travel ``Δs t̂`` along the tangent
   ``t̂`` (the requested direction carried onto the tangent plane, then transported from cycle
   to cycle) plus a rotation about the tip turning S6 onto ``−n̂`` (or the commanded tilt
-  towards ``t̂``);
+  towards ``t̂``), plus, on a curved path, the surface's own turn under the step,
+  ``κ̂ Δs`` about ``n̂ × t̂`` (``κ̂`` the normal curvature of a circle fitted to the measured
+  tips, :func:`~kinestat.control.contact_estimate.path_curvature`) when the tool is tilted
+  onto the friction cone (``auto_tilt``): without it S6 lags the turning normal by a step
+  and the dead band, falls inside the cone and the tip sticks. Along the normal
+  (frictionless) the lag costs nothing, and turning ahead of the estimate about a free tip
+  excites the soft mode (the tip runs ahead), so the feedback alone turns S6 there;
 * ``−K⁻¹ W Δλ``, the twist of compliance that raises the normal force by
   ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ);
   once μ̂ is measured, along the friction cone's edge ``W_c = [n̂ − μ̂ t̂; p × (n̂ − μ̂ t̂)]``
@@ -45,6 +51,11 @@ analysis and rounded to counts with the press task's vernier; the envelope
 prediction. While settling, the force is raised only once S6 is within ``SETTLE_ALIGN_DEG`` of
 the normal; travel starts once ``|F_n − |F_req|| ≤ settle_tol``.
 
+This module is over 600 lines for a reason: the estimator (:func:`_observe`) and the law
+(:func:`_act`) share :class:`FollowState` and its constants, and splitting them would put
+one task's state machine across modules; the reusable pieces already live in
+:mod:`kinestat.control.contact_estimate`.
+
 Phases (the ``label`` of each cycle): ``a`` approach along S6 (no contact), ``b`` first
 contact, ``d`` settling the normal force before travel, ``f`` following (travel), ``e`` done.
 """
@@ -56,7 +67,12 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from kinestat.control.contact_estimate import cone_normal, friction_sample, update_friction
+from kinestat.control.contact_estimate import (
+    cone_normal,
+    friction_sample,
+    path_curvature,
+    update_friction,
+)
 from kinestat.control.controller import (
     Command,
     ControllerConfig,
@@ -139,6 +155,9 @@ SETTLE_ALIGN_DEG = 2.0
 """While settling, the force is raised only once S6 is within this of the normal estimate."""
 TURN_DEADBAND_DEG = 0.3
 """Misalignments of S6 below this are not corrected (the normal estimate's noise)."""
+CURVATURE_SPAN = 4.0
+"""Shortest span (mm) of the measured tip path along the travel over which its curvature is
+fitted (below it the path counts as straight)."""
 TRAVEL_TOL = 0.02
 """Remaining travel (mm) at which the follow task is complete."""
 END_STEP = 0.25
@@ -313,6 +332,7 @@ class FollowState(ControllerState):
     step: float = 0.0
     sticking: bool = False
     breakaway: float = 0.0
+    curvature: float = 0.0
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -446,7 +466,9 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ n)))))
         brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
         brk /= config.max_turn_deg
-    return replace(st, travel=travel, normal=n, last_tip=tip, path=path,
+    t = s - (s @ n) * n
+    kappa = path_curvature(np.asarray(path), tip, n, t / np.linalg.norm(t), CURVATURE_SPAN)
+    return replace(st, travel=travel, normal=n, last_tip=tip, path=path, curvature=kappa,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
                    path_dir=None if c is None else c / np.linalg.norm(c),
                    sticking=False, breakaway=brk)
@@ -477,7 +499,7 @@ def decide_follow(config: FollowConfig, state: ControllerState,
     info = {"phase": st.phase, "tip": meas.tip(model), "normal_estimate": st.normal,
             "normal_force": fn, "tangential_force": ft, "travel": st.travel,
             "in_contact": contact,
-            "friction_ratio": st.friction_ratio}
+            "friction_ratio": st.friction_ratio, "curvature": st.curvature}
     kw = {"force_error": err, "info": info}
     bad = check_measurement(env, model, meas)
     if bad:
@@ -544,6 +566,9 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         travel_vec = step * t
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
              else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
+    if config.auto_tilt and step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs
+        omega = _curvature_feedforward(n, t, st.curvature * step, omega,
+                                       math.radians(config.max_turn_deg))
     dlam = config.gain * err
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
         dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
@@ -558,6 +583,20 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     action = "follow" if phase == "travel" else "settle"
     return _command(config, st, meas, new, label, action, step,
                     math.degrees(float(np.linalg.norm(omega))), kw)
+
+
+def _curvature_feedforward(n: np.ndarray, t: np.ndarray, angle: float, omega: np.ndarray,
+                           limit_rad: float) -> np.ndarray:
+    """Feed the surface's turn forward: the normal at the end of the step is turned by
+    ``angle = κ Δs`` towards the travel (:func:`turn_by_curvature`), so S6 turns by it about
+    ``n̂ × t̂`` on top of the feedback turn ``omega`` (together at most ``limit_rad``). The
+    travel stays along the tangent (a twist of freedom; the chord's sag ``κ Δs²/2`` is left
+    to the force control)."""
+    w = omega + angle * cross3(n, t)
+    a = float(np.linalg.norm(w))
+    if a > limit_rad:
+        w *= limit_rad / a
+    return w
 
 
 def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Target, label: str,

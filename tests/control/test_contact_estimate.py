@@ -6,14 +6,19 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from kinestat.control.contact_estimate import (
     MIN_FRICTION_WEIGHT,
+    circle_centre_radius,
     cone_normal,
+    fit_circle,
     friction_sample,
     normal_and_friction,
+    path_curvature,
+    turn_by_curvature,
     update_friction,
 )
 
@@ -109,3 +114,91 @@ def test_the_running_mean_of_mu_averages_noisy_samples():
     assert abs(mu - 0.3) < 4 * 0.03 * math.sqrt(MIN_FRICTION_WEIGHT / 2)
     # the first sample is taken as it is
     assert update_friction(0.0, 0, 0.25) == (0.25, 1)
+
+
+# --- the curvature of the tip path (circle fit) --------------------------------------------
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.floats(-50.0, 50.0), st.floats(-400.0, -5.0), st.floats(5.0, 400.0),
+       st.floats(0.0, 2 * math.pi), st.floats(0.05, 0.6))
+def test_fit_circle_recovers_a_known_circle(xc, yc, r, a0, span):
+    """Exact points on an arc of a known circle (centre off the x axis): the fit's centre and
+    radius are the circle's."""
+    yc = yc if abs(yc) > 1.0 else -1.0
+    a = a0 + np.linspace(0.0, span, 9)
+    x, y = xc + r * np.cos(a), yc + r * np.sin(a)
+    c, rad = circle_centre_radius(fit_circle(x, y))
+    assert np.allclose(c, [xc, yc], rtol=1e-7, atol=1e-6 * r)
+    assert rad == pytest.approx(r, rel=1e-7)
+
+
+def test_fit_circle_of_a_line_is_flat():
+    x = np.linspace(-5.0, 5.0, 7)
+    A, B, D = fit_circle(x, 0.2 * x + 1.5)
+    assert abs(A) < 1e-12 and B == pytest.approx(0.2) and D == pytest.approx(1.5)
+
+
+def _cylinder_path(rng, R, s_back, n_pts, obliq=0.0):
+    """Tips on a cylinder of radius R (random pose) travelled along a helix at angle `obliq`
+    from the circumference, ending at the last tip; the surface normal and travel direction
+    there. The normal curvature along the travel is cos²(obliq)/R (Euler's theorem)."""
+    Q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    centre = rng.normal(size=3) * 100.0
+    s = np.linspace(-s_back, 0.0, n_pts)  # arc length along the helix, last tip at s = 0
+    th, z = s * math.cos(obliq) / R, s * math.sin(obliq)
+    P = centre + np.column_stack([R * np.cos(th), R * np.sin(th), z]) @ Q.T
+    n = Q @ np.array([1.0, 0.0, 0.0])
+    t = Q @ np.array([0.0, math.cos(obliq), math.sin(obliq)])
+    return P, n, t
+
+
+@pytest.mark.parametrize("R, obliq_deg", [(150.0, 0.0), (200.0, 0.0), (400.0, 0.0),
+                                          (200.0, 20.0), (300.0, 35.0)])
+def test_path_curvature_of_exact_tips_on_a_cylinder(R, obliq_deg):
+    """Convex: +cos²φ/R (the centre inside the material), to the helix's small torsion."""
+    rng = np.random.default_rng(int(R) + int(obliq_deg))
+    P, n, t = _cylinder_path(rng, R, 11.0, 12, math.radians(obliq_deg))
+    k = path_curvature(P[:-1], P[-1], n, t, 4.0)
+    assert k == pytest.approx(math.cos(math.radians(obliq_deg)) ** 2 / R, rel=2e-3)
+    # concave: the same path seen from inside the material
+    assert path_curvature(P[:-1], P[-1], -n, t, 4.0) == pytest.approx(-k, rel=1e-9)
+
+
+def test_path_curvature_is_zero_on_a_plane_and_below_the_span():
+    rng = np.random.default_rng(3)
+    n, t = _frame(rng)
+    s = np.linspace(-10.0, 0.0, 11)
+    P = np.outer(s, t) + 0.001 * np.outer(s, n)  # a straight, slightly sloped path
+    assert abs(path_curvature(P[:-1], P[-1], n, t, 4.0)) < 1e-9
+    P2, n2, t2 = _cylinder_path(rng, 200.0, 3.0, 6)
+    assert path_curvature(P2[:-1], P2[-1], n2, t2, 4.0) == 0.0  # spans 3 mm < 4 mm
+    assert path_curvature(P2[:1], P2[-1], n2, t2, 0.0) == 0.0  # too few points
+
+
+def test_turn_by_curvature_follows_the_circle():
+    """The normal and tangent predicted a step ds ahead on a circle of radius R are the
+    circle's own at that point (n = radial, t = its derivative)."""
+    R, ds = 200.0, 1.0
+    th0, th1 = 0.3, 0.3 + ds / R
+    n, t = turn_by_curvature([math.cos(th0), math.sin(th0), 0.0],
+                             [-math.sin(th0), math.cos(th0), 0.0], ds / R)
+    assert np.allclose(n, [math.cos(th1), math.sin(th1), 0.0], atol=1e-14)
+    assert np.allclose(t, [-math.sin(th1), math.cos(th1), 0.0], atol=1e-14)
+
+
+def test_path_curvature_ignores_noise_on_a_straight_path_and_keeps_a_real_arc():
+    """Tips with 0.02 mm noise along the normal: on a straight path any fitted curvature is
+    not significant (0); on an R = 200 mm arc over 11 mm (sagitta 0.076 mm) it is kept, near
+    1/R."""
+    rng = np.random.default_rng(7)
+    n, t = _frame(rng)
+    s = np.linspace(-11.0, 0.0, 12)
+    zeros = 0
+    for _ in range(50):
+        P = np.outer(s, t) + np.outer(rng.normal(0.0, 0.02, 12), n)
+        zeros += path_curvature(P[:-1], P[-1], n, t, 4.0) == 0.0
+    assert zeros >= 45
+    P2, n2, t2 = _cylinder_path(rng, 200.0, 11.0, 12)
+    P2 = P2 + np.outer(rng.normal(0.0, 0.005, 12), n2)
+    assert path_curvature(P2[:-1], P2[-1], n2, t2, 4.0) == pytest.approx(1 / 200.0, rel=0.5)

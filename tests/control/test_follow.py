@@ -254,8 +254,28 @@ def test_friction_03_the_normal_is_unbiased_and_the_force_held_once_sliding(tmp_
     assert out["true_normal_force_max_error"] <= 0.5
 
 
-@pytest.mark.xfail(strict=True, reason="issue 13 open: on the cylinder, stick-slip events swing "
-                   "the normal force by up to ~1.3 N (docs/control.md, Limits)")
+def test_friction_03_cylinder_no_stick_slip_after_the_breakaway(tmp_path):
+    """With the path's curvature fed forward, the tool keeps up with the turning normal: on the
+    R = 200 mm cylinder (ideal sensor, μ = 0.3) the curvature estimate is 1/R and, once past
+    the breakaway (travel ≥ 15 mm), the tip slides every cycle and the true normal force is
+    held to the ideal sensor's 0.05 N RMS (the breakaway itself is the xfail below)."""
+    cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.3, cylinder=cyl,
+                                                          ideal_sensor=True), auto_tilt=True)
+    assert out["completed"], rep.stop_reason
+    late = [c for c in rep.cycles if c["phase"] == "travel" and 15.0 <= c["travel"] <= 49.5]
+    assert len(late) >= 25
+    assert all(c["curvature"] == pytest.approx(1 / 200.0, rel=0.02) for c in late)
+    adv = np.diff([c["travel"] for c in late])
+    assert np.all(adv >= 0.5)  # slides every cycle: no stick
+    err = np.array([_true_normal_force(c) - 4.0 for c in late])
+    assert float(np.sqrt(np.mean(err ** 2))) <= 0.05
+    assert float(np.max(np.abs(err))) <= 0.15
+
+
+@pytest.mark.xfail(strict=True, reason="issue 13 open: on the cylinder, the breakaway's stick-slip "
+                   "(first 10 mm) swings the normal force by up to ~1.3 N (docs/control.md, "
+                   "Curvature feed-forward)")
 def test_friction_03_cylinder_meets_the_acceptance(tmp_path):
     cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
     prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.3, cylinder=cyl),
