@@ -71,11 +71,21 @@ def _pair(y, x):
 
 
 @nb.njit(inline="always", **_OPTS)
+def _unit(y, x):
+    """``(cos θ, sin θ)`` of ``θ = atan2(y, x)`` (θ itself not needed)."""
+    h = math.sqrt(x * x + y * y)
+    if h == 0.0:
+        return 1.0, 0.0
+    return x / h, y / h
+
+
+@nb.njit(inline="always", **_OPTS)
 def _shift(a, c, s, sign):
-    """``(θa + sign·α, cos, sin)`` for the angle triple a and α given by its cosine and sine:
-    the angle-addition formulas, the angle from the resulting pair."""
-    cs = a[1] * c - sign * a[2] * s
-    sn = a[2] * c + sign * a[1] * s
+    """``(θa + sign·α, cos, sin)`` for θa given by its cosine ``a[-2]`` and sine ``a[-1]`` (an
+    angle triple or a pair) and α by c, s: the angle-addition formulas, the angle from the
+    resulting pair."""
+    cs = a[-2] * c - sign * a[-1] * s
+    sn = a[-1] * c + sign * a[-2] * s
     return math.atan2(sn, cs), cs, sn
 
 
@@ -204,7 +214,7 @@ def _sp3(w, r, p, q, delta, tol):
     v = _sub(q, r)
     up = _sub(u, _scale(w, _dot(u, w)))
     vp = _sub(v, _scale(w, _dot(v, w)))
-    t0 = _pair(_dot(w, _cross(up, vp)), _dot(up, vp))
+    t0 = _unit(_dot(w, _cross(up, vp)), _dot(up, vp))
     h = _dot(w, _sub(p, q))
     d2 = delta * delta - h * h
     nu = _norm(up)
@@ -234,7 +244,7 @@ def _sp4(h, w, p, d, tol):
         return False, _NONE, _NONE
     c = min(max(c, -1.0), 1.0)
     s = math.sqrt(1.0 - c * c)
-    phi = (math.atan2(B, A), A / n, B / n)
+    phi = (A / n, B / n)
     return True, _shift(phi, c, s, -1.0), _shift(phi, c, s, 1.0)
 
 
@@ -244,6 +254,17 @@ def _link(C, i, a, t):
     """The running FK transform t (12 scalars) times ``Z(θ_i) C_i`` for the angle triple a of
     joint i (1-based): the serial FK kernel's step with the angle's cosine and sine."""
     return _affine(C[i], _turn(a[1], a[2], t))
+
+
+@nb.njit(inline="always", **_OPTS)
+def _clear(n, out_q, out_valid, out_pos, out_rot):
+    """Empty slots of pose n (NaN, not valid): the caller's outputs are uninitialised."""
+    for k in range(out_q.shape[1]):
+        for i in range(6):
+            out_q[n, k, i] = np.nan
+        out_valid[n, k] = False
+        out_pos[n, k] = np.nan
+        out_rot[n, k] = np.nan
 
 
 @nb.njit(**_OPTS)
@@ -268,6 +289,11 @@ def _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
 @nb.njit(**_OPTS)
 def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
                  out_pos, out_rot, out_sing, out_sign, out_fam):
+    _clear(n, out_q, out_valid, out_pos, out_rot)
+    for k in range(out_q.shape[1]):
+        out_sing[n, k] = False
+        out_sign[n, k] = 0.0
+        out_fam[n, k] = np.nan
     Tn = T[n]
     Rg, tg = _pose_times(Tn, T0inv)
     W0, W1, W2, W3, W4, W5 = _row(W, 0), _row(W, 1), _row(W, 2), _row(W, 3), _row(W, 4), _row(W, 5)
@@ -322,7 +348,7 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
 @nb.njit(parallel=True, **_OPTS)
 def pieper_batch(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
                  out_rot, out_sing, out_sign, out_fam):
-    """Spherical-wrist closed form for N poses (outputs pre-filled by the caller)."""
+    """Spherical-wrist closed form for N poses into the (uninitialised) outputs."""
     for n in nb.prange(T.shape[0]):
         _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
                      out_pos, out_rot, out_sing, out_sign, out_fam)
@@ -349,6 +375,7 @@ def _theta4(phi, t2, t3, sg):
 @nb.njit(**_OPTS)
 def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
                          out_valid, out_pos, out_rot):
+    _clear(n, out_q, out_valid, out_pos, out_rot)
     Tn = T[n]
     Rg, tg = _pose_times(Tn, T0inv)
     W0, W1, W2, W4, W5 = _row(W, 0), _row(W, 1), _row(W, 2), _row(W, 4), _row(W, 5)

@@ -153,7 +153,9 @@ _REASON_3P = ("no real solution: the pose is out of reach (subproblem 4 for θ1 
 
 
 def _outputs(N: int, K: int):
-    return nan_array((N, K, 6)), np.zeros((N, K), dtype=bool), nan_array((N, K)), nan_array((N, K))
+    """Uninitialised outputs ``q (N, K, 6)``, ``valid``, ``pos``, ``rot`` (the kernels clear
+    every pose's slots first)."""
+    return np.empty((N, K, 6)), np.empty((N, K), dtype=bool), np.empty((N, K)), np.empty((N, K))
 
 
 def _result(q, valid, pos, rot, sing, sign, fam, joints, reason, method, tol) -> IKAllResult:
@@ -173,9 +175,9 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     ax = data["axes"]
     N = T.shape[0]
     q, valid, pos, rot = _outputs(N, 8)
-    sing = np.zeros((N, 8), dtype=bool)
-    sign = np.zeros((N, 8))
-    fam = nan_array((N, 8))
+    sing = np.empty((N, 8), dtype=bool)
+    sign = np.empty((N, 8))
+    fam = np.empty((N, 8))
     run = K.pieper_batch if N >= _PARALLEL_MIN else K.pieper_serial
     if "kernel_args" not in data:  # pose-independent, kept with the model's cached geometry
         data["kernel_args"] = (np.asarray(model.constants), np.linalg.inv(ax.T0), ax.w, ax.r,
