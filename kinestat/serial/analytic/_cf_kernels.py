@@ -304,7 +304,7 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
     pw = _add(_mv(Rg, wc), tg)
     ok3, a3, b3 = _sp3(W2, P2, wc, sc, _norm(_sub(pw, sc)), tol)
     if not ok3:
-        return
+        return 0
     f0 = _start(C[0])
     cnt = 0
     for i3 in range(2):
@@ -343,24 +343,42 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
                     out_sign[n, cnt] = sig
                     out_fam[n, cnt] = _wrap(out_q[n, cnt, 3] + sig * out_q[n, cnt, 5])
                 cnt = new
+    return cnt
+
+
+@nb.njit(inline="always", **_OPTS)
+def _unpack(Kp):
+    """The pose-independent data packed by :func:`pack` (one array: one argument to unbox per
+    call): ``C (7, 4, 4)``, ``T0inv (4, 4)``, ``W (6, 3)``, ``P (6, 3)`` and three 3-vectors."""
+    return (Kp[:112].reshape((7, 4, 4)), Kp[112:128].reshape((4, 4)), Kp[128:146].reshape((6, 3)),
+            Kp[146:164].reshape((6, 3)), Kp[164:167], Kp[167:170], Kp[170:173])
+
+
+def pack(C, T0inv, W, P, a, b, c) -> np.ndarray:
+    """Pack a kernel's pose-independent data (see :func:`_unpack`) into one float array."""
+    return np.ascontiguousarray(np.concatenate([np.ravel(x) for x in (C, T0inv, W, P, a, b, c)]),
+                                dtype=np.float64)
 
 
 @nb.njit(parallel=True, **_OPTS)
-def pieper_batch(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
-                 out_rot, out_sing, out_sign, out_fam):
-    """Spherical-wrist closed form for N poses into the (uninitialised) outputs."""
+def pieper_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
+                 out_sign, out_fam, out_cnt):
+    """Spherical-wrist closed form for N poses into the (uninitialised) outputs; ``out_cnt
+    (N,)`` the number of solutions."""
+    C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
-        _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
-                     out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q,
+                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 @nb.njit(**_OPTS)
-def pieper_serial(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
-                  out_pos, out_rot, out_sing, out_sign, out_fam):
+def pieper_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
+                  out_sign, out_fam, out_cnt):
     """:func:`pieper_batch` on one thread (small batches: no thread start-up)."""
+    C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     for n in range(T.shape[0]):
-        _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
-                     out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q,
+                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 # -- three parallel axes, wrist pair meeting (UR type) ------------------------------------------
@@ -374,8 +392,9 @@ def _theta4(phi, t2, t3, sg):
 
 @nb.njit(**_OPTS)
 def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                         out_valid, out_pos, out_rot):
+                         out_valid, out_pos, out_rot, out_near):
     _clear(n, out_q, out_valid, out_pos, out_rot)
+    out_near[n] = False
     Tn = T[n]
     Rg, tg = _pose_times(Tn, T0inv)
     W0, W1, W2, W4, W5 = _row(W, 0), _row(W, 1), _row(W, 2), _row(W, 4), _row(W, 5)
@@ -386,18 +405,21 @@ def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedu
     q56 = _add(_mv(Rg, pc), tg)
     ok1, psi_a, psi_b = _sp4(h, W0, _sub(q56, P0), _dot(h, _sub(pc, P0)), tol)  # ψ = −θ1
     if not ok1:
-        return
+        return 0
     f0 = _start(C[0])
     cnt = 0
     for i1 in range(2):
         psi = psi_a if i1 == 0 else psi_b
         Rr = _mm(_rot(W0, psi), Rg)
+        hr = _mtv(Rr, h)
+        off = _norm(_cross(hr, W5))
+        if off < 1e-6:
+            out_near[n] = True
+        if off < wrist_tol:
+            continue  # wrist-singular: axis 6 parallel to axes 2-4 (families.py adds them)
         ok5, t5a, t5b = _sp4(h, W4, W5, _dot(h, _mv(Rr, W5)), tol)
         if not ok5:
             continue
-        hr = _mtv(Rr, h)
-        if _norm(_cross(hr, W5)) < wrist_tol:
-            continue  # wrist-singular: axis 6 parallel to axes 2-4 (not reported)
         t1 = _neg(psi)
         f1 = _link(C, 1, t1, f0)
         for i5 in range(2):
@@ -420,24 +442,29 @@ def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedu
                 q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
                 cnt = _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot,
                              cnt)
+    return cnt
 
 
 @nb.njit(parallel=True, **_OPTS)
-def three_parallel_batch(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                         out_valid, out_pos, out_rot):
-    """Three-parallel-axes (UR-type) closed form for N poses."""
+def three_parallel_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot,
+                         out_cnt, out_near):
+    """Three-parallel-axes (UR-type) closed form for N poses; ``out_cnt (N,)`` the number of
+    solutions, ``out_near (N,)`` a θ1 branch is near the wrist-singular set (axis 6 within
+    1e-6 of parallel to axes 2-4: where :mod:`~kinestat.serial.analytic.families` looks)."""
+    C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
-        _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                             out_valid, out_pos, out_rot)
+        out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
+                                          dedup, out_q, out_valid, out_pos, out_rot, out_near)
 
 
 @nb.njit(**_OPTS)
-def three_parallel_serial(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                          out_valid, out_pos, out_rot):
+def three_parallel_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot,
+                          out_cnt, out_near):
     """:func:`three_parallel_batch` on one thread."""
+    C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     for n in range(T.shape[0]):
-        _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                             out_valid, out_pos, out_rot)
+        out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
+                                          dedup, out_q, out_valid, out_pos, out_rot, out_near)
 
 
 # -- pose checks ------------------------------------------------------------------------------
