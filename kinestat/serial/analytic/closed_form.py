@@ -186,8 +186,9 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
                                           data["wrist"], data["shoulder"], _perp(ax.w[5]))
     run(Kp, T, tol, wrist_tol, 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
     return IKAllResult.build((N,) if shape is None else shape, q=q, valid=valid,
-                             position_error=pos, rotation_error=rot, singular=sing, family_sign=sign,
-                             family_value=fam, family_joints=(3, 5), n_solutions=cnt,
+                             position_error=pos, rotation_error=rot, singular=sing,
+                             family_sign=sign, family_value=fam, family_joints=(3, 5),
+                             n_solutions=cnt,
                              reason=reasons(cnt, _REASON_PIEPER), method="pieper", tol=tol)
 
 
