@@ -177,22 +177,6 @@ def test_top_level_export():
     assert kinestat.ik_all is ik_all
 
 
-@pytest.mark.parametrize("name", ["ur5", "puma560", "puma762", "jaco6", "random2"])
-def test_compiled_kernels_match_numpy_references(name):
-    model = arm(name)
-    q = _configs(model, 150, seed=21)
-    T = kinestat.fk(model, q)
-    a = ik_all(model, T)
-    b = ik_all(model, T, backend="numpy")
-    assert a.method == b.method
-    np.testing.assert_array_equal(a.n_solutions, b.n_solutions)
-    for i in range(q.shape[0]):
-        sa, sb = a.solutions((i,)), b.solutions((i,))
-        for s in sb:
-            assert np.min(wrapped_distance(sa, s)) < 1e-6
-    np.testing.assert_array_equal(a.singular.sum(-1), b.singular.sum(-1))
-
-
 @pytest.mark.parametrize("name", ["ur5", "puma560", "random1"])
 def test_rounded_pose_is_projected_onto_a_rotation(name):
     model = arm(name)

@@ -22,7 +22,7 @@ def _configs(name, n, seed):
     return q
 
 
-@pytest.mark.parametrize("name", ["ur5", "puma560", "puma762", "jaco6", "random3"])
+@pytest.mark.parametrize("name", ["ur5", "puma560", "puma762", "jaco6", "random2", "random3"])
 def test_kernels_equal_numpy_references_both_ways(name):
     model = arm(name)
     q = _configs(name, 120, seed=5)
