@@ -183,12 +183,14 @@ def peer_rtb(model):
 
 
 # -- runs -----------------------------------------------------------------------------------
-def run(n: int, n_single: int, repeat: int = 5) -> dict:
+def run(n: int, n_single: int, repeat: int = 5, arms=ARMS) -> dict:
     rng = np.random.default_rng(20261201)
     rows = {}
     for name in ARMS:
+        q = rng.uniform(-PI, PI, (n, 6))  # drawn for every arm: the same poses either way
+        if name not in arms:
+            continue
         model = arm(name)
-        q = rng.uniform(-PI, PI, (n, 6))
         T = kinestat.fk(model, q)
         ik_all(model, T[:512])  # compile / load the kernels (serial and parallel paths)
         dt = cpu_batch = math.inf
@@ -245,9 +247,10 @@ def main(argv=None) -> int:
     ap.add_argument("--single", type=int, default=200, help="poses for single-call timing")
     ap.add_argument("--repeat", type=int, default=5,
                     help="batched kinestat calls per arm; the fastest is reported")
+    ap.add_argument("--arms", default=",".join(ARMS), help=f"comma-separated subset of {ARMS}")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
-    rows = run(a.n, a.single, a.repeat)
+    rows = run(a.n, a.single, a.repeat, tuple(a.arms.split(",")))
     meta = {"cpus": os.cpu_count(), "numba_threads": __import__("numba").get_num_threads(),
             "machine": platform.platform(), "load_avg": os.getloadavg()}
     if a.json:
