@@ -14,6 +14,8 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.spatial._elimination import eliminate
+
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
 __all__ = ["stiffness_axis_one", "tip_compliance_one", "pinned_tip_step_one"]
@@ -100,27 +102,8 @@ def _solve_k_tip(K, p, X, y, b):
     M[3, 7], M[3, 8] = -p[2], p[1]
     M[4, 6], M[4, 8] = p[2], -p[0]
     M[5, 6], M[5, 7] = -p[1], p[0]
-    for c in range(6):
-        piv = c
-        for r in range(c + 1, 6):
-            if abs(M[r, c]) > abs(M[piv, c]):
-                piv = r
-        if not abs(M[piv, c]) > 0.0:
-            return False
-        if piv != c:
-            for k in range(10):
-                M[c, k], M[piv, k] = M[piv, k], M[c, k]
-        for r in range(c + 1, 6):
-            f = M[r, c] / M[c, c]
-            if f != 0.0:
-                for k in range(c, 10):
-                    M[r, k] -= f * M[c, k]
-    for r in range(5, -1, -1):
-        for k in range(6, 10):
-            s = M[r, k]
-            for m in range(r + 1, 6):
-                s -= M[r, m] * M[m, k]
-            M[r, k] = s / M[r, r]
+    if not eliminate(M, 6, 0.0, None) > 0.0:  # [K | A b] → [· | X y]
+        return False
     for r in range(6):
         for c in range(3):
             X[r, c] = M[r, 6 + c]
@@ -226,23 +209,8 @@ def _solve3(A, r, x):
         for j in range(3):
             M[i, j] = A[i, j]
         M[i, 3] = r[i]
-    for c in range(3):
-        piv = c
-        for i in range(c + 1, 3):
-            if abs(M[i, c]) > abs(M[piv, c]):
-                piv = i
-        if not abs(M[piv, c]) > 0.0:
-            return False
-        if piv != c:
-            for k in range(4):
-                M[c, k], M[piv, k] = M[piv, k], M[c, k]
-        for i in range(c + 1, 3):
-            f = M[i, c] / M[c, c]
-            for k in range(c, 4):
-                M[i, k] -= f * M[c, k]
-    for i in range(2, -1, -1):
-        s = M[i, 3]
-        for m in range(i + 1, 3):
-            s -= M[i, m] * x[m]
-        x[i] = s / M[i, i]
+    if not eliminate(M, 3, 0.0, None) > 0.0:
+        return False
+    for i in range(3):
+        x[i] = M[i, 3]
     return True

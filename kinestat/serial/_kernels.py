@@ -26,28 +26,19 @@ SCREW = int(JointKind.SCREW)
 
 
 @nb.njit(inline="always", **_OPTS)
-def _step(C, kind, h, qi, t):
-    """Apply ``Z(qi) · C`` to the running transform ``t`` (12 values, row-major 3x4)."""
+def _turn(c, s, t):
+    """``t · Rz`` for the rotation about z with cosine c and sine s (12 values, row-major 3x4:
+    only the first two columns change)."""
     r00, r01, r02, p0, r10, r11, r12, p1, r20, r21, r22, p2 = t
-    if kind != PRISMATIC:
-        c = math.cos(qi)
-        s = math.sin(qi)
-        a0 = c * r00 + s * r01
-        a1 = c * r10 + s * r11
-        a2 = c * r20 + s * r21
-        r01 = c * r01 - s * r00
-        r11 = c * r11 - s * r10
-        r21 = c * r21 - s * r20
-        r00, r10, r20 = a0, a1, a2
-        if kind == SCREW:
-            d = h * qi
-            p0 += d * r02
-            p1 += d * r12
-            p2 += d * r22
-    else:
-        p0 += qi * r02
-        p1 += qi * r12
-        p2 += qi * r22
+    return (c * r00 + s * r01, c * r01 - s * r00, r02, p0,
+            c * r10 + s * r11, c * r11 - s * r10, r12, p1,
+            c * r20 + s * r21, c * r21 - s * r20, r22, p2)
+
+
+@nb.njit(inline="always", **_OPTS)
+def _affine(C, t):
+    """``t · C`` for the running transform ``t`` (12 values) and a rigid ``C (4, 4)``."""
+    r00, r01, r02, p0, r10, r11, r12, p1, r20, r21, r22, p2 = t
     n00 = r00 * C[0, 0] + r01 * C[1, 0] + r02 * C[2, 0]
     n01 = r00 * C[0, 1] + r01 * C[1, 1] + r02 * C[2, 1]
     n02 = r00 * C[0, 2] + r01 * C[1, 2] + r02 * C[2, 2]
@@ -61,6 +52,21 @@ def _step(C, kind, h, qi, t):
     n22 = r20 * C[0, 2] + r21 * C[1, 2] + r22 * C[2, 2]
     n23 = r20 * C[0, 3] + r21 * C[1, 3] + r22 * C[2, 3] + p2
     return (n00, n01, n02, n03, n10, n11, n12, n13, n20, n21, n22, n23)
+
+
+@nb.njit(inline="always", **_OPTS)
+def _step(C, kind, h, qi, t):
+    """Apply ``Z(qi) · C`` to the running transform ``t`` (12 values, row-major 3x4)."""
+    if kind != PRISMATIC:
+        t = _turn(math.cos(qi), math.sin(qi), t)
+        if kind == SCREW:
+            d = h * qi
+            t = (t[0], t[1], t[2], t[3] + d * t[2], t[4], t[5], t[6], t[7] + d * t[6],
+                 t[8], t[9], t[10], t[11] + d * t[10])
+    else:
+        t = (t[0], t[1], t[2], t[3] + qi * t[2], t[4], t[5], t[6], t[7] + qi * t[6],
+             t[8], t[9], t[10], t[11] + qi * t[10])
+    return _affine(C, t)
 
 
 @nb.njit(inline="always", **_OPTS)

@@ -16,8 +16,9 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.serial._kernels import _affine, _start, _turn
 from kinestat.serial._numba_options import OPTS as _OPTS
-from kinestat.serial.analytic._solution_kernels import fk6, polish, pose_errors, scratch, store
+from kinestat.serial.analytic._solution_kernels import polish, pose_errors, scratch, store
 from kinestat.serial.analytic._solution_kernels import wrap as _wrap
 
 _Z3 = (0.0, 0.0, 0.0)
@@ -60,15 +61,51 @@ def _norm(a):
 
 
 @nb.njit(inline="always", **_OPTS)
-def _rot(w, th):
-    """Rodrigues' rotation matrix (MLS eq. 2.14) as a row-major 9-tuple."""
-    c = math.cos(th)
-    s = math.sin(th)
+def _pair(y, x):
+    """``(θ, cos θ, sin θ)`` of ``θ = atan2(y, x)``: the cosine and sine are the normalised
+    arguments (no cos/sin call; equal to ``cos θ``, ``sin θ`` to rounding)."""
+    h = math.sqrt(x * x + y * y)
+    if h == 0.0:
+        return 0.0, 1.0, 0.0
+    return math.atan2(y, x), x / h, y / h
+
+
+@nb.njit(inline="always", **_OPTS)
+def _unit(y, x):
+    """``(cos θ, sin θ)`` of ``θ = atan2(y, x)`` (θ itself not needed)."""
+    h = math.sqrt(x * x + y * y)
+    if h == 0.0:
+        return 1.0, 0.0
+    return x / h, y / h
+
+
+@nb.njit(inline="always", **_OPTS)
+def _shift(a, c, s, sign):
+    """``(θa + sign·α, cos, sin)`` for θa given by its cosine ``a[-2]`` and sine ``a[-1]`` (an
+    angle triple or a pair) and α by c, s: the angle-addition formulas, the angle from the
+    resulting pair."""
+    cs = a[-2] * c - sign * a[-1] * s
+    sn = a[-1] * c + sign * a[-2] * s
+    return math.atan2(sn, cs), cs, sn
+
+
+@nb.njit(inline="always", **_OPTS)
+def _rot(w, a):
+    """Rodrigues' rotation matrix (MLS eq. 2.14) as a row-major 9-tuple, for the angle triple
+    ``a = (θ, cos θ, sin θ)``."""
+    c = a[1]
+    s = a[2]
     v = 1.0 - c
     x, y, z = w[0], w[1], w[2]
     return (c + x * x * v, x * y * v - z * s, x * z * v + y * s,
             y * x * v + z * s, c + y * y * v, y * z * v - x * s,
             z * x * v - y * s, z * y * v + x * s, c + z * z * v)
+
+
+@nb.njit(inline="always", **_OPTS)
+def _neg(a):
+    """The angle triple of −θ."""
+    return -a[0], a[1], -a[2]
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -119,9 +156,9 @@ def _mmt(A, B):
 
 
 @nb.njit(inline="always", **_OPTS)
-def _rotate(w, r, th, x):
-    """The point x turned by θ about the axis (ω, r)."""
-    return _add(r, _mv(_rot(w, th), _sub(x, r)))
+def _rotate(w, r, a, x):
+    """The point x turned by the angle triple a about the axis (ω, r)."""
+    return _add(r, _mv(_rot(w, a), _sub(x, r)))
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -134,6 +171,8 @@ def _pose_times(T, A):
 
 
 # -- Paden–Kahan subproblems (the NumPy references are in subproblems.py) -----------------------
+# Every angle is the triple (θ, cos θ, sin θ): the rotations and the FK check use the pair, so
+# no cos/sin is evaluated (θ comes from atan2 of the same pair).
 @nb.njit(inline="always", **_OPTS)
 def _sp1(w, r, p, q):
     """Subproblem 1: the angle of p → q about (ω, r)."""
@@ -141,7 +180,10 @@ def _sp1(w, r, p, q):
     v = _sub(q, r)
     up = _sub(u, _scale(w, _dot(u, w)))
     vp = _sub(v, _scale(w, _dot(v, w)))
-    return math.atan2(_dot(w, _cross(up, vp)), _dot(up, vp))
+    return _pair(_dot(w, _cross(up, vp)), _dot(up, vp))
+
+
+_NONE = (0.0, 1.0, 0.0)
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -157,7 +199,7 @@ def _sp2(w1, w2, r, p, q, tol):
     uu = _dot(u, u)
     g2 = (uu - a * a - b * b - 2.0 * a * b * c12) / _dot(x, x)
     if g2 < -tol * (1.0 + uu) or abs(uu - _dot(v, v)) > tol * (1.0 + uu):
-        return False, 0.0, 0.0, 0.0, 0.0
+        return False, _NONE, _NONE, _NONE, _NONE
     g = math.sqrt(max(g2, 0.0))
     base = _add(r, _add(_scale(w1, a), _scale(w2, b)))
     c = _add(base, _scale(x, g))
@@ -167,49 +209,70 @@ def _sp2(w1, w2, r, p, q, tol):
 
 @nb.njit(inline="always", **_OPTS)
 def _sp3(w, r, p, q, delta, tol):
-    """Subproblem 3: ``(exists, θ, θ')`` with ``|e^{ξ̂θ} p − q| = δ``."""
+    """Subproblem 3: ``(exists, θ, θ')`` with ``|e^{ξ̂θ} p − q| = δ`` (θ0 ∓ acos c)."""
     u = _sub(p, r)
     v = _sub(q, r)
     up = _sub(u, _scale(w, _dot(u, w)))
     vp = _sub(v, _scale(w, _dot(v, w)))
-    t0 = math.atan2(_dot(w, _cross(up, vp)), _dot(up, vp))
+    t0 = _unit(_dot(w, _cross(up, vp)), _dot(up, vp))
     h = _dot(w, _sub(p, q))
     d2 = delta * delta - h * h
     nu = _norm(up)
     nv = _norm(vp)
     if nu * nv == 0.0:
-        return False, 0.0, 0.0
+        return False, _NONE, _NONE
     c = (nu * nu + nv * nv - d2) / (2.0 * nu * nv)
     if abs(c) > 1.0 + tol:
-        return False, 0.0, 0.0
-    a = math.acos(min(max(c, -1.0), 1.0))
-    return True, t0 - a, t0 + a
+        return False, _NONE, _NONE
+    c = min(max(c, -1.0), 1.0)
+    s = math.sqrt(1.0 - c * c)
+    return True, _shift(t0, c, s, -1.0), _shift(t0, c, s, 1.0)
 
 
 @nb.njit(inline="always", **_OPTS)
 def _sp4(h, w, p, d, tol):
-    """Subproblem 4 (one axis): ``(exists, θ, θ')`` with ``hᵀ R(ω, θ) p = d``."""
+    """Subproblem 4 (one axis): ``(exists, θ, θ')`` with ``hᵀ R(ω, θ) p = d`` (φ ∓ acos c)."""
     par = _scale(w, _dot(w, p))
     A = _dot(h, _sub(p, par))
     B = _dot(h, _cross(w, p))
     C = d - _dot(h, par)
-    n = math.hypot(A, B)
+    n = math.sqrt(A * A + B * B)
     if n <= tol:
-        return False, 0.0, 0.0
+        return False, _NONE, _NONE
     c = C / n
     if abs(c) > 1.0 + tol:
-        return False, 0.0, 0.0
-    phi = math.atan2(B, A)
-    a = math.acos(min(max(c, -1.0), 1.0))
-    return True, phi - a, phi + a
+        return False, _NONE, _NONE
+    c = min(max(c, -1.0), 1.0)
+    s = math.sqrt(1.0 - c * c)
+    phi = (A / n, B / n)
+    return True, _shift(phi, c, s, -1.0), _shift(phi, c, s, 1.0)
 
 
 # -- verification, de-duplication, storage ------------------------------------------------------
+@nb.njit(inline="always", **_OPTS)
+def _link(C, i, a, t):
+    """The running FK transform t (12 scalars) times ``Z(θ_i) C_i`` for the angle triple a of
+    joint i (1-based): the serial FK kernel's step with the angle's cosine and sine."""
+    return _affine(C[i], _turn(a[1], a[2], t))
+
+
+@nb.njit(inline="always", **_OPTS)
+def _clear(n, out_q, out_valid, out_pos, out_rot):
+    """Empty slots of pose n (NaN, not valid): the caller's outputs are uninitialised."""
+    for k in range(out_q.shape[1]):
+        for i in range(6):
+            out_q[n, k, i] = np.nan
+        out_valid[n, k] = False
+        out_pos[n, k] = np.nan
+        out_rot[n, k] = np.nan
+
+
 @nb.njit(**_OPTS)
-def _store(n, C, Tn, q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
-    """Verify q (6-tuple) by FK against Tn and store it unless it repeats a stored one; returns
-    the new count."""
-    pos, rot = pose_errors(fk6(C, q), Tn)
+def _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
+    """Verify q (6-tuple) whose forward kinematics f (12 scalars, the chain product at the
+    cosines and sines of q) against Tn and store it unless it repeats a stored one; returns the
+    new count."""
+    pos, rot = pose_errors(f, Tn)
     if not (pos <= tol and rot <= tol):  # rounding near a singular set: two Newton steps
         qa = np.empty(6)
         for i in range(6):
@@ -226,24 +289,31 @@ def _store(n, C, Tn, q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
 @nb.njit(**_OPTS)
 def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
                  out_pos, out_rot, out_sing, out_sign, out_fam):
-    Rg, tg = _pose_times(T[n], T0inv)
+    _clear(n, out_q, out_valid, out_pos, out_rot)
+    for k in range(out_q.shape[1]):
+        out_sing[n, k] = False
+        out_sign[n, k] = 0.0
+        out_fam[n, k] = np.nan
+    Tn = T[n]
+    Rg, tg = _pose_times(Tn, T0inv)
     W0, W1, W2, W3, W4, W5 = _row(W, 0), _row(W, 1), _row(W, 2), _row(W, 3), _row(W, 4), _row(W, 5)
     P2 = _row(P, 2)
     wc = (w[0], w[1], w[2])
     sc = (s[0], s[1], s[2])
     xs = (x6[0], x6[1], x6[2])
     pw = _add(_mv(Rg, wc), tg)
-    ok3, t3a, t3b = _sp3(W2, P2, wc, sc, _norm(_sub(pw, sc)), tol)
+    ok3, a3, b3 = _sp3(W2, P2, wc, sc, _norm(_sub(pw, sc)), tol)
     if not ok3:
-        return
+        return 0
+    f0 = _start(C[0])
     cnt = 0
     for i3 in range(2):
-        t3 = t3a if i3 == 0 else t3b
-        w3 = _rotate(W2, P2, t3, wc)
+        t3 = a3 if i3 == 0 else b3
+        R3 = _rot(W2, t3)
+        w3 = _add(P2, _mv(R3, _sub(wc, P2)))
         ok12, t1a, t2a, t1b, t2b = _sp2(W0, W1, sc, w3, pw, tol)
         if not ok12:
             continue
-        R3 = _rot(W2, t3)
         for i12 in range(2):
             t1 = t1a if i12 == 0 else t1b
             t2 = t2a if i12 == 0 else t2b
@@ -251,76 +321,114 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
             target = _mv(Rp, W5)
             sing = _norm(_cross(W3, target)) < wrist_tol
             if sing:  # θ4 free: θ4 = 0, align ω6 with θ5 alone
-                t4a = t4b = 0.0
+                t4a = t4b = _NONE
                 t5a = t5b = _sp1(W4, _Z3, W5, target)
             else:
                 ok45, t4a, t5a, t4b, t5b = _sp2(W3, W4, _Z3, W5, target, tol)
                 if not ok45:
                     continue
+            f3 = _link(C, 3, t3, _link(C, 2, t2, _link(C, 1, t1, f0)))  # shared by 2 wrists
             for i45 in range(2):
                 t4 = t4a if i45 == 0 else t4b
                 t5 = t5a if i45 == 0 else t5b
                 R5 = _rot(W4, t5)
                 t6 = _sp1(W5, _Z3, xs, _mtv(_mm(_rot(W3, t4), R5), _mv(Rp, xs)))
-                q = (t1, t2, t3, t4, t5, t6)
-                new = _store(n, C, T[n], q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
+                f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, f3)))
+                q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
+                new = _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot,
+                             cnt)
                 if new > cnt and sing:
                     sig = 1.0 if _dot(W3, _mv(R5, W5)) >= 0.0 else -1.0
                     out_sing[n, cnt] = True
                     out_sign[n, cnt] = sig
                     out_fam[n, cnt] = _wrap(out_q[n, cnt, 3] + sig * out_q[n, cnt, 5])
                 cnt = new
+    return cnt
+
+
+@nb.njit(inline="always", **_OPTS)
+def _unpack(Kp):
+    """The pose-independent data packed by :func:`pack` (one array: one argument to unbox per
+    call): ``C (7, 4, 4)``, ``T0inv (4, 4)``, ``W (6, 3)``, ``P (6, 3)`` and three 3-vectors."""
+    return (Kp[:112].reshape((7, 4, 4)), Kp[112:128].reshape((4, 4)), Kp[128:146].reshape((6, 3)),
+            Kp[146:164].reshape((6, 3)), Kp[164:167], Kp[167:170], Kp[170:173])
+
+
+def pack(C, T0inv, W, P, a, b, c) -> np.ndarray:
+    """Pack a kernel's pose-independent data (see :func:`_unpack`) into one float array."""
+    return np.ascontiguousarray(np.concatenate([np.ravel(x) for x in (C, T0inv, W, P, a, b, c)]),
+                                dtype=np.float64)
 
 
 @nb.njit(parallel=True, **_OPTS)
-def pieper_batch(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
-                 out_rot, out_sing, out_sign, out_fam):
-    """Spherical-wrist closed form for N poses (outputs pre-filled by the caller)."""
+def pieper_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
+                 out_sign, out_fam, out_cnt):
+    """Spherical-wrist closed form for N poses into the (uninitialised) outputs; ``out_cnt
+    (N,)`` the number of solutions."""
+    C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
-        _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
-                     out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q,
+                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 @nb.njit(**_OPTS)
-def pieper_serial(C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
-                  out_pos, out_rot, out_sing, out_sign, out_fam):
+def pieper_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
+                  out_sign, out_fam, out_cnt):
     """:func:`pieper_batch` on one thread (small batches: no thread start-up)."""
+    C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     for n in range(T.shape[0]):
-        _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
-                     out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q,
+                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 # -- three parallel axes, wrist pair meeting (UR type) ------------------------------------------
+@nb.njit(inline="always", **_OPTS)
+def _theta4(phi, t2, t3, sg):
+    """θ4 = σ3 (φ − σ1 θ2 − σ2 θ3) (axes 2-4 parallel with signs σ) as an angle triple."""
+    u = _shift(phi, t2[1], t2[2], -sg[0])
+    u = _shift(u, t3[1], t3[2], -sg[1])
+    return sg[2] * (phi[0] - sg[0] * t2[0] - sg[1] * t3[0]), u[1], sg[2] * u[2]
+
+
 @nb.njit(**_OPTS)
 def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                         out_valid, out_pos, out_rot):
-    Rg, tg = _pose_times(T[n], T0inv)
+                         out_valid, out_pos, out_rot, out_near):
+    _clear(n, out_q, out_valid, out_pos, out_rot)
+    out_near[n] = False
+    Tn = T[n]
+    Rg, tg = _pose_times(Tn, T0inv)
     W0, W1, W2, W4, W5 = _row(W, 0), _row(W, 1), _row(W, 2), _row(W, 4), _row(W, 5)
     P0, P1, P2, P3, P4, P5 = _row(P, 0), _row(P, 1), _row(P, 2), _row(P, 3), _row(P, 4), _row(P, 5)
     h = W1
     pc = (p56[0], p56[1], p56[2])
     xc = (xh[0], xh[1], xh[2])
     q56 = _add(_mv(Rg, pc), tg)
-    ok1, psi_a, psi_b = _sp4(h, W0, _sub(q56, P0), _dot(h, _sub(pc, P0)), tol)
+    ok1, psi_a, psi_b = _sp4(h, W0, _sub(q56, P0), _dot(h, _sub(pc, P0)), tol)  # ψ = −θ1
     if not ok1:
-        return
+        return 0
+    f0 = _start(C[0])
     cnt = 0
     for i1 in range(2):
         psi = psi_a if i1 == 0 else psi_b
         Rr = _mm(_rot(W0, psi), Rg)
+        hr = _mtv(Rr, h)
+        off = _norm(_cross(hr, W5))
+        if off < 1e-6:
+            out_near[n] = True
+        if off < wrist_tol:
+            continue  # wrist-singular: axis 6 parallel to axes 2-4 (families.py adds them)
         ok5, t5a, t5b = _sp4(h, W4, W5, _dot(h, _mv(Rr, W5)), tol)
         if not ok5:
             continue
-        hr = _mtv(Rr, h)
-        if _norm(_cross(hr, W5)) < wrist_tol:
-            continue  # wrist-singular: axis 6 parallel to axes 2-4 (not reported)
+        t1 = _neg(psi)
+        f1 = _link(C, 1, t1, f0)
         for i5 in range(2):
             t5 = t5a if i5 == 0 else t5b
             R5 = _rot(W4, t5)
             t6 = _sp1(W5, _Z3, hr, _mtv(R5, h))
             R234 = _mmt(Rr, _mm(R5, _rot(W5, t6)))
             phi = _sp1(h, _Z3, xc, _mv(R234, xc))
-            y = _rotate(W5, P5, -t6, _rotate(W4, P4, -t5, P3))
+            y = _rotate(W5, P5, _neg(t6), _rotate(W4, P4, _neg(t5), P3))
             y = _rotate(W0, P0, psi, _add(_mv(Rg, y), tg))
             ok3, t3a, t3b = _sp3(W2, P2, P3, P1, _norm(_sub(y, P1)), tol)
             if not ok3:
@@ -328,27 +436,35 @@ def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedu
             for i3 in range(2):
                 t3 = t3a if i3 == 0 else t3b
                 t2 = _sp1(W1, P1, _rotate(W2, P2, t3, P3), y)
-                t4 = sg[2] * (phi - sg[0] * t2 - sg[1] * t3)
-                q = (-psi, t2, t3, t4, t5, t6)
-                cnt = _store(n, C, T[n], q, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
+                t4 = _theta4(phi, t2, t3, sg)
+                f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, _link(
+                    C, 3, t3, _link(C, 2, t2, f1)))))
+                q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
+                cnt = _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot,
+                             cnt)
+    return cnt
 
 
 @nb.njit(parallel=True, **_OPTS)
-def three_parallel_batch(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                         out_valid, out_pos, out_rot):
-    """Three-parallel-axes (UR-type) closed form for N poses."""
+def three_parallel_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot,
+                         out_cnt, out_near):
+    """Three-parallel-axes (UR-type) closed form for N poses; ``out_cnt (N,)`` the number of
+    solutions, ``out_near (N,)`` a θ1 branch is near the wrist-singular set (axis 6 within
+    1e-6 of parallel to axes 2-4: where :mod:`~kinestat.serial.analytic.families` looks)."""
+    C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
-        _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                             out_valid, out_pos, out_rot)
+        out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
+                                          dedup, out_q, out_valid, out_pos, out_rot, out_near)
 
 
 @nb.njit(**_OPTS)
-def three_parallel_serial(C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                          out_valid, out_pos, out_rot):
+def three_parallel_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot,
+                          out_cnt, out_near):
     """:func:`three_parallel_batch` on one thread."""
+    C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     for n in range(T.shape[0]):
-        _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
-                             out_valid, out_pos, out_rot)
+        out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
+                                          dedup, out_q, out_valid, out_pos, out_rot, out_near)
 
 
 # -- pose checks ------------------------------------------------------------------------------

@@ -27,6 +27,7 @@ from kinestat.mechanism.joints import JointKind
 from kinestat.serial._kernels import _step
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._solution_kernels import polish, store
+from kinestat.spatial._elimination import eliminate
 
 # LAPACK dgeev through Numba's own binding (cacheable, unlike a ctypes pointer)
 _rgeev = _LAPACK().numba_ez_rgeev(types.float64)
@@ -42,52 +43,9 @@ _CHUNK = 16  # poses per scratch allocation in the parallel loop
 _A2_PIVOT_MIN = 1e-5
 #: the Möbius parameters tried in turn (0: the plain variable)
 _MOBIUS = (0.0, 0.7, -1.3, 2.9)
+#: relative pivot size below which a pivot is replaced (inverse iteration, the companion)
+_TINY_PIVOT = 1e-17
 _B0 = (0.31, -0.72, 0.55, 0.13, -0.94, 0.67, -0.28, 0.81, -0.46, 0.19, 0.73, -0.35)
-
-
-@nb.njit(**_OPTS)
-def _gauss(A, B):
-    """Solve ``A X = B`` in place (B ← X) by Gaussian elimination with partial pivoting; A is
-    overwritten. Returns the smallest |pivot| relative to the largest |entry| of A; pivots below
-    1e-17 of it are replaced by that size so X stays finite (inverse iteration relies on it)."""
-    n = A.shape[0]
-    m = B.shape[1]
-    big = 0.0
-    for i in range(n):
-        for j in range(n):
-            big = max(big, abs(A[i, j]))
-    if big == 0.0:
-        return 0.0
-    small = np.inf
-    for k in range(n):
-        p = k
-        for i in range(k + 1, n):
-            if abs(A[i, k]) > abs(A[p, k]):
-                p = i
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-            for j in range(m):
-                B[k, j], B[p, j] = B[p, j], B[k, j]
-        piv = A[k, k]
-        small = min(small, abs(piv) / big)
-        if abs(piv) < 1e-17 * big:  # (near) singular: a tiny pivot keeps X finite
-            piv = 1e-17 * big if piv >= 0.0 else -1e-17 * big
-            A[k, k] = piv
-        for i in range(k + 1, n):
-            f = A[i, k] / piv
-            if f != 0.0:
-                for j in range(k + 1, n):
-                    A[i, j] -= f * A[k, j]
-                for j in range(m):
-                    B[i, j] -= f * B[k, j]
-    for k in range(n - 1, -1, -1):
-        for j in range(m):
-            acc = B[k, j]
-            for i in range(k + 1, n):
-                acc -= A[k, i] * B[i, j]
-            B[k, j] = acc / A[k, k]
-    return small
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -292,15 +250,16 @@ def _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw):
 
 
 @nb.njit(**_OPTS)
-def _companion_eigvals(A, X, A2, Mc, wr, wi, dummy):
+def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
     """Eigenvalues (into wr, wi) of ``A2 x² + A1 x + A0`` (A normalised in place) through the
     24x24 companion with the inverse leading coefficient (LAPACK dgeev, eigenvalues only).
 
     When A2 is ill-conditioned (smallest relative pivot below ``_A2_PIVOT_MIN``) the variable
     is changed by the Möbius map ``x = (y + t)/(1 − t y)`` (a shift of the half-angle by
     atan t): ``B(y) = (1 − t y)² A(x)`` has the leading coefficient ``A0 t² − A1 t + A2``,
-    regular unless −1/t is itself a root. False when no tried t gives a regular one. X (12, 24),
-    A2 (12, 12), Mc (24, 24): scratch."""
+    regular unless −1/t is itself a root. False when no tried t gives a regular one.
+    ``XA (12, 36)``: ``[A2 | A0 A1]`` solved in place to ``[· | X]``, ``X = A2⁻¹ [A0 A1]``;
+    Mc (24, 24): scratch."""
     sc = 0.0
     for k in range(3):
         for i in range(12):
@@ -317,14 +276,15 @@ def _companion_eigvals(A, X, A2, Mc, wr, wi, dummy):
         for i in range(12):
             for j in range(12):
                 a0, a1, a2 = A[0, i, j], A[1, i, j], A[2, i, j]
-                X[i, j] = a0 + t * a1 + tt * a2
-                X[i, 12 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
-                A2[i, j] = tt * a0 - t * a1 + a2
-        if _gauss(A2, X) >= _A2_PIVOT_MIN:
+                XA[i, 12 + j] = a0 + t * a1 + tt * a2
+                XA[i, 24 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
+                XA[i, j] = tt * a0 - t * a1 + a2
+        if eliminate(XA, 12, _TINY_PIVOT, None) >= _A2_PIVOT_MIN:
             regular = True
             break
     if not regular:
         return False
+    X = XA[:, 12:]
     big = 0.0
     for i in range(12):
         for j in range(24):
@@ -352,41 +312,9 @@ def _companion_eigvals(A, X, A2, Mc, wr, wi, dummy):
 
 
 @nb.njit(**_OPTS)
-def _lu(A, perm):
-    """LU factors of ``A (n, n)`` in place with partial pivoting (row order in perm); pivots
-    below 1e-17 of the largest |entry| are replaced by that size so solves stay finite
-    (inverse iteration on a singular matrix relies on it)."""
-    n = A.shape[0]
-    big = 0.0
-    for i in range(n):
-        perm[i] = i
-        for j in range(n):
-            big = max(big, abs(A[i, j]))
-    tiny = 1e-17 * big if big > 0.0 else 1e-300
-    for k in range(n):
-        p = k
-        for i in range(k + 1, n):
-            if abs(A[i, k]) > abs(A[p, k]):
-                p = i
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-            perm[k], perm[p] = perm[p], perm[k]
-        piv = A[k, k]
-        if abs(piv) < tiny:
-            piv = tiny if piv >= 0.0 else -tiny
-            A[k, k] = piv
-        for i in range(k + 1, n):
-            f = A[i, k] / piv
-            A[i, k] = f
-            if f != 0.0:
-                for j in range(k + 1, n):
-                    A[i, j] -= f * A[k, j]
-
-
-@nb.njit(**_OPTS)
 def _lu_solve(A, perm, b, y):
-    """``b ← A⁻¹ b`` with the factors of :func:`_lu`; y (n,) scratch."""
+    """``b ← A⁻¹ b`` with the LU factors and row order of :func:`eliminate`; y (n,)
+    scratch."""
     n = A.shape[0]
     for i in range(n):
         acc = b[perm[i], 0]
@@ -415,7 +343,7 @@ def _null_vector(A, x, S, v, perm, y):
     for i in range(12):
         for j in range(12):
             S[i, j] = c0 * A[0, i, j] + c1 * A[1, i, j] + c2 * A[2, i, j]
-    _lu(S, perm)
+    eliminate(S, 12, _TINY_PIVOT, perm)  # factors only; tiny pivots replaced
     for _ in range(2):
         _lu_solve(S, perm, v, y)
         nv = 0.0
@@ -510,9 +438,9 @@ def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
 def _scratch():
     """Work arrays of :func:`_solve_pose` (one set per chunk of poses)."""
     return (np.empty((3, 4, 4)), np.empty((15, 9)), np.empty((15, 15)), np.empty((5, 15)),
-            np.empty((3, 12, 12)), np.empty((6, 27)), np.empty((12, 24)), np.empty((12, 12)),
+            np.empty((3, 12, 12)), np.empty((6, 27)), np.empty((12, 36)), np.empty((12, 12)),
             np.empty((24, 24)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
-            np.empty(8), np.empty((3, 6, 6)), np.empty((4, 6)), np.empty(6), np.empty(6),
+            np.empty(8), np.empty((3, 6, 7)), np.empty((4, 6)), np.empty(6), np.empty(6),
             np.empty((14, 14)), np.empty((8, 8)), np.empty(8, dtype=np.int64), np.empty((8, 14)),
             np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12))
 
@@ -523,7 +451,7 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
     """All solutions of pose n. ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant M1 / Ts of the
     formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0 constant, 1
     ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``)."""
-    Gs, Rh, MA, V15, A, E, X, A2, Mc, W24, v, m, coef, Ms, Vs, th, q, H, R, piv, Vr, Aw, \
+    Gs, Rh, MA, V15, A, E, XA, A2, Mc, W24, v, m, coef, Ms, Vs, th, q, H, R, piv, Vr, Aw, \
         perm, y12 = S
     _rigid_product(form[0], T[n], form[1], Gs[1])
     _rigid_inverse(Gs[1], Gs[2])
@@ -539,7 +467,7 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
         flags[n] = flag
         return
     wr, wi = W24[0], W24[1]
-    if not _companion_eigvals(A, X, A2, Mc, wr, wi, W24[2]):
+    if not _companion_eigvals(A, XA, Mc, wr, wi, W24[2]):
         flags[n] = FLAG_ILL_CONDITIONED
         return
     cnt = 0

@@ -18,6 +18,7 @@ from kinestat.mechanism.joints import JointKind
 from kinestat.serial._kernels import _jac_column, _start, _step
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial._numba_options import PI, SQRT8, TWO_PI
+from kinestat.spatial._elimination import eliminate
 
 REVOLUTE = int(JointKind.REVOLUTE)
 
@@ -45,16 +46,17 @@ def pose_errors(t, Tn):
     for i in range(3):
         for j in range(3):
             d2 += (t[4 * i + j] - Tn[i, j]) ** 2
-    return pos, 2.0 * math.asin(min(math.sqrt(d2) / SQRT8, 1.0))
+    return pos, _two_asin(math.sqrt(d2) / SQRT8)
 
 
 @nb.njit(inline="always", **_OPTS)
-def fk6(C, q):
-    """End pose (12 scalars) of the revolute chain ``C (7, 4, 4)`` at q (6-tuple or array)."""
-    t = _start(C[0])
-    for i in range(6):
-        t = _step(C[i + 1], REVOLUTE, 0.0, q[i], t)
-    return t
+def _two_asin(x):
+    """``2 asin(min(x, 1))`` for x ≥ 0; below 1e-4 by its series ``x + x³/6 + 3x⁵/40 +
+    5x⁷/112`` (the next term is 35x⁹/1152: relative 3e-34, below rounding)."""
+    if x < 1e-4:
+        x2 = x * x
+        return 2.0 * x * (1.0 + x2 * (1.0 / 6.0 + x2 * (3.0 / 40.0 + x2 * (5.0 / 112.0))))
+    return 2.0 * math.asin(min(x, 1.0))
 
 
 @nb.njit(inline="always", **_OPTS)
@@ -95,66 +97,28 @@ def _twist_error(t, Tn, e):
     return math.sqrt(s)
 
 
-@nb.njit(**_OPTS)
-def solve6(A, b):
-    """Solve ``A x = b`` (6x6) in place (b ← x, A overwritten) by Gaussian elimination with
-    partial pivoting; returns the smallest |pivot| relative to the largest |entry|."""
-    n = 6
-    big = 0.0
-    for i in range(n):
-        for j in range(n):
-            big = max(big, abs(A[i, j]))
-    if big == 0.0:
-        return 0.0
-    small = np.inf
-    for k in range(n):
-        p = k
-        for i in range(k + 1, n):
-            if abs(A[i, k]) > abs(A[p, k]):
-                p = i
-        if p != k:
-            for j in range(n):
-                A[k, j], A[p, j] = A[p, j], A[k, j]
-            b[k], b[p] = b[p], b[k]
-        piv = A[k, k]
-        small = min(small, abs(piv) / big)
-        if piv == 0.0:
-            return 0.0
-        for i in range(k + 1, n):
-            f = A[i, k] / piv
-            if f != 0.0:
-                for j in range(k + 1, n):
-                    A[i, j] -= f * A[k, j]
-                b[i] -= f * b[k]
-    for k in range(n - 1, -1, -1):
-        acc = b[k]
-        for i in range(k + 1, n):
-            acc -= A[k, i] * b[i]
-        b[k] = acc / A[k, k]
-    return small
-
-
 @nb.njit(inline="always", **_OPTS)
 def scratch():
     """The scratch :func:`polish` needs (allocate once per pose, not per root)."""
-    return np.empty((3, 6, 6)), np.empty((4, 6))
+    return np.empty((3, 6, 7)), np.empty((4, 6))
 
 
 @nb.njit(**_OPTS)
 def polish(C, Tn, q, iters, Ms, Vs):
     """Newton steps ``J δq = ξ`` (Nadkarni eq. 4-11) with backtracking (halved until the twist
     error drops) on ``q (6,)`` in place; returns the (position, rotation) errors of the final
-    q. ``Ms (3, 6, 6)``, ``Vs (4, 6)``: scratch (:func:`scratch`)."""
-    J, Jn, Jc = Ms[0], Ms[1], Ms[2]
-    e, en_v, dq, qn = Vs[0], Vs[1], Vs[2], Vs[3]
+    q. ``Ms (3, 6, 7)``, ``Vs (4, 6)``: scratch (:func:`scratch`)."""
+    J, Jn, Jc = Ms[0, :, :6], Ms[1, :, :6], Ms[2]
+    e, en_v, qn = Vs[0], Vs[1], Vs[3]
+    dq = Jc[:, 6]
     t = _fk_jac(C, q, J)
     en = _twist_error(t, Tn, e)
     for _ in range(iters):
         if en < 1e-15:
             break
-        Jc[:, :] = J
-        dq[:] = e
-        if solve6(Jc, dq) < 1e-14:
+        Jc[:, :6] = J
+        Jc[:, 6] = e
+        if eliminate(Jc, 6, 0.0, None) < 1e-14:  # [J | e] → [· | δq]
             break
         step = 1.0
         moved = False

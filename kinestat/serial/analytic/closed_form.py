@@ -24,6 +24,7 @@ import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic._common import nan_array, pack, reasons
+from kinestat.serial.analytic.families import add_wrist_families
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
 
@@ -153,59 +154,68 @@ _REASON_3P = ("no real solution: the pose is out of reach (subproblem 4 for θ1 
 
 
 def _outputs(N: int, K: int):
-    return nan_array((N, K, 6)), np.zeros((N, K), dtype=bool), nan_array((N, K)), nan_array((N, K))
+    """Uninitialised outputs ``q (N, K, 6)``, ``valid``, ``pos``, ``rot`` and the counts ``(N,)``
+    (the kernels clear every pose's slots first)."""
+    return (np.empty((N, K, 6)), np.empty((N, K), dtype=bool), np.empty((N, K)),
+            np.empty((N, K)), np.empty(N, dtype=np.int64))
 
 
-def _result(q, valid, pos, rot, sing, sign, fam, joints, reason, method, tol) -> IKAllResult:
-    nsol = np.count_nonzero(valid, axis=1)
-    return IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot, singular=sing,
-                       family_sign=sign, family_value=fam, family_joints=joints,
-                       n_solutions=nsol, reason=reasons(nsol, reason), method=method, tol=tol)
+def _cf_kernels():
+    K = sys.modules.get("kinestat.serial.analytic._cf_kernels")
+    if K is None:
+        from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
+    return K
 
 
 def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
-                          wrist_tol: float = _WRIST_TOL) -> IKAllResult:
-    """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first)."""
-    K = sys.modules.get("kinestat.serial.analytic._cf_kernels")
-    if K is None:
-        from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
-
-    ax = data["axes"]
+                          wrist_tol: float = _WRIST_TOL,
+                          shape: tuple[int, ...] | None = None) -> IKAllResult:
+    """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first); ``shape``:
+    the batch shape of the result (default ``(N,)``)."""
+    K = _cf_kernels()
     N = T.shape[0]
-    q, valid, pos, rot = _outputs(N, 8)
-    sing = np.zeros((N, 8), dtype=bool)
-    sign = np.zeros((N, 8))
-    fam = nan_array((N, 8))
+    q, valid, pos, rot, cnt = _outputs(N, 8)
+    sing = np.empty((N, 8), dtype=bool)
+    sign = np.empty((N, 8))
+    fam = np.empty((N, 8))
     run = K.pieper_batch if N >= _PARALLEL_MIN else K.pieper_serial
-    if "kernel_args" not in data:  # pose-independent, kept with the model's cached geometry
-        data["kernel_args"] = (np.asarray(model.constants), np.linalg.inv(ax.T0), ax.w, ax.r,
-                               np.asarray(data["wrist"]), np.asarray(data["shoulder"]),
-                               _perp(ax.w[5]))
-    C, T0inv, W, P, w, s, x6 = data["kernel_args"]
-    run(C, np.ascontiguousarray(T), T0inv, W, P, w, s, x6, tol, wrist_tol, 1e-6, q, valid, pos,
-        rot, sing, sign, fam)
-    return _result(q, valid, pos, rot, sing, sign, fam, (3, 5), _REASON_PIEPER, "pieper", tol)
+    Kp = data.get("kernel_args")
+    if Kp is None:  # pose-independent, kept with the model's cached geometry
+        ax = data["axes"]
+        Kp = data["kernel_args"] = K.pack(model.constants, np.linalg.inv(ax.T0), ax.w, ax.r,
+                                          data["wrist"], data["shoulder"], _perp(ax.w[5]))
+    run(Kp, T, tol, wrist_tol, 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
+    return IKAllResult.build((N,) if shape is None else shape, q=q, valid=valid,
+                             position_error=pos, rotation_error=rot, singular=sing,
+                             family_sign=sign, family_value=fam, family_joints=(3, 5),
+                             n_solutions=cnt,
+                             reason=reasons(cnt, _REASON_PIEPER), method="pieper", tol=tol)
 
 
 def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, *,
-                                  tol: float = 1e-9,
-                                  wrist_tol: float = _WRIST_TOL) -> IKAllResult:
-    """:func:`solve_three_parallel` by the compiled kernel."""
-    K = sys.modules.get("kinestat.serial.analytic._cf_kernels")
-    if K is None:
-        from kinestat.serial.analytic import _cf_kernels as K  # lazy: Numba start-up
-
-    ax = data["axes"]
+                                  tol: float = 1e-9, wrist_tol: float = _WRIST_TOL,
+                                  shape: tuple[int, ...] | None = None) -> IKAllResult:
+    """:func:`solve_three_parallel` by the compiled kernel, with the wrist-singular families
+    (:func:`kinestat.serial.analytic.families.add_wrist_families`) added."""
+    K = _cf_kernels()
     N = T.shape[0]
-    if "kernel_args" not in data:
+    Kp = data.get("kernel_args")
+    if Kp is None:
+        ax = data["axes"]
         h = ax.w[1]
         sg = np.array([float(np.sign(ax.w[i] @ h)) for i in (1, 2, 3)])
-        data["kernel_args"] = (np.asarray(model.constants), np.linalg.inv(ax.T0), ax.w, ax.r,
-                               np.asarray(data["p56"]), _perp(h), sg)
-    C, T0inv, W, P, p56, xh, sg = data["kernel_args"]
-    q, valid, pos, rot = _outputs(N, 8)
+        Kp = data["kernel_args"] = K.pack(model.constants, np.linalg.inv(ax.T0), ax.w, ax.r,
+                                          data["p56"], _perp(h), sg)
+    q, valid, pos, rot, cnt = _outputs(N, 8)
+    near = np.empty(N, dtype=bool)
     run = K.three_parallel_batch if N >= _PARALLEL_MIN else K.three_parallel_serial
-    run(C, np.ascontiguousarray(T), T0inv, W, P, p56, xh, sg, tol, wrist_tol, 1e-6, q, valid,
-        pos, rot)
-    return _result(q, valid, pos, rot, np.zeros((N, 8), dtype=bool), np.zeros((N, 8)),
-                   nan_array((N, 8)), None, _REASON_3P, "three-parallel", tol)
+    run(Kp, T, tol, wrist_tol, 1e-6, q, valid, pos, rot, cnt, near)
+    fields = dict(q=q, valid=valid, position_error=pos, rotation_error=rot,
+                  singular=np.zeros((N, 8), dtype=bool), family_sign=np.zeros((N, 8)),
+                  family_value=nan_array((N, 8)), family_joints=None, n_solutions=cnt,
+                  reason=reasons(cnt, _REASON_3P), method="three-parallel", tol=tol)
+    where = np.flatnonzero(near) if N > 1 else (np.zeros(1, dtype=np.intp) if near[0] else None)
+    if where is not None and where.size:
+        res = add_wrist_families(model, T, data, IKAllResult.build((N,), **fields), near=where)
+        fields = {f: getattr(res, f) for f in fields} | {"family_curve": res.family_curve}
+    return IKAllResult.build((N,) if shape is None else shape, **fields)

@@ -106,9 +106,11 @@ def _members(c: WristCurve, n: int, t1: float, t5: float, t6: np.ndarray):
 
 
 def add_wrist_families(model: ChainModel, T: np.ndarray, data: dict, res: IKAllResult, *,
-                       wrist_tol: float = 1e-10) -> IKAllResult:
+                       wrist_tol: float = 1e-10, near: np.ndarray | None = None) -> IKAllResult:
     """``res`` of the three-parallel solver for poses ``T (N, 4, 4)`` with one member of every
-    wrist-singular family added in its free slots (``singular`` True, verified by FK)."""
+    wrist-singular family added in its free slots (``singular`` True, verified by FK).
+    ``near``: indices of the poses to examine (a superset of the wrist-singular ones, e.g. the
+    compiled kernel's flags); by default a cheap necessary test picks them."""
     ax = data["axes"]
     W, P = ax.w, ax.r
     h = W[1]
@@ -118,8 +120,9 @@ def add_wrist_families(model: ChainModel, T: np.ndarray, data: dict, res: IKAllR
     T0inv, w6, w0h = data["family_args"]
     # necessary (cheap) test: a rotation about axis 1 keeps the component along it, so axis 6
     # (g ω6) can be parallel to h only where ω1ᵀ g ω6 = ±ω1ᵀ h
-    c = T[:, :3, :3] @ w6 @ W[0]
-    near = np.flatnonzero(np.minimum(np.abs(c - w0h), np.abs(c + w0h)) < 1e-6)
+    if near is None:
+        c = T[:, :3, :3] @ w6 @ W[0]
+        near = np.flatnonzero(np.minimum(np.abs(c - w0h), np.abs(c + w0h)) < 1e-6)
     if near.size == 0:
         return res
     g = T[near] @ T0inv

@@ -67,6 +67,26 @@ class IKAllResult:
     tol: float
     family_curve: object | None = None
 
+    _BATCHED = ("q", "valid", "position_error", "rotation_error", "singular", "family_sign",
+                "family_value", "n_solutions", "reason")
+
+    @classmethod
+    def build(cls, shape: tuple[int, ...], **fields) -> IKAllResult:
+        """The result from flat ``(N, ...)`` arrays, reshaped (views) to the batch ``shape``.
+
+        The compiled solvers' constructor: it sets the fields in one step instead of one frozen
+        ``__setattr__`` each (a single-pose call is a few µs, so that matters); the fields are
+        the dataclass's, ``family_curve`` optional.
+        """
+        if len(shape) != 1:
+            for f in cls._BATCHED:
+                a = fields[f]
+                fields[f] = a.reshape(shape + a.shape[1:])
+        fields.setdefault("family_curve", None)
+        obj = object.__new__(cls)
+        obj.__dict__.update(fields)
+        return obj
+
     @property
     def shape(self) -> tuple[int, ...]:
         """The batch shape ``B``."""

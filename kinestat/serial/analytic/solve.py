@@ -61,7 +61,7 @@ def method_for(model: ChainModel) -> str:
 
 
 def _reshape(res: IKAllResult, shape: tuple[int, ...]) -> IKAllResult:
-    if len(shape) == 1:
+    if len(shape) == 1 or res.valid.shape[:-1] == shape:
         return res
 
     def r(a):
@@ -149,12 +149,16 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
                              f"(millimetres, Vibhute Table 2-2); model {model.name!r} differs")
         res = thesis_puma762.solve_puma762(model, Tf, tol=tol, backend=backend)
     elif use == "pieper":
-        solver = closed_form.solve_pieper_compiled if fast else closed_form.solve_pieper
-        res = solver(model, Tf, data, tol=tol)
+        if fast:
+            return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape)
+        res = closed_form.solve_pieper(model, Tf, data, tol=tol)
     elif use == "three-parallel":
-        solver = (closed_form.solve_three_parallel_compiled if fast
-                  else closed_form.solve_three_parallel)
-        res = families.add_wrist_families(model, Tf, data, solver(model, Tf, data, tol=tol))
+        if fast:
+            return closed_form.solve_three_parallel_compiled(model, Tf, data, tol=tol,
+                                                             shape=shape)
+        res = families.add_wrist_families(model, Tf, data,
+                                          closed_form.solve_three_parallel(model, Tf, data,
+                                                                           tol=tol))
     else:
         res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend)
     return _reshape(res, shape)

@@ -54,6 +54,17 @@ def wrapped_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.max(np.abs(np.mod(a - b + PI, 2 * PI) - PI), axis=-1)
 
 
+def slot_residuals(model, res, T: np.ndarray):
+    """Residuals of every valid slot of the all-solutions result ``res`` against its poses
+    ``T (..., 4, 4)``, recomputed here with :func:`kinestat.fk` (independent of the solver):
+    ``(pos, dR)`` of shape ``(..., K)``, the flange-origin distance and the Frobenius norm of
+    the rotation difference, 0 in slots that are not valid."""
+    F = kinestat.fk(model, np.where(res.valid[..., None], res.q, 0.0))
+    pos = np.linalg.norm(F[..., :3, 3] - T[..., None, :3, 3], axis=-1)
+    dR = np.linalg.norm(F[..., :3, :3] - T[..., None, :3, :3], axis=(-2, -1))
+    return np.where(res.valid, pos, 0.0), np.where(res.valid, dR, 0.0)
+
+
 def _twist_error(F, T):
     dR = T[..., :3, :3] @ np.swapaxes(F[..., :3, :3], -1, -2)
     ang = 0.5 * np.stack([dR[..., 2, 1] - dR[..., 1, 2], dR[..., 0, 2] - dR[..., 2, 0],

@@ -12,7 +12,7 @@ from kinestat.mechanism.chain import from_standard_dh
 from kinestat.serial.analytic import ik_all, method_for
 from kinestat.serial.analytic.general6r import FORMULATIONS, solve_general_6r
 
-from .arms import PI, arm, newton_solutions, wrapped_distance
+from .arms import PI, arm, newton_solutions, slot_residuals, wrapped_distance
 
 ARMS = {
     "ur5": "three-parallel",
@@ -50,11 +50,8 @@ def test_generating_configuration_found_and_residuals(name):
     found = np.any(np.where(res.valid, d, np.inf) < 1e-6, axis=1)
     assert found.all(), f"{name}: generating configuration missed in {np.sum(~found)} poses"
     # every returned solution reproduces the pose (checked here independently of the solver)
-    F = kinestat.fk(model, np.where(res.valid[..., None], res.q, 0.0))
-    pos = np.linalg.norm(F[..., :3, 3] - T[:, None, :3, 3], axis=-1)
-    rot = np.linalg.norm(F[..., :3, :3] - T[:, None, :3, :3], axis=(-2, -1))
-    assert np.max(np.where(res.valid, pos, 0)) <= 1e-9
-    assert np.max(np.where(res.valid, rot, 0)) <= 1e-9
+    pos, dR = slot_residuals(model, res, T)
+    assert pos.max() <= 1e-9 and dR.max() <= 1e-9
     assert np.all(res.n_solutions == res.valid.sum(-1))
     assert np.all(res.reason[res.n_solutions > 0] == "")
 
@@ -180,22 +177,6 @@ def test_top_level_export():
     assert kinestat.ik_all is ik_all
 
 
-@pytest.mark.parametrize("name", ["ur5", "puma560", "puma762", "jaco6", "random2"])
-def test_compiled_kernels_match_numpy_references(name):
-    model = arm(name)
-    q = _configs(model, 150, seed=21)
-    T = kinestat.fk(model, q)
-    a = ik_all(model, T)
-    b = ik_all(model, T, backend="numpy")
-    assert a.method == b.method
-    np.testing.assert_array_equal(a.n_solutions, b.n_solutions)
-    for i in range(q.shape[0]):
-        sa, sb = a.solutions((i,)), b.solutions((i,))
-        for s in sb:
-            assert np.min(wrapped_distance(sa, s)) < 1e-6
-    np.testing.assert_array_equal(a.singular.sum(-1), b.singular.sum(-1))
-
-
 @pytest.mark.parametrize("name", ["ur5", "puma560", "random1"])
 def test_rounded_pose_is_projected_onto_a_rotation(name):
     model = arm(name)
@@ -205,3 +186,33 @@ def test_rounded_pose_is_projected_onto_a_rotation(name):
     res = ik_all(model, T32)
     assert int(res.n_solutions) == int(ik_all(model, T).n_solutions) > 0
     assert np.min(wrapped_distance(res.solutions(), q)) < 1e-5
+
+
+#: Jaco2-type poses (seeds 1, 9, 10 of ``default_rng(seed).uniform(-π, π, (10000, 6))``,
+#: indices 958, 402, 1231, 2595) away from singular sets (Jacobian σmin/σmax 4e-4 to 2e-2)
+#: whose real roots in x3 cluster (two to four solutions within 1e-2 of each other)
+CLUSTERED_JACO2 = [
+    [-2.9990693597623244, 2.851083638534363, -0.2933357539065655, -1.4712548427920535,
+     -1.423546409551335e-05, 2.8023057158851117],
+    [1.9908017746558668, 2.102751691031207, 0.04270623573529386, 1.9499435174410493,
+     0.7600162212469774, -0.9131653312109211],
+    [-0.46298639331932856, -1.576455216457984, -2.631875602055599, 1.28465839015698,
+     -2.831596672919139, -0.9390962407344805],
+    [-2.795838279438122, 2.6536384322725777, 1.5962027603915674, 1.5215279545921865,
+     2.965037610130878, 1.305933511055482],
+]
+
+
+@pytest.mark.xfail(strict=True, reason="known limitation (docs/ik-all.md, Not done yet): "
+                   "clustered real roots of the 24x24 companion come out 1e-4 to 1e-1 off or "
+                   "as complex pairs, so the eigenvalue method misses solutions (both backends)")
+def test_jaco2_poses_with_clustered_roots_are_complete():
+    model = arm("jaco6")
+    q = np.array(CLUSTERED_JACO2)
+    T = kinestat.fk(model, q)
+    res = ik_all(model, T)
+    oracle = newton_solutions(model, T, starts=300, iters=50, seed=3)
+    for i, sols in enumerate(oracle):
+        mine = res.solutions((i,))
+        assert len(mine) and np.min(wrapped_distance(mine, q[i])) < 1e-6, i
+        assert len(sols) == res.n_solutions[i], (i, len(sols), res.n_solutions[i])
