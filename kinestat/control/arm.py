@@ -36,7 +36,7 @@ from kinestat.spatial.validate import frozen
 if TYPE_CHECKING:
     from kinestat.serial.analytic import IKAllResult
 
-__all__ = ["Arm", "ToolFrame", "Puma762Arm", "ChainArm", "THESIS_ARM"]
+__all__ = ["Arm", "ToolFrame", "Puma762Arm", "ChainArm", "THESIS_ARM", "frame_from_tool"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -136,8 +136,14 @@ THESIS_ARM = Puma762Arm()
 """The PUMA 762 of the thesis's cell (the controller's default arm)."""
 
 
-def _frame_from_tool(tool_point, s6, a67, tool_point_6) -> np.ndarray:
-    """``T_base_end`` with z = ``s6``, x = ``a67`` and ``T · P_tool_6 = tool_point``."""
+def frame_from_tool(tool_point, s6, a67, tool_point_6) -> np.ndarray:
+    """``T_base_end`` (4, 4) with z = ``s6``, x = ``a67`` (made perpendicular to z) and
+    ``T · P_tool_6 = tool_point``: the thesis's target description as a pose.
+
+    >>> T = frame_from_tool([0, 0, 300.0], [0, 0, 1.0], [1.0, 0, 0], [0, 0, 100.0])
+    >>> T[:3, 3].tolist()
+    [0.0, 0.0, 200.0]
+    """
     z = np.asarray(s6, dtype=float)
     x = np.asarray(a67, dtype=float)
     z = z / np.linalg.norm(z)
@@ -209,7 +215,7 @@ class ChainArm:
             wrap_to_limits,
         )
 
-        res = self.ik_all(_frame_from_tool(tool_point, s6, a67, tool_point_6))
+        res = self.ik_all(frame_from_tool(tool_point, s6, a67, tool_point_6))
         if int(res.n_solutions) == 0:
             raise UnreachableError(f"{self.model.name}: no inverse-kinematics solution "
                                    f"({res.reason[()]})")
