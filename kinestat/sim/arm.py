@@ -31,10 +31,13 @@ class SimulatedArm:
     >>> arm = SimulatedArm(kinestat.load("puma560"), np.zeros(6))
     >>> arm.move_to([0.1, 0.2, -0.3, 0.0, 0.5, 0.0]).round(2).tolist()
     [0.1, 0.2, -0.3, 0.0, 0.5, 0.0]
-    >>> arm.move_to([0.0, 0.0, 0.0, 0.0, 3.0, 0.0])
-    Traceback (most recent call last):
-    ...
-    kinestat.errors.DeviceError: simulated arm 'puma560': joint 5 commanded to 171.887 deg, outside its limits [-100, 100] deg; not moved
+    >>> try:
+    ...     arm.move_to([0.0, 0.0, 0.0, 0.0, 3.0, 0.0])
+    ... except DeviceError as exc:
+    ...     print(str(exc).split(": ")[1])
+    joint 5 commanded to 171.887 deg, outside its limits [-100, 100] deg; not moved
+    >>> arm.q[4]  # not moved
+    np.float64(0.5)
     """
 
     def __init__(self, model: ChainModel, q_start) -> None:
