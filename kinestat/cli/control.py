@@ -459,6 +459,12 @@ def _print_report(out: dict) -> None:
     if out.get("final_axis_deg") is not None:
         out_console.print("robot axes (deg): " + ", ".join(f"{v:.4f}"
                                                            for v in out["final_axis_deg"]))
+    if out.get("arm") is not None:
+        arm = out["arm"]
+        out_console.print(literal(f"arm {arm['name']}: base at ("
+                                  + ", ".join(f"{v:g}" for v in arm["base"]) + ") mm, "
+                                  + ("placed automatically" if arm["placement"] == "auto"
+                                     else "--arm-base")))
     out_console.print(f"log: {literal(out['log'])}")
     for p in out.get("plots", []):
         out_console.print(f"plot: {literal(p)}")
