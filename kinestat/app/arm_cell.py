@@ -73,13 +73,16 @@ class PlacedArm:
     source_name: str
 
     def header(self) -> dict:
-        """The log header's and report's ``arm`` entry."""
+        """The log header's and report's ``arm`` entry (with ``constants``, the placed chain's
+    ``C0 … C6`` in mm, so that ``kinestat view log`` draws this arm)."""
         m = self.arm.model
         return {"name": self.source_name, "joints": [j.name for j in m.joints],
                 "base": self.base.tolist(), "placement": self.placement,
                 "limits_deg": np.asarray(self.arm.limits_deg).tolist(),
                 "axis_deg_per_count": ARM_DEG_PER_COUNT,
-                "start_joints_deg": np.degrees(self.q_start).tolist()}
+                "start_joints_deg": np.degrees(self.q_start).tolist(),
+                # the placed chain itself (mm): a log replays without the model file
+                "constants": np.asarray(m.constants).tolist()}
 
 
 def in_millimetres(model: ChainModel) -> ChainModel:

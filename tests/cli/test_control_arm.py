@@ -10,6 +10,7 @@ import pytest
 
 import kinestat
 from kinestat.cli.main import main
+from kinestat.viz.cell_scene import _logged_arm
 from tests.cli._cell_helpers import json_of, use_fast_moves
 from tests.urdf_arms import arm_path
 
@@ -39,6 +40,15 @@ def test_ur5_urdf_press_json(tmp_path, capsys):
     np.testing.assert_allclose(tool, rep["tool_point"], atol=1e-6)
     records = _log(log)
     assert records[0]["arm"] == arm and records[-1]["type"] == "end"
+    # the replay draws this arm: the chain the header records puts the tool where it was
+    chain = _logged_arm(records[0]["arm"])
+    for r in (r for r in records if r["type"] == "cycle"):
+        T = kinestat.fk(chain, np.radians(r["measured"]["joints_deg"]))
+        np.testing.assert_allclose(T[:3, :3] @ [0, 0, 235.0] + T[:3, 3],
+                                   r["measured"]["tool_point"], atol=1e-6)
+    html = tmp_path / "replay.html"
+    assert main(["view", "log", str(log), "--html", str(html), "--no-open"]) == 0
+    assert html.stat().st_size > 0
 
 
 def test_arm_base_given_and_text_report(tmp_path, capsys):
