@@ -42,7 +42,7 @@ from kinestat.sim.contact import Cell
 from kinestat.sim.sensor import Sensor
 
 __all__ = ["ARM_DEG_PER_COUNT", "CONTINUOUS_LIMIT_DEG", "ArmSpec", "PlacedArm", "in_millimetres",
-           "placed", "auto_base", "place_arm", "chain_arm", "arm_control_model",
+           "placed", "shoulder", "auto_base", "place_arm", "chain_arm", "arm_control_model",
            "arm_start_counts", "arm_io"]
 
 ARM_DEG_PER_COUNT = 1e-4
@@ -52,7 +52,7 @@ ARM_DEG_PER_COUNT = 1e-4
 CONTINUOUS_LIMIT_DEG = 360.0
 """The range the controller allows a joint without limits (a URDF ``continuous`` joint): ±360°."""
 
-PLACEMENT_SAMPLES = 512
+PLACEMENT_SAMPLES = 1024
 """Candidate tool positions :func:`auto_base` tries (forward kinematics of seeded random joint
 vectors within the limits)."""
 
@@ -174,20 +174,36 @@ def _solutions(arm: ChainArm, frames: np.ndarray) -> tuple[np.ndarray, np.ndarra
     return q, ok.all(axis=-1) & res.valid
 
 
+def shoulder(model: ChainModel) -> np.ndarray:
+    """The arm's shoulder (3,): the point of joint 2's axis nearest joint 1's axis at q = 0
+    (joint 2's frame origin when the axes are parallel), model frame."""
+    F1 = np.array(model.constants[0])
+    F2 = F1 @ model.constants[1]
+    p1, w1, p2, w2 = F1[:3, 3], F1[:3, 2], F2[:3, 3], F2[:3, 2]
+    c = float(w1 @ w2)
+    if 1.0 - c * c < 1e-12:
+        return p2
+    d = p2 - p1
+    t = (c * float(d @ w1) - float(d @ w2)) / (1.0 - c * c)  # along joint 2's axis
+    return p2 + t * w2
+
+
 def auto_base(arm: ChainArm, start, s6, a67, tool_point_6) -> tuple[np.ndarray, np.ndarray]:
     """Where to put the base of ``arm`` (its model at the origin, mm) so that the start pose
     is reached comfortably: (base (3,) mm, whole millimetres; the joints q (6,) there).
 
     Candidate tool positions are those of :data:`PLACEMENT_SAMPLES` seeded random joint
     vectors within the limits; at each the start orientation is solved (``ik_all``), and the
-    solution with the best :func:`_scores` wins among those whose tool point ``p`` (from the
-    base) satisfies ``p · s6 ≥ 0.1 · reach`` — the base behind the workpiece's plane."""
+    solution with the best :func:`_scores` wins among those whose tool point ``p``, seen from
+    the :func:`shoulder`, satisfies ``p · s6 ≥ 0.1 · reach`` — the tool pushes away from the
+    shoulder, which stands behind the workpiece's plane (``reach``: the farthest candidate)."""
     rng = np.random.default_rng(0)
     lim = np.radians(np.asarray(arm.limits_deg))
     lo, hi = np.maximum(lim[:, 0], -math.pi), np.minimum(lim[:, 1], math.pi)
     _, pts = _tool_points(arm.model, rng.uniform(lo, hi, (PLACEMENT_SAMPLES, 6)), tool_point_6)
-    reach = float(np.max(np.linalg.norm(pts, axis=-1)))
-    pts = pts[pts @ s6 >= 0.1 * reach]
+    rel = pts - shoulder(arm.model)
+    reach = float(np.max(np.linalg.norm(rel, axis=-1)))
+    pts = pts[rel @ s6 >= 0.1 * reach]
     if len(pts) == 0:
         raise InputError(f"--arm {arm.model.name!r}: no placement found for the start pose; "
                          "give --arm-base x,y,z")

@@ -239,3 +239,25 @@ def test_embedded_ur5_is_the_urdf_ur5():
     np.testing.assert_allclose(np.linalg.norm(np.diff(a, axis=0), axis=1),
                                np.linalg.norm(np.diff(b, axis=0), axis=1), atol=1e-9)
     np.testing.assert_allclose(_limits_deg(dh), _limits_deg(urdf), atol=1e-6)
+
+
+@pytest.mark.parametrize("name, direction", [("puma560", (0.0, 0.0, -1.0)),
+                                             ("ur5", (-1.0, 0.0, 0.0))])
+def test_automatic_placement_for_other_directions(tmp_path, name, direction):
+    """Pressing straight down (the wrist must not be placed near its singularity, where a few
+    degrees of reorientation turn axis 4 by more than the envelope's step) and along −x;
+    the embedded DH models."""
+    model = kinestat.load(name)
+    f = np.asarray(direction)
+    req = ControlRequest(force=4.0 * f, start_tool_point=np.array([100.0, -200.0, 300.0]),
+                         cell=SimulatedCell(), arm=ArmSpec(model, name=name))
+    prep, out, records = _run(req, tmp_path / "log.jsonl")
+    assert out["converged"], out["stop_reason"]
+    assert abs(out["true_force_magnitude"] - 4.0) <= 0.5
+    # the shoulder stands behind the workpiece plane (the tool pushes away from it)
+    # (both DH tables have a1 = 0: the shoulder is on joint 1's axis, d1 above the base)
+    sh = np.array([0.0, 0.0, 1000.0 * model.parameters[0][1]]) + out["arm"]["base"]
+    assert float((np.array([100.0, -200.0, 300.0]) - sh) @ f) > 0
+    lim = _limits_deg(model)
+    qs = np.array(list(_joint_vectors(records)))
+    assert np.all(qs >= lim[:, 0] - 1e-6) and np.all(qs <= lim[:, 1] + 1e-6)
