@@ -17,8 +17,8 @@ given in (for the PUMA 762 its base frame). The arm is loaded in millimetres
 (axes parallel). Without ``arm_base`` it is placed automatically (:func:`auto_base`): among
 reachable tool positions of the arm, the one where the start pose (tool point, tool axis along
 the force, a67 as the controller's default) is reached with the best-conditioned Jacobian and
-joint-limit margin, with the base on the tool's side of the workpiece (the tool pushes away from
-the base) — then rounded to whole millimetres.
+joint-limit margin, with the arm's shoulder on the tool's side of the workpiece (the tool pushes
+away from the shoulder) — then rounded to whole millimetres.
 """
 
 from __future__ import annotations

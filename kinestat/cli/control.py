@@ -299,8 +299,8 @@ def control_command(
     arm_base: str = typer.Option(
         None, "--arm-base", metavar="X,Y,Z", help="--arm: where its base frame is (mm, fixed "
         "frame, axes parallel). Default: placed automatically so that the start pose is "
-        "reached with the best-conditioned Jacobian and joint-limit margin, the base behind "
-        "the workpiece's plane (reported as arm.base)."),
+        "reached with the best-conditioned Jacobian and joint-limit margin, the arm's "
+        "shoulder behind the workpiece's plane (reported as arm.base)."),
     as_json: bool = flag(False, "--json", help="Print the final report as JSON."),
 ) -> None:
     """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
