@@ -25,6 +25,7 @@ from kinestat.control.log import read_log
 from kinestat.errors import DeviceError, InputError
 from kinestat.sim.arm import SimulatedArm
 from kinestat.sim.contact import equilibrium
+from tests.serial.analytic.arms import jaco6
 from tests.urdf_arms import arm_path
 
 START = np.array([-400.0, 800.0, -100.0])
@@ -261,3 +262,15 @@ def test_automatic_placement_for_other_directions(tmp_path, name, direction):
     lim = _limits_deg(model)
     qs = np.array(list(_joint_vectors(records)))
     assert np.all(qs >= lim[:, 0] - 1e-6) and np.all(qs <= lim[:, 1] + 1e-6)
+
+
+def test_a_general_6r_arm_presses(tmp_path):
+    """An arm without closed-form structure (a Jaco2-type 60° wrist: ``ik_all``'s general 6R
+    solver) in the cell: converged, the true force recomputed from its own model."""
+    model = jaco6()
+    prep, out, records = _run(_request(model), tmp_path / "log.jsonl")
+    assert out["converged"], out["stop_reason"]
+    last = [r for r in records if r["type"] == "cycle"][-1]
+    eq = equilibrium(prep.cell, _independent_flange(model, out["arm"]["base"],
+                                                    last["true"]["joints_deg"]))
+    assert abs(np.linalg.norm(eq.tool_force) - 4.0) <= 0.5
