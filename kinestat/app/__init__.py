@@ -5,6 +5,8 @@ io, viz; imported only by the CLI).
   (:class:`SimHarness`), and in-process without devices (:class:`InProcessIO`).
 - :mod:`kinestat.app.control_run` — assembling the cell and the controller for
   ``kinestat control`` (simulated or real devices) and running it.
+- :mod:`kinestat.app.arm_cell` — another arm (``kinestat control --arm``) in the in-process
+  simulated cell: millimetres, automatic placement, start joints.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submodules=None,
     submod_attrs={
+        'arm_cell': ['ArmSpec', 'PlacedArm', 'place_arm'],
         'control_run': [
             'ControlRequest', 'PreparedRun', 'RealDevices', 'SimulatedCell', 'prepare_control',
             'run_control',

@@ -5,7 +5,9 @@ the report; this module builds what the run needs — the thesis's experiment as
 cell (Vibhute 2011 §5.1: the special 6-6 platform centred on the flange, the tool at
 ``P_tool_6``, a tilted plane ahead of the start tool point) behind the simulated Galil and
 encoder box (:mod:`kinestat.app.sim_cell`), or the real Galil and encoder stream — and runs
-the kinestatic loop (:func:`kinestat.control.loop.run`) on it.
+the kinestatic loop (:func:`kinestat.control.loop.run`) on it. With another arm
+(``ControlRequest.arm``, ``kinestat control --arm``) the same simulated cell carries that arm
+in-process (:mod:`kinestat.app.arm_cell`).
 """
 
 from __future__ import annotations
@@ -18,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 
+from kinestat.app.arm_cell import ArmSpec, PlacedArm, arm_control_model, arm_io, place_arm
 from kinestat.app.calibrations import (
     NamedCalibration,
     calibrated_model,
@@ -160,6 +163,7 @@ class ControlRequest:
     travel_step: float = 1.0
     tilt_deg: float = 0.0
     auto_tilt: bool = False
+    arm: ArmSpec | None = None
 
 
 def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: np.ndarray,
@@ -227,6 +231,7 @@ class PreparedRun:
     cell: Cell | None = None
     sensor: Sensor | None = None
     follow: FollowConfig | None = None
+    arm: PlacedArm | None = None
 
 
 def prepare_control(req: ControlRequest) -> PreparedRun:
@@ -273,17 +278,37 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
             cal = NamedCalibration(cal.name, fine)
         cell, sensor = simulated_cell(s, req.start_tool_point, direction, platform, truth)
         config = _config(req, calibrated_model(platform, cal))
+        placed_arm = None
+        if req.arm is not None:
+            config, placed_arm = _with_arm(req.arm, config)
+            header["arm"] = placed_arm.header()
         wp = cell.workpiece
         header.update({"plane_point": wp.point, "plane_normal": wp.normal} if s.cylinder is None
                       else {"workpiece": {"kind": "cylinder", "radius": wp.radius,
                                           "axis": wp.axis, "point": wp.point}})
         header.update({"friction": s.friction, "ideal_sensor": s.ideal_sensor, "noise": s.noise,
                        "rate_hz": s.rate_hz, "sim_legs": truth.name})
-        return PreparedRun(req, config, header, cell, sensor)
+        return PreparedRun(req, config, header, cell, sensor, arm=placed_arm)
+    if req.arm is not None:
+        raise InputError("--arm: another arm runs on the in-process simulated cell only; the "
+                         "Galil and encoder protocols are the PUMA 762's hardware (drop "
+                         "--galil/--serial)")
     d = req.cell
     header.update({"galil": f"{d.host}:{d.port}", "serial": d.serial,
                    "serial_format": d.serial_format})
     return PreparedRun(req, _config(req, calibrated_model(platform, cal)), header)
+
+
+def _with_arm(spec: ArmSpec, config: ControllerConfig) -> tuple[ControllerConfig, PlacedArm]:
+    """The controller's settings with the arm of ``spec`` placed in the cell (its start pose
+    checked reachable: an InputError before anything moves). The vernier is off: the arm's
+    command resolution (:data:`~kinestat.app.arm_cell.ARM_DEG_PER_COUNT`) is already fine."""
+    model = config.model
+    placed_arm = place_arm(spec.model, config.start_tool_point, config.start_s6,
+                           config.start_a67, model.tool_point_6, base=spec.base,
+                           source_name=spec.name)
+    return (replace(config, model=arm_control_model(model, placed_arm), vernier=False),
+            placed_arm)
 
 
 def run_control(prepared: PreparedRun, log_path: Path, *,
@@ -301,6 +326,12 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
     safety = {"guard": sent_command_guard(config.envelope, config.model),
               "max_stream_faults": config.envelope.max_stream_faults,
               "move_rule": req.move_rule}
+    if prepared.arm is not None:
+        io = arm_io(prepared.cell, prepared.sensor, prepared.arm, seed=req.cell.seed,
+                    guard=safety["guard"])
+        with CycleLog(log_path) as cycle_log:
+            return run(config, io, cycle_log, progress=progress, extra_header=header,
+                       decide_fn=decide_fn)
     if isinstance(req.cell, SimulatedCell):
         with SimHarness(prepared.cell, prepared.sensor, start_counts=start_counts(config),
                         rate_hz=req.cell.rate_hz, seed=req.cell.seed) as h:
@@ -336,6 +367,8 @@ def report_dict(prepared: PreparedRun, report: RunReport) -> dict:
         out["completed"] = report.converged
         out.update(follow_summary(report.cycles, prepared.config.force_target,
                                   prepared.follow.travel))
+    if prepared.arm is not None:
+        out["arm"] = prepared.arm.header()
     return out
 
 

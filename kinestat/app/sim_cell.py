@@ -12,7 +12,10 @@ friction anchor follows the path) and turns the true leg lengths into encoder co
 client and reader (:class:`kinestat.devices.cell_io.DeviceIO`), over TCP loopback and the pty.
 
 :class:`InProcessIO` is the same cell without devices (an exact robot, counts straight from the
-sensor model): fast, deterministic, for tests of the control law.
+sensor model): fast, deterministic, for tests of the control law. Given a
+:class:`~kinestat.sim.arm.SimulatedArm` it carries that arm instead of the PUMA 762 (joints set
+directly within the arm's limits, the flange pose from the arm's model): the cell of
+``kinestat control --arm`` (:mod:`kinestat.app.arm_cell`).
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ from kinestat.hardware.puma762_axes import (
     counts_to_joint_rad,
 )
 from kinestat.serial import puma762
+from kinestat.sim.arm import SimulatedArm
 from kinestat.sim.contact import Cell, Equilibrium, unloaded_tip
 from kinestat.sim.dmc import DmcSimulator, SimClock
 from kinestat.sim.encoder_emitter import EncoderEmitter
@@ -74,10 +78,13 @@ class CellState:
 
     :meth:`solve` is quasi-static: call it along the robot's motion (the emitter does, at its
     rate) so that a sticking contact's anchor and the first-contact point follow the path.
+    ``arm``: the robot carrying the platform (default the PUMA 762's closed form).
     """
 
-    def __init__(self, cell: Cell, sensor: Sensor | None = None, *, seed: int | None = 0) -> None:
+    def __init__(self, cell: Cell, sensor: Sensor | None = None, *, seed: int | None = 0,
+                 arm: SimulatedArm | None = None) -> None:
         self.cell = cell
+        self.arm = arm
         self.sensor = sensor if sensor is not None else Sensor()
         self._rng = np.random.default_rng(seed)
         self._lock = threading.Lock()
@@ -94,7 +101,7 @@ class CellState:
         with self._lock:
             if key == self._key and self._eq is not None:
                 return self._eq
-            T = puma762.forward(q).pose
+            T = puma762.forward(q).pose if self.arm is None else self.arm.flange_pose(q)
             try:
                 guess = (self._eq.top_pose if self._eq is not None and self._eq.in_contact
                          else None)  # continuation along the robot's motion
@@ -120,7 +127,12 @@ class CellState:
     def truth(self, q, tool_point_6) -> dict:
         """The true state at ``q`` for logs and reports (fixed frame)."""
         eq = self.solve(q)
-        fwd = puma762.forward(np.asarray(q, dtype=float), tool_point_6)
+        if self.arm is None:
+            fwd = puma762.forward(np.asarray(q, dtype=float), tool_point_6)
+            tool_axis, tool_point = fwd.s6, fwd.tool_point
+        else:
+            T = self.arm.flange_pose(q)
+            tool_axis, tool_point = T[:3, 2].copy(), T[:3, :3] @ tool_point_6 + T[:3, 3]
         return {
             "tool_force": eq.tool_force,
             "tool_force_magnitude": float(np.linalg.norm(eq.tool_force)),
@@ -128,8 +140,8 @@ class CellState:
             "sticking": eq.sticking,
             "tip": eq.tip,
             "leg_lengths": eq.leg_lengths,
-            "tool_axis": fwd.s6,
-            "tool_point": fwd.tool_point,
+            "tool_axis": tool_axis,
+            "tool_point": tool_point,
             "joints_deg": np.degrees(q),
             "residual": eq.residual,
             "normal": (surface_normal(self.cell.workpiece, eq.tip) if eq.in_contact
@@ -307,21 +319,36 @@ class InProcessIO:
     The robot reaches every commanded count exactly (no coupling, no motion time); the sensor
     counts come straight from the cell. Moves are evaluated quasi-statically at ``substeps``
     points along the straight joint-space path (for friction's history).
+
+    With ``arm`` (a :class:`~kinestat.sim.arm.SimulatedArm`) the robot is that arm: axis angle
+    = counts · ``axis_deg_per_count``, joint = axis − ``axis_offset`` (radians), set directly on
+    the arm, which refuses (DeviceError, nothing moves) a joint outside its limits; ``guard``
+    (``guard(sent_counts, counts_now)``, e.g. the envelope's
+    :func:`~kinestat.control.envelope.sent_command_guard`) checks every command before that.
     """
 
     def __init__(self, cell: Cell, sensor: Sensor | None = None, *, start_counts,
-                 axis_deg_per_count=None, seed: int | None = 0, substeps: int = 4) -> None:
-        self.state = CellState(cell, sensor, seed=seed)
+                 axis_deg_per_count=None, seed: int | None = 0, substeps: int = 4,
+                 arm: SimulatedArm | None = None, axis_offset=None, guard=None) -> None:
+        self.state = CellState(cell, sensor, seed=seed, arm=arm)
         self.cell = cell
+        self.arm = arm
+        self._offset = np.zeros(6) if axis_offset is None else np.asarray(axis_offset, float)
+        self._guard = guard
         self._res = np.asarray(AXIS_DEG_PER_COUNT if axis_deg_per_count is None
                                else axis_deg_per_count, dtype=float)
         self._counts = np.asarray(start_counts, dtype=np.int64).copy()
+        if arm is not None:
+            arm.move_to(self._q(self._counts))
         self.substeps = int(substeps)
         self.stopped = False
         self.moves: list[np.ndarray] = []
 
     def _q(self, counts) -> np.ndarray:
-        return puma762.from_axis_angles(np.radians(np.asarray(counts, dtype=float) * self._res))
+        axis = np.radians(np.asarray(counts, dtype=float) * self._res)
+        if self.arm is not None:
+            return axis - self._offset
+        return puma762.from_axis_angles(axis)
 
     def robot_counts(self) -> np.ndarray:
         """The exact robot's axis counts A..F."""
@@ -333,6 +360,10 @@ class InProcessIO:
         (:func:`kinestat.devices.motion.coordinated_move_plan`, the thesis's maxima)."""
         new = np.asarray(axis_counts, dtype=np.int64)
         old = self._counts.astype(float)
+        if self._guard is not None:
+            self._guard(new, self._counts)
+        if self.arm is not None:
+            return self._move_arm(new, old)
         for s in np.linspace(0.0, 1.0, self.substeps + 1)[1:]:
             self.state.solve(self._q(old + s * (new - old)))
         self._counts = new.copy()
@@ -341,6 +372,18 @@ class InProcessIO:
         return {"delta_counts": (new - old).astype(np.int64).tolist(),
                 "speed": plan.speed.tolist(), "accel": plan.accel.tolist(),
                 "rule": "coordinated"}
+
+    def _move_arm(self, new: np.ndarray, old: np.ndarray) -> dict:
+        """The simulated arm's move: its joints checked first (nothing moves when refused),
+        then the cell solved along the straight joint-space path."""
+        q_new = self.arm.move_to(self._q(new))  # the limits, before any state changes
+        q_old = self._q(old)
+        for s in np.linspace(0.0, 1.0, self.substeps + 1)[1:]:
+            self.state.solve(q_old + s * (q_new - q_old))
+        self._counts = new.copy()
+        self.moves.append(new.copy())
+        return {"delta_counts": (new - old).astype(np.int64).tolist(),
+                "joints_deg": np.degrees(q_new).tolist(), "rule": "direct"}
 
     def sensor(self) -> SensorSample:
         """Leg counts of the cell at the present pose, through the sensor model."""

@@ -3,8 +3,10 @@
 With no device arguments the command starts the Galil simulator and the encoder emitter
 itself (loopback TCP and a pty), builds the simulated cell (the thesis's experiment by
 default: Vibhute 2011 §5.1) and drives it through the real client and reader. With
-``--galil HOST:PORT --serial DEVICE`` it drives real hardware. This module only parses and
-prints; the assembly is :mod:`kinestat.app.control_run`.
+``--galil HOST:PORT --serial DEVICE`` it drives real hardware. With ``--arm MODEL`` another
+6-joint arm with an analytic solver carries the platform in the in-process simulated cell
+(:mod:`kinestat.app.arm_cell`). This module only parses and prints; the assembly is
+:mod:`kinestat.app.control_run`.
 """
 
 from __future__ import annotations
@@ -24,6 +26,13 @@ from kinestat.app.control_defaults import (
     TASKS,
 )
 from kinestat.app.signals import stop_on_signals
+from kinestat.cli._model import (
+    base_option,
+    length_unit_option,
+    load_model,
+    scale_option,
+    tip_option,
+)
 from kinestat.cli._options import check_seed, flag
 from kinestat.cli._output import console as out_console
 from kinestat.cli._output import err_console, literal, parse_floats, print_json, table
@@ -124,6 +133,35 @@ def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor,
             sim_legs=sim_legs, cylinder=cylinder)
     host, port = _host_port(galil)
     return RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
+
+
+THESIS_ARM_NAME = "puma762"
+"""``--arm`` naming the thesis's PUMA 762 (the default): today's cell, Galil and encoders."""
+
+
+def _arm(arm, tip, base, scale, length_unit, arm_base, galil, serial):
+    """The ``--arm`` of the run (an :class:`~kinestat.app.arm_cell.ArmSpec`), or None for the
+    thesis's PUMA 762; every refusal before anything is loaded or moves."""
+    urdf = [o for o, v in (("--tip", tip), ("--base", base), ("--scale", scale),
+                           ("--length-unit", length_unit)) if v is not None]
+    if arm is None:
+        if urdf or arm_base is not None:
+            raise InputError(f"{'/'.join(urdf + (['--arm-base'] if arm_base else []))}: "
+                             "options of --arm MODEL; give --arm")
+        return None
+    if arm == THESIS_ARM_NAME and not urdf:
+        if arm_base is not None:
+            raise InputError("--arm-base: the thesis's PUMA 762 is the cell's fixed frame; "
+                             "--arm-base places another arm")
+        return None
+    if galil is not None or serial is not None:
+        raise InputError(f"--arm {arm}: another arm runs on the in-process simulated cell "
+                         "only; the Galil and encoder protocols are the PUMA 762's hardware "
+                         "(drop --galil/--serial)")
+    from kinestat.app.arm_cell import ArmSpec  # lazy: start-up (numba)
+
+    b = None if arm_base is None else parse_floats(arm_base, 3, "arm-base")
+    return ArmSpec(model=load_model(arm, tip, base, scale, length_unit), base=b, name=arm)
 
 
 def _print_progress(rec: dict) -> None:
@@ -249,6 +287,20 @@ def control_command(
         None, "--workpiece", help="Simulated workpiece: 'plane' (default, --plane-point/"
         "--plane-normal) or 'cylinder:radius=R,axis=x,y,z[,point=x,y,z]' (without point: its "
         f"surface {DEFAULT_PLANE_DISTANCE} mm ahead of the start tool point along F_req)."),
+    arm: str = typer.Option(
+        None, "--arm", metavar="MODEL", help="The robot: an embedded model name (e.g. "
+        "puma560), a TOML model or a URDF file, any 6-joint arm with an analytic solver; "
+        "default the thesis's PUMA 762. Another arm runs on the in-process simulated cell: its "
+        "joints are set directly within its limits, its base at --arm-base (docs/control.md)."),
+    tip: str = tip_option(),
+    base: str = base_option(),
+    scale: float = scale_option(),
+    length_unit: str = length_unit_option(),
+    arm_base: str = typer.Option(
+        None, "--arm-base", metavar="X,Y,Z", help="--arm: where its base frame is (mm, fixed "
+        "frame, axes parallel). Default: placed automatically so that the start pose is "
+        "reached with the best-conditioned Jacobian and joint-limit margin, the arm's "
+        "shoulder behind the workpiece's plane (reported as arm.base)."),
     as_json: bool = flag(False, "--json", help="Print the final report as JSON."),
 ) -> None:
     """Kinestatic control: press the tool on the workpiece with |F_req| along the force.
@@ -264,7 +316,7 @@ def control_command(
     equivalent wrench's force, N: base − tool torque = tool_point × it), procedure,
     calibration, cycles; with --task follow also task, completed, travel,
     normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
-    simulated).
+    simulated); with --arm also arm (name, joints, base, placement, limits_deg).
     """
     _check_counts(samples, max_iterations)
     check_seed(seed)
@@ -293,6 +345,7 @@ def control_command(
     )
     from kinestat.cli._compile import KERNELS, compiling_notice, is_cold, warm_kernels
 
+    arm_spec = _arm(arm, tip, base, scale, length_unit, arm_base, galil, serial)
     cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
                  friction, rate, seed, sim_legs, workpiece)
     simulated = isinstance(cell, SimulatedCell)
@@ -304,7 +357,8 @@ def control_command(
                          assume_homed=assume_homed, task=task, travel=travel,
                          travel_dir=(None if travel_dir is None
                                      else parse_floats(travel_dir, 3, "travel-dir")),
-                         travel_step=travel_step, tilt_deg=tilt_deg, auto_tilt=auto_tilt)
+                         travel_step=travel_step, tilt_deg=tilt_deg, auto_tilt=auto_tilt,
+                         arm=arm_spec)
     cold = tuple(g for g in KERNELS if is_cold(g))
     if cold:  # compile before the run, so that its timing is the loop's own
         with compiling_notice(*cold):
@@ -315,7 +369,8 @@ def control_command(
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {procedure}, method "
                       f"{method}, calibration {calibration}, "
                       + ("simulated cell" if simulated
-                         else literal(f"Galil {galil}, sensor {serial}")))
+                         else literal(f"Galil {galil}, sensor {serial}"))
+                      + ("" if prepared.arm is None else literal(_arm_words(prepared.arm))))
     # SIGTERM / SIGHUP stop the cell as Ctrl-C does: ST, a fault and an end record, status 2
     with stop_on_signals():
         try:
@@ -343,6 +398,13 @@ def control_command(
         what = "the follow task did not complete" if task == "follow" else (
             "kinestatic control did not converge")
         raise KinestatError(f"{what}: {report.stop_reason}")
+
+
+def _arm_words(placed) -> str:
+    """The banner's words on another arm: its name and where its base was put."""
+    b = ", ".join(f"{v:g}" for v in placed.base)
+    how = "placed automatically" if placed.placement == "auto" else "--arm-base"
+    return f", arm {placed.source_name} (base at {b} mm, {how})"
 
 
 def _check_counts(samples: int, max_iterations: int | None) -> None:
@@ -397,6 +459,12 @@ def _print_report(out: dict) -> None:
     if out.get("final_axis_deg") is not None:
         out_console.print("robot axes (deg): " + ", ".join(f"{v:.4f}"
                                                            for v in out["final_axis_deg"]))
+    if out.get("arm") is not None:
+        arm = out["arm"]
+        out_console.print(literal(f"arm {arm['name']}: base at ("
+                                  + ", ".join(f"{v:g}" for v in arm["base"]) + ") mm, "
+                                  + ("placed automatically" if arm["placement"] == "auto"
+                                     else "--arm-base")))
     out_console.print(f"log: {literal(out['log'])}")
     for p in out.get("plots", []):
         out_console.print(f"plot: {literal(p)}")

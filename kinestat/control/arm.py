@@ -36,7 +36,7 @@ from kinestat.spatial.validate import frozen
 if TYPE_CHECKING:
     from kinestat.serial.analytic import IKAllResult
 
-__all__ = ["Arm", "ToolFrame", "Puma762Arm", "ChainArm", "THESIS_ARM"]
+__all__ = ["Arm", "ToolFrame", "Puma762Arm", "ChainArm", "THESIS_ARM", "frame_from_tool"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -136,8 +136,14 @@ THESIS_ARM = Puma762Arm()
 """The PUMA 762 of the thesis's cell (the controller's default arm)."""
 
 
-def _frame_from_tool(tool_point, s6, a67, tool_point_6) -> np.ndarray:
-    """``T_base_end`` with z = ``s6``, x = ``a67`` and ``T · P_tool_6 = tool_point``."""
+def frame_from_tool(tool_point, s6, a67, tool_point_6) -> np.ndarray:
+    """``T_base_end`` (4, 4) with z = ``s6``, x = ``a67`` (made perpendicular to z) and
+    ``T · P_tool_6 = tool_point``: the thesis's target description as a pose.
+
+    >>> T = frame_from_tool([0, 0, 300.0], [0, 0, 1.0], [1.0, 0, 0], [0, 0, 100.0])
+    >>> T[:3, 3].tolist()
+    [0.0, 0.0, 200.0]
+    """
     z = np.asarray(s6, dtype=float)
     x = np.asarray(a67, dtype=float)
     z = z / np.linalg.norm(z)
@@ -147,6 +153,19 @@ def _frame_from_tool(tool_point, s6, a67, tool_point_6) -> np.ndarray:
     T[:3, 0], T[:3, 1], T[:3, 2] = x, np.cross(z, x), z
     T[:3, 3] = np.asarray(tool_point, dtype=float) - T[:3, :3] @ np.asarray(tool_point_6, float)
     return T
+
+
+_FEW = 16
+
+
+def _fk_few(model: ChainModel, q: np.ndarray) -> np.ndarray:
+    """``fk`` with a batch of at most :data:`_FEW` joint vectors taken one by one: the
+    single-vector kernel takes microseconds where the batched (threaded) one pays a thread
+    launch of milliseconds on a loaded machine (the controller's candidates, one per cycle)."""
+    if q.ndim < 2 or q.size > _FEW * q.shape[-1]:
+        return fk(model, q)
+    rows = np.ascontiguousarray(q.reshape(-1, q.shape[-1]))
+    return np.stack([fk(model, r) for r in rows]).reshape(q.shape[:-1] + (4, 4))
 
 
 @dataclass(frozen=True, eq=False)
@@ -190,7 +209,7 @@ class ChainArm:
         return np.asarray(q, dtype=float) + self.axis_offset
 
     def forward(self, q, tool_point_6=(0.0, 0.0, 0.0)) -> ToolFrame:
-        T = fk(self.model, np.asarray(q, dtype=float))
+        T = _fk_few(self.model, np.asarray(q, dtype=float))
         p = np.einsum("...ij,j->...i", T[..., :3, :3], np.asarray(tool_point_6, float))
         return ToolFrame(tool_point=p + T[..., :3, 3], s6=T[..., :3, 2].copy(),
                          a67=T[..., :3, 0].copy(), pose=T)
@@ -209,7 +228,7 @@ class ChainArm:
             wrap_to_limits,
         )
 
-        res = self.ik_all(_frame_from_tool(tool_point, s6, a67, tool_point_6))
+        res = self.ik_all(frame_from_tool(tool_point, s6, a67, tool_point_6))
         if int(res.n_solutions) == 0:
             raise UnreachableError(f"{self.model.name}: no inverse-kinematics solution "
                                    f"({res.reason[()]})")

@@ -14,6 +14,8 @@ are imported here; the wiring of a simulated cell to the controller is
   told otherwise).
 - :mod:`kinestat.sim.encoder_emitter` — a simulated encoder box streaming packets onto a
   pseudo-terminal, with fault injection.
+- :mod:`kinestat.sim.arm` — any 6-joint arm whose joints are set directly within its limits
+  (the in-process cell of ``kinestat control --arm``).
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submodules=None,
     submod_attrs={
+        'arm': ['SimulatedArm'],
         'contact': ['Cell', 'Equilibrium', 'Workpiece', 'equilibrium', 'make_cell'],
         'dmc': ['DmcSimulator', 'SimClock'],
         'encoder_emitter': ['EncoderEmitter', 'constant_counts'],

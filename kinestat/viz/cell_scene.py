@@ -1,6 +1,7 @@
 """The kinestatic cell replayed from a control run's cycle log (``kinestat control --log``).
 
-Per cycle (one scene step): the PUMA 762 at its measured joints, the compliant platform mounted
+Per cycle (one scene step): the PUMA 762 (or the run's ``--arm``, from the chain its log header
+records) at its measured joints, the compliant platform mounted
 on the flange (base = ``F_6T · 6_BT``, top = base · measured top pose), the tool from the top to
 its measured tip, the workpiece plane of a simulated run, and the measured and true force arrows.
 The state a–e and the controller's decision are the step's label.
@@ -17,6 +18,8 @@ import kinestat
 from kinestat.control.log import read_log
 from kinestat.errors import InputError
 from kinestat.io.library import prototype
+from kinestat.mechanism.chain import ChainModel
+from kinestat.mechanism.joints import Joint
 from kinestat.viz.scene import _base, _pt, chain_frames, force_color, robot_record
 
 __all__ = ["read_cycle_log", "cell_scene"]
@@ -99,11 +102,24 @@ def _cycle_items(platform, mount, F6, meas: dict, true: dict | None,
     return items
 
 
+def _logged_arm(arm: dict) -> ChainModel:
+    """The ``--arm`` of a run as its log header records it (placed chain, mm, limits)."""
+    try:
+        lim = np.radians(np.asarray(arm["limits_deg"], dtype=float))
+        joints = tuple(Joint(name=str(n), lower=float(lo), upper=float(hi))
+                       for n, (lo, hi) in zip(arm["joints"], lim, strict=True))
+        return ChainModel(name=str(arm["name"]), joints=joints,
+                          constants=np.asarray(arm["constants"], dtype=float), length_unit="mm")
+    except (KeyError, TypeError, ValueError) as exc:
+        raise InputError(f"the log's arm record is incomplete ({exc}): it cannot be drawn"
+                         ) from exc
+
+
 def cell_scene(start: dict, cycles: list[dict], end: dict | None = None, *, platform=None,
                title: str = "kinestatic control run") -> dict:
     """The scene of a control run: one step per cycle record (see the module docstring)."""
     platform = prototype() if platform is None else platform
-    model = kinestat.load("puma762")
+    model = kinestat.load("puma762") if "arm" not in start else _logged_arm(start["arm"])
     cfg = start["config"]
     mount = np.asarray(cfg.get("mount", np.eye(4)), dtype=float)
     Q = np.radians(np.array([c["measured"]["joints_deg"] for c in cycles], dtype=float))
