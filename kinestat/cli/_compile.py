@@ -28,6 +28,8 @@ KERNELS: dict[str, str] = {
     "cycle": "kinestat.serial.puma762._cycle_kernels",
     "stiffness": "kinestat.parallel._stiffness_kernels",
     "platform": "kinestat.parallel._fk_kernels",
+    "kinestatic": "kinestat.parallel._kinestatic_kernels",
+    "estimate": "kinestat.control._estimate_kernels",
 }
 #: kernel groups compiled on demand by the command that uses them (not by ``kinestat warmup``)
 ON_DEMAND: dict[str, str] = {
@@ -137,8 +139,30 @@ def _warm_platform() -> None:
     fk_list(p, leg_lengths(p, p.home_pose))
 
 
+def _warm_kinestatic() -> None:
+    """The follow law's one-stiffness kernels (kinestat.parallel.kinestatic.solve_one and
+    compose_twist_line's singularity check)."""
+    from kinestat.parallel.kinestatic import compose_twist_line, solve_one  # lazy: numba
+
+    K = np.diag([10.0, 10.0, 10.0, 1.0, 1.0, 1.0])
+    w = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+    solve_one(K, w)
+    compose_twist_line(K, w, np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0]), 2.0 * w)
+
+
+def _warm_estimate() -> None:
+    """The follow task's path curvature (kinestat.control.contact_estimate.path_curvature_one)."""
+    from kinestat.control.contact_estimate import path_curvature_one  # lazy: numba
+
+    a = np.linspace(0.0, 0.05, 6)
+    pts = np.column_stack([100.0 * np.sin(a), 100.0 * np.cos(a) - 100.0, 0.0 * a])
+    path_curvature_one(pts[:-1], pts[-1], np.array([0.0, 1.0, 0.0]),
+                       np.array([1.0, 0.0, 0.0]), 1.0)
+
+
 _WARM = {"serial": _warm_serial, "ik": _warm_ik, "puma762": _warm_puma762,
-         "cycle": _warm_cycle, "stiffness": _warm_stiffness, "platform": _warm_platform}
+         "cycle": _warm_cycle, "stiffness": _warm_stiffness, "platform": _warm_platform,
+         "kinestatic": _warm_kinestatic, "estimate": _warm_estimate}
 
 
 def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:

@@ -76,9 +76,10 @@ def reference_cycle() -> Iterator[None]:
     analysis for the flange pose, the NumPy stiffness recomputed on every use, the batched
     ``compose_twist`` and ``twist_exp`` in the follow law, NumPy's solves and SciPy's rotations
     in the prediction, NumPy's tip compliance and SciPy's rotation vector on every motion check;
-    in the follow task's estimator the batched NumPy ``cone_normal``, ``friction_sample`` and
-    ``path_curvature`` (``lstsq``), ``numpy.linalg.norm``, ``dataclasses.replace`` and the
-    mount's inverse on every use. Not thread-safe (it swaps module attributes)."""
+    in the follow task's estimator and law the batched NumPy ``cone_normal``,
+    ``friction_sample`` and ``path_curvature`` (``lstsq``), ``numpy.linalg.norm`` and
+    ``numpy.linalg.solve``, ``dataclasses.replace`` and the mount's inverse on every use. Not
+    thread-safe (it swaps module attributes)."""
     saved = [(controller, "_solve_counts", solve_counts_reference),
              (controller, "_flange_pose", lambda model, q: puma762.forward(q).pose),
              (envelope, "cycle_data", UncachedCycleData),
@@ -89,6 +90,7 @@ def reference_cycle() -> Iterator[None]:
              (follow, "friction_sample_one", friction_sample),
              (follow, "path_curvature_one", path_curvature),
              (follow, "norm3", np.linalg.norm),
+             (follow, "solve_one", np.linalg.solve),
              (follow, "replace", dataclasses.replace),
              (follow, "mount_inverse", lambda model: inv(model.mount)),
              (envelope, "rotvec_matrix_one",

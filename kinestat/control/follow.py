@@ -90,7 +90,7 @@ from kinestat.control.envelope import (
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
-from kinestat.parallel.kinestatic import compose_twist_line
+from kinestat.parallel.kinestatic import compose_twist_line, solve_one
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
@@ -382,13 +382,13 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     if friction > 0.0 and slip is not None:
         s = R.T @ slip
         Wt = np.concatenate([s, cross3(p, s)])
-    Tc = -dlam * np.linalg.solve(K, W - friction * Wt)  # K⁻¹ δw, δw = −Δλ W_c
+    Tc = -dlam * solve_one(K, W - friction * Wt)  # K⁻¹ δw, δw = −Δλ W_c
     dp = Tc[3:] + cross3(Tc[:3], p)  # the tip's motion under the compliance twist
     scale = max(abs(float(dp @ n)) / max_correction,
                 norm3(dp) / (TANGENTIAL_FACTOR * max_correction), 1.0)
     T = compose_twist_line(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
     if friction > 0.0 and slip is not None:
-        T = T + (dlam / scale) * friction * np.linalg.solve(K, Wt)
+        T = T + (dlam / scale) * friction * solve_one(K, Wt)
     return T
 
 

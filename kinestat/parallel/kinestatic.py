@@ -59,6 +59,7 @@ from typing import NamedTuple
 import numpy as np
 
 from kinestat.errors import InputError, SingularityError
+from kinestat.parallel import _kinestatic_kernels as _kk
 from kinestat.parallel.statics import forces_from_wrench
 from kinestat.parallel.stiffness import stiffness
 from kinestat.spatial.transforms import as_array
@@ -74,6 +75,7 @@ __all__ = [
     "decompose_twist",
     "compose_twist",
     "compose_twist_line",
+    "solve_one",
     "wrench_coordinates",
     "freedom_basis",
     "platform_stiffness_axis",
@@ -292,7 +294,10 @@ def compose_twist_line(K, w, freedom, delta_wrench) -> np.ndarray:
     value ``T_f + K⁻¹ δw``, without the batched machinery (the control cycle's hot path).
     The span check projects on ``w`` directly instead of through a pseudo-inverse, and the
     vector checks run in scalar arithmetic; they agree with the batched ones to rounding, far
-    inside the 1e-9 tolerance.
+    inside the 1e-9 tolerance. K's singularity check takes LAPACK's SVD only where the compiled
+    one-sided Jacobi ratio ``s_min/s_max`` (:func:`~kinestat.parallel._kinestatic_kernels.
+    singular_ratio6`, accurate to ~1e-15 of ``s_max``) is not clearly above the threshold
+    (twice it): the same verdicts, without the SVD on a regular K.
 
     >>> K = np.diag([10.0, 10.0, 10.0, 1.0, 1.0, 1.0]) @ DELTA
     >>> compose_twist_line(K, np.array([0, 0, 1.0, 0, 0, 0]), np.array([0, 0, 0, 1.0, 0, 0]),
@@ -304,9 +309,10 @@ def compose_twist_line(K, w, freedom, delta_wrench) -> np.ndarray:
     Tf = np.asarray(freedom, dtype=float)
     dw = np.asarray(delta_wrench, dtype=float)
     ok = K.shape == (6, 6) and all(map(math.isfinite, K.ravel().tolist()))
-    s = np.linalg.svd(K, compute_uv=False) if ok else None
-    if s is None or s[-1] <= _K_TOL * s[0]:
-        K, _ = _check_stiffness(K)  # raises its message: a bad shape, not finite, singular
+    if not (ok and _kk.singular_ratio6(np.ascontiguousarray(K)) > 2.0 * _K_TOL):
+        s = np.linalg.svd(K, compute_uv=False) if ok else None
+        if s is None or s[-1] <= _K_TOL * s[0]:
+            K, _ = _check_stiffness(K)  # raises its message: a bad shape, not finite, singular
     vals = []
     for v, name in ((w, "contact wrenches W"), (Tf, "twist of freedom"), (dw, "wrench change")):
         x = v.tolist()
@@ -329,6 +335,24 @@ def compose_twist_line(K, w, freedom, delta_wrench) -> np.ndarray:
                          f"(relative |Wᵀ Δ T_f| = {abs(r) / scale:.3g}): it would push "
                          "into the contact; project it with decompose_twist first")
     return Tf + np.linalg.solve(K, dw[..., None])[..., 0]
+
+
+def solve_one(K, b) -> np.ndarray:
+    """``K⁻¹ b`` (6,) for ONE stiffness ``K`` (6, 6) and ONE wrench ``b`` (6,), compiled
+    (:func:`~kinestat.parallel._kinestatic_kernels.solve6`, Gaussian elimination with partial
+    pivoting): ``numpy.linalg.solve``'s value to rounding, without its set-up (the control
+    cycle's twists of compliance). No validation; a singular K runs ``numpy.linalg.solve``,
+    which raises :class:`numpy.linalg.LinAlgError`.
+
+    >>> solve_one(np.diag([1.0, 2.0, 4.0, 1.0, 1.0, 1.0]), np.ones(6)).tolist()
+    [1.0, 0.5, 0.25, 1.0, 1.0, 1.0]
+    """
+    K = np.ascontiguousarray(K, dtype=float)
+    b = np.array(b, dtype=float)
+    x = np.empty(6)
+    if K.shape == (6, 6) and b.shape == (6,) and _kk.solve6(K, b, x):
+        return x
+    return np.linalg.solve(K, b)
 
 
 def freedom_basis(W) -> np.ndarray:
