@@ -29,7 +29,7 @@ KERNELS: dict[str, str] = {
     "stiffness": "kinestat.parallel._stiffness_kernels",
     "platform": "kinestat.parallel._fk_kernels",
     "kinestatic": "kinestat.parallel._kinestatic_kernels",
-    "estimate": "kinestat.control._estimate_kernels",
+    "control": "kinestat.control._cycle_kernels",
 }
 #: kernel groups compiled on demand by the command that uses them (not by ``kinestat warmup``)
 ON_DEMAND: dict[str, str] = {
@@ -150,9 +150,14 @@ def _warm_kinestatic() -> None:
     compose_twist_line(K, w, np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0]), 2.0 * w)
 
 
-def _warm_estimate() -> None:
-    """The follow task's path curvature (kinestat.control.contact_estimate.path_curvature_one)."""
+def _warm_control() -> None:
+    """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
+    vernier_pick) and the follow task's path curvature (contact_estimate.path_curvature_one)."""
+    from kinestat.control._cycle_kernels import vernier_tables_kernel  # lazy: numba
     from kinestat.control.contact_estimate import path_curvature_one  # lazy: numba
+
+    vernier_tables_kernel(np.zeros(6, dtype=np.int64), np.zeros((1, 6), dtype=np.int64),
+                          1, 1, 1, 1, 1, 0.0, 0.0, np.ones(6), np.zeros(6))
 
     a = np.linspace(0.0, 0.05, 6)
     pts = np.column_stack([100.0 * np.sin(a), 100.0 * np.cos(a) - 100.0, 0.0 * a])
@@ -162,7 +167,7 @@ def _warm_estimate() -> None:
 
 _WARM = {"serial": _warm_serial, "ik": _warm_ik, "puma762": _warm_puma762,
          "cycle": _warm_cycle, "stiffness": _warm_stiffness, "platform": _warm_platform,
-         "kinestatic": _warm_kinestatic, "estimate": _warm_estimate}
+         "kinestatic": _warm_kinestatic, "control": _warm_control}
 
 
 def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:

@@ -30,7 +30,7 @@ normal at the next point is predicted by turning the estimate by ``κ Δs`` towa
 :func:`friction_sample_one` are :func:`cone_normal` and :func:`friction_sample` for one force
 and one chord in scalar arithmetic (the same operations in the same order: equal to them to
 rounding, bit for bit on the reference machine); :func:`path_curvature_one` is
-:func:`path_curvature` compiled (:mod:`kinestat.control._estimate_kernels`: the least squares
+:func:`path_curvature` compiled (:mod:`kinestat.control._cycle_kernels`: the least squares
 by QR instead of NumPy's SVD, equal to rounding).
 """
 
@@ -40,7 +40,7 @@ import math
 
 import numpy as np
 
-from kinestat.control._estimate_kernels import path_curvature_kernel
+from kinestat.control._cycle_kernels import path_curvature_kernel
 
 __all__ = [
     "cone_normal",
@@ -219,7 +219,7 @@ def path_curvature(points, tip, normal, tangent, min_span: float) -> float:
 
 
 def path_curvature_one(points, tip, normal, tangent, min_span: float) -> float:
-    """:func:`path_curvature` compiled (:func:`~kinestat.control._estimate_kernels.
+    """:func:`path_curvature` compiled (:func:`~kinestat.control._cycle_kernels.
     path_curvature_kernel`, the least squares by QR): equal to it to rounding; a fit near rank
     deficiency runs :func:`path_curvature` itself.
 

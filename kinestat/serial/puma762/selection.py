@@ -51,6 +51,22 @@ def _limits_rad(limits_deg) -> tuple[np.ndarray, np.ndarray]:
     return np.radians(L[:, 0]), np.radians(L[:, 1])
 
 
+_LIMITS_RAD: dict[int, tuple] = {}
+
+
+def _limits_rad_frozen(limits_deg) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_limits_rad` of an immutable limits array (read-only, owning its data: a model's
+    frozen limits) checked and converted once (the array is kept, so its id is not reused);
+    any other limits every call."""
+    if isinstance(limits_deg, np.ndarray) and not limits_deg.flags.writeable \
+            and limits_deg.flags.owndata:
+        got = _LIMITS_RAD.get(id(limits_deg))
+        if got is None or got[0] is not limits_deg:
+            got = _LIMITS_RAD[id(limits_deg)] = (limits_deg, _limits_rad(limits_deg))
+        return got[1]
+    return _limits_rad(limits_deg)
+
+
 def wrap_into_limits(angles, current, lower, upper) -> tuple[np.ndarray, np.ndarray]:
     """Shift each angle by a multiple of 2π to the value nearest ``current`` inside its limits.
 
@@ -242,7 +258,7 @@ def select_axis_one(tool_point, s6, a67, tool_point_6, current_q, limits_deg) ->
         out[8]
     axis = np.empty(6)
     if not err and not status and valid.any():
-        lo, hi = _limits_rad(limits_deg)
+        lo, hi = _limits_rad_frozen(limits_deg)
         if _ck.select_one(q, valid, sing, fsum, fval, cur, _AXIS_OFFSET, lo, hi, axis):
             return axis
     sel = select(reverse(p, z, x, p6), cur, limits_deg)

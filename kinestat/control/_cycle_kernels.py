@@ -1,6 +1,8 @@
-"""Compiled (Numba) contact estimate of one cycle: the curvature of the measured tip path
-(:func:`kinestat.control.contact_estimate.path_curvature` for one path, the follow task's hot
-path). The circle fit's least squares is solved by Householder QR of the (N, 3) design matrix
+"""Compiled (Numba) pieces of one control cycle: the vernier's cos/sin tables
+(:func:`vernier_tables_kernel`, :func:`kinestat.control.vernier.vernier_tables`'s arithmetic
+value for value) and the curvature of the measured tip path
+(:func:`kinestat.control.contact_estimate.path_curvature` for one path, the follow task's
+estimator). The circle fit's least squares is solved by Householder QR of the (N, 3) design matrix
 instead of NumPy's SVD-based ``lstsq``: for a full-rank matrix both give the least-squares
 solution, equal to rounding (relative ~ condition number × 1e-16). A design matrix near rank
 deficiency (where ``lstsq`` would return its minimum-norm solution) is left to the NumPy
@@ -17,7 +19,59 @@ import numpy as np
 
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
-__all__ = ["path_curvature_kernel"]
+__all__ = ["path_curvature_kernel", "vernier_tables_kernel"]
+
+_PI = math.pi
+_TWO_PI = 2.0 * math.pi
+_DEG = math.pi / 180.0  # numpy.radians(x) is x * (π/180)
+
+
+@nb.njit(**_OPTS)
+def vernier_tables_kernel(c0, off, n1, n2, n3, n4, n5, now3, coupling, res, axis_offset):
+    """The PUMA 762 vernier's cos/sin tables (:func:`kinestat.control.vernier.vernier_tables`)
+    for the counts ``c0`` (6,) int64 and the grid rows ``off`` (rows, 6) int64
+    (:func:`~kinestat.control.vernier.grid_rows`: axes 1-3's values in the first rows, the
+    wrist's ``n4 n5`` combinations in the last): each candidate's count → axis-5 residual of
+    the 4 → 5 compensation (``now3`` the current axis-4 count, ``coupling``) → degrees
+    (``res``, (6,)) → radians → joint angle (``axis_offset``, joint 1 wrapped to [−π, π)) →
+    cos, sin, the same operations in the same order as the NumPy formulation.
+
+    Returns ``(cs1 (n1, 2), cs2 (n2, 2), cs3 (n3, 2), cs4 (n4, 2), cs5 (n4, n5, 2), cs6 (2,))``.
+    """
+    rows = off.shape[0]
+    q = np.empty((rows, 6))
+    for r in range(rows):
+        kappa = coupling * (float(c0[3] + off[r, 3]) - now3)
+        a = -kappa
+        rnd = (1.0 if a > 0.0 else (-1.0 if a < 0.0 else 0.0)) * math.floor(abs(a) + 0.5)
+        for j in range(6):
+            phys = float(c0[j] + off[r, j])
+            if j == 4:
+                phys += float(np.int64(rnd)) + kappa
+            v = phys * res[j] * _DEG - axis_offset[j]
+            if j == 0:
+                v = (v + _PI) % _TWO_PI - _PI
+            q[r, j] = v
+    cs1 = np.empty((n1, 2))
+    cs2 = np.empty((n2, 2))
+    cs3 = np.empty((n3, 2))
+    for i in range(n1):
+        cs1[i, 0], cs1[i, 1] = math.cos(q[i, 0]), math.sin(q[i, 0])
+    for i in range(n2):
+        cs2[i, 0], cs2[i, 1] = math.cos(q[i, 1]), math.sin(q[i, 1])
+    for i in range(n3):
+        cs3[i, 0], cs3[i, 1] = math.cos(q[i, 2]), math.sin(q[i, 2])
+    w0 = rows - n4 * n5
+    cs4 = np.empty((n4, 2))
+    cs5 = np.empty((n4, n5, 2))
+    for i4 in range(n4):
+        cs4[i4, 0], cs4[i4, 1] = math.cos(q[w0 + i4 * n5, 3]), math.sin(q[w0 + i4 * n5, 3])
+        for i5 in range(n5):
+            v = q[w0 + i4 * n5 + i5, 4]
+            cs5[i4, i5, 0], cs5[i4, i5, 1] = math.cos(v), math.sin(v)
+    cs6 = np.empty(2)
+    cs6[0], cs6[1] = math.cos(q[0, 5]), math.sin(q[0, 5])
+    return cs1, cs2, cs3, cs4, cs5, cs6
 
 #: smallest |R_kk| / max |R_jj| of the QR factor the kernel solves with (else: NumPy's lstsq)
 RANK_TOL = 1e-10
