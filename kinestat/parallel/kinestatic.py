@@ -308,28 +308,34 @@ def compose_twist_line(K, w, freedom, delta_wrench) -> np.ndarray:
     w = np.asarray(w, dtype=float)
     Tf = np.asarray(freedom, dtype=float)
     dw = np.asarray(delta_wrench, dtype=float)
-    ok = K.shape == (6, 6) and all(map(math.isfinite, K.ravel().tolist()))
-    if not (ok and _kk.singular_ratio6(np.ascontiguousarray(K)) > 2.0 * _K_TOL):
+    # a regular K (the Jacobi ratio clearly above the threshold; 0 for a non-finite K) skips
+    # the checks below, which raise their messages: a bad shape, not finite, singular
+    if not (K.shape == (6, 6) and _kk.singular_ratio6(np.ascontiguousarray(K)) > 2.0 * _K_TOL):
+        ok = K.shape == (6, 6) and all(map(math.isfinite, K.ravel().tolist()))
         s = np.linalg.svd(K, compute_uv=False) if ok else None
         if s is None or s[-1] <= _K_TOL * s[0]:
-            K, _ = _check_stiffness(K)  # raises its message: a bad shape, not finite, singular
+            K, _ = _check_stiffness(K)
     vals = []
     for v, name in ((w, "contact wrenches W"), (Tf, "twist of freedom"), (dw, "wrench change")):
         x = v.tolist()
         if v.shape != (6,) or not all(map(math.isfinite, x)):
             raise InputError(f"{name} must be 6 finite numbers, got {x}")
         vals.append(x)
-    wl, tl, dl = vals
-    wn = math.sqrt(sum(a * a for a in wl))
+    (w0, w1, w2, w3, w4, w5), (t0, t1, t2, t3, t4, t5), (d0, d1, d2, d3, d4, d5) = vals
+    # the sums of the batched checks, term by term in the same order
+    wn = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2 + w3 * w3 + w4 * w4 + w5 * w5)
     if wn == 0.0:
         raise InputError("contact wrench 1 is zero")
-    c = sum(a * b for a, b in zip(wl, dl, strict=True)) / (wn * wn)
-    res = math.sqrt(sum((b - a * c) ** 2 for a, b in zip(wl, dl, strict=True)))
-    if res > _IN_TOL * max(math.sqrt(sum(b * b for b in dl)), _TINY):
+    c = (w0 * d0 + w1 * d1 + w2 * d2 + w3 * d3 + w4 * d4 + w5 * d5) / (wn * wn)
+    res = math.sqrt((d0 - w0 * c) ** 2 + (d1 - w1 * c) ** 2 + (d2 - w2 * c) ** 2
+                    + (d3 - w3 * c) ** 2 + (d4 - w4 * c) ** 2 + (d5 - w5 * c) ** 2)
+    dn = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2 + d3 * d3 + d4 * d4 + d5 * d5)
+    if res > _IN_TOL * max(dn, _TINY):
         raise InputError("the wrench change is not one the contact can exert: it is not a "
                          "combination of the contact wrenches W")
-    r = sum(wl[i] * tl[(i + 3) % 6] for i in range(6))  # w · (T_f Δ), Δ swaps the halves
-    scale = max(wn * math.sqrt(sum(a * a for a in tl)), _TINY)
+    r = w0 * t3 + w1 * t4 + w2 * t5 + w3 * t0 + w4 * t1 + w5 * t2  # w · (T_f Δ)
+    scale = max(wn * math.sqrt(t0 * t0 + t1 * t1 + t2 * t2 + t3 * t3 + t4 * t4 + t5 * t5),
+                _TINY)
     if abs(r) > _IN_TOL * scale:
         raise InputError(f"the twist of freedom is not reciprocal to the contact wrenches "
                          f"(relative |Wᵀ Δ T_f| = {abs(r) / scale:.3g}): it would push "
