@@ -28,10 +28,10 @@ import numpy as np
 
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial._numba_options import TWO_PI as _TWO_PI
-from kinestat.serial.puma762._kernels import _link, _wrap
+from kinestat.serial.puma762._kernels import _link, _wrap, reverse_vectors_one
 from kinestat.serial.puma762.params import _A, _CA, _S, _SA
 
-__all__ = ["grid_nearest", "select_one", "pose_one"]
+__all__ = ["grid_nearest", "select_one", "reverse_select_one", "pose_one"]
 
 #: mm: the rounding slack of grid_nearest's bound on an arm frame's along-S6 terms (the
 #: terms are sums of a few products of ~1e3 mm, rounded at ~1e-13 mm)
@@ -232,3 +232,25 @@ def pose_one(cs, T):
     T[1, 0], T[1, 1], T[1, 2], T[1, 3] = x1, y1, z1, p1
     T[2, 0], T[2, 1], T[2, 2], T[2, 3] = x2, y2, z2, p2
     T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0
+
+
+@nb.njit(**_OPTS)
+def reverse_select_one(p, z, x, p6, q_now, offset, lo, hi, axis):
+    """:func:`~kinestat.serial.puma762._kernels.reverse_vectors_one` (tolerances 1e-6, 1e-9,
+    1e-10) and :func:`select_one` in one call (one dispatch): the axis angles of the
+    least-motion solution within ``[lo, hi]`` into ``axis``; False when the reverse analysis
+    fails (an error code or status), finds no valid branch or none lies within the limits
+    (the caller then runs the NumPy path for its message)."""
+    out = reverse_vectors_one(p, z, x, p6, 1e-6, 1e-9, 1e-10)
+    err, status, q, valid, sing, fsum, fval = out[0], out[2], out[4], out[5], out[6], out[7], \
+        out[8]
+    if err or status:
+        return False
+    any_valid = False
+    for i in range(valid.shape[0]):
+        if valid[i]:
+            any_valid = True
+            break
+    if not any_valid:
+        return False
+    return select_one(q, valid, sing, fsum, fval, q_now, offset, lo, hi, axis)
