@@ -7,7 +7,8 @@ follow run; both include the closed-form reverse analysis, the vernier's roundin
 the envelope's prediction), on the fast path and — side by side, alternating, in the same run —
 on the unoptimised reference path (:func:`kinestat.control._reference.reference_cycle`: the
 NumPy vernier and selection, the stiffness recomputed on every use, SciPy's rotation vector in
-every motion check). Also times the parts: the reverse analysis + selection + vernier
+every motion check; in the follow task the batched NumPy cone normal, friction sample and
+path curvature (``lstsq``), NumPy's norms and solves and ``dataclasses.replace``). Also times the parts: the reverse analysis + selection + vernier
 (``_solve_counts``), the envelope's prediction (``predict``), the decision without the
 vernier, the decision alone (the fast path's calls back to back, as in a control loop: the
 alternating runs let the reference path's large arrays evict the caches before every fast

@@ -152,12 +152,24 @@ def _warm_kinestatic() -> None:
 
 def _warm_control() -> None:
     """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
-    vernier_pick) and the follow task's path curvature (contact_estimate.path_curvature_one)."""
+    vernier_pick), the envelope's prediction (envelope.predict) and the follow task's path
+    curvature (contact_estimate.path_curvature_one)."""
     from kinestat.control._cycle_kernels import vernier_tables_kernel  # lazy: numba
     from kinestat.control.contact_estimate import path_curvature_one  # lazy: numba
 
     vernier_tables_kernel(np.zeros(6, dtype=np.int64), np.zeros((1, 6), dtype=np.int64),
                           1, 1, 1, 1, 1, 0.0, 0.0, np.ones(6), np.zeros(6))
+    from kinestat.control._cycle_kernels import predict_kernel  # lazy: numba
+    from kinestat.io.library import prototype  # lazy: start-up
+    from kinestat.parallel.stiffness import platform_arrays, stiffness_axis_trusted  # lazy
+
+    pf = prototype()
+    B, P_top, _, l0 = platform_arrays(pf)
+    T = pf.home_pose.copy()
+    e4, v3, v6 = np.eye(4), np.array([0.0, 0.0, 100.0]), l0.copy()
+    predict_kernel(e4, e4.copy(), v3, v3.copy(), e4.copy(), np.ones(3), B, P_top, T,
+                   stiffness_axis_trusted(pf, T), e4.copy(), v6, v6.copy(), np.empty(3),
+                   np.empty(6), np.empty(3), np.empty((4, 4)))
 
     a = np.linspace(0.0, 0.05, 6)
     pts = np.column_stack([100.0 * np.sin(a), 100.0 * np.cos(a) - 100.0, 0.0 * a])

@@ -1,13 +1,14 @@
 """Compiled (Numba) pieces of one control cycle: the vernier's cos/sin tables
 (:func:`vernier_tables_kernel`, :func:`kinestat.control.vernier.vernier_tables`'s arithmetic
-value for value) and the curvature of the measured tip path
-(:func:`kinestat.control.contact_estimate.path_curvature` for one path, the follow task's
-estimator). The circle fit's least squares is solved by Householder QR of the (N, 3) design matrix
-instead of NumPy's SVD-based ``lstsq``: for a full-rank matrix both give the least-squares
-solution, equal to rounding (relative ~ condition number × 1e-16). A design matrix near rank
-deficiency (where ``lstsq`` would return its minimum-norm solution) is left to the NumPy
-formulation (the kernel says so). Compiled on first use and cached on disk (``cache=True``, in
-``__pycache__``).
+value for value), the envelope's prediction around the platform's kernel
+(:func:`predict_kernel`, equal to its NumPy wrapping to rounding) and the curvature of the
+measured tip path (:func:`kinestat.control.contact_estimate.path_curvature` for one path, the
+follow task's estimator). The circle fit's least squares is solved by Householder QR of the
+(N, 3) design matrix instead of NumPy's SVD-based ``lstsq``: for a full-rank matrix both give
+the least-squares solution, equal to rounding (relative ~ condition number × 1e-16). A design
+matrix near rank deficiency (where ``lstsq`` would return its minimum-norm solution) is left to
+the NumPy formulation (the kernel says so). Compiled on first use and cached on disk
+(``cache=True``, in ``__pycache__``).
 """
 
 from __future__ import annotations
@@ -17,9 +18,11 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.parallel._stiffness_kernels import pinned_tip_step_one
+
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
-__all__ = ["path_curvature_kernel", "vernier_tables_kernel"]
+__all__ = ["path_curvature_kernel", "predict_kernel", "vernier_tables_kernel"]
 
 _PI = math.pi
 _TWO_PI = 2.0 * math.pi
@@ -175,3 +178,50 @@ def path_curvature_kernel(points, tip, normal, tangent, min_span):
     if abs(kappa) * span * span / 8.0 < 2.0 * math.sqrt(ss / n):
         return 0.0, True
     return kappa, True
+
+
+@nb.njit(**_OPTS)
+def predict_kernel(Tn, mount, tip_F, p, base_R, f_point, B, P_top, T, K, flange, lengths,
+                   free_lengths, force, defl, tip_motion, top):
+    """:func:`kinestat.control.envelope.predict`'s compiled path for one measurement and one
+    new flange pose ``Tn`` (4, 4), in one call: the base's new pose ``Tn · mount``, the pinned
+    tip's offset ``u`` in the new base frame and the external force ``F = −R_Bᵀ f_point`` on
+    the tip (base frame), the platform's response
+    (:func:`kinestat.parallel._stiffness_kernels.pinned_tip_step_one`), then the force on the
+    workpiece ``−R_new (F + δF)`` into ``force`` (3,), the deflections ``l − l0 + δl`` into
+    ``defl`` (6,), the flange-carried tip point's motion into ``tip_motion`` (3,) and the moved
+    top pose into ``top`` (4, 4). ``tip_F``/``p`` (3,) the measured tip (fixed/base frame),
+    ``flange`` (4, 4) the measured flange pose, ``B``/``P_top`` (6, 3) the platform's points,
+    ``T`` the measured top pose, ``K`` its stiffness (axis order), ``lengths``/``free_lengths``
+    (6,). False when the platform kernel meets a singular matrix (outputs then unset)."""
+    TB = np.empty((3, 4))
+    for r in range(3):
+        for c in range(4):
+            TB[r, c] = (Tn[r, 0] * mount[0, c] + Tn[r, 1] * mount[1, c]
+                        + Tn[r, 2] * mount[2, c] + Tn[r, 3] * mount[3, c])
+    u = np.empty(3)
+    F = np.empty(3)
+    for j in range(3):
+        u[j] = ((tip_F[0] - TB[0, 3]) * TB[0, j] + (tip_F[1] - TB[1, 3]) * TB[1, j]
+                + (tip_F[2] - TB[2, 3]) * TB[2, j]) - p[j]
+        F[j] = -(f_point[0] * base_R[0, j] + f_point[1] * base_R[1, j]
+                 + f_point[2] * base_R[2, j])
+    dF = np.empty(3)
+    D = np.empty(6)
+    dl = np.empty(6)
+    if not pinned_tip_step_one(B, P_top, T, K, p, u, F, dF, D, dl, top):
+        return False
+    for r in range(3):
+        force[r] = -(TB[r, 0] * (F[0] + dF[0]) + TB[r, 1] * (F[1] + dF[1])
+                     + TB[r, 2] * (F[2] + dF[2]))
+    for i in range(6):
+        defl[i] = (lengths[i] - free_lengths[i]) + dl[i]
+    loc = np.empty(3)
+    for j in range(3):  # the tip in the measured flange frame
+        loc[j] = ((tip_F[0] - flange[0, 3]) * flange[0, j]
+                  + (tip_F[1] - flange[1, 3]) * flange[1, j]
+                  + (tip_F[2] - flange[2, 3]) * flange[2, j])
+    for r in range(3):
+        tip_motion[r] = (Tn[r, 0] * loc[0] + Tn[r, 1] * loc[1] + Tn[r, 2] * loc[2]
+                         + Tn[r, 3]) - tip_F[r]
+    return True

@@ -174,3 +174,45 @@ def test_norm3_and_mount_inverse(model):
     M = mount_inverse(model)
     np.testing.assert_array_equal(M, inv(model.mount))
     assert mount_inverse(model) is M and not M.flags.writeable
+
+
+def test_compiled_prediction_wrapping_equals_the_numpy_wrapping():
+    """envelope.predict's one-call kernel against the platform kernel wrapped in NumPy, on the
+    measurements of a simulated press run and random flange moves."""
+    import copy
+    import functools
+    import tempfile
+    from pathlib import Path
+
+    from kinestat.app.sim_cell import InProcessIO, start_counts
+    from kinestat.control import envelope as env_mod
+    from kinestat.control.controller import decide
+    from kinestat.control.log import CycleLog
+    from kinestat.control.loop import run
+    from kinestat.spatial.se3 import twist_exp
+
+    prep = prepare_control(ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION,
+                                          start_tool_point=np.array([-400.0, 800.0, -100.0]),
+                                          cell=SimulatedCell()))
+    meas = []
+
+    def recording(state, m):
+        meas.append(m)
+        return functools.partial(decide, prep.config)(state, m)
+
+    io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
+    with tempfile.TemporaryDirectory() as tmp, CycleLog(Path(tmp) / "log.jsonl") as log:
+        run(prep.config, io, log, decide_fn=recording)
+    model = prep.config.model
+    compared = 0
+    for m in meas:
+        for _ in range(10):
+            dT = twist_exp(np.concatenate([RNG.normal(0, 0.01, 3), RNG.normal(0, 1.0, 3)]))
+            Tn = m.flange_pose @ dT
+            a = env_mod._predict_compiled(model, copy.copy(m), Tn)
+            b = env_mod._predict_numpy_wrapped(model, copy.copy(m), Tn)
+            for x, y in ((a.force, b.force), (a.deflections, b.deflections),
+                         (a.tip_motion, b.tip_motion), (a.top_pose, b.top_pose)):
+                np.testing.assert_allclose(x, y, rtol=1e-12, atol=1e-12)
+            compared += 1
+    assert compared >= 30
