@@ -9,7 +9,7 @@ first use by the same functions the callers used before (so the values are the s
 bit), except K and C_tip: compiled for the one pose
 (:func:`kinestat.parallel.stiffness.stiffness_axis_trusted`,
 :func:`~kinestat.parallel.stiffness.tip_compliance_one`), equal to the NumPy formulations to
-rounding. :func:`cycle_data` finds a measurement's data (a weak map keyed by the measurement, so
+rounding. :func:`cycle_data` finds a measurement's data (kept with the measurement, so
 that :func:`~kinestat.control.controller.decide`, the envelope's prediction and the follow
 task's control law share it without passing it around, and it goes with the measurement).
 
@@ -26,7 +26,6 @@ from __future__ import annotations
 import dataclasses
 import math
 import weakref
-from functools import cached_property
 
 import numpy as np
 
@@ -120,6 +119,23 @@ def mount_inverse(model: ControlModel) -> np.ndarray:
     return got
 
 
+class _once:
+    """A per-instance value computed on first use and stored in the instance (as
+    :class:`functools.cached_property`, without its lock: a cycle's data belongs to one
+    decision)."""
+
+    def __init__(self, fn) -> None:
+        self.fn = fn
+        self.name = fn.__name__
+        self.__doc__ = fn.__doc__
+
+    def __get__(self, obj, cls=None):
+        if obj is None:
+            return self
+        value = obj.__dict__[self.name] = self.fn(obj)
+        return value
+
+
 class CycleData:
     """Values of one measurement at the model's platform, each computed on first use.
 
@@ -137,34 +153,33 @@ class CycleData:
         # the platform's forward kinematics made this pose (checked there): used unchecked
         self.top_pose = np.asarray(meas.top_pose, dtype=float)
 
-    @cached_property
+    @_once
     def K(self) -> np.ndarray:
         return stiffness_axis_trusted(self.model.platform, self.top_pose)
 
-    @cached_property
+    @_once
     def tip_base(self) -> np.ndarray:
         return apply(self.top_pose, self.model.tool_tip_top)
 
-    @cached_property
+    @_once
     def tip_fixed(self) -> np.ndarray:
         return self.meas.tip(self.model)
 
-    @cached_property
+    @_once
     def C_tip(self) -> np.ndarray:
         return tip_compliance_one(self.K, self.tip_base)
 
-    @cached_property
+    @_once
     def leg_directions(self) -> tuple[np.ndarray, np.ndarray]:
         return leg_directions_trusted(self.model.platform, self.top_pose)
 
 
-_DATA: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
-
-
 def cycle_data(model: ControlModel, meas: Measurement) -> CycleData:
     """The :class:`CycleData` of ``meas`` at ``model``, made on first use (and again for
-    another model)."""
-    d = _DATA.get(meas)
-    if d is None or d.model is not model:
-        d = _DATA[meas] = CycleData(model, meas)
+    another model). Kept in the measurement's instance dictionary beside
+    :meth:`Measurement.tip`'s cache (a cache, not a field: the measurement stays frozen, and
+    the data goes with it)."""
+    d = meas.__dict__.get("_cycle_data")
+    if d is None or d.model is not model or d.meas is not meas:
+        d = meas.__dict__["_cycle_data"] = CycleData(model, meas)
     return d
