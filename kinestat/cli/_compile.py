@@ -154,15 +154,19 @@ def _warm_control() -> None:
     """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
     vernier_pick), the envelope's prediction (envelope.predict) and the follow task's path
     curvature (contact_estimate.path_curvature_one)."""
-    from kinestat.control._cycle_kernels import vernier_tables_kernel  # lazy: numba
+    from kinestat.control._cycle_kernels import (  # lazy: start-up (numba)
+        predict_kernel,
+        vernier_tables_kernel,
+    )
     from kinestat.control.contact_estimate import path_curvature_one  # lazy: numba
+    from kinestat.io.library import prototype  # lazy: start-up
+    from kinestat.parallel.stiffness import (  # lazy: start-up (numba)
+        platform_arrays,
+        stiffness_axis_trusted,
+    )
 
     vernier_tables_kernel(np.zeros(6, dtype=np.int64), np.zeros((1, 6), dtype=np.int64),
                           1, 1, 1, 1, 1, 0.0, 0.0, np.ones(6), np.zeros(6))
-    from kinestat.control._cycle_kernels import predict_kernel  # lazy: numba
-    from kinestat.io.library import prototype  # lazy: start-up
-    from kinestat.parallel.stiffness import platform_arrays, stiffness_axis_trusted  # lazy
-
     pf = prototype()
     B, P_top, _, l0 = platform_arrays(pf)
     T = pf.home_pose.copy()
