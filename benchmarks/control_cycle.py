@@ -1,20 +1,22 @@
 """Compute time of one control cycle: the pure decision plus the PUMA's IK, press vs follow.
 
-Records every (state, measurement) pair of a run on the in-process simulated cell (the
-default thesis cell: 5° tilted plane, thesis calibration and sensor), then times the decision
-function on each recorded pair (``decide`` for the press task, ``decide_follow`` for a 50 mm
-follow run; both include the closed-form reverse analysis, the vernier's rounding to counts and
-the envelope's prediction), on the fast path and — side by side, alternating, in the same run —
-on the unoptimised reference path (:func:`kinestat.control._reference.reference_cycle`: the
-NumPy vernier and selection, the stiffness recomputed on every use, SciPy's rotation vector in
-every motion check). Also times the parts: the reverse analysis + selection + vernier
-(``_solve_counts``), the envelope's prediction (``predict``), the decision without the
-vernier, the decision alone (the fast path's calls back to back, as in a control loop: the
-alternating runs let the reference path's large arrays evict the caches before every fast
-call) and the measurement chain (``measure``, not part of the decision). Figures are medians
-over the moving cycles of the median of repeats; every call gets a fresh copy of its
-Measurement (no per-cycle data is reused between calls). The kernels are compiled (or loaded
-from the cache) before anything is timed; that first load is reported on its own.
+Records every (state, measurement) pair of a run on the in-process simulated cell (the default
+thesis cell: 5° tilted plane, thesis calibration and sensor), then times the decision function
+on each recorded pair (``decide`` for the press task, ``decide_follow`` for a 50 mm follow run;
+both include the closed-form reverse analysis, the vernier's rounding to counts and the
+envelope's prediction), on the fast path and — side by side, alternating, in the same run — on
+the unoptimised reference path (:func:`kinestat.control._reference.reference_cycle`: the NumPy
+vernier and selection, the stiffness recomputed on every use, SciPy's rotation vector in every
+motion check; in the follow task the batched NumPy cone normal, friction sample and path
+curvature (``lstsq``), NumPy's norms and solves and ``dataclasses.replace``). Also times the
+parts: the reverse analysis + selection + vernier (``_solve_counts``), the envelope's
+prediction (``predict``), the decision without the vernier, the decision alone (the fast path's
+calls back to back, as in a control loop: the alternating runs let the reference path's large
+arrays evict the caches before every fast call) and the measurement chain (``measure``, not
+part of the decision). Figures are medians over the moving cycles of the median of repeats;
+every call gets a fresh copy of its Measurement (no per-cycle data is reused between calls).
+The kernels are compiled (or loaded from the cache) before anything is timed; that first load
+is reported on its own.
 
     .venv/bin/python benchmarks/control_cycle.py [--json] [--repeat N] [--clock wall|cpu]
 """

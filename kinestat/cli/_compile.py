@@ -28,6 +28,8 @@ KERNELS: dict[str, str] = {
     "cycle": "kinestat.serial.puma762._cycle_kernels",
     "stiffness": "kinestat.parallel._stiffness_kernels",
     "platform": "kinestat.parallel._fk_kernels",
+    "kinestatic": "kinestat.parallel._kinestatic_kernels",
+    "control": "kinestat.control._cycle_kernels",
 }
 #: kernel groups compiled on demand by the command that uses them (not by ``kinestat warmup``)
 ON_DEMAND: dict[str, str] = {
@@ -137,8 +139,51 @@ def _warm_platform() -> None:
     fk_list(p, leg_lengths(p, p.home_pose))
 
 
+def _warm_kinestatic() -> None:
+    """The follow law's one-stiffness kernels (kinestat.parallel.kinestatic.solve_one and
+    compose_twist_line's singularity check)."""
+    from kinestat.parallel.kinestatic import compose_twist_line, solve_one  # lazy: numba
+
+    K = np.diag([10.0, 10.0, 10.0, 1.0, 1.0, 1.0])
+    w = np.array([0.0, 0.0, 1.0, 0.0, 0.0, 0.0])
+    solve_one(K, w)
+    compose_twist_line(K, w, np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0]), 2.0 * w)
+
+
+def _warm_control() -> None:
+    """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
+    vernier_pick), the envelope's prediction (envelope.predict) and the follow task's path
+    curvature (contact_estimate.path_curvature_one)."""
+    from kinestat.control._cycle_kernels import (  # lazy: start-up (numba)
+        predict_kernel,
+        vernier_tables_kernel,
+    )
+    from kinestat.control.contact_estimate import path_curvature_one  # lazy: numba
+    from kinestat.io.library import prototype  # lazy: start-up
+    from kinestat.parallel.stiffness import (  # lazy: start-up (numba)
+        platform_arrays,
+        stiffness_axis_trusted,
+    )
+
+    vernier_tables_kernel(np.zeros(6, dtype=np.int64), np.zeros((1, 6), dtype=np.int64),
+                          1, 1, 1, 1, 1, 0.0, 0.0, np.ones(6), np.zeros(6))
+    pf = prototype()
+    B, P_top, _, l0 = platform_arrays(pf)
+    T = pf.home_pose.copy()
+    e4, v3, v6 = np.eye(4), np.array([0.0, 0.0, 100.0]), l0.copy()
+    predict_kernel(e4, e4.copy(), v3, v3.copy(), e4.copy(), np.ones(3), B, P_top, T,
+                   stiffness_axis_trusted(pf, T), e4.copy(), v6, v6.copy(), np.empty(3),
+                   np.empty(6), np.empty(3), np.empty((4, 4)))
+
+    a = np.linspace(0.0, 0.05, 6)
+    pts = np.column_stack([100.0 * np.sin(a), 100.0 * np.cos(a) - 100.0, 0.0 * a])
+    path_curvature_one(pts[:-1], pts[-1], np.array([0.0, 1.0, 0.0]),
+                       np.array([1.0, 0.0, 0.0]), 1.0)
+
+
 _WARM = {"serial": _warm_serial, "ik": _warm_ik, "puma762": _warm_puma762,
-         "cycle": _warm_cycle, "stiffness": _warm_stiffness, "platform": _warm_platform}
+         "cycle": _warm_cycle, "stiffness": _warm_stiffness, "platform": _warm_platform,
+         "kinestatic": _warm_kinestatic, "control": _warm_control}
 
 
 def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:

@@ -12,12 +12,14 @@ the last few bits (the two formulations round differently, ~1e-13 mm).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 from collections.abc import Iterator
 
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from kinestat.control import controller, cycle, envelope, follow
+from kinestat.control.contact_estimate import cone_normal, friction_sample, path_curvature
 from kinestat.control.controller import Target
 from kinestat.control.model import ControlModel
 from kinestat.control.vernier import q_to_axis_counts, vernier_costs
@@ -25,6 +27,7 @@ from kinestat.parallel.kinestatic import compose_twist
 from kinestat.parallel.stiffness import stiffness, tip_compliance
 from kinestat.serial import puma762
 from kinestat.spatial.se3 import twist_exp
+from kinestat.spatial.transforms import inv
 
 __all__ = ["solve_counts_reference", "vernier_costs_reference", "UncachedCycleData",
            "reference_cycle"]
@@ -72,14 +75,24 @@ def reference_cycle() -> Iterator[None]:
     the NumPy vernier and selection (:func:`solve_counts_reference`), the NumPy forward
     analysis for the flange pose, the NumPy stiffness recomputed on every use, the batched
     ``compose_twist`` and ``twist_exp`` in the follow law, NumPy's solves and SciPy's rotations
-    in the prediction, NumPy's tip compliance and SciPy's rotation vector on every motion check.
-    Not thread-safe (it swaps module attributes)."""
+    in the prediction, NumPy's tip compliance and SciPy's rotation vector on every motion check;
+    in the follow task's estimator and law the batched NumPy ``cone_normal``,
+    ``friction_sample`` and ``path_curvature`` (``lstsq``), ``numpy.linalg.norm`` and
+    ``numpy.linalg.solve``, ``dataclasses.replace`` and the mount's inverse on every use. Not
+    thread-safe (it swaps module attributes)."""
     saved = [(controller, "_solve_counts", solve_counts_reference),
              (controller, "_flange_pose", lambda model, q: puma762.forward(q).pose),
              (envelope, "cycle_data", UncachedCycleData),
              (follow, "cycle_data", UncachedCycleData),
              (follow, "compose_twist_line", compose_twist),
              (follow, "twist_exp_one", twist_exp),
+             (follow, "cone_normal_one", cone_normal),
+             (follow, "friction_sample_one", friction_sample),
+             (follow, "path_curvature_one", path_curvature),
+             (follow, "norm3", np.linalg.norm),
+             (follow, "solve_one", np.linalg.solve),
+             (follow, "replace", dataclasses.replace),
+             (follow, "mount_inverse", lambda model: inv(model.mount)),
              (envelope, "rotvec_matrix_one",
               lambda r: Rotation.from_rotvec(r).as_matrix()),
              (envelope, "_rotation_clear", lambda *a: False),

@@ -37,12 +37,13 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from kinestat.control._cycle_kernels import predict_kernel
 from kinestat.control.cycle import cross3, cross_rows, cycle_data
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
 from kinestat.hardware.platform_spec import MAX_DEFLECTION, MAX_LOAD, MOTION_RANGE
-from kinestat.parallel.stiffness import pinned_tip_step
+from kinestat.parallel.stiffness import pinned_tip_step, platform_arrays
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
 from kinestat.spatial.se3 import rotvec_matrix_one
 from kinestat.spatial.transforms import apply, inv, skew
@@ -188,12 +189,44 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
                       top_pose=top)
 
 
+def _c(a) -> np.ndarray:
+    """``a`` as a writeable C-ordered float array (itself when it is one: the kernels compile
+    for one array type)."""
+    if type(a) is np.ndarray and a.dtype is _F64:
+        f = a.flags
+        if f.c_contiguous and f.writeable:
+            return a
+    return np.array(a, dtype=float)
+
+
+_F64 = np.dtype(np.float64)
+
+
 def _predict_compiled(model: ControlModel, meas: Measurement, Tn: np.ndarray) -> Prediction | None:
-    """:func:`predict`'s formulation with its linear algebra compiled for the one pose
-    (:func:`kinestat.parallel.stiffness.pinned_tip_step`: one elimination of K instead of
-    three solves, the legs and the Rodrigues rotation in scalars); equal to the NumPy
-    formulation to rounding. None when the kernel meets a singular matrix (the NumPy
-    formulation then runs and raises)."""
+    """:func:`predict`'s formulation compiled for the one pose, in one call
+    (:func:`kinestat.control._cycle_kernels.predict_kernel` around
+    :func:`kinestat.parallel._stiffness_kernels.pinned_tip_step_one`: one elimination of K
+    instead of three solves, the legs and the Rodrigues rotation in scalars, the frame changes
+    around them in scalars); equal to the NumPy formulation to rounding. None when the kernel
+    meets a singular matrix (the NumPy formulation then runs and raises)."""
+    data = cycle_data(model, meas)
+    k = _consts(model)
+    B, P_top, _, _ = platform_arrays(model.platform)
+    force, defl, tip_motion, top = np.empty(3), np.empty(6), np.empty(3), np.empty((4, 4))
+    if not predict_kernel(_c(Tn), k.mount, _c(data.tip_fixed), _c(data.tip_base),
+                          _c(meas.base_pose), _c(meas.estimate("point")), B, P_top,
+                          _c(data.top_pose), _c(data.K), _c(meas.flange_pose),
+                          _c(meas.leg_lengths), k.free_lengths_array, force, defl, tip_motion,
+                          top):
+        return None
+    return Prediction(force=force, deflections=defl, tip_motion=tip_motion, top_pose=top)
+
+
+def _predict_numpy_wrapped(model: ControlModel, meas: Measurement,
+                           Tn: np.ndarray) -> Prediction | None:
+    """:func:`_predict_compiled` as first written: the platform's kernel
+    (:func:`kinestat.parallel.stiffness.pinned_tip_step`) wrapped in NumPy (kept for the
+    tests of the compiled wrapping)."""
     TB_new = Tn @ model.mount
     data = cycle_data(model, meas)
     tip_F = data.tip_fixed
@@ -239,6 +272,9 @@ class _Consts:
         self.lo = model.limits_deg[:, 0].tolist()
         self.hi = model.limits_deg[:, 1].tolist()
         self.free_lengths = model.platform.free_lengths.tolist()
+        # writeable C copies for the compiled prediction (it compiles for one array type)
+        self.mount = np.array(model.mount, dtype=float)
+        self.free_lengths_array = np.array(model.platform.free_lengths, dtype=float)
 
 
 _CONSTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()

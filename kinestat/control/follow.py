@@ -63,14 +63,14 @@ contact, ``d`` settling the normal force before travel, ``f`` following (travel)
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
 from kinestat.control.contact_estimate import (
-    cone_normal,
-    friction_sample,
-    path_curvature,
+    cone_normal_one,
+    friction_sample_one,
+    path_curvature_one,
     update_friction,
 )
 from kinestat.control.controller import (
@@ -81,7 +81,7 @@ from kinestat.control.controller import (
     Target,
     move_command,
 )
-from kinestat.control.cycle import cross3, cycle_data
+from kinestat.control.cycle import cross3, cycle_data, mount_inverse, norm3, replace
 from kinestat.control.envelope import (
     Envelope,
     check_measurement,
@@ -90,12 +90,12 @@ from kinestat.control.envelope import (
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
-from kinestat.parallel.kinestatic import compose_twist_line
+from kinestat.parallel.kinestatic import compose_twist_line, solve_one
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
 from kinestat.spatial.se3 import twist_exp, twist_exp_one
-from kinestat.spatial.transforms import apply, inv, skew
+from kinestat.spatial.transforms import apply, skew
 
 __all__ = [
     "FollowConfig",
@@ -352,7 +352,7 @@ def estimate_normal(force, path_dir=None) -> np.ndarray:
 def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
     """Rotation vector turning ``s6`` towards ``axis`` by at most ``limit_rad``."""
     c = cross3(s6, axis)
-    s = float(np.linalg.norm(c))
+    s = norm3(c)
     if s < 1e-15:
         return np.zeros(3)
     ang = min(math.atan2(s, float(s6 @ axis)), limit_rad)
@@ -382,19 +382,19 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     if friction > 0.0 and slip is not None:
         s = R.T @ slip
         Wt = np.concatenate([s, cross3(p, s)])
-    Tc = -dlam * np.linalg.solve(K, W - friction * Wt)  # K⁻¹ δw, δw = −Δλ W_c
+    Tc = -dlam * solve_one(K, W - friction * Wt)  # K⁻¹ δw, δw = −Δλ W_c
     dp = Tc[3:] + cross3(Tc[:3], p)  # the tip's motion under the compliance twist
     scale = max(abs(float(dp @ n)) / max_correction,
-                float(np.linalg.norm(dp)) / (TANGENTIAL_FACTOR * max_correction), 1.0)
+                norm3(dp) / (TANGENTIAL_FACTOR * max_correction), 1.0)
     T = compose_twist_line(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
     if friction > 0.0 and slip is not None:
-        T = T + (dlam / scale) * friction * np.linalg.solve(K, Wt)
+        T = T + (dlam / scale) * friction * solve_one(K, Wt)
     return T
 
 
 def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
     TB_new = meas.base_pose @ twist_exp_one(T_base)
-    T6 = TB_new @ inv(model.mount)
+    T6 = TB_new @ mount_inverse(model)
     return Target(apply(T6, model.tool_point_6), T6[:3, 2].copy(), T6[:3, 0].copy())
 
 
@@ -407,7 +407,7 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
     """The chord from the latest earlier tip at least ``min_len`` mm away to ``tip``."""
     for old in reversed(path):
         c = tip - old
-        if float(np.linalg.norm(c)) >= min_len:
+        if norm3(c) >= min_len:
             return c
     return None
 
@@ -418,7 +418,7 @@ def _creeping(st: FollowState, path: tuple, tip: np.ndarray) -> bool:
     if st.friction_samples >= LEARN_CHORDS:
         return False
     c = _chord(path, tip, LEARN_CHORD_LENGTH)
-    return c is not None and float(c @ st.tangent) > 0.5 * float(np.linalg.norm(c))
+    return c is not None and float(c @ st.tangent) > 0.5 * norm3(c)
 
 
 def _breakaway_step(st: FollowState) -> float:
@@ -449,28 +449,28 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         stuck = st.step > 0 or st.sticking
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
                        breakaway=st.breakaway + (_breakaway_step(st) if stuck else 0.0))
-    u = -F / float(np.linalg.norm(F))  # the force on the tool's direction
+    u = -F / norm3(F)  # the force on the tool's direction
     mu, raw, samples = st.friction_ratio, st.friction_mean, st.friction_samples
     c = _chord(path, tip, CHORD_LENGTH if st.friction_samples >= LEARN_CHORDS
                else LEARN_CHORD_LENGTH)
     n = n0  # kept until a chord has measured the friction
-    if c is not None and float(c @ s) > 0.5 * float(np.linalg.norm(c)):
-        raw, samples = update_friction(raw, samples, friction_sample(u, c))
+    if c is not None and float(c @ s) > 0.5 * norm3(c):
+        raw, samples = update_friction(raw, samples, friction_sample_one(u, c))
         mu = min(max(raw, 0.0), MAX_FRICTION)
-        n = cone_normal(u, c, mu)
+        n = cone_normal_one(u, c, mu)
     elif samples:
-        n = cone_normal(u, s, mu)
-    n = n / np.linalg.norm(n)
+        n = cone_normal_one(u, s, mu)
+    n = n / norm3(n)
     brk = max(st.breakaway - BREAKAWAY_DECAY, 0.0)
     if samples and not st.friction_samples:  # first slip measured: keep the tool's tilt
         tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ n)))))
         brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
         brk /= config.max_turn_deg
     t = s - (s @ n) * n
-    kappa = path_curvature(np.asarray(path), tip, n, t / np.linalg.norm(t), CURVATURE_SPAN)
+    kappa = path_curvature_one(np.asarray(path), tip, n, t / norm3(t), CURVATURE_SPAN)
     return replace(st, travel=travel, normal=n, last_tip=tip, path=path, curvature=kappa,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
-                   path_dir=None if c is None else c / np.linalg.norm(c),
+                   path_dir=None if c is None else c / norm3(c),
                    sticking=False, breakaway=brk)
 
 
@@ -488,13 +488,13 @@ def decide_follow(config: FollowConfig, state: ControllerState,
     st = state if isinstance(state, FollowState) else FollowState(**vars(state))
     st = replace(st, cycle=st.cycle + 1, top_pose=meas.top_pose)
     F = meas.estimate(base.estimator)
-    contact = float(np.linalg.norm(F)) >= base.contact_force
+    contact = norm3(F) >= base.contact_force
     st = _observe(config, st, meas, F, contact)
     label = {"approach": "a", "settle": "d", "travel": "f"}[st.phase]
     if contact and st.phase == "approach":
         label = "b"
     fn = float(-(F @ st.normal)) if (contact and st.normal is not None) else 0.0
-    ft = 0.0 if not contact else float(np.linalg.norm(F + fn * st.normal))
+    ft = 0.0 if not contact else norm3(F + fn * st.normal)
     err = base.force_target - fn
     info = {"phase": st.phase, "tip": meas.tip(model), "normal_estimate": st.normal,
             "normal_force": fn, "tangential_force": ft, "travel": st.travel,
@@ -533,11 +533,11 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     n = st.normal
     t0 = st.tangent if st.tangent is not None else config.travel_dir
     t = t0 - (t0 @ n) * n
-    if np.linalg.norm(t) < math.sin(math.radians(config.min_angle_deg)):
+    if norm3(t) < math.sin(math.radians(config.min_angle_deg)):
         return _stop(st, label, f"the travel direction {np.round(t0, 4).tolist()} is within "
                      f"{config.min_angle_deg:g}° of the measured normal "
                      f"{np.round(n, 4).tolist()}: it points into the surface", **kw)
-    t /= np.linalg.norm(t)
+    t /= norm3(t)
     tilt = math.radians(config.tilt_deg)
     if config.auto_tilt:  # S6 along the force's cone edge; tilt more while the tip sticks
         tilt = ((math.atan(st.friction_ratio) + math.radians(AUTO_TILT_MARGIN_DEG)
@@ -582,7 +582,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     new = _target(model, meas, T)
     action = "follow" if phase == "travel" else "settle"
     return _command(config, st, meas, new, label, action, step,
-                    math.degrees(float(np.linalg.norm(omega))), kw)
+                    math.degrees(norm3(omega)), kw)
 
 
 def _curvature_feedforward(n: np.ndarray, t: np.ndarray, angle: float, omega: np.ndarray,
@@ -593,7 +593,7 @@ def _curvature_feedforward(n: np.ndarray, t: np.ndarray, angle: float, omega: np
     travel stays along the tangent (a twist of freedom; the chord's sag ``κ Δs²/2`` is left
     to the force control)."""
     w = omega + angle * cross3(n, t)
-    a = float(np.linalg.norm(w))
+    a = norm3(w)
     if a > limit_rad:
         w *= limit_rad / a
     return w

@@ -17,16 +17,18 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from kinestat.control._cycle_kernels import vernier_tables_kernel
 from kinestat.control.model import ControlModel
 from kinestat.hardware.puma762_axes import round_half_away
 from kinestat.serial.puma762._cycle_kernels import grid_nearest
+from kinestat.serial.puma762.params import AXIS_OFFSET
 
 if TYPE_CHECKING:
     from kinestat.control.controller import Target
 
 __all__ = ["AXIS_OFFSETS", "OFFSETS", "VERNIER_SCALES", "ZERO_OFFSETS", "axis5_residual",
            "axis_counts_to_q", "q_to_axis_counts", "vernier_costs", "vernier_generic",
-           "vernier_pick", "vernier_tables"]
+           "vernier_pick", "vernier_tables", "vernier_tables_one"]
 
 
 def axis_counts_to_q(model: ControlModel, counts) -> np.ndarray:
@@ -101,15 +103,37 @@ def vernier_tables(model: ControlModel, c0: np.ndarray, counts_now, offsets) -> 
             np.ascontiguousarray(cs[0, 5]))
 
 
+_AXIS_OFFSET = np.array(AXIS_OFFSET)  # writeable: the kernel compiles for one array type
+
+
+def vernier_tables_one(model: ControlModel, c0: np.ndarray, counts_now, offsets) -> tuple:
+    """:func:`vernier_tables` for the PUMA 762's axis conventions, compiled
+    (:func:`kinestat.control._cycle_kernels.vernier_tables_kernel`: the same operations in the
+    same order; equal to the NumPy tables where the kernel's cos/sin are NumPy's, as on the
+    reference machine, and to the last bit otherwise)."""
+    off, _ = grid_rows(offsets)
+    return vernier_tables_kernel(np.asarray(c0, dtype=np.int64), off, len(offsets[0]),
+                                 len(offsets[1]), len(offsets[2]), len(offsets[3]),
+                                 len(offsets[4]), float(counts_now[3]), model.coupling,
+                                 _resolution(model), _AXIS_OFFSET)
+
+
+def _resolution(model: ControlModel) -> np.ndarray:
+    """``model.axis_deg_per_count`` as a writeable C array (the kernel's one signature)."""
+    r = model.axis_deg_per_count
+    return r if r.flags.writeable and r.flags.c_contiguous else np.array(r, dtype=float)
+
+
 def vernier_pick(model: ControlModel, target: Target, c0: np.ndarray, counts_now,
                   offsets) -> tuple[int, float]:
     """The index (in the grid ``offsets``' row order, :data:`OFFSETS` for the full grid) of
     the count vector whose tool point best realises ``target`` and its offset along S6 (mm):
-    the compiled grid search :func:`kinestat.serial.puma762._cycle_kernels.grid_nearest`."""
+    the compiled grid search :func:`kinestat.serial.puma762._cycle_kernels.grid_nearest` on
+    the compiled tables (:func:`vernier_tables_one`)."""
     _, centre = grid_rows(offsets)
     p6, tp, ts = (np.array(v, dtype=float) for v in (model.tool_point_6, target.tool_point,
                                                       target.s6))  # writeable, C order
-    k, along, _ = grid_nearest(*vernier_tables(model, c0, counts_now, offsets), p6, tp, ts,
+    k, along, _ = grid_nearest(*vernier_tables_one(model, c0, counts_now, offsets), p6, tp, ts,
                                *VERNIER_SCALES, centre)
     return int(k), float(along)
 

@@ -59,6 +59,7 @@ from typing import NamedTuple
 import numpy as np
 
 from kinestat.errors import InputError, SingularityError
+from kinestat.parallel import _kinestatic_kernels as _kk
 from kinestat.parallel.statics import forces_from_wrench
 from kinestat.parallel.stiffness import stiffness
 from kinestat.spatial.transforms import as_array
@@ -74,6 +75,7 @@ __all__ = [
     "decompose_twist",
     "compose_twist",
     "compose_twist_line",
+    "solve_one",
     "wrench_coordinates",
     "freedom_basis",
     "platform_stiffness_axis",
@@ -292,7 +294,10 @@ def compose_twist_line(K, w, freedom, delta_wrench) -> np.ndarray:
     value ``T_f + K⁻¹ δw``, without the batched machinery (the control cycle's hot path).
     The span check projects on ``w`` directly instead of through a pseudo-inverse, and the
     vector checks run in scalar arithmetic; they agree with the batched ones to rounding, far
-    inside the 1e-9 tolerance.
+    inside the 1e-9 tolerance. K's singularity check takes LAPACK's SVD only where the compiled
+    one-sided Jacobi ratio ``s_min/s_max`` (:func:`~kinestat.parallel._kinestatic_kernels.
+    singular_ratio6`, accurate to ~1e-15 of ``s_max``) is not clearly above the threshold
+    (twice it): the same verdicts, without the SVD on a regular K.
 
     >>> K = np.diag([10.0, 10.0, 10.0, 1.0, 1.0, 1.0]) @ DELTA
     >>> compose_twist_line(K, np.array([0, 0, 1.0, 0, 0, 0]), np.array([0, 0, 0, 1.0, 0, 0]),
@@ -303,32 +308,57 @@ def compose_twist_line(K, w, freedom, delta_wrench) -> np.ndarray:
     w = np.asarray(w, dtype=float)
     Tf = np.asarray(freedom, dtype=float)
     dw = np.asarray(delta_wrench, dtype=float)
-    ok = K.shape == (6, 6) and all(map(math.isfinite, K.ravel().tolist()))
-    s = np.linalg.svd(K, compute_uv=False) if ok else None
-    if s is None or s[-1] <= _K_TOL * s[0]:
-        K, _ = _check_stiffness(K)  # raises its message: a bad shape, not finite, singular
+    # a regular K (the Jacobi ratio clearly above the threshold; 0 for a non-finite K) skips
+    # the checks below, which raise their messages: a bad shape, not finite, singular
+    if not (K.shape == (6, 6) and _kk.singular_ratio6(np.ascontiguousarray(K)) > 2.0 * _K_TOL):
+        ok = K.shape == (6, 6) and all(map(math.isfinite, K.ravel().tolist()))
+        s = np.linalg.svd(K, compute_uv=False) if ok else None
+        if s is None or s[-1] <= _K_TOL * s[0]:
+            K, _ = _check_stiffness(K)
     vals = []
     for v, name in ((w, "contact wrenches W"), (Tf, "twist of freedom"), (dw, "wrench change")):
         x = v.tolist()
         if v.shape != (6,) or not all(map(math.isfinite, x)):
             raise InputError(f"{name} must be 6 finite numbers, got {x}")
         vals.append(x)
-    wl, tl, dl = vals
-    wn = math.sqrt(sum(a * a for a in wl))
+    (w0, w1, w2, w3, w4, w5), (t0, t1, t2, t3, t4, t5), (d0, d1, d2, d3, d4, d5) = vals
+    # the sums of the batched checks, term by term in the same order
+    wn = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2 + w3 * w3 + w4 * w4 + w5 * w5)
     if wn == 0.0:
         raise InputError("contact wrench 1 is zero")
-    c = sum(a * b for a, b in zip(wl, dl, strict=True)) / (wn * wn)
-    res = math.sqrt(sum((b - a * c) ** 2 for a, b in zip(wl, dl, strict=True)))
-    if res > _IN_TOL * max(math.sqrt(sum(b * b for b in dl)), _TINY):
+    c = (w0 * d0 + w1 * d1 + w2 * d2 + w3 * d3 + w4 * d4 + w5 * d5) / (wn * wn)
+    res = math.sqrt((d0 - w0 * c) ** 2 + (d1 - w1 * c) ** 2 + (d2 - w2 * c) ** 2
+                    + (d3 - w3 * c) ** 2 + (d4 - w4 * c) ** 2 + (d5 - w5 * c) ** 2)
+    dn = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2 + d3 * d3 + d4 * d4 + d5 * d5)
+    if res > _IN_TOL * max(dn, _TINY):
         raise InputError("the wrench change is not one the contact can exert: it is not a "
                          "combination of the contact wrenches W")
-    r = sum(wl[i] * tl[(i + 3) % 6] for i in range(6))  # w · (T_f Δ), Δ swaps the halves
-    scale = max(wn * math.sqrt(sum(a * a for a in tl)), _TINY)
+    r = w0 * t3 + w1 * t4 + w2 * t5 + w3 * t0 + w4 * t1 + w5 * t2  # w · (T_f Δ)
+    scale = max(wn * math.sqrt(t0 * t0 + t1 * t1 + t2 * t2 + t3 * t3 + t4 * t4 + t5 * t5),
+                _TINY)
     if abs(r) > _IN_TOL * scale:
         raise InputError(f"the twist of freedom is not reciprocal to the contact wrenches "
                          f"(relative |Wᵀ Δ T_f| = {abs(r) / scale:.3g}): it would push "
                          "into the contact; project it with decompose_twist first")
     return Tf + np.linalg.solve(K, dw[..., None])[..., 0]
+
+
+def solve_one(K, b) -> np.ndarray:
+    """``K⁻¹ b`` (6,) for ONE stiffness ``K`` (6, 6) and ONE wrench ``b`` (6,), compiled
+    (:func:`~kinestat.parallel._kinestatic_kernels.solve6`, Gaussian elimination with partial
+    pivoting): ``numpy.linalg.solve``'s value to rounding, without its set-up (the control
+    cycle's twists of compliance). No validation; a singular K runs ``numpy.linalg.solve``,
+    which raises :class:`numpy.linalg.LinAlgError`.
+
+    >>> solve_one(np.diag([1.0, 2.0, 4.0, 1.0, 1.0, 1.0]), np.ones(6)).tolist()
+    [1.0, 0.5, 0.25, 1.0, 1.0, 1.0]
+    """
+    K = np.ascontiguousarray(K, dtype=float)
+    b = np.array(b, dtype=float)
+    x = np.empty(6)
+    if K.shape == (6, 6) and b.shape == (6,) and _kk.solve6(K, b, x):
+        return x
+    return np.linalg.solve(K, b)
 
 
 def freedom_basis(W) -> np.ndarray:

@@ -46,8 +46,8 @@ from kinestat.spatial.transforms import as_array, skew
 
 __all__ = ["stiffness", "stiffness_axis_trusted", "stiffness_terms", "load_asymmetry",
            "equilibrium_pose",
-           "tip_compliance", "tip_compliance_one", "pinned_tip_step", "tip_stiffness",
-           "TWIST_ORDERS"]
+           "tip_compliance", "tip_compliance_one", "pinned_tip_step", "platform_arrays",
+           "tip_stiffness", "TWIST_ORDERS"]
 
 TWIST_ORDERS = ("ray", "axis")
 
@@ -152,6 +152,12 @@ def pinned_tip_step(platform: Platform, T: np.ndarray, K: np.ndarray, tip, u,
 
 
 _ARRAYS: dict[int, tuple] = {}
+
+
+def platform_arrays(platform: Platform) -> tuple:
+    """``(base_points, top_points, stiffness, free_lengths)`` of ``platform`` as writeable C
+    arrays, made once per platform, for compiled single-pose kernels (do not modify them)."""
+    return _platform_arrays(platform)
 
 
 def _platform_arrays(platform: Platform) -> tuple:

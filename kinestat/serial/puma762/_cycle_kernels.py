@@ -10,10 +10,11 @@ configuration, so the whole grid costs one product per candidate instead of five
 candidate whose tool point is off the target by ``d`` is
 ``(d·ŝ / w_along)² + (|d − (d·ŝ) ŝ| / w_lateral)² + (acos(S6·ŝ) / w_tilt)²`` (``ŝ`` the target's
 S6); the first term alone bounds the cost from below, so most candidates are discarded after a
-dot product (branch and bound; the minimum and its index are exact, ties go to the lowest index
-as ``numpy.argmin``). The trigonometric tables are computed by the caller (with NumPy, exactly as
-the forward analysis of the reference would), which keeps the kernel free of the joint and
-encoder conventions.
+dot product, and whole arm frames after one (their wrists' tool points lie within a small
+radius of their centroid; branch and bound: the minimum and its index are exact, ties go to the
+lowest index as ``numpy.argmin``). The trigonometric tables are computed by the caller (with
+NumPy's operations, exactly as the forward analysis of the reference would), which keeps the
+kernel free of the joint and encoder conventions.
 
 Compiled on first use and cached on disk (``cache=True``, in ``__pycache__``).
 """
@@ -27,10 +28,14 @@ import numpy as np
 
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial._numba_options import TWO_PI as _TWO_PI
-from kinestat.serial.puma762._kernels import _link, _wrap
+from kinestat.serial.puma762._kernels import _link, _wrap, reverse_vectors_one
 from kinestat.serial.puma762.params import _A, _CA, _S, _SA
 
-__all__ = ["grid_nearest", "select_one", "pose_one"]
+__all__ = ["grid_nearest", "select_one", "reverse_select_one", "pose_one"]
+
+#: mm: the rounding slack of grid_nearest's bound on an arm frame's along-S6 terms (the
+#: terms are sums of a few products of ~1e3 mm, rounded at ~1e-13 mm)
+_BOUND_SLACK = 1e-9
 
 
 @nb.njit(**_OPTS)
@@ -94,6 +99,22 @@ def grid_nearest(cs1, cs2, cs3, cs4, cs5, cs6, p6, tp, ts, w_along, w_lat, w_til
     n1, n2, n3 = cs1.shape[0], cs2.shape[0], cs3.shape[0]
     n4, n5 = cs5.shape[0], cs5.shape[1]
     vp, vz = _wrist_tables(cs4, cs5, cs6, p6)
+    # the wrists' tool points lie within ``rho`` of their centroid ``vc``: an arm frame whose
+    # centroid term is off by more than ``rho`` (+ rounding slack) beyond the best cost's bound
+    # cannot hold a better candidate (|u| ≤ 1), so its wrists are skipped together
+    vc0, vc1, vc2 = 0.0, 0.0, 0.0
+    for i4 in range(n4):
+        for i5 in range(n5):
+            vc0 += vp[i4, i5, 0]
+            vc1 += vp[i4, i5, 1]
+            vc2 += vp[i4, i5, 2]
+    vc0, vc1, vc2 = vc0 / (n4 * n5), vc1 / (n4 * n5), vc2 / (n4 * n5)
+    rho = 0.0
+    for i4 in range(n4):
+        for i5 in range(n5):
+            e0, e1, e2 = vp[i4, i5, 0] - vc0, vp[i4, i5, 1] - vc1, vp[i4, i5, 2] - vc2
+            rho = max(rho, math.sqrt(e0 * e0 + e1 * e1 + e2 * e2))
+    rho = rho * (1.0 + 1e-12) + _BOUND_SLACK
     best = np.inf
     best_k = -1
     best_along = 0.0
@@ -114,6 +135,12 @@ def grid_nearest(cs1, cs2, cs3, cs4, cs5, cs6, p6, tp, ts, w_along, w_lat, w_til
                     u0 = x0 * ts[0] + x1 * ts[1] + x2 * ts[2]
                     u1 = y0 * ts[0] + y1 * ts[1] + y2 * ts[2]
                     u2 = z0 * ts[0] + z1 * ts[1] + z2 * ts[2]
+                    if sweep == 1:
+                        lo = abs(a0 + vc0 * u0 + vc1 * u1 + vc2 * u2) - rho
+                        if lo > 0.0:
+                            a = lo / w_along
+                            if a * a > best:
+                                continue  # every wrist's along term exceeds the best cost
                     for i4 in range(n4):
                         for i5 in range(n5):
                             k = arm * nw + i4 * n5 + i5
@@ -205,3 +232,25 @@ def pose_one(cs, T):
     T[1, 0], T[1, 1], T[1, 2], T[1, 3] = x1, y1, z1, p1
     T[2, 0], T[2, 1], T[2, 2], T[2, 3] = x2, y2, z2, p2
     T[3, 0], T[3, 1], T[3, 2], T[3, 3] = 0.0, 0.0, 0.0, 1.0
+
+
+@nb.njit(**_OPTS)
+def reverse_select_one(p, z, x, p6, q_now, offset, lo, hi, axis):
+    """:func:`~kinestat.serial.puma762._kernels.reverse_vectors_one` (tolerances 1e-6, 1e-9,
+    1e-10) and :func:`select_one` in one call (one dispatch): the axis angles of the
+    least-motion solution within ``[lo, hi]`` into ``axis``; False when the reverse analysis
+    fails (an error code or status), finds no valid branch or none lies within the limits
+    (the caller then runs the NumPy path for its message)."""
+    out = reverse_vectors_one(p, z, x, p6, 1e-6, 1e-9, 1e-10)
+    err, status, q, valid, sing, fsum, fval = out[0], out[2], out[4], out[5], out[6], out[7], \
+        out[8]
+    if err or status:
+        return False
+    any_valid = False
+    for i in range(valid.shape[0]):
+        if valid[i]:
+            any_valid = True
+            break
+    if not any_valid:
+        return False
+    return select_one(q, valid, sing, fsum, fval, q_now, offset, lo, hi, axis)

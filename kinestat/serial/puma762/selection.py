@@ -9,7 +9,6 @@ import numpy as np
 
 from kinestat.errors import InputError, JointLimitError
 from kinestat.serial.puma762 import _cycle_kernels as _ck
-from kinestat.serial.puma762 import _kernels as _pk
 from kinestat.serial.puma762.forward import _check_q
 from kinestat.serial.puma762.params import _TWO_PI, AXIS_LIMITS_DEG, AXIS_OFFSET, _wrap
 from kinestat.serial.puma762.reverse import ReverseBatch, ReverseResult, reverse
@@ -49,6 +48,22 @@ def _limits_rad(limits_deg) -> tuple[np.ndarray, np.ndarray]:
         raise InputError(f"axis limits must be 6 finite (lower, upper) pairs in degrees, "
                          f"got shape {L.shape}")
     return np.radians(L[:, 0]), np.radians(L[:, 1])
+
+
+_LIMITS_RAD: dict[int, tuple] = {}
+
+
+def _limits_rad_frozen(limits_deg) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_limits_rad` of an immutable limits array (read-only, owning its data: a model's
+    frozen limits) checked and converted once (the array is kept, so its id is not reused);
+    any other limits every call."""
+    if isinstance(limits_deg, np.ndarray) and not limits_deg.flags.writeable \
+            and limits_deg.flags.owndata:
+        got = _LIMITS_RAD.get(id(limits_deg))
+        if got is None or got[0] is not limits_deg:
+            got = _LIMITS_RAD[id(limits_deg)] = (limits_deg, _limits_rad(limits_deg))
+        return got[1]
+    return _limits_rad(limits_deg)
 
 
 def wrap_into_limits(angles, current, lower, upper) -> tuple[np.ndarray, np.ndarray]:
@@ -235,15 +250,17 @@ def select_axis_one(tool_point, s6, a67, tool_point_6, current_q, limits_deg) ->
     outside the limits raises what :func:`reverse` and :func:`select` raise (they are run for
     the message).
     """
-    p, z, x, p6, cur = (np.array(v, dtype=float) for v in (tool_point, s6, a67, tool_point_6,
-                                                             current_q))  # writeable, C order
-    out = _pk.reverse_vectors_one(p, z, x, p6, 1e-6, 1e-9, 1e-10)
-    err, status, q, valid, sing, fsum, fval = out[0], out[2], out[4], out[5], out[6], out[7], \
-        out[8]
+    p = np.array(tool_point, dtype=float)  # writeable, C order: the kernel's one signature
+    z = np.array(s6, dtype=float)
+    x = np.array(a67, dtype=float)
+    p6 = np.array(tool_point_6, dtype=float)
+    cur = np.array(current_q, dtype=float)
     axis = np.empty(6)
-    if not err and not status and valid.any():
-        lo, hi = _limits_rad(limits_deg)
-        if _ck.select_one(q, valid, sing, fsum, fval, cur, _AXIS_OFFSET, lo, hi, axis):
-            return axis
+    try:
+        lo, hi = _limits_rad_frozen(limits_deg)
+    except InputError:  # bad limits: the NumPy path raises (after the reverse analysis's own)
+        lo = None
+    if lo is not None and _ck.reverse_select_one(p, z, x, p6, cur, _AXIS_OFFSET, lo, hi, axis):
+        return axis
     sel = select(reverse(p, z, x, p6), cur, limits_deg)
     return sel.axis  # pragma: no cover - select raises when no branch is within the limits

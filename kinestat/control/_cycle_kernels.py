@@ -1,0 +1,227 @@
+"""Compiled (Numba) pieces of one control cycle: the vernier's cos/sin tables
+(:func:`vernier_tables_kernel`, :func:`kinestat.control.vernier.vernier_tables`'s arithmetic
+value for value), the envelope's prediction around the platform's kernel
+(:func:`predict_kernel`, equal to its NumPy wrapping to rounding) and the curvature of the
+measured tip path (:func:`kinestat.control.contact_estimate.path_curvature` for one path, the
+follow task's estimator). The circle fit's least squares is solved by Householder QR of the
+(N, 3) design matrix instead of NumPy's SVD-based ``lstsq``: for a full-rank matrix both give
+the least-squares solution, equal to rounding (relative ~ condition number × 1e-16). A design
+matrix near rank deficiency (where ``lstsq`` would return its minimum-norm solution) is left to
+the NumPy formulation (the kernel says so). Compiled on first use and cached on disk
+(``cache=True``, in ``__pycache__``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba as nb
+import numpy as np
+
+from kinestat.parallel._stiffness_kernels import pinned_tip_step_one
+
+_OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
+
+__all__ = ["path_curvature_kernel", "predict_kernel", "vernier_tables_kernel"]
+
+_PI = math.pi
+_TWO_PI = 2.0 * math.pi
+_DEG = math.pi / 180.0  # numpy.radians(x) is x * (π/180)
+
+
+@nb.njit(**_OPTS)
+def vernier_tables_kernel(c0, off, n1, n2, n3, n4, n5, now3, coupling, res, axis_offset):
+    """The PUMA 762 vernier's cos/sin tables (:func:`kinestat.control.vernier.vernier_tables`)
+    for the counts ``c0`` (6,) int64 and the grid rows ``off`` (rows, 6) int64
+    (:func:`~kinestat.control.vernier.grid_rows`: axes 1-3's values in the first rows, the
+    wrist's ``n4 n5`` combinations in the last): each candidate's count → axis-5 residual of
+    the 4 → 5 compensation (``now3`` the current axis-4 count, ``coupling``) → degrees
+    (``res``, (6,)) → radians → joint angle (``axis_offset``, joint 1 wrapped to [−π, π)) →
+    cos, sin, the same operations in the same order as the NumPy formulation.
+
+    Returns ``(cs1 (n1, 2), cs2 (n2, 2), cs3 (n3, 2), cs4 (n4, 2), cs5 (n4, n5, 2), cs6 (2,))``.
+    """
+    rows = off.shape[0]
+    q = np.empty((rows, 6))
+    for r in range(rows):
+        kappa = coupling * (float(c0[3] + off[r, 3]) - now3)
+        a = -kappa
+        rnd = (1.0 if a > 0.0 else (-1.0 if a < 0.0 else 0.0)) * math.floor(abs(a) + 0.5)
+        for j in range(6):
+            phys = float(c0[j] + off[r, j])
+            if j == 4:
+                phys += float(np.int64(rnd)) + kappa
+            v = phys * res[j] * _DEG - axis_offset[j]
+            if j == 0:
+                v = (v + _PI) % _TWO_PI - _PI
+            q[r, j] = v
+    cs1 = np.empty((n1, 2))
+    cs2 = np.empty((n2, 2))
+    cs3 = np.empty((n3, 2))
+    for i in range(n1):
+        cs1[i, 0], cs1[i, 1] = math.cos(q[i, 0]), math.sin(q[i, 0])
+    for i in range(n2):
+        cs2[i, 0], cs2[i, 1] = math.cos(q[i, 1]), math.sin(q[i, 1])
+    for i in range(n3):
+        cs3[i, 0], cs3[i, 1] = math.cos(q[i, 2]), math.sin(q[i, 2])
+    w0 = rows - n4 * n5
+    cs4 = np.empty((n4, 2))
+    cs5 = np.empty((n4, n5, 2))
+    for i4 in range(n4):
+        cs4[i4, 0], cs4[i4, 1] = math.cos(q[w0 + i4 * n5, 3]), math.sin(q[w0 + i4 * n5, 3])
+        for i5 in range(n5):
+            v = q[w0 + i4 * n5 + i5, 4]
+            cs5[i4, i5, 0], cs5[i4, i5, 1] = math.cos(v), math.sin(v)
+    cs6 = np.empty(2)
+    cs6[0], cs6[1] = math.cos(q[0, 5]), math.sin(q[0, 5])
+    return cs1, cs2, cs3, cs4, cs5, cs6
+
+#: smallest |R_kk| / max |R_jj| of the QR factor the kernel solves with (else: NumPy's lstsq)
+RANK_TOL = 1e-10
+
+
+@nb.njit(**_OPTS)
+def _householder_lstsq(M, b, coef):
+    """Least squares ``min |M coef − b|`` for ``M`` (n, 3) by Householder QR (``M`` and ``b``
+    overwritten); False when ``R``'s smallest diagonal is below :data:`RANK_TOL` of its
+    largest."""
+    n = M.shape[0]
+    for k in range(3):
+        s = 0.0
+        for i in range(k, n):
+            s += M[i, k] * M[i, k]
+        nrm = math.sqrt(s)
+        if nrm == 0.0:
+            return False
+        alpha = -nrm if M[k, k] >= 0.0 else nrm
+        v = np.empty(n - k)
+        for i in range(k, n):
+            v[i - k] = M[i, k]
+        v[0] -= alpha
+        vv = 0.0
+        for i in range(n - k):
+            vv += v[i] * v[i]
+        if vv > 0.0:
+            for j in range(k, 3):
+                d = 0.0
+                for i in range(k, n):
+                    d += v[i - k] * M[i, j]
+                f = 2.0 * d / vv
+                for i in range(k, n):
+                    M[i, j] -= f * v[i - k]
+            d = 0.0
+            for i in range(k, n):
+                d += v[i - k] * b[i]
+            f = 2.0 * d / vv
+            for i in range(k, n):
+                b[i] -= f * v[i - k]
+    rmax = max(abs(M[0, 0]), abs(M[1, 1]), abs(M[2, 2]))
+    if min(abs(M[0, 0]), abs(M[1, 1]), abs(M[2, 2])) <= RANK_TOL * rmax:
+        return False
+    for k in range(2, -1, -1):
+        s = b[k]
+        for j in range(k + 1, 3):
+            s -= M[k, j] * coef[j]
+        coef[k] = s / M[k, k]
+    return True
+
+
+@nb.njit(**_OPTS)
+def path_curvature_kernel(points, tip, normal, tangent, min_span):
+    """The signed curvature of the tip path (:func:`~kinestat.control.contact_estimate.
+    path_curvature`'s formulation: the points and the tip in the plane of ``tangent`` and
+    ``normal`` through ``tip``, the circle ``A (x² + y²) + B x − y + D = 0`` fitted in the
+    least-squares sense, ``κ = −2A / sqrt(max(B² + 1 − 4AD, 1e-12))``, 0 for a span below
+    ``min_span`` or a sagitta ``|κ| span²/8`` below twice the RMS residual).
+
+    Args:
+        points: (N, 3), N ≥ 3, the earlier tips; tip, normal, tangent: (3,).
+
+    Returns ``(κ, ok)``; ``ok`` False when the fit's matrix is near rank deficient (the
+    caller then runs the NumPy formulation).
+    """
+    n = points.shape[0] + 1
+    x = np.empty(n)
+    y = np.empty(n)
+    for i in range(n - 1):
+        d0 = points[i, 0] - tip[0]
+        d1 = points[i, 1] - tip[1]
+        d2 = points[i, 2] - tip[2]
+        x[i] = d0 * tangent[0] + d1 * tangent[1] + d2 * tangent[2]
+        y[i] = d0 * normal[0] + d1 * normal[1] + d2 * normal[2]
+    x[n - 1] = 0.0
+    y[n - 1] = 0.0
+    xmin = x[0]
+    xmax = x[0]
+    for i in range(1, n):
+        xmin = min(xmin, x[i])
+        xmax = max(xmax, x[i])
+    span = xmax - xmin
+    if span < min_span:
+        return 0.0, True
+    M = np.empty((n, 3))
+    b = np.empty(n)
+    for i in range(n):
+        M[i, 0] = x[i] * x[i] + y[i] * y[i]
+        M[i, 1] = x[i]
+        M[i, 2] = 1.0
+        b[i] = y[i]
+    coef = np.empty(3)
+    if not _householder_lstsq(M, b, coef):
+        return 0.0, False
+    A, B, D = coef[0], coef[1], coef[2]
+    kappa = -2.0 * A / math.sqrt(max(B * B + 1.0 - 4.0 * A * D, 1e-12))
+    ss = 0.0
+    for i in range(n):
+        r = y[i] - (A * (x[i] * x[i] + y[i] * y[i]) + B * x[i] + D)
+        ss += r * r
+    if abs(kappa) * span * span / 8.0 < 2.0 * math.sqrt(ss / n):
+        return 0.0, True
+    return kappa, True
+
+
+@nb.njit(**_OPTS)
+def predict_kernel(Tn, mount, tip_F, p, base_R, f_point, B, P_top, T, K, flange, lengths,
+                   free_lengths, force, defl, tip_motion, top):
+    """:func:`kinestat.control.envelope.predict`'s compiled path for one measurement and one
+    new flange pose ``Tn`` (4, 4), in one call: the base's new pose ``Tn · mount``, the pinned
+    tip's offset ``u`` in the new base frame and the external force ``F = −R_Bᵀ f_point`` on
+    the tip (base frame), the platform's response
+    (:func:`kinestat.parallel._stiffness_kernels.pinned_tip_step_one`), then the force on the
+    workpiece ``−R_new (F + δF)`` into ``force`` (3,), the deflections ``l − l0 + δl`` into
+    ``defl`` (6,), the flange-carried tip point's motion into ``tip_motion`` (3,) and the moved
+    top pose into ``top`` (4, 4). ``tip_F``/``p`` (3,) the measured tip (fixed/base frame),
+    ``flange`` (4, 4) the measured flange pose, ``B``/``P_top`` (6, 3) the platform's points,
+    ``T`` the measured top pose, ``K`` its stiffness (axis order), ``lengths``/``free_lengths``
+    (6,). False when the platform kernel meets a singular matrix (outputs then unset)."""
+    TB = np.empty((3, 4))
+    for r in range(3):
+        for c in range(4):
+            TB[r, c] = (Tn[r, 0] * mount[0, c] + Tn[r, 1] * mount[1, c]
+                        + Tn[r, 2] * mount[2, c] + Tn[r, 3] * mount[3, c])
+    u = np.empty(3)
+    F = np.empty(3)
+    for j in range(3):
+        u[j] = ((tip_F[0] - TB[0, 3]) * TB[0, j] + (tip_F[1] - TB[1, 3]) * TB[1, j]
+                + (tip_F[2] - TB[2, 3]) * TB[2, j]) - p[j]
+        F[j] = -(f_point[0] * base_R[0, j] + f_point[1] * base_R[1, j]
+                 + f_point[2] * base_R[2, j])
+    dF = np.empty(3)
+    D = np.empty(6)
+    dl = np.empty(6)
+    if not pinned_tip_step_one(B, P_top, T, K, p, u, F, dF, D, dl, top):
+        return False
+    for r in range(3):
+        force[r] = -(TB[r, 0] * (F[0] + dF[0]) + TB[r, 1] * (F[1] + dF[1])
+                     + TB[r, 2] * (F[2] + dF[2]))
+    for i in range(6):
+        defl[i] = (lengths[i] - free_lengths[i]) + dl[i]
+    loc = np.empty(3)
+    for j in range(3):  # the tip in the measured flange frame
+        loc[j] = ((tip_F[0] - flange[0, 3]) * flange[0, j]
+                  + (tip_F[1] - flange[1, 3]) * flange[1, j]
+                  + (tip_F[2] - flange[2, 3]) * flange[2, j])
+    for r in range(3):
+        tip_motion[r] = (Tn[r, 0] * loc[0] + Tn[r, 1] * loc[1] + Tn[r, 2] * loc[2]
+                         + Tn[r, 3]) - tip_F[r]
+    return True
