@@ -140,7 +140,7 @@ BREAKAWAY_DECAY = 0.1
 """Once the friction is measured, the breakaway tilt decays by this many ``max_turn_deg`` per
 sliding cycle (turning a pushed tool back onto the cone at once jams the tip), and grows by as
 much per cycle the tip sticks."""
-BREAKAWAY_FIRST = 0.25
+BREAKAWAY_FIRST = 0.2
 """Growth of the breakaway tilt (``max_turn_deg``) per sticking cycle before the first slip:
 every degree the tool is tilted past the friction cone lets the pushed tip run ahead ~1.5 mm
 and drops the normal force ~1.7 N (the soft mode against the axial spring), so the tilt
@@ -160,6 +160,11 @@ CURVATURE_SPAN = 4.0
 fitted (below it the path counts as straight)."""
 TRAVEL_TOL = 0.02
 """Remaining travel (mm) at which the follow task is complete."""
+STEP_RAMP = 0.25
+TILT_RATE_DEG = 0.15
+SMOOTH_BREAKAWAY = True
+REALIGN_DEG = 2.0
+CONE_CLEARANCE_DEG = 1.0
 END_STEP = 0.25
 """Smallest travel step (mm) while the end is approached in halving steps."""
 
@@ -333,6 +338,8 @@ class FollowState(ControllerState):
     sticking: bool = False
     breakaway: float = 0.0
     curvature: float = 0.0
+    step_cap: float = 0.0
+    slid: bool = False
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -447,7 +454,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
     if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip):
         stuck = st.step > 0 or st.sticking
-        return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
+        return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck, slid=False,
+                       step_cap=0.0 if stuck else st.step_cap,
                        breakaway=st.breakaway + (_breakaway_step(st) if stuck else 0.0))
     u = -F / float(np.linalg.norm(F))  # the force on the tool's direction
     mu, raw, samples = st.friction_ratio, st.friction_mean, st.friction_samples
@@ -471,7 +479,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     return replace(st, travel=travel, normal=n, last_tip=tip, path=path, curvature=kappa,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
                    path_dir=None if c is None else c / np.linalg.norm(c),
-                   sticking=False, breakaway=brk)
+                   sticking=False, breakaway=brk, slid=True)
 
 
 def decide_follow(config: FollowConfig, state: ControllerState,
@@ -555,17 +563,41 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     if phase == "travel" and remaining <= TRAVEL_TOL:
         return (Command(kind="done", label="e", reason=f"travelled {st.travel:.3f} mm along the "
                         "surface", **kw), replace(st, label="e", done=True))
-    if phase == "travel" and not (config.auto_tilt and st.sticking):
+    realign = (config.auto_tilt and phase == "travel" and st.friction_samples
+               and mis > REALIGN_DEG)
+    if phase == "travel" and not (config.auto_tilt and st.sticking) and not realign:
         learning = config.auto_tilt and st.friction_samples < LEARN_CHORDS
         # half the remaining travel at most (but not below END_STEP, ~10 robot counts at the
         # tool): the tip slides on the surface by up to ~2 mm a cycle as the tool turns (its
         # tangential stiffness is low), so the end is approached in shrinking steps instead of
         # overshot by a full one
-        step = min(config.travel_step * (LEARN_STEP if learning else 1.0),
-                   max(0.5 * remaining, min(END_STEP, remaining)))
+        cap = config.travel_step * (LEARN_STEP if learning else 1.0)
+        if config.auto_tilt and not learning and STEP_RAMP:
+            cap = min(max(st.step_cap, LEARN_STEP * config.travel_step)
+                      + STEP_RAMP * config.travel_step, cap)
+            st = replace(st, step_cap=cap)
+        step = min(cap, max(0.5 * remaining, min(END_STEP, remaining)))
         travel_vec = step * t
-    omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
-             else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
+    turn_limit = config.max_turn_deg
+    if config.auto_tilt and phase == "travel" and st.friction_samples and TILT_RATE_DEG:
+        # the tip stuck and S6 well inside the friction cone: turning about the tip carries
+        # the force with the tool (the top's deflection is unchanged), so S6 may turn fast;
+        # near the cone's edge or while sliding every degree beyond it runs the tip ahead
+        fast = min(turn_limit, mis - 1.0)
+        if fast > TILT_RATE_DEG:
+            w = _turn(meas.s6, axis, math.radians(fast))
+            s6_new = meas.s6 + cross3(w, meas.s6)
+            s6_new /= np.linalg.norm(s6_new)
+            now, new = (math.degrees(math.acos(max(-1.0, min(1.0, -float(v @ n)))))
+                        for v in (meas.s6, s6_new))
+            edge = math.degrees(math.atan(st.friction_ratio)) - CONE_CLEARANCE_DEG
+            if not (new < edge or new < now):
+                fast = TILT_RATE_DEG
+        turn_limit = max(TILT_RATE_DEG, fast)
+    growing = (config.auto_tilt and phase == "travel" and not st.friction_samples
+               and st.sticking and SMOOTH_BREAKAWAY)
+    omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG and not growing
+             else _turn(meas.s6, axis, math.radians(turn_limit)))
     if config.auto_tilt and step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs
         omega = _curvature_feedforward(n, t, st.curvature * step, omega,
                                        math.radians(config.max_turn_deg))
