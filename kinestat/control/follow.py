@@ -266,7 +266,10 @@ class FollowConfig:
             before the first slip, ``BREAKAWAY_DECAY`` after) and decays while it slides:
             a point contact on the long tool is very soft tangentially (the top turns about
             the tip), so friction carried across the tool axis turns the top beyond Table
-            3-1's range; along the axis the platform carries it.
+            3-1's range; along the axis the platform carries it. Once μ is measured, S6
+            turns by ``TILT_RATE_DEG`` a cycle near the cone's edge (faster only inward or
+            well inside it), is first turned back without travel when it is more than
+            ``REALIGN_DEG`` off its axis, and the travel step ramps up (``_step_cap``).
         max_contact_lost: cycles without contact during travel before a safe stop.
         min_angle_deg: smallest angle between the travel direction and the approach direction
             or the measured normal.
