@@ -174,6 +174,10 @@ REALIGN_DEG = 2.0
 """With the automatic tilt, once μ is measured, S6 further than this (degrees) from its axis
 is turned back without travel."""
 CONE_CLEARANCE_DEG = 1.0
+CURVATURE_RAMP = 4
+"""With the automatic tilt, the curvature feed-forward is fed in over this many cycles after
+the path's curvature is first estimated (the first estimates, over a short span, are the
+noisiest: a full turn on one made the tip stick under the step, +0.6 N)."""
 """S6 may turn fast while it stays this far (degrees) inside the estimated friction cone."""
 CREEP_HOLD = 0.1
 """With the automatic tilt, a tip that advanced this far (mm) in a cycle without travel is
@@ -356,6 +360,7 @@ class FollowState(ControllerState):
     curvature: float = 0.0
     step_cap: float = 0.0
     slid: bool = False
+    curvature_cycles: int = 0
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -519,6 +524,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     t = s - (s @ n) * n
     kappa = path_curvature(np.asarray(path), tip, n, t / np.linalg.norm(t), CURVATURE_SPAN)
     return replace(st, travel=travel, normal=n, last_tip=tip, path=path, curvature=kappa,
+                   curvature_cycles=st.curvature_cycles + 1 if kappa != 0.0 else 0,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
                    path_dir=None if c is None else c / np.linalg.norm(c),
                    sticking=False, breakaway=brk, slid=True)
@@ -630,7 +636,9 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG and not growing
              else _turn(meas.s6, axis, math.radians(turn_limit)))
     if config.auto_tilt and step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs
-        omega = _curvature_feedforward(n, t, st.curvature * step, omega,
+        # the first estimates of κ are the noisiest (short span): fed in over CURVATURE_RAMP
+        ramp = min(1.0, st.curvature_cycles / CURVATURE_RAMP) if CURVATURE_RAMP else 1.0
+        omega = _curvature_feedforward(n, t, ramp * st.curvature * step, omega,
                                        math.radians(config.max_turn_deg))
     dlam = config.gain * err
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
