@@ -140,7 +140,7 @@ BREAKAWAY_DECAY = 0.1
 """Once the friction is measured, the breakaway tilt decays by this many ``max_turn_deg`` per
 sliding cycle (turning a pushed tool back onto the cone at once jams the tip), and grows by as
 much per cycle the tip sticks."""
-BREAKAWAY_FIRST = 0.25
+BREAKAWAY_FIRST = 0.2
 """Growth of the breakaway tilt (``max_turn_deg``) per sticking cycle before the first slip:
 every degree the tool is tilted past the friction cone lets the pushed tip run ahead ~1.5 mm
 and drops the normal force ~1.7 N (the soft mode against the axial spring), so the tilt
@@ -160,6 +160,28 @@ CURVATURE_SPAN = 4.0
 fitted (below it the path counts as straight)."""
 TRAVEL_TOL = 0.02
 """Remaining travel (mm) at which the follow task is complete."""
+STEP_RAMP = 0.25
+"""With the automatic tilt, once μ is measured, the step limit grows by this fraction of the
+full step per sliding cycle, from ``LEARN_STEP`` (and again from there after a stick)."""
+UNKNOWN_CURVATURE_STEP = 0.5
+"""With the automatic tilt, the largest step (fraction of the full step) until the path's
+curvature is known (the path spans ``CURVATURE_SPAN``)."""
+TILT_RATE_DEG = 0.1
+"""With the automatic tilt, once μ is measured, the largest turn of S6 per cycle (degrees)
+near the friction cone's edge (see :func:`_auto_turn_limit`); the curvature feed-forward
+comes on top."""
+REALIGN_DEG = 2.0
+"""With the automatic tilt, once μ is measured, S6 further than this (degrees) from its axis
+is turned back without travel."""
+CONE_CLEARANCE_DEG = 1.0
+CURVATURE_RAMP = 4
+"""With the automatic tilt, the curvature feed-forward is fed in over this many cycles after
+the path's curvature is first estimated (the first estimates, over a short span, are the
+noisiest: a full turn on one made the tip stick under the step, +0.6 N)."""
+"""S6 may turn fast while it stays this far (degrees) inside the estimated friction cone."""
+CREEP_HOLD = 0.1
+"""With the automatic tilt, a tip that advanced this far (mm) in a cycle without travel is
+slipping: the breakaway tilt is held, not grown."""
 END_STEP = 0.25
 """Smallest travel step (mm) while the end is approached in halving steps."""
 
@@ -248,7 +270,10 @@ class FollowConfig:
             before the first slip, ``BREAKAWAY_DECAY`` after) and decays while it slides:
             a point contact on the long tool is very soft tangentially (the top turns about
             the tip), so friction carried across the tool axis turns the top beyond Table
-            3-1's range; along the axis the platform carries it.
+            3-1's range; along the axis the platform carries it. Once μ is measured, S6
+            turns by ``TILT_RATE_DEG`` a cycle near the cone's edge (faster only inward or
+            well inside it), is first turned back without travel when it is more than
+            ``REALIGN_DEG`` off its axis, and the travel step ramps up (``_step_cap``).
         max_contact_lost: cycles without contact during travel before a safe stop.
         min_angle_deg: smallest angle between the travel direction and the approach direction
             or the measured normal.
@@ -333,6 +358,9 @@ class FollowState(ControllerState):
     sticking: bool = False
     breakaway: float = 0.0
     curvature: float = 0.0
+    step_cap: float = 0.0
+    slid: bool = False
+    curvature_cycles: int = 0
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -412,6 +440,14 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
     return None
 
 
+def _path_span(path: tuple, tip: np.ndarray, t: np.ndarray) -> float:
+    """The span (mm) along ``t`` of the measured tip path and ``tip``."""
+    if not path:
+        return 0.0
+    x = (np.asarray(path) - tip) @ t
+    return float(max(x.max(), 0.0) - min(x.min(), 0.0))
+
+
 def _creeping(st: FollowState, path: tuple, tip: np.ndarray) -> bool:
     """While μ is learnt, a tip that crept :data:`LEARN_CHORD_LENGTH` along the travel over
     the last cycles slides (the breakaway tilt slips it slowly, below ``MIN_SLIP`` a cycle)."""
@@ -419,6 +455,13 @@ def _creeping(st: FollowState, path: tuple, tip: np.ndarray) -> bool:
         return False
     c = _chord(path, tip, LEARN_CHORD_LENGTH)
     return c is not None and float(c @ st.tangent) > 0.5 * norm3(c)
+
+
+def _tilt_past_force(s6: np.ndarray, force: np.ndarray, t: np.ndarray) -> float:
+    """How far (degrees) S6 leans past the measured force's direction towards the travel
+    ``t``: the angle from ``F/|F|`` to S6 in their plane's component along ``t``."""
+    f = force / float(np.linalg.norm(force))
+    return math.degrees(float((s6 - f) @ t))
 
 
 def _breakaway_step(st: FollowState) -> float:
@@ -447,8 +490,20 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
     if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip):
         stuck = st.step > 0 or st.sticking
-        return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck,
-                       breakaway=st.breakaway + (_breakaway_step(st) if stuck else 0.0))
+        if config.auto_tilt and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
+            # S6 leans past the measured force by the margin: a stuck tip's force turns with
+            # the tool, so this tip is on the cone's edge (creeping): more tilt would only
+            # turn the top; it travels (a step slides it)
+            stuck = False
+        # a tip creeping on under a turn alone (no travel commanded) is slipping already:
+        # the breakaway tilt is held, not grown (it would run the tip ahead at the slip)
+        grow = stuck and not (config.auto_tilt and st.step == 0.0 and advance >= CREEP_HOLD)
+        # nor in the cycle a travel step stuck: the step pressed the tip along the tilted
+        # tool's axis (the force rose); the force control relieves it first
+        grow = grow and not (config.auto_tilt and st.step > 0.0)
+        return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck, slid=False,
+                       step_cap=0.0 if stuck else st.step_cap,
+                       breakaway=st.breakaway + (_breakaway_step(st) if grow else 0.0))
     u = -F / norm3(F)  # the force on the tool's direction
     mu, raw, samples = st.friction_ratio, st.friction_mean, st.friction_samples
     c = _chord(path, tip, CHORD_LENGTH if st.friction_samples >= LEARN_CHORDS
@@ -469,9 +524,10 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     t = s - (s @ n) * n
     kappa = path_curvature_one(np.asarray(path), tip, n, t / norm3(t), CURVATURE_SPAN)
     return replace(st, travel=travel, normal=n, last_tip=tip, path=path, curvature=kappa,
+                   curvature_cycles=st.curvature_cycles + 1 if kappa != 0.0 else 0,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
                    path_dir=None if c is None else c / norm3(c),
-                   sticking=False, breakaway=brk)
+                   sticking=False, breakaway=brk, slid=True)
 
 
 def decide_follow(config: FollowConfig, state: ControllerState,
@@ -555,19 +611,34 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     if phase == "travel" and remaining <= TRAVEL_TOL:
         return (Command(kind="done", label="e", reason=f"travelled {st.travel:.3f} mm along the "
                         "surface", **kw), replace(st, label="e", done=True))
-    if phase == "travel" and not (config.auto_tilt and st.sticking):
-        learning = config.auto_tilt and st.friction_samples < LEARN_CHORDS
+    # automatic tilt, once the friction is measured: S6 far from its axis (the first slip
+    # measured a normal the tool is not tilted about, e.g. the force at first contact leaned
+    # sideways) is turned back first, without travel (the tip sticks, the force unchanged)
+    realign = (config.auto_tilt and phase == "travel" and st.friction_samples > 0
+               and mis > REALIGN_DEG)
+    if phase == "travel" and not (config.auto_tilt and st.sticking) and not realign:
         # half the remaining travel at most (but not below END_STEP, ~10 robot counts at the
         # tool): the tip slides on the surface by up to ~2 mm a cycle as the tool turns (its
         # tangential stiffness is low), so the end is approached in shrinking steps instead of
         # overshot by a full one
-        step = min(config.travel_step * (LEARN_STEP if learning else 1.0),
-                   max(0.5 * remaining, min(END_STEP, remaining)))
+        cap = _step_cap(config, st, meas.tip(model), t)
+        if config.auto_tilt:
+            st = replace(st, step_cap=cap)
+        step = min(cap, max(0.5 * remaining, min(END_STEP, remaining)))
         travel_vec = step * t
-    omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG
-             else _turn(meas.s6, axis, math.radians(config.max_turn_deg)))
+    turn_limit = config.max_turn_deg
+    if config.auto_tilt and phase == "travel" and st.friction_samples:
+        turn_limit = _auto_turn_limit(config, st, meas.s6, axis, n, mis)
+    # before the first slip the breakaway tilt grows every cycle the tip sticks: S6 follows
+    # it cycle by cycle (no dead band), so it passes the cone's edge by one increment at most
+    growing = (config.auto_tilt and phase == "travel" and not st.friction_samples
+               and st.sticking)
+    omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG and not growing
+             else _turn(meas.s6, axis, math.radians(turn_limit)))
     if config.auto_tilt and step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs
-        omega = _curvature_feedforward(n, t, st.curvature * step, omega,
+        # the first estimates of κ are the noisiest (short span): fed in over CURVATURE_RAMP
+        ramp = min(1.0, st.curvature_cycles / CURVATURE_RAMP) if CURVATURE_RAMP else 1.0
+        omega = _curvature_feedforward(n, t, ramp * st.curvature * step, omega,
                                        math.radians(config.max_turn_deg))
     dlam = config.gain * err
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
@@ -583,6 +654,48 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     action = "follow" if phase == "travel" else "settle"
     return _command(config, st, meas, new, label, action, step,
                     math.degrees(norm3(omega)), kw)
+
+
+def _step_cap(config: FollowConfig, st: FollowState, tip: np.ndarray, t: np.ndarray) -> float:
+    """The largest travel step of this cycle (mm): the full step; with the automatic tilt
+    ``LEARN_STEP`` of it while μ is learnt, then growing by ``STEP_RAMP`` of it per sliding
+    cycle from ``LEARN_STEP`` (again after each stick: a tip that sticks under a step of
+    Δs is pushed along the tilted tool's axis by Δs sin(tilt), ~1.2 N per mm), and at most
+    ``UNKNOWN_CURVATURE_STEP`` of it until the path's curvature is known (a convex surface
+    turns by κ Δs under the tool, beyond the cone's edge while S6 turns by
+    ``TILT_RATE_DEG`` a cycle)."""
+    full = config.travel_step
+    if not config.auto_tilt:
+        return full
+    if st.friction_samples < LEARN_CHORDS:
+        return LEARN_STEP * full
+    cap = min(max(st.step_cap, LEARN_STEP * full) + STEP_RAMP * full, full)
+    if st.curvature == 0.0 and _path_span(st.path, tip, t) < CURVATURE_SPAN:
+        cap = min(cap, UNKNOWN_CURVATURE_STEP * full)
+    return cap
+
+
+def _auto_turn_limit(config: FollowConfig, st: FollowState, s6: np.ndarray, axis: np.ndarray,
+                     n: np.ndarray, mis: float) -> float:
+    """The automatic tilt's largest turn of S6 this cycle (degrees), once μ is measured.
+
+    Every degree S6 turns beyond the friction cone's edge while the tip slides runs the tip
+    ahead ~1.5 mm and drops the normal force ~1.7 N (the force stays on the edge in space, so
+    in the base frame it turns, and the top deflects in its soft mode), so S6 turns by
+    ``TILT_RATE_DEG`` a cycle at most. Faster (up to ``max_turn_deg``, to 1° short of the
+    axis) only where that is harmless: when the turn takes S6 towards the normal estimate,
+    or keeps it ``CONE_CLEARANCE_DEG`` inside the cone: a stuck tip's force turns with the
+    tool about it (the top's deflection does not change)."""
+    fast = min(config.max_turn_deg, mis - 1.0)
+    if fast <= TILT_RATE_DEG:
+        return TILT_RATE_DEG
+    w = _turn(s6, axis, math.radians(fast))
+    s6_new = s6 + cross3(w, s6)
+    s6_new /= np.linalg.norm(s6_new)
+    now, new = (math.degrees(math.acos(max(-1.0, min(1.0, -float(v @ n)))))
+                for v in (s6, s6_new))
+    edge = math.degrees(math.atan(st.friction_ratio)) - CONE_CLEARANCE_DEG
+    return fast if (new < edge or new < now) else TILT_RATE_DEG
 
 
 def _curvature_feedforward(n: np.ndarray, t: np.ndarray, angle: float, omega: np.ndarray,
