@@ -122,6 +122,9 @@ CHORD_HISTORY = 12
 """Measured tips kept for the chord."""
 MAX_FRICTION = 1.0
 """Largest friction coefficient the estimate takes."""
+FRICTION_HINT_RATIO = 0.05
+"""From this measured friction ratio μ̂ (or a sticking tip) a refusal without the automatic
+tilt names friction as the cause."""
 TANGENTIAL_FACTOR = 4.0
 """The compliance twist's whole tip motion may be this multiple of ``max_correction`` (its
 normal part is limited to ``max_correction``: a frictionless tip slides freely along the
@@ -712,6 +715,17 @@ def _curvature_feedforward(n: np.ndarray, t: np.ndarray, angle: float, omega: np
     return w
 
 
+def _friction_hint(config: FollowConfig, st: FollowState) -> str:
+    """What to do when a refusal came from friction: without the automatic tilt a sticking
+    tip drags the top round until the motion range stops the run (docs/control.md, *With
+    friction*)."""
+    if config.auto_tilt or not (st.sticking or st.friction_ratio >= FRICTION_HINT_RATIO):
+        return ""
+    mu = f" (friction ratio measured {st.friction_ratio:.2f})" if st.friction_ratio else ""
+    return (f"; the tip sticks on the workpiece{mu}: with friction use the automatic tilt "
+            "(--auto-tilt, FollowConfig.auto_tilt), which leans the tool onto the friction cone")
+
+
 def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Target, label: str,
              action: str, step: float, rotation_deg: float,
              kw: dict) -> tuple[Command, FollowState]:
@@ -720,7 +734,7 @@ def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Targ
     cmd = move_command(base.model, base.envelope, base.vernier, meas, new, st.axis_counts,
                        label=label, action=action, step=step, rotation_deg=rotation_deg, info=kw)
     if isinstance(cmd, Refusal):
-        return _stop(st, label, cmd.reason, **cmd.extra, **kw)
+        return _stop(st, label, cmd.reason + _friction_hint(config, st), **cmd.extra, **kw)
     return cmd, replace(st, label=label, last_action=action, target=new,
                         axis_counts=cmd.axis_counts, step=step if action == "follow" else 0.0)
 

@@ -22,7 +22,13 @@ from kinestat.app.control_run import (
 )
 from kinestat.app.sim_cell import InProcessIO, start_counts
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, start
-from kinestat.control.follow import FollowConfig, decide_follow, estimate_normal
+from kinestat.control.follow import (
+    FollowConfig,
+    FollowState,
+    _friction_hint,
+    decide_follow,
+    estimate_normal,
+)
 from kinestat.control.log import CycleLog
 from kinestat.control.loop import run
 from kinestat.control.wrench import measure
@@ -203,7 +209,22 @@ def test_friction_without_tilt_stops_safely_on_the_motion_range(tmp_path):
     prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.3))
     assert not out["completed"]
     assert "Table 3-1" in rep.stop_reason and "refused by the envelope" in rep.stop_reason
+    assert "the tip sticks" in rep.stop_reason and "--auto-tilt" in rep.stop_reason
     assert out["contact_lost"] == 0
+
+
+def test_the_friction_hint_only_when_friction_is_seen_and_the_tilt_is_off(tmp_path):
+    base = _base(tmp_path)
+    _, st0 = start(base, np.zeros(6))
+    st = FollowState(**vars(st0))
+    off = FollowConfig(base=base, travel=10.0, travel_dir=Y)
+    on = FollowConfig(base=base, travel=10.0, travel_dir=Y, auto_tilt=True)
+    assert _friction_hint(off, st) == ""  # a free (frictionless) tip: the refusal as it is
+    assert _friction_hint(off, replace(st, friction_ratio=0.01)) == ""
+    for seen in (replace(st, sticking=True), replace(st, friction_ratio=0.3)):
+        assert "--auto-tilt" in _friction_hint(off, seen)
+        assert _friction_hint(on, seen) == ""
+    assert "0.30" in _friction_hint(off, replace(st, friction_ratio=0.3))
 
 
 def test_auto_tilt_follows_with_light_friction_and_learns_mu(tmp_path):
