@@ -26,19 +26,29 @@ HOLD = 0.2
 """How long (s) after the end of the motion a packet sampled during it is delivered: far
 beyond the settle time (12.5 ms)."""
 
+GAP = 0.05
+"""The next packet's delay (s) after the late one."""
+
 FAST = MotionProfile(speed=(80000.0,) * 6, accel=(800000.0,) * 6)
 
 
 def _late_mid_motion_packets(ctrl: DmcSimulator, server: GalilSimServer, held: list):
     """counts_now for the emitter: the true axis counts; when sampled mid-motion, returned
-    only ``HOLD`` s after the motion ended (the emitter thread blocks meanwhile)."""
+    only ``HOLD`` s after the motion ended (the emitter thread blocks meanwhile), and the next
+    packet ``GAP`` s after that (so that the reader takes the late packet on its own)."""
+    after_hold = [False]
+
     def counts_now() -> np.ndarray:
+        if after_hold[0]:
+            after_hold[0] = False
+            time.sleep(GAP)
         c = np.asarray(server.true_axis_counts(), dtype=float)
         if any(ctrl.moving()):
             while any(ctrl.moving()):
                 time.sleep(0.001)
             time.sleep(HOLD)
             held.append(c.copy())
+            after_hold[0] = True
         return c
     return counts_now
 
