@@ -27,7 +27,7 @@ from kinestat.devices.safe_stop import RECONNECT_TIMEOUT, send_stop
 from kinestat.errors import DeviceError, InputError
 from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, axis45_compensation
 
-__all__ = ["MAX_SAMPLES", "SensorSample", "MotionProfile", "DeviceIO"]
+__all__ = ["MAX_SAMPLES", "STALE_PACKETS_SKIPPED", "SensorSample", "MotionProfile", "DeviceIO"]
 
 
 STALE_PACKETS_SKIPPED = 1
