@@ -312,6 +312,9 @@ class SimCheckedReader:
     def latest(self, *args: Any, **kw: Any) -> Any:
         return self._checked(self._reader.latest, *args, **kw)
 
+    def drain(self, *args: Any, **kw: Any) -> Any:
+        return self._checked(self._reader.drain, *args, **kw)
+
 
 class InProcessIO:
     """The simulated cell as a :class:`~kinestat.control.loop.CellIO` without devices.

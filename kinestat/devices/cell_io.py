@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from kinestat.devices.ceilings import MAX_SAMPLES
-from kinestat.devices.encoder_stream import TooManyFaultsError
+from kinestat.devices.encoder_stream import TooManyFaultsError, sampled_after
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.devices.motion import MOVE_RULES, MoveRule, move_plan
 from kinestat.devices.motion_check import POSITION_TOLERANCE_COUNTS, check_arrival
@@ -27,8 +27,13 @@ from kinestat.devices.safe_stop import RECONNECT_TIMEOUT, send_stop
 from kinestat.errors import DeviceError, InputError
 from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, axis45_compensation
 
-__all__ = ["MAX_SAMPLES", "SensorSample", "MotionProfile", "DeviceIO"]
+__all__ = ["MAX_SAMPLES", "STALE_PACKETS_SKIPPED", "SensorSample", "MotionProfile", "DeviceIO"]
 
+
+STALE_PACKETS_SKIPPED = 1
+"""Packets after the drain that may still have been sampled before it (in the box, on air or
+in the receiver's buffer): with a box that delivers each packet within one period of sampling
+it, the second packet after the drain was sampled after it (:meth:`DeviceIO.sensor`)."""
 
 DEFAULT_MAX_STREAM_FAULTS = 5
 """Stream faults tolerated while acquiring one measurement (the envelope's default,
@@ -59,10 +64,15 @@ class DeviceIO:
     :class:`~kinestat.devices.galil.GalilClient` and an
     :class:`~kinestat.devices.encoder_stream.EncoderReader` (both opened by the caller).
 
-    Moves compensate the axis 4 -> 5 coupling (``coupling``, as the model's). After each move it
-    waits ``settle`` seconds past the end of the motion and averages ``samples`` fresh packets
-    received after that (a running sum: nothing grows with ``samples``; at most
-    :data:`MAX_SAMPLES`). More than ``max_stream_faults`` stream faults while acquiring one
+    Moves compensate the axis 4 -> 5 coupling (``coupling``, as the model's). After each move
+    the measurement averages ``samples`` packets SAMPLED after the motion ended and ``settle``
+    seconds passed (a running sum: nothing grows with ``samples``; at most
+    :data:`MAX_SAMPLES`). A packet's arrival time does not tell when it was sampled (it may
+    have waited in the box, on air, in the serial buffer or in a descheduled emitter thread),
+    so the rule counts packets instead (:meth:`sensor`): wait ``settle`` past the end of the
+    motion, drain what is buffered, skip :data:`STALE_PACKETS_SKIPPED` packet(s) after the
+    drain (by sequence number in the ``ks`` format, by count in the legacy one), then take
+    the next ones. More than ``max_stream_faults`` stream faults while acquiring one
     measurement end it at once (the loop then stops). ``truth`` is an optional callable
     returning the true state (simulation only). ``move_rule`` chooses each move's per-axis
     speeds (:mod:`kinestat.devices.motion`): "coordinated" (default: the axes start and finish
@@ -143,8 +153,16 @@ class DeviceIO:
                 "accel": plan.accel.tolist(), "rule": self.move_rule}
 
     def sensor(self) -> SensorSample:
-        """The mean of ``samples`` fresh packets received after the motion settled, with the
-        stream faults seen while waiting for them (summed as they come: no list of samples).
+        """The mean of ``samples`` packets sampled after the motion settled, with the stream
+        faults seen while waiting for them (summed as they come: no list of samples).
+
+        The rule (the same on hardware and on the simulated cell): keep reading until
+        ``settle`` seconds after the end of the last move, drain what the reader has buffered
+        (:meth:`EncoderReader.drain`), skip the :data:`STALE_PACKETS_SKIPPED` packet(s) that
+        may have been sampled before the drain, then average the next ``samples``
+        (:func:`kinestat.devices.encoder_stream.sampled_after`). Valid while the encoder box
+        delivers each packet within one period of sampling it (a serial stream at a fixed rate:
+        ~2-7 ms per frame at 115200 baud against a 5-10 ms period).
 
         With more than ``max_stream_faults`` faults it returns at once with the faults and no
         counts (NaN): the loop stops on them."""
@@ -153,6 +171,9 @@ class DeviceIO:
         faults: list[str] = []
         last = None
         budget = self.max_stream_faults
+        while self._clock() < self._t_ready:
+            self.reader.poll()  # the settle time, keeping the serial buffer drained
+        mark = self.reader.drain()
         while n < self.samples:
             left = None if budget is None else max(0, budget - len(faults))
             try:
@@ -161,7 +182,7 @@ class DeviceIO:
                 faults.extend(f"{f.kind}: {f.message}" for f in exc.faults)
                 return SensorSample(counts=np.full(6, np.nan), faults=tuple(faults))
             faults.extend(f"{f.kind}: {f.message}" for f in r.faults)
-            if r.received_at >= self._t_ready:
+            if sampled_after(r, mark, STALE_PACKETS_SKIPPED):
                 total += np.asarray(r.counts, dtype=float)
                 n += 1
                 last = r

@@ -81,6 +81,8 @@ __all__ = [
     "StreamParser",
     "StaleDataError",
     "Reading",
+    "StreamMark",
+    "sampled_after",
     "EncoderReader",
 ]
 
@@ -306,7 +308,9 @@ class TooManyFaultsError(ProtocolError):
 class Reading:
     """The latest valid counts: ``counts`` per leg 1..6, ``channel_counts`` per channel A..F.
 
-    ``age`` is the time in seconds between its arrival and the call that returned it.
+    ``age`` is the time in seconds between its arrival and the call that returned it;
+    ``received_at`` is when the READER took it off the line, not when the box sampled it.
+    ``index`` is the packet's ordinal in the reader (1 for the first packet it took).
     """
 
     seq: int | None
@@ -316,6 +320,41 @@ class Reading:
     age: float
     fmt: Format = "ks"
     faults: tuple[StreamFault, ...] = field(default=())
+    index: int = 0
+
+
+@dataclass(frozen=True)
+class StreamMark:
+    """Where a drained stream stood (:meth:`EncoderReader.drain`): ``index`` packets taken so
+    far and the last one's sequence number ``seq`` (None if none, or in the legacy format)."""
+
+    index: int
+    seq: int | None = None
+
+
+def sampled_after(reading: Reading, mark: StreamMark, skip: int = 1) -> bool:
+    """True when ``reading`` comes more than ``skip`` packets after ``mark``: then it was
+    SAMPLED after the drain that made the mark, whatever its arrival time.
+
+    The packet following the mark may have been sampled before the drain and been on its way
+    (in the box, on air, in the receiver's buffer) during it; with a box that samples at a
+    fixed rate and delivers each packet within ``skip`` periods, the ones after it were
+    sampled after the drain. Packets are counted by the reader (``index``: works for both
+    formats, and packets lost on air only make it wait longer); in the ``ks`` format a
+    sequence number advanced by more than ``skip`` (lost packets included, a restart
+    excluded) also counts.
+
+    >>> m = StreamMark(index=10, seq=0xFFFF)
+    >>> def r(seq, index):
+    ...     return Reading(seq, np.zeros(6), (0,) * 6, received_at=0.0, age=0.0, index=index)
+    >>> sampled_after(r(0, 11), m), sampled_after(r(1, 11), m), sampled_after(r(None, 12), m)
+    (False, True, True)
+    """
+    if reading.index - mark.index > skip:
+        return True
+    if reading.seq is None or mark.seq is None:
+        return False
+    return skip < (reading.seq - mark.seq) % SEQ_MODULUS < SEQ_MODULUS // 2
 
 
 class EncoderReader:
@@ -407,16 +446,35 @@ class EncoderReader:
     # -- I/O
     def poll(self) -> list[Event]:
         """Read what has arrived (waiting at most ``read_timeout``); return its events."""
+        return self._consume(self._read_chunk(wait=True))
+
+    def drain(self, max_chunks: int = 64) -> StreamMark:
+        """Take in every byte already waiting, without waiting for more (at most
+        ``max_chunks`` reads), and return where the stream now stands: the mark from which
+        :func:`sampled_after` tells packets sampled after this moment."""
+        for _ in range(max_chunks):
+            data = self._read_chunk(wait=False)
+            if not data:
+                break
+            self._consume(data)
+        return StreamMark(index=self._latest_id,
+                          seq=None if self._latest is None else self._latest.seq)
+
+    def _read_chunk(self, *, wait: bool) -> bytes:
         import serial  # lazy: pyserial is loaded only when a port is used
 
         if self._ser is None:
             self.open()
         try:
             waiting = self._ser.in_waiting
-            data = self._ser.read(max(1, waiting))
+            if not waiting and not wait:
+                return b""
+            return self._ser.read(max(1, waiting))
         except (serial.SerialException, OSError) as exc:
             raise DeviceError(f"encoder stream {self.port!r} failed while reading: {exc}. "
                               "The device was unplugged or the emitter stopped") from exc
+
+    def _consume(self, data: bytes) -> list[Event]:
         if not data:
             return []
         now = self._clock()
@@ -441,7 +499,8 @@ class EncoderReader:
         faults, self._pending_faults = tuple(self._pending_faults), []
         return Reading(seq=self._latest.seq, counts=self._latest_legs.copy(),
                        channel_counts=self._latest.counts, received_at=self._latest_t,
-                       age=now - self._latest_t, fmt=self._latest.fmt, faults=faults)
+                       age=now - self._latest_t, fmt=self._latest.fmt, faults=faults,
+                       index=self._latest_id)
 
     def _stale(self, now: float, why: str) -> StaleDataError:
         age = math.inf if self._latest_t is None else now - self._latest_t
