@@ -56,6 +56,7 @@ from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.platform import Platform
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
+from kinestat.sim._slide import damped_slide
 from kinestat.spatial.transforms import apply, apply_vector, as_array, inv, make_pose, skew
 from kinestat.spatial.validate import frozen
 
@@ -499,38 +500,6 @@ def _finish(cell: Cell, T, X, contact_force_F, anchor, sticking, res, iters, ext
                        residual=float(res), iterations=int(iters), normal_force=fn, extra=extra)
 
 
-def _damped_slide(resid, d2: np.ndarray, Xg: np.ndarray, iters: int = 60):
-    """The sliding contact's 2-D Newton with backtracking (the fallback when the plain Newton of
-    :func:`_stick_or_slip` wanders): each step is halved until the residual's largest component
-    falls, from the secant's point ``d2``. Returns the best ``(d2, X)`` seen."""
-    r, Xs = resid(d2, Xg)[:2]
-    best = float(np.max(np.abs(r)))
-    for _ in range(iters):
-        if best <= SLIDE_CONVERGED:
-            break
-        h = 1e-7
-        J = np.zeros((2, 2))
-        for k in range(2):
-            dk = d2.copy()
-            dk[k] += h
-            J[:, k] = (resid(dk, Xs)[0] - r) / h
-        try:
-            step = np.linalg.solve(J, r)
-        except np.linalg.LinAlgError:
-            break
-        t = 1.0
-        for _ in range(12):
-            cand = d2 - t * step
-            rc, Xc = resid(cand, Xs)[:2]
-            if float(np.max(np.abs(rc))) < best:
-                d2, r, Xs, best = cand, rc, Xc, float(np.max(np.abs(rc)))
-                break
-            t *= 0.5
-        else:
-            break
-    return d2, Xs
-
-
 def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
     """Sticking at ``a_F`` if friction allows, else quasi-static slip; None if it would pull.
 
@@ -612,7 +581,7 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
         Xg = Xs
     r, Xs, fs, fFs, rs, fns = resid(d2, Xg)
     if not np.max(np.abs(r)) <= SLIDE_TOL:  # the plain Newton wandered off: damped instead
-        d2b, Xgb = _damped_slide(resid, s1 * u, Xb)
+        d2b, Xgb = damped_slide(resid, s1 * u, Xb, SLIDE_CONVERGED)
         rb = resid(d2b, Xgb)
         if np.max(np.abs(rb[0])) < np.max(np.abs(r)):
             d2, Xg = d2b, Xgb
