@@ -5,6 +5,18 @@ from __future__ import annotations
 import numpy as np
 
 
+def fd_jacobian(resid, d2: np.ndarray, X: np.ndarray, r: np.ndarray,
+                h: float = 1e-7) -> np.ndarray:
+    """Forward-difference Jacobian (2, 2) of the slide residual ``resid(d2, X)[0]`` at ``d2``,
+    where it is ``r``."""
+    J = np.zeros((2, 2))
+    for k in range(2):
+        dk = d2.copy()
+        dk[k] += h
+        J[:, k] = (resid(dk, X)[0] - r) / h
+    return J
+
+
 def damped_slide(resid, d2: np.ndarray, Xg: np.ndarray, tol: float, iters: int = 60):
     """The sliding contact's 2-D Newton with backtracking, the fallback when the plain Newton of
     ``kinestat.sim.contact._stick_or_slip`` wanders: from the secant's point ``d2`` each step is
@@ -15,12 +27,7 @@ def damped_slide(resid, d2: np.ndarray, Xg: np.ndarray, tol: float, iters: int =
     for _ in range(iters):
         if best <= tol:
             break
-        h = 1e-7
-        J = np.zeros((2, 2))
-        for k in range(2):
-            dk = d2.copy()
-            dk[k] += h
-            J[:, k] = (resid(dk, Xs)[0] - r) / h
+        J = fd_jacobian(resid, d2, Xs, r)
         try:
             step = np.linalg.solve(J, r)
         except np.linalg.LinAlgError:

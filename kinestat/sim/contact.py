@@ -56,7 +56,7 @@ from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.platform import Platform
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
-from kinestat.sim._slide import damped_slide
+from kinestat.sim._slide import damped_slide, fd_jacobian
 from kinestat.spatial.transforms import apply, apply_vector, as_array, inv, make_pose, skew
 from kinestat.spatial.validate import frozen
 
@@ -571,12 +571,7 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
         r, Xs, fs, fFs, rs, fns = resid(d2, Xg)
         if np.max(np.abs(r)) <= 1e-10:
             break
-        h = 1e-7
-        J = np.zeros((2, 2))
-        for k in range(2):
-            dk = d2.copy()
-            dk[k] += h
-            J[:, k] = (resid(dk, Xs)[0] - r) / h
+        J = fd_jacobian(resid, d2, Xs, r)
         d2 = d2 - np.linalg.solve(J, r)
         Xg = Xs
     r, Xs, fs, fFs, rs, fns = resid(d2, Xg)
