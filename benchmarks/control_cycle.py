@@ -2,7 +2,8 @@
 
 Records every (state, measurement) pair of a run on the in-process simulated cell (the default
 thesis cell: 5° tilted plane, thesis calibration and sensor), then times the decision function
-on each recorded pair (``decide`` for the press task, ``decide_follow`` for a 50 mm follow run;
+on each recorded pair (``decide`` for the press task, ``decide_follow`` for a 50 mm follow run,
+and for one with friction 0.3 on an R = 200 mm cylinder with the automatic tilt;
 both include the closed-form reverse analysis, the vernier's rounding to counts and the
 envelope's prediction), on the fast path and — side by side, alternating, in the same run — on
 the unoptimised reference path (:func:`kinestat.control._reference.reference_cycle`: the NumPy
@@ -40,7 +41,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from kinestat.app.control_run import ControlRequest, SimulatedCell, prepare_control  # noqa: E402
+from kinestat.app.control_run import (  # noqa: E402
+    ControlRequest,
+    CylinderSpec,
+    SimulatedCell,
+    prepare_control,
+)
 from kinestat.app.sim_cell import InProcessIO, start_counts  # noqa: E402
 from kinestat.cli._compile import warm_kernels  # noqa: E402
 from kinestat.control._reference import reference_cycle, solve_counts_reference  # noqa: E402
@@ -60,12 +66,27 @@ START = np.array([-400.0, 800.0, -100.0])
 GOAL_US = 200.0
 
 
+TASKS = ("press", "follow", "follow-friction")
+"""The recorded runs: the press task and a 50 mm follow run on the default 5° plane, and a
+follow run with Coulomb friction 0.3 on an R = 200 mm cylinder with the automatic tilt (the
+friction estimator, cone normal and curvature fit in every sliding cycle)."""
+
+
+def _request(task: str) -> ControlRequest:
+    if task == "follow-friction":
+        cell = SimulatedCell(friction=0.3, cylinder=CylinderSpec(
+            radius=200.0, axis=np.array([0.0, 0.0, 1.0])))
+        return ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START,
+                              cell=cell, task="follow", travel_dir=np.array([0.0, 1.0, 0.0]),
+                              auto_tilt=True)
+    return ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START,
+                          cell=SimulatedCell(), task=task, travel_dir=np.array([0.0, 1.0, 0.0]))
+
+
 def _record(task: str) -> tuple:
-    req = ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START,
-                         cell=SimulatedCell(), task=task, travel_dir=np.array([0.0, 1.0, 0.0]))
-    prep = prepare_control(req)
+    prep = prepare_control(_request(task))
     pairs: list = []
-    if task == "follow":
+    if prep.follow is not None:
         base_fn = functools.partial(decide_follow, prep.follow)
     else:
         base_fn = functools.partial(decide, prep.config)
@@ -132,7 +153,7 @@ def _single(fn, pairs, repeat: int) -> float:
 def _task_row(task: str, repeat: int) -> dict:
     prep, pairs, rep = _record(task)
     model = prep.config.model
-    if task == "follow":
+    if prep.follow is not None:
         fc = prep.follow
         full = functools.partial(decide_follow, fc)
         plain = functools.partial(decide_follow, replace(fc, base=replace(fc.base, vernier=False)))
@@ -181,7 +202,7 @@ def main(argv: list[str] | None = None) -> int:
     t0 = time.perf_counter()
     warm_kernels()  # compile (first run) or load from the cache: never part of a cycle's time
     first_load_s = time.perf_counter() - t0
-    rows = [_task_row(task, args.repeat) for task in ("press", "follow")]
+    rows = [_task_row(task, args.repeat) for task in TASKS]
     meta = {"date": datetime.now(UTC).strftime("%Y-%m-%d %H:%M UTC"),
             "machine": f"{platform.machine()}, {os.cpu_count()} cores",
             "python": platform.python_version(), "kernel_load_s": first_load_s,
@@ -193,12 +214,12 @@ def main(argv: list[str] | None = None) -> int:
           f"{args.clock} clock; kernels compiled/loaded first in {first_load_s:.1f} s (not timed)")
     print("µs per cycle (median over the moving cycles), fast path vs reference path "
           "(same run, alternating)")
-    print(f"{'task':7s} {'cycles':>6s} {'decide+IK':>10s} {'reference':>10s} {'×':>5s} "
+    print(f"{'task':15s} {'cycles':>6s} {'decide+IK':>10s} {'reference':>10s} {'×':>5s} "
           f"{'best-of':>8s} {'(ref)':>7s} "
           f"{'IK+vernier':>11s} {'(ref)':>7s} {'prediction':>11s} {'(ref)':>7s} {'rest':>6s} "
           f"{'no vernier':>11s} {'measure':>8s} {'alone':>6s}")
     for r in rows:
-        print(f"{r['task']:7s} {r['cycles']:6d} {r['decide_us']:10.0f} "
+        print(f"{r['task']:15s} {r['cycles']:6d} {r['decide_us']:10.0f} "
               f"{r['reference_decide_us']:10.0f} {r['speedup']:5.1f} {r['decide_best_us']:8.0f} "
               f"{r['reference_decide_best_us']:7.0f} {r['ik_vernier_us']:11.0f} "
               f"{r['reference_ik_vernier_us']:7.0f} {r['predict_us']:11.0f} "
