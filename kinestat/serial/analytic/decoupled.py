@@ -201,7 +201,8 @@ def _move(kind: str, w: np.ndarray, r: np.ndarray, q: np.ndarray, x: np.ndarray)
 
 
 def _position_jacobian(ax: HomeAxes, kinds: str, q: np.ndarray, w=None) -> np.ndarray:
-    """``∂(M1 M2 M3 w)/∂q (..., 3, 3)`` at ``q (..., 3)`` (spatial axes moved by the joints before)."""
+    """``∂(M1 M2 M3 w)/∂q (..., 3, 3)`` at ``q (..., 3)`` (each axis moved by the joints
+    before it; w defaults to the point on axis 4)."""
     W, P = ax.w, ax.r
     w = P[3] if w is None else w
     axes, pts = [], []
@@ -463,5 +464,6 @@ def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     ok = np.broadcast_to(((has3[..., None] & ok2) & e45)[..., None], sh).reshape(N, -1)
     q = np.where(ok[..., None], q, 0.0)
     return pack(model, q, ok, T, 8, tol=tol, method=METHOD, reason_none=_REASON,
-                singular=np.broadcast_to(sing[..., None], sh).reshape(N, -1), family_sign=np.broadcast_to(sig, sh).reshape(N, -1),
+                singular=np.broadcast_to(sing[..., None], sh).reshape(N, -1),
+                family_sign=np.broadcast_to(sig, sh).reshape(N, -1),
                 family_value=np.broadcast_to(fam, sh).reshape(N, -1), family_joints=(3, 5))
