@@ -48,11 +48,12 @@ import numpy as np
 
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic._common import pack
+from kinestat.serial.analytic._common import _twist_error, pack, pose_residuals
 from kinestat.serial.analytic.closed_form import _wrist
 from kinestat.serial.analytic.geometry import HomeAxes, home_axes, meet, parallel
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1
+from kinestat.serial.jacobian import fk_and_jacobian
 
 __all__ = ["Plan", "plan", "solve_decoupled", "METHOD"]
 
@@ -64,6 +65,7 @@ _CHEB_NODES = 9
 _POLY_DEG = 4
 _ROOT_TOL = 1e-5  # distance of an accepted root from the unit circle / real axis (relative)
 _TRIM = 1e-10  # top coefficients below this fraction of the largest are dropped
+_SNAP = 1e-12  # |cos| this close to 1 (or a discriminant this small): a double root
 _REASON = ("no real solution: the wrist centre is out of reach of joints 1-3 (the eliminant has "
            "no real root), or the wrist cannot reach the orientation")
 
@@ -296,6 +298,7 @@ def _joint2(pl: Plan, y: np.ndarray, p, h, rho2):
         al, be = math.atan2(g[1], g[0]), np.arctan2(vp[..., 1], vp[..., 0])
         den = np.linalg.norm(g) * np.linalg.norm(vp, axis=-1)
         c = -C[..., j] / np.where(den > 0, den, 1.0)
+        c = np.where(np.abs(c) > 1.0 - _SNAP, np.sign(c), c)  # a double root: exactly
         ac = np.arccos(np.clip(c, -1.0, 1.0))[..., None] * np.array([1.0, -1.0])
         ok = (np.abs(c) <= 1.0 + 1e-7) & (den > 0)
         return (al - be)[..., None] + ac, np.broadcast_to(ok[..., None], ac.shape)
@@ -307,7 +310,9 @@ def _joint2(pl: Plan, y: np.ndarray, p, h, rho2):
         q2 = (h - s @ W[0]) / float(W[0] @ W[1])
         return q2[..., None], np.ones(q2.shape + (1,), dtype=bool)
     b = s @ W[1]
-    disc = b * b - (np.sum(s * s, axis=-1) - rho2)
+    ss = np.sum(s * s, axis=-1)
+    disc = b * b - (ss - rho2)
+    disc = np.where(np.abs(disc) <= _SNAP * (b * b + ss + rho2), 0.0, disc)
     ok = disc >= -1e-9 * (1.0 + rho2)
     r = np.sqrt(np.maximum(disc, 0.0))[..., None] * np.array([1.0, -1.0])
     return -b[..., None] + r, np.broadcast_to(ok[..., None], r.shape)
@@ -425,6 +430,41 @@ def _rotation(pl: Plan, q: np.ndarray) -> np.ndarray:
     return R
 
 
+def _polish_least_squares(model: ChainModel, q: np.ndarray, T: np.ndarray, tol: float,
+                          iters: int = 4) -> np.ndarray:
+    """Gauss–Newton steps with a truncated pseudo-inverse on candidates ``q (M, 6)`` that miss
+    ``T (M, 4, 4)`` by more than ``tol / 10`` (a step is kept where it lowers the error).
+
+    Where the position root is a double one (the wrist centre on the boundary of what joints
+    1-3 reach, e.g. the Stanford arm at q2 = 0) the back-substitution is good to √ε only; with a
+    regular wrist the wrist absorbs it, but near θ5 = 0 it cannot, and the Jacobian is singular
+    there (hence the truncated pseudo-inverse: the error left is of the order of the step's
+    square).
+    """
+    pos, ang = pose_residuals(model, q, T)
+    bad = np.flatnonzero(np.maximum(pos, ang) > 0.1 * tol)
+    if bad.size == 0:
+        return q
+    qb, Tb = q[bad], T[bad]
+    F, J = fk_and_jacobian(model, qb)
+    e = _twist_error(F, Tb)
+    en = np.linalg.norm(e, axis=-1)
+    for _ in range(iters):
+        dq = np.einsum("mij,mj->mi", np.linalg.pinv(J, rcond=1e-7), e)
+        qn = qb + np.where(np.isfinite(dq), dq, 0.0)
+        Fn, Jn = fk_and_jacobian(model, qn)
+        e_new = _twist_error(Fn, Tb)
+        nn = np.linalg.norm(e_new, axis=-1)
+        better = nn < en
+        qb = np.where(better[:, None], qn, qb)
+        J = np.where(better[:, None, None], Jn, J)
+        e = np.where(better[:, None], e_new, e)
+        en = np.where(better, nn, en)
+    q = q.copy()
+    q[bad] = qb
+    return q
+
+
 def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
                     wrist_tol: float = _WRIST_TOL) -> IKAllResult:
     """All solutions (8 slots) of the decoupled ``model`` for poses ``T (N, 4, 4)``.
@@ -463,7 +503,11 @@ def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
                         np.stack([t4, t5, t6], axis=-1)], axis=-1).reshape(N, -1, 6)
     ok = np.broadcast_to(((has3[..., None] & ok2) & e45)[..., None], sh).reshape(N, -1)
     q = np.where(ok[..., None], q, 0.0)
+    sing = np.broadcast_to(sing[..., None], sh).reshape(N, -1)
+    sig = np.broadcast_to(sig, sh).reshape(N, -1)
+    fam = np.broadcast_to(fam, sh).reshape(N, -1)
+    if ok.any():  # double position roots are good to √ε only: polish where needed
+        q[ok] = _polish_least_squares(model, q[ok], np.broadcast_to(
+            T[:, None], ok.shape + (4, 4))[ok], tol)
     return pack(model, q, ok, T, 8, tol=tol, method=METHOD, reason_none=_REASON,
-                singular=np.broadcast_to(sing[..., None], sh).reshape(N, -1),
-                family_sign=np.broadcast_to(sig, sh).reshape(N, -1),
-                family_value=np.broadcast_to(fam, sh).reshape(N, -1), family_joints=(3, 5))
+                singular=sing, family_sign=sig, family_value=fam, family_joints=(3, 5))
