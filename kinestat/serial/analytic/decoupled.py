@@ -395,8 +395,9 @@ def _roots_prismatic(pl: Plan, p, h, rho2) -> np.ndarray:
 
 # -- the solver ---------------------------------------------------------------------------------
 
-def _polish(pl: Plan, q: np.ndarray, p: np.ndarray, iters: int = 3) -> np.ndarray:
-    """Newton steps on ``M1 M2 M3 w = p`` for ``q (..., 3)``; a step is kept where it helps."""
+def _polish(pl: Plan, q: np.ndarray, p: np.ndarray, iters: int = 3):
+    """Newton steps on ``M1 M2 M3 w = p`` for ``q (..., 3)``; a step is kept where it helps.
+    Returns q and the distance left ``|M1 M2 M3 w − p|``."""
     f = _place(pl, q) - p
     fn = np.linalg.norm(f, axis=-1)
     for _ in range(iters):
@@ -411,7 +412,7 @@ def _polish(pl: Plan, q: np.ndarray, p: np.ndarray, iters: int = 3) -> np.ndarra
         q = np.where(better[..., None], qn, q)
         f = np.where(better[..., None], f_new, f)
         fn = np.where(better, nn, fn)
-    return q
+    return q, fn
 
 
 def _joint1(pl: Plan, x: np.ndarray, p: np.ndarray) -> np.ndarray:
@@ -445,7 +446,7 @@ def _polish_least_squares(model: ChainModel, q: np.ndarray, T: np.ndarray, tol: 
     bad = np.flatnonzero(np.maximum(pos, ang) > 0.1 * tol)
     if bad.size == 0:
         return q
-    qb, Tb = q[bad], T[bad]
+    qb, Tb = q[bad], T[bad]  # (the pseudo-inverse: a handful of rows)
     F, J = fk_and_jacobian(model, qb)
     e = _twist_error(F, Tb)
     en = np.linalg.norm(e, axis=-1)
@@ -495,8 +496,10 @@ def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     pB = p[:, None, None]
     q1 = _joint1(pl, x, np.broadcast_to(pB, x.shape))
     q123 = np.stack([q1, q2, np.broadcast_to(q3z[..., None], q2.shape)], axis=-1)
-    q123 = _polish(pl, q123, pB)
+    q123, miss = _polish(pl, q123, pB)
     Rp = np.swapaxes(_rotation(pl, q123), -1, -2) @ g[:, None, None, :3, :3]
+    # where the wrist is near θ5 = 0 it cannot absorb an error of the position stage
+    near = np.linalg.norm(np.cross(W[3], Rp @ W[5]), axis=-1) < 1e-6
     t4, t5, t6, e45, sing, sig, fam = _wrist(W, Rp, wrist_tol)  # (N, R, B, 2)
     sh = (N, R, B, 2)
     q = np.concatenate([np.broadcast_to(q123[..., None, :], sh + (3,)),
@@ -506,8 +509,9 @@ def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     sing = np.broadcast_to(sing[..., None], sh).reshape(N, -1)
     sig = np.broadcast_to(sig, sh).reshape(N, -1)
     fam = np.broadcast_to(fam, sh).reshape(N, -1)
-    if ok.any():  # double position roots are good to √ε only: polish where needed
-        q[ok] = _polish_least_squares(model, q[ok], np.broadcast_to(
-            T[:, None], ok.shape + (4, 4))[ok], tol)
+    need = ok & np.broadcast_to(((miss > 0.01 * tol) | near)[..., None], sh).reshape(N, -1)
+    if need.any():  # double position roots are good to √ε only: polish where needed
+        q[need] = _polish_least_squares(model, q[need], np.broadcast_to(
+            T[:, None], ok.shape + (4, 4))[need], tol)
     return pack(model, q, ok, T, 8, tol=tol, method=METHOD, reason_none=_REASON,
                 singular=sing, family_sign=sig, family_value=fam, family_joints=(3, 5))
