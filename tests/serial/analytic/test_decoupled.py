@@ -163,9 +163,12 @@ def test_unreachable_pose_gives_empty_set_with_reason():
         assert int(res.n_solutions) == 0 and "no real solution" in res.reason[()]
 
 
-def test_wrist_singular_family_on_the_stanford_arm():
+@pytest.mark.parametrize("q", [[0.4, -0.7, 0.8, 0.9, 0.0, -0.3], [0.0, 0.0, 0.6, 0.0, 0.0, 0.0]])
+def test_wrist_singular_family_on_the_stanford_arm(q):
+    """θ5 = 0 (axes 4 and 6 aligned); the second is the home pose, where also the wrist centre
+    is at distance d2 from axis 1 (a double root of the position)."""
     model = kinestat.load("stanford")
-    q = np.array([0.4, -0.7, 0.8, 0.9, 0.0, -0.3])  # θ5 = 0: axes 4 and 6 aligned
+    q = np.array(q)
     T = kinestat.fk(model, q)
     res = ik_all(model, T)
     assert res.family_joints == (3, 5) and res.singular.any()
