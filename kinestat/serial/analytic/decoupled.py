@@ -395,12 +395,15 @@ def _roots_prismatic(pl: Plan, p, h, rho2) -> np.ndarray:
 
 # -- the solver ---------------------------------------------------------------------------------
 
-def _polish(pl: Plan, q: np.ndarray, p: np.ndarray, iters: int = 3):
-    """Newton steps on ``M1 M2 M3 w = p`` for ``q (..., 3)``; a step is kept where it helps.
-    Returns q and the distance left ``|M1 M2 M3 w − p|``."""
+def _polish(pl: Plan, q: np.ndarray, p: np.ndarray, live: np.ndarray, iters: int = 3):
+    """Newton steps on ``M1 M2 M3 w = p`` for ``q (..., 3)``; a step is kept where it helps
+    (none once every ``live`` candidate is at rounding). Returns q and ``|M1 M2 M3 w − p|``."""
     f = _place(pl, q) - p
     fn = np.linalg.norm(f, axis=-1)
+    small = 1e-14 * (pl.axes.scale + np.linalg.norm(p, axis=-1))
     for _ in range(iters):
+        if not np.any(live & (fn > small)):  # at rounding already (the usual case)
+            break
         J = _position_jacobian(pl.axes, pl.kinds, q, pl.wrist)
         ok = np.abs(np.linalg.det(J)) > 1e-300
         Js = np.where(ok[..., None, None], J, np.eye(3))
@@ -466,6 +469,17 @@ def _polish_least_squares(model: ChainModel, q: np.ndarray, T: np.ndarray, tol: 
     return q
 
 
+def _slots(ok: np.ndarray, K: int) -> np.ndarray:
+    """Indices of the columns of ``ok (N, C)`` that some row fills, padded (with unused or
+    out-of-range indices) to at least ``K``, in order."""
+    used = ok.any(axis=0)
+    k = np.flatnonzero(used)
+    if k.size < K:
+        k = np.sort(np.concatenate([k, np.flatnonzero(~used)[:K - k.size]]))
+        k = np.concatenate([k, np.arange(ok.shape[1], ok.shape[1] + K - k.size)])
+    return k
+
+
 def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
                     wrist_tol: float = _WRIST_TOL) -> IKAllResult:
     """All solutions (8 slots) of the decoupled ``model`` for poses ``T (N, 4, 4)``.
@@ -484,8 +498,11 @@ def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     p = np.einsum("nij,j->ni", g[:, :3, :3], pl.wrist) + g[:, :3, 3]
     h, rho2 = _invariants(pl, p)
     q3 = (_roots_revolute if pl.kinds[2] == "R" else _roots_prismatic)(pl, p, h, rho2)
-    R = q3.shape[1]
     has3 = np.isfinite(q3)
+    col = has3.any(axis=0)  # root slots that some pose uses
+    col[0] |= not col.any()
+    q3, has3 = q3[:, col], has3[:, col]
+    R = q3.shape[1]
     q3z = np.where(has3, q3, 0.0)
     y = _move(pl.kinds[2], W[2], pl.axes.r[2], q3z, np.broadcast_to(pl.wrist, (N, R, 3)))
     pN, hN, rN = p[:, None], h[:, None], rho2[:, None]
@@ -496,7 +513,7 @@ def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     pB = p[:, None, None]
     q1 = _joint1(pl, x, np.broadcast_to(pB, x.shape))
     q123 = np.stack([q1, q2, np.broadcast_to(q3z[..., None], q2.shape)], axis=-1)
-    q123, miss = _polish(pl, q123, pB)
+    q123, miss = _polish(pl, q123, pB, has3[..., None] & ok2)
     Rp = np.swapaxes(_rotation(pl, q123), -1, -2) @ g[:, None, None, :3, :3]
     # where the wrist is near θ5 = 0 it cannot absorb an error of the position stage
     near = np.linalg.norm(np.cross(W[3], Rp @ W[5]), axis=-1) < 1e-6
@@ -513,5 +530,8 @@ def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     if need.any():  # double position roots are good to √ε only: polish where needed
         q[need] = _polish_least_squares(model, q[need], np.broadcast_to(
             T[:, None], ok.shape + (4, 4))[need], tol)
+    k = _slots(ok, 8)  # the candidate slots some pose fills (fewer pairs to de-duplicate)
+    q, ok, sing, sig, fam = (np.take(a, k, axis=1, mode="clip") for a in (q, ok, sing, sig, fam))
+    ok = ok & (k < sh[1] * sh[2] * sh[3])  # padding slots hold nothing
     return pack(model, q, ok, T, 8, tol=tol, method=METHOD, reason_none=_REASON,
                 singular=sing, family_sign=sig, family_value=fam, family_joints=(3, 5))
