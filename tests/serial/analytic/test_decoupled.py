@@ -14,6 +14,7 @@ import kinestat
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import from_standard_dh
 from kinestat.serial.analytic import ik_all, method_for, select_nearest
+from kinestat.serial.analytic.decoupled import plan
 
 from .arms import PI, newton_solutions, slot_residuals, wrapped_distance
 
@@ -229,3 +230,28 @@ def test_errors_name_why_a_chain_is_outside_the_class():
     with pytest.raises(ModelError, match="'decoupled' does not apply"):
         ik_all(ur5, np.eye(4), method="decoupled")
     assert math.isfinite(float(stanford.upper[2]))
+
+
+def test_orientation_out_of_the_wrists_reach_names_the_wrist():
+    """A wrist with oblique twists cannot turn to every orientation: with the wrist centre kept
+    where joints 1-3 reach it and a random rotation, a pose either has solutions or the reason
+    names the wrist; many-start Newton finds nothing on the latter."""
+    model = random_decoupled("RPR", 3)
+    rng = np.random.default_rng(0)
+    q = configs(model, 60, seed=5)
+    T = kinestat.fk(model, q)
+    T0 = kinestat.fk(model, np.zeros(6))
+    w_flange = np.linalg.solve(T0, np.append(plan(model).wrist, 1.0))[:3]
+    p = T[:, :3, :3] @ w_flange + T[:, :3, 3]  # the wrist centre of each pose
+    A = rng.normal(size=(60, 3, 3))
+    R, _ = np.linalg.qr(A)
+    R *= np.sign(np.linalg.det(R))[:, None, None]
+    T[:, :3, :3] = R
+    T[:, :3, 3] = p - R @ w_flange
+    res = ik_all(model, T)
+    none = res.n_solutions == 0
+    assert none.any() and (~none).any()
+    assert all("spherical wrist cannot turn" in r for r in res.reason[none])
+    idx = np.flatnonzero(none)[:4]
+    for sols in newton_solutions(model, T[idx], starts=200, iters=50, seed=1, span=3.0):
+        assert len(sols) == 0
