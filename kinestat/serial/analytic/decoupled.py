@@ -125,9 +125,9 @@ def _wrist_centre(model: ChainModel, ax: HomeAxes, tol: float) -> np.ndarray:
     w = meet(ax, 3, 4, tol)
     if w is None or float(np.linalg.norm(np.cross(w - ax.r[5], ax.w[5]))) > tol * ax.scale:
         raise ModelError(
-            f"ik_all: model {model.name!r} has prismatic joints but axes 4, 5, 6 do not meet at "
-            f"one point; the all-solutions solver for prismatic joints needs a spherical wrist "
-            f"— use kinestat.ik for a numerical solution")
+            f"ik_all: axes 4, 5, 6 of model {model.name!r} do not meet at one point; the "
+            f"all-solutions solver for arms with prismatic joints (decoupled) needs a spherical "
+            f"wrist — use kinestat.ik for a numerical solution")
     return w
 
 

@@ -61,8 +61,6 @@ def _check_chain(model: ChainModel) -> None:
 
 @lru_cache(maxsize=64)
 def _classified(model: ChainModel):
-    if model.prismatic.any():
-        return decoupled.METHOD, {}
     return classify(model)
 
 

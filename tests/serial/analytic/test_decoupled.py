@@ -209,7 +209,7 @@ def test_errors_name_why_a_chain_is_outside_the_class():
     with pytest.raises(ModelError, match="joint 5 .* prismatic.*spherical wrist"):
         ik_all(from_standard_dh(_rows(), ["revolute"] * 4 + ["prismatic", "revolute"]),
                np.eye(4))
-    with pytest.raises(ModelError, match="axes 4, 5, 6 do not meet"):
+    with pytest.raises(ModelError, match="axes 4, 5, 6 of model 'chain' do not meet"):
         ik_all(from_standard_dh(_rows(), ["prismatic"] + ["revolute"] * 5), np.eye(4))
     cart = np.array([[0, 0, 0, 0], [0, 0.2, 0, 0], [0, 0.3, 0, -H]] + _wrist())
     with pytest.raises(ModelError, match="prismatic joints 1 and 2 .* parallel"):
