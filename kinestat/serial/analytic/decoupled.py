@@ -128,6 +128,10 @@ def _wrist_centre(model: ChainModel, ax: HomeAxes, tol: float) -> np.ndarray:
             f"ik_all: axes 4, 5, 6 of model {model.name!r} do not meet at one point; the "
             f"all-solutions solver for arms with prismatic joints (decoupled) needs a spherical "
             f"wrist — use kinestat.ik for a numerical solution")
+    if parallel(ax, 4, 5, tol):
+        raise ModelError(
+            f"ik_all: axes 5 and 6 of model {model.name!r} coincide; the wrist turns about two "
+            f"axes only (solutions not isolated)")
     return w
 
 

@@ -217,6 +217,11 @@ def test_errors_name_why_a_chain_is_outside_the_class():
     flat = np.array([[0, 0, 0, -H], [0, 0.2, 0, H], [0, 0.3, 0, 0]] + _wrist())  # P3 ∥ P1
     with pytest.raises(ModelError, match="three independent directions"):
         ik_all(from_standard_dh(flat, ["prismatic"] * 3 + ["revolute"] * 3), np.eye(4))
+    coaxial = np.array([[0, 0.1, 0.3, H], [0, 0, 0.4, 0], [0, 0, 0.3, H], [0, 0, 0, -H],
+                        [0, 0, 0, 0], [0, 0.1, 0, 0]])  # α5 = 0: axis 6 on axis 5
+    with pytest.raises(ModelError, match="axes 5 and 6 .* coincide"):
+        ik_all(from_standard_dh(coaxial, ["revolute", "prismatic"] + ["revolute"] * 4),
+               np.eye(4))
     with pytest.raises(ModelError, match="screw"):
         ik_all(from_standard_dh(np.array([[0, 0.1, 0.3, H], [0, 0, 0.4, 0], [0, 0, 0, H]]
                                          + _wrist()), ["screw"] + ["revolute"] * 5,
