@@ -26,16 +26,19 @@ Position (one univariate eliminant in q3):
    (FFT: exact, perfectly conditioned) or at 9 Chebyshev nodes on ``[−L, L]`` (least squares);
    negligible top coefficients are dropped per pose and the roots come from a companion matrix
    in ``z = e^{i q3}`` (roots on the unit circle) or in ``q3 / L`` (real roots).
-4. Back-substitution gives q2, then q1 (subproblem 1, or the displacement along ω1); three
-   Newton steps on the wrist-centre equation polish (q1, q2, q3); the spherical wrist
-   (``closed_form._wrist``: subproblems 2 and 1, the θ5 = 0/π families ``q4 + σ q6``) gives
-   two wrist branches. ``pack`` verifies every candidate by forward kinematics.
+4. Back-substitution gives q2 (a double root, |cos| within 1e-12 of 1 or a vanishing
+   discriminant, taken exactly), then q1 (subproblem 1, or the displacement along ω1); Newton
+   steps on the wrist-centre equation where it misses by more than rounding; the spherical
+   wrist (``closed_form._wrist``: subproblems 2 and 1, the θ5 = 0/π families ``q4 + σ q6``)
+   gives two wrist branches; candidates whose wrist centre still misses or whose wrist is near
+   θ5 = 0 get Gauss–Newton steps on the whole pose (truncated pseudo-inverse); ``pack``
+   verifies every candidate by forward kinematics.
 
 At most 4 wrist-centre solutions × 2 wrist branches = 8 slots. Not covered: screw joints (a
 helical joint turns and slides together, so q and q + 2π are different configurations and
 the solution set depends on the joint range), a prismatic joint in the wrist, and positioning
 singular poses with a continuum of wrist-centre solutions (e.g. the wrist centre on axis 1 of
-an arm whose axis 2 meets it: one member may come back, not flagged as a family).
+a cylindrical arm): the continuum gets no slot (the isolated solutions do).
 """
 
 from __future__ import annotations
