@@ -96,9 +96,9 @@ def ik_command(
         False, "--ignore-limits", help="Numerical IK: ignore the model's joint limits."
     ),
     all_solutions: bool = flag(
-        False, "--all", help="With --pose: every analytic solution of a 6R arm (kinestat.ik_all) "
-        "and the one nearest --current-deg (or --q0-deg; default the model's home) within the "
-        "limits."
+        False, "--all", help="With --pose: every analytic solution of a 6R arm, or of an arm "
+        "with prismatic joints before a spherical wrist (kinestat.ik_all), and the one nearest "
+        "--current-deg (or --q0-deg; default the model's home) within the limits."
     ),
     tip: str = tip_option(),
     base: str = base_option(),
@@ -115,9 +115,10 @@ def ik_command(
     Any model, numerically (--pose): JSON {"q", "q_deg", "success", "position_error",
     "rotation_error", "iterations", "attempts", "joint_names"}.
 
-    Any 6R arm, every solution (--pose --all): JSON {"solutions": [{"q", "q_deg", "residual",
-    "within_limits", "singular"}], "singular_families", "selected", "reason", "method",
-    "units"}; an unreachable pose gives no solution, the reason, and exit status 0.
+    Any 6R arm, or R/P arm with a spherical wrist, every solution (--pose --all): JSON
+    {"solutions": [{"q", "q_deg", "residual", "within_limits", "singular"}],
+    "singular_families", "selected", "reason", "method", "units"}; an unreachable pose gives no
+    solution, the reason, and exit status 0.
     """
     closed = any(v is not None for v in (tool_point, s6, a67))
     if all_solutions:
@@ -343,8 +344,8 @@ def _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg, urd
     if ref_text is not None:
         v = parse_floats(ref_text, m.n, ref_name)
         ref = np.where(m.prismatic, v, np.radians(v))
-    groups = ("ik_all_closed",) if method_for(m) != "raghavan-roth" else \
-        ("ik_all_closed", "ik_all_general")
+    groups = {"raghavan-roth": ("ik_all_closed", "ik_all_general"),
+              "decoupled": ("serial",)}.get(method_for(m), ("ik_all_closed",))
     with compiling_notice(*groups):
         res = ik_all(m, T)
     sel = select_nearest(m, res, ref)

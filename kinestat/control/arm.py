@@ -191,6 +191,11 @@ class ChainArm:
     def __post_init__(self) -> None:
         if not isinstance(self.model, ChainModel) or self.model.n != 6:
             raise ModelError("ChainArm: the controller needs a 6-joint ChainModel")
+        for i, j in enumerate(self.model.joints):  # ik_all also solves prismatic arms now
+            if j.kind != "revolute":
+                raise ModelError(f"ChainArm: joint {i + 1} of model {self.model.name!r} is "
+                                 f"{j.kind}; the controller's arm has revolute joints only (axis "
+                                 f"angles and limits in degrees)")
         off = np.asarray(self.axis_offset, dtype=float)
         if off.shape != (6,):
             raise ModelError(f"ChainArm: axis_offset must be 6 numbers, got shape {off.shape}")

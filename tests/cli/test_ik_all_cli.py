@@ -117,7 +117,6 @@ def test_human_table_names_the_joints(capsys):
 
 
 @pytest.mark.parametrize("args, msg", [
-    (["nadkarni-config2"], "joint 1 of model 'nadkarni-config2' is prismatic"),
     (["puma560", "--current-deg", "0,0,0,0,0,0", "--q0-deg", "0,0,0,0,0,0"],
      "give the reference configuration once"),
     (["puma762", "--tool-point", "0,0,0"], "--all goes with --pose"),

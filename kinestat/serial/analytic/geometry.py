@@ -8,6 +8,8 @@ axis geometry:
   meet (PUMA-type shoulders): subproblems 3, 2, 2, 1.
 - ``"three-parallel"``: axes 2, 3, 4 parallel and axes 5, 6 meeting (UR-type): subproblems 4,
   4, 1, 1, 3, 1.
+- ``"decoupled"``: prismatic joints among joints 1-3 and a spherical wrist (one univariate
+  eliminant for the wrist centre, :mod:`kinestat.serial.analytic.decoupled`).
 """
 
 from __future__ import annotations
@@ -65,12 +67,20 @@ def meet(ax: HomeAxes, i: int, j: int, tol: float = 1e-9):
 
 
 def classify(model: ChainModel, tol: float = 1e-9) -> tuple[str, dict]:
-    """``("pieper" | "three-parallel" | "general", data)`` for a 6-joint revolute model."""
-    if model.n != 6 or any(j.kind != "revolute" for j in model.joints):
+    """``("pieper" | "three-parallel" | "general", data)`` for a 6-joint revolute model;
+    ``("decoupled", data)`` for one with prismatic joints among joints 1-3 and a spherical
+    wrist (:mod:`kinestat.serial.analytic.decoupled` checks the rest); ``("none", {})``
+    otherwise."""
+    kinds = [j.kind for j in model.joints]
+    if model.n != 6 or "screw" in kinds or "prismatic" in kinds[3:]:
         return "none", {}
     ax = home_axes(model)
     w = meet(ax, 3, 4, tol)
-    if w is not None and float(np.linalg.norm(np.cross(w - ax.r[5], ax.w[5]))) <= tol * ax.scale:
+    spherical = w is not None and \
+        float(np.linalg.norm(np.cross(w - ax.r[5], ax.w[5]))) <= tol * ax.scale
+    if "prismatic" in kinds:
+        return ("decoupled", {"axes": ax, "wrist": w}) if spherical else ("none", {})
+    if spherical:
         r12 = meet(ax, 0, 1, tol)
         if r12 is not None:
             return "pieper", {"axes": ax, "wrist": w, "shoulder": r12}

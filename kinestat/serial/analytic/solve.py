@@ -2,7 +2,9 @@
 
 Dispatch (:func:`kinestat.serial.analytic.geometry.classify`): a closed form by subproblems when
 the geometry admits one (spherical wrist with meeting shoulder axes; three parallel axes with a
-meeting wrist pair), otherwise the general 6R eigenvalue method of Raghavan & Roth.
+meeting wrist pair), otherwise the general 6R eigenvalue method of Raghavan & Roth. A model with
+prismatic joints goes to the decoupled solver (:mod:`kinestat.serial.analytic.decoupled`: any
+three R/P positioning joints and a spherical wrist).
 ``method="puma762"`` runs the thesis's PUMA 762 closed form
 (:mod:`kinestat.serial.analytic.thesis_puma762`) on a model with the PUMA 762's geometry.
 """
@@ -16,14 +18,20 @@ import numpy as np
 
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic import closed_form, families, general6r, thesis_puma762
+from kinestat.serial.analytic import (
+    closed_form,
+    decoupled,
+    families,
+    general6r,
+    thesis_puma762,
+)
 from kinestat.serial.analytic._common import check_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["ik_all", "METHODS", "BACKENDS", "method_for"]
 
-METHODS = ("auto", "pieper", "three-parallel", "raghavan-roth", "puma762")
+METHODS = ("auto", "pieper", "three-parallel", "decoupled", "raghavan-roth", "puma762")
 BACKENDS = ("numba", "numpy")
 
 
@@ -41,11 +49,14 @@ def _check_chain(model: ChainModel) -> None:
             f"ik_all: model {model.name!r} has {model.n} joints; all-solutions IK needs exactly "
             f"6 (fewer: the pose is over-constrained, more: the solutions are not isolated)")
     for i, j in enumerate(model.joints):
-        if j.kind != "revolute":
+        if j.kind == "screw":
             raise ModelError(
-                f"ik_all: joint {i + 1} of model {model.name!r} is {j.kind}; the all-solutions "
-                f"solvers handle revolute joints only (prismatic and screw joints are not "
-                f"supported yet — use kinestat.ik for a numerical solution)")
+                f"ik_all: joint {i + 1} of model {model.name!r} is a screw joint; the "
+                f"all-solutions solvers handle revolute and prismatic joints only (q and q + 2π "
+                f"of a screw joint are different configurations) — use kinestat.ik for a "
+                f"numerical solution")
+    if model.prismatic.any():
+        decoupled.plan(model)  # raises, naming why, outside the decoupled class
 
 
 @lru_cache(maxsize=64)
@@ -99,12 +110,13 @@ def _kernels():
 
 def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
            backend: str = "numba") -> IKAllResult:
-    """Every IK solution of the 6R ``model`` for poses ``T_base_flange (..., 4, 4)``.
+    """Every IK solution of the 6-joint ``model`` for poses ``T_base_flange (..., 4, 4)``.
 
     Returns an :class:`~kinestat.serial.analytic.result.IKAllResult` (``q (..., K, 6)``,
     ``valid (..., K)``, residuals, singular families); each valid solution reproduces its pose
     by :func:`kinestat.fk` within ``tol`` (model length unit; radians). An unreachable pose
-    gives no valid slot and a ``reason``; a model that is not six revolute joints, or a pose
+    gives no valid slot and a ``reason``; a model that is not six revolute joints (or prismatic
+    joints before a spherical wrist: ``method="decoupled"``), or a pose
     that is not a rigid transform, raises a :class:`~kinestat.errors.KinestatError`.
     ``backend``: ``"numba"`` (compiled kernels, default) or ``"numpy"`` (the references).
     A rotation accepted as orthonormal within 1e-6 but not to rounding (float32 or printed
@@ -137,7 +149,7 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     shape = T.shape[:-2]
     kind, data = _classified(model)
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
-    if use in ("pieper", "three-parallel") and use != kind:
+    if (use in ("pieper", "three-parallel") or kind == decoupled.METHOD) and use != kind:
         raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
                          f"(its geometry is {kind!r})")
     if backend not in BACKENDS:
@@ -148,6 +160,14 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
             raise ModelError(f"ik_all: method 'puma762' applies only to the PUMA 762's geometry "
                              f"(millimetres, Vibhute Table 2-2); model {model.name!r} differs")
         res = thesis_puma762.solve_puma762(model, Tf, tol=tol, backend=backend)
+    elif use == decoupled.METHOD:
+        if kind != use:
+            try:
+                decoupled.plan(model)
+            except ModelError as exc:
+                raise ModelError(f"ik_all: method 'decoupled' does not apply to model "
+                                 f"{model.name!r}: {exc}") from None
+        res = decoupled.solve_decoupled(model, Tf, tol=tol)
     elif use == "pieper":
         if fast:
             return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape)

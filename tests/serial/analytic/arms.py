@@ -49,9 +49,10 @@ def arm(name: str):
     return kinestat.load(name)
 
 
-def wrapped_distance(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Max over joints of the 2π-wrapped difference."""
-    return np.max(np.abs(np.mod(a - b + PI, 2 * PI) - PI), axis=-1)
+def wrapped_distance(a: np.ndarray, b: np.ndarray, rotates=True) -> np.ndarray:
+    """Max over joints of the difference, 2π-wrapped where ``rotates`` (default: all joints)."""
+    d = a - b
+    return np.max(np.abs(np.where(rotates, np.mod(d + PI, 2 * PI) - PI, d)), axis=-1)
 
 
 def slot_residuals(model, res, T: np.ndarray):
@@ -74,12 +75,15 @@ def _twist_error(F, T):
 
 
 def newton_solutions(model, T: np.ndarray, starts: int = 400, iters: int = 60,
-                     seed: int = 0) -> list[np.ndarray]:
+                     seed: int = 0, span: float = 2.0) -> list[np.ndarray]:
     """Distinct IK solutions of each pose ``T (P, 4, 4)`` by damped Newton from many random
-    starts (Levenberg–Marquardt on the twist error), de-duplicated modulo 2π."""
+    starts (Levenberg–Marquardt on the twist error), de-duplicated modulo 2π (revolute joints;
+    prismatic joints start uniformly in ``[−span, span]`` and are not wrapped)."""
     rng = np.random.default_rng(seed)
     P = T.shape[0]
+    rot = ~model.prismatic
     q = rng.uniform(-PI, PI, (P, starts, 6))
+    q = np.where(rot, q, q / PI * span)
     Tt = np.broadcast_to(T[:, None], (P, starts, 4, 4))
     lam = np.full((P, starts), 1e-2)
     e = _twist_error(kinestat.fk(model, q), Tt)
@@ -101,8 +105,8 @@ def newton_solutions(model, T: np.ndarray, starts: int = 400, iters: int = 60,
     for i in range(P):
         sols: list[np.ndarray] = []
         for qi in q[i][en[i] < 1e-11]:
-            qi = np.mod(qi + PI, 2 * PI) - PI
-            if all(wrapped_distance(qi, s) > 1e-6 for s in sols):
+            qi = np.where(rot, np.mod(qi + PI, 2 * PI) - PI, qi)
+            if all(wrapped_distance(qi, s, rot) > 1e-6 for s in sols):
                 sols.append(qi)
         out.append(np.array(sols).reshape(-1, 6))
     return out
