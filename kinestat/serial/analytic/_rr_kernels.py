@@ -26,6 +26,7 @@ from numba.np.linalg import _LAPACK
 from kinestat.mechanism.joints import JointKind
 from kinestat.serial._kernels import _step
 from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial.analytic._rr_qz import pencil_eigvals_qz, qz_scratch
 from kinestat.serial.analytic._solution_kernels import polish, store
 from kinestat.spatial._elimination import eliminate
 
@@ -45,6 +46,8 @@ _A2_PIVOT_MIN = 1e-5
 _MOBIUS = (0.0, 0.7, -1.3, 2.9)
 #: relative pivot size below which a pivot is replaced (inverse iteration, the companion)
 _TINY_PIVOT = 1e-17
+#: a complex eigenvalue with ``|Im x| ≤ _NEAR_REAL (1 + |x|)`` makes the pose suspect
+_NEAR_REAL = 1e-3
 _B0 = (0.31, -0.72, 0.55, 0.13, -0.94, 0.67, -0.28, 0.81, -0.46, 0.19, 0.73, -0.35)
 
 
@@ -442,17 +445,60 @@ def _scratch():
             np.empty((24, 24)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
             np.empty(8), np.empty((3, 6, 7)), np.empty((4, 6)), np.empty(6), np.empty(6),
             np.empty((14, 14)), np.empty((8, 8)), np.empty(8, dtype=np.int64), np.empty((8, 14)),
-            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12))
+            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12), qz_scratch())
 
 
 @nb.njit(**_OPTS)
-def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                out_q, out_valid, out_pos, out_rot, flags, S):
+def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, sign, tol, iters,
+             dedup, out_q, out_valid, out_pos, out_rot, cnt, S):
+    """Solutions of pose n from the real eigenvalues ``wr + i wi (24,)``: power products,
+    angles, Newton polishing, verification, storage after the ``cnt`` already stored. Returns
+    (the new count, real eigenvalues tried, of them lost: not verified or a repeat)."""
+    A2, v, m, coef, Ms, Vs, th, q, perm, y12 = S[7], S[10], S[11], S[12], S[13], S[14], \
+        S[15], S[16], S[22], S[23]
+    tried = 0
+    lost = 0
+    for k in range(24):
+        if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
+            continue
+        tried += 1
+        _null_vector(A, wr[k], A2, v, perm, y12)
+        if not _angles(wr[k], v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
+            lost += 1
+            continue
+        for i in range(6):
+            q[order[i]] = sign * th[i]
+        pos, rot = polish(C, T[n], q, iters, Ms, Vs)
+        if not (pos <= tol and rot <= tol):
+            lost += 1
+            continue
+        new = store(n, (q[0], q[1], q[2], q[3], q[4], q[5]), pos, rot, dedup, out_q, out_valid,
+                    out_pos, out_rot, cnt)
+        lost += new == cnt
+        cnt = new
+    return cnt, tried, lost
+
+
+@nb.njit(**_OPTS)
+def _nearly_real(wr, wi):
+    """The smallest ``|Im x| / (1 + |x|)`` of the non-real eigenvalues (inf if none)."""
+    near = np.inf
+    for k in range(24):
+        if abs(wi[k]) > 1e-6 * (1.0 + abs(wr[k])):
+            near = min(near, abs(wi[k]) / (1.0 + abs(complex(wr[k], wi[k]))))
+    return near
+
+
+@nb.njit(**_OPTS)
+def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
+                out_q, out_valid, out_pos, out_rot, flags, stats, S):
     """All solutions of pose n. ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant M1 / Ts of the
     formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0 constant, 1
-    ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``)."""
-    Gs, Rh, MA, V15, A, E, XA, A2, Mc, W24, v, m, coef, Ms, Vs, th, q, H, R, piv, Vr, Aw, \
-        perm, y12 = S
+    ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``). ``recheck``: 0 never, 1 on suspect poses, 2 always rerun
+    the roots with the QZ eigenvalues. ``stats[n]``: real roots tried and lost, the nearest-real
+    complex eigenvalue, the count after the first pass, 1 if the QZ pass ran."""
+    Gs, Rh, MA, V15, A, E, XA, Mc, W24 = S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[8], S[9]
+    H, R, piv, Vr, Aw = S[17], S[18], S[19], S[20], S[21]
     _rigid_product(form[0], T[n], form[1], Gs[1])
     _rigid_inverse(Gs[1], Gs[2])
     Gs[0] = form[2]
@@ -467,29 +513,42 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
         flags[n] = flag
         return
     wr, wi = W24[0], W24[1]
-    if not _companion_eigvals(A, XA, Mc, wr, wi, W24[2]):
-        flags[n] = FLAG_ILL_CONDITIONED
-        return
-    cnt = 0
-    for k in range(24):
-        if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
-            continue
-        _null_vector(A, wr[k], A2, v, perm, y12)
-        if not _angles(wr[k], v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
-            continue
-        for i in range(6):
-            q[order[i]] = sign * th[i]
-        pos, rot = polish(C, T[n], q, iters, Ms, Vs)
-        if not (pos <= tol and rot <= tol):
-            continue
-        cnt = store(n, (q[0], q[1], q[2], q[3], q[4], q[5]), pos, rot, dedup, out_q, out_valid,
-                    out_pos, out_rot, cnt)
+    cnt, tried, lost, near = 0, 0, 0, np.inf
+    if _companion_eigvals(A, XA, Mc, wr, wi, W24[2]):
+        cnt, tried, lost = _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts,
+                                    order, sign, tol, iters, dedup, out_q, out_valid, out_pos,
+                                    out_rot, cnt, S)
+        near = _nearly_real(wr, wi)
+        suspect = recheck == 2 or (recheck == 1 and _suspect(tried, lost, near))
+    else:
+        suspect = True  # no usable companion: QZ is the only pass
+    stats[n, 0] = tried
+    stats[n, 1] = lost
+    stats[n, 2] = near
+    stats[n, 3] = cnt
+    stats[n, 4] = 0.0
     flags[n] = FLAG_OK
+    if suspect:
+        stats[n, 4] = 1.0
+        if not pencil_eigvals_qz(A, wr, wi, S[24]):
+            flags[n] = FLAG_ILL_CONDITIONED
+            return
+        _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, sign, tol,
+                 iters, dedup, out_q, out_valid, out_pos, out_rot, cnt, S)
+
+
+@nb.njit(inline="always", **_OPTS)
+def _suspect(tried, lost, near):
+    """Whether the first pass may have missed roots: a real eigenvalue that did not give a new
+    verified solution, an odd number of real eigenvalues (the degree-16 polynomial has an even
+    number of real roots with multiplicity), or a complex eigenvalue within ``_NEAR_REAL`` of
+    the real axis (a real cluster the companion split into a pair)."""
+    return lost > 0 or tried % 2 == 1 or near <= _NEAR_REAL
 
 
 @nb.njit(parallel=True, **_OPTS)
-def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                out_q, out_valid, out_pos, out_rot, flags):
+def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
+                out_q, out_valid, out_pos, out_rot, flags, stats):
     """All solutions of N poses (see the module docstring); outputs pre-filled by the caller
     (q NaN, valid False, errors NaN)."""
     N = T.shape[0]
@@ -497,14 +556,14 @@ def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedu
         S = _scratch()
         for n in range(c * _CHUNK, min(N, (c + 1) * _CHUNK)):
             _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                        out_q, out_valid, out_pos, out_rot, flags, S)
+                        recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)
 
 
 @nb.njit(**_OPTS)
-def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                 out_q, out_valid, out_pos, out_rot, flags):
+def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
+                 out_q, out_valid, out_pos, out_rot, flags, stats):
     """:func:`solve_batch` on one thread (small batches: no thread start-up)."""
     S = _scratch()
     for n in range(T.shape[0]):
         _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                    out_q, out_valid, out_pos, out_rot, flags, S)
+                    recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)

@@ -311,7 +311,17 @@ def _compiled_data(model: ChainModel, form: Formulation):
             np.array(OFFSETS), np.array(list(order) + [at0, at5], dtype=np.int64), float(sign))
 
 
-def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
+RECHECK = {"never": 0, "suspect": 1, "always": 2}
+"""When the compiled kernel reruns a pose's roots with the QZ eigenvalues
+(:mod:`kinestat.serial.analytic._rr_qz`): never, on poses its first pass marks as suspect
+(the default), always."""
+
+
+def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
+    """The compiled kernel on poses ``T (N, 4, 4)``: ``q (N, 16, 6)``, valid, position and
+    rotation errors, the per-pose flags and ``stats (N, 5)``: real eigenvalues tried and lost
+    by the first pass, its nearest-real complex eigenvalue ``|Im x| / (1 + |x|)``, its count,
+    1.0 where the QZ pass ran."""
     K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
     if K is None:
         from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
@@ -324,9 +334,20 @@ def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
     pos = nan_array((N, K16))
     rot = nan_array((N, K16))
     flags = np.zeros(N, dtype=np.int64)
+    stats = np.zeros((N, 5))
     run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
-    run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6, q, valid,
-        pos, rot, flags)
+    run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6,
+        RECHECK[recheck], q, valid, pos, rot, flags, stats)
+    return q, valid, pos, rot, flags, stats
+
+
+def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect") -> IKAllResult:
+    K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
+    if K is None:
+        from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
+
+    q, valid, pos, rot, flags, _ = run_kernel(model, T, form, tol, polish_iters, recheck)
+    N, K16 = valid.shape
     nsol = np.count_nonzero(valid, axis=1)
     reason = reasons(nsol, _REASON_NONE)
     if not flags.any():
