@@ -8,10 +8,15 @@ least-squares back-substitution), the 12x12 matrix quadratic, the eigenvalues of
 24x24 companion (LAPACK dgeev), the power-product vector of each real root by inverse
 iteration, back-substitution, θ6 (the serial FK kernel's scalar steps), Newton polishing
 against FK, verification and de-duplication
-(:mod:`kinestat.serial.analytic._solution_kernels`). Every work array is allocated once per
-chunk of poses (:func:`_scratch`), not per root or per step; only dgeev allocates its
-workspace. Flags: 0 solved, 1 Q rank deficient, 2 A2 ill-conditioned
-(the caller reruns the pose with the generalised eigenproblem).
+(:mod:`kinestat.serial.analytic._solution_kernels`). On a suspect pose (``_rr_qz.suspect``: a
+lost real root, an odd real count, a complex pair within the double-root split of the
+observed eigenvalue error, a nearly singular leading coefficient; about 1 % of Jaco2-type
+poses, fewer on general arms) the roots are recovered again from the QZ eigenvalues of the
+companion pencil (:mod:`kinestat.serial.analytic._rr_qz`), which are backward stable where the
+companion's are not: clustered real roots. Every work array is allocated once per chunk of
+poses (:func:`_scratch`), not per root or per step; only dgeev allocates its workspace.
+Flags: 0 solved, 1 Q rank deficient, 2 dggev failed (the caller reruns the pose with the NumPy
+reference).
 """
 
 from __future__ import annotations
@@ -26,7 +31,7 @@ from numba.np.linalg import _LAPACK
 from kinestat.mechanism.joints import JointKind
 from kinestat.serial._kernels import _step
 from kinestat.serial._numba_options import OPTS as _OPTS
-from kinestat.serial.analytic._rr_qz import pencil_eigvals_qz, qz_scratch
+from kinestat.serial.analytic._rr_qz import nearly_real, pencil_eigvals_qz, qz_scratch, suspect
 from kinestat.serial.analytic._solution_kernels import polish, store
 from kinestat.spatial._elimination import eliminate
 
@@ -46,8 +51,6 @@ _A2_PIVOT_MIN = 1e-5
 _MOBIUS = (0.0, 0.7, -1.3, 2.9)
 #: relative pivot size below which a pivot is replaced (inverse iteration, the companion)
 _TINY_PIVOT = 1e-17
-#: a complex eigenvalue with ``|Im x| ≤ _NEAR_REAL (1 + |x|)`` makes the pose suspect
-_NEAR_REAL = 1e-3
 _B0 = (0.31, -0.72, 0.55, 0.13, -0.94, 0.67, -0.28, 0.81, -0.46, 0.19, 0.73, -0.35)
 
 
@@ -260,7 +263,8 @@ def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
     When A2 is ill-conditioned (smallest relative pivot below ``_A2_PIVOT_MIN``) the variable
     is changed by the Möbius map ``x = (y + t)/(1 − t y)`` (a shift of the half-angle by
     atan t): ``B(y) = (1 − t y)² A(x)`` has the leading coefficient ``A0 t² − A1 t + A2``,
-    regular unless −1/t is itself a root. False when no tried t gives a regular one.
+    regular unless −1/t is itself a root. Returns the leading coefficient's smallest relative
+    pivot, 0 when no tried t gives a regular one (or dgeev fails).
     ``XA (12, 36)``: ``[A2 | A0 A1]`` solved in place to ``[· | X]``, ``X = A2⁻¹ [A0 A1]``;
     Mc (24, 24): scratch."""
     sc = 0.0
@@ -274,6 +278,7 @@ def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
                 A[k, i, j] /= sc
     t = 0.0
     regular = False
+    pivot = 0.0
     for t in _MOBIUS:
         tt = t * t
         for i in range(12):
@@ -282,20 +287,21 @@ def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
                 XA[i, 12 + j] = a0 + t * a1 + tt * a2
                 XA[i, 24 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
                 XA[i, j] = tt * a0 - t * a1 + a2
-        if eliminate(XA, 12, _TINY_PIVOT, None) >= _A2_PIVOT_MIN:
+        pivot = eliminate(XA, 12, _TINY_PIVOT, None)
+        if pivot >= _A2_PIVOT_MIN:
             regular = True
             break
     if not regular:
-        return False
+        return 0.0
     X = XA[:, 12:]
     big = 0.0
     for i in range(12):
         for j in range(24):
             if not math.isfinite(X[i, j]):
-                return False
+                return 0.0
             big = max(big, abs(X[i, j]))
     if big > 1e10:
-        return False
+        return 0.0
     # stored transposed (LAPACK is column-major): same eigenvalues
     for i in range(24):
         for j in range(12):
@@ -311,7 +317,7 @@ def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
             x = (complex(wr[k], wi[k]) + t) / (1.0 - t * complex(wr[k], wi[k]))
             wr[k] = x.real
             wi[k] = x.imag
-    return info == 0
+    return pivot if info == 0 else 0.0
 
 
 @nb.njit(**_OPTS)
@@ -453,11 +459,13 @@ def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, si
              dedup, out_q, out_valid, out_pos, out_rot, cnt, S):
     """Solutions of pose n from the real eigenvalues ``wr + i wi (24,)``: power products,
     angles, Newton polishing, verification, storage after the ``cnt`` already stored. Returns
-    (the new count, real eigenvalues tried, of them lost: not verified or a repeat)."""
+    (the new count, real eigenvalues tried, of them lost: not verified or a repeat, the largest
+    eigenvalue error ``|x − x*| / (1 + |x*|)`` against the polished root x*)."""
     A2, v, m, coef, Ms, Vs, th, q, perm, y12 = S[7], S[10], S[11], S[12], S[13], S[14], \
         S[15], S[16], S[22], S[23]
     tried = 0
     lost = 0
+    err = 0.0
     for k in range(24):
         if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
             continue
@@ -472,21 +480,13 @@ def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, si
         if not (pos <= tol and rot <= tol):
             lost += 1
             continue
+        xs = math.tan(0.5 * (sign * q[order[2]] - off[0]))
+        err = max(err, abs(wr[k] - xs) / (1.0 + abs(xs)))
         new = store(n, (q[0], q[1], q[2], q[3], q[4], q[5]), pos, rot, dedup, out_q, out_valid,
                     out_pos, out_rot, cnt)
         lost += new == cnt
         cnt = new
-    return cnt, tried, lost
-
-
-@nb.njit(**_OPTS)
-def _nearly_real(wr, wi):
-    """The smallest ``|Im x| / (1 + |x|)`` of the non-real eigenvalues (inf if none)."""
-    near = np.inf
-    for k in range(24):
-        if abs(wi[k]) > 1e-6 * (1.0 + abs(wr[k])):
-            near = min(near, abs(wi[k]) / (1.0 + abs(complex(wr[k], wi[k]))))
-    return near
+    return cnt, tried, lost, err
 
 
 @nb.njit(**_OPTS)
@@ -494,9 +494,11 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
                 out_q, out_valid, out_pos, out_rot, flags, stats, S):
     """All solutions of pose n. ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant M1 / Ts of the
     formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0 constant, 1
-    ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``). ``recheck``: 0 never, 1 on suspect poses, 2 always rerun
-    the roots with the QZ eigenvalues. ``stats[n]``: real roots tried and lost, the nearest-real
-    complex eigenvalue, the count after the first pass, 1 if the QZ pass ran."""
+    ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``). ``recheck``: 0 never, 1 on suspect poses
+    (``_rr_qz.suspect``), 2 always: the roots are recovered again from the QZ eigenvalues,
+    which replace the companion's (its solutions are dropped: near a fold a companion root
+    can stall at a near-singular point within ``tol`` beside the two true roots).
+    ``stats[n]``: see ``general6r.run_kernel``."""
     Gs, Rh, MA, V15, A, E, XA, Mc, W24 = S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[8], S[9]
     H, R, piv, Vr, Aw = S[17], S[18], S[19], S[20], S[21]
     _rigid_product(form[0], T[n], form[1], Gs[1])
@@ -513,37 +515,37 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
         flags[n] = flag
         return
     wr, wi = W24[0], W24[1]
-    cnt, tried, lost, near = 0, 0, 0, np.inf
-    if _companion_eigvals(A, XA, Mc, wr, wi, W24[2]):
-        cnt, tried, lost = _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts,
-                                    order, sign, tol, iters, dedup, out_q, out_valid, out_pos,
-                                    out_rot, cnt, S)
-        near = _nearly_real(wr, wi)
-        suspect = recheck == 2 or (recheck == 1 and _suspect(tried, lost, near))
+    cnt, tried, lost, near, err = 0, 0, 0, np.inf, 0.0
+    pivot = _companion_eigvals(A, XA, Mc, wr, wi, W24[2])
+    stats[n, 5] = pivot
+    if pivot > 0.0:
+        cnt, tried, lost, err = _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links,
+                                         Ts, order, sign, tol, iters, dedup, out_q, out_valid,
+                                         out_pos, out_rot, cnt, S)
+        near = nearly_real(wr, wi)
+        rerun = recheck == 2 or (recheck == 1 and suspect(tried, lost, near, err, pivot))
     else:
-        suspect = True  # no usable companion: QZ is the only pass
+        rerun = True  # no usable companion: QZ is the only pass
     stats[n, 0] = tried
     stats[n, 1] = lost
     stats[n, 2] = near
     stats[n, 3] = cnt
     stats[n, 4] = 0.0
+    stats[n, 6] = err
     flags[n] = FLAG_OK
-    if suspect:
+    if rerun:
         stats[n, 4] = 1.0
         if not pencil_eigvals_qz(A, wr, wi, S[24]):
             flags[n] = FLAG_ILL_CONDITIONED
             return
+        for j in range(cnt):  # the QZ roots replace the companion's
+            out_valid[n, j] = False
+            out_pos[n, j] = np.nan
+            out_rot[n, j] = np.nan
+            for i in range(6):
+                out_q[n, j, i] = np.nan
         _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, sign, tol,
-                 iters, dedup, out_q, out_valid, out_pos, out_rot, cnt, S)
-
-
-@nb.njit(inline="always", **_OPTS)
-def _suspect(tried, lost, near):
-    """Whether the first pass may have missed roots: a real eigenvalue that did not give a new
-    verified solution, an odd number of real eigenvalues (the degree-16 polynomial has an even
-    number of real roots with multiplicity), or a complex eigenvalue within ``_NEAR_REAL`` of
-    the real axis (a real cluster the companion split into a pair)."""
-    return lost > 0 or tried % 2 == 1 or near <= _NEAR_REAL
+                 iters, dedup, out_q, out_valid, out_pos, out_rot, 0, S)
 
 
 @nb.njit(parallel=True, **_OPTS)

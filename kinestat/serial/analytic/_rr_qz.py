@@ -1,4 +1,5 @@
-"""QZ eigenvalues of the Raghavan–Roth matrix quadratic for the compiled general-6R kernel.
+"""QZ eigenvalues of the Raghavan–Roth matrix quadratic for the compiled general-6R kernel, and
+the test that decides on which poses the kernel uses them.
 
 The kernel's first pass (:mod:`kinestat.serial.analytic._rr_kernels`) takes the eigenvalues of
 the standard companion ``[0 I; −A2⁻¹A0 −A2⁻¹A1]`` (LAPACK dgeev). That is cheap but not
@@ -17,6 +18,8 @@ make them uncacheable). ``cython_lapack`` uses 32-bit LAPACK integers.
 
 from __future__ import annotations
 
+import math
+
 import llvmlite.binding as llvm
 import numba as nb
 import numpy as np
@@ -25,7 +28,8 @@ from numba.extending import get_cython_function_address
 
 from kinestat.serial._numba_options import OPTS as _OPTS
 
-__all__ = ["LWORK", "qz_scratch", "pencil_eigvals_qz"]
+__all__ = ["LWORK", "NEAR_REAL", "PIVOT_SUSPECT", "qz_scratch", "pencil_eigvals_qz", "nearly_real",
+           "suspect"]
 
 _SYMBOL = "kinestat_lapack_dggev"
 llvm.add_symbol(_SYMBOL, get_cython_function_address("scipy.linalg.cython_lapack", "dggev"))
@@ -34,6 +38,12 @@ _dggev = types.ExternalFunction(_SYMBOL, types.void(*([types.voidptr] * 17)))
 #: dggev's workspace (it needs at least 8n = 192 for n = 24; more lets it block)
 LWORK = 1024
 _N = 24
+#: the QZ pass runs where a complex eigenvalue has ``|Im x| ≤ NEAR_REAL √err (1 + |x|)``
+#: (:func:`suspect`); on the Jaco2 poses where the companion lost roots and no other rule
+#: fired, ``|Im x| / ((1 + |x|) √err)`` was at most 0.13 (2026-12-02, docs/ik-all.md)
+NEAR_REAL = 10.0
+#: ... or where the companion's leading coefficient has a smaller relative pivot
+PIVOT_SUSPECT = 1e-4
 
 
 @nb.njit(**_OPTS)
@@ -83,3 +93,32 @@ def pencil_eigvals_qz(A, wr, wi, S):
             wr[k] /= beta[k]
             wi[k] /= beta[k]
     return True
+
+
+@nb.njit(**_OPTS)
+def nearly_real(wr, wi):
+    """The smallest ``|Im x| / (1 + |x|)`` of the non-real eigenvalues (inf if none)."""
+    near = np.inf
+    for k in range(24):
+        if abs(wi[k]) > 1e-6 * (1.0 + abs(wr[k])):
+            near = min(near, abs(wi[k]) / (1.0 + abs(complex(wr[k], wi[k]))))
+    return near
+
+
+@nb.njit(inline="always", **_OPTS)
+def suspect(tried, lost, near, err, pivot):
+    """Whether the companion pass may have missed real roots (then the QZ pass runs):
+
+    - a real eigenvalue gave no new verified solution (not verified, or a repeat: two
+      eigenvalues of one cluster polished onto the same root);
+    - an odd number of real eigenvalues (the degree-16 polynomial has an even number of real
+      roots counted with multiplicity);
+    - a complex eigenvalue ``|Im x| / (1 + |x|) ≤ 10 √err``: within the split that the
+      observed accuracy ``err`` of the pose's real eigenvalues gives a double root (a
+      perturbation η moves a double root by O(√η), a simple one by O(η)), so possibly a real
+      pair the companion turned complex; ``err`` is floored at 1e-12;
+    - the companion's leading coefficient has a relative pivot below ``PIVOT_SUSPECT`` (its
+      error grows like 1/pivot).
+    """
+    return (lost > 0 or tried % 2 == 1 or near <= NEAR_REAL * math.sqrt(max(err, 1e-12))
+            or pivot < PIVOT_SUSPECT)

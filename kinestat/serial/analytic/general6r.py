@@ -312,16 +312,18 @@ def _compiled_data(model: ChainModel, form: Formulation):
 
 
 RECHECK = {"never": 0, "suspect": 1, "always": 2}
-"""When the compiled kernel reruns a pose's roots with the QZ eigenvalues
-(:mod:`kinestat.serial.analytic._rr_qz`): never, on poses its first pass marks as suspect
-(the default), always."""
+"""When the compiled kernel recovers a pose's roots again from the QZ eigenvalues
+(:mod:`kinestat.serial.analytic._rr_qz`; they replace the companion's): never, on poses its
+first pass marks as suspect (the default), always. Where the companion is unusable (its
+leading coefficient singular for every Möbius parameter) QZ is the only pass in every mode."""
 
 
 def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     """The compiled kernel on poses ``T (N, 4, 4)``: ``q (N, 16, 6)``, valid, position and
-    rotation errors, the per-pose flags and ``stats (N, 5)``: real eigenvalues tried and lost
+    rotation errors, the per-pose flags and ``stats (N, 7)``: real eigenvalues tried and lost
     by the first pass, its nearest-real complex eigenvalue ``|Im x| / (1 + |x|)``, its count,
-    1.0 where the QZ pass ran."""
+    1.0 where the QZ pass ran, the smallest relative pivot of the companion's leading
+    coefficient (0 where it was unusable), the first pass's largest real-eigenvalue error."""
     K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
     if K is None:
         from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
@@ -334,7 +336,7 @@ def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     pos = nan_array((N, K16))
     rot = nan_array((N, K16))
     flags = np.zeros(N, dtype=np.int64)
-    stats = np.zeros((N, 5))
+    stats = np.zeros((N, 7))
     run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
     run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6,
         RECHECK[recheck], q, valid, pos, rot, flags, stats)
