@@ -12,7 +12,9 @@ Raghavan & Roth (1993), in the numerically stable form of Manocha & Canny (1994)
    (Manocha–Canny eq. 13).
 4. ``x3`` are the eigenvalues of the 24x24 companion pencil (the standard problem with
    ``A2⁻¹`` when A2 is well conditioned, otherwise the generalised one, ``scipy.linalg.eig``);
-   up to 16 are real (the spurious ``x3 = ±i`` of the half-angle factor are not).
+   up to 16 are real (the spurious ``x3 = ±i`` of the half-angle factor are not). The
+   compiled kernel reruns suspect poses with the QZ eigenvalues
+   (:mod:`kinestat.serial.analytic._rr_qz`; ``recheck``).
 5. x4, x5 from the eigenvector's power-product ratios; (c1, s1, c2, s2) from the linear
    equations ``Q S = P R`` (least squares); θ6 from the remaining rotation.
 6. Newton steps against FK polish each root; a root counts only if FK reproduces the pose
@@ -29,7 +31,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.linalg
 
-from kinestat.errors import ModelError
+from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _rr_algebra as rr
 from kinestat.serial.analytic._common import nan_array, newton_polish, pack, reasons
@@ -364,7 +366,7 @@ def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect") -> IKA
                       family_value=nan_array((N, K16)), family_joints=None,
                       n_solutions=nsol, reason=reason, method=_method_name(form), tol=tol)
     redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
-    if redo.size:  # the generalised eigenproblem (scipy) for these poses
+    if redo.size:  # dggev failed in the kernel: the NumPy reference for these poses
         sub = _solve(model, T[redo], form, tol, polish_iters)
         for f in ("q", "valid", "position_error", "rotation_error", "n_solutions", "reason"):
             getattr(res, f)[redo] = getattr(sub, f)
@@ -377,16 +379,19 @@ def _method_name(form: Formulation) -> str:
 
 def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
                      polish_iters: int = 8, form: Formulation | None = None,
-                     backend: str = "numba") -> IKAllResult:
+                     backend: str = "numba", recheck: str = "suspect") -> IKAllResult:
     """All IK solutions of a 6R ``model`` for poses ``T (N, 4, 4)`` (Raghavan–Roth 1993).
 
     Returns an :class:`IKAllResult` with ``K = 16`` slots. ``form`` defaults to the model's
     :func:`formulation`; ``backend`` ``"numba"`` (compiled kernel, for formulations with shift
-    0 or 5) or ``"numpy"`` (the reference).
+    0 or 5) or ``"numpy"`` (the reference). ``recheck`` (compiled kernel): when the roots are
+    recovered from the QZ eigenvalues instead of the companion's, :data:`RECHECK`.
     """
     check_general(model)
+    if recheck not in RECHECK:
+        raise InputError(f"solve_general_6r: recheck={recheck!r}; one of {sorted(RECHECK)}")
     if form is None:
         form, _ = formulation(model)
     if backend == "numba" and form.shift in (0, 5):
-        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters)
+        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters, recheck)
     return _solve(model, T, form, tol, polish_iters)

@@ -102,3 +102,19 @@ def test_recheck_is_rare_and_loses_nothing(name):
         sa, sb = a[0][i][a[1][i]], b[0][i][b[1][i]]
         for s in sb:
             assert np.min(wrapped_distance(sa, s)) < 1e-6
+
+
+def test_recheck_option_of_the_solver():
+    """``solve_general_6r(recheck=…)``: "always" equals the default on clustered poses, the
+    companion alone ("never") loses solutions there, a bad value is one clear error."""
+    from .test_ik_all import CLUSTERED_JACO2
+
+    model = arm("jaco6")
+    T = kinestat.fk(model, np.array(CLUSTERED_JACO2))
+    default = g.solve_general_6r(model, T)
+    always = g.solve_general_6r(model, T, recheck="always")
+    never = g.solve_general_6r(model, T, recheck="never")
+    np.testing.assert_array_equal(default.n_solutions, always.n_solutions)
+    assert np.sum(never.n_solutions) < np.sum(default.n_solutions)
+    with pytest.raises(kinestat.KinestatError, match="recheck"):
+        g.solve_general_6r(model, T, recheck="sometimes")
