@@ -451,7 +451,7 @@ def _scratch():
             np.empty((24, 24)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
             np.empty(8), np.empty((3, 6, 7)), np.empty((4, 6)), np.empty(6), np.empty(6),
             np.empty((14, 14)), np.empty((8, 8)), np.empty(8, dtype=np.int64), np.empty((8, 14)),
-            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12), qz_scratch())
+            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12))
 
 
 @nb.njit(**_OPTS)
@@ -535,7 +535,7 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
     flags[n] = FLAG_OK
     if rerun:
         stats[n, 4] = 1.0
-        if not pencil_eigvals_qz(A, wr, wi, S[24]):
+        if not pencil_eigvals_qz(A, wr, wi, qz_scratch()):  # allocated here: rare
             flags[n] = FLAG_ILL_CONDITIONED
             return
         for j in range(cnt):  # the QZ roots replace the companion's

@@ -39,8 +39,9 @@ _dggev = types.ExternalFunction(_SYMBOL, types.void(*([types.voidptr] * 17)))
 LWORK = 1024
 _N = 24
 #: the QZ pass runs where a complex eigenvalue has ``|Im x| ≤ NEAR_REAL √err (1 + |x|)``
-#: (:func:`suspect`); on the Jaco2 poses where the companion lost roots and no other rule
-#: fired, ``|Im x| / ((1 + |x|) √err)`` was at most 0.13 (2026-12-02, docs/ik-all.md)
+#: (:func:`suspect`); on 30 near-fold Jaco2 poses where the companion lost roots and no root
+#: was lost visibly, ``|Im x| / ((1 + |x|) √err)`` was at most 0.13 (3.3 with err floored;
+#: 2026-12-02, docs/ik-all.md)
 NEAR_REAL = 10.0
 #: ... or where the companion's leading coefficient has a smaller relative pivot
 PIVOT_SUSPECT = 1e-4
