@@ -8,10 +8,15 @@ least-squares back-substitution), the 12x12 matrix quadratic, the eigenvalues of
 24x24 companion (LAPACK dgeev), the power-product vector of each real root by inverse
 iteration, back-substitution, θ6 (the serial FK kernel's scalar steps), Newton polishing
 against FK, verification and de-duplication
-(:mod:`kinestat.serial.analytic._solution_kernels`). Every work array is allocated once per
-chunk of poses (:func:`_scratch`), not per root or per step; only dgeev allocates its
-workspace. Flags: 0 solved, 1 Q rank deficient, 2 A2 ill-conditioned
-(the caller reruns the pose with the generalised eigenproblem).
+(:mod:`kinestat.serial.analytic._solution_kernels`). On a suspect pose (``_rr_qz.suspect``: a
+lost real root, an odd real count, a complex pair within the double-root split of the
+observed eigenvalue error, a nearly singular leading coefficient; about 1 % of Jaco2-type
+poses, fewer on general arms) the roots are recovered again from the QZ eigenvalues of the
+companion pencil (:mod:`kinestat.serial.analytic._rr_qz`), which are backward stable where the
+companion's are not: clustered real roots. Every work array is allocated once per chunk of
+poses (:func:`_scratch`), not per root or per step; only dgeev allocates its workspace.
+Flags: 0 solved, 1 Q rank deficient, 2 dggev failed (the caller reruns the pose with the NumPy
+reference).
 """
 
 from __future__ import annotations
@@ -26,6 +31,7 @@ from numba.np.linalg import _LAPACK
 from kinestat.mechanism.joints import JointKind
 from kinestat.serial._kernels import _step
 from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial.analytic._rr_qz import nearly_real, pencil_eigvals_qz, qz_scratch, suspect
 from kinestat.serial.analytic._solution_kernels import polish, store
 from kinestat.spatial._elimination import eliminate
 
@@ -257,7 +263,8 @@ def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
     When A2 is ill-conditioned (smallest relative pivot below ``_A2_PIVOT_MIN``) the variable
     is changed by the Möbius map ``x = (y + t)/(1 − t y)`` (a shift of the half-angle by
     atan t): ``B(y) = (1 − t y)² A(x)`` has the leading coefficient ``A0 t² − A1 t + A2``,
-    regular unless −1/t is itself a root. False when no tried t gives a regular one.
+    regular unless −1/t is itself a root. Returns the leading coefficient's smallest relative
+    pivot, 0 when no tried t gives a regular one (or dgeev fails).
     ``XA (12, 36)``: ``[A2 | A0 A1]`` solved in place to ``[· | X]``, ``X = A2⁻¹ [A0 A1]``;
     Mc (24, 24): scratch."""
     sc = 0.0
@@ -271,6 +278,7 @@ def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
                 A[k, i, j] /= sc
     t = 0.0
     regular = False
+    pivot = 0.0
     for t in _MOBIUS:
         tt = t * t
         for i in range(12):
@@ -279,20 +287,21 @@ def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
                 XA[i, 12 + j] = a0 + t * a1 + tt * a2
                 XA[i, 24 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
                 XA[i, j] = tt * a0 - t * a1 + a2
-        if eliminate(XA, 12, _TINY_PIVOT, None) >= _A2_PIVOT_MIN:
+        pivot = eliminate(XA, 12, _TINY_PIVOT, None)
+        if pivot >= _A2_PIVOT_MIN:
             regular = True
             break
     if not regular:
-        return False
+        return 0.0
     X = XA[:, 12:]
     big = 0.0
     for i in range(12):
         for j in range(24):
             if not math.isfinite(X[i, j]):
-                return False
+                return 0.0
             big = max(big, abs(X[i, j]))
     if big > 1e10:
-        return False
+        return 0.0
     # stored transposed (LAPACK is column-major): same eigenvalues
     for i in range(24):
         for j in range(12):
@@ -308,7 +317,7 @@ def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
             x = (complex(wr[k], wi[k]) + t) / (1.0 - t * complex(wr[k], wi[k]))
             wr[k] = x.real
             wi[k] = x.imag
-    return info == 0
+    return pivot if info == 0 else 0.0
 
 
 @nb.njit(**_OPTS)
@@ -446,13 +455,52 @@ def _scratch():
 
 
 @nb.njit(**_OPTS)
-def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                out_q, out_valid, out_pos, out_rot, flags, S):
+def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, sign, tol, iters,
+             dedup, out_q, out_valid, out_pos, out_rot, cnt, S):
+    """Solutions of pose n from the real eigenvalues ``wr + i wi (24,)``: power products,
+    angles, Newton polishing, verification, storage after the ``cnt`` already stored. Returns
+    (the new count, real eigenvalues tried, of them lost: not verified or a repeat, the largest
+    eigenvalue error ``|x − x*| / (1 + |x*|)`` against the polished root x*)."""
+    A2, v, m, coef, Ms, Vs, th, q, perm, y12 = S[7], S[10], S[11], S[12], S[13], S[14], \
+        S[15], S[16], S[22], S[23]
+    tried = 0
+    lost = 0
+    err = 0.0
+    for k in range(24):
+        if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
+            continue
+        tried += 1
+        _null_vector(A, wr[k], A2, v, perm, y12)
+        if not _angles(wr[k], v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
+            lost += 1
+            continue
+        for i in range(6):
+            q[order[i]] = sign * th[i]
+        pos, rot = polish(C, T[n], q, iters, Ms, Vs)
+        if not (pos <= tol and rot <= tol):
+            lost += 1
+            continue
+        xs = math.tan(0.5 * (sign * q[order[2]] - off[0]))
+        err = max(err, abs(wr[k] - xs) / (1.0 + abs(xs)))
+        new = store(n, (q[0], q[1], q[2], q[3], q[4], q[5]), pos, rot, dedup, out_q, out_valid,
+                    out_pos, out_rot, cnt)
+        lost += new == cnt
+        cnt = new
+    return cnt, tried, lost, err
+
+
+@nb.njit(**_OPTS)
+def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
+                out_q, out_valid, out_pos, out_rot, flags, stats, S):
     """All solutions of pose n. ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant M1 / Ts of the
     formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0 constant, 1
-    ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``)."""
-    Gs, Rh, MA, V15, A, E, XA, A2, Mc, W24, v, m, coef, Ms, Vs, th, q, H, R, piv, Vr, Aw, \
-        perm, y12 = S
+    ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``). ``recheck``: 0 never, 1 on suspect poses
+    (``_rr_qz.suspect``), 2 always: the roots are recovered again from the QZ eigenvalues,
+    which replace the companion's (its solutions are dropped: near a fold a companion root
+    can stall at a near-singular point within ``tol`` beside the two true roots).
+    ``stats[n]``: see ``general6r.run_kernel``."""
+    Gs, Rh, MA, V15, A, E, XA, Mc, W24 = S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[8], S[9]
+    H, R, piv, Vr, Aw = S[17], S[18], S[19], S[20], S[21]
     _rigid_product(form[0], T[n], form[1], Gs[1])
     _rigid_inverse(Gs[1], Gs[2])
     Gs[0] = form[2]
@@ -467,29 +515,42 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
         flags[n] = flag
         return
     wr, wi = W24[0], W24[1]
-    if not _companion_eigvals(A, XA, Mc, wr, wi, W24[2]):
-        flags[n] = FLAG_ILL_CONDITIONED
-        return
-    cnt = 0
-    for k in range(24):
-        if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
-            continue
-        _null_vector(A, wr[k], A2, v, perm, y12)
-        if not _angles(wr[k], v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
-            continue
-        for i in range(6):
-            q[order[i]] = sign * th[i]
-        pos, rot = polish(C, T[n], q, iters, Ms, Vs)
-        if not (pos <= tol and rot <= tol):
-            continue
-        cnt = store(n, (q[0], q[1], q[2], q[3], q[4], q[5]), pos, rot, dedup, out_q, out_valid,
-                    out_pos, out_rot, cnt)
+    cnt, tried, lost, near, err = 0, 0, 0, np.inf, 0.0
+    pivot = _companion_eigvals(A, XA, Mc, wr, wi, W24[2])
+    stats[n, 5] = pivot
+    if pivot > 0.0:
+        cnt, tried, lost, err = _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links,
+                                         Ts, order, sign, tol, iters, dedup, out_q, out_valid,
+                                         out_pos, out_rot, cnt, S)
+        near = nearly_real(wr, wi)
+        rerun = recheck == 2 or (recheck == 1 and suspect(tried, lost, near, err, pivot))
+    else:
+        rerun = True  # no usable companion: QZ is the only pass
+    stats[n, 0] = tried
+    stats[n, 1] = lost
+    stats[n, 2] = near
+    stats[n, 3] = cnt
+    stats[n, 4] = 0.0
+    stats[n, 6] = err
     flags[n] = FLAG_OK
+    if rerun:
+        stats[n, 4] = 1.0
+        if not pencil_eigvals_qz(A, wr, wi, qz_scratch()):  # allocated here: rare
+            flags[n] = FLAG_ILL_CONDITIONED
+            return
+        for j in range(cnt):  # the QZ roots replace the companion's
+            out_valid[n, j] = False
+            out_pos[n, j] = np.nan
+            out_rot[n, j] = np.nan
+            for i in range(6):
+                out_q[n, j, i] = np.nan
+        _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, sign, tol,
+                 iters, dedup, out_q, out_valid, out_pos, out_rot, 0, S)
 
 
 @nb.njit(parallel=True, **_OPTS)
-def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                out_q, out_valid, out_pos, out_rot, flags):
+def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
+                out_q, out_valid, out_pos, out_rot, flags, stats):
     """All solutions of N poses (see the module docstring); outputs pre-filled by the caller
     (q NaN, valid False, errors NaN)."""
     N = T.shape[0]
@@ -497,14 +558,14 @@ def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedu
         S = _scratch()
         for n in range(c * _CHUNK, min(N, (c + 1) * _CHUNK)):
             _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                        out_q, out_valid, out_pos, out_rot, flags, S)
+                        recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)
 
 
 @nb.njit(**_OPTS)
-def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                 out_q, out_valid, out_pos, out_rot, flags):
+def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
+                 out_q, out_valid, out_pos, out_rot, flags, stats):
     """:func:`solve_batch` on one thread (small batches: no thread start-up)."""
     S = _scratch()
     for n in range(T.shape[0]):
         _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                    out_q, out_valid, out_pos, out_rot, flags, S)
+                    recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)

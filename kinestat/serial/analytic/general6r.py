@@ -12,7 +12,9 @@ Raghavan & Roth (1993), in the numerically stable form of Manocha & Canny (1994)
    (Manocha–Canny eq. 13).
 4. ``x3`` are the eigenvalues of the 24x24 companion pencil (the standard problem with
    ``A2⁻¹`` when A2 is well conditioned, otherwise the generalised one, ``scipy.linalg.eig``);
-   up to 16 are real (the spurious ``x3 = ±i`` of the half-angle factor are not).
+   up to 16 are real (the spurious ``x3 = ±i`` of the half-angle factor are not). The
+   compiled kernel reruns suspect poses with the QZ eigenvalues
+   (:mod:`kinestat.serial.analytic._rr_qz`; ``recheck``).
 5. x4, x5 from the eigenvector's power-product ratios; (c1, s1, c2, s2) from the linear
    equations ``Q S = P R`` (least squares); θ6 from the remaining rotation.
 6. Newton steps against FK polish each root; a root counts only if FK reproduces the pose
@@ -29,7 +31,7 @@ from functools import lru_cache
 import numpy as np
 import scipy.linalg
 
-from kinestat.errors import ModelError
+from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _rr_algebra as rr
 from kinestat.serial.analytic._common import nan_array, newton_polish, pack, reasons
@@ -311,7 +313,19 @@ def _compiled_data(model: ChainModel, form: Formulation):
             np.array(OFFSETS), np.array(list(order) + [at0, at5], dtype=np.int64), float(sign))
 
 
-def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
+RECHECK = {"never": 0, "suspect": 1, "always": 2}
+"""When the compiled kernel recovers a pose's roots again from the QZ eigenvalues
+(:mod:`kinestat.serial.analytic._rr_qz`; they replace the companion's): never, on poses its
+first pass marks as suspect (the default), always. Where the companion is unusable (its
+leading coefficient singular for every Möbius parameter) QZ is the only pass in every mode."""
+
+
+def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
+    """The compiled kernel on poses ``T (N, 4, 4)``: ``q (N, 16, 6)``, valid, position and
+    rotation errors, the per-pose flags and ``stats (N, 7)``: real eigenvalues tried and lost
+    by the first pass, its nearest-real complex eigenvalue ``|Im x| / (1 + |x|)``, its count,
+    1.0 where the QZ pass ran, the smallest relative pivot of the companion's leading
+    coefficient (0 where it was unusable), the first pass's largest real-eigenvalue error."""
     K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
     if K is None:
         from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
@@ -324,9 +338,20 @@ def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
     pos = nan_array((N, K16))
     rot = nan_array((N, K16))
     flags = np.zeros(N, dtype=np.int64)
+    stats = np.zeros((N, 7))
     run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
-    run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6, q, valid,
-        pos, rot, flags)
+    run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6,
+        RECHECK[recheck], q, valid, pos, rot, flags, stats)
+    return q, valid, pos, rot, flags, stats
+
+
+def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect") -> IKAllResult:
+    K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
+    if K is None:
+        from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
+
+    q, valid, pos, rot, flags, _ = run_kernel(model, T, form, tol, polish_iters, recheck)
+    N, K16 = valid.shape
     nsol = np.count_nonzero(valid, axis=1)
     reason = reasons(nsol, _REASON_NONE)
     if not flags.any():
@@ -341,7 +366,7 @@ def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
                       family_value=nan_array((N, K16)), family_joints=None,
                       n_solutions=nsol, reason=reason, method=_method_name(form), tol=tol)
     redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
-    if redo.size:  # the generalised eigenproblem (scipy) for these poses
+    if redo.size:  # dggev failed in the kernel: the NumPy reference for these poses
         sub = _solve(model, T[redo], form, tol, polish_iters)
         for f in ("q", "valid", "position_error", "rotation_error", "n_solutions", "reason"):
             getattr(res, f)[redo] = getattr(sub, f)
@@ -354,16 +379,19 @@ def _method_name(form: Formulation) -> str:
 
 def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
                      polish_iters: int = 8, form: Formulation | None = None,
-                     backend: str = "numba") -> IKAllResult:
+                     backend: str = "numba", recheck: str = "suspect") -> IKAllResult:
     """All IK solutions of a 6R ``model`` for poses ``T (N, 4, 4)`` (Raghavan–Roth 1993).
 
     Returns an :class:`IKAllResult` with ``K = 16`` slots. ``form`` defaults to the model's
     :func:`formulation`; ``backend`` ``"numba"`` (compiled kernel, for formulations with shift
-    0 or 5) or ``"numpy"`` (the reference).
+    0 or 5) or ``"numpy"`` (the reference). ``recheck`` (compiled kernel): when the roots are
+    recovered from the QZ eigenvalues instead of the companion's, :data:`RECHECK`.
     """
     check_general(model)
+    if recheck not in RECHECK:
+        raise InputError(f"solve_general_6r: recheck={recheck!r}; one of {sorted(RECHECK)}")
     if form is None:
         form, _ = formulation(model)
     if backend == "numba" and form.shift in (0, 5):
-        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters)
+        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters, recheck)
     return _solve(model, T, form, tol, polish_iters)

@@ -188,9 +188,10 @@ def test_rounded_pose_is_projected_onto_a_rotation(name):
     assert np.min(wrapped_distance(res.solutions(), q)) < 1e-5
 
 
-#: Jaco2-type poses (seeds 1, 9, 10 of ``default_rng(seed).uniform(-π, π, (10000, 6))``,
-#: indices 958, 402, 1231, 2595) away from singular sets (Jacobian σmin/σmax 4e-4 to 2e-2)
-#: whose real roots in x3 cluster (two to four solutions within 1e-2 of each other)
+#: Jaco2-type poses (seeds 1, 9, 10, 100, 122 of ``default_rng(seed).uniform(-π, π, (10000, 6))``,
+#: indices 958, 402, 1231, 2595, 4251, 2486) away from singular sets (Jacobian σmin/σmax 4e-4
+#: to 2e-2) whose real roots in x3 cluster (two to four solutions within 1e-2 of each other):
+#: the standard companion alone lost solutions on each (docs/ik-all.md)
 CLUSTERED_JACO2 = [
     [-2.9990693597623244, 2.851083638534363, -0.2933357539065655, -1.4712548427920535,
      -1.423546409551335e-05, 2.8023057158851117],
@@ -201,14 +202,13 @@ CLUSTERED_JACO2 = [
     [-2.795838279438122, 2.6536384322725777, 1.5962027603915674, 1.5215279545921865,
      2.965037610130878, 1.305933511055482],
 ]
+CLUSTERED_SEEDS = [(100, 4251), (122, 2486)]
 
 
-@pytest.mark.xfail(strict=True, reason="known limitation (docs/ik-all.md, Not done yet): "
-                   "clustered real roots of the 24x24 companion come out 1e-4 to 1e-1 off or "
-                   "as complex pairs, so the eigenvalue method misses solutions (both backends)")
 def test_jaco2_poses_with_clustered_roots_are_complete():
     model = arm("jaco6")
-    q = np.array(CLUSTERED_JACO2)
+    extra = [np.random.default_rng(s).uniform(-PI, PI, (10000, 6))[i] for s, i in CLUSTERED_SEEDS]
+    q = np.vstack([CLUSTERED_JACO2, extra])
     T = kinestat.fk(model, q)
     res = ik_all(model, T)
     oracle = newton_solutions(model, T, starts=300, iters=50, seed=3)
@@ -216,3 +216,7 @@ def test_jaco2_poses_with_clustered_roots_are_complete():
         mine = res.solutions((i,))
         assert len(mine) and np.min(wrapped_distance(mine, q[i])) < 1e-6, i
         assert len(sols) == res.n_solutions[i], (i, len(sols), res.n_solutions[i])
+        for s in sols:
+            assert np.min(wrapped_distance(mine, s)) < 1e-6, i
+    pos, dR = slot_residuals(model, res, T)
+    assert pos.max() <= 1e-9 and dR.max() <= 1e-9
