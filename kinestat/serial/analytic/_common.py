@@ -27,7 +27,10 @@ def nan_array(shape: tuple[int, ...]) -> np.ndarray:
 def reasons(n_solutions: np.ndarray, why_none: str) -> np.ndarray:
     """Object array: ``""`` where a pose has solutions, ``why_none`` where it has none."""
     r = np.empty(n_solutions.shape, dtype=object)
-    if n_solutions.size == 1:  # one pose: no mask
+    if n_solutions.shape == (1,):  # one pose (a single call): no mask
+        r[0] = why_none if n_solutions[0] == 0 else ""
+        return r
+    if n_solutions.size == 1:
         r.fill(why_none if n_solutions.flat[0] == 0 else "")
         return r
     r.fill("")

@@ -311,7 +311,7 @@ def _compiled_data(model: ChainModel, form: Formulation):
             np.array(OFFSETS), np.array(list(order) + [at0, at5], dtype=np.int64), float(sign))
 
 
-def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
+def _solve_compiled(model, T, form, tol, polish_iters, shape=None) -> IKAllResult:
     K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
     if K is None:
         from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
@@ -327,25 +327,30 @@ def _solve_compiled(model, T, form, tol, polish_iters) -> IKAllResult:
     run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
     run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6, q, valid,
         pos, rot, flags)
-    nsol = np.count_nonzero(valid, axis=1)
+    # result building (a single call is ~70 µs: NumPy's per-call costs matter, so one pose
+    # takes the scalar route and the result is built once, in its final shape)
+    if N == 1:
+        nsol = np.empty(1, dtype=np.int64)
+        nsol[0] = np.count_nonzero(valid)
+        flagged = flags[0] != K.FLAG_OK
+    else:
+        nsol = np.count_nonzero(valid, axis=1)
+        flagged = flags.any()
     reason = reasons(nsol, _REASON_NONE)
-    if not flags.any():
-        return IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
-                           singular=np.zeros((N, K16), dtype=bool),
-                           family_sign=np.zeros((N, K16)), family_value=nan_array((N, K16)),
-                           family_joints=None, n_solutions=nsol, reason=reason,
-                           method=_method_name(form), tol=tol)
-    reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
-    res = IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
-                      singular=np.zeros((N, K16), dtype=bool), family_sign=np.zeros((N, K16)),
-                      family_value=nan_array((N, K16)), family_joints=None,
-                      n_solutions=nsol, reason=reason, method=_method_name(form), tol=tol)
-    redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
-    if redo.size:  # the generalised eigenproblem (scipy) for these poses
-        sub = _solve(model, T[redo], form, tol, polish_iters)
-        for f in ("q", "valid", "position_error", "rotation_error", "n_solutions", "reason"):
-            getattr(res, f)[redo] = getattr(sub, f)
-    return res
+    if flagged:
+        reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
+        redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
+        if redo.size:  # the generalised eigenproblem (scipy) for these poses
+            sub = _solve(model, T[redo], form, tol, polish_iters)
+            q[redo], valid[redo], pos[redo], rot[redo] = (sub.q, sub.valid, sub.position_error,
+                                                          sub.rotation_error)
+            nsol[redo], reason[redo] = sub.n_solutions, sub.reason
+    return IKAllResult.build((N,) if shape is None else shape, q=q, valid=valid,
+                             position_error=pos, rotation_error=rot,
+                             singular=np.zeros((N, K16), dtype=bool),
+                             family_sign=np.zeros((N, K16)), family_value=nan_array((N, K16)),
+                             family_joints=None, n_solutions=nsol, reason=reason,
+                             method=_method_name(form), tol=tol)
 
 
 def _method_name(form: Formulation) -> str:
@@ -354,16 +359,18 @@ def _method_name(form: Formulation) -> str:
 
 def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
                      polish_iters: int = 8, form: Formulation | None = None,
-                     backend: str = "numba") -> IKAllResult:
+                     backend: str = "numba",
+                     shape: tuple[int, ...] | None = None) -> IKAllResult:
     """All IK solutions of a 6R ``model`` for poses ``T (N, 4, 4)`` (Raghavan–Roth 1993).
 
     Returns an :class:`IKAllResult` with ``K = 16`` slots. ``form`` defaults to the model's
     :func:`formulation`; ``backend`` ``"numba"`` (compiled kernel, for formulations with shift
-    0 or 5) or ``"numpy"`` (the reference).
+    0 or 5) or ``"numpy"`` (the reference). ``shape``: the batch shape of a compiled result
+    (default ``(N,)``; the NumPy reference always returns ``(N,)``).
     """
     check_general(model)
     if form is None:
         form, _ = formulation(model)
     if backend == "numba" and form.shift in (0, 5):
-        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters)
+        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters, shape)
     return _solve(model, T, form, tol, polish_iters)

@@ -78,7 +78,10 @@ class IKAllResult:
         ``__setattr__`` each (a single-pose call is a few µs, so that matters); the fields are
         the dataclass's, ``family_curve`` optional.
         """
-        if len(shape) != 1:
+        if shape == ():  # one pose: index the leading axis of length 1 (a view, cheaper)
+            for f in cls._BATCHED:
+                fields[f] = fields[f][0, ...]  # 0-d arrays stay arrays
+        elif len(shape) != 1:
             for f in cls._BATCHED:
                 a = fields[f]
                 fields[f] = a.reshape(shape + a.shape[1:])

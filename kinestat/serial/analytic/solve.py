@@ -160,5 +160,5 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
                                           closed_form.solve_three_parallel(model, Tf, data,
                                                                            tol=tol))
     else:
-        res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend)
+        res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend, shape=shape)
     return _reshape(res, shape)
