@@ -23,7 +23,7 @@ import sys
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic._common import nan_array, pack, reasons
+from kinestat.serial.analytic._common import call_compiled, nan_array, pack, plain_poses, reasons
 from kinestat.serial.analytic.families import add_wrist_families
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
@@ -178,13 +178,18 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     sing = np.empty((N, 8), dtype=bool)
     sign = np.empty((N, 8))
     fam = np.empty((N, 8))
-    run = K.pieper_batch if N >= _PARALLEL_MIN else K.pieper_serial
     Kp = data.get("kernel_args")
     if Kp is None:  # pose-independent, kept with the model's cached geometry
         ax = data["axes"]
         Kp = data["kernel_args"] = K.pack(model.constants, np.linalg.inv(ax.T0), ax.w, ax.r,
                                           data["wrist"], data["shoulder"], _perp(ax.w[5]))
-    run(Kp, T, tol, wrist_tol, 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
+    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
+    if N >= _PARALLEL_MIN:
+        K.pieper_batch(*args)
+    elif plain_poses(T):
+        call_compiled(K.pieper_serial, *args)
+    else:
+        K.pieper_serial(*args)
     return IKAllResult.build((N,) if shape is None else shape, q=q, valid=valid,
                              position_error=pos, rotation_error=rot, singular=sing,
                              family_sign=sign, family_value=fam, family_joints=(3, 5),
@@ -208,8 +213,13 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
                                           data["p56"], _perp(h), sg)
     q, valid, pos, rot, cnt = _outputs(N, 8)
     near = np.empty(N, dtype=bool)
-    run = K.three_parallel_batch if N >= _PARALLEL_MIN else K.three_parallel_serial
-    run(Kp, T, tol, wrist_tol, 1e-6, q, valid, pos, rot, cnt, near)
+    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, cnt, near)
+    if N >= _PARALLEL_MIN:
+        K.three_parallel_batch(*args)
+    elif plain_poses(T):
+        call_compiled(K.three_parallel_serial, *args)
+    else:
+        K.three_parallel_serial(*args)
     fields = dict(q=q, valid=valid, position_error=pos, rotation_error=rot,
                   singular=np.zeros((N, 8), dtype=bool), family_sign=np.zeros((N, 8)),
                   family_value=nan_array((N, 8)), family_joints=None, n_solutions=cnt,

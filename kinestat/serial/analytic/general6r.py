@@ -32,7 +32,14 @@ import scipy.linalg
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _rr_algebra as rr
-from kinestat.serial.analytic._common import nan_array, newton_polish, pack, reasons
+from kinestat.serial.analytic._common import (
+    call_compiled,
+    nan_array,
+    newton_polish,
+    pack,
+    plain_poses,
+    reasons,
+)
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.fk import fk
 
@@ -324,9 +331,14 @@ def _solve_compiled(model, T, form, tol, polish_iters, shape=None) -> IKAllResul
     pos = nan_array((N, K16))
     rot = nan_array((N, K16))
     flags = np.zeros(N, dtype=np.int64)
-    run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
-    run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6, q, valid,
-        pos, rot, flags)
+    args = (C, T, consts, links, LH, h0, L, off, order, sign, float(tol), int(polish_iters), 1e-6,
+            q, valid, pos, rot, flags)
+    if N >= _PARALLEL_MIN:
+        K.solve_batch(*args)
+    elif plain_poses(T):
+        call_compiled(K.solve_serial, *args)
+    else:
+        K.solve_serial(*args)
     # result building (a single call is ~70 µs: NumPy's per-call costs matter, so one pose
     # takes the scalar route and the result is built once, in its final shape)
     if N == 1:

@@ -17,7 +17,7 @@ import numpy as np
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import closed_form, families, general6r, thesis_puma762
-from kinestat.serial.analytic._common import check_poses
+from kinestat.serial.analytic._common import call_compiled, check_poses, plain_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 
@@ -126,7 +126,10 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
             T.shape[-2:] == (4, 4) and backend == "numba":
         Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
-        bad, n_project = _kernels().check_rigid(Tf, 1e-6)
+        if plain_poses(Tf):
+            bad, n_project = call_compiled(_kernels().check_rigid, Tf, 1e-6)
+        else:
+            bad, n_project = _kernels().check_rigid(Tf, 1e-6)
         if bad >= 0:
             check_poses(T)  # raises with the full message
         if n_project:
