@@ -1,7 +1,7 @@
 """Single-call ``ik_all`` time across separate processes, beside a machine probe.
 
 Run ``.venv/bin/python benchmarks/ik_all_processes.py [--processes 20] [--single 200]
-[--arms jaco6,random1] [--taskset CPU] [--json]``.
+[--arms jaco6,random1] [--taskset CPU] [--roots DIR,DIR] [--json]``.
 
 Each of ``--processes`` fresh Python processes (run one after another) times ``ik_all(model,
 T)`` on one pose per call (median over ``--single`` poses, after the batched warm-up call the
@@ -11,6 +11,8 @@ step, throughput-bound) and a latency-bound scalar loop (one dependent multiply-
 Per arm it prints the distribution of the process medians (min / quartiles / max, and how many
 exceed 100 µs) and the same for the ratio ``ik_all / dgeev probe``: when the slow processes are
 slow in the probe too (ratio unchanged) the machine, not kinestat, made them slow.
+``--roots``: checkouts of kinestat to compare (e.g. ``/work/main,.``); their processes
+alternate (root 1, root 2, root 1, ...), so both see the same machine.
 """
 
 from __future__ import annotations
@@ -60,10 +62,11 @@ def _probes():
     return (lambda: geev(M0, Mc, wr, wi, d)), (lambda: chain(10_000))
 
 
-def child(arms: list[str], n_single: int) -> dict:
-    """One process: per arm the median single-call µs of ik_all and of the two probes."""
-    sys.path.insert(0, os.path.join(_ROOT, "tests", "serial", "analytic"))
-    sys.path.insert(0, _ROOT)
+def child(arms: list[str], n_single: int, root: str = _ROOT) -> dict:
+    """One process: per arm the median single-call µs of ik_all and of the two probes, with
+    the kinestat of checkout ``root``."""
+    sys.path.insert(0, os.path.join(root, "tests", "serial", "analytic"))
+    sys.path.insert(0, root)
     from arms import arm  # lazy: test arms, only in the child processes
 
     import kinestat  # lazy: only in the child processes
@@ -93,9 +96,9 @@ def child(arms: list[str], n_single: int) -> dict:
     return out
 
 
-def _quart(v) -> str:
+def _quart(v, spec: str = ".1f") -> str:
     q = np.percentile(v, [0, 25, 50, 75, 100])
-    return " / ".join(f"{x:.1f}" for x in q)
+    return " / ".join(format(x, spec) for x in q)
 
 
 def main(argv=None) -> int:
@@ -104,25 +107,34 @@ def main(argv=None) -> int:
     ap.add_argument("--single", type=int, default=200, help="poses timed per process and arm")
     ap.add_argument("--arms", default="jaco6,random1")
     ap.add_argument("--taskset", default=None, help="pin the processes to this CPU list")
+    ap.add_argument("--roots", default=_ROOT, help="comma-separated kinestat checkouts")
     ap.add_argument("--json", action="store_true")
     ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     a = ap.parse_args(argv)
     arms = a.arms.split(",")
+    roots = [os.path.abspath(r) for r in a.roots.split(",")]
     if a.child:
-        print(json.dumps(child(arms, a.single)))
+        print(json.dumps(child(arms, a.single, roots[0])))
         return 0
-    cmd = [sys.executable, os.path.abspath(__file__), "--child", "--arms", a.arms,
-           "--single", str(a.single)]
-    if a.taskset:
-        cmd = ["taskset", "-c", a.taskset] + cmd
-    runs = []
+    by_root: dict[str, list] = {r: [] for r in roots}
     for _ in range(a.processes):
-        p = subprocess.run(cmd, capture_output=True, text=True, check=True)
-        runs.append(json.loads(p.stdout.strip().splitlines()[-1]))
+        for r in roots:
+            cmd = [sys.executable, os.path.abspath(__file__), "--child", "--arms", a.arms,
+                   "--single", str(a.single), "--roots", r]
+            if a.taskset:
+                cmd = ["taskset", "-c", a.taskset] + cmd
+            p = subprocess.run(cmd, capture_output=True, text=True, check=True)
+            by_root[r].append(json.loads(p.stdout.strip().splitlines()[-1]))
     if a.json:
-        print(json.dumps({"load_avg": os.getloadavg(), "runs": runs}, indent=1))
+        print(json.dumps({"load_avg": os.getloadavg(), "runs": by_root}, indent=1))
         return 0
-    print(f"# ik_all single call over {a.processes} processes, {a.single} poses each, "
+    for r, runs in by_root.items():
+        _report(r, runs, arms, a)
+    return 0
+
+
+def _report(root, runs, arms, a) -> None:
+    print(f"# {root}: ik_all single call over {a.processes} processes, {a.single} poses each, "
           f"load {os.getloadavg()}; min / 25% / median / 75% / max of the process medians")
     for name in arms:
         ik = np.array([r[name]["ik_all"] for r in runs])
@@ -132,9 +144,8 @@ def main(argv=None) -> int:
               f"/{ik.size}")
         print(f"{'':8} dgeev probe µs {_quart(ge)}")
         print(f"{'':8} chain probe µs {_quart(ch)}")
-        print(f"{'':8} ik_all / dgeev {_quart(ik / ge)}")
+        print(f"{'':8} ik_all / dgeev {_quart(ik / ge, '.3f')}")
         print(f"{'':8} per process    " + " ".join(f"{x:.0f}" for x in ik))
-    return 0
 
 
 if __name__ == "__main__":
