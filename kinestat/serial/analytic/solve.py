@@ -53,6 +53,13 @@ def _classified(model: ChainModel):
     return classify(model)
 
 
+@lru_cache(maxsize=64)
+def _plan(model: ChainModel):
+    """The model checks and its geometry class, once per model (ik_all's per-call cost)."""
+    _check_chain(model)
+    return _classified(model)
+
+
 def method_for(model: ChainModel) -> str:
     """The method ``ik_all(model, T)`` uses with ``method="auto"``."""
     _check_model(model)
@@ -119,13 +126,17 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     >>> bool(np.any(np.all(np.abs(res.solutions() - q) < 1e-9, axis=1)))
     True
     """
-    _check_model(model)
+    if not isinstance(model, ChainModel):
+        raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
+    kind, data = _plan(model)
     if method not in METHODS:
         raise ModelError(f"ik_all: unknown method {method!r}; expected one of {METHODS}")
     T = T_base_flange
     if type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
             T.shape[-2:] == (4, 4) and backend == "numba":
-        Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
+        # one pose (the single call): a view with the batch axis; otherwise flattened
+        Tf = T[None] if T.ndim == 2 and T.flags.c_contiguous else \
+            np.ascontiguousarray(T.reshape(-1, 4, 4))
         if plain_poses(Tf):
             bad, n_project = call_compiled(_kernels().check_rigid, Tf, 1e-6)
         else:
@@ -138,7 +149,6 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         T = check_poses(T)
         Tf = _nearest_rigid(np.ascontiguousarray(T.reshape(-1, 4, 4)))
     shape = T.shape[:-2]
-    kind, data = _classified(model)
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
     if use in ("pieper", "three-parallel") and use != kind:
         raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
