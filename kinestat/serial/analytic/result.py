@@ -90,6 +90,22 @@ class IKAllResult:
         obj.__dict__.update(fields)
         return obj
 
+    @classmethod
+    def build_one(cls, q, valid, position_error, rotation_error, singular, family_sign,
+                  family_value, family_joints, n_solutions, reason, method, tol,
+                  family_curve=None) -> IKAllResult:
+        """:meth:`build` for one pose (batch shape ``()``) from ``(1, ...)`` arrays, positional:
+        a single call's result in one step (the keyword packing and the loop of :meth:`build`
+        are a sizeable part of a few-µs call)."""
+        obj = object.__new__(cls)
+        obj.__dict__.update(
+            q=q[0], valid=valid[0], position_error=position_error[0],
+            rotation_error=rotation_error[0], singular=singular[0], family_sign=family_sign[0],
+            family_value=family_value[0], family_joints=family_joints,
+            n_solutions=n_solutions[0, ...], reason=reason[0, ...], method=method, tol=tol,
+            family_curve=family_curve)
+        return obj
+
     @property
     def shape(self) -> tuple[int, ...]:
         """The batch shape ``B``."""
