@@ -192,7 +192,7 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
         K.pieper_serial(*args)
     if shape == ():
         return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
-                                     reasons(cnt, _REASON_PIEPER), "pieper", tol)
+                                     _REASON_PIEPER if cnt[0] == 0 else "", "pieper", tol)
     return IKAllResult.build((N,) if shape is None else shape, q=q, valid=valid,
                              position_error=pos, rotation_error=rot, singular=sing,
                              family_sign=sign, family_value=fam, family_joints=(3, 5),
@@ -226,7 +226,7 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
     if shape == () and not near[0]:  # one pose away from the wrist-singular set
         return IKAllResult.build_one(q, valid, pos, rot, np.zeros((1, 8), dtype=bool),
                                      np.zeros((1, 8)), nan_array((1, 8)), None, cnt,
-                                     reasons(cnt, _REASON_3P), "three-parallel", tol)
+                                     _REASON_3P if cnt[0] == 0 else "", "three-parallel", tol)
     fields = dict(q=q, valid=valid, position_error=pos, rotation_error=rot,
                   singular=np.zeros((N, 8), dtype=bool), family_sign=np.zeros((N, 8)),
                   family_value=nan_array((N, 8)), family_joints=None, n_solutions=cnt,

@@ -360,7 +360,7 @@ def _solve_compiled(model, T, form, tol, polish_iters, shape=None) -> IKAllResul
     if shape == ():
         return IKAllResult.build_one(q, valid, pos, rot, np.zeros((1, K16), dtype=bool),
                                      np.zeros((1, K16)), nan_array((1, K16)), None, nsol,
-                                     reason, _method_name(form), tol)
+                                     reason[0], _method_name(form), tol)
     return IKAllResult.build((N,) if shape is None else shape, q=q, valid=valid,
                              position_error=pos, rotation_error=rot,
                              singular=np.zeros((N, K16), dtype=bool),

@@ -96,13 +96,14 @@ class IKAllResult:
                   family_curve=None) -> IKAllResult:
         """:meth:`build` for one pose (batch shape ``()``) from ``(1, ...)`` arrays, positional:
         a single call's result in one step (the keyword packing and the loop of :meth:`build`
-        are a sizeable part of a few-µs call)."""
+        are a sizeable part of a few-µs call). ``reason``: the pose's string."""
         obj = object.__new__(cls)
         obj.__dict__.update(
             q=q[0], valid=valid[0], position_error=position_error[0],
             rotation_error=rotation_error[0], singular=singular[0], family_sign=family_sign[0],
             family_value=family_value[0], family_joints=family_joints,
-            n_solutions=n_solutions[0, ...], reason=reason[0, ...], method=method, tol=tol,
+            n_solutions=n_solutions[0, ...], reason=np.array(reason, dtype=object),
+            method=method, tol=tol,
             family_curve=family_curve)
         return obj
 
