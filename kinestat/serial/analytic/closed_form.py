@@ -168,10 +168,11 @@ def _cf_kernels():
 
 
 def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
-                          wrist_tol: float = _WRIST_TOL,
-                          shape: tuple[int, ...] | None = None) -> IKAllResult:
+                          wrist_tol: float = _WRIST_TOL, shape: tuple[int, ...] | None = None,
+                          plain: bool | None = None) -> IKAllResult:
     """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first); ``shape``:
-    the batch shape of the result (default ``(N,)``)."""
+    the batch shape of the result (default ``(N,)``); ``plain``: the caller has checked
+    :func:`~kinestat.serial.analytic._common.plain_poses` (None: check here)."""
     K = _cf_kernels()
     N = T.shape[0]
     q, valid, pos, rot, cnt = _outputs(N, 8)
@@ -186,7 +187,7 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
     if N >= _PARALLEL_MIN:
         K.pieper_batch(*args)
-    elif plain_poses(T):
+    elif plain_poses(T) if plain is None else plain:
         call_compiled(K.pieper_serial, *args)
     else:
         K.pieper_serial(*args)
@@ -202,9 +203,11 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
 
 def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, *,
                                   tol: float = 1e-9, wrist_tol: float = _WRIST_TOL,
-                                  shape: tuple[int, ...] | None = None) -> IKAllResult:
+                                  shape: tuple[int, ...] | None = None,
+                                  plain: bool | None = None) -> IKAllResult:
     """:func:`solve_three_parallel` by the compiled kernel, with the wrist-singular families
-    (:func:`kinestat.serial.analytic.families.add_wrist_families`) added."""
+    (:func:`kinestat.serial.analytic.families.add_wrist_families`) added; ``shape``, ``plain``
+    as for :func:`solve_pieper_compiled`."""
     K = _cf_kernels()
     N = T.shape[0]
     Kp = data.get("kernel_args")
@@ -219,7 +222,7 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
     args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, cnt, near)
     if N >= _PARALLEL_MIN:
         K.three_parallel_batch(*args)
-    elif plain_poses(T):
+    elif plain_poses(T) if plain is None else plain:
         call_compiled(K.three_parallel_serial, *args)
     else:
         K.three_parallel_serial(*args)

@@ -137,7 +137,8 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         # one pose (the single call): a view with the batch axis; otherwise flattened
         Tf = T[None] if T.ndim == 2 and T.flags.c_contiguous else \
             np.ascontiguousarray(T.reshape(-1, 4, 4))
-        if plain_poses(Tf):
+        plain = plain_poses(Tf)
+        if plain:
             bad, n_project = call_compiled(_kernels().check_rigid, Tf, 1e-6)
         else:
             bad, n_project = _kernels().check_rigid(Tf, 1e-6)
@@ -145,9 +146,11 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
             check_poses(T)  # raises with the full message
         if n_project:
             Tf = _nearest_rigid(Tf)
+            plain = None
     else:
         T = check_poses(T)
         Tf = _nearest_rigid(np.ascontiguousarray(T.reshape(-1, 4, 4)))
+        plain = None
     shape = T.shape[:-2]
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
     if use in ("pieper", "three-parallel") and use != kind:
@@ -163,12 +166,13 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         res = thesis_puma762.solve_puma762(model, Tf, tol=tol, backend=backend)
     elif use == "pieper":
         if fast:
-            return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape)
+            return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape,
+                                                     plain=plain)
         res = closed_form.solve_pieper(model, Tf, data, tol=tol)
     elif use == "three-parallel":
         if fast:
             return closed_form.solve_three_parallel_compiled(model, Tf, data, tol=tol,
-                                                             shape=shape)
+                                                             shape=shape, plain=plain)
         res = families.add_wrist_families(model, Tf, data,
                                           closed_form.solve_three_parallel(model, Tf, data,
                                                                            tol=tol))
