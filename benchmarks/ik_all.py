@@ -19,6 +19,10 @@ verified solutions kinestat lacks. ``n/a`` marks a solver that does not apply. T
 adapter (product-of-exponentials vectors from kinestat's home axes) is validated only for the
 three-parallel class; its zero completeness elsewhere is an adapter/convention mismatch, not a
 finding about ik-geo.
+
+Single-call figures of one process can sit 1.3-1.5x high when the host slows this virtual CPU
+(see docs/ik-all.md, "Performance"); ``benchmarks/ik_all_processes.py`` gives their
+distribution over many processes beside a LAPACK probe that shows the machine's state.
 """
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ import sys
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic._common import nan_array, pack, reasons
+from kinestat.serial.analytic._common import call_compiled, nan_array, pack, plain_poses, reasons
 from kinestat.serial.analytic.families import add_wrist_families
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
@@ -168,23 +168,32 @@ def _cf_kernels():
 
 
 def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
-                          wrist_tol: float = _WRIST_TOL,
-                          shape: tuple[int, ...] | None = None) -> IKAllResult:
+                          wrist_tol: float = _WRIST_TOL, shape: tuple[int, ...] | None = None,
+                          plain: bool | None = None) -> IKAllResult:
     """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first); ``shape``:
-    the batch shape of the result (default ``(N,)``)."""
+    the batch shape of the result (default ``(N,)``); ``plain``: the caller has checked
+    :func:`~kinestat.serial.analytic._common.plain_poses` (None: check here)."""
     K = _cf_kernels()
     N = T.shape[0]
     q, valid, pos, rot, cnt = _outputs(N, 8)
     sing = np.empty((N, 8), dtype=bool)
     sign = np.empty((N, 8))
     fam = np.empty((N, 8))
-    run = K.pieper_batch if N >= _PARALLEL_MIN else K.pieper_serial
     Kp = data.get("kernel_args")
     if Kp is None:  # pose-independent, kept with the model's cached geometry
         ax = data["axes"]
         Kp = data["kernel_args"] = K.pack(model.constants, np.linalg.inv(ax.T0), ax.w, ax.r,
                                           data["wrist"], data["shoulder"], _perp(ax.w[5]))
-    run(Kp, T, tol, wrist_tol, 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
+    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
+    if N >= _PARALLEL_MIN:
+        K.pieper_batch(*args)
+    elif plain_poses(T) if plain is None else plain:
+        call_compiled(K.pieper_serial, *args)
+    else:
+        K.pieper_serial(*args)
+    if shape == ():
+        return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
+                                     _REASON_PIEPER if cnt[0] == 0 else "", "pieper", tol)
     return IKAllResult.build((N,) if shape is None else shape, q=q, valid=valid,
                              position_error=pos, rotation_error=rot, singular=sing,
                              family_sign=sign, family_value=fam, family_joints=(3, 5),
@@ -194,9 +203,11 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
 
 def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, *,
                                   tol: float = 1e-9, wrist_tol: float = _WRIST_TOL,
-                                  shape: tuple[int, ...] | None = None) -> IKAllResult:
+                                  shape: tuple[int, ...] | None = None,
+                                  plain: bool | None = None) -> IKAllResult:
     """:func:`solve_three_parallel` by the compiled kernel, with the wrist-singular families
-    (:func:`kinestat.serial.analytic.families.add_wrist_families`) added."""
+    (:func:`kinestat.serial.analytic.families.add_wrist_families`) added; ``shape``, ``plain``
+    as for :func:`solve_pieper_compiled`."""
     K = _cf_kernels()
     N = T.shape[0]
     Kp = data.get("kernel_args")
@@ -208,8 +219,17 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
                                           data["p56"], _perp(h), sg)
     q, valid, pos, rot, cnt = _outputs(N, 8)
     near = np.empty(N, dtype=bool)
-    run = K.three_parallel_batch if N >= _PARALLEL_MIN else K.three_parallel_serial
-    run(Kp, T, tol, wrist_tol, 1e-6, q, valid, pos, rot, cnt, near)
+    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, cnt, near)
+    if N >= _PARALLEL_MIN:
+        K.three_parallel_batch(*args)
+    elif plain_poses(T) if plain is None else plain:
+        call_compiled(K.three_parallel_serial, *args)
+    else:
+        K.three_parallel_serial(*args)
+    if shape == () and not near[0]:  # one pose away from the wrist-singular set
+        return IKAllResult.build_one(q, valid, pos, rot, np.zeros((1, 8), dtype=bool),
+                                     np.zeros((1, 8)), nan_array((1, 8)), None, cnt,
+                                     _REASON_3P if cnt[0] == 0 else "", "three-parallel", tol)
     fields = dict(q=q, valid=valid, position_error=pos, rotation_error=rot,
                   singular=np.zeros((N, 8), dtype=bool), family_sign=np.zeros((N, 8)),
                   family_value=nan_array((N, 8)), family_joints=None, n_solutions=cnt,

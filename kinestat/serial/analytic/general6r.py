@@ -34,7 +34,14 @@ import scipy.linalg
 from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _rr_algebra as rr
-from kinestat.serial.analytic._common import nan_array, newton_polish, pack, reasons
+from kinestat.serial.analytic._common import (
+    call_compiled,
+    nan_array,
+    newton_polish,
+    pack,
+    plain_poses,
+    reasons,
+)
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.fk import fk
 
@@ -339,38 +346,53 @@ def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     rot = nan_array((N, K16))
     flags = np.zeros(N, dtype=np.int64)
     stats = np.zeros((N, 7))
-    run = K.solve_batch if N >= _PARALLEL_MIN else K.solve_serial
-    run(C, T, consts, links, LH, h0, L, off, order, sign, tol, polish_iters, 1e-6,
-        RECHECK[recheck], q, valid, pos, rot, flags, stats)
+    args = (C, T, consts, links, LH, h0, L, off, order, sign, float(tol), int(polish_iters), 1e-6,
+            RECHECK[recheck], q, valid, pos, rot, flags, stats)
+    if N >= _PARALLEL_MIN:
+        K.solve_batch(*args)
+    elif plain_poses(T):
+        call_compiled(K.solve_serial, *args)
+    else:
+        K.solve_serial(*args)
     return q, valid, pos, rot, flags, stats
 
 
-def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect") -> IKAllResult:
+def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect",
+                    shape=None) -> IKAllResult:
     K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
     if K is None:
         from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
 
     q, valid, pos, rot, flags, _ = run_kernel(model, T, form, tol, polish_iters, recheck)
     N, K16 = valid.shape
-    nsol = np.count_nonzero(valid, axis=1)
+    # result building (a single call is ~70 µs: NumPy's per-call costs matter, so one pose
+    # takes the scalar route and the result is built once, in its final shape)
+    if N == 1:
+        nsol = np.empty(1, dtype=np.int64)
+        nsol[0] = np.count_nonzero(valid)
+        flagged = flags[0] != K.FLAG_OK
+    else:
+        nsol = np.count_nonzero(valid, axis=1)
+        flagged = flags.any()
     reason = reasons(nsol, _REASON_NONE)
-    if not flags.any():
-        return IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
-                           singular=np.zeros((N, K16), dtype=bool),
-                           family_sign=np.zeros((N, K16)), family_value=nan_array((N, K16)),
-                           family_joints=None, n_solutions=nsol, reason=reason,
-                           method=_method_name(form), tol=tol)
-    reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
-    res = IKAllResult(q=q, valid=valid, position_error=pos, rotation_error=rot,
-                      singular=np.zeros((N, K16), dtype=bool), family_sign=np.zeros((N, K16)),
-                      family_value=nan_array((N, K16)), family_joints=None,
-                      n_solutions=nsol, reason=reason, method=_method_name(form), tol=tol)
-    redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
-    if redo.size:  # dggev failed in the kernel: the NumPy reference for these poses
-        sub = _solve(model, T[redo], form, tol, polish_iters)
-        for f in ("q", "valid", "position_error", "rotation_error", "n_solutions", "reason"):
-            getattr(res, f)[redo] = getattr(sub, f)
-    return res
+    if flagged:
+        reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
+        redo = np.flatnonzero(flags == K.FLAG_ILL_CONDITIONED)
+        if redo.size:  # dggev failed in the kernel: the NumPy reference for these poses
+            sub = _solve(model, T[redo], form, tol, polish_iters)
+            q[redo], valid[redo], pos[redo], rot[redo] = (sub.q, sub.valid, sub.position_error,
+                                                          sub.rotation_error)
+            nsol[redo], reason[redo] = sub.n_solutions, sub.reason
+    if shape == ():
+        return IKAllResult.build_one(q, valid, pos, rot, np.zeros((1, K16), dtype=bool),
+                                     np.zeros((1, K16)), nan_array((1, K16)), None, nsol,
+                                     reason[0], _method_name(form), tol)
+    return IKAllResult.build((N,) if shape is None else shape, q=q, valid=valid,
+                             position_error=pos, rotation_error=rot,
+                             singular=np.zeros((N, K16), dtype=bool),
+                             family_sign=np.zeros((N, K16)), family_value=nan_array((N, K16)),
+                             family_joints=None, n_solutions=nsol, reason=reason,
+                             method=_method_name(form), tol=tol)
 
 
 def _method_name(form: Formulation) -> str:
@@ -379,13 +401,16 @@ def _method_name(form: Formulation) -> str:
 
 def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
                      polish_iters: int = 8, form: Formulation | None = None,
-                     backend: str = "numba", recheck: str = "suspect") -> IKAllResult:
+                     backend: str = "numba", recheck: str = "suspect",
+                     shape: tuple[int, ...] | None = None) -> IKAllResult:
     """All IK solutions of a 6R ``model`` for poses ``T (N, 4, 4)`` (Raghavan–Roth 1993).
 
     Returns an :class:`IKAllResult` with ``K = 16`` slots. ``form`` defaults to the model's
     :func:`formulation`; ``backend`` ``"numba"`` (compiled kernel, for formulations with shift
     0 or 5) or ``"numpy"`` (the reference). ``recheck`` (compiled kernel): when the roots are
-    recovered from the QZ eigenvalues instead of the companion's, :data:`RECHECK`.
+    recovered from the QZ eigenvalues instead of the companion's, :data:`RECHECK`. ``shape``:
+    the batch shape of a compiled result (default ``(N,)``; the NumPy reference always returns
+    ``(N,)``).
     """
     check_general(model)
     if recheck not in RECHECK:
@@ -393,5 +418,6 @@ def solve_general_6r(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     if form is None:
         form, _ = formulation(model)
     if backend == "numba" and form.shift in (0, 5):
-        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters, recheck)
+        return _solve_compiled(model, np.ascontiguousarray(T), form, tol, polish_iters, recheck,
+                               shape)
     return _solve(model, T, form, tol, polish_iters)

@@ -78,13 +78,33 @@ class IKAllResult:
         ``__setattr__`` each (a single-pose call is a few µs, so that matters); the fields are
         the dataclass's, ``family_curve`` optional.
         """
-        if len(shape) != 1:
+        if shape == ():  # one pose: index the leading axis of length 1 (a view, cheaper)
+            for f in cls._BATCHED:
+                fields[f] = fields[f][0, ...]  # 0-d arrays stay arrays
+        elif len(shape) != 1:
             for f in cls._BATCHED:
                 a = fields[f]
                 fields[f] = a.reshape(shape + a.shape[1:])
         fields.setdefault("family_curve", None)
         obj = object.__new__(cls)
         obj.__dict__.update(fields)
+        return obj
+
+    @classmethod
+    def build_one(cls, q, valid, position_error, rotation_error, singular, family_sign,
+                  family_value, family_joints, n_solutions, reason, method, tol,
+                  family_curve=None) -> IKAllResult:
+        """:meth:`build` for one pose (batch shape ``()``) from ``(1, ...)`` arrays, positional:
+        a single call's result in one step (the keyword packing and the loop of :meth:`build`
+        are a sizeable part of a few-µs call). ``reason``: the pose's string."""
+        obj = object.__new__(cls)
+        obj.__dict__.update(
+            q=q[0], valid=valid[0], position_error=position_error[0],
+            rotation_error=rotation_error[0], singular=singular[0], family_sign=family_sign[0],
+            family_value=family_value[0], family_joints=family_joints,
+            n_solutions=n_solutions[0, ...], reason=np.array(reason, dtype=object),
+            method=method, tol=tol,
+            family_curve=family_curve)
         return obj
 
     @property

@@ -25,7 +25,7 @@ from kinestat.serial.analytic import (
     general6r,
     thesis_puma762,
 )
-from kinestat.serial.analytic._common import check_poses
+from kinestat.serial.analytic._common import call_compiled, check_poses, plain_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 
@@ -62,6 +62,13 @@ def _check_chain(model: ChainModel) -> None:
 @lru_cache(maxsize=64)
 def _classified(model: ChainModel):
     return classify(model)
+
+
+@lru_cache(maxsize=64)
+def _plan(model: ChainModel):
+    """The model checks and its geometry class, once per model (ik_all's per-call cost)."""
+    _check_chain(model)
+    return _classified(model)
 
 
 def method_for(model: ChainModel) -> str:
@@ -131,23 +138,32 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     >>> bool(np.any(np.all(np.abs(res.solutions() - q) < 1e-9, axis=1)))
     True
     """
-    _check_model(model)
+    if not isinstance(model, ChainModel):
+        raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
+    kind, data = _plan(model)
     if method not in METHODS:
         raise ModelError(f"ik_all: unknown method {method!r}; expected one of {METHODS}")
     T = T_base_flange
     if type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
             T.shape[-2:] == (4, 4) and backend == "numba":
-        Tf = np.ascontiguousarray(T.reshape(-1, 4, 4))
-        bad, n_project = _kernels().check_rigid(Tf, 1e-6)
+        # one pose (the single call): a view with the batch axis; otherwise flattened
+        Tf = T[None] if T.ndim == 2 and T.flags.c_contiguous else \
+            np.ascontiguousarray(T.reshape(-1, 4, 4))
+        plain = plain_poses(Tf)
+        if plain:
+            bad, n_project = call_compiled(_kernels().check_rigid, Tf, 1e-6)
+        else:
+            bad, n_project = _kernels().check_rigid(Tf, 1e-6)
         if bad >= 0:
             check_poses(T)  # raises with the full message
         if n_project:
             Tf = _nearest_rigid(Tf)
+            plain = None
     else:
         T = check_poses(T)
         Tf = _nearest_rigid(np.ascontiguousarray(T.reshape(-1, 4, 4)))
+        plain = None
     shape = T.shape[:-2]
-    kind, data = _classified(model)
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
     if (use in ("pieper", "three-parallel") or kind == decoupled.METHOD) and use != kind:
         raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
@@ -170,15 +186,16 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         res = decoupled.solve_decoupled(model, Tf, tol=tol)
     elif use == "pieper":
         if fast:
-            return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape)
+            return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape,
+                                                     plain=plain)
         res = closed_form.solve_pieper(model, Tf, data, tol=tol)
     elif use == "three-parallel":
         if fast:
             return closed_form.solve_three_parallel_compiled(model, Tf, data, tol=tol,
-                                                             shape=shape)
+                                                             shape=shape, plain=plain)
         res = families.add_wrist_families(model, Tf, data,
                                           closed_form.solve_three_parallel(model, Tf, data,
                                                                            tol=tol))
     else:
-        res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend)
+        res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend, shape=shape)
     return _reshape(res, shape)
