@@ -161,8 +161,12 @@ TURN_DEADBAND_DEG = 0.3
 CURVATURE_SPAN = 4.0
 """Shortest span (mm) of the measured tip path along the travel over which its curvature is
 fitted (below it the path counts as straight)."""
-TRAVEL_TOL = 0.02
-"""Remaining travel (mm) at which the follow task is complete."""
+TRAVEL_TOL = 0.05
+"""Remaining travel (mm) at which the follow task is complete: a few of the robot's counts at
+the tool (one axis count moves the tool by ~0.015-0.03 mm), so that the last step is one the
+rounding to counts can make. At 0.02 mm (below one count) a last step of 0.021 mm rounded to
+no motion and a frictionless run repeated it until its cycle limit (2 of 20 planes with the
+ideal sensor, 2026-12-02)."""
 STEP_RAMP = 0.25
 """With the automatic tilt, once μ is measured, the step limit grows by this fraction of the
 full step per sliding cycle, from ``LEARN_STEP`` (and again from there after a stick)."""

@@ -23,6 +23,7 @@ from kinestat.app.control_run import (
 from kinestat.app.sim_cell import InProcessIO, start_counts
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, start
 from kinestat.control.follow import (
+    TRAVEL_TOL,
     FollowConfig,
     FollowState,
     _friction_hint,
@@ -322,3 +323,31 @@ def test_friction_03_cylinder_meets_the_acceptance():
     assert out["true_normal_force_max_error"] <= 0.5
     assert out["normal_force_rms_error"] <= 0.2
     assert out["friction_estimate"] == pytest.approx(0.3, abs=0.02)
+
+
+def _study_workpiece(k: int):
+    """Workpiece ``k`` of scripts/follow_study.py (seed 13) and its travel direction."""
+    import importlib.util  # lazy: only this test loads the study script
+
+    path = Path(__file__).resolve().parents[2] / "scripts" / "follow_study.py"
+    spec = importlib.util.spec_from_file_location("follow_study", path)
+    study = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(study)
+    rng = np.random.default_rng(13)
+    for i in range(k + 1):
+        name, cell = study.random_cell(rng, i)
+        travel_dir = Y + rng.uniform(-0.2, 0.2, 3)
+    return name, cell, travel_dir
+
+
+def test_the_last_step_is_one_the_robot_can_make(tmp_path):
+    """A frictionless plane of the 20-workpiece study (ideal sensor) whose last travel step,
+    0.021 mm with a 0.02 mm completion tolerance, rounded to no motion: the run repeated it
+    until the cycle limit. It completes, within the tolerance, in far fewer cycles."""
+    name, cell, travel_dir = _study_workpiece(8)
+    assert name.startswith("plane")
+    prep, rep, out = _follow(tmp_path, cell=replace(cell, ideal_sensor=True),
+                             travel_dir=travel_dir)
+    assert out["completed"] and rep.converged, rep.stop_reason
+    assert 50.0 - TRAVEL_TOL <= out["travel"] <= 51.0
+    assert rep.iterations < prep.config.max_iterations // 2
