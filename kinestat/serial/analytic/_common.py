@@ -118,15 +118,40 @@ def _twist_error(F: np.ndarray, T: np.ndarray) -> np.ndarray:
     return np.concatenate([w, v], axis=-1)
 
 
-def newton_polish(model: ChainModel, q: np.ndarray, T: np.ndarray, iters: int = 3) -> np.ndarray:
+def newton_polish(model: ChainModel, q: np.ndarray, T: np.ndarray, iters: int = 3,
+                  rcond: float | None = None) -> np.ndarray:
     """Newton steps ``J(q) δq = ξ(q)`` (Nadkarni eq. 4-11) towards the pose T, batched.
 
     ``q (M, n)``, ``T (M, 4, 4)``; a step is kept only where it lowers the twist error (a
-    singular Jacobian leaves the row as it was).
+    singular Jacobian leaves the row as it was). With ``rcond`` the steps are Gauss–Newton
+    with the pseudo-inverse truncated at ``rcond`` (for Jacobians that are singular at the
+    root).
     """
     q = q.copy()
     if q.shape[0] == 0:
         return q
+    F, J = fk_and_jacobian(model, q)
+    e = _twist_error(F, T)
+    en = np.linalg.norm(e, axis=-1)
+    for _ in range(iters):
+        if rcond is not None:
+            dq = np.einsum("mij,mj->mi", np.linalg.pinv(J, rcond=rcond), e)
+        else:
+            try:
+                dq = np.linalg.solve(J, e[..., None])[..., 0]
+            except np.linalg.LinAlgError:
+                dq = (np.linalg.pinv(J) @ e[..., None])[..., 0]  # some Jacobian is singular
+        dq = np.where(np.isfinite(dq), dq, 0.0)
+        qn = q + dq
+        Fn, Jn = fk_and_jacobian(model, qn)
+        en_new = _twist_error(Fn, T)
+        nn = np.linalg.norm(en_new, axis=-1)
+        better = nn < en
+        q = np.where(better[:, None], qn, q)
+        J = np.where(better[:, None, None], Jn, J)
+        e = np.where(better[:, None], en_new, e)
+        en = np.where(better, nn, en)
+    return q
     F, J = fk_and_jacobian(model, q)
     e = _twist_error(F, T)
     en = np.linalg.norm(e, axis=-1)

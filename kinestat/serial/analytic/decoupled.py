@@ -51,12 +51,11 @@ import numpy as np
 
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic._common import _twist_error, pack, pose_residuals
+from kinestat.serial.analytic._common import newton_polish, pack, pose_residuals
 from kinestat.serial.analytic.closed_form import _wrist
 from kinestat.serial.analytic.geometry import HomeAxes, home_axes, meet, parallel
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1
-from kinestat.serial.jacobian import fk_and_jacobian
 
 __all__ = ["Plan", "plan", "solve_decoupled", "METHOD"]
 
@@ -458,23 +457,8 @@ def _polish_least_squares(model: ChainModel, q: np.ndarray, T: np.ndarray, tol: 
     bad = np.flatnonzero(np.maximum(pos, ang) > 0.1 * tol)
     if bad.size == 0:
         return q
-    qb, Tb = q[bad], T[bad]  # (the pseudo-inverse: a handful of rows)
-    F, J = fk_and_jacobian(model, qb)
-    e = _twist_error(F, Tb)
-    en = np.linalg.norm(e, axis=-1)
-    for _ in range(iters):
-        dq = np.einsum("mij,mj->mi", np.linalg.pinv(J, rcond=1e-7), e)
-        qn = qb + np.where(np.isfinite(dq), dq, 0.0)
-        Fn, Jn = fk_and_jacobian(model, qn)
-        e_new = _twist_error(Fn, Tb)
-        nn = np.linalg.norm(e_new, axis=-1)
-        better = nn < en
-        qb = np.where(better[:, None], qn, qb)
-        J = np.where(better[:, None, None], Jn, J)
-        e = np.where(better[:, None], e_new, e)
-        en = np.where(better, nn, en)
-    q = q.copy()
-    q[bad] = qb
+    q = q.copy()  # (the pseudo-inverse: a handful of rows)
+    q[bad] = newton_polish(model, q[bad], T[bad], iters, rcond=1e-7)
     return q
 
 
