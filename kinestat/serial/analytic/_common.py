@@ -152,25 +152,6 @@ def newton_polish(model: ChainModel, q: np.ndarray, T: np.ndarray, iters: int = 
         e = np.where(better[:, None], en_new, e)
         en = np.where(better, nn, en)
     return q
-    F, J = fk_and_jacobian(model, q)
-    e = _twist_error(F, T)
-    en = np.linalg.norm(e, axis=-1)
-    for _ in range(iters):
-        try:
-            dq = np.linalg.solve(J, e[..., None])[..., 0]
-        except np.linalg.LinAlgError:
-            dq = (np.linalg.pinv(J) @ e[..., None])[..., 0]  # some Jacobian is singular
-        dq = np.where(np.isfinite(dq), dq, 0.0)
-        qn = q + dq
-        Fn, Jn = fk_and_jacobian(model, qn)
-        en_new = _twist_error(Fn, T)
-        nn = np.linalg.norm(en_new, axis=-1)
-        better = nn < en
-        q = np.where(better[:, None], qn, q)
-        J = np.where(better[:, None, None], Jn, J)
-        e = np.where(better[:, None], en_new, e)
-        en = np.where(better, nn, en)
-    return q
 
 
 def pack(model: ChainModel, q: np.ndarray, cand: np.ndarray, T: np.ndarray, K: int, *,
