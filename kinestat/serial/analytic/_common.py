@@ -48,6 +48,19 @@ def call_compiled(kernel, *args):
     return out
 
 
+def run_kernels(batch, serial, args: tuple, T: np.ndarray, parallel_min: int,
+                plain: bool | None = None) -> None:
+    """Run a kernel pair on ``args`` (poses ``T (N, 4, 4)`` among them): the parallel
+    ``batch`` kernel from ``parallel_min`` poses on, else the ``serial`` one, through
+    :func:`call_compiled` when the poses are plain (``plain``, or :func:`plain_poses`)."""
+    if T.shape[0] >= parallel_min:
+        batch(*args)
+    elif plain_poses(T) if plain is None else plain:
+        call_compiled(serial, *args)
+    else:
+        serial(*args)
+
+
 def plain_poses(T: np.ndarray) -> bool:
     """``T`` is a C-contiguous, aligned, writeable float64 ``(N, 4, 4)`` array: the poses
     :func:`call_compiled` may pass to a kernel (one Numba type for all of them)."""

@@ -23,7 +23,7 @@ import sys
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic._common import call_compiled, nan_array, pack, plain_poses, reasons
+from kinestat.serial.analytic._common import nan_array, pack, reasons, run_kernels
 from kinestat.serial.analytic.families import add_wrist_families
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
@@ -185,12 +185,7 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
         Kp = data["kernel_args"] = K.pack(model.constants, np.linalg.inv(ax.T0), ax.w, ax.r,
                                           data["wrist"], data["shoulder"], _perp(ax.w[5]))
     args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
-    if N >= _PARALLEL_MIN:
-        K.pieper_batch(*args)
-    elif plain_poses(T) if plain is None else plain:
-        call_compiled(K.pieper_serial, *args)
-    else:
-        K.pieper_serial(*args)
+    run_kernels(K.pieper_batch, K.pieper_serial, args, T, _PARALLEL_MIN, plain)
     if shape == ():
         return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
                                      _REASON_PIEPER if cnt[0] == 0 else "", "pieper", tol)
@@ -220,12 +215,7 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
     q, valid, pos, rot, cnt = _outputs(N, 8)
     near = np.empty(N, dtype=bool)
     args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, cnt, near)
-    if N >= _PARALLEL_MIN:
-        K.three_parallel_batch(*args)
-    elif plain_poses(T) if plain is None else plain:
-        call_compiled(K.three_parallel_serial, *args)
-    else:
-        K.three_parallel_serial(*args)
+    run_kernels(K.three_parallel_batch, K.three_parallel_serial, args, T, _PARALLEL_MIN, plain)
     if shape == () and not near[0]:  # one pose away from the wrist-singular set
         return IKAllResult.build_one(q, valid, pos, rot, np.zeros((1, 8), dtype=bool),
                                      np.zeros((1, 8)), nan_array((1, 8)), None, cnt,

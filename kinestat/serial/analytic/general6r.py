@@ -35,12 +35,11 @@ from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _rr_algebra as rr
 from kinestat.serial.analytic._common import (
-    call_compiled,
     nan_array,
     newton_polish,
     pack,
-    plain_poses,
     reasons,
+    run_kernels,
 )
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.fk import fk
@@ -348,12 +347,7 @@ def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     stats = np.zeros((N, 7))
     args = (C, T, consts, links, LH, h0, L, off, order, sign, float(tol), int(polish_iters), 1e-6,
             RECHECK[recheck], q, valid, pos, rot, flags, stats)
-    if N >= _PARALLEL_MIN:
-        K.solve_batch(*args)
-    elif plain_poses(T):
-        call_compiled(K.solve_serial, *args)
-    else:
-        K.solve_serial(*args)
+    run_kernels(K.solve_batch, K.solve_serial, args, T, _PARALLEL_MIN)
     return q, valid, pos, rot, flags, stats
 
 
