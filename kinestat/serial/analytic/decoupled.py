@@ -69,7 +69,7 @@ _ROOT_TOL = 1e-5  # distance of an accepted root from the unit circle / real axi
 _TRIM = 1e-10  # top coefficients below this fraction of the largest are dropped
 _SNAP = 1e-12  # |cos| this close to 1 (or a discriminant this small): a double root
 _REASON = ("no real solution: the wrist centre is out of reach of joints 1-3 (the eliminant has "
-           "no real root, or joint 2 cannot follow)")
+           "no real root, joint 2 cannot follow, or no root places the centre)")
 _REASON_WRIST = ("no real solution: the wrist centre is reached, but the spherical wrist cannot "
                  "turn to the orientation (subproblem 2 for q4, q5 has no real root)")
 
@@ -528,6 +528,9 @@ def solve_decoupled(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
     ok = ok & (k < sh[1] * sh[2] * sh[3])  # padding slots hold nothing
     res = pack(model, q, ok, T, 8, tol=tol, method=METHOD, reason_none=_REASON,
                singular=sing, family_sign=sig, family_value=fam, family_joints=(3, 5))
-    placed = (has3[..., None] & ok2).any(axis=(1, 2)) & (res.n_solutions == 0)
+    # the wrist centre is reached (not only a root of the eliminant found: at a pose out of
+    # reach a real root can still leave the centre off by the distance to what joints 1-3 reach)
+    reached = has3[..., None] & ok2 & (miss <= 1e-6 * pl.axes.scale)
+    placed = reached.any(axis=(1, 2)) & (res.n_solutions == 0)
     res.reason[placed] = _REASON_WRIST  # (a fresh array of this call's result)
     return res

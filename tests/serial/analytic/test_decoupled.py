@@ -260,3 +260,19 @@ def test_orientation_out_of_the_wrists_reach_names_the_wrist():
     idx = np.flatnonzero(none)[:4]
     for sols in newton_solutions(model, T[idx], starts=200, iters=50, seed=1, span=3.0):
         assert len(sols) == 0
+
+
+def test_a_wrist_centre_out_of_reach_is_named_as_such():
+    """A pose whose wrist centre joints 1-3 cannot place (checked by sampling them) is
+    refused as out of the position stage's reach, not of the wrist's."""
+    model = kinestat.load("stanford")
+    T = np.eye(4)  # the flange at the base origin
+    w_flange = np.linalg.solve(kinestat.fk(model, np.zeros(6)), np.append(plan(model).wrist, 1))
+    g = np.meshgrid(np.linspace(-np.pi, np.pi, 60), np.linspace(-np.pi, np.pi, 60),
+                    np.linspace(-2.0, 2.0, 60), indexing="ij")
+    q = np.zeros((g[0].size, 6))
+    q[:, 0], q[:, 1], q[:, 2] = (a.ravel() for a in g)
+    centres = kinestat.fk(model, q) @ w_flange
+    assert np.min(np.linalg.norm(centres[:, :3] - (T @ w_flange)[:3], axis=1)) > 0.05
+    res = kinestat.ik_all(model, T)
+    assert res.n_solutions == 0 and "out of reach of joints 1-3" in str(res.reason)
