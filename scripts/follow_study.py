@@ -6,10 +6,13 @@ the start tool point, normal tilted 0-8° from −F_req in a random azimuth) and
 cylinders (radius 150-400 mm, axis within ~20° of the fixed z axis), the initial travel
 direction within ~11° of +y; then the acceptance runs (the default plane and the R = 200 mm
 cylinder, thesis and ideal sensor). Prints one row per run (true figures from the simulator)
-and a summary. Options: ``--friction MU`` (Coulomb friction of every workpiece; it turns on
-``--auto-tilt``), ``--ideal`` (1 nm leg encoders instead of the thesis's resolution).
+and a summary. Options: ``--friction MU`` (Coulomb friction of every workpiece), ``--ideal``
+(1 nm leg encoders instead of the thesis's resolution), ``--auto-tilt auto|on|off`` (the
+follow task's automatic tilt; default auto, as the CLI: it switches itself on when the tip
+sticks; the friction studies before 2026-12-02 ran with it on from the start).
 
     .venv/bin/python scripts/follow_study.py [N] [--acceptance] [--friction MU] [--ideal]
+        [--auto-tilt auto|on|off]
 """
 
 from __future__ import annotations
@@ -60,10 +63,14 @@ def random_cell(rng: np.random.Generator, k: int) -> tuple[str, SimulatedCell]:
     return f"cylinder R {r:.0f}", SimulatedCell(cylinder=CylinderSpec(radius=r, axis=axis))
 
 
-def follow(cell: SimulatedCell, travel_dir, travel: float = 50.0) -> dict:
+AUTO_TILT = {"auto": None, "on": True, "off": False}
+
+
+def follow(cell: SimulatedCell, travel_dir, travel: float = 50.0,
+           auto_tilt: bool | None = None) -> dict:
     req = ControlRequest(force=4.0 * F_HAT, start_tool_point=START, cell=cell, task="follow",
                          travel=travel, travel_dir=np.asarray(travel_dir, dtype=float),
-                         auto_tilt=cell.friction > 0)
+                         auto_tilt=auto_tilt)
     prep = prepare_control(req)
     io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
     t0 = time.perf_counter()
@@ -88,15 +95,17 @@ def _row(name: str, out: dict) -> str:
 HEAD = "| workpiece          | ok  | travel | RMS N  | max N  | lost | cycles | mu^ | stop |"
 
 
-def main(n: int = 20, friction: float = 0.0, ideal: bool = False) -> None:
+def main(n: int = 20, friction: float = 0.0, ideal: bool = False,
+         auto_tilt: str = "auto") -> None:
     rng = np.random.default_rng(13)
-    print(f"friction {friction:g}, {'ideal' if ideal else 'thesis'} sensor")
+    print(f"friction {friction:g}, {'ideal' if ideal else 'thesis'} sensor, automatic tilt "
+          f"{auto_tilt}")
     print(HEAD)
     rows = []
     for k in range(n):
         name, cell = random_cell(rng, k)
         cell = dataclasses.replace(cell, friction=friction, ideal_sensor=ideal)
-        out = follow(cell, Y + rng.uniform(-0.2, 0.2, 3))
+        out = follow(cell, Y + rng.uniform(-0.2, 0.2, 3), auto_tilt=AUTO_TILT[auto_tilt])
         rows.append(out)
         print(_row(name, out), flush=True)
     done = [r for r in rows if r["completed"]]
@@ -106,6 +115,8 @@ def main(n: int = 20, friction: float = 0.0, ideal: bool = False) -> None:
              f"worst {max(r['true_normal_force_max_error'] for r in done):.3f} N; travel "
              f"{min(r['travel'] for r in done):.2f}-{max(r['travel'] for r in done):.2f} mm"
              if done else ""))
+    n_on = sum(bool(r.get("auto_tilt")) for r in rows)
+    print(f"automatic tilt on in {n_on}/{n} runs")
     print(f"passed (completed, RMS <= {0.05 if ideal else 0.2} N, max <= 0.5 N, no contact "
           f"lost, travel within 1 mm): {sum(_passes(r, ideal) for r in rows)}/{n}")
 
@@ -118,8 +129,9 @@ def _passes(out: dict, ideal: bool) -> bool:
                 and out["true_normal_force_max_error"] <= 0.5)
 
 
-def acceptance(friction: float = 0.0) -> None:
-    print(f"acceptance runs (default plane and R = 200 mm cylinder), friction {friction:g}:")
+def acceptance(friction: float = 0.0, auto_tilt: str = "auto") -> None:
+    print(f"acceptance runs (default plane and R = 200 mm cylinder), friction {friction:g}, "
+          f"automatic tilt {auto_tilt}:")
     print(HEAD)
     cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
     for name, cell in (("plane 5°, thesis", SimulatedCell()),
@@ -127,7 +139,7 @@ def acceptance(friction: float = 0.0) -> None:
                        ("cyl R 200, thesis", SimulatedCell(cylinder=cyl)),
                        ("cyl R 200, ideal", SimulatedCell(ideal_sensor=True, cylinder=cyl))):
         cell = dataclasses.replace(cell, friction=friction)
-        print(_row(name, follow(cell, Y)), flush=True)
+        print(_row(name, follow(cell, Y, auto_tilt=AUTO_TILT[auto_tilt])), flush=True)
 
 
 if __name__ == "__main__":
@@ -136,8 +148,11 @@ if __name__ == "__main__":
     ap.add_argument("--acceptance", action="store_true", help="only the acceptance runs")
     ap.add_argument("--friction", type=float, default=0.0)
     ap.add_argument("--ideal", action="store_true")
+    ap.add_argument("--auto-tilt", choices=sorted(AUTO_TILT), default="auto",
+                    help="the follow task's automatic tilt: auto (default: it switches itself "
+                    "on when the tip sticks), on (from the start), off")
     a = ap.parse_args()
     if a.acceptance:
-        acceptance(a.friction)
+        acceptance(a.friction, a.auto_tilt)
     else:
-        main(a.n, a.friction, a.ideal)
+        main(a.n, a.friction, a.ideal, a.auto_tilt)

@@ -162,7 +162,7 @@ class ControlRequest:
     travel_dir: np.ndarray | None = None
     travel_step: float = 1.0
     tilt_deg: float = 0.0
-    auto_tilt: bool = False
+    auto_tilt: bool | None = None
     arm: ArmSpec | None = None
 
 

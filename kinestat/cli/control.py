@@ -280,9 +280,11 @@ def control_command(
     tilt_deg: float = typer.Option(
         0.0, "--tilt-deg", help="follow: tool axis tilted from the measured normal towards "
         "the travel direction (degrees)."),
-    auto_tilt: bool = flag(
-        False, "--auto-tilt", help="follow: tilt the tool axis onto the friction cone's edge "
-        "(estimated), more while the tip sticks (experimental; docs/control.md)."),
+    auto_tilt: bool | None = typer.Option(
+        None, "--auto-tilt/--no-auto-tilt", metavar="", help="follow: tilt the tool axis onto "
+        "the friction cone's edge (estimated), more while the tip sticks: --auto-tilt from "
+        "the start, --no-auto-tilt never; default: it switches itself on when the tip sticks "
+        "under a travel step (friction), unless --tilt-deg is given (docs/control.md)."),
     workpiece: str = typer.Option(
         None, "--workpiece", help="Simulated workpiece: 'plane' (default, --plane-point/"
         "--plane-normal) or 'cylinder:radius=R,axis=x,y,z[,point=x,y,z]' (without point: its "

@@ -191,6 +191,10 @@ CREEP_HOLD = 0.1
 slipping: the breakaway tilt is held, not grown."""
 END_STEP = 0.25
 """Smallest travel step (mm) while the end is approached in halving steps."""
+ENGAGE_STEP = 2.0 * MIN_SLIP
+"""With ``auto_tilt`` None (the default), the automatic tilt switches itself on when the tip
+advanced less than ``SLIDE_FRACTION`` of two travel steps in a row of at least this (mm): the
+tip sticks (:func:`_engages`)."""
 
 
 def _unit3(v, name: str) -> np.ndarray:
@@ -281,6 +285,11 @@ class FollowConfig:
             turns by ``TILT_RATE_DEG`` a cycle near the cone's edge (faster only inward or
             well inside it), is first turned back without travel when it is more than
             ``REALIGN_DEG`` off its axis, and the travel step ramps up (``_step_cap``).
+            True: from the first travel cycle; False: never (a sticking tip then drags the
+            top round until the envelope stops the run, with a hint); None (default): it
+            switches itself on the first time the tip does not follow a travel step of at
+            least ``ENGAGE_STEP`` (:func:`_engages`), unless a tilt is commanded
+            (``tilt_deg``). A frictionless run never engages it and keeps its commands.
         max_contact_lost: cycles without contact during travel before a safe stop.
         min_angle_deg: smallest angle between the travel direction and the approach direction
             or the measured normal.
@@ -295,7 +304,7 @@ class FollowConfig:
     gain: float = 0.8
     settle_tol: float = 0.2
     tilt_deg: float = 0.0
-    auto_tilt: bool = False
+    auto_tilt: bool | None = None
     max_contact_lost: int = 3
     min_angle_deg: float = 10.0
 
@@ -310,6 +319,9 @@ class FollowConfig:
                 raise InputError(f"{name} must be a positive number, got {v!r}")
         if not 0.0 < self.gain <= 1.0:
             raise InputError(f"gain must be in (0, 1], got {self.gain!r}")
+        if self.auto_tilt not in (None, True, False):
+            raise InputError(f"auto_tilt must be True, False or None (automatic), got "
+                             f"{self.auto_tilt!r}")
         if not (math.isfinite(self.tilt_deg) and abs(self.tilt_deg) < 45.0):
             raise InputError(f"tilt must be within ±45°, got {self.tilt_deg!r}")
         d = self.base.start_s6
@@ -368,6 +380,7 @@ class FollowState(ControllerState):
     step_cap: float = 0.0
     slid: bool = False
     curvature_cycles: int = 0
+    tilting: bool = False
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -471,6 +484,22 @@ def _tilt_past_force(s6: np.ndarray, force: np.ndarray, t: np.ndarray) -> float:
     return math.degrees(float((s6 - f) @ t))
 
 
+def _engages(config: FollowConfig, st: FollowState, advance: float) -> bool:
+    """Whether the automatic tilt switches itself on (``auto_tilt`` None, no commanded tilt):
+    the tip advanced less than ``SLIDE_FRACTION`` of a travel step of at least
+    ``ENGAGE_STEP``, twice in a row (``st.sticking``: the last cycle stuck too), and either
+    it never slid yet or the friction ratio measured is at least ``FRICTION_HINT_RATIO``.
+
+    A frictionless tip follows such steps: it slides freely. The short end-of-travel steps
+    are no evidence of friction, nor is one step a frictionless tip lagged (on the R = 200 mm
+    cylinder with the ideal sensor one full step advanced −0.07 mm after the tip had run
+    ahead; μ̂ ≈ 0 there)."""
+    return (config.auto_tilt is None and not st.tilting and config.tilt_deg == 0.0
+            and st.sticking and st.step >= ENGAGE_STEP
+            and advance < SLIDE_FRACTION * st.step
+            and (st.friction_samples == 0 or st.friction_ratio >= FRICTION_HINT_RATIO))
+
+
 def _breakaway_step(st: FollowState) -> float:
     """The automatic tilt's growth (units of ``max_turn_deg``) for a cycle the tip stuck: a
     full turn until the first slip measured the friction, then :data:`BREAKAWAY_DECAY` while
@@ -497,17 +526,20 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
     if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip):
         stuck = st.step > 0 or st.sticking
-        if config.auto_tilt and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
+        if _engages(config, st, advance):  # friction: the tip did not follow a full step
+            return replace(st, travel=travel, last_tip=tip, path=path, sticking=True,
+                           slid=False, step_cap=0.0, tilting=True)
+        if st.tilting and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
             # S6 leans past the measured force by the margin: a stuck tip's force turns with
             # the tool, so this tip is on the cone's edge (creeping): more tilt would only
             # turn the top; it travels (a step slides it)
             stuck = False
         # a tip creeping on under a turn alone (no travel commanded) is slipping already:
         # the breakaway tilt is held, not grown (it would run the tip ahead at the slip)
-        grow = stuck and not (config.auto_tilt and st.step == 0.0 and advance >= CREEP_HOLD)
+        grow = stuck and not (st.tilting and st.step == 0.0 and advance >= CREEP_HOLD)
         # nor in the cycle a travel step stuck: the step pressed the tip along the tilted
         # tool's axis (the force rose); the force control relieves it first
-        grow = grow and not (config.auto_tilt and st.step > 0.0)
+        grow = grow and not (st.tilting and st.step > 0.0)
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck, slid=False,
                        step_cap=0.0 if stuck else st.step_cap,
                        breakaway=st.breakaway + (_breakaway_step(st) if grow else 0.0))
@@ -548,7 +580,8 @@ def decide_follow(config: FollowConfig, state: ControllerState,
         raise InputError("decide_follow: the run is over (state.done); start a new one")
     base = config.base
     model, env = base.model, base.envelope
-    st = state if isinstance(state, FollowState) else FollowState(**vars(state))
+    st = (state if isinstance(state, FollowState)
+          else FollowState(**vars(state), tilting=config.auto_tilt is True))
     st = replace(st, cycle=st.cycle + 1, top_pose=meas.top_pose)
     F = meas.estimate(base.estimator)
     contact = norm3(F) >= base.contact_force
@@ -562,7 +595,8 @@ def decide_follow(config: FollowConfig, state: ControllerState,
     info = {"phase": st.phase, "tip": meas.tip(model), "normal_estimate": st.normal,
             "normal_force": fn, "tangential_force": ft, "travel": st.travel,
             "in_contact": contact,
-            "friction_ratio": st.friction_ratio, "curvature": st.curvature}
+            "friction_ratio": st.friction_ratio, "curvature": st.curvature,
+            "auto_tilt": st.tilting}
     kw = {"force_error": err, "info": info}
     bad = check_measurement(env, model, meas)
     if bad:
@@ -602,7 +636,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
                      f"{np.round(n, 4).tolist()}: it points into the surface", **kw)
     t /= norm3(t)
     tilt = math.radians(config.tilt_deg)
-    if config.auto_tilt:  # S6 along the force's cone edge; tilt more while the tip sticks
+    if st.tilting:  # S6 along the force's cone edge; tilt more while the tip sticks
         tilt = ((math.atan(st.friction_ratio) + math.radians(AUTO_TILT_MARGIN_DEG)
                  if st.friction_samples else 0.0)
                 + math.radians(config.max_turn_deg) * st.breakaway)
@@ -621,28 +655,28 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     # automatic tilt, once the friction is measured: S6 far from its axis (the first slip
     # measured a normal the tool is not tilted about, e.g. the force at first contact leaned
     # sideways) is turned back first, without travel (the tip sticks, the force unchanged)
-    realign = (config.auto_tilt and phase == "travel" and st.friction_samples > 0
+    realign = (st.tilting and phase == "travel" and st.friction_samples > 0
                and mis > REALIGN_DEG)
-    if phase == "travel" and not (config.auto_tilt and st.sticking) and not realign:
+    if phase == "travel" and not (st.tilting and st.sticking) and not realign:
         # half the remaining travel at most (but not below END_STEP, ~10 robot counts at the
         # tool): the tip slides on the surface by up to ~2 mm a cycle as the tool turns (its
         # tangential stiffness is low), so the end is approached in shrinking steps instead of
         # overshot by a full one
         cap = _step_cap(config, st, meas.tip(model), t)
-        if config.auto_tilt:
+        if st.tilting:
             st = replace(st, step_cap=cap)
         step = min(cap, max(0.5 * remaining, min(END_STEP, remaining)))
         travel_vec = step * t
     turn_limit = config.max_turn_deg
-    if config.auto_tilt and phase == "travel" and st.friction_samples:
+    if st.tilting and phase == "travel" and st.friction_samples:
         turn_limit = _auto_turn_limit(config, st, meas.s6, axis, n, mis)
     # before the first slip the breakaway tilt grows every cycle the tip sticks: S6 follows
     # it cycle by cycle (no dead band), so it passes the cone's edge by one increment at most
-    growing = (config.auto_tilt and phase == "travel" and not st.friction_samples
+    growing = (st.tilting and phase == "travel" and not st.friction_samples
                and st.sticking)
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG and not growing
              else _turn(meas.s6, axis, math.radians(turn_limit)))
-    if config.auto_tilt and step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs
+    if st.tilting and step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs
         # the first estimates of κ are the noisiest (short span): fed in over CURVATURE_RAMP
         ramp = min(1.0, st.curvature_cycles / CURVATURE_RAMP) if CURVATURE_RAMP else 1.0
         omega = _curvature_feedforward(n, t, ramp * st.curvature * step, omega,
@@ -672,7 +706,7 @@ def _step_cap(config: FollowConfig, st: FollowState, tip: np.ndarray, t: np.ndar
     turns by κ Δs under the tool, beyond the cone's edge while S6 turns by
     ``TILT_RATE_DEG`` a cycle)."""
     full = config.travel_step
-    if not config.auto_tilt:
+    if not st.tilting:
         return full
     if st.friction_samples < LEARN_CHORDS:
         return LEARN_STEP * full
@@ -723,11 +757,13 @@ def _friction_hint(config: FollowConfig, st: FollowState) -> str:
     """What to do when a refusal came from friction: without the automatic tilt a sticking
     tip drags the top round until the motion range stops the run (docs/control.md, *With
     friction*)."""
-    if config.auto_tilt or not (st.sticking or st.friction_ratio >= FRICTION_HINT_RATIO):
+    if st.tilting or not (st.sticking or st.friction_ratio >= FRICTION_HINT_RATIO):
         return ""
     mu = f" (friction ratio measured {st.friction_ratio:.2f})" if st.friction_ratio else ""
     return (f"; the tip sticks on the workpiece{mu}: with friction use the automatic tilt "
-            "(--auto-tilt, FollowConfig.auto_tilt), which leans the tool onto the friction cone")
+            "(--auto-tilt, FollowConfig.auto_tilt=True; by default it switches itself on when "
+            "the tip sticks under a travel step, unless --no-auto-tilt or --tilt-deg is given), "
+            "which leans the tool onto the friction cone")
 
 
 def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Target, label: str,
@@ -747,7 +783,9 @@ def follow_summary(cycles: list[dict], target_force: float, travel: float) -> di
     """The follow report's figures from the loop's per-cycle summaries: ``travel`` (mm, the
     measured path along the surface), the normal-force errors over the travel cycles (from the
     first travel cycle on; measured, and true when simulated), ``contact_lost`` (travel cycles
-    without contact), and once the tip slid with friction ``friction_estimate`` (μ̂) and
+    without contact), ``auto_tilt`` (whether the automatic tilt was on) and
+    ``auto_tilt_from_travel`` (mm travelled when it came on, None if never), and once the tip
+    slid with friction ``friction_estimate`` (μ̂) and
     ``friction_force_mean`` (N, the tangential force over those cycles)."""
     trav = [c for c in cycles if c.get("phase") == "travel"]
     err = [abs(c["normal_force"] - target_force) for c in trav if c.get("in_contact")]
@@ -755,6 +793,9 @@ def follow_summary(cycles: list[dict], target_force: float, travel: float) -> di
            "contact_lost": sum(1 for c in trav if not c.get("in_contact")),
            "normal_force_rms_error": float(np.sqrt(np.mean(np.square(err)))) if err else None,
            "normal_force_max_error": float(max(err)) if err else None}
+    on = next((c for c in cycles if c.get("auto_tilt")), None)
+    out["auto_tilt"] = on is not None  # the automatic tilt was on (set, or switched itself on)
+    out["auto_tilt_from_travel"] = None if on is None else float(on["travel"])
     slid = [c for c in trav if c.get("in_contact") and c.get("friction_ratio")]
     if slid:  # the friction measured, not fought: mu estimate and mean friction force
         out["friction_estimate"] = float(slid[-1]["friction_ratio"])

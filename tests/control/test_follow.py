@@ -26,6 +26,7 @@ from kinestat.control.follow import (
     TRAVEL_TOL,
     FollowConfig,
     FollowState,
+    _engages,
     _friction_hint,
     decide_follow,
     estimate_normal,
@@ -207,8 +208,8 @@ def test_follow_config_rejects_a_finished_state(tmp_path):
 def test_friction_without_tilt_stops_safely_on_the_motion_range(tmp_path):
     # a sticking tip lags the flange; the top turns about it (Table 3-1's 4°) long before the
     # platform carries mu * F_n across the tool axis: a safe stop with the reason
-    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.3))
-    assert not out["completed"]
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.3), auto_tilt=False)
+    assert not out["completed"] and not out["auto_tilt"]
     assert "Table 3-1" in rep.stop_reason and "refused by the envelope" in rep.stop_reason
     assert "the tip sticks" in rep.stop_reason and "--auto-tilt" in rep.stop_reason
     assert out["contact_lost"] == 0
@@ -218,14 +219,69 @@ def test_the_friction_hint_only_when_friction_is_seen_and_the_tilt_is_off(tmp_pa
     base = _base(tmp_path)
     _, st0 = start(base, np.zeros(6))
     st = FollowState(**vars(st0))
-    off = FollowConfig(base=base, travel=10.0, travel_dir=Y)
-    on = FollowConfig(base=base, travel=10.0, travel_dir=Y, auto_tilt=True)
+    off = FollowConfig(base=base, travel=10.0, travel_dir=Y, auto_tilt=False)
     assert _friction_hint(off, st) == ""  # a free (frictionless) tip: the refusal as it is
     assert _friction_hint(off, replace(st, friction_ratio=0.01)) == ""
     for seen in (replace(st, sticking=True), replace(st, friction_ratio=0.3)):
         assert "--auto-tilt" in _friction_hint(off, seen)
-        assert _friction_hint(on, seen) == ""
+        assert _friction_hint(off, replace(seen, tilting=True)) == ""  # the tilt is on
     assert "0.30" in _friction_hint(off, replace(st, friction_ratio=0.3))
+
+
+def test_the_automatic_tilt_switches_on_only_when_the_tip_sticks_under_a_step(tmp_path):
+    base = _base(tmp_path)
+    _, st0 = start(base, np.zeros(6))
+    st = FollowState(**vars(st0))
+    auto = FollowConfig(base=base, travel=10.0, travel_dir=Y)
+    assert auto.auto_tilt is None  # the default
+    stuck = replace(st, step=1.0, sticking=True)  # the last full step stuck too
+    assert _engages(auto, stuck, advance=0.1)
+    assert not _engages(auto, replace(stuck, sticking=False), advance=0.1)  # once only
+    assert not _engages(auto, stuck, advance=0.6)  # slid
+    assert not _engages(auto, replace(stuck, step=0.1), advance=0.0)  # an end step
+    assert not _engages(auto, replace(stuck, tilting=True), advance=0.0)  # already on
+    # it slid before: only with a measured friction ratio
+    assert not _engages(auto, replace(stuck, friction_samples=3, friction_ratio=0.01), 0.0)
+    assert _engages(auto, replace(stuck, friction_samples=3, friction_ratio=0.2), 0.0)
+    for cfg in (replace(auto, auto_tilt=False), replace(auto, auto_tilt=True),
+                replace(auto, tilt_deg=5.0)):  # set either way, or a commanded tilt
+        assert not _engages(cfg, stuck, advance=0.0)
+    with pytest.raises(InputError, match="auto_tilt"):
+        FollowConfig(base=base, travel=10.0, travel_dir=Y, auto_tilt="yes")
+    # the first cycle's state carries the setting
+    prep = prepare_control(ControlRequest(force=4.0 * F_HAT, start_tool_point=START,
+                                          cell=SimulatedCell(), task="follow", travel_dir=Y))
+    io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
+    from kinestat.control.controller import axis_counts_to_q
+
+    q = axis_counts_to_q(prep.config.model, io.robot_counts())
+    _, s0 = start(prep.config, q, counts_now=io.robot_counts())
+    m = measure(prep.config.model, q, io.sensor().counts, s0.top_pose)
+    for setting in (None, True, False):
+        _, s1 = decide_follow(replace(prep.follow, auto_tilt=setting), s0, m)
+        assert s1.tilting is (setting is True)
+
+
+def test_by_default_friction_switches_the_automatic_tilt_on_and_the_run_completes(tmp_path):
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(friction=0.3))
+    assert out["completed"], rep.stop_reason
+    assert out["auto_tilt"] and out["auto_tilt_from_travel"] <= 1.0  # at the first steps
+    assert out["contact_lost"] == 0 and abs(out["travel"] - 50.0) <= 1.0
+    assert out["friction_estimate"] == pytest.approx(0.3, abs=0.02)
+
+
+def test_frictionless_runs_never_switch_the_automatic_tilt_on(tmp_path):
+    # the default (automatic) gives the very commands of a run with the tilt off
+    cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
+    for cell in (SimulatedCell(), SimulatedCell(cylinder=cyl, ideal_sensor=True)):
+        runs = [_follow(tmp_path, travel=20.0, cell=cell, auto_tilt=a) for a in (None, False)]
+        (_, rep_a, out_a), (_, rep_b, _) = runs
+        assert out_a["completed"] and not out_a["auto_tilt"]
+        assert out_a["auto_tilt_from_travel"] is None
+        assert len(rep_a.cycles) == len(rep_b.cycles)
+        for ca, cb in zip(rep_a.cycles, rep_b.cycles, strict=True):
+            assert ca.get("axis_counts") == cb.get("axis_counts")
+            np.testing.assert_array_equal(ca["tip"], cb["tip"])
 
 
 def test_auto_tilt_follows_with_light_friction_and_learns_mu(tmp_path):
