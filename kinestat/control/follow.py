@@ -381,6 +381,8 @@ class FollowState(ControllerState):
     slid: bool = False
     curvature_cycles: int = 0
     tilting: bool = False
+    stuck_travel: float = 0.0
+    withdraw: float = 0.0
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -526,9 +528,13 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
     if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip):
         stuck = st.step > 0 or st.sticking
-        if _engages(config, st, advance):  # friction: the tip did not follow a full step
+        pushed = st.stuck_travel + st.step  # the travel commanded since the tip last slid
+        if _engages(config, st, advance):  # friction: the tip did not follow its steps
+            # the steps it did not follow are taken back first (the flange returns, the stuck
+            # tip stays): the breakaway then starts as with the tilt on from the start
             return replace(st, travel=travel, last_tip=tip, path=path, sticking=True,
-                           slid=False, step_cap=0.0, tilting=True)
+                           slid=False, step_cap=0.0, tilting=True, stuck_travel=0.0,
+                           withdraw=max(pushed - max(advance, 0.0), 0.0))
         if st.tilting and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
             # S6 leans past the measured force by the margin: a stuck tip's force turns with
             # the tool, so this tip is on the cone's edge (creeping): more tilt would only
@@ -539,8 +545,9 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         grow = stuck and not (st.tilting and st.step == 0.0 and advance >= CREEP_HOLD)
         # nor in the cycle a travel step stuck: the step pressed the tip along the tilted
         # tool's axis (the force rose); the force control relieves it first
-        grow = grow and not (st.tilting and st.step > 0.0)
+        grow = grow and not (st.tilting and st.step > 0.0) and st.withdraw == 0.0
         return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck, slid=False,
+                       stuck_travel=pushed if stuck else 0.0,
                        step_cap=0.0 if stuck else st.step_cap,
                        breakaway=st.breakaway + (_breakaway_step(st) if grow else 0.0))
     u = -F / norm3(F)  # the force on the tool's direction
@@ -566,7 +573,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
                    curvature_cycles=st.curvature_cycles + 1 if kappa != 0.0 else 0,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
                    path_dir=None if c is None else c / norm3(c),
-                   sticking=False, breakaway=brk, slid=True)
+                   sticking=False, breakaway=brk, slid=True, stuck_travel=0.0)
 
 
 def decide_follow(config: FollowConfig, state: ControllerState,
@@ -657,7 +664,11 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     # sideways) is turned back first, without travel (the tip sticks, the force unchanged)
     realign = (st.tilting and phase == "travel" and st.friction_samples > 0
                and mis > REALIGN_DEG)
-    if phase == "travel" and not (st.tilting and st.sticking) and not realign:
+    if phase == "travel" and st.withdraw > 0.0:  # the automatic tilt came on: steps back
+        back = min(st.withdraw, config.travel_step)
+        travel_vec = -back * t
+        st = replace(st, withdraw=st.withdraw - back if st.withdraw - back > 1e-9 else 0.0)
+    elif phase == "travel" and not (st.tilting and st.sticking) and not realign:
         # half the remaining travel at most (but not below END_STEP, ~10 robot counts at the
         # tool): the tip slides on the surface by up to ~2 mm a cycle as the tool turns (its
         # tangential stiffness is low), so the end is approached in shrinking steps instead of
