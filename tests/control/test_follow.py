@@ -268,6 +268,15 @@ def test_by_default_friction_switches_the_automatic_tilt_on_and_the_run_complete
     assert out["auto_tilt"] and out["auto_tilt_from_travel"] <= 1.0  # at the first steps
     assert out["contact_lost"] == 0 and abs(out["travel"] - 50.0) <= 1.0
     assert out["friction_estimate"] == pytest.approx(0.3, abs=0.02)
+    # the steps the stuck tip did not follow are taken back before the tilt grows: the
+    # commanded tool point returns along the travel to where it was before the first step
+    cyc = rep.cycles
+    first = next(i for i, c in enumerate(cyc) if c["phase"] == "travel")
+    on = next(i for i, c in enumerate(cyc) if c.get("auto_tilt"))
+    along = [float((c["tool_point"] - cyc[first - 1]["tool_point"]) @ Y)
+             for c in cyc[first - 1:on + 4]]
+    assert max(along) >= 1.5, along  # two stuck steps of 1 mm
+    assert abs(along[-1]) <= 0.3, along
 
 
 def test_frictionless_runs_never_switch_the_automatic_tilt_on(tmp_path):
