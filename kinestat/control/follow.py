@@ -150,8 +150,12 @@ and drops the normal force ~1.7 N (the soft mode against the axial spring), so t
 creeps up to the slip."""
 LEARN_CHORD_LENGTH = 0.4
 """Shortest chord (mm) for the first ``LEARN_CHORDS`` friction samples (a slow first slip)."""
-AUTO_TILT_MARGIN_DEG = 1.0
-"""The automatic tilt's margin beyond the friction cone (keeps the tip sliding)."""
+AUTO_TILT_MARGIN_DEG = 1.5
+"""The automatic tilt's margin beyond the friction cone (keeps the tip sliding). 1.5°, was 1°
+(2026-12-02): over 40 random workpieces with μ = 0.3 (thesis sensor, seeds 13 and 29) 33/40
+passed every bound, against 29/40 at 1° and 32/40 at 2° (one of which did not complete): a
+tool leaning further past the edge keeps the tip sliding when S6 lags the turning normal,
+and the breakaway's run-ahead was smaller (docs/control.md)."""
 CARRY_MARGIN = 1.0
 """Newtons above the requested force the platform must carry (control overshoot)."""
 SETTLE_ALIGN_DEG = 2.0

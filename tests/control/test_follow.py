@@ -345,12 +345,14 @@ def test_friction_03_the_normal_is_unbiased_and_the_force_held_once_sliding(tmp_
 
 @functools.cache
 def _cylinder_friction_03(ideal: bool):
-    """The R = 200 mm cylinder with μ = 0.3 and the automatic tilt (one run per sensor, shared
-    by the tests below)."""
+    """The R = 200 mm cylinder with μ = 0.3 on the default path: the automatic tilt switches
+    itself on when the tip sticks (one run per sensor, shared by the tests below)."""
     cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
     with tempfile.TemporaryDirectory() as tmp:
-        return _follow(Path(tmp), cell=SimulatedCell(friction=0.3, cylinder=cyl,
-                                                     ideal_sensor=ideal), auto_tilt=True)
+        prep, rep, out = _follow(Path(tmp), cell=SimulatedCell(friction=0.3, cylinder=cyl,
+                                                               ideal_sensor=ideal))
+        assert out["auto_tilt"]
+        return prep, rep, out
 
 
 def test_friction_03_cylinder_no_stick_slip_after_the_breakaway():
