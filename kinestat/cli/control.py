@@ -284,7 +284,7 @@ def control_command(
         None, "--auto-tilt/--no-auto-tilt", metavar="", help="follow: tilt the tool axis onto "
         "the friction cone's edge (estimated), more while the tip sticks: --auto-tilt from "
         "the start, --no-auto-tilt never; default: it switches itself on when the tip sticks "
-        "under a travel step (friction), unless --tilt-deg is given (docs/control.md)."),
+        "under the travel steps (friction), unless --tilt-deg is given (docs/control.md)."),
     workpiece: str = typer.Option(
         None, "--workpiece", help="Simulated workpiece: 'plane' (default, --plane-point/"
         "--plane-normal) or 'cylinder:radius=R,axis=x,y,z[,point=x,y,z]' (without point: its "

@@ -291,9 +291,10 @@ class FollowConfig:
             ``REALIGN_DEG`` off its axis, and the travel step ramps up (``_step_cap``).
             True: from the first travel cycle; False: never (a sticking tip then drags the
             top round until the envelope stops the run, with a hint); None (default): it
-            switches itself on the first time the tip does not follow a travel step of at
-            least ``ENGAGE_STEP`` (:func:`_engages`), unless a tilt is commanded
-            (``tilt_deg``). A frictionless run never engages it and keeps its commands.
+            switches itself on the first time the tip does not follow two travel steps in a
+            row of at least ``ENGAGE_STEP`` (:func:`_engages`), unless a tilt is commanded
+            (``tilt_deg``), and the steps the stuck tip did not follow are taken back first.
+            A frictionless run never engages it and keeps its commands.
         max_contact_lost: cycles without contact during travel before a safe stop.
         min_angle_deg: smallest angle between the travel direction and the approach direction
             or the measured normal.
@@ -768,7 +769,7 @@ def _curvature_feedforward(n: np.ndarray, t: np.ndarray, angle: float, omega: np
     return w
 
 
-def _friction_hint(config: FollowConfig, st: FollowState) -> str:
+def _friction_hint(st: FollowState) -> str:
     """What to do when a refusal came from friction: without the automatic tilt a sticking
     tip drags the top round until the motion range stops the run (docs/control.md, *With
     friction*)."""
@@ -789,7 +790,7 @@ def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Targ
     cmd = move_command(base.model, base.envelope, base.vernier, meas, new, st.axis_counts,
                        label=label, action=action, step=step, rotation_deg=rotation_deg, info=kw)
     if isinstance(cmd, Refusal):
-        return _stop(st, label, cmd.reason + _friction_hint(config, st), **cmd.extra, **kw)
+        return _stop(st, label, cmd.reason + _friction_hint(st), **cmd.extra, **kw)
     return cmd, replace(st, label=label, last_action=action, target=new,
                         axis_counts=cmd.axis_counts, step=step if action == "follow" else 0.0)
 

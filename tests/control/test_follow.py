@@ -219,13 +219,12 @@ def test_the_friction_hint_only_when_friction_is_seen_and_the_tilt_is_off(tmp_pa
     base = _base(tmp_path)
     _, st0 = start(base, np.zeros(6))
     st = FollowState(**vars(st0))
-    off = FollowConfig(base=base, travel=10.0, travel_dir=Y, auto_tilt=False)
-    assert _friction_hint(off, st) == ""  # a free (frictionless) tip: the refusal as it is
-    assert _friction_hint(off, replace(st, friction_ratio=0.01)) == ""
+    assert _friction_hint(st) == ""  # a free (frictionless) tip: the refusal as it is
+    assert _friction_hint(replace(st, friction_ratio=0.01)) == ""
     for seen in (replace(st, sticking=True), replace(st, friction_ratio=0.3)):
-        assert "--auto-tilt" in _friction_hint(off, seen)
-        assert _friction_hint(off, replace(seen, tilting=True)) == ""  # the tilt is on
-    assert "0.30" in _friction_hint(off, replace(st, friction_ratio=0.3))
+        assert "--auto-tilt" in _friction_hint(seen)
+        assert _friction_hint(replace(seen, tilting=True)) == ""  # the tilt is on
+    assert "0.30" in _friction_hint(replace(st, friction_ratio=0.3))
 
 
 def test_the_automatic_tilt_switches_on_only_when_the_tip_sticks_under_a_step(tmp_path):
