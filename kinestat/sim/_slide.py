@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from kinestat.errors import UnreachableError
+
 
 def fd_jacobian(resid, d2: np.ndarray, X: np.ndarray, r: np.ndarray,
                 h: float = 1e-7) -> np.ndarray:
@@ -35,7 +37,11 @@ def damped_slide(resid, d2: np.ndarray, Xg: np.ndarray, tol: float, iters: int =
         t = 1.0
         for _ in range(12):
             cand = d2 - t * step
-            rc, Xc = resid(cand, Xs)[:2]
+            try:
+                rc, Xc = resid(cand, Xs)[:2]
+            except UnreachableError:  # no sticking equilibrium at that anchor: shorter
+                t *= 0.5
+                continue
             if float(np.max(np.abs(rc))) < best:
                 d2, r, Xs, best = cand, rc, Xc, float(np.max(np.abs(rc)))
                 break

@@ -567,15 +567,21 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
     d2 = s1 * u
     Xg = Xb
     # 2-D Newton with a finite-difference Jacobian
-    for _ in range(30):
+    try:
+        for _ in range(30):
+            r, Xs, fs, fFs, rs, fns = resid(d2, Xg)
+            if np.max(np.abs(r)) <= 1e-10:
+                break
+            J = fd_jacobian(resid, d2, Xs, r)
+            d2 = d2 - np.linalg.solve(J, r)
+            Xg = Xs
         r, Xs, fs, fFs, rs, fns = resid(d2, Xg)
-        if np.max(np.abs(r)) <= 1e-10:
-            break
-        J = fd_jacobian(resid, d2, Xs, r)
-        d2 = d2 - np.linalg.solve(J, r)
-        Xg = Xs
-    r, Xs, fs, fFs, rs, fns = resid(d2, Xg)
-    if not np.max(np.abs(r)) <= SLIDE_TOL:  # the plain Newton wandered off: damped instead
+        wandered = not np.max(np.abs(r)) <= SLIDE_TOL
+    except (UnreachableError, np.linalg.LinAlgError):
+        # a step took the anchor metres away, where no sticking equilibrium exists (seen on
+        # a cylinder with friction 0.3: an anchor 15 m off): the damped Newton instead
+        wandered, r = True, np.full(2, np.inf)
+    if wandered:  # the plain Newton wandered off: damped instead
         d2b, Xgb = damped_slide(resid, s1 * u, Xb, SLIDE_CONVERGED)
         rb = resid(d2b, Xgb)
         if np.max(np.abs(rb[0])) < np.max(np.abs(r)):

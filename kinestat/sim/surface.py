@@ -31,6 +31,7 @@ __all__ = ["Cylinder", "solve", "surface_normal", "cylinder_ahead"]
 
 _FIXED_POINT_TOL = 1e-10  # mm: the contact point has settled on the surface
 _FIXED_POINT_ITER = 60
+_FIXED_POINT_ACCEPT = 1e-3  # mm: the best pass is taken when the passes stall below this
 
 
 def _vec3(v, name: str) -> np.ndarray:
@@ -142,6 +143,7 @@ def solve(cell: Cell, flange_pose, *, anchor=None, approach_from=None,
     q = unloaded_tip(cell, flange_pose) if anchor is None else np.asarray(anchor, dtype=float)
     hist: list[float] = []
     prev = None
+    best = None
     for _ in range(_FIXED_POINT_ITER):
         plane = wp.tangent_plane(q)
         eq = equilibrium(replace(cell, workpiece=plane), flange_pose, anchor=anchor,
@@ -149,15 +151,22 @@ def solve(cell: Cell, flange_pose, *, anchor=None, approach_from=None,
         if not eq.in_contact:
             return eq
         hist.append(float(np.linalg.norm(wp.project(eq.tip) - plane.point)))
+        if eq.anchor is not None:
+            eq = replace(eq, anchor=wp.project(eq.anchor))
         if hist[-1] <= _FIXED_POINT_TOL:
-            if eq.anchor is not None:
-                eq = replace(eq, anchor=wp.project(eq.anchor))
             return eq
+        if best is None or hist[-1] < best[0]:
+            best = (hist[-1], eq)
         d = eq.tip - q
         if prev is None:  # a plain pass, then an Aitken-extrapolated one (linear contraction)
             q, prev = eq.tip, d
         else:
             r = min(max(float(d @ prev) / max(float(prev @ prev), 1e-300), -0.9), 0.95)
             q, prev = q + d / (1.0 - r), None
+    if best is not None and best[0] <= _FIXED_POINT_ACCEPT:
+        # the passes stall where the sliding solve's accepted residual (contact.SLIDE_TOL)
+        # leaves the tip: ~1e-4 mm on one R = 282 mm cylinder with friction 0.3, far below a
+        # robot count or the sensor's resolution; the closest pass is the equilibrium
+        return best[1]
     raise UnreachableError(f"simulated cell: the contact point on the cylinder did not settle "
                            f"after {_FIXED_POINT_ITER} tangent-plane passes {hist}")

@@ -3,16 +3,20 @@ surface, in equilibrium with the force along the true normal; a plane is unchang
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from kinestat.errors import InputError
+from kinestat.app.control_run import ControlRequest, CylinderSpec, SimulatedCell, prepare_control
+from kinestat.errors import InputError, UnreachableError
 from kinestat.parallel.platform import special_6_6
 from kinestat.parallel.statics import spring_wrench
-from kinestat.sim.contact import Workpiece, equilibrium, make_cell, unloaded_tip
+from kinestat.sim._slide import damped_slide
+from kinestat.sim.contact import Workpiece, _springs, equilibrium, make_cell, unloaded_tip
 from kinestat.sim.surface import Cylinder, cylinder_ahead, solve, surface_normal
 from kinestat.spatial.transforms import apply_vector, inv
 
@@ -98,3 +102,49 @@ def test_out_of_contact_and_placement():
         Cylinder([0, 0, 0], [0, 0, 1], -1.0)
     with pytest.raises(InputError, match="axis"):
         cylinder_ahead(np.zeros(3), F_HAT, 2.0, 100.0, F_HAT)
+
+
+def test_a_slide_whose_plain_newton_wanders_still_settles():
+    """A state from a follow run (R = 282 mm cylinder, friction 0.3, 2026-12-02) where the
+    slip search's plain Newton stepped the anchor ~15 m away and the tangent-plane passes then
+    stalled at ~1e-4 mm: the slide must still be found, on the surface, on the friction cone's
+    edge and in equilibrium."""
+    d = json.loads((Path(__file__).parent / "data" / "stalled_slide.json").read_text())
+    spec = CylinderSpec(radius=d["radius"], axis=np.array(d["axis"]), point=np.array(d["point"]))
+    prep = prepare_control(ControlRequest(
+        force=4.0 * F_HAT, start_tool_point=np.array([0.0, 0.0, 0.0]), task="follow",
+        travel_dir=np.array([0.0, 1.0, 0.0]),
+        cell=SimulatedCell(friction=d["friction"], cylinder=spec)))
+    cell = prep.cell
+    eq = solve(cell, np.array(d["flange_pose"]), anchor=np.array(d["anchor"]),
+               approach_from=np.array(d["approach_from"]),
+               top_pose_guess=np.array(d["top_pose_guess"]))
+    wp = cell.workpiece
+    assert eq.in_contact and not eq.sticking  # it slides
+    assert abs(float(wp.gap(eq.tip))) <= 1e-3  # on the cylinder (mm)
+    n = surface_normal(wp, eq.tip)
+    fn = float(eq.contact_force @ n)
+    ft = np.linalg.norm(eq.contact_force - fn * n)
+    assert 3.0 < fn < 5.0
+    assert ft == pytest.approx(d["friction"] * fn, rel=1e-3, abs=1e-3)  # on the cone's edge
+    # the springs balance the contact force at the tip (base frame of the top)
+    TB = eq.extra["base_pose"]
+    w = spring_wrench(_springs(cell, eq.top_pose), eq.top_pose)
+    fB = apply_vector(inv(TB), eq.contact_force)
+    pB = (inv(TB) @ np.append(eq.tip, 1.0))[:3]
+    assert np.allclose(w, np.concatenate([fB, np.cross(pB, fB)]), atol=1e-6)
+
+
+def test_the_damped_slide_shortens_steps_into_anchors_without_equilibrium():
+    """``damped_slide`` takes a trial anchor with no sticking equilibrium (the residual raises)
+    as a step too long, and halves it."""
+    root = np.array([0.3, -0.2])
+
+    def resid(d2, X):
+        if np.linalg.norm(d2) > 1.0:  # no equilibrium that far
+            raise UnreachableError("no sticking equilibrium")
+        # flat far from the root: a full Newton step from 0.9 lands at about -4.3
+        return np.array([np.arctan(10.0 * (d2[0] - root[0])), d2[1] - root[1]]), X
+
+    d2, _ = damped_slide(resid, np.array([0.9, 0.0]), None, 1e-12)
+    assert np.allclose(d2, root, atol=1e-9)
