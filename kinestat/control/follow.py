@@ -185,14 +185,20 @@ REALIGN_DEG = 2.0
 """With the automatic tilt, once μ is measured, S6 further than this (degrees) from its axis
 is turned back without travel."""
 CONE_CLEARANCE_DEG = 1.0
+"""S6 may turn fast while it stays this far (degrees) inside the estimated friction cone."""
 CURVATURE_RAMP = 4
 """With the automatic tilt, the curvature feed-forward is fed in over this many cycles after
 the path's curvature is first estimated (the first estimates, over a short span, are the
 noisiest: a full turn on one made the tip stick under the step, +0.6 N)."""
-"""S6 may turn fast while it stays this far (degrees) inside the estimated friction cone."""
 CREEP_HOLD = 0.1
 """With the automatic tilt, a tip that advanced this far (mm) in a cycle without travel is
 slipping: the breakaway tilt is held, not grown."""
+CREEP_MIN = 0.02
+"""Smallest advance of the tip (mm) in a cycle that counts as creeping while μ is learnt. With
+fine leg encoders a stuck tip's measured advance stays below 0.005 mm; with the thesis's
+counts the measured tip jitters by up to ~0.1 mm a cycle (the long tool magnifies a count),
+so there this gate passes noise and the chord (``LEARN_CHORD_LENGTH`` along the travel) is
+what tells a creep."""
 END_STEP = 0.25
 """Smallest travel step (mm) while the end is approached in halving steps."""
 ENGAGE_STEP = 2.0 * MIN_SLIP
@@ -365,6 +371,7 @@ class FollowState(ControllerState):
             (:func:`~kinestat.control.contact_estimate.update_friction`).
         friction_ratio: running estimate of the tangential-to-normal force ratio along the
             slip (μ when sliding), from the force and the chord.
+        sample_tip: (3,) the measured tip at the last friction sample, None before one.
     """
 
     phase: str = "approach"
@@ -388,6 +395,7 @@ class FollowState(ControllerState):
     tilting: bool = False
     stuck_travel: float = 0.0
     withdraw: float = 0.0
+    sample_tip: np.ndarray | None = None
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -475,12 +483,24 @@ def _path_span(path: tuple, tip: np.ndarray, t: np.ndarray) -> float:
     return float(max(x.max(), 0.0) - min(x.min(), 0.0))
 
 
-def _creeping(st: FollowState, path: tuple, tip: np.ndarray) -> bool:
-    """While μ is learnt, a tip that crept :data:`LEARN_CHORD_LENGTH` along the travel over
-    the last cycles slides (the breakaway tilt slips it slowly, below ``MIN_SLIP`` a cycle)."""
-    if st.friction_samples >= LEARN_CHORDS:
+def _creeping(st: FollowState, path: tuple, tip: np.ndarray, advance: float) -> bool:
+    """While μ is learnt, a tip that moved on by ``CREEP_MIN`` this cycle and crept
+    :data:`LEARN_CHORD_LENGTH` along the travel (over the last cycles, and since the last
+    friction sample) slides: the breakaway tilt slips it slowly, below ``MIN_SLIP`` a cycle.
+
+    A tip that stopped sticks again, its force back inside the cone: a sample there
+    underestimates μ and tilts the normal estimate back against the travel (one R = 303 mm
+    cylinder, μ = 0.3: μ̂ 0.289 and the normal 1.8° off from two samples of a stopped tip;
+    with the thesis's counts, whose jitter passes ``CREEP_MIN``, μ̂ 0.246 and 4.6° off, and
+    the tool then tilted inside the true cone stuck and slipped by ±0.56 N). Hence the
+    fresh chord."""
+    if st.friction_samples >= LEARN_CHORDS or advance < CREEP_MIN:
         return False
     c = _chord(path, tip, LEARN_CHORD_LENGTH)
+    if st.sample_tip is not None:  # a fresh chord: it crept on since the last sample
+        c = tip - st.sample_tip
+        if norm3(c) < LEARN_CHORD_LENGTH:
+            return False
     return c is not None and float(c @ st.tangent) > 0.5 * norm3(c)
 
 
@@ -531,7 +551,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     advance = float((tip - st.last_tip) @ s)
     travel = st.travel + advance
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
-    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip):
+    if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip, advance):
         stuck = st.step > 0 or st.sticking
         pushed = st.stuck_travel + st.step  # the travel commanded since the tip last slid
         if _engages(config, st, advance):  # friction: the tip did not follow its steps
@@ -560,8 +580,10 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     c = _chord(path, tip, CHORD_LENGTH if st.friction_samples >= LEARN_CHORDS
                else LEARN_CHORD_LENGTH)
     n = n0  # kept until a chord has measured the friction
+    sample_tip = st.sample_tip
     if c is not None and float(c @ s) > 0.5 * norm3(c):
         raw, samples = update_friction(raw, samples, friction_sample_one(u, c))
+        sample_tip = tip
         mu = min(max(raw, 0.0), MAX_FRICTION)
         n = cone_normal_one(u, c, mu)
     elif samples:
@@ -577,7 +599,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     return replace(st, travel=travel, normal=n, last_tip=tip, path=path, curvature=kappa,
                    curvature_cycles=st.curvature_cycles + 1 if kappa != 0.0 else 0,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
-                   path_dir=None if c is None else c / norm3(c),
+                   path_dir=None if c is None else c / norm3(c), sample_tip=sample_tip,
                    sticking=False, breakaway=brk, slid=True, stuck_travel=0.0)
 
 

@@ -23,9 +23,11 @@ from kinestat.app.control_run import (
 from kinestat.app.sim_cell import InProcessIO, start_counts
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, start
 from kinestat.control.follow import (
+    LEARN_CHORDS,
     TRAVEL_TOL,
     FollowConfig,
     FollowState,
+    _creeping,
     _engages,
     _friction_hint,
     decide_follow,
@@ -259,6 +261,25 @@ def test_the_automatic_tilt_switches_on_only_when_the_tip_sticks_under_a_step(tm
     for setting in (None, True, False):
         _, s1 = decide_follow(replace(prep.follow, auto_tilt=setting), s0, m)
         assert s1.tilting is (setting is True)
+
+
+def test_a_creeping_tip_counts_as_sliding_only_while_it_moves(tmp_path):
+    """While μ is learnt, a tip that crept a chord counts as sliding (a friction sample) only
+    in the cycles it moves on: once it stopped, its force falls back inside the cone and a
+    sample would underestimate μ and tilt the normal estimate back."""
+    _, st0 = start(_base(tmp_path), np.zeros(6))
+    st = replace(FollowState(**vars(st0)), tangent=Y, tilting=True, friction_samples=1)
+    path = tuple(np.array([0.0, 0.1 * k, 0.0]) for k in range(6))  # crept 0.5 mm along y
+    assert _creeping(st, path, path[-1] + 0.05 * Y, advance=0.05)  # moving on
+    assert not _creeping(st, path, path[-1], advance=0.0)  # stopped: the same chord
+    assert not _creeping(st, path, path[-1] + 0.01 * Y, advance=0.01)  # below CREEP_MIN
+    side = np.array([1.0, 0.0, 0.0])
+    assert not _creeping(st, tuple(0.1 * k * side for k in range(6)), 0.55 * side, 0.05)
+    assert not _creeping(replace(st, friction_samples=LEARN_CHORDS), path,
+                         path[-1] + 0.05 * Y, advance=0.05)  # learnt: full chords only
+    # the next sample needs a fresh chord: LEARN_CHORD_LENGTH crept since the last one
+    assert not _creeping(replace(st, sample_tip=path[-1]), path, path[-1] + 0.05 * Y, 0.05)
+    assert _creeping(replace(st, sample_tip=path[0]), path, path[-1] + 0.05 * Y, 0.05)
 
 
 def test_by_default_friction_switches_the_automatic_tilt_on_and_the_run_completes(tmp_path):
