@@ -96,10 +96,10 @@ HEAD = "| workpiece          | ok  | travel | RMS N  | max N  | lost | cycles | 
 
 
 def main(n: int = 20, friction: float = 0.0, ideal: bool = False,
-         auto_tilt: str = "auto") -> None:
-    rng = np.random.default_rng(13)
+         auto_tilt: str = "auto", seed: int = 13) -> None:
+    rng = np.random.default_rng(seed)
     print(f"friction {friction:g}, {'ideal' if ideal else 'thesis'} sensor, automatic tilt "
-          f"{auto_tilt}")
+          f"{auto_tilt}, seed {seed}")
     print(HEAD)
     rows = []
     for k in range(n):
@@ -151,8 +151,10 @@ if __name__ == "__main__":
     ap.add_argument("--auto-tilt", choices=sorted(AUTO_TILT), default="auto",
                     help="the follow task's automatic tilt: auto (default: it switches itself "
                     "on when the tip sticks), on (from the start), off")
+    ap.add_argument("--seed", type=int, default=13,
+                    help="the random workpieces' draw (docs/control.md quotes 13, and 29)")
     a = ap.parse_args()
     if a.acceptance:
         acceptance(a.friction, a.auto_tilt)
     else:
-        main(a.n, a.friction, a.ideal, a.auto_tilt)
+        main(a.n, a.friction, a.ideal, a.auto_tilt, a.seed)
