@@ -496,8 +496,9 @@ def _creeping(st: FollowState, path: tuple, tip: np.ndarray, advance: float) -> 
     fresh chord."""
     if st.friction_samples >= LEARN_CHORDS or advance < CREEP_MIN:
         return False
-    c = _chord(path, tip, LEARN_CHORD_LENGTH)
-    if st.sample_tip is not None:  # a fresh chord: it crept on since the last sample
+    if st.sample_tip is None:
+        c = _chord(path, tip, LEARN_CHORD_LENGTH)
+    else:  # a fresh chord: it crept on since the last sample
         c = tip - st.sample_tip
         if norm3(c) < LEARN_CHORD_LENGTH:
             return False
