@@ -203,8 +203,8 @@ END_STEP = 0.25
 """Smallest travel step (mm) while the end is approached in halving steps."""
 ENGAGE_STEP = 2.0 * MIN_SLIP
 """With ``auto_tilt`` None (the default), the automatic tilt switches itself on when the tip
-advanced less than ``SLIDE_FRACTION`` of two travel steps in a row of at least this (mm): the
-tip sticks (:func:`_engages`)."""
+advanced less than ``SLIDE_FRACTION`` of two travel steps in a row of at least this (mm), or of
+the full ``travel_step`` when that is shorter: the tip sticks (:func:`_engages`)."""
 
 
 def _unit3(v, name: str) -> np.ndarray:
@@ -515,15 +515,18 @@ def _tilt_past_force(s6: np.ndarray, force: np.ndarray, t: np.ndarray) -> float:
 def _engages(config: FollowConfig, st: FollowState, advance: float) -> bool:
     """Whether the automatic tilt switches itself on (``auto_tilt`` None, no commanded tilt):
     the tip advanced less than ``SLIDE_FRACTION`` of a travel step of at least
-    ``ENGAGE_STEP``, twice in a row (``st.sticking``: the last cycle stuck too), and either
-    it never slid yet or the friction ratio measured is at least ``FRICTION_HINT_RATIO``.
+    ``ENGAGE_STEP`` (or of the full ``travel_step``, when that is shorter: with
+    ``--travel-step 0.3`` and μ = 0.3 the tilt never came on, and the stuck tip's growing
+    tangential load stopped the run on the envelope), twice in a row (``st.sticking``: the
+    last cycle stuck too), and either it never slid yet or the friction ratio measured is at
+    least ``FRICTION_HINT_RATIO``.
 
     A frictionless tip follows such steps: it slides freely. The short end-of-travel steps
     are no evidence of friction, nor is one step a frictionless tip lagged (on the R = 200 mm
     cylinder with the ideal sensor one full step advanced −0.07 mm after the tip had run
     ahead; μ̂ ≈ 0 there)."""
     return (config.auto_tilt is None and not st.tilting and config.tilt_deg == 0.0
-            and st.sticking and st.step >= ENGAGE_STEP
+            and st.sticking and st.step >= min(ENGAGE_STEP, config.travel_step)
             and advance < SLIDE_FRACTION * st.step
             and (st.friction_samples == 0 or st.friction_ratio >= FRICTION_HINT_RATIO))
 

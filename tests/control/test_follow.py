@@ -240,6 +240,11 @@ def test_the_automatic_tilt_switches_on_only_when_the_tip_sticks_under_a_step(tm
     assert not _engages(auto, replace(stuck, sticking=False), advance=0.1)  # once only
     assert not _engages(auto, stuck, advance=0.6)  # slid
     assert not _engages(auto, replace(stuck, step=0.1), advance=0.0)  # an end step
+    # with a travel step below ENGAGE_STEP its full steps count (else the tilt never came on)
+    fine = replace(auto, travel_step=0.3)
+    assert _engages(fine, replace(stuck, step=0.3), advance=0.05)
+    assert not _engages(fine, replace(stuck, step=0.3), advance=0.2)  # it followed
+    assert not _engages(fine, replace(stuck, step=0.1), advance=0.0)  # an end step
     assert not _engages(auto, replace(stuck, tilting=True), advance=0.0)  # already on
     # it slid before: only with a measured friction ratio
     assert not _engages(auto, replace(stuck, friction_samples=3, friction_ratio=0.01), 0.0)
@@ -261,6 +266,17 @@ def test_the_automatic_tilt_switches_on_only_when_the_tip_sticks_under_a_step(tm
     for setting in (None, True, False):
         _, s1 = decide_follow(replace(prep.follow, auto_tilt=setting), s0, m)
         assert s1.tilting is (setting is True)
+
+
+def test_with_a_short_travel_step_friction_still_switches_the_tilt_on(tmp_path):
+    """``--travel-step 0.3`` (below ENGAGE_STEP) with μ = 0.3: the automatic tilt comes on and
+    the run completes (before, the tip stuck under every step and the run stopped on the
+    envelope at the start)."""
+    prep, rep, out = _follow(tmp_path, travel=5.0, travel_step=0.3,
+                             cell=SimulatedCell(friction=0.3))
+    assert out["completed"], rep.stop_reason
+    assert out["auto_tilt"] and out["contact_lost"] == 0
+    assert abs(out["travel"] - 5.0) <= 1.0
 
 
 def test_a_creeping_tip_counts_as_sliding_only_while_it_moves(tmp_path):
