@@ -104,12 +104,25 @@ def test_out_of_contact_and_placement():
         cylinder_ahead(np.zeros(3), F_HAT, 2.0, 100.0, F_HAT)
 
 
-def test_a_slide_whose_plain_newton_wanders_still_settles():
-    """A state from a follow run (R = 282 mm cylinder, friction 0.3, 2026-12-02) where the
-    slip search's plain Newton stepped the anchor ~15 m away and the tangent-plane passes then
-    stalled at ~1e-4 mm: the slide must still be found, on the surface, on the friction cone's
-    edge and in equilibrium."""
-    d = json.loads((Path(__file__).parent / "data" / "stalled_slide.json").read_text())
+@pytest.mark.parametrize("name", ["stalled_slide", "wandering_slide"])
+def test_a_slide_whose_plain_newton_wanders_still_settles(name, monkeypatch):
+    """States from follow runs (friction 0.3, 2026-12-02) where the tangent-plane passes on a
+    sliding contact wandered at 1e-5 to 3e-4 mm: ``stalled_slide`` (R = 282 mm; the slip
+    search's plain Newton also stepped the anchor ~15 m away) and ``wandering_slide``
+    (R = 200 mm, ``kinestat control`` on the simulated devices: all 60 passes, 5 s, stopped the
+    run on stale encoder data). The slide must be found in a few passes, on the surface, on the
+    friction cone's edge and in equilibrium."""
+    import kinestat.sim.surface as surface
+
+    passes = []
+    plain = surface.equilibrium
+
+    def counted(*a, **kw):
+        passes.append(1)
+        return plain(*a, **kw)
+
+    monkeypatch.setattr(surface, "equilibrium", counted)
+    d = json.loads((Path(__file__).parent / "data" / f"{name}.json").read_text())
     spec = CylinderSpec(radius=d["radius"], axis=np.array(d["axis"]), point=np.array(d["point"]))
     prep = prepare_control(ControlRequest(
         force=4.0 * F_HAT, start_tool_point=np.array([0.0, 0.0, 0.0]), task="follow",
@@ -133,6 +146,7 @@ def test_a_slide_whose_plain_newton_wanders_still_settles():
     fB = apply_vector(inv(TB), eq.contact_force)
     pB = (inv(TB) @ np.append(eq.tip, 1.0))[:3]
     assert np.allclose(w, np.concatenate([fB, np.cross(pB, fB)]), atol=1e-6)
+    assert len(passes) <= 6, len(passes)
 
 
 def test_the_damped_slide_shortens_steps_into_anchors_without_equilibrium():
