@@ -59,9 +59,11 @@ def _found(res_q, valid, q):
 
 
 def test_near_fold_jaco2_generating_configuration_always_found():
-    """10⁴ near-fold poses: the companion alone misses generators here (checked below), the
-    default (QZ on suspect poses) misses none and equals rechecking every pose."""
-    model, q = _near_fold_jaco2(10_000, seed=8)
+    """10⁴ near-fold poses (θ5 within 0.01 of the fold): the companion alone misses generators
+    here (checked below), the default (QZ on suspect poses) misses none and equals rechecking
+    every pose. (Within 0.05 the companion alone missed some on the machine of 2026-12-01 and
+    none on that of 2026-12-02: rounding differs between machines, hence the narrower band.)"""
+    model, q = _near_fold_jaco2(10_000, seed=8, width=0.01)
     T = kinestat.fk(model, q)
     form, _ = g.formulation(model)
     runs = {m: g.run_kernel(model, T, form, 1e-9, 8, m) for m in ("never", "suspect", "always")}
