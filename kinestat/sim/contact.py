@@ -6,6 +6,10 @@ flange pose this module solves the **contact equilibrium** of the top platform a
 true leg lengths and the true contact force; :class:`kinestat.sim.sensor.Sensor` turns leg
 lengths into encoder counts as the platform's encoders would.
 
+Over 600 lines on purpose: the stick/slip solve (:func:`_stick_or_slip`) keeps the sticking
+solve and its slide residual as closures shared by the slide's three searches (secant and
+Newton here; the damped Newton and the snap in :mod:`kinestat.sim._slide`).
+
 Frames and conventions (all lengths in mm, forces in N):
 
 * ``flange_pose`` is ``F_6T``, frame 6 in the fixed frame (:func:`kinestat.serial.puma762.forward`).
@@ -56,7 +60,7 @@ from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.platform import Platform
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
-from kinestat.sim._slide import damped_slide, fd_jacobian
+from kinestat.sim._slide import damped_slide, fd_jacobian, snap_slide
 from kinestat.spatial.transforms import apply, apply_vector, as_array, inv, make_pose, skew
 from kinestat.spatial.validate import frozen
 
@@ -455,7 +459,7 @@ def equilibrium(
         else:
             a = as_array(anchor, shape_tail=(3,), name="anchor")
             a = a - float(wp.gap(a)) * wp.normal
-        sol = _stick_or_slip(cell, TB, TBinv, nB, a, home, tol, max_iter)
+        sol = _stick_or_slip(cell, TB, TBinv, nB, a, home, tol, max_iter, top_pose_guess)
         if sol is not None:
             X, f_B, a_new, sticking, res, iters = sol
             fF = apply_vector(TB, f_B)
@@ -500,8 +504,10 @@ def _finish(cell: Cell, T, X, contact_force_F, anchor, sticking, res, iters, ext
                        residual=float(res), iterations=int(iters), normal_force=fn, extra=extra)
 
 
-def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
+def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter, guess=None):
     """Sticking at ``a_F`` if friction allows, else quasi-static slip; None if it would pull.
+    The sticking solve starts from ``home``, then from ``guess`` (the previous solution's top
+    pose: continuation) if that fails.
 
     Returns (X, f_B, anchor_F, sticking, residual, iterations)."""
     mu = cell.workpiece.friction
@@ -525,7 +531,12 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
         fF = apply_vector(TB, f)
         return X, f, fF, res
 
-    X, f, fF, res = stick(a_F, home)
+    try:
+        X, f, fF, res = stick(a_F, home)
+    except UnreachableError:
+        if guess is None:
+            raise
+        X, f, fF, res = stick(a_F, np.asarray(guess, dtype=float))
     fn = float(fF @ nF)
     if fn < 0.0:
         return None
@@ -550,24 +561,25 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
         return float(r @ u), Xs
 
     s0 = (np.linalg.norm(ft) - mu * fn) / 2.0  # ~N per (N/mm): a first guess in mm
-    s0 = max(min(s0, 5.0), 1e-3)
-    ga, Xa = g1(s0, X)
-    s1 = s0 * 1.5
-    gb, Xb = g1(s1, Xa)
-    for _ in range(60):
-        if abs(gb - ga) < 1e-300:
-            break
-        s2 = s1 - gb * (s1 - s0) / (gb - ga)
-        s2 = max(s2, 1e-9)
-        s0, ga, Xa = s1, gb, Xb
-        s1 = s2
-        gb, Xb = g1(s1, Xa)
-        if abs(gb) < 1e-11 or abs(s1 - s0) < 1e-13:
-            break
-    d2 = s1 * u
-    Xg = Xb
-    # 2-D Newton with a finite-difference Jacobian
+    s0 = s1 = max(min(s0, 5.0), 1e-3)
+    Xb, Xs, fs, fFs, rs, fns = X, X, f, fF, res, fn
     try:
+        ga, Xa = g1(s0, X)
+        s1 = s0 * 1.5
+        gb, Xb = g1(s1, Xa)
+        for _ in range(60):
+            if abs(gb - ga) < 1e-300:
+                break
+            s2 = s1 - gb * (s1 - s0) / (gb - ga)
+            s2 = max(s2, 1e-9)
+            s0, ga, Xa = s1, gb, Xb
+            s1 = s2
+            gb, Xb = g1(s1, Xa)
+            if abs(gb) < 1e-11 or abs(s1 - s0) < 1e-13:
+                break
+        d2 = s1 * u
+        Xg = Xb
+        # 2-D Newton with a finite-difference Jacobian
         for _ in range(30):
             r, Xs, fs, fFs, rs, fns = resid(d2, Xg)
             if np.max(np.abs(r)) <= 1e-10:
@@ -580,10 +592,14 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
     except (UnreachableError, np.linalg.LinAlgError):
         # a step took the anchor metres away, where no sticking equilibrium exists (seen on
         # a cylinder with friction 0.3: an anchor 15 m off): the damped Newton instead
-        wandered, r = True, np.full(2, np.inf)
+        wandered, r, d2 = True, np.full(2, np.inf), np.zeros(2)
+        Xs, fs, fFs, rs, fns = X, f, fF, res, fn
     if wandered:  # the plain Newton wandered off: damped instead
-        d2b, Xgb = damped_slide(resid, s1 * u, Xb, SLIDE_CONVERGED)
-        rb = resid(d2b, Xgb)
+        try:
+            d2b, Xgb = damped_slide(resid, s1 * u, Xb, SLIDE_CONVERGED)
+            rb = resid(d2b, Xgb)
+        except UnreachableError:  # not even the secant's point: the snap below
+            rb = (np.full(2, np.inf),)
         if np.max(np.abs(rb[0])) < np.max(np.abs(r)):
             d2, Xg = d2b, Xgb
             r, Xs, fs, fFs, rs, fns = rb
@@ -593,6 +609,15 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter):
     # within the cone up to the accepted residual (|f_t| ≤ μ f_n + |r| when r is the residual)
     if not (np.max(np.abs(r)) <= SLIDE_TOL
             and np.linalg.norm(ft_s) <= mu * fns * (1.0 + 1e-6) + np.hypot(*r)):
+        def tangential(d, Xq):  # (f_t in the plane's basis, f_n, X) at the anchor a_F + d
+            Xq, _, fq, _ = stick(a_F + d[0] * e1 + d[1] * e2, Xq)
+            return np.array([fq @ e1, fq @ e2]), float(fq @ nF), Xq
+
+        snap = snap_slide(tangential, mu, X)
+        if snap is not None:  # no root near the anchor: the tip snaps on and sticks again
+            aF = a_F + snap[0][0] * e1 + snap[0][1] * e2
+            Xs, fs, _, rs = stick(aF, snap[1])
+            return Xs, fs, aF, True, rs, iters
         raise UnreachableError(
             f"simulated cell: the sliding contact did not settle (friction residual "
             f"{np.max(np.abs(r)):.3g} N)")
