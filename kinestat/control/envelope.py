@@ -22,7 +22,11 @@ through the platform's point stiffness at the tip, ``K_tip``, the inverse of the
 translational compliance computed from the spatial stiffness at the measured pose
 (:func:`kinestat.parallel.stiffness.stiffness`, which includes the load terms), plus the
 moment of the present load about the moved point of application. Out of contact the same
-prediction is the load if the workpiece were met at the very start of the step.
+prediction is the load if the workpiece were met at the very start of the step. The pinned
+tip bounds the load, not the top's motion: a frictionless tip that runs on a tight convex
+surface (an R = 100 mm cylinder at 4 N, docs/control.md "Limits") carried the top 0.01–0.03°
+past the 4° range after commands predicted inside it; the next measurement's check stopped
+the run there.
 
 Every check returns a list of violations (empty: safe); :func:`require` turns them into a
 :class:`~kinestat.errors.SafetyStop`.
