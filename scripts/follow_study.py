@@ -12,7 +12,7 @@ follow task's automatic tilt; default auto, as the CLI: it switches itself on wh
 sticks; the friction studies before 2026-12-02 ran with it on from the start).
 
     .venv/bin/python scripts/follow_study.py [N] [--acceptance] [--friction MU] [--ideal]
-        [--auto-tilt auto|on|off]
+        [--auto-tilt auto|on|off] [--seed N] [--budget]
 """
 
 from __future__ import annotations
@@ -81,33 +81,55 @@ def follow(cell: SimulatedCell, travel_dir, travel: float = 50.0,
     return out
 
 
-def _row(name: str, out: dict) -> str:
+def error_budget(out: dict, target: float = 4.0) -> tuple[float, int, float, int]:
+    """The true normal-force error's squares summed over the travel cycles before the first
+    friction sample (the tip stuck, the normal still the first contact's force) and from it
+    on: ``(N² before, cycles before, N² after, cycles after)``. A frictionless run, whose μ̂
+    stays 0, counts as all "before"."""
+    sums = [0.0, 0, 0.0, 0]
+    slid = False
+    for c in out["cycles"]:
+        if c.get("phase") != "travel" or c.get("true_force") is None:
+            continue
+        slid = slid or bool(c.get("friction_ratio"))
+        fn = -float(np.asarray(c["true_force"]) @ np.asarray(c["true_normal"]))
+        k = 2 if slid else 0
+        sums[k] += (fn - target) ** 2
+        sums[k + 1] += 1
+    return sums[0], sums[1], sums[2], sums[3]
+
+
+def _row(name: str, out: dict, budget: bool = False) -> str:
     def f(key, fmt):
         v = out.get(key)
         return "-" if v is None else format(v, fmt)
+    extra = ""
+    if budget:
+        b, nb, a, na = error_budget(out)
+        extra = f" {b:.3f} N² / {nb} | {a:.3f} N² / {na} |"
     return (f"| {name:18s} | {'yes' if out['completed'] else 'NO':3s} | {out['travel']:6.2f} | "
             f"{f('true_normal_force_rms_error', '.3f'):>6s} | "
             f"{f('true_normal_force_max_error', '.3f'):>6s} | {out['contact_lost']} | "
             f"{out['iterations']:3d} | {f('friction_estimate', '.3f'):>5s} | "
-            f"{out['stop_reason'][:60]} |")
+            f"{out['stop_reason'][:60]} |" + extra)
 
 
 HEAD = "| workpiece          | ok  | travel | RMS N  | max N  | lost | cycles | mu^ | stop |"
 
 
 def main(n: int = 20, friction: float = 0.0, ideal: bool = False,
-         auto_tilt: str = "auto", seed: int = 13) -> None:
+         auto_tilt: str = "auto", seed: int = 13, budget: bool = False) -> None:
     rng = np.random.default_rng(seed)
     print(f"friction {friction:g}, {'ideal' if ideal else 'thesis'} sensor, automatic tilt "
           f"{auto_tilt}, seed {seed}")
-    print(HEAD)
+    print(HEAD + (" error² before the first slip / cycles | after |" if budget else ""))
     rows = []
     for k in range(n):
         name, cell = random_cell(rng, k)
         cell = dataclasses.replace(cell, friction=friction, ideal_sensor=ideal)
         out = follow(cell, Y + rng.uniform(-0.2, 0.2, 3), auto_tilt=AUTO_TILT[auto_tilt])
         rows.append(out)
-        print(_row(name, out), flush=True)
+        print(_row(name, out, budget), flush=True)
     done = [r for r in rows if r["completed"]]
     print(f"\ncompleted {len(done)}/{n}; "
           + (f"true normal-force RMS error median {np.median([r['true_normal_force_rms_error'] for r in done]):.3f} N, "  # noqa: E501
@@ -119,6 +141,10 @@ def main(n: int = 20, friction: float = 0.0, ideal: bool = False,
     print(f"automatic tilt on in {n_on}/{n} runs")
     print(f"passed (completed, RMS <= {0.05 if ideal else 0.2} N, max <= 0.5 N, no contact "
           f"lost, travel within 1 mm): {sum(_passes(r, ideal) for r in rows)}/{n}")
+    if budget:
+        tot = np.sum([error_budget(r) for r in rows], axis=0)
+        print(f"squared error over all runs: {tot[0]:.2f} N² in {int(tot[1])} cycles before "
+              f"the first slip, {tot[2]:.2f} N² in {int(tot[3])} cycles after")
 
 
 def _passes(out: dict, ideal: bool) -> bool:
@@ -151,10 +177,12 @@ if __name__ == "__main__":
     ap.add_argument("--auto-tilt", choices=sorted(AUTO_TILT), default="auto",
                     help="the follow task's automatic tilt: auto (default: it switches itself "
                     "on when the tip sticks), on (from the start), off")
+    ap.add_argument("--budget", action="store_true",
+                    help="also the squared error before the first slip and after, per run")
     ap.add_argument("--seed", type=int, default=13,
                     help="the random workpieces' draw (docs/control.md quotes 13, and 29)")
     a = ap.parse_args()
     if a.acceptance:
         acceptance(a.friction, a.auto_tilt)
     else:
-        main(a.n, a.friction, a.ideal, a.auto_tilt, a.seed)
+        main(a.n, a.friction, a.ideal, a.auto_tilt, a.seed, a.budget)
