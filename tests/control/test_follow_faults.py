@@ -1,0 +1,78 @@
+"""The follow task behind the real Galil client and encoder reader (TCP loopback and a pty),
+with faults injected during the travel: like the press task's (``test_loop.py``), every fault
+must end in a safe stop (ST sent) with a complete log, and no command may leave the axis
+limits or the platform's load and deflection limits."""
+
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+import pytest
+
+from kinestat.app.control_run import ControlRequest, SimulatedCell, prepare_control
+from kinestat.app.sim_cell import SimHarness, start_counts
+from kinestat.control.follow import decide_follow
+from kinestat.control.log import CycleLog, read_log
+from kinestat.control.loop import run
+
+from .conftest import F_HAT
+from .test_loop import FAST
+
+START = np.array([-400.0, 800.0, -100.0])
+
+
+def _follow_with(tmp_path, inject, friction=0.0):
+    prep = prepare_control(ControlRequest(
+        force=4.0 * F_HAT, start_tool_point=START, cell=SimulatedCell(friction=friction),
+        task="follow", travel=10.0, travel_dir=np.array([0.0, 1.0, 0.0])))
+    path = tmp_path / "log.jsonl"
+    with SimHarness(prep.cell, prep.sensor, start_counts=start_counts(prep.config),
+                    record=True) as h:
+        io = h.device_io(profile=FAST, reader_options={"stale_after": 0.3}, client_timeout=0.5)
+        injected = []
+
+        def progress(rec):  # the fault comes during the travel, a few cycles in
+            task = rec.get("task") or {}
+            if not injected and task.get("phase") == "travel" and task.get("travel", 0.0) > 1.0:
+                injected.append(rec["cycle"])
+                inject(h)
+
+        with CycleLog(path) as log:
+            rep = run(prep.config, io, log, progress=progress,
+                      decide_fn=functools.partial(decide_follow, prep.follow))
+        commands = list(h.controller.commands)
+    return prep, rep, read_log(path), commands, injected
+
+
+FAULTS = {
+    "corrupt packets": (lambda h: h.emitter.corrupt(40), "sensor link unreliable"),
+    "frozen sensor": (lambda h: h.emitter.freeze(), "stale encoder data"),
+    "silent sensor": (lambda h: h.emitter.silence(), "stale encoder data"),
+    "rejected move": (lambda h: h.server.reject_next("PA"), "Galil rejected 'PA"),
+    "closed link": (lambda h: h.server.drop_link(), "device fault"),
+}
+
+
+@pytest.mark.parametrize("friction", [0.0, 0.3])
+@pytest.mark.parametrize("fault", sorted(FAULTS))
+def test_a_fault_during_the_travel_stops_the_cell_with_a_complete_log(tmp_path, fault,
+                                                                       friction):
+    inject, reason = FAULTS[fault]
+    prep, rep, recs, commands, injected = _follow_with(tmp_path, inject, friction)
+    assert injected, "the travel never started"
+    assert not rep.converged and reason in rep.stop_reason, rep.stop_reason
+    assert commands[-1] == "ST" or "ST sent" in rep.stop_reason
+    kinds = [r["type"] for r in recs]
+    assert kinds[0] == "start" and kinds[-1] == "end"
+    assert kinds.count("cycle") == rep.iterations
+    assert any(r["type"] == "fault" for r in recs)
+    lo, hi = prep.config.model.limits_deg.T
+    for r in recs:
+        c = r.get("commanded")
+        if c:
+            a = np.asarray(c["axis_deg"])
+            assert np.all((a >= lo) & (a <= hi))
+            if c.get("predicted_force_magnitude") is not None:
+                assert c["predicted_force_magnitude"] <= 50.0
+                assert np.max(np.abs(c["predicted_deflections"])) <= 5.0
