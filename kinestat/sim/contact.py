@@ -562,7 +562,7 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter, guess=No
 
     s0 = (np.linalg.norm(ft) - mu * fn) / 2.0  # ~N per (N/mm): a first guess in mm
     s0 = s1 = max(min(s0, 5.0), 1e-3)
-    Xb, Xs, fs, fFs, rs, fns = X, X, f, fF, res, fn
+    Xb = X  # the damped Newton's start if the secant fails at once
     try:
         ga, Xa = g1(s0, X)
         s1 = s0 * 1.5

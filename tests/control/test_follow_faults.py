@@ -17,7 +17,7 @@ from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import run
 
 from .conftest import F_HAT
-from .test_loop import FAST
+from .test_loop import FAST, _assert_inside_envelope, _assert_log_complete
 
 START = np.array([-400.0, 800.0, -100.0])
 
@@ -63,16 +63,6 @@ def test_a_fault_during_the_travel_stops_the_cell_with_a_complete_log(tmp_path, 
     assert injected, "the travel never started"
     assert not rep.converged and reason in rep.stop_reason, rep.stop_reason
     assert commands[-1] == "ST" or "ST sent" in rep.stop_reason
-    kinds = [r["type"] for r in recs]
-    assert kinds[0] == "start" and kinds[-1] == "end"
-    assert kinds.count("cycle") == rep.iterations
+    _assert_log_complete(recs, rep)
     assert any(r["type"] == "fault" for r in recs)
-    lo, hi = prep.config.model.limits_deg.T
-    for r in recs:
-        c = r.get("commanded")
-        if c:
-            a = np.asarray(c["axis_deg"])
-            assert np.all((a >= lo) & (a <= hi))
-            if c.get("predicted_force_magnitude") is not None:
-                assert c["predicted_force_magnitude"] <= 50.0
-                assert np.max(np.abs(c["predicted_deflections"])) <= 5.0
+    _assert_inside_envelope(recs, prep.config)  # the axis limits from the config's model
