@@ -38,7 +38,7 @@ from kinestat.app.control_defaults import (
 from kinestat.app.sim_cell import SimHarness, start_counts
 from kinestat.control.controller import MAX_ITERATIONS, ControllerConfig, Procedure, StepMethod
 from kinestat.control.envelope import Envelope, sent_command_guard
-from kinestat.control.follow import FollowConfig, decide_follow, follow_summary
+from kinestat.control.follow import PROBE_SPAN, FollowConfig, decide_follow, follow_summary
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, refuse, run
 from kinestat.control.model import ControlModel
@@ -164,6 +164,7 @@ class ControlRequest:
     tilt_deg: float = 0.0
     auto_tilt: bool | None = None
     arm: ArmSpec | None = None
+    probe_span: float | None = None
 
 
 def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: np.ndarray,
@@ -249,9 +250,11 @@ def prepare_control(req: ControlRequest) -> PreparedRun:
         raise InputError("the follow task needs a travel direction (--travel-dir x,y,z)")
     follow = FollowConfig(base=prepared.config, travel=req.travel, travel_dir=req.travel_dir,
                           travel_step=req.travel_step, tilt_deg=req.tilt_deg,
-                          auto_tilt=req.auto_tilt)
+                          auto_tilt=req.auto_tilt,
+                          probe_span=PROBE_SPAN if req.probe_span is None else req.probe_span)
     header = dict(prepared.header, task="follow", travel=req.travel,
-                  travel_dir=follow.travel_dir, tilt_deg=req.tilt_deg, auto_tilt=req.auto_tilt)
+                  travel_dir=follow.travel_dir, tilt_deg=req.tilt_deg, auto_tilt=req.auto_tilt,
+                  probe_span=follow.probe_span)
     return replace(prepared, follow=follow, header=header)
 
 

@@ -285,6 +285,11 @@ def control_command(
         "the friction cone's edge (estimated), more while the tip sticks: --auto-tilt from "
         "the start, --no-auto-tilt never; default: it switches itself on when the tip sticks "
         "under the travel steps (friction), unless --tilt-deg is given (docs/control.md)."),
+    probe_span: float = typer.Option(
+        None, "--probe-span", metavar="MM", help="follow: before raising the force, touch the "
+        "surface MM either side of the first contact (across and along the travel) and fit "
+        "its normal to the touches (default 3; 0: take the first contact force's direction, "
+        "which friction can tilt by up to atan(mu))."),
     workpiece: str = typer.Option(
         None, "--workpiece", help="Simulated workpiece: 'plane' (default, --plane-point/"
         "--plane-normal) or 'cylinder:radius=R,axis=x,y,z[,point=x,y,z]' (without point: its "
@@ -360,7 +365,7 @@ def control_command(
                          travel_dir=(None if travel_dir is None
                                      else parse_floats(travel_dir, 3, "travel-dir")),
                          travel_step=travel_step, tilt_deg=tilt_deg, auto_tilt=auto_tilt,
-                         arm=arm_spec)
+                         arm=arm_spec, probe_span=probe_span)
     cold = tuple(g for g in KERNELS if is_cold(g))
     if cold:  # compile before the run, so that its timing is the loop's own
         with compiling_notice(*cold):

@@ -26,6 +26,13 @@ the normal and the travel (:func:`fit_circle`, :func:`path_curvature`) measures 
 normal at the next point is predicted by turning the estimate by ``κ Δs`` towards the travel
 (:func:`turn_by_curvature`) instead of lagging the surface by a step.
 
+**Probing.** Before the force is raised the tip sticks where it touched, and with friction its
+force can lie anywhere in the cone: the normal is not observable from the force. Touches of
+the surface around the first contact are surface points, and the plane fitted to them
+(:func:`fit_plane`) gives the normal; for touches placed symmetrically about the centre
+(``±r`` across and along) the fitted plane's slope is the central difference of the surface,
+exact for a quadric, so a curved surface costs no bias at the centre.
+
 **One cycle's values** (the follow task's hot path): :func:`cone_normal_one` and
 :func:`friction_sample_one` are :func:`cone_normal` and :func:`friction_sample` for one force
 and one chord in scalar arithmetic (the same operations in the same order: equal to them to
@@ -55,6 +62,7 @@ __all__ = [
     "path_curvature",
     "path_curvature_one",
     "turn_by_curvature",
+    "fit_plane",
 ]
 
 MIN_FRICTION_WEIGHT = 0.05
@@ -253,3 +261,49 @@ def turn_by_curvature(normal, tangent, angle: float) -> tuple[np.ndarray, np.nda
     t = np.asarray(tangent, dtype=float)
     c, s = math.cos(angle), math.sin(angle)
     return c * n + s * t, c * t - s * n
+
+
+def fit_plane(points, approach) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The plane of surface points touched along ``approach``: the least-squares fit of their
+    height against the approach, ``H = α + β x + γ y`` (``x, y`` along two axes ⊥ approach),
+    and its unit normal facing against the approach, ``−d̂ − β û − γ v̂``.
+
+    The height fit, not the points' principal plane, is what makes a symmetric pattern
+    exact on a curved surface: for touches at the centre and ``±r`` along two axes the
+    slopes are the central differences, exact for any quadric height field.
+
+    Args:
+        points: (..., k, 3), k ≥ 3.
+        approach: (..., 3) the direction the touches were made along (into the surface).
+
+    Returns:
+        normal (..., 3); rms (...), the RMS height residual; spread (...), the smaller RMS
+        spread of the touches across the approach (near 0 for collinear touches, where the
+        plane is undefined).
+
+    >>> n, rms, spread = fit_plane([[0, 0, 0], [1, 0, -1], [0, 1, 0], [1, 1, -1]], [0, 0, -1])
+    >>> (np.round(n * math.sqrt(2), 12) + 0.0).tolist(), round(float(rms), 12)
+    ([1.0, 0.0, 1.0], 0.0)
+    """
+    P = np.asarray(points, dtype=float)
+    if P.ndim < 2 or P.shape[-1] != 3 or P.shape[-2] < 3:
+        raise ValueError(f"fit_plane: points must be (..., k >= 3, 3), got {P.shape}")
+    d = np.broadcast_to(np.asarray(approach, dtype=float), P.shape[:-2] + (3,))
+    d = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    a = np.where(np.abs(d[..., :1]) < 0.9, [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    u = np.cross(d, a)
+    u /= np.linalg.norm(u, axis=-1, keepdims=True)
+    v = np.cross(d, u)
+    k = P.shape[-2]
+    Q = P - P.mean(axis=-2, keepdims=True)
+    x, y = np.einsum("...kj,...j->...k", Q, u), np.einsum("...kj,...j->...k", Q, v)
+    h = -np.einsum("...kj,...j->...k", Q, d)
+    A = np.stack([x, y], axis=-1)  # centred: the intercept drops out
+    AtA = np.swapaxes(A, -1, -2) @ A
+    # pinv: collinear touches give a finite (meaningless) slope and a spread near 0
+    slope = (np.linalg.pinv(AtA) @ (np.swapaxes(A, -1, -2) @ h[..., None]))[..., 0]
+    res = h - (A @ slope[..., None])[..., 0]
+    n = -d - slope[..., :1] * u - slope[..., 1:] * v
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    spread = np.sqrt(np.maximum(np.linalg.eigvalsh(AtA)[..., 0], 0.0) / k)
+    return n, np.sqrt(np.mean(res ** 2, axis=-1)), spread

@@ -8,11 +8,19 @@ cycle's :class:`~kinestat.control.wrench.Measurement` and returns the next
 The start move is the press task's (:func:`kinestat.control.controller.start`).
 
 **Contact estimator** (the controller is not told the surface). The contact point is the
-measured deflected tool tip (:meth:`Measurement.tip`). The normal (out of the material) is at
-first contact the measured force's direction, ``n̂ = −F/|F|`` (``F`` the point-contact fit of
-the force the tool applies), and is KEPT while the force settles: a sticking tip's force turns
-with the tool, chasing it would walk round the friction cone. During travel, on every cycle the
-tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``, or, while μ is learnt,
+measured deflected tool tip (:meth:`Measurement.tip`). The normal (out of the material) is,
+before the force is raised, **probed** (:func:`_probe`, ``probe_span`` > 0, the default): the
+tool lifts off, touches the surface ``probe_span`` either side of the first contact across and
+along the travel and back at the centre, and the plane fitted to the touches' heights
+(:func:`probe_normal`) is the normal (with friction the first contact force can lie anywhere
+in the cone, 16.7° off at μ = 0.3). Without probing (or when the touches fit no plane) it is
+the measured force's direction, ``n̂ = −F/|F|`` (``F`` the point-contact fit of the force the
+tool applies). It is KEPT while the force settles: a sticking tip's force turns with the
+tool, chasing it would walk round the friction cone. With the probe's normal the first slip
+measures μ directly, ``μ̂ = |F_t|/F_n`` (the largest ratio the stuck tip reached, a sliding
+tip's force being on the cone's edge; :func:`_slipped_on_probe_normal`), and while μ̂ is
+known a tip whose force ratio is below ``μ̂ − EDGE_TOL`` is stuck. During travel, on every
+cycle the tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``, or, while μ is learnt,
 crept ``LEARN_CHORD_LENGTH``), it is the sliding contact's normal of Coulomb's law
 (:mod:`kinestat.control.contact_estimate`): the force on the tool ``û = −F/|F|`` leans from the
 normal by ``atan μ̂`` against the slip, measured by the chord ``c`` (≥ ``CHORD_LENGTH``,
@@ -38,6 +46,12 @@ line through the measured tip ``p``, the base (flange) is displaced by
   and the dead band, falls inside the cone and the tip sticks. Along the normal
   (frictionless) the lag costs nothing, and turning ahead of the estimate about a free tip
   excites the soft mode (the tip runs ahead), so the feedback alone turns S6 there;
+* ``−K⁻¹ δw_hold`` while the tip slides (μ̂ known): a sliding tip's force stays on the
+  cone's edge in space, which turns with the surface (``κ̂ Δs`` about ``n̂ × t̂``), not with the
+  base; the base's turn ``ω`` relative to the surface's would turn the force in the
+  platform's frame by ``(ω_s − ω) × f`` and the soft mode would run the tip ahead and drop
+  the normal force (~1.7 N per degree), so the platform's wrench is changed by that much
+  in advance (``hold`` in :func:`_base_twist`);
 * ``−K⁻¹ W Δλ``, the twist of compliance that raises the normal force by
   ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ);
   once μ̂ is measured, along the friction cone's edge ``W_c = [n̂ − μ̂ t̂; p × (n̂ − μ̂ t̂)]``
@@ -57,7 +71,8 @@ one task's state machine across modules; the reusable pieces already live in
 :mod:`kinestat.control.contact_estimate`.
 
 Phases (the ``label`` of each cycle): ``a`` approach along S6 (no contact), ``b`` first
-contact, ``d`` settling the normal force before travel, ``f`` following (travel), ``e`` done.
+contact, ``p`` probing the normal, ``d`` settling the normal force before travel, ``f``
+following (travel), ``e`` done.
 """
 
 from __future__ import annotations
@@ -69,6 +84,7 @@ import numpy as np
 
 from kinestat.control.contact_estimate import (
     cone_normal_one,
+    fit_plane,
     friction_sample_one,
     path_curvature_one,
     update_friction,
@@ -103,6 +119,7 @@ __all__ = [
     "FOLLOW_STATES",
     "decide_follow",
     "estimate_normal",
+    "probe_normal",
     "carry_check",
     "follow_summary",
 ]
@@ -110,6 +127,7 @@ __all__ = [
 FOLLOW_STATES = {
     "a": "approach along S6, no contact",
     "b": "first contact",
+    "p": "probing: touching the surface around the first contact to measure its normal",
     "d": "settling the normal force before travel",
     "f": "following the surface: travel + force control",
     "e": "requested travel done",
@@ -201,6 +219,38 @@ so there this gate passes noise and the chord (``LEARN_CHORD_LENGTH`` along the 
 what tells a creep."""
 END_STEP = 0.25
 """Smallest travel step (mm) while the end is approached in halving steps."""
+PROBE_SPAN = 3.0
+"""Default ``FollowConfig.probe_span`` (mm): the probe touches lie this far either side of the
+first contact. The fitted normal's error from a sensor's tip jitter ``e`` is about
+``e / span`` rad (the thesis's counts: ~0.1 mm, so ~1°); the pattern's symmetry cancels a
+curved surface's second-order term."""
+PROBE_DESCENT = 20.0
+"""Largest descent (mm) along S6 below the first contact's height at a probe offset before
+the run stops: the surface is not there (an edge)."""
+PROBE_STEP = 1.0
+"""Probing: the lift above the surface once out of contact and the largest step across (mm;
+the approach step when that is larger). A surface rising into the tool on the way across is
+touched lightly (a slope of 10° rises 0.18 mm over a step) and recorded as a touch."""
+PROBE_MAX_CYCLES = 150
+"""Largest number of probing cycles before the run stops."""
+PROBE_FIT_RMS = 0.5
+"""Largest RMS distance (mm) of the probe touches from their fitted plane: beyond it the
+surface is not smooth there and the normal is the first contact force's direction."""
+FIRST_SLIP_CYCLES = 10
+"""With the probe's normal: stuck travel cycles (measuring the tip's jitter at rest) before a
+first slip is told by one cycle's advance (:func:`_first_slip`)."""
+FIRST_SLIP_JITTER = 3.0
+"""With the probe's normal: a first slip advances the tip by more than this many times the
+largest advance measured while it stuck (the thesis's counts: ~0.1 mm; fine encoders:
+~0.001 mm)."""
+EDGE_TOL = 0.003
+"""With the probe's normal: a tip whose force ratio is this far below μ̂ (about 0.17° at
+μ = 0.3) is inside the cone: stuck. At 0.02 and 0.006 a re-stuck tip (the thesis's sensor,
+its force 0.7° and 0.3° inside) counted as on the edge, and the travel step pushed it:
++0.6 N and +0.3 N."""
+UNSLIP_MARGIN = 0.03
+"""A stuck tip whose force ratio exceeds the first slip's μ̂ by this much shows that slip
+false (:func:`_unslipped`)."""
 ENGAGE_STEP = 2.0 * MIN_SLIP
 """With ``auto_tilt`` None (the default), the automatic tilt switches itself on when the tip
 advanced less than ``SLIDE_FRACTION`` of two travel steps in a row of at least this (mm), or of
@@ -304,6 +354,11 @@ class FollowConfig:
         max_contact_lost: cycles without contact during travel before a safe stop.
         min_angle_deg: smallest angle between the travel direction and the approach direction
             or the measured normal.
+        probe_span: before the force is raised, the surface's normal is measured by touching
+            it at this distance (mm) either side of the first contact, across and along the
+            travel, and fitting a plane to the touches (:func:`_probe`); 0: the first contact
+            force's direction is taken instead (with friction it can lie anywhere in the
+            friction cone, and a normal off by θ costs about |F_t| θ of normal force).
     """
 
     base: ControllerConfig
@@ -318,6 +373,7 @@ class FollowConfig:
     auto_tilt: bool | None = None
     max_contact_lost: int = 3
     min_angle_deg: float = 10.0
+    probe_span: float = PROBE_SPAN
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.travel) and 0.0 < self.travel <= 1000.0):
@@ -330,6 +386,9 @@ class FollowConfig:
                 raise InputError(f"{name} must be a positive number, got {v!r}")
         if not 0.0 < self.gain <= 1.0:
             raise InputError(f"gain must be in (0, 1], got {self.gain!r}")
+        if not (math.isfinite(self.probe_span) and 0.0 <= self.probe_span <= 20.0):
+            raise InputError(f"probe_span must be in [0, 20] mm (0: no probing), got "
+                             f"{self.probe_span!r}")
         if self.auto_tilt not in (None, True, False):
             raise InputError(f"auto_tilt must be True, False or None (automatic), got "
                              f"{self.auto_tilt!r}")
@@ -353,7 +412,7 @@ class FollowState(ControllerState):
     """The follow task's state: the press state plus the contact estimate and the travel.
 
     Attributes:
-        phase: "approach", "settle" or "travel".
+        phase: "approach", "probe", "settle" or "travel".
         normal: (3,) the last normal estimate (out of the material), None before contact.
         tangent: (3,) the travel direction on the tangent plane, None before contact.
         path_dir: (3,) the last measured tip chord's direction, None before sliding.
@@ -372,6 +431,21 @@ class FollowState(ControllerState):
         friction_ratio: running estimate of the tangential-to-normal force ratio along the
             slip (μ when sliding), from the force and the chord.
         sample_tip: (3,) the measured tip at the last friction sample, None before one.
+        probe_points: the measured tips of the probe touches so far (surface points).
+        probe_index: the probe offset being touched (:func:`_probe_offsets`).
+        probe_mode: "lift", "shift" or "descend" while probing.
+        probe_origin: (3,) the commanded tool point at first contact (the probe's centre).
+        probe_cycles: cycles spent probing.
+        probe_trusted: the probe's fitted normal is the normal estimate.
+        probe_line: the probe's touches on the line of travel (behind, centre, ahead): the
+            path's first points for its curvature (:func:`_curvature`).
+        stick_jitter: before the first slip, the largest measured advance of the stuck tip in
+            one cycle (mm): the measurement's jitter, which a slip must exceed.
+        stick_cycles: travel cycles the tip stuck before the first slip.
+        direct_slip: the advance (mm) of the first slip that measured μ against the probe's
+            normal, until a chord confirms it sliding (0: none pending).
+        ratio_max: before the first slip, the largest tangential-to-normal force ratio of the
+            stuck tip against the probe's normal (a lower bound of μ).
     """
 
     phase: str = "approach"
@@ -396,6 +470,17 @@ class FollowState(ControllerState):
     stuck_travel: float = 0.0
     withdraw: float = 0.0
     sample_tip: np.ndarray | None = None
+    probe_points: tuple = ()
+    probe_index: int = 0
+    probe_mode: str = ""
+    probe_origin: np.ndarray | None = None
+    probe_cycles: int = 0
+    probe_trusted: bool = False
+    probe_line: tuple = ()
+    stick_jitter: float = 0.0
+    stick_cycles: int = 0
+    direct_slip: float = 0.0
+    ratio_max: float = 0.0
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -425,7 +510,7 @@ def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
 def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal: np.ndarray,
                 omega: np.ndarray, travel: np.ndarray, dlam: float,
                 max_correction: float, friction: float = 0.0,
-                slip: np.ndarray | None = None) -> np.ndarray:
+                slip: np.ndarray | None = None, hold: np.ndarray | None = None) -> np.ndarray:
     """The base's twist T = T_f − K⁻¹ W_c Δλ (base frame, axis order [ω; v_O0]); the compliance
     part scaled so that it moves the tip by at most ``max_correction``. ``W_c`` is the contact
     normal's line W, or, for a tip sliding along ``slip`` with the friction ratio
@@ -452,6 +537,10 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     T = compose_twist_line(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
     if friction > 0.0 and slip is not None:
         T = T + (dlam / scale) * friction * solve_one(K, Wt)
+    if hold is not None:  # the sliding contact's force turns with the surface, not the base
+        f_world, w_surf = hold
+        df = cross3(R.T @ w_surf - w, R.T @ f_world)
+        T = T - solve_one(K, np.concatenate([df, cross3(p, df)]))
     return T
 
 
@@ -540,6 +629,76 @@ def _breakaway_step(st: FollowState) -> float:
     return BREAKAWAY_DECAY
 
 
+def _curvature(st: FollowState, path: tuple, tip: np.ndarray, n: np.ndarray,
+               t: np.ndarray) -> float:
+    """The path's normal curvature along ``t`` (:func:`~kinestat.control.contact_estimate.
+    path_curvature`): from the measured tips, and while they span less than
+    ``CURVATURE_SPAN`` along the travel, from the probe's touches on the line of travel too
+    (±``probe_span`` about the start: known from the first travel cycle, where the path's
+    own tips need ``CURVATURE_SPAN`` of travel; a noisy touch fails the fit's significance
+    test and leaves it 0)."""
+    pts = path
+    if st.probe_line and _path_span(path, tip, t) < CURVATURE_SPAN:
+        pts = st.probe_line + tuple(path)
+    return path_curvature_one(np.asarray(pts), tip, n, t, CURVATURE_SPAN)
+
+
+def _first_slip(st: FollowState, advance: float) -> bool:
+    """Whether this cycle is the first slip measured against the probe's normal: the normal is
+    the probe's (trusted), no friction sample yet, the tip stuck for at least
+    ``FIRST_SLIP_CYCLES`` travel cycles (their measured advances are the jitter of a tip at
+    rest) and now advanced by more than ``FIRST_SLIP_JITTER`` times that jitter (and
+    ``CREEP_MIN``)."""
+    return (st.probe_trusted and not st.friction_samples
+            and st.stick_cycles >= FIRST_SLIP_CYCLES
+            and advance >= max(CREEP_MIN, FIRST_SLIP_JITTER * st.stick_jitter))
+
+
+def _slipped_on_probe_normal(config: FollowConfig, st: FollowState, meas: Measurement,
+                             F: np.ndarray, tip: np.ndarray, travel: float,
+                             path: tuple) -> FollowState:
+    """The first slip with the probe's normal known: a sliding tip's force lies on the
+    friction cone's edge, so ``μ̂ = |F_t| / F_n`` against the known normal (one sample in
+    place of the ``LEARN_CHORDS`` chords, which exist to find the normal); the tool's
+    tilt is kept (the breakaway tilt is what it leans past the new cone edge and margin)."""
+    n = st.normal
+    ratio = _stuck_ratio(F, n)
+    mu = min(max(ratio, st.ratio_max), MAX_FRICTION)
+    # the tip slipped and stuck again (its force back inside the cone: the force control
+    # raised the normal force after the slip): μ is the largest ratio seen, and the tip is
+    # stuck now (no travel step until it slides)
+    stuck = ratio < mu - EDGE_TOL
+    tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ n)))))
+    brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
+    advance = float((tip - st.last_tip) @ st.tangent)
+    t = st.tangent - float(st.tangent @ n) * n
+    kappa = _curvature(st, path, tip, n, t / norm3(t))
+    return replace(st, travel=travel, last_tip=tip, path=path, friction_ratio=mu,
+                   curvature=kappa, curvature_cycles=1 if kappa != 0.0 else 0,
+                   friction_mean=mu, friction_samples=LEARN_CHORDS, sample_tip=tip,
+                   sticking=stuck, breakaway=brk / config.max_turn_deg, slid=not stuck,
+                   stuck_travel=0.0, direct_slip=max(advance, CREEP_MIN))
+
+
+def _stuck_ratio(F: np.ndarray, n: np.ndarray) -> float:
+    """The tangential-to-normal ratio of the force ``F`` against the normal ``n`` (a stuck
+    tip's ratio is a lower bound of μ)."""
+    fn = float(-(F @ n))
+    return norm3(F + fn * n) / fn if fn > 0.0 else 0.0
+
+
+def _unslipped(config: FollowConfig, st: FollowState, meas: Measurement) -> FollowState:
+    """A first slip measured against the probe's normal, after which the stuck tip's force
+    leans further from the normal than ``atan μ̂`` (by ``UNSLIP_MARGIN`` in ratio), was the
+    measurement's jitter (the thesis's counts; a plane of 0.7°: μ̂ 0.01): μ is unknown again, the
+    breakaway tilt carries on from the tool's tilt, and a slip must now exceed that advance
+    (``FIRST_SLIP_JITTER`` times it)."""
+    tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ st.normal)))))
+    return replace(st, friction_ratio=0.0, friction_mean=0.0, friction_samples=0,
+                   sample_tip=None, breakaway=tilt / config.max_turn_deg,
+                   stick_jitter=max(st.stick_jitter, st.direct_slip), direct_slip=0.0)
+
+
 def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.ndarray,
              contact: bool) -> FollowState:
     """Update the travel, the friction ratio and the normal estimate from this measurement
@@ -547,15 +706,30 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     tip = meas.tip(config.base.model)
     if not contact:
         return st
-    if st.normal is None:  # first contact: the force's direction
-        return replace(st, normal=estimate_normal(F), last_tip=tip)
+    if st.normal is None:  # first contact: the force's direction (until the probe's fit)
+        st = replace(st, normal=estimate_normal(F), last_tip=tip)
+        if config.probe_span > 0.0:
+            st = replace(st, phase="probe", probe_points=(tip,), probe_line=(tip,),
+                         probe_index=0,
+                         probe_mode="lift", probe_origin=st.target.tool_point.copy())
+        return st
+    if st.phase == "probe":
+        return st
     if st.phase != "travel":  # settling: kept (a sticking tip's force turns with the tool)
         return replace(st, last_tip=tip)
     n0, s = st.normal, st.tangent
     advance = float((tip - st.last_tip) @ s)
     travel = st.travel + advance
     path = (st.path + (st.last_tip,))[-CHORD_HISTORY:]
+    if _first_slip(st, advance):  # the probe's normal: μ from this sliding force directly
+        return _slipped_on_probe_normal(config, st, meas, F, tip, travel, path)
     if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip, advance):
+        if st.direct_slip and _stuck_ratio(F, st.normal) > st.friction_ratio + UNSLIP_MARGIN:
+            st = _unslipped(config, st, meas)  # a stuck tip's force beyond μ̂'s cone: no slip
+        if not st.friction_samples:
+            st = replace(st, stick_jitter=max(st.stick_jitter, abs(advance)),
+                         stick_cycles=st.stick_cycles + 1,
+                         ratio_max=max(st.ratio_max, _stuck_ratio(F, st.normal)))
         stuck = st.step > 0 or st.sticking
         pushed = st.stuck_travel + st.step  # the travel commanded since the tip last slid
         if _engages(config, st, advance):  # friction: the tip did not follow its steps
@@ -564,7 +738,10 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
             return replace(st, travel=travel, last_tip=tip, path=path, sticking=True,
                            slid=False, step_cap=0.0, tilting=True, stuck_travel=0.0,
                            withdraw=max(pushed - max(advance, 0.0), 0.0))
-        if st.tilting and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
+        if st.probe_trusted and st.friction_samples:
+            # the normal is known: the force's ratio tells whether the tip is on the edge
+            stuck = stuck and _stuck_ratio(F, n0) < st.friction_ratio - EDGE_TOL
+        elif st.tilting and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
             # S6 leans past the measured force by the margin: a stuck tip's force turns with
             # the tool, so this tip is on the cone's edge (creeping): more tilt would only
             # turn the top; it travels (a step slides it)
@@ -585,6 +762,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
                else LEARN_CHORD_LENGTH)
     n = n0  # kept until a chord has measured the friction
     sample_tip = st.sample_tip
+    if st.probe_trusted and not samples:  # it slid: μ against the probe's normal
+        return _slipped_on_probe_normal(config, st, meas, F, tip, travel, path)
     if c is not None and float(c @ s) > 0.5 * norm3(c):
         raw, samples = update_friction(raw, samples, friction_sample_one(u, c))
         sample_tip = tip
@@ -599,7 +778,9 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
         brk /= config.max_turn_deg
     t = s - (s @ n) * n
-    kappa = path_curvature_one(np.asarray(path), tip, n, t / norm3(t), CURVATURE_SPAN)
+    kappa = _curvature(st, path, tip, n, t / norm3(t))
+    if c is not None:
+        st = replace(st, direct_slip=0.0)  # a chord: the tip slides
     return replace(st, travel=travel, normal=n, last_tip=tip, path=path, curvature=kappa,
                    curvature_cycles=st.curvature_cycles + 1 if kappa != 0.0 else 0,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
@@ -624,8 +805,8 @@ def decide_follow(config: FollowConfig, state: ControllerState,
     F = meas.estimate(base.estimator)
     contact = norm3(F) >= base.contact_force
     st = _observe(config, st, meas, F, contact)
-    label = {"approach": "a", "settle": "d", "travel": "f"}[st.phase]
-    if contact and st.phase == "approach":
+    label = {"approach": "a", "probe": "p", "settle": "d", "travel": "f"}[st.phase]
+    if contact and (st.phase == "approach" or (st.phase == "probe" and st.probe_cycles == 0)):
         label = "b"
     fn = float(-(F @ st.normal)) if (contact and st.normal is not None) else 0.0
     ft = 0.0 if not contact else norm3(F + fn * st.normal)
@@ -653,6 +834,20 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     model = base.model
     tgt = st.target
     omega, step, travel_vec, dlam = np.zeros(3), 0.0, np.zeros(3), 0.0
+    if st.phase == "probe":
+        st, new, why, fit = _probe(config, st, meas, contact)
+        if why:
+            return _stop(st, label, why, **kw)
+        if new is not None:
+            return _command(config, st, meas, new, label, "probe", 0.0, 0.0, kw)
+        kw["info"]["probe"] = fit
+        kw["info"]["phase"] = st.phase  # probing done: settle from this contact
+        kw["info"]["normal_estimate"] = st.normal
+        F = meas.estimate(base.estimator)
+        fn = float(-(F @ st.normal))
+        kw["info"]["normal_force"] = fn
+        err = base.force_target - fn
+        kw["force_error"] = err
     if not contact:
         if st.phase == "travel":
             lost = st.contact_lost + 1
@@ -728,8 +923,15 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
     try:
         sliding = phase == "travel" and st.friction_samples > 0
+        hold = None
+        if sliding and not st.sticking and st.tilting:
+            w_surf = st.curvature * step * cross3(n, t)  # the surface's turn under the step
+            s6n = meas.s6 + cross3(omega - w_surf, meas.s6)
+            if step > 0.0 or -float(s6n @ n) < -float(meas.s6 @ n):  # slides on / turns out
+                hold = (-meas.estimate(base.estimator), w_surf)  # the force on the tool
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
-                        config.max_correction, st.friction_ratio if sliding else 0.0, t)
+                        config.max_correction, st.friction_ratio if sliding else 0.0, t,
+                        hold)
     except (InputError, np.linalg.LinAlgError) as exc:
         return _stop(st, label, f"the contact basis is singular for the platform stiffness: "
                      f"{exc}", **kw)
@@ -737,6 +939,103 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     action = "follow" if phase == "travel" else "settle"
     return _command(config, st, meas, new, label, action, step,
                     math.degrees(norm3(omega)), kw)
+
+
+def _probe_offsets(config: FollowConfig, d: np.ndarray) -> list[np.ndarray]:
+    """The probe touches' offsets from the first contact (mm, perpendicular to the approach
+    direction ``d``): ``r`` across the travel, ``r`` back along it, ``r`` across the other
+    way, ``r`` ahead, then the centre again (where the force is raised): a symmetric
+    pattern, so that the fitted plane's slope is the surface's central difference."""
+    t = config.travel_dir - float(config.travel_dir @ d) * d
+    t = t / norm3(t)
+    b = cross3(d, t)
+    r = config.probe_span
+    return [r * b, -r * t, -r * b, r * t, np.zeros(3)]
+
+
+def probe_normal(points, normal_guess, approach) -> tuple[np.ndarray, dict]:
+    """The surface normal (out of the material) from the probe's touches and what the fit
+    found: the plane fitted to the touches' heights against the ``approach`` direction
+    (:func:`~kinestat.control.contact_estimate.fit_plane`, facing against it);
+    ``normal_guess`` (the first contact force's direction) instead where the touches are
+    nearly collinear, lie more than ``PROBE_FIT_RMS`` from a plane (an edge or a step), or
+    the plane is more than 45° (the steepest friction cone the estimator takes, μ = 1) from
+    the guess.
+
+    >>> pts = [[0, 0, 0], [3, 0, 0.3], [0, 3, 0], [-3, 0, -0.3], [0, -3, 0]]
+    >>> n, fit = probe_normal(pts, [0.0, 0.0, 1.0], [0.0, 0.0, -1.0])
+    >>> (np.round(n, 6) + 0.0).tolist(), fit["used"]
+    ([-0.099504, 0.0, 0.995037], True)
+    """
+    P = np.asarray(points, dtype=float)
+    guess = np.asarray(normal_guess, dtype=float)
+    n, rms, spread = fit_plane(P, approach)
+    fit = {"points": int(len(P)), "fit_rms": float(rms), "normal": n.copy(), "used": True}
+    half = 0.5 * float(np.max(np.linalg.norm(P - P.mean(axis=0), axis=1)))
+    cos_cone = math.cos(math.atan(MAX_FRICTION))
+    if spread < 0.25 * half or rms > PROBE_FIT_RMS or float(n @ guess) < cos_cone:
+        fit["used"] = False
+        return guess.copy(), fit
+    return n, fit
+
+
+def _probe(config: FollowConfig, st: FollowState, meas: Measurement,
+           contact: bool) -> tuple[FollowState, Target | None, str, dict | None]:
+    """One probing cycle: the next target (None when probing is done and the force is to be
+    raised from this contact), a stop reason (empty if none) and, when done, the fit.
+
+    Around the first contact the tool is lifted along −S6 until out of contact and
+    ``PROBE_STEP`` more (``lift``), moved across to the next offset of
+    :func:`_probe_offsets` in steps of ``PROBE_STEP`` (``shift``; touching the surface on the way
+    records a touch and lifts again), and lowered along S6 until contact (``descend``); each
+    contact's measured tip is a surface point. S6 is not turned. The normal is then
+    :func:`probe_normal` of the touches."""
+    base = config.base
+    tgt = st.target
+    d, step = tgt.s6, base.approach_step
+    wide = max(step, PROBE_STEP)
+    offs = _probe_offsets(config, d)
+    st = replace(st, probe_cycles=st.probe_cycles + 1)
+    if st.probe_cycles > PROBE_MAX_CYCLES:
+        return st, None, (f"probing the surface did not finish in {PROBE_MAX_CYCLES} cycles "
+                          f"({len(st.probe_points)} touches)"), None
+    tip = meas.tip(base.model)
+    mode = st.probe_mode
+    if mode == "descend" and contact:
+        pts = st.probe_points + (tip,)
+        if abs(float(offs[st.probe_index] @ cross3(d, config.travel_dir))) < 1e-9:
+            st = replace(st, probe_line=st.probe_line + (tip,))  # on the line of travel
+        idx = st.probe_index + 1
+        if idx == len(offs):
+            n, fit = probe_normal(pts, st.normal, d)
+            return replace(st, probe_points=pts, probe_index=idx, probe_mode="",
+                           phase="settle", normal=n, last_tip=tip,
+                           probe_trusted=fit["used"]), None, "", fit
+        st, mode = replace(st, probe_points=pts, probe_index=idx, probe_mode="lift"), "lift"
+    if mode == "shift" and contact:  # the surface rose into the tool: a touch too
+        st, mode = replace(st, probe_points=st.probe_points + (tip,), probe_mode="lift"), "lift"
+    if mode == "lift":
+        if not contact:  # clear of the surface: PROBE_STEP more, then across
+            st = replace(st, probe_mode="shift")
+        return st, Target(tgt.tool_point - (step if contact else wide) * d, tgt.s6,
+                          tgt.a67), "", None
+    depth = float((tgt.tool_point - st.probe_origin) @ d)
+    if mode == "shift":
+        goal = st.probe_origin + offs[st.probe_index] + depth * d
+        rem = goal - tgt.tool_point
+        dist = norm3(rem)
+        if dist > 1e-9:
+            if dist <= wide:
+                st = replace(st, probe_mode="descend")
+            return st, Target(tgt.tool_point + rem * min(1.0, wide / dist), tgt.s6,
+                              tgt.a67), "", None
+        st = replace(st, probe_mode="descend")
+    if depth > PROBE_DESCENT:
+        return st, None, (f"probing: no surface within {PROBE_DESCENT:g} mm below the first "
+                          f"contact at offset {np.round(offs[st.probe_index], 3).tolist()} mm "
+                          "(an edge of the workpiece?); use a smaller --probe-span or "
+                          "--probe-span 0"), None
+    return st, Target(tgt.tool_point + step * d, tgt.s6, tgt.a67), "", None
 
 
 def _step_cap(config: FollowConfig, st: FollowState, tip: np.ndarray, t: np.ndarray) -> float:
