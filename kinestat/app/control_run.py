@@ -38,10 +38,11 @@ from kinestat.app.control_defaults import (
 from kinestat.app.sim_cell import SimHarness, start_counts
 from kinestat.control.controller import MAX_ITERATIONS, ControllerConfig, Procedure, StepMethod
 from kinestat.control.envelope import Envelope, sent_command_guard
-from kinestat.control.follow import PROBE_SPAN, FollowConfig, decide_follow, follow_summary
+from kinestat.control.follow import FollowConfig, decide_follow, follow_summary
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, refuse, run
 from kinestat.control.model import ControlModel
+from kinestat.control.probe import PROBE_SPAN
 from kinestat.control.wrench import Estimator
 from kinestat.devices.cell_io import MAX_SAMPLES, DeviceIO
 from kinestat.devices.encoder_stream import EncoderReader, Format

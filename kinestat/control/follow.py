@@ -9,26 +9,26 @@ The start move is the press task's (:func:`kinestat.control.controller.start`).
 
 **Contact estimator** (the controller is not told the surface). The contact point is the
 measured deflected tool tip (:meth:`Measurement.tip`). The normal (out of the material) is,
-before the force is raised, **probed** (:func:`_probe`, ``probe_span`` > 0, the default): the
-tool lifts off, touches the surface ``probe_span`` either side of the first contact across and
-along the travel and back at the centre, and the plane fitted to the touches' heights
-(:func:`probe_normal`) is the normal (with friction the first contact force can lie anywhere
-in the cone, 16.7° off at μ = 0.3). Without probing (or when the touches fit no plane) it is
-the measured force's direction, ``n̂ = −F/|F|`` (``F`` the point-contact fit of the force the
-tool applies). It is KEPT while the force settles: a sticking tip's force turns with the
-tool, chasing it would walk round the friction cone. With the probe's normal the first slip
-measures μ directly, ``μ̂ = |F_t|/F_n`` (the largest ratio the stuck tip reached, a sliding
-tip's force being on the cone's edge; :func:`_slipped_on_probe_normal`), and while μ̂ is
-known a tip whose force ratio is below ``μ̂ − EDGE_TOL`` is stuck. During travel, on every
-cycle the tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``, or, while μ is learnt,
-crept ``LEARN_CHORD_LENGTH``), it is the sliding contact's normal of Coulomb's law
+before the force is raised, **probed** (:mod:`kinestat.control.probe`, ``probe_span`` > 0, the
+default): the tool lifts off, touches the surface ``probe_span`` either side of the first
+contact across and along the travel and back at the centre, and the plane fitted to the touches'
+heights (:func:`~kinestat.control.probe.probe_normal`) is the normal (with friction the first
+contact force can lie anywhere in the cone, 16.7° off at μ = 0.3). Without probing (or when the
+touches fit no plane) it is the measured force's direction, ``n̂ = −F/|F|`` (``F`` the
+point-contact fit of the force the tool applies). It is KEPT while the force settles: a sticking
+tip's force turns with the tool, chasing it would walk round the friction cone. With the probe's
+normal the first slip measures μ directly, ``μ̂ = |F_t|/F_n`` (the largest ratio the stuck tip
+reached, a sliding tip's force being on the cone's edge; :func:`_slipped_on_probe_normal`), and
+while μ̂ is known a tip whose force ratio is below ``μ̂ − EDGE_TOL`` is stuck. During travel, on
+every cycle the tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``, or, while μ
+is learnt, crept ``LEARN_CHORD_LENGTH``), it is the sliding contact's normal of Coulomb's law
 (:mod:`kinestat.control.contact_estimate`): the force on the tool ``û = −F/|F|`` leans from the
 normal by ``atan μ̂`` against the slip, measured by the chord ``c`` (≥ ``CHORD_LENGTH``,
 ``LEARN_CHORD_LENGTH`` for the first ``LEARN_CHORDS`` samples) of the measured tip path, which
 lies in the surface: ``n̂ = cos α̂ û + sin α̂ ĝ`` (``ĝ`` the chord made ⊥ û, ``α̂ = atan μ̂``),
-μ̂ the running mean of the samples ``tan α``, ``sin α = −û·ĉ``. Until a chord exists the
-normal is kept. Frictionless, ``μ̂ ≈ 0`` and the normal is the force's direction. The normal
-force is ``F_n = −F·n̂``; the friction force ``F + F_n n̂`` is reported, not fought.
+μ̂ the running mean of the samples ``tan α``, ``sin α = −û·ĉ``. Until a chord exists the normal
+is kept. Frictionless, ``μ̂ ≈ 0`` and the normal is the force's direction. The normal force is
+``F_n = −F·n̂``; the friction force ``F + F_n n̂`` is reported, not fought.
 
 **Control law** (Griffis & Duffy's kinestatic decomposition,
 :func:`kinestat.parallel.kinestatic.compose_twist`). In the platform base frame, with ``K``
@@ -84,7 +84,6 @@ import numpy as np
 
 from kinestat.control.contact_estimate import (
     cone_normal_one,
-    fit_plane,
     friction_sample_one,
     path_curvature_one,
     update_friction,
@@ -104,6 +103,7 @@ from kinestat.control.envelope import (
     check_motion,
 )
 from kinestat.control.model import ControlModel
+from kinestat.control.probe import PROBE_SPAN, Probe, probe_normal, probe_step, start_probe
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
 from kinestat.parallel.kinestatic import compose_twist_line, solve_one
@@ -119,7 +119,6 @@ __all__ = [
     "FOLLOW_STATES",
     "decide_follow",
     "estimate_normal",
-    "probe_normal",
     "carry_check",
     "follow_summary",
 ]
@@ -219,23 +218,6 @@ so there this gate passes noise and the chord (``LEARN_CHORD_LENGTH`` along the 
 what tells a creep."""
 END_STEP = 0.25
 """Smallest travel step (mm) while the end is approached in halving steps."""
-PROBE_SPAN = 3.0
-"""Default ``FollowConfig.probe_span`` (mm): the probe touches lie this far either side of the
-first contact. The fitted normal's error from a sensor's tip jitter ``e`` is about
-``e / span`` rad (the thesis's counts: ~0.1 mm, so ~1°); the pattern's symmetry cancels a
-curved surface's second-order term."""
-PROBE_DESCENT = 20.0
-"""Largest descent (mm) along S6 below the first contact's height at a probe offset before
-the run stops: the surface is not there (an edge)."""
-PROBE_STEP = 1.0
-"""Probing: the lift above the surface once out of contact and the largest step across (mm;
-the approach step when that is larger). A surface rising into the tool on the way across is
-touched lightly (a slope of 10° rises 0.18 mm over a step) and recorded as a touch."""
-PROBE_MAX_CYCLES = 150
-"""Largest number of probing cycles before the run stops."""
-PROBE_FIT_RMS = 0.5
-"""Largest RMS distance (mm) of the probe touches from their fitted plane: beyond it the
-surface is not smooth there and the normal is the first contact force's direction."""
 FIRST_SLIP_CYCLES = 10
 """With the probe's normal: stuck travel cycles (measuring the tip's jitter at rest) before a
 first slip is told by one cycle's advance (:func:`_first_slip`)."""
@@ -356,9 +338,10 @@ class FollowConfig:
             or the measured normal.
         probe_span: before the force is raised, the surface's normal is measured by touching
             it at this distance (mm) either side of the first contact, across and along the
-            travel, and fitting a plane to the touches (:func:`_probe`); 0: the first contact
-            force's direction is taken instead (with friction it can lie anywhere in the
-            friction cone, and a normal off by θ costs about |F_t| θ of normal force).
+            travel, and fitting a plane to the touches (:mod:`kinestat.control.probe`); 0:
+            the first contact force's direction is taken instead (with friction it can lie
+            anywhere in the friction cone, and a normal off by θ costs about |F_t| θ of
+            normal force).
     """
 
     base: ControllerConfig
@@ -431,14 +414,9 @@ class FollowState(ControllerState):
         friction_ratio: running estimate of the tangential-to-normal force ratio along the
             slip (μ when sliding), from the force and the chord.
         sample_tip: (3,) the measured tip at the last friction sample, None before one.
-        probe_points: the measured tips of the probe touches so far (surface points).
-        probe_index: the probe offset being touched (:func:`_probe_offsets`).
-        probe_mode: "lift", "shift" or "descend" while probing.
-        probe_origin: (3,) the commanded tool point at first contact (the probe's centre).
-        probe_cycles: cycles spent probing.
+        probe: the surface probe's progress and touches (:mod:`kinestat.control.probe`),
+            None without probing.
         probe_trusted: the probe's fitted normal is the normal estimate.
-        probe_line: the probe's touches on the line of travel (behind, centre, ahead): the
-            path's first points for its curvature (:func:`_curvature`).
         stick_jitter: before the first slip, the largest measured advance of the stuck tip in
             one cycle (mm): the measurement's jitter, which a slip must exceed.
         stick_cycles: travel cycles the tip stuck before the first slip.
@@ -470,13 +448,8 @@ class FollowState(ControllerState):
     stuck_travel: float = 0.0
     withdraw: float = 0.0
     sample_tip: np.ndarray | None = None
-    probe_points: tuple = ()
-    probe_index: int = 0
-    probe_mode: str = ""
-    probe_origin: np.ndarray | None = None
-    probe_cycles: int = 0
+    probe: Probe | None = None
     probe_trusted: bool = False
-    probe_line: tuple = ()
     stick_jitter: float = 0.0
     stick_cycles: int = 0
     direct_slip: float = 0.0
@@ -632,14 +605,14 @@ def _breakaway_step(st: FollowState) -> float:
 def _curvature(st: FollowState, path: tuple, tip: np.ndarray, n: np.ndarray,
                t: np.ndarray) -> float:
     """The path's normal curvature along ``t`` (:func:`~kinestat.control.contact_estimate.
-    path_curvature`): from the measured tips, and while they span less than
-    ``CURVATURE_SPAN`` along the travel, from the probe's touches on the line of travel too
+    path_curvature`): from the measured tips, and until the tip travelled ``CURVATURE_SPAN``,
+    from the probe's touches on the line of travel too
     (±``probe_span`` about the start: known from the first travel cycle, where the path's
     own tips need ``CURVATURE_SPAN`` of travel; a noisy touch fails the fit's significance
     test and leaves it 0)."""
     pts = path
-    if st.probe_line and _path_span(path, tip, t) < CURVATURE_SPAN:
-        pts = st.probe_line + tuple(path)
+    if st.probe is not None and st.travel < CURVATURE_SPAN:  # (cheaper than the path's span)
+        pts = st.probe.line + tuple(path)
     return path_curvature_one(np.asarray(pts), tip, n, t, CURVATURE_SPAN)
 
 
@@ -709,9 +682,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if st.normal is None:  # first contact: the force's direction (until the probe's fit)
         st = replace(st, normal=estimate_normal(F), last_tip=tip)
         if config.probe_span > 0.0:
-            st = replace(st, phase="probe", probe_points=(tip,), probe_line=(tip,),
-                         probe_index=0,
-                         probe_mode="lift", probe_origin=st.target.tool_point.copy())
+            st = replace(st, phase="probe", probe=start_probe(
+                tip, st.target.tool_point, st.target.s6, config.travel_dir, config.probe_span))
         return st
     if st.phase == "probe":
         return st
@@ -806,7 +778,7 @@ def decide_follow(config: FollowConfig, state: ControllerState,
     contact = norm3(F) >= base.contact_force
     st = _observe(config, st, meas, F, contact)
     label = {"approach": "a", "probe": "p", "settle": "d", "travel": "f"}[st.phase]
-    if contact and (st.phase == "approach" or (st.phase == "probe" and st.probe_cycles == 0)):
+    if contact and (st.phase == "approach" or (st.phase == "probe" and st.probe.cycles == 0)):
         label = "b"
     fn = float(-(F @ st.normal)) if (contact and st.normal is not None) else 0.0
     ft = 0.0 if not contact else norm3(F + fn * st.normal)
@@ -835,11 +807,16 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     tgt = st.target
     omega, step, travel_vec, dlam = np.zeros(3), 0.0, np.zeros(3), 0.0
     if st.phase == "probe":
-        st, new, why, fit = _probe(config, st, meas, contact)
-        if why:
-            return _stop(st, label, why, **kw)
-        if new is not None:
+        ps = probe_step(st.probe, tgt.tool_point, contact, meas.tip(model), base.approach_step)
+        st = replace(st, probe=ps.probe)
+        if ps.reason:
+            return _stop(st, label, ps.reason, **kw)
+        if not ps.done:
+            new = Target(ps.tool_point, tgt.s6, tgt.a67)
             return _command(config, st, meas, new, label, "probe", 0.0, 0.0, kw)
+        n, fit = probe_normal(ps.probe.points, st.normal, tgt.s6)
+        st = replace(st, phase="settle", normal=n, last_tip=meas.tip(model),
+                     probe_trusted=fit["used"])
         kw["info"]["probe"] = fit
         kw["info"]["phase"] = st.phase  # probing done: settle from this contact
         kw["info"]["normal_estimate"] = st.normal
@@ -939,103 +916,6 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     action = "follow" if phase == "travel" else "settle"
     return _command(config, st, meas, new, label, action, step,
                     math.degrees(norm3(omega)), kw)
-
-
-def _probe_offsets(config: FollowConfig, d: np.ndarray) -> list[np.ndarray]:
-    """The probe touches' offsets from the first contact (mm, perpendicular to the approach
-    direction ``d``): ``r`` across the travel, ``r`` back along it, ``r`` across the other
-    way, ``r`` ahead, then the centre again (where the force is raised): a symmetric
-    pattern, so that the fitted plane's slope is the surface's central difference."""
-    t = config.travel_dir - float(config.travel_dir @ d) * d
-    t = t / norm3(t)
-    b = cross3(d, t)
-    r = config.probe_span
-    return [r * b, -r * t, -r * b, r * t, np.zeros(3)]
-
-
-def probe_normal(points, normal_guess, approach) -> tuple[np.ndarray, dict]:
-    """The surface normal (out of the material) from the probe's touches and what the fit
-    found: the plane fitted to the touches' heights against the ``approach`` direction
-    (:func:`~kinestat.control.contact_estimate.fit_plane`, facing against it);
-    ``normal_guess`` (the first contact force's direction) instead where the touches are
-    nearly collinear, lie more than ``PROBE_FIT_RMS`` from a plane (an edge or a step), or
-    the plane is more than 45° (the steepest friction cone the estimator takes, μ = 1) from
-    the guess.
-
-    >>> pts = [[0, 0, 0], [3, 0, 0.3], [0, 3, 0], [-3, 0, -0.3], [0, -3, 0]]
-    >>> n, fit = probe_normal(pts, [0.0, 0.0, 1.0], [0.0, 0.0, -1.0])
-    >>> (np.round(n, 6) + 0.0).tolist(), fit["used"]
-    ([-0.099504, 0.0, 0.995037], True)
-    """
-    P = np.asarray(points, dtype=float)
-    guess = np.asarray(normal_guess, dtype=float)
-    n, rms, spread = fit_plane(P, approach)
-    fit = {"points": int(len(P)), "fit_rms": float(rms), "normal": n.copy(), "used": True}
-    half = 0.5 * float(np.max(np.linalg.norm(P - P.mean(axis=0), axis=1)))
-    cos_cone = math.cos(math.atan(MAX_FRICTION))
-    if spread < 0.25 * half or rms > PROBE_FIT_RMS or float(n @ guess) < cos_cone:
-        fit["used"] = False
-        return guess.copy(), fit
-    return n, fit
-
-
-def _probe(config: FollowConfig, st: FollowState, meas: Measurement,
-           contact: bool) -> tuple[FollowState, Target | None, str, dict | None]:
-    """One probing cycle: the next target (None when probing is done and the force is to be
-    raised from this contact), a stop reason (empty if none) and, when done, the fit.
-
-    Around the first contact the tool is lifted along −S6 until out of contact and
-    ``PROBE_STEP`` more (``lift``), moved across to the next offset of
-    :func:`_probe_offsets` in steps of ``PROBE_STEP`` (``shift``; touching the surface on the way
-    records a touch and lifts again), and lowered along S6 until contact (``descend``); each
-    contact's measured tip is a surface point. S6 is not turned. The normal is then
-    :func:`probe_normal` of the touches."""
-    base = config.base
-    tgt = st.target
-    d, step = tgt.s6, base.approach_step
-    wide = max(step, PROBE_STEP)
-    offs = _probe_offsets(config, d)
-    st = replace(st, probe_cycles=st.probe_cycles + 1)
-    if st.probe_cycles > PROBE_MAX_CYCLES:
-        return st, None, (f"probing the surface did not finish in {PROBE_MAX_CYCLES} cycles "
-                          f"({len(st.probe_points)} touches)"), None
-    tip = meas.tip(base.model)
-    mode = st.probe_mode
-    if mode == "descend" and contact:
-        pts = st.probe_points + (tip,)
-        if abs(float(offs[st.probe_index] @ cross3(d, config.travel_dir))) < 1e-9:
-            st = replace(st, probe_line=st.probe_line + (tip,))  # on the line of travel
-        idx = st.probe_index + 1
-        if idx == len(offs):
-            n, fit = probe_normal(pts, st.normal, d)
-            return replace(st, probe_points=pts, probe_index=idx, probe_mode="",
-                           phase="settle", normal=n, last_tip=tip,
-                           probe_trusted=fit["used"]), None, "", fit
-        st, mode = replace(st, probe_points=pts, probe_index=idx, probe_mode="lift"), "lift"
-    if mode == "shift" and contact:  # the surface rose into the tool: a touch too
-        st, mode = replace(st, probe_points=st.probe_points + (tip,), probe_mode="lift"), "lift"
-    if mode == "lift":
-        if not contact:  # clear of the surface: PROBE_STEP more, then across
-            st = replace(st, probe_mode="shift")
-        return st, Target(tgt.tool_point - (step if contact else wide) * d, tgt.s6,
-                          tgt.a67), "", None
-    depth = float((tgt.tool_point - st.probe_origin) @ d)
-    if mode == "shift":
-        goal = st.probe_origin + offs[st.probe_index] + depth * d
-        rem = goal - tgt.tool_point
-        dist = norm3(rem)
-        if dist > 1e-9:
-            if dist <= wide:
-                st = replace(st, probe_mode="descend")
-            return st, Target(tgt.tool_point + rem * min(1.0, wide / dist), tgt.s6,
-                              tgt.a67), "", None
-        st = replace(st, probe_mode="descend")
-    if depth > PROBE_DESCENT:
-        return st, None, (f"probing: no surface within {PROBE_DESCENT:g} mm below the first "
-                          f"contact at offset {np.round(offs[st.probe_index], 3).tolist()} mm "
-                          "(an edge of the workpiece?); use a smaller --probe-span or "
-                          "--probe-span 0"), None
-    return st, Target(tgt.tool_point + step * d, tgt.s6, tgt.a67), "", None
 
 
 def _step_cap(config: FollowConfig, st: FollowState, tip: np.ndarray, t: np.ndarray) -> float:

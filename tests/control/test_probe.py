@@ -10,11 +10,13 @@ import pytest
 
 from kinestat.app.control_run import SimulatedCell
 from kinestat.control.contact_estimate import fit_plane
-from kinestat.control.follow import (
+from kinestat.control.follow import FollowConfig
+from kinestat.control.probe import (
     PROBE_SPAN,
-    FollowConfig,
-    _probe_offsets,
     probe_normal,
+    probe_offsets,
+    probe_step,
+    start_probe,
 )
 from kinestat.errors import InputError
 
@@ -82,8 +84,7 @@ def test_the_probe_pattern_measures_a_curved_surface_normal_at_its_centre(seed):
     approach = F_HAT + rng.uniform(-0.2, 0.2, 3)
     approach /= np.linalg.norm(approach)
     travel = Y + rng.uniform(-0.3, 0.3, 3)
-    cfg = _StubConfig(travel_dir=travel / np.linalg.norm(travel), probe_span=PROBE_SPAN)
-    offs = [np.zeros(3)] + _probe_offsets(cfg, approach)
+    offs = [np.zeros(3), *probe_offsets(travel, approach, PROBE_SPAN)]
     grad = rng.uniform(-0.15, 0.15, 2)
     A = rng.uniform(-1 / 150, 1 / 150, (2, 2))
     hess = A + A.T
@@ -98,11 +99,6 @@ def test_the_probe_pattern_measures_a_curved_surface_normal_at_its_centre(seed):
     n3, _ = probe_normal(p3, n_true, approach)
     if np.abs(hess).max() > 1e-3:
         assert _angle_deg(n3, n_true) > 1e-3
-
-
-class _StubConfig:
-    def __init__(self, travel_dir, probe_span):
-        self.travel_dir, self.probe_span = travel_dir, probe_span
 
 
 def test_probe_normal_falls_back_on_collinear_or_rough_touches():
@@ -171,3 +167,85 @@ def test_with_friction_the_probe_finds_the_normal_the_force_cannot(tmp_path, ide
             assert len(pre) > 30  # the breakaway tilt grows for a while
             return max(abs(_true_normal_force(c) - 4.0) for c in pre[5:])
         assert pre_slip_err(rep) < 0.05 < pre_slip_err(rep0)
+
+
+def _run_probe(surface_height, approach, travel_dir, span=PROBE_SPAN, step=0.25,
+               max_cycles=400):
+    """Drive :func:`probe_step` against a rigid height field (no compliance: the tip is the
+    surface point under the commanded tool point once that point reaches the surface)."""
+    d = np.asarray(approach, dtype=float)
+    d /= np.linalg.norm(d)
+    u, v = _frame(d)
+
+    def height(p):  # the surface's height against d at p's lateral position
+        return surface_height(float(p @ u), float(p @ v))
+
+    def touching(p):
+        return -float(p @ d) <= height(p)
+
+    tp = np.zeros(3)
+    while not touching(tp):  # the approach
+        tp = tp + step * d
+    tip = tp - (-float(tp @ d) - height(tp)) * -d  # the surface point under the tool point
+    pr = start_probe(tip, tp, d, travel_dir, span)
+    commanded = [tp]
+    for _ in range(max_cycles):
+        contact = touching(tp)
+        tip = tp + (-float(tp @ d) - height(tp)) * d if contact else tp
+        ps = probe_step(pr, tp, contact, tip, step)
+        pr = ps.probe
+        if ps.reason or ps.done:
+            return ps, commanded
+        tp = ps.tool_point
+        commanded.append(tp)
+    raise AssertionError("the probe did not finish")
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_probe_step_touches_a_surface_and_finds_its_normal(seed):
+    rng = np.random.default_rng(seed)
+    approach = np.array([0.0, 0.0, -1.0]) + rng.uniform(-0.2, 0.2, 3)
+    approach /= np.linalg.norm(approach)
+    g = rng.uniform(-0.15, 0.15, 2)  # slopes up to ~8.5°
+    k = rng.uniform(-1 / 150, 1 / 150, 2)  # and curvature
+    h0 = -rng.uniform(2.0, 4.0)  # the surface ahead of the start
+
+    def h(x, y):
+        return h0 + g[0] * x + g[1] * y + 0.5 * (k[0] * x * x + k[1] * y * y)
+
+    travel = np.array([0.0, 1.0, 0.0]) + rng.uniform(-0.2, 0.2, 3)
+    step = 0.25
+    ps, commanded = _run_probe(h, approach, travel, step=step)
+    assert ps.done and not ps.reason
+    pr = ps.probe
+    assert pr.index == len(pr.offsets) == 5
+    # every touch is a surface point; the last is back at the centre
+    u, v = _frame(approach)
+    for p in pr.points:
+        assert -float(p @ approach) == pytest.approx(h(float(p @ u), float(p @ v)), abs=1e-9)
+    assert np.linalg.norm(pr.points[-1] - pr.points[0]) < step + 1e-9
+    # the line of travel: the first contact, behind, ahead, the centre again
+    assert len(pr.line) == 4
+    # no command pushes more than one approach step into the surface
+    for tp in commanded:
+        penetration = h(float(tp @ u), float(tp @ v)) + float(tp @ approach)
+        assert penetration <= step + 1e-9
+    n, fit = probe_normal(pr.points, -approach, approach)
+    n_true = -approach - g[0] * u - g[1] * v
+    n_true /= np.linalg.norm(n_true)
+    assert fit["used"]
+    # the touches are up to one approach step off the offsets (the descent's resolution):
+    # the curvature then leaves a small slope error, |κ| step ≈ 0.002 rad at most
+    assert _angle_deg(n, n_true) < 0.15
+
+
+def test_probe_step_stops_where_there_is_no_surface():
+    # a ledge: the surface falls away 30 mm beyond x = 2 mm (the first touch across the
+    # travel is at x = +3 mm): the descent gives up with a reason naming the offset
+    def h(x, y):
+        return -3.0 if x < 2.0 else -33.0
+
+    ps, commanded = _run_probe(h, [0.0, 0.0, -1.0], [0.0, 1.0, 0.0])
+    assert ps.reason.startswith("probing: no surface within 20 mm") and not ps.done
+    assert "offset" in ps.reason and "--probe-span" in ps.reason
+    assert max(-float(tp[2]) for tp in commanded) <= 3.0 + 20.0 + 1.0
