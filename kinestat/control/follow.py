@@ -817,6 +817,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         n, fit = probe_normal(ps.probe.points, st.normal, tgt.s6)
         st = replace(st, phase="settle", normal=n, last_tip=meas.tip(model),
                      probe_trusted=fit["used"])
+
         kw["info"]["probe"] = fit
         kw["info"]["phase"] = st.phase  # probing done: settle from this contact
         kw["info"]["normal_estimate"] = st.normal
