@@ -34,6 +34,10 @@ def test_follow_cylinder_json_and_plots(tmp_path, capsys):
         assert key in last
     names = sorted(p.rsplit("/", 1)[-1] for p in rep["plots"])
     assert names == ["normal-force-vs-travel.png", "tool-path.png", "wrench-vs-state.png"]
+    # the surface was probed before the force was raised: its fit is in the report
+    assert "p" in rep["states"]
+    fit = next(c["probe"] for c in rep["cycles"] if c.get("probe"))
+    assert fit["used"] and fit["points"] >= 6 and len(fit["normal"]) == 3
 
 
 @pytest.mark.parametrize("args, message", [
@@ -42,6 +46,8 @@ def test_follow_cylinder_json_and_plots(tmp_path, capsys):
     ([], "travel direction"),
     (["--travel-dir", "0,1,0", "--workpiece", "sphere:radius=3"], "--workpiece"),
     (["--travel-dir", "0,1,0", "--task", "slide"], "--task"),
+    (["--travel-dir", "0,1,0", "--probe-span", "-1"], "probe_span"),
+    (["--travel-dir", "0,1,0", "--probe-span", "30"], "probe_span"),
 ])
 def test_bad_follow_requests_fail_before_any_motion(tmp_path, capsys, args, message):
     argv = ["control", "--log", str(tmp_path / "log.jsonl"), "--no-plot"]
