@@ -22,7 +22,16 @@ from .test_loop import FAST, _assert_inside_envelope, _assert_log_complete
 START = np.array([-400.0, 800.0, -100.0])
 
 
-def _follow_with(tmp_path, inject, friction=0.0):
+def _during_travel(rec) -> bool:
+    task = rec.get("task") or {}
+    return task.get("phase") == "travel" and task.get("travel", 0.0) > 1.0
+
+
+def _during_probing(rec) -> bool:  # a few cycles into the surface probe (lifted or touching)
+    return rec.get("action") == "probe" and rec.get("cycle", 0) >= 25
+
+
+def _follow_with(tmp_path, inject, friction=0.0, when=_during_travel):
     prep = prepare_control(ControlRequest(
         force=4.0 * F_HAT, start_tool_point=START, cell=SimulatedCell(friction=friction),
         task="follow", travel=10.0, travel_dir=np.array([0.0, 1.0, 0.0])))
@@ -32,9 +41,8 @@ def _follow_with(tmp_path, inject, friction=0.0):
         io = h.device_io(profile=FAST, reader_options={"stale_after": 0.3}, client_timeout=0.5)
         injected = []
 
-        def progress(rec):  # the fault comes during the travel, a few cycles in
-            task = rec.get("task") or {}
-            if not injected and task.get("phase") == "travel" and task.get("travel", 0.0) > 1.0:
+        def progress(rec):  # the fault comes during the travel (or probing), a few cycles in
+            if not injected and when(rec):
                 injected.append(rec["cycle"])
                 inject(h)
 
@@ -66,3 +74,16 @@ def test_a_fault_during_the_travel_stops_the_cell_with_a_complete_log(tmp_path, 
     _assert_log_complete(recs, rep)
     assert any(r["type"] == "fault" for r in recs)
     _assert_inside_envelope(recs, prep.config)  # the axis limits from the config's model
+
+
+@pytest.mark.parametrize("fault", sorted(FAULTS))
+def test_a_fault_while_probing_the_surface_stops_the_cell_with_a_complete_log(tmp_path, fault):
+    # the probe lifts the tool off and moves it across: a fault then must stop it the same way
+    inject, reason = FAULTS[fault]
+    prep, rep, recs, commands, injected = _follow_with(tmp_path, inject, 0.3, _during_probing)
+    assert injected, "the probe never ran"
+    assert not rep.converged and reason in rep.stop_reason, rep.stop_reason
+    assert commands[-1] == "ST" or "ST sent" in rep.stop_reason
+    _assert_log_complete(recs, rep)
+    assert any(r["type"] == "fault" for r in recs)
+    _assert_inside_envelope(recs, prep.config)
