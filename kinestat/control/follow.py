@@ -230,6 +230,12 @@ EDGE_TOL = 0.003
 μ = 0.3) is inside the cone: stuck. At 0.02 and 0.006 a re-stuck tip (the thesis's sensor,
 its force 0.7° and 0.3° inside) counted as on the edge, and the travel step pushed it:
 +0.6 N and +0.3 N."""
+CREEP_WINDOW = 4
+CREEP_SPAN = 0.2
+"""With μ̂ known, a tip that advanced ``CREEP_SPAN`` mm over the last ``CREEP_WINDOW`` cycles
+slides (:func:`_crept`). Without it a creeping tip whose force ratio read low counted as
+stuck: no travel step, the breakaway tilt grew, and the CLI's R = 200 mm cylinder run (thesis
+sensor, μ = 0.3) turned the top to the 4° limit after 3.9 mm."""
 UNSLIP_MARGIN = 0.03
 """A stuck tip whose force ratio exceeds the first slip's μ̂ by this much shows that slip
 false (:func:`_unslipped`)."""
@@ -653,6 +659,15 @@ def _slipped_on_probe_normal(config: FollowConfig, st: FollowState, meas: Measur
                    stuck_travel=0.0, direct_slip=max(advance, CREEP_MIN))
 
 
+def _crept(path: tuple, tip: np.ndarray, s: np.ndarray) -> bool:
+    """Whether the tip advanced at least ``CREEP_SPAN`` along ``s`` over the last
+    ``CREEP_WINDOW`` cycles (a slow slide, below ``MIN_SLIP`` a cycle: a stuck tip's measured
+    position jitters by ~0.1 mm with the thesis's counts but does not advance)."""
+    if len(path) < CREEP_WINDOW:
+        return False
+    return float((tip - path[-CREEP_WINDOW]) @ s) >= CREEP_SPAN
+
+
 def _stuck_ratio(F: np.ndarray, n: np.ndarray) -> float:
     """The tangential-to-normal ratio of the force ``F`` against the normal ``n`` (a stuck
     tip's ratio is a lower bound of μ)."""
@@ -711,8 +726,11 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
                            slid=False, step_cap=0.0, tilting=True, stuck_travel=0.0,
                            withdraw=max(pushed - max(advance, 0.0), 0.0))
         if st.probe_trusted and st.friction_samples:
-            # the normal is known: the force's ratio tells whether the tip is on the edge
-            stuck = stuck and _stuck_ratio(F, n0) < st.friction_ratio - EDGE_TOL
+            # the normal is known: the force's ratio tells whether the tip is on the edge,
+            # and a tip creeping on over the last cycles is sliding whatever the ratio says
+            # (with the thesis's counts the ratio can read 0.013 low on a sliding tip)
+            stuck = (stuck and _stuck_ratio(F, n0) < st.friction_ratio - EDGE_TOL
+                     and not _crept(path, tip, s))
         elif st.tilting and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
             # S6 leans past the measured force by the margin: a stuck tip's force turns with
             # the tool, so this tip is on the cone's edge (creeping): more tilt would only

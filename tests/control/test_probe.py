@@ -249,3 +249,20 @@ def test_probe_step_stops_where_there_is_no_surface():
     assert ps.reason.startswith("probing: no surface within 20 mm") and not ps.done
     assert "offset" in ps.reason and "--probe-span" in ps.reason
     assert max(-float(tp[2]) for tp in commanded) <= 3.0 + 20.0 + 1.0
+
+
+def test_a_creeping_tip_slides_and_a_jittering_one_sticks():
+    # with μ̂ known a tip whose force ratio reads low still slides if it creeps on: 0.06 mm a
+    # cycle (the CLI's R = 200 mm run, thesis sensor) over four cycles; a stuck tip's measured
+    # position jitters by ±0.1 mm (the thesis's counts) but does not advance
+    from kinestat.control.follow import CREEP_SPAN, CREEP_WINDOW, _crept
+
+    s = np.array([0.0, 1.0, 0.0])
+    rng = np.random.default_rng(2)
+    for _ in range(200):
+        stuck = tuple(rng.uniform(-0.1, 0.1, (CREEP_WINDOW + 2, 3)))
+        assert not _crept(stuck, rng.uniform(-0.1, 0.1, 3), s)
+    creep = tuple(np.outer(np.arange(8) * 0.06, s))
+    assert _crept(creep[:-1], creep[-1], s)
+    assert 0.06 * CREEP_WINDOW >= CREEP_SPAN
+    assert not _crept(creep[:2], creep[2], s)  # too few tips yet
