@@ -489,7 +489,8 @@ def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
 def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal: np.ndarray,
                 omega: np.ndarray, travel: np.ndarray, dlam: float,
                 max_correction: float, friction: float = 0.0,
-                slip: np.ndarray | None = None, hold: np.ndarray | None = None) -> np.ndarray:
+                slip: np.ndarray | None = None,
+                hold: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """The base's twist T = T_f − K⁻¹ W_c Δλ (base frame, axis order [ω; v_O0]); the compliance
     part scaled so that it moves the tip by at most ``max_correction``. ``W_c`` is the contact
     normal's line W, or, for a tip sliding along ``slip`` with the friction ratio
@@ -647,15 +648,14 @@ def _slipped_on_probe_normal(config: FollowConfig, st: FollowState, meas: Measur
     # raised the normal force after the slip): μ is the largest ratio seen, and the tip is
     # stuck now (no travel step until it slides)
     stuck = ratio < mu - EDGE_TOL
-    tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ n)))))
-    brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
     advance = float((tip - st.last_tip) @ st.tangent)
     t = st.tangent - float(st.tangent @ n) * n
     kappa = _curvature(st, path, tip, n, t / norm3(t))
     return replace(st, travel=travel, last_tip=tip, path=path, friction_ratio=mu,
                    curvature=kappa, curvature_cycles=1 if kappa != 0.0 else 0,
                    friction_mean=mu, friction_samples=LEARN_CHORDS, sample_tip=tip,
-                   sticking=stuck, breakaway=brk / config.max_turn_deg, slid=not stuck,
+                   sticking=stuck, breakaway=_kept_breakaway(config, meas.s6, n, mu),
+                   slid=not stuck,
                    stuck_travel=0.0, direct_slip=max(advance, CREEP_MIN))
 
 
@@ -666,6 +666,18 @@ def _crept(path: tuple, tip: np.ndarray, s: np.ndarray) -> bool:
     if len(path) < CREEP_WINDOW:
         return False
     return float((tip - path[-CREEP_WINDOW]) @ s) >= CREEP_SPAN
+
+
+def _tilt_deg(s6: np.ndarray, n: np.ndarray) -> float:
+    """The angle (degrees) between S6 and ``−n``: the tool's tilt from the normal."""
+    return math.degrees(math.acos(min(1.0, max(-1.0, -float(s6 @ n)))))
+
+
+def _kept_breakaway(config: FollowConfig, s6: np.ndarray, n: np.ndarray, mu: float) -> float:
+    """At the first slip: the breakaway tilt (units of ``max_turn_deg``) that keeps S6 where it
+    is, its tilt from ``n`` past the new cone edge ``atan μ̂`` and the margin (0 inside)."""
+    brk = max(_tilt_deg(s6, n) - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
+    return brk / config.max_turn_deg
 
 
 def _stuck_ratio(F: np.ndarray, n: np.ndarray) -> float:
@@ -681,9 +693,8 @@ def _unslipped(config: FollowConfig, st: FollowState, meas: Measurement) -> Foll
     measurement's jitter (the thesis's counts; a plane of 0.7°: μ̂ 0.01): μ is unknown again, the
     breakaway tilt carries on from the tool's tilt, and a slip must now exceed that advance
     (``FIRST_SLIP_JITTER`` times it)."""
-    tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ st.normal)))))
     return replace(st, friction_ratio=0.0, friction_mean=0.0, friction_samples=0,
-                   sample_tip=None, breakaway=tilt / config.max_turn_deg,
+                   sample_tip=None, breakaway=_tilt_deg(meas.s6, st.normal) / config.max_turn_deg,
                    stick_jitter=max(st.stick_jitter, st.direct_slip), direct_slip=0.0)
 
 
@@ -711,12 +722,12 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if _first_slip(st, advance):  # the probe's normal: μ from this sliding force directly
         return _slipped_on_probe_normal(config, st, meas, F, tip, travel, path)
     if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip, advance):
-        if st.direct_slip and _stuck_ratio(F, st.normal) > st.friction_ratio + UNSLIP_MARGIN:
+        ratio = _stuck_ratio(F, n0) if st.probe_trusted else 0.0  # against the probe's normal
+        if st.direct_slip and ratio > st.friction_ratio + UNSLIP_MARGIN:
             st = _unslipped(config, st, meas)  # a stuck tip's force beyond μ̂'s cone: no slip
         if not st.friction_samples:
             st = replace(st, stick_jitter=max(st.stick_jitter, abs(advance)),
-                         stick_cycles=st.stick_cycles + 1,
-                         ratio_max=max(st.ratio_max, _stuck_ratio(F, st.normal)))
+                         stick_cycles=st.stick_cycles + 1, ratio_max=max(st.ratio_max, ratio))
         stuck = st.step > 0 or st.sticking
         pushed = st.stuck_travel + st.step  # the travel commanded since the tip last slid
         if _engages(config, st, advance):  # friction: the tip did not follow its steps
@@ -729,7 +740,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
             # the normal is known: the force's ratio tells whether the tip is on the edge,
             # and a tip creeping on over the last cycles is sliding whatever the ratio says
             # (with the thesis's counts the ratio can read 0.013 low on a sliding tip)
-            stuck = (stuck and _stuck_ratio(F, n0) < st.friction_ratio - EDGE_TOL
+            stuck = (stuck and ratio < st.friction_ratio - EDGE_TOL
                      and not _crept(path, tip, s))
         elif st.tilting and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
             # S6 leans past the measured force by the margin: a stuck tip's force turns with
@@ -764,9 +775,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     n = n / norm3(n)
     brk = max(st.breakaway - BREAKAWAY_DECAY, 0.0)
     if samples and not st.friction_samples:  # first slip measured: keep the tool's tilt
-        tilt = math.degrees(math.acos(min(1.0, max(-1.0, -float(meas.s6 @ n)))))
-        brk = max(tilt - math.degrees(math.atan(mu)) - AUTO_TILT_MARGIN_DEG, 0.0)
-        brk /= config.max_turn_deg
+        brk = _kept_breakaway(config, meas.s6, n, mu)
     t = s - (s @ n) * n
     kappa = _curvature(st, path, tip, n, t / norm3(t))
     if c is not None:
