@@ -243,6 +243,21 @@ ENGAGE_STEP = 2.0 * MIN_SLIP
 """With ``auto_tilt`` None (the default), the automatic tilt switches itself on when the tip
 advanced less than ``SLIDE_FRACTION`` of two travel steps in a row of at least this (mm), or of
 the full ``travel_step`` when that is shorter: the tip sticks (:func:`_engages`)."""
+BREAKAWAY_LEAD = 0.5
+"""Before the first slip, with the probe's normal: the breakaway first turns S6 with the force
+held (degrees it leads the measured force by, along the travel), then turns both. A tip that
+breaks away with S6 behind its force runs ahead and drops the normal force (a 0.05° a cycle
+breakaway, S6 1° behind: 1.1 mm and −1.15 N); with S6 ahead, the slip is a creep
+(docs/control.md, "The breakaway with S6 ahead")."""
+EDGE_STEP = 0.1
+"""The travel steps just after the first slip measured against the probe's normal
+(fraction of ``travel_step``): ``EDGE_STEP`` of it in the slip's cycle, growing by as
+much a cycle. The slip seen by the lead may leave the tip just inside the cone, and a step
+pushes a stuck tip along the tilted tool's axis (~1.2 N per mm)."""
+EDGE_LEAD = 0.35
+"""Degrees the lead of S6 past the measured force must grow above its mean since the hold
+(``FollowState.lead_ref``) to show the tip on the cone's edge: a stuck tip's force turns with
+the tool, an edge's does not (the lead's jitter with the thesis's counts: ±0.1°)."""
 
 
 def _unit3(v, name: str) -> np.ndarray:
@@ -430,6 +445,12 @@ class FollowState(ControllerState):
             normal, until a chord confirms it sliding (0: none pending).
         ratio_max: before the first slip, the largest tangential-to-normal force ratio of the
             stuck tip against the probe's normal (a lower bound of μ).
+        lead_ref: before the first slip, with the probe's normal: the mean lead of S6 past
+            the measured force (degrees) over the stuck cycles since the lead reached
+            ``BREAKAWAY_LEAD`` (None before: the breakaway turns S6 with the force held).
+        lead_cycles: the stuck cycles in ``lead_ref``'s mean.
+        slip_cycle: the cycle of the first slip measured against the probe's normal (the
+            creep rule's window starts after it: the slip itself is no creep).
     """
 
     phase: str = "approach"
@@ -460,6 +481,9 @@ class FollowState(ControllerState):
     stick_cycles: int = 0
     direct_slip: float = 0.0
     ratio_max: float = 0.0
+    lead_ref: float | None = None
+    lead_cycles: int = 0
+    slip_cycle: int = 0
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -656,7 +680,32 @@ def _slipped_on_probe_normal(config: FollowConfig, st: FollowState, meas: Measur
                    friction_mean=mu, friction_samples=LEARN_CHORDS, sample_tip=tip,
                    sticking=stuck, breakaway=_kept_breakaway(config, meas.s6, n, mu),
                    slid=not stuck,
-                   stuck_travel=0.0, direct_slip=max(advance, CREEP_MIN))
+                   stuck_travel=0.0, direct_slip=max(advance, CREEP_MIN), slip_cycle=st.cycle)
+
+
+def _lead_tracked(st: FollowState) -> bool:
+    """Whether the breakaway's lead of S6 past the force is tracked (the probe's normal, the
+    automatic tilt on, μ unknown)."""
+    return st.probe_trusted and st.tilting and not st.friction_samples
+
+
+def _on_edge_by_lead(st: FollowState, meas: Measurement, F: np.ndarray, s: np.ndarray) -> bool:
+    """Whether the stuck-looking tip is on the friction cone's edge: S6 leads the measured
+    force by ``EDGE_LEAD`` more than its mean since the hold (a stuck tip's force turns with
+    the tool about the tip; once on the edge it stays, and the lead grows)."""
+    return (_lead_tracked(st) and st.lead_ref is not None and st.lead_cycles >= 2
+            and _tilt_past_force(meas.s6, F, s) > st.lead_ref + EDGE_LEAD)
+
+
+def _track_lead(st: FollowState, meas: Measurement, F: np.ndarray, s: np.ndarray) -> FollowState:
+    """The lead's mean over the stuck cycles once it reached ``BREAKAWAY_LEAD``."""
+    if not _lead_tracked(st):
+        return st
+    lead = _tilt_past_force(meas.s6, F, s)
+    if st.lead_ref is None:
+        return replace(st, lead_ref=lead, lead_cycles=1) if lead >= BREAKAWAY_LEAD else st
+    k = st.lead_cycles + 1
+    return replace(st, lead_ref=st.lead_ref + (lead - st.lead_ref) / k, lead_cycles=k)
 
 
 def _crept(path: tuple, tip: np.ndarray, s: np.ndarray) -> bool:
@@ -728,6 +777,9 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         if not st.friction_samples:
             st = replace(st, stick_jitter=max(st.stick_jitter, abs(advance)),
                          stick_cycles=st.stick_cycles + 1, ratio_max=max(st.ratio_max, ratio))
+            if _on_edge_by_lead(st, meas, F, s):  # the force stopped turning with the tool
+                return _slipped_on_probe_normal(config, st, meas, F, tip, travel, path)
+            st = _track_lead(st, meas, F, s)
         stuck = st.step > 0 or st.sticking
         pushed = st.stuck_travel + st.step  # the travel commanded since the tip last slid
         if _engages(config, st, advance):  # friction: the tip did not follow its steps
@@ -741,7 +793,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
             # and a tip creeping on over the last cycles is sliding whatever the ratio says
             # (with the thesis's counts the ratio can read 0.013 low on a sliding tip)
             stuck = (stuck and ratio < st.friction_ratio - EDGE_TOL
-                     and not _crept(path, tip, s))
+                     and not (st.cycle - st.slip_cycle > CREEP_WINDOW and _crept(path, tip, s)))
         elif st.tilting and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
             # S6 leans past the measured force by the margin: a stuck tip's force turns with
             # the tool, so this tip is on the cone's edge (creeping): more tilt would only
@@ -934,6 +986,10 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
             s6n = meas.s6 + cross3(omega - w_surf, meas.s6)
             if step > 0.0 or -float(s6n @ n) < -float(meas.s6 @ n):  # slides on / turns out
                 hold = (-meas.estimate(base.estimator), w_surf)  # the force on the tool
+        if growing and _lead_tracked(st) and st.lead_ref is None:
+            # the breakaway's first turns hold the force (a stuck tip's force would turn
+            # with the tool): S6 comes to lead it by BREAKAWAY_LEAD before both turn
+            hold = (-meas.estimate(base.estimator), np.zeros(3))
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
                         config.max_correction, st.friction_ratio if sliding else 0.0, t,
                         hold)
@@ -962,6 +1018,8 @@ def _step_cap(config: FollowConfig, st: FollowState, tip: np.ndarray, t: np.ndar
     cap = min(max(st.step_cap, LEARN_STEP * full) + STEP_RAMP * full, full)
     if st.curvature == 0.0 and _path_span(st.path, tip, t) < CURVATURE_SPAN:
         cap = min(cap, UNKNOWN_CURVATURE_STEP * full)
+    if st.slip_cycle:  # just after the first slip the tip may be just inside the cone
+        cap = min(cap, EDGE_STEP * full * (st.cycle - st.slip_cycle + 1))
     return cap
 
 

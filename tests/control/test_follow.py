@@ -312,7 +312,27 @@ def test_by_default_friction_switches_the_automatic_tilt_on_and_the_run_complete
     along = [float((c["tool_point"] - cyc[first - 1]["tool_point"]) @ Y)
              for c in cyc[first - 1:on + 4]]
     assert max(along) >= 1.5, along  # two stuck steps of 1 mm
-    assert abs(along[-1]) <= 0.3, along
+    peak = int(np.argmax(along))  # (the breakaway's hold then moves it, turning the wrench)
+    assert min(abs(a) for a in along[peak:]) <= 0.3, along
+    # issue 13's acceptance on this default path (thesis sensor, true figures), the first
+    # slip included: S6 leads the force when the tip breaks away, so the slip is a creep
+    assert out["true_normal_force_max_error"] <= 0.5
+    assert out["true_normal_force_rms_error"] <= 0.2
+    # the breakaway's first turns hold the force: S6 turns, the stuck tip's force does not
+    # (then both turn together)
+    brk = [c for c in cyc[on:] if not c["friction_ratio"]]
+    assert len(brk) > 30
+
+    def turned(key, a, b):
+        u, v = (np.asarray(cyc_[key], dtype=float) for cyc_ in (a, b))
+        return math.degrees(math.acos(min(1.0, float(u @ v) / float(np.linalg.norm(u)
+                                                                     * np.linalg.norm(v)))))
+    held = [i for i in range(15) if turned("s6", brk[i], brk[i + 3]) >= 0.5
+            and turned("true_force", brk[i], brk[i + 3]) <= 0.1]
+    assert held, "no breakaway cycles turned S6 with the force held"
+    # then it turns onto the cone's edge with the tool
+    assert turned("true_force", brk[held[-1] + 3], brk[-1]) >= 5.0
+    assert all(abs(_true_normal_force(c) - 4.0) <= 0.1 for c in brk[held[0]:held[-1] + 4])
 
 
 def test_frictionless_runs_never_switch_the_automatic_tilt_on(tmp_path):

@@ -4,12 +4,14 @@ plane fitted to touches around the first contact, and its use on the simulated c
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from kinestat.app.control_run import SimulatedCell
 from kinestat.control.contact_estimate import fit_plane
+from kinestat.control.controller import start
 from kinestat.control.follow import FollowConfig
 from kinestat.control.probe import (
     PROBE_SPAN,
@@ -266,3 +268,56 @@ def test_a_creeping_tip_slides_and_a_jittering_one_sticks():
     assert _crept(creep[:-1], creep[-1], s)
     assert 0.06 * CREEP_WINDOW >= CREEP_SPAN
     assert not _crept(creep[:2], creep[2], s)  # too few tips yet
+
+
+def test_the_lead_of_s6_past_the_force_shows_the_cone_edge(tmp_path):
+    # before the first slip (the probe's normal known) a stuck tip's force turns with the tool:
+    # S6's lead past it stays at its mean, within the jitter of the thesis's counts (±0.1°),
+    # and 80 such cycles (20 runs) never read as the edge; a tip on the cone's edge keeps its
+    # force as S6 turns on by 0.2° a cycle, and the lead shows it within three cycles
+    from types import SimpleNamespace
+
+    from kinestat.control.follow import (
+        BREAKAWAY_LEAD,
+        FollowState,
+        _on_edge_by_lead,
+        _track_lead,
+    )
+
+    t = np.array([0.0, 1.0, 0.0])
+    n = np.array([0.0, 0.0, 1.0])
+
+    def meas(tilt_deg):  # S6 tilted from −n towards t
+        a = math.radians(tilt_deg)
+        return SimpleNamespace(s6=-math.cos(a) * n + math.sin(a) * t)
+
+    def force(angle_deg):  # the tool's force on the workpiece, leaning towards t
+        a = math.radians(angle_deg)
+        return 4.0 * (-math.cos(a) * n + math.sin(a) * t)
+
+    rng = np.random.default_rng(5)
+    _, st0 = start(_base(tmp_path), np.zeros(6))
+    base = replace(FollowState(**vars(st0)), probe_trusted=True, tilting=True)
+    for trial in range(20):
+        st, tilt, fa = base, 0.0, 0.0
+        # the hold: S6 turns, the force does not, until S6 leads by BREAKAWAY_LEAD
+        while st.lead_ref is None:
+            assert not _on_edge_by_lead(st, meas(tilt), force(fa), t)
+            st = _track_lead(st, meas(tilt), force(fa), t)
+            tilt += 0.2
+        assert st.lead_ref >= BREAKAWAY_LEAD
+        for _ in range(80):  # stuck: both turn (to ~17°), the force's direction jitters
+            tilt += 0.2
+            m, f = meas(tilt), force(tilt - st.lead_ref + rng.uniform(-0.1, 0.1))
+            assert not _on_edge_by_lead(st, m, f, t), trial
+            st = _track_lead(st, m, f, t)
+        edge = tilt - st.lead_ref
+        seen = []
+        for k in range(1, 4):  # on the edge: the force stays, S6 turns on
+            m, f = meas(tilt + 0.2 * k), force(edge + rng.uniform(-0.1, 0.1))
+            seen.append(_on_edge_by_lead(st, m, f, t))
+            st = _track_lead(st, m, f, t)
+        assert any(seen), (trial, seen)
+    # μ known, or no probe: not tracked
+    for other in (replace(base, friction_samples=3), replace(base, probe_trusted=False)):
+        assert _track_lead(other, meas(5.0), force(0.0), t).lead_ref is None
