@@ -19,7 +19,11 @@ point-contact fit of the force the tool applies). It is KEPT while the force set
 tip's force turns with the tool, chasing it would walk round the friction cone. With the probe's
 normal the first slip measures μ directly, ``μ̂ = |F_t|/F_n`` (the largest ratio the stuck tip
 reached, a sliding tip's force being on the cone's edge; :func:`_slipped_on_probe_normal`), and
-while μ̂ is known a tip whose force ratio is below ``μ̂ − EDGE_TOL`` is stuck. During travel, on
+while μ̂ is known a tip whose force ratio is below ``μ̂ − EDGE_TOL`` is stuck. The breakaway
+that brings the stuck tip's force onto the edge keeps S6 ahead of it: its first turns hold the
+force (the hold below) until S6 leads it by ``BREAKAWAY_LEAD``, and the edge shows as that lead
+growing by ``EDGE_LEAD`` over its recent mean (:func:`_on_edge_by_lead`): a stuck tip's force
+turns with the tool, an edge's does not. During travel, on
 every cycle the tip slid (advanced ≥ half the last travel step and ≥ ``MIN_SLIP``, or, while μ
 is learnt, crept ``LEARN_CHORD_LENGTH``), it is the sliding contact's normal of Coulomb's law
 (:mod:`kinestat.control.contact_estimate`): the force on the tool ``û = −F/|F|`` leans from the
@@ -51,7 +55,8 @@ line through the measured tip ``p``, the base (flange) is displaced by
   base; the base's turn ``ω`` relative to the surface's would turn the force in the
   platform's frame by ``(ω_s − ω) × f`` and the soft mode would run the tip ahead and drop
   the normal force (~1.7 N per degree), so the platform's wrench is changed by that much
-  in advance (``hold`` in :func:`_base_twist`);
+  in advance (``hold`` in :func:`_base_twist`). The breakaway's first turns use it too
+  (``ω_s = 0``), so that S6 turns while the stuck tip's force does not;
 * ``−K⁻¹ W Δλ``, the twist of compliance that raises the normal force by
   ``Δλ = gain · (|F_req| − F_n)`` (sign rule: a base motion T changes the wrench by −Wλ);
   once μ̂ is measured, along the friction cone's edge ``W_c = [n̂ − μ̂ t̂; p × (n̂ − μ̂ t̂)]``
