@@ -700,20 +700,20 @@ def _lead_tracked(st: FollowState) -> bool:
     return st.probe_trusted and st.tilting and not st.friction_samples
 
 
-def _on_edge_by_lead(st: FollowState, meas: Measurement, F: np.ndarray, s: np.ndarray) -> bool:
-    """Whether the stuck-looking tip is on the friction cone's edge: S6 leads the measured
-    force by ``EDGE_LEAD`` more than its recent mean (a stuck tip's force turns with
-    the tool about the tip; once on the edge it stays, and the lead grows)."""
+def _on_edge_by_lead(st: FollowState, lead: float) -> bool:
+    """Whether the stuck-looking tip is on the friction cone's edge: S6's lead past the
+    measured force (:func:`_tilt_past_force`, degrees) exceeds its recent mean by ``EDGE_LEAD``
+    (a stuck tip's force turns with the tool about the tip; once on the edge it stays, and the
+    lead grows)."""
     return (_lead_tracked(st) and st.lead_ref is not None and st.lead_cycles >= 2
-            and _tilt_past_force(meas.s6, F, s) > st.lead_ref + EDGE_LEAD)
+            and lead > st.lead_ref + EDGE_LEAD)
 
 
-def _track_lead(st: FollowState, meas: Measurement, F: np.ndarray, s: np.ndarray) -> FollowState:
-    """The lead's recent mean over the stuck cycles once it reached ``BREAKAWAY_LEAD``
-    (``LEAD_WINDOW``)."""
+def _track_lead(st: FollowState, lead: float) -> FollowState:
+    """The lead's (:func:`_tilt_past_force`, degrees) recent mean over the stuck cycles once it
+    reached ``BREAKAWAY_LEAD`` (``LEAD_WINDOW``)."""
     if not _lead_tracked(st):
         return st
-    lead = _tilt_past_force(meas.s6, F, s)
     if st.lead_ref is None:
         return replace(st, lead_ref=lead, lead_cycles=1) if lead >= BREAKAWAY_LEAD else st
     k = st.lead_cycles + 1
@@ -790,9 +790,11 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         if not st.friction_samples:
             st = replace(st, stick_jitter=max(st.stick_jitter, abs(advance)),
                          stick_cycles=st.stick_cycles + 1, ratio_max=max(st.ratio_max, ratio))
-            if _on_edge_by_lead(st, meas, F, s):  # the force stopped turning with the tool
-                return _slipped_on_probe_normal(config, st, meas, F, tip, travel, path)
-            st = _track_lead(st, meas, F, s)
+            if _lead_tracked(st):
+                lead = _tilt_past_force(meas.s6, F, s)
+                if _on_edge_by_lead(st, lead):  # the force stopped turning with the tool
+                    return _slipped_on_probe_normal(config, st, meas, F, tip, travel, path)
+                st = _track_lead(st, lead)
         stuck = st.step > 0 or st.sticking
         pushed = st.stuck_travel + st.step  # the travel commanded since the tip last slid
         if _engages(config, st, advance):  # friction: the tip did not follow its steps

@@ -282,6 +282,7 @@ def test_the_lead_of_s6_past_the_force_shows_the_cone_edge(tmp_path):
         BREAKAWAY_LEAD,
         FollowState,
         _on_edge_by_lead,
+        _tilt_past_force,
         _track_lead,
     )
 
@@ -303,8 +304,8 @@ def test_the_lead_of_s6_past_the_force_shows_the_cone_edge(tmp_path):
         st, tilt, fa = base, 0.0, 0.0
         # the hold: S6 turns, the force does not, until S6 leads by BREAKAWAY_LEAD
         while st.lead_ref is None:
-            assert not _on_edge_by_lead(st, meas(tilt), force(fa), t)
-            st = _track_lead(st, meas(tilt), force(fa), t)
+            assert not _on_edge_by_lead(st, _tilt_past_force(meas(tilt).s6, force(fa), t))
+            st = _track_lead(st, _tilt_past_force(meas(tilt).s6, force(fa), t))
             tilt += 0.2
         assert st.lead_ref >= BREAKAWAY_LEAD
         lead0 = st.lead_ref
@@ -312,15 +313,15 @@ def test_the_lead_of_s6_past_the_force_shows_the_cone_edge(tmp_path):
             tilt += 0.2  # the lead drifts (up to 0.025° a cycle, the CLI's R = 200 mm run)
             lead = lead0 + 0.025 * min(k, 20) * (1 if trial % 2 else -1)
             m, f = meas(tilt), force(tilt - lead + rng.uniform(-0.1, 0.1))
-            assert not _on_edge_by_lead(st, m, f, t), trial
-            st = _track_lead(st, m, f, t)
+            assert not _on_edge_by_lead(st, _tilt_past_force(m.s6, f, t)), trial
+            st = _track_lead(st, _tilt_past_force(m.s6, f, t))
         edge = tilt - lead
         seen = []
         for k in range(1, 4):  # on the edge: the force stays, S6 turns on
             m, f = meas(tilt + 0.2 * k), force(edge + rng.uniform(-0.1, 0.1))
-            seen.append(_on_edge_by_lead(st, m, f, t))
-            st = _track_lead(st, m, f, t)
+            seen.append(_on_edge_by_lead(st, _tilt_past_force(m.s6, f, t)))
+            st = _track_lead(st, _tilt_past_force(m.s6, f, t))
         assert any(seen), (trial, seen)
     # μ known, or no probe: not tracked
     for other in (replace(base, friction_samples=3), replace(base, probe_trusted=False)):
-        assert _track_lead(other, meas(5.0), force(0.0), t).lead_ref is None
+        assert _track_lead(other, _tilt_past_force(meas(5.0).s6, force(0.0), t)).lead_ref is None
