@@ -8,6 +8,24 @@ settings.register_profile("ci", max_examples=60, deadline=None)
 settings.register_profile("dev", max_examples=30, deadline=None)
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci"))
 
+#: the most pytest-xdist workers ``-n auto`` starts (pyproject's addopts): the long tests are
+#: whole simulated control runs, one core each; more workers than this only add start-up time
+MAX_WORKERS = 4
+
+# A pytest-xdist worker finds COLUMNS=80 (and LINES=24) in its environment, set as it starts,
+# not by the user. The CLI's human output honours COLUMNS (else a width of 160 for a pipe), so a
+# worker would wrap what a serial run does not: the workers get the user's COLUMNS, or none.
+if not os.environ.get("PYTEST_XDIST_WORKER"):
+    os.environ["KINESTAT_TEST_USER_COLUMNS"] = os.environ.get("COLUMNS", "")
+elif os.environ.get("KINESTAT_TEST_USER_COLUMNS"):
+    os.environ["COLUMNS"] = os.environ["KINESTAT_TEST_USER_COLUMNS"]
+else:
+    os.environ.pop("COLUMNS", None)
+
+
+def pytest_xdist_auto_num_workers(config):
+    return max(1, min(os.cpu_count() or 1, MAX_WORKERS))
+
 
 @pytest.fixture
 def rng():
