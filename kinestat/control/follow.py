@@ -212,6 +212,11 @@ CURVATURE_RAMP = 4
 """With the automatic tilt, the curvature feed-forward is fed in over this many cycles after
 the path's curvature is first estimated (the first estimates, over a short span, are the
 noisiest: a full turn on one made the tip stick under the step, +0.6 N)."""
+HOLD_CURVATURE_CYCLES = 2
+"""With the automatic tilt, the sliding hold (the force kept while S6 turns) counts the
+surface's turn under the step, κ Δs, only once the path's curvature has been estimated this
+many cycles in a row: a fit read a false κ̂ = 1/138 mm⁻¹ for one cycle on a 5.2° plane, and the
+hold, unlike the ramped feed-forward, took it whole (+0.54 N)."""
 CREEP_HOLD = 0.1
 """With the automatic tilt, a tip that advanced this far (mm) in a cycle without travel is
 slipping: the breakaway tilt is held, not grown."""
@@ -997,7 +1002,9 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         sliding = phase == "travel" and st.friction_samples > 0
         hold = None
         if sliding and not st.sticking and st.tilting:
-            w_surf = st.curvature * step * cross3(n, t)  # the surface's turn under the step
+            # the surface's turn under the step, once κ has held HOLD_CURVATURE_CYCLES cycles
+            kappa = st.curvature if st.curvature_cycles >= HOLD_CURVATURE_CYCLES else 0.0
+            w_surf = kappa * step * cross3(n, t)
             s6n = meas.s6 + cross3(omega - w_surf, meas.s6)
             if step > 0.0 or -float(s6n @ n) < -float(meas.s6 @ n):  # slides on / turns out
                 hold = (-meas.estimate(base.estimator), w_surf)  # the force on the tool
