@@ -1002,9 +1002,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         sliding = phase == "travel" and st.friction_samples > 0
         hold = None
         if sliding and not st.sticking and st.tilting:
-            # the surface's turn under the step, once κ has held HOLD_CURVATURE_CYCLES cycles
             kappa = st.curvature if st.curvature_cycles >= HOLD_CURVATURE_CYCLES else 0.0
-            w_surf = kappa * step * cross3(n, t)
+            w_surf = kappa * step * cross3(n, t)  # the surface's turn under the step
             s6n = meas.s6 + cross3(omega - w_surf, meas.s6)
             if step > 0.0 or -float(s6n @ n) < -float(meas.s6 @ n):  # slides on / turns out
                 hold = (-meas.estimate(base.estimator), w_surf)  # the force on the tool
