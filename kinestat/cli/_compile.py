@@ -153,8 +153,9 @@ def _warm_kinestatic() -> None:
 def _warm_control() -> None:
     """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
     vernier_pick), the envelope's prediction (envelope.predict) and the follow task's path
-    curvature (contact_estimate.path_curvature_one)."""
+    curvature (contact_estimate.path_curvature_one) and base twist (follow._base_twist)."""
     from kinestat.control._cycle_kernels import (  # lazy: start-up (numba)
+        base_twist_kernel,
         predict_kernel,
         vernier_tables_kernel,
     )
@@ -174,6 +175,10 @@ def _warm_control() -> None:
     predict_kernel(e4, e4.copy(), v3, v3.copy(), e4.copy(), np.ones(3), B, P_top, T,
                    stiffness_axis_trusted(pf, T), e4.copy(), v6, v6.copy(), np.empty(3),
                    np.empty(6), np.empty(3), np.empty((4, 4)))
+
+    z3, K = np.zeros(3), stiffness_axis_trusted(pf, T)
+    base_twist_kernel(e4, K, v3, np.array([0.0, 0.0, 1.0]), z3, z3, 0.1, 0.5, 4.0, 0.0, z3,
+                      False, z3, z3, False, 1e-12, 1e-9, np.empty(6))
 
     a = np.linspace(0.0, 0.05, 6)
     pts = np.column_stack([100.0 * np.sin(a), 100.0 * np.cos(a) - 100.0, 0.0 * a])

@@ -18,11 +18,13 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.parallel._kinestatic_kernels import singular_ratio6, solve6
 from kinestat.parallel._stiffness_kernels import pinned_tip_step_one
 
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
-__all__ = ["path_curvature_kernel", "predict_kernel", "vernier_tables_kernel"]
+__all__ = ["base_twist_kernel", "path_curvature_kernel", "predict_kernel",
+           "vernier_tables_kernel"]
 
 _PI = math.pi
 _TWO_PI = 2.0 * math.pi
@@ -224,4 +226,133 @@ def predict_kernel(Tn, mount, tip_F, p, base_R, f_point, B, P_top, T, K, flange,
     for r in range(3):
         tip_motion[r] = (Tn[r, 0] * loc[0] + Tn[r, 1] * loc[1] + Tn[r, 2] * loc[2]
                          + Tn[r, 3]) - tip_F[r]
+    return True
+
+
+@nb.njit(**_OPTS)
+def _rt3(R, x, out, o):
+    """``out[o:o+3] = Rᵀ x`` for the (3, 3) block ``R`` and the 3-vector ``x``."""
+    for i in range(3):
+        out[o + i] = R[0, i] * x[0] + R[1, i] * x[1] + R[2, i] * x[2]
+
+
+@nb.njit(**_OPTS)
+def _cross_into(a, ao, b, bo, out, o):
+    """``out[o:o+3] = a[ao:ao+3] × b[bo:bo+3]``."""
+    a0, a1, a2 = a[ao], a[ao + 1], a[ao + 2]
+    b0, b1, b2 = b[bo], b[bo + 1], b[bo + 2]
+    out[o] = a1 * b2 - a2 * b1
+    out[o + 1] = a2 * b0 - a0 * b2
+    out[o + 2] = a0 * b1 - a1 * b0
+
+
+@nb.njit(**_OPTS)
+def base_twist_kernel(TB, K, tip, normal, omega, travel, dlam, max_correction, tangential_factor,
+                      friction, slip, use_slip, hold_f, hold_w, use_hold, k_tol, in_tol, out):
+    """The follow law's base twist (:func:`kinestat.control.follow._base_twist_numpy`, the same
+    formulas in the same order, each ``K⁻¹ b`` by :func:`~kinestat.parallel.
+    _kinestatic_kernels.solve6`): T = T_f − K⁻¹ W_c Δλ with the compliance part scaled to move
+    the tip by at most ``max_correction`` (``tangential_factor`` times it along the surface),
+    the friction cone's edge for a sliding tip (``use_slip``: ``slip`` (3,), ``friction``) and
+    the sliding hold (``use_hold``: the held force ``hold_f`` turning by ``hold_w``), into
+    ``out`` (6,), axis order ``[ω; v_O0]`` in the platform base frame. ``TB`` (4, 4) the base
+    pose, ``K`` (6, 6) its loaded stiffness; ``tip``, ``normal``, ``omega``, ``travel`` (3,),
+    fixed frame.
+
+    The checks of :func:`~kinestat.parallel.kinestatic.compose_twist_line` are made with its
+    tolerances (``k_tol``: K regular, its Jacobi ratio above twice it; ``in_tol``: the wrench
+    change along W, the twist of freedom reciprocal to W). Returns False (``out`` unset) where
+    one fails or a solve meets a zero pivot: the caller then runs the NumPy formulation, which
+    raises its message.
+    """
+    if not singular_ratio6(K) > 2.0 * k_tol:
+        return False
+    R = TB[:3, :3]
+    d = np.empty(3)
+    for i in range(3):
+        d[i] = tip[i] - TB[i, 3]
+    v = np.empty(3)
+    p = np.empty(3)
+    _rt3(R, d, p, 0)
+    W = np.empty(6)
+    _rt3(R, normal, W, 0)
+    _cross_into(p, 0, W, 0, W, 3)
+    Tf = np.empty(6)
+    _rt3(R, omega, Tf, 0)
+    _rt3(R, travel, v, 0)
+    _cross_into(Tf, 0, p, 0, d, 0)  # ω × p (d reused)
+    for i in range(3):
+        Tf[3 + i] = v[i] - d[i]  # the tip moves by `travel`, turning about the tip
+    Wt = np.zeros(6)
+    sliding = friction > 0.0 and use_slip
+    if sliding:
+        _rt3(R, slip, Wt, 0)
+        _cross_into(p, 0, Wt, 0, Wt, 3)
+    b = np.empty(6)
+    for i in range(6):
+        b[i] = W[i] - friction * Wt[i]
+    x = np.empty(6)
+    if not solve6(K, b, x):
+        return False
+    Tc = np.empty(6)
+    for i in range(6):
+        Tc[i] = -dlam * x[i]
+    dp = np.empty(3)
+    _cross_into(Tc, 0, p, 0, dp, 0)
+    for i in range(3):
+        dp[i] += Tc[3 + i]
+    dpn = dp[0] * W[0] + dp[1] * W[1] + dp[2] * W[2]
+    dpl = math.sqrt(dp[0] * dp[0] + dp[1] * dp[1] + dp[2] * dp[2])
+    scale = max(abs(dpn) / max_correction, dpl / (tangential_factor * max_correction), 1.0)
+    c = -(dlam / scale)
+    dw = np.empty(6)
+    wn2 = 0.0
+    tn2 = 0.0
+    dn2 = 0.0
+    r = 0.0
+    cd = 0.0
+    for i in range(6):
+        dw[i] = c * W[i]
+        wn2 += W[i] * W[i]
+        tn2 += Tf[i] * Tf[i]
+        dn2 += dw[i] * dw[i]
+        cd += W[i] * dw[i]
+        r += W[i] * Tf[(i + 3) % 6]  # w · (T_f Δ)
+    if not (math.isfinite(wn2) and math.isfinite(tn2) and math.isfinite(dn2)):
+        return False  # (the NumPy formulation names the vector that is not finite)
+    wn = math.sqrt(wn2)
+    if wn == 0.0:
+        return False
+    cd /= wn * wn
+    res = 0.0
+    for i in range(6):
+        res += (dw[i] - W[i] * cd) ** 2
+    tiny = 2.2250738585072014e-308
+    if math.sqrt(res) > in_tol * max(math.sqrt(dn2), tiny):
+        return False
+    if abs(r) > in_tol * max(wn * math.sqrt(tn2), tiny):
+        return False
+    if not solve6(K, dw, x):
+        return False
+    for i in range(6):
+        out[i] = Tf[i] + x[i]  # = T_f + T_c
+    if sliding:
+        if not solve6(K, Wt, x):
+            return False
+        for i in range(6):
+            out[i] = out[i] + (dlam / scale) * friction * x[i]
+    if use_hold:  # the sliding contact's force turns with the surface, not the base
+        ws = np.empty(3)
+        f = np.empty(3)
+        _rt3(R, hold_w, ws, 0)
+        _rt3(R, hold_f, f, 0)
+        for i in range(3):
+            ws[i] -= Tf[i]
+        h = np.empty(6)
+        _cross_into(ws, 0, f, 0, h, 0)
+        _cross_into(p, 0, h, 0, h, 3)
+        if not solve6(K, h, x):
+            return False
+        for i in range(6):
+            out[i] = out[i] - x[i]
     return True

@@ -74,9 +74,10 @@ def reference_cycle() -> Iterator[None]:
     :func:`~kinestat.control.follow.decide_follow` on the unoptimised path inside the block:
     the NumPy vernier and selection (:func:`solve_counts_reference`), the NumPy forward
     analysis for the flange pose, the NumPy stiffness recomputed on every use, the batched
-    ``compose_twist`` and ``twist_exp`` in the follow law, NumPy's solves and SciPy's rotations
-    in the prediction, NumPy's tip compliance and SciPy's rotation vector on every motion check;
-    in the follow task's estimator and law the batched NumPy ``cone_normal``,
+    ``compose_twist`` and ``twist_exp`` in the follow law (not its compiled base twist),
+    NumPy's solves and SciPy's rotations in the prediction, NumPy's tip compliance and SciPy's
+    rotation vector on every motion check; in the follow task's estimator and law the batched
+    NumPy ``cone_normal``,
     ``friction_sample`` and ``path_curvature`` (``lstsq``), ``numpy.linalg.norm`` and
     ``numpy.linalg.solve``, ``dataclasses.replace`` and the mount's inverse on every use. Not
     thread-safe (it swaps module attributes)."""
@@ -84,6 +85,7 @@ def reference_cycle() -> Iterator[None]:
              (controller, "_flange_pose", lambda model, q: puma762.forward(q).pose),
              (envelope, "cycle_data", UncachedCycleData),
              (follow, "cycle_data", UncachedCycleData),
+             (follow, "_base_twist_fast", lambda *a: None),
              (follow, "compose_twist_line", compose_twist),
              (follow, "twist_exp_one", twist_exp),
              (follow, "cone_normal_one", cone_normal),

@@ -87,6 +87,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinestat.control._cycle_kernels import base_twist_kernel
 from kinestat.control.contact_estimate import (
     cone_normal_one,
     friction_sample_one,
@@ -111,6 +112,8 @@ from kinestat.control.model import ControlModel
 from kinestat.control.probe import PROBE_SPAN, Probe, probe_normal, probe_step, start_probe
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
+from kinestat.parallel.kinestatic import _IN_TOL as IN_TOL
+from kinestat.parallel.kinestatic import _K_TOL as K_TOL
 from kinestat.parallel.kinestatic import compose_twist_line, solve_one
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
@@ -526,6 +529,29 @@ def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
     return c / s * ang
 
 
+_ZERO3 = np.zeros(3)
+_ZERO3.setflags(write=False)
+
+
+def _base_twist_fast(model: ControlModel, meas: Measurement, tip: np.ndarray,
+                     normal: np.ndarray, omega: np.ndarray, travel: np.ndarray, dlam: float,
+                     max_correction: float, friction: float, slip: np.ndarray | None,
+                     hold: tuple[np.ndarray, np.ndarray] | None) -> np.ndarray | None:
+    """:func:`_base_twist` compiled (:func:`~kinestat.control._cycle_kernels.
+    base_twist_kernel`, equal to :func:`_base_twist_numpy` to rounding); None where a check
+    or a solve failed (the NumPy formulation then says why)."""
+    f64 = np.float64
+    out = np.empty(6)
+    hf, hw = (_ZERO3, _ZERO3) if hold is None else hold
+    ok = base_twist_kernel(
+        np.asarray(meas.base_pose, f64), cycle_data(model, meas).K, np.asarray(tip, f64),
+        np.asarray(normal, f64), np.asarray(omega, f64), np.asarray(travel, f64), float(dlam),
+        float(max_correction), TANGENTIAL_FACTOR, float(friction),
+        _ZERO3 if slip is None else np.asarray(slip, f64), slip is not None,
+        np.asarray(hf, f64), np.asarray(hw, f64), hold is not None, K_TOL, IN_TOL, out)
+    return out if ok else None
+
+
 def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal: np.ndarray,
                 omega: np.ndarray, travel: np.ndarray, dlam: float,
                 max_correction: float, friction: float = 0.0,
@@ -536,7 +562,22 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     normal's line W, or, for a tip sliding along ``slip`` with the friction ratio
     ``friction``, the friction cone's edge ``[n − μ ŝ; p × (n − μ ŝ)]``: a sliding contact's
     force changes along the edge, so the normal force changes by Δλ and the tip keeps
-    sliding."""
+    sliding. Compiled (:func:`_base_twist_fast`); where its checks fail, the NumPy formulation
+    (:func:`_base_twist_numpy`) raises the error."""
+    T = _base_twist_fast(model, meas, tip, normal, omega, travel, dlam, max_correction,
+                         friction, slip, hold)
+    if T is not None:
+        return T
+    return _base_twist_numpy(model, meas, tip, normal, omega, travel, dlam, max_correction,
+                             friction, slip, hold)
+
+
+def _base_twist_numpy(model: ControlModel, meas: Measurement, tip: np.ndarray,
+                      normal: np.ndarray, omega: np.ndarray, travel: np.ndarray, dlam: float,
+                      max_correction: float, friction: float = 0.0,
+                      slip: np.ndarray | None = None,
+                      hold: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+    """:func:`_base_twist` in NumPy (the reference formulation; it raises the errors)."""
     TB = meas.base_pose
     R = TB[:3, :3]
     p = R.T @ (tip - TB[:3, 3])

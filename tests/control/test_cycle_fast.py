@@ -202,6 +202,45 @@ def test_compose_twist_line_is_compose_twist_for_one_contact(model_and_counts):
         np.testing.assert_array_equal(compose_twist_line(K, w, Tf, dw), ref)
 
 
+def test_compiled_base_twist_is_the_numpy_formulation(model_and_counts):
+    """The follow law's base twist, compiled, against its NumPy formulation at random loaded
+    poses, base poses, contacts and motions (with and without the friction edge and the hold);
+    a singular K falls back to the NumPy formulation, which raises its error."""
+    from types import SimpleNamespace
+
+    from kinestat.control import follow
+    from kinestat.errors import InputError
+    from kinestat.spatial.se3 import twist_exp
+
+    model, rng = model_and_counts
+    plat = model.platform
+    for i in range(300):
+        top = twist_exp(np.concatenate([rng.normal(0, 0.03, 3), rng.normal(0, 2, 3)])) \
+            @ plat.home_pose
+        base = twist_exp(np.concatenate([rng.normal(0, 1.0, 3), rng.normal(0, 500, 3)]))
+        meas = SimpleNamespace(top_pose=top, base_pose=base)
+        n = rng.normal(size=3)
+        n /= np.linalg.norm(n)
+        t = np.cross(n, rng.normal(size=3))  # a travel along the tangent plane
+        args = (model, meas, base[:3, 3] + rng.normal(0, 300, 3), n, rng.normal(0, 0.01, 3),
+                rng.uniform(0, 2) * t / np.linalg.norm(t), rng.normal(0, 1), 0.5,
+                rng.uniform(0, 0.5) if i % 2 else 0.0, t if i % 3 else None,
+                (rng.normal(0, 5, 3), rng.normal(0, 0.01, 3)) if i % 4 else None)
+        fast = follow._base_twist_fast(*args)
+        ref = follow._base_twist_numpy(*args)
+        assert fast is not None
+        np.testing.assert_allclose(fast, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+        np.testing.assert_array_equal(follow._base_twist(*args), fast)
+    meas = SimpleNamespace(top_pose=plat.home_pose, base_pose=np.eye(4))
+    ctl_cycle = follow.cycle_data(model, meas)
+    ctl_cycle.__dict__["K"] = np.diag([1.0, 1.0, 1.0, 1.0, 1.0, 0.0])  # singular
+    args = (model, meas, np.zeros(3), np.array([0.0, 0.0, 1.0]), np.zeros(3),
+            np.array([1.0, 0.0, 0.0]), 0.5, 0.5)
+    assert follow._base_twist_fast(*args, 0.0, None, None) is None
+    with pytest.raises((InputError, np.linalg.LinAlgError)):  # (what _act stops on)
+        follow._base_twist(*args)
+
+
 def test_single_twist_and_rotation_vector_agree_with_the_batched_ones():
     from scipy.spatial.transform import Rotation
 
