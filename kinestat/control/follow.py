@@ -211,6 +211,13 @@ REALIGN_DEG = 2.0
 is turned back without travel."""
 CONE_CLEARANCE_DEG = 1.0
 """S6 may turn fast while it stays this far (degrees) inside the estimated friction cone."""
+CURVATURE_PROBE_TRAVEL = 2.0 * CURVATURE_SPAN
+"""Travel (mm) up to which the path's curvature falls back on the probe's touches when the
+path's own tips do not yet give a significant fit: at ``CURVATURE_SPAN`` the path's few
+distinct tips (the stuck cycles' tips lie together) have a sagitta ``κ s²/8`` of ~0.013 mm on
+R = 154 mm, below the thesis counts' tip jitter, so the fit read 0 for a cycle and the
+curvature feed-forward restarted its ramp (S6 fell behind the surface's turn by 0.6° over two
+cycles, −0.51 N; seed 57's R = 154 mm cylinder, 2026-12-03)."""
 CURVATURE_RAMP = 4
 """With the automatic tilt, the curvature feed-forward is fed in over this many cycles after
 the path's curvature is first estimated (the first estimates, over a short span, are the
@@ -697,11 +704,17 @@ def _curvature(st: FollowState, path: tuple, tip: np.ndarray, n: np.ndarray,
     from the probe's touches on the line of travel too
     (±``probe_span`` about the start: known from the first travel cycle, where the path's
     own tips need ``CURVATURE_SPAN`` of travel; a noisy touch fails the fit's significance
-    test and leaves it 0)."""
+    test and leaves it 0). Until ``CURVATURE_PROBE_TRAVEL``, a fit of the path's own tips that
+    fails the significance test is replaced by the fit with the probe's touches."""
     pts = path
     if st.probe is not None and st.travel < CURVATURE_SPAN:  # (cheaper than the path's span)
         pts = st.probe.line + tuple(path)
-    return path_curvature_one(np.asarray(pts), tip, n, t, CURVATURE_SPAN)
+    kappa = path_curvature_one(np.asarray(pts), tip, n, t, CURVATURE_SPAN)
+    if (kappa == 0.0 and st.probe is not None
+            and CURVATURE_SPAN <= st.travel < CURVATURE_PROBE_TRAVEL):
+        kappa = path_curvature_one(np.asarray(st.probe.line + tuple(path)), tip, n, t,
+                                   CURVATURE_SPAN)
+    return kappa
 
 
 def _first_slip(st: FollowState, advance: float) -> bool:

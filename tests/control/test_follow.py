@@ -526,3 +526,33 @@ def test_the_sliding_hold_takes_the_surface_turn_only_from_a_curvature_held_two_
         assert np.linalg.norm(w_two) > 0.0
         checked += 1
     assert checked >= 3  # the run slid with a known curvature under the hold
+
+
+def test_an_insignificant_path_fit_falls_back_on_the_probe_touches_early_in_the_travel():
+    """Just past CURVATURE_SPAN the path's own tips span too little for their jitter (sagitta
+    below twice the fit's residual): the curvature comes from the fit with the probe's touches
+    while the travel is below CURVATURE_PROBE_TRAVEL, and from the path alone after it."""
+    from types import SimpleNamespace
+
+    from kinestat.control import follow
+    from kinestat.control.contact_estimate import path_curvature
+
+    R = 150.0
+
+    def on_circle(x, dz=0.0):  # the convex arc z = sqrt(R² − x²) − R, centre on −z
+        return np.array([x, 0.0, math.sqrt(R * R - x * x) - R + dz])
+
+    xs = np.linspace(0.0, 4.5, 10)
+    path = tuple(on_circle(x, 0.01 * (-1) ** k) for k, x in enumerate(xs[:-1]))  # jitter
+    tip = on_circle(xs[-1])
+    a = xs[-1] / R
+    n, t = np.array([math.sin(a), 0.0, math.cos(a)]), np.array([math.cos(a), 0.0, -math.sin(a)])
+    line = tuple(on_circle(x) for x in (-3.0, -1.5, 0.0, 1.5, 3.0))
+    # the premise: the path alone is not significant, with the touches it is
+    assert path_curvature(np.asarray(path), tip, n, t, follow.CURVATURE_SPAN) == 0.0
+    both = path_curvature(np.asarray(line + path), tip, n, t, follow.CURVATURE_SPAN)
+    assert both == pytest.approx(1.0 / R, rel=0.1)
+    st = SimpleNamespace(probe=SimpleNamespace(line=line), travel=follow.CURVATURE_SPAN + 0.5)
+    assert follow._curvature(st, path, tip, n, t) == pytest.approx(both, rel=1e-9)
+    st.travel = follow.CURVATURE_PROBE_TRAVEL
+    assert follow._curvature(st, path, tip, n, t) == 0.0
