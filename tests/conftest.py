@@ -1,4 +1,6 @@
 import os
+import signal
+import threading
 
 import numpy as np
 import pytest
@@ -21,6 +23,14 @@ elif os.environ.get("KINESTAT_TEST_USER_COLUMNS"):
     os.environ["COLUMNS"] = os.environ["KINESTAT_TEST_USER_COLUMNS"]
 else:
     os.environ.pop("COLUMNS", None)
+
+# A run started with SIGINT ignored (SIG_IGN is inherited: a background job of a shell without
+# job control, or a CI runner that ignores it) keeps ignoring Ctrl-C, and so do the processes it
+# starts: the tests of Ctrl-C (a real SIGINT, in-process and to a `kinestat view --serve` child)
+# would fail. The tests get Python's default handler (a child then starts with the default).
+if (threading.current_thread() is threading.main_thread()
+        and signal.getsignal(signal.SIGINT) is signal.SIG_IGN):
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 def pytest_xdist_auto_num_workers(config):
