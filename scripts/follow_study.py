@@ -180,7 +180,7 @@ if __name__ == "__main__":
     ap.add_argument("--budget", action="store_true",
                     help="also the squared error before the first slip and after, per run")
     ap.add_argument("--seed", type=int, default=13,
-                    help="the random workpieces' draw (docs/control.md quotes 13, and 29)")
+                    help="the random workpieces' draw (docs/control.md quotes 13, 29 and 57)")
     a = ap.parse_args()
     if a.acceptance:
         acceptance(a.friction, a.auto_tilt)
