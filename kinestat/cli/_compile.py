@@ -172,11 +172,12 @@ def _warm_control() -> None:
     B, P_top, _, l0 = platform_arrays(pf)
     T = pf.home_pose.copy()
     e4, v3, v6 = np.eye(4), np.array([0.0, 0.0, 100.0]), l0.copy()
+    K = stiffness_axis_trusted(pf, T)
     predict_kernel(e4, e4.copy(), v3, v3.copy(), e4.copy(), np.ones(3), B, P_top, T,
-                   stiffness_axis_trusted(pf, T), e4.copy(), v6, v6.copy(), np.empty(3),
+                   K, e4.copy(), v6, v6.copy(), np.empty(3),
                    np.empty(6), np.empty(3), np.empty((4, 4)))
 
-    z3, K = np.zeros(3), stiffness_axis_trusted(pf, T)
+    z3 = np.zeros(3)
     base_twist_kernel(e4, K, v3, np.array([0.0, 0.0, 1.0]), z3, z3, 0.1, 0.5, 4.0, 0.0, z3,
                       False, z3, z3, False, 1e-12, 1e-9, np.empty(6))
 

@@ -706,15 +706,13 @@ def _curvature(st: FollowState, path: tuple, tip: np.ndarray, n: np.ndarray,
     own tips need ``CURVATURE_SPAN`` of travel; a noisy touch fails the fit's significance
     test and leaves it 0). Until ``CURVATURE_PROBE_TRAVEL``, a fit of the path's own tips that
     fails the significance test is replaced by the fit with the probe's touches."""
-    pts = path
-    if st.probe is not None and st.travel < CURVATURE_SPAN:  # (cheaper than the path's span)
-        pts = st.probe.line + tuple(path)
-    kappa = path_curvature_one(np.asarray(pts), tip, n, t, CURVATURE_SPAN)
-    if (kappa == 0.0 and st.probe is not None
-            and CURVATURE_SPAN <= st.travel < CURVATURE_PROBE_TRAVEL):
-        kappa = path_curvature_one(np.asarray(st.probe.line + tuple(path)), tip, n, t,
-                                   CURVATURE_SPAN)
-    return kappa
+    with_probe = st.probe is not None and st.travel < CURVATURE_PROBE_TRAVEL
+    if not (with_probe and st.travel < CURVATURE_SPAN):  # (cheaper than the path's span)
+        kappa = path_curvature_one(np.asarray(path), tip, n, t, CURVATURE_SPAN)
+        if kappa != 0.0 or not with_probe:
+            return kappa
+    return path_curvature_one(np.asarray(st.probe.line + tuple(path)), tip, n, t,
+                              CURVATURE_SPAN)
 
 
 def _first_slip(st: FollowState, advance: float) -> bool:
