@@ -26,7 +26,7 @@ def _run(tmp_path, *, inject=None, at_cycle=2, config_kw=None, scn=None, io_kw=N
     cfg = scn.config(**(config_kw or {}))
     path = tmp_path / "log.jsonl"
     with SimHarness(scn.cell, scn.sensor, start_counts=start_counts(cfg), record=True) as h:
-        io = h.device_io(profile=FAST, reader_options={"stale_after": 0.3}, client_timeout=0.5,
+        io = h.device_io(profile=FAST, client_timeout=0.5,
                          **(io_kw or {}))
 
         def progress(rec):

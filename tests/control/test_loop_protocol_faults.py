@@ -31,7 +31,7 @@ def _run(tmp_path, inject, at_cycle=2):
     cfg = scn.config()
     path = tmp_path / "log.jsonl"
     with SimHarness(scn.cell, scn.sensor, start_counts=start_counts(cfg), record=True) as h:
-        io = h.device_io(profile=FAST, reader_options={"stale_after": 0.3}, client_timeout=0.5,
+        io = h.device_io(profile=FAST, client_timeout=0.5,
                          guard=sent_command_guard(cfg.envelope, cfg.model))
         marks = {}
 

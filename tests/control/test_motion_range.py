@@ -96,7 +96,7 @@ def test_measured_state_outside_the_ranges_stops_with_st_and_a_complete_log(tmp_
     cfg = replace(prep.config, envelope=ROT_X)
     path = tmp_path / "log.jsonl"
     with SimHarness(prep.cell, prep.sensor, start_counts=start_counts(cfg), record=True) as h:
-        io = h.device_io(profile=FAST, reader_options={"stale_after": 0.3}, client_timeout=0.5)
+        io = h.device_io(profile=FAST, client_timeout=0.5)
 
         def progress(rec):
             if rec["cycle"] == 2:
