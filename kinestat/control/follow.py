@@ -283,6 +283,10 @@ LEAD_WINDOW = 4
 mean with weight ``1/LEAD_WINDOW``: the stuck tip's lead drifts (0.9° to 1.15° over 10 cycles
 on the CLI's R = 200 mm run, thesis sensor), and a mean since the hold lagged it by the
 ``EDGE_LEAD`` (a false edge: μ̂ 0.28, and steps then pushed the stuck tip by +0.55 N)."""
+SLIP_DIRECTION_TOL = 0.01
+"""rad: the direction error (the tip's jitter over the chord's length) allowed in a chord
+taken as the slip's direction before a ``CHORD_LENGTH`` chord exists
+(:func:`_slip_chord_length`): 0.01 rad tilts the cone's normal by ≤ 0.17° at μ = 0.3."""
 
 
 def _unit3(v, name: str) -> np.ndarray:
@@ -632,6 +636,24 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
     return None
 
 
+def _slip_chord_length(st: FollowState) -> float:
+    """The shortest chord of the tip's path (mm) whose direction is the slip's to
+    ``SLIP_DIRECTION_TOL``: the tip's jitter measured at rest (``stick_jitter``, over at least
+    ``FIRST_SLIP_CYCLES``) over the tolerance, at least ``LEARN_CHORD_LENGTH`` and at most
+    ``CHORD_LENGTH``; ``CHORD_LENGTH`` when the jitter was not measured.
+
+    The cone's normal (:func:`~kinestat.control.contact_estimate.cone_normal`) needs the
+    slip's direction. Just after a breakaway the tip slides where the platform's stored
+    tangential force pushes it, ~5° off the commanded tangent on steep cylinders met 28–30°
+    off their normal; taken along the tangent, the normal read ~1.6° off (μ = 0.3) for the
+    cycles until a ``CHORD_LENGTH`` chord existed, and the force 0.1–0.2 N low. With the
+    thesis's counts (jitter ~0.1 mm) no shorter chord is precise enough, and the tangent
+    stays the estimate."""
+    if st.stick_cycles < FIRST_SLIP_CYCLES:
+        return CHORD_LENGTH
+    return min(CHORD_LENGTH, max(LEARN_CHORD_LENGTH, st.stick_jitter / SLIP_DIRECTION_TOL))
+
+
 def _path_span(path: tuple, tip: np.ndarray, t: np.ndarray) -> float:
     """The span (mm) along ``t`` of the measured tip path and ``tip``."""
     if not path:
@@ -894,8 +916,9 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         sample_tip = tip
         mu = min(max(raw, 0.0), MAX_FRICTION)
         n = cone_normal_one(u, c, mu)
-    elif samples:
-        n = cone_normal_one(u, s, mu)
+    elif samples:  # no chord for μ yet: the slip's direction, measured if precise enough
+        g = _chord(path, tip, _slip_chord_length(st))
+        n = cone_normal_one(u, g if g is not None and float(g @ s) > 0.5 * norm3(g) else s, mu)
     n = n / norm3(n)
     brk = max(st.breakaway - BREAKAWAY_DECAY, 0.0)
     if samples and not st.friction_samples:  # first slip measured: keep the tool's tilt
