@@ -15,7 +15,13 @@ from kinestat.errors import ParseError
 from kinestat.mechanism.joints import JOINT_KINDS
 
 __all__ = ["number", "numbers", "string", "choice", "short_repr", "matrix", "refuse_unknown",
-           "joint_type_and_pitch"]
+           "joint_type_and_pitch", "MAX_MAGNITUDE"]
+
+MAX_MAGNITUDE = 1e12
+"""Largest magnitude a number in these files may have. No length (mm), angle, pitch,
+stiffness (N/mm) or count in a model, platform, axes or calibration file comes near it;
+beyond ~1e154 a product of two overflows to inf in the kinematics (a NumPy warning, then an
+error far from the field), so a larger value is refused here, naming its field."""
 
 
 def _too_big(v: int) -> str:
@@ -30,6 +36,10 @@ def number(v, source: str, field: str, **where) -> float:
     Traceback (most recent call last):
     kinestat.errors.ParseError: a.toml, field x: expected a finite number, got an integer of \
 401 digits (too large)
+    >>> number(1.7e308, "a.toml", "x")
+    Traceback (most recent call last):
+    kinestat.errors.ParseError: a.toml, field x: 1.7e+308 is implausibly large (the limit is \
+1e+12 in the file's units)
     """
     if isinstance(v, bool) or not isinstance(v, (int, float)):
         raise ParseError(f"expected a number, got {short_repr(v)}", file=source, field=field,
@@ -41,6 +51,9 @@ def number(v, source: str, field: str, **where) -> float:
     if not math.isfinite(x):
         raise ParseError(f"expected a finite number, got {v!r}", file=source, field=field,
                          **where)
+    if abs(x) > MAX_MAGNITUDE:
+        raise ParseError(f"{x:.3g} is implausibly large (the limit is {MAX_MAGNITUDE:.0e} in "
+                         "the file's units)", file=source, field=field, **where)
     return x
 
 
@@ -113,6 +126,9 @@ def matrix(v, source: str, field: str, shape: tuple[int, int]) -> np.ndarray:
     if a.shape != shape or not np.all(np.isfinite(a)):
         raise ParseError(f"expected a finite {shape[0]}x{shape[1]} array, got shape {a.shape}",
                          file=source, field=field)
+    if np.any(np.abs(a) > MAX_MAGNITUDE):
+        raise ParseError(f"an entry is implausibly large (the limit is {MAX_MAGNITUDE:.0e} in "
+                         "the file's units)", file=source, field=field)
     return a
 
 

@@ -112,3 +112,53 @@ def test_any_value_in_any_field_raises_only_kinestat_errors(name, workdir, data)
     else:
         text = json.dumps(_replace_somewhere(json.loads(text), rng, value))
     _feed(name, text, workdir)
+
+
+def _numeric_paths(node, path=()):
+    """The paths (keys and indices) of every number in a parsed document."""
+    if isinstance(node, dict):
+        for k, v in node.items():
+            yield from _numeric_paths(v, path + (k,))
+    elif isinstance(node, list):
+        for i, v in enumerate(node):
+            yield from _numeric_paths(v, path + (i,))
+    elif isinstance(node, (int, float)) and not isinstance(node, bool):
+        yield path
+
+
+#: readers whose every number goes through ``kinestat.io._fields`` (bounded by MAX_MAGNITUDE)
+_BOUNDED = {"platform_toml", "axes_toml", "axes_json"}
+
+
+@pytest.mark.parametrize("name", sorted(_STRUCTURED))
+def test_a_huge_number_in_any_field_never_leaks_a_numpy_overflow(name, workdir):
+    """Every number of every seed set in turn to ±1.7e308 or 1e200: NumPy never warns of an
+    overflow on the way, and only kinestat errors are raised. The platform and axes files
+    refuse the value at its field (``_fields.MAX_MAGNITUDE``); before the bound, 45 of their
+    fields overflowed in products first (a RuntimeWarning, then an error far from the field)."""
+    import copy
+    import warnings
+
+    fmt = _STRUCTURED[name]
+    checked = 0
+    for text in seeds(name):
+        base = tomllib.loads(text) if fmt == "toml" else json.loads(text)
+        for path in _numeric_paths(base):
+            for value in (1.7e308, -1.7e308, 1e200):
+                doc = copy.deepcopy(base)
+                node = doc
+                for key in path[:-1]:
+                    node = node[key]
+                node[path[-1]] = value
+                out = tomli_w.dumps(doc) if fmt == "toml" else json.dumps(doc)
+                with warnings.catch_warnings():
+                    warnings.simplefilter("error", RuntimeWarning)
+                    try:
+                        READERS[name].call(out, workdir)
+                    except KinestatError as exc:
+                        if name in _BOUNDED:
+                            assert "implausibly large" in str(exc), (path, str(exc))
+                    else:
+                        assert name not in _BOUNDED, f"{path} = {value} was accepted"
+                checked += 1
+    assert checked > 0
