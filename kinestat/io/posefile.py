@@ -21,6 +21,7 @@ from pathlib import Path
 import numpy as np
 
 from kinestat.errors import ParseError
+from kinestat.io._fields import MAX_MAGNITUDE
 from kinestat.io.textfile import parse_json, parse_toml, read_text_file
 
 __all__ = ["read_text_file", "pose_from_document", "read_pose_file"]
@@ -51,6 +52,10 @@ def pose_from_document(doc, source: str, *, allow_batch: bool = False) -> np.nda
                          file=source)
     if not np.all(np.isfinite(arr)):
         raise ParseError("the pose contains NaN or infinity", file=source)
+    big = float(np.max(np.abs(arr)))
+    if big > MAX_MAGNITUDE:
+        raise ParseError(f"the pose has an entry of magnitude {big:.3g}: implausibly large (the "
+                         f"limit is {MAX_MAGNITUDE:.0e})", file=source)
     return arr
 
 

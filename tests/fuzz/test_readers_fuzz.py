@@ -126,16 +126,17 @@ def _numeric_paths(node, path=()):
         yield path
 
 
-#: readers whose every number goes through ``kinestat.io._fields`` (bounded by MAX_MAGNITUDE)
-_BOUNDED = {"platform_toml", "axes_toml", "axes_json"}
+#: readers whose every number is bounded by ``kinestat.io._fields.MAX_MAGNITUDE``
+_BOUNDED = {"platform_toml", "axes_toml", "axes_json", "pose_json", "pose_toml"}
 
 
 @pytest.mark.parametrize("name", sorted(_STRUCTURED))
 def test_a_huge_number_in_any_field_never_leaks_a_numpy_overflow(name, workdir):
     """Every number of every seed set in turn to ±1.7e308 or 1e200: NumPy never warns of an
-    overflow on the way, and only kinestat errors are raised. The platform and axes files
-    refuse the value at its field (``_fields.MAX_MAGNITUDE``); before the bound, 45 of their
-    fields overflowed in products first (a RuntimeWarning, then an error far from the field)."""
+    overflow on the way, and only kinestat errors are raised. The platform, axes and pose files
+    refuse the value (``_fields.MAX_MAGNITUDE``), the first two naming its field; before the
+    bound, 45 fields of the platform and axes files overflowed in products first (a
+    RuntimeWarning, then an error far from the field)."""
     import copy
     import warnings
 
