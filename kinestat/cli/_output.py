@@ -134,7 +134,9 @@ def print_pairs(title: str | None, pairs: Iterable[tuple[str, Any]], fmt: str = 
 
 
 def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.ndarray:
-    """Parse ``"1,2,3"`` into floats, checking the count; raises InputError."""
+    """Parse ``"1,2,3"`` into floats, checking the count and that every number is finite and
+    within :data:`kinestat.io._fields.MAX_MAGNITUDE` (the bound the file readers apply: no
+    length, angle, force or count comes near it); raises InputError."""
     items = [v.strip() for v in text.split(",")] if text.strip() else []
     if "" in items:
         raise InputError(f"--{name}: empty value at position {items.index('') + 1} in "
@@ -151,6 +153,12 @@ def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.nda
     arr = np.asarray(vals)
     if not np.all(np.isfinite(arr)):
         raise InputError(f"--{name}: values must be finite, got {text!r}")
+    from kinestat.io._fields import MAX_MAGNITUDE
+
+    big = np.flatnonzero(np.abs(arr) > MAX_MAGNITUDE)
+    if big.size:
+        raise InputError(f"--{name}: value {big[0] + 1} ({arr[big[0]]:.3g}) is implausibly "
+                         f"large (the limit is {MAX_MAGNITUDE:.0e})")
     return arr
 
 
