@@ -91,7 +91,8 @@ def test_sim_bad_options(capsys, argv, msg):
     (["sim", "galil", "--duration", "-1"], "--duration"),
     (["sim", "encoders", "--duration", "-1"], "--duration"),
     # counts beyond 32 bits used to start the emitter, warn from NumPy, then fail late
-    (["sim", "encoders", "--counts", "1e30,0,0,0,0,0", "--duration", "0"], "signed 32-bit"),
+    (["sim", "encoders", "--counts", "1e11,0,0,0,0,0", "--duration", "0"], "signed 32-bit"),
+        (["sim", "encoders", "--counts", "1e30,0,0,0,0,0", "--duration", "0"], "implausibly large"),
     # the Galil simulator took fractional or out-of-range encoder counts
     (["sim", "galil", "--initial-counts", "1.5,0,0,0,0,0", "--duration", "0"], "integers"),
     (["sim", "galil", "--initial-counts", "3e9,0,0,0,0,0", "--duration", "0"], "signed 32-bit"),
