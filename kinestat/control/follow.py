@@ -809,6 +809,73 @@ def _crept(path: tuple, tip: np.ndarray, s: np.ndarray) -> bool:
     return float((tip - path[-CREEP_WINDOW]) @ s) >= CREEP_SPAN
 
 
+def _held_by_step(config: FollowConfig, st: FollowState, s6: np.ndarray, n: np.ndarray,
+                  pushed: float) -> bool:
+    """Whether a tip counts as stuck by the travel it did not follow (μ̂ known, automatic
+    tilt): ``pushed`` (mm of travel commanded since it last slid) is at least
+    ``ENGAGE_STEP`` and S6's tilt from ``n`` is more than ``TURN_DEADBAND_DEG`` short of the
+    automatic tilt's axis (``atan μ̂`` + margin + breakaway).
+
+    The force-ratio test alone trusts μ̂ to ``EDGE_TOL``; a first slip read with the thesis's
+    counts can be 0.005 low (μ̂ 0.295, μ 0.3). On a R = 273 mm cylinder the tip stuck again
+    0.15° inside the cone, its ratio counted as on the edge, and every few cycles a 0.5 mm
+    step pressed it (+0.5 to +1.1 N) and knocked S6 back 0.2°, so S6 never reached its axis:
+    800 cycles at 2.3 mm of travel. Held, the tip gets no step until S6 has turned onto its
+    axis (past the cone's edge) or the tip slides."""
+    return pushed >= ENGAGE_STEP and _short_of_axis(config, st, s6, n)
+
+
+def _short_of_axis(config: FollowConfig, st: FollowState, s6: np.ndarray,
+                   n: np.ndarray) -> bool:
+    """Whether S6's tilt from ``n`` is more than ``TURN_DEADBAND_DEG`` short of the automatic
+    tilt's axis (:func:`_shortfall_deg`): S6 is inside the cone's edge or near it, not past it
+    by the margin."""
+    return _shortfall_deg(config, st, s6, n) > TURN_DEADBAND_DEG
+
+
+def _shortfall_deg(config: FollowConfig, st: FollowState, s6: np.ndarray,
+                   n: np.ndarray) -> float:
+    """How far (degrees) S6's tilt from ``n`` is short of the automatic tilt's axis,
+    ``atan μ̂`` + ``AUTO_TILT_MARGIN_DEG`` + the breakaway (negative past it); 0 unless μ̂ is
+    known and the automatic tilt on."""
+    if not (st.tilting and st.friction_samples):
+        return 0.0
+    axis_deg = (math.degrees(math.atan(st.friction_ratio)) + AUTO_TILT_MARGIN_DEG
+                + config.max_turn_deg * st.breakaway)
+    return axis_deg - _tilt_deg(s6, n)
+
+
+def _feed_fraction(config: FollowConfig, st: FollowState, s6: np.ndarray, n: np.ndarray,
+                   angle: float, feedback: float) -> float:
+    """The fraction of a convex surface's turn under the step, ``angle`` = κ̂ Δs (rad), that is
+    fed forward: all of it unless S6 is short of its axis by more than ``TURN_DEADBAND_DEG``;
+    then the surface's own turn (which raises S6's tilt from the normal) makes up the
+    shortfall beyond the dead band and the feedback turn ``feedback`` (rad), and only the
+    rest is fed forward (none when the shortfall exceeds the turn). A concave surface's turn
+    (``angle`` < 0) is always fed forward whole.
+
+    With the thesis's counts the first κ̂ (the probe's touches, ±3 mm) can read 2.4× the
+    surface's curvature: fed forward whole, it turned S6 back inside the cone."""
+    if angle <= 0.0:
+        return 1.0
+    short = math.radians(_shortfall_deg(config, st, s6, n) - TURN_DEADBAND_DEG) - feedback
+    return 1.0 if short <= 0.0 else max(angle - short, 0.0) / angle
+
+
+def _force_line(F: np.ndarray, n: np.ndarray) -> tuple[float, np.ndarray]:
+    """The contact force's own line as a friction-cone edge: ``(ratio, ŝ)`` with the force on
+    the tool ``−F`` = F_n (n − ratio ŝ) (ŝ the direction of impending slip, against the
+    tangential force on the tool). Relieving the normal force along this line scales the
+    whole force down: the ratio is kept."""
+    f = -np.asarray(F, dtype=float)
+    fn = float(f @ n)
+    ft = f - fn * n
+    a = norm3(ft)
+    if fn <= 0.0 or a == 0.0:
+        return 0.0, n
+    return a / fn, -ft / a
+
+
 def _tilt_deg(s6: np.ndarray, n: np.ndarray) -> float:
     """The angle (degrees) between S6 and ``−n``: the tool's tilt from the normal."""
     return math.degrees(math.acos(min(1.0, max(-1.0, -float(s6 @ n)))))
@@ -885,8 +952,11 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         if st.probe_trusted and st.friction_samples:
             # the normal is known: the force's ratio tells whether the tip is on the edge,
             # and a tip creeping on over the last cycles is sliding whatever the ratio says
-            # (with the thesis's counts the ratio can read 0.013 low on a sliding tip)
-            stuck = (stuck and ratio < st.friction_ratio - EDGE_TOL
+            # (with the thesis's counts the ratio can read 0.013 low on a sliding tip); but a
+            # tip that did not follow a full step while S6 is short of its axis is inside the
+            # cone, whatever a low μ̂ says (_held_by_step)
+            stuck = (stuck and (ratio < st.friction_ratio - EDGE_TOL
+                                or _held_by_step(config, st, meas.s6, n0, pushed))
                      and not (st.cycle - st.slip_cycle > CREEP_WINDOW and _crept(path, tip, s)))
         elif st.tilting and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
             # S6 leans past the measured force by the margin: a stuck tip's force turns with
@@ -1065,10 +1135,16 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
                and st.sticking)
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG and not growing
              else _turn(meas.s6, axis, math.radians(turn_limit)))
+    # on a convex surface the step itself turns the normal towards the travel, which raises
+    # S6's tilt from it: while S6 is short of its axis that is wanted, and that much of the
+    # turn is not fed forward (an early κ̂ read 2.4× too high turned S6 back inside the cone)
+    feed = 1.0
     if st.tilting and step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs
         # the first estimates of κ are the noisiest (short span): fed in over CURVATURE_RAMP
         ramp = min(1.0, st.curvature_cycles / CURVATURE_RAMP) if CURVATURE_RAMP else 1.0
-        omega = _curvature_feedforward(n, t, ramp * st.curvature * step, omega,
+        feed = _feed_fraction(config, st, meas.s6, n, ramp * st.curvature * step,
+                              norm3(omega))
+        omega = _curvature_feedforward(n, t, feed * ramp * st.curvature * step, omega,
                                        math.radians(config.max_turn_deg))
     dlam = config.gain * err
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
@@ -1077,7 +1153,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         sliding = phase == "travel" and st.friction_samples > 0
         hold = None
         if sliding and not st.sticking and st.tilting:
-            kappa = st.curvature if st.curvature_cycles >= HOLD_CURVATURE_CYCLES else 0.0
+            kappa = feed * st.curvature if st.curvature_cycles >= HOLD_CURVATURE_CYCLES else 0.0
             w_surf = kappa * step * cross3(n, t)  # the surface's turn under the step
             s6n = meas.s6 + cross3(omega - w_surf, meas.s6)
             if step > 0.0 or -float(s6n @ n) < -float(meas.s6 @ n):  # slides on / turns out
@@ -1086,9 +1162,11 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
             # the breakaway's first turns hold the force (a stuck tip's force would turn
             # with the tool): S6 comes to lead it by BREAKAWAY_LEAD before both turn
             hold = (-meas.estimate(base.estimator), np.zeros(3))
+        mu_c, slip_c = (st.friction_ratio, t) if sliding else (0.0, t)
+        if dlam < 0.0 and _lead_tracked(st) and phase == "travel":
+            mu_c, slip_c = _force_line(meas.estimate(base.estimator), n)
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
-                        config.max_correction, st.friction_ratio if sliding else 0.0, t,
-                        hold)
+                        config.max_correction, mu_c, slip_c, hold)
     except (InputError, np.linalg.LinAlgError) as exc:
         return _stop(st, label, f"the contact basis is singular for the platform stiffness: "
                      f"{exc}", **kw)
