@@ -153,7 +153,7 @@ def parse_floats(text: str, n: int | None = None, name: str = "value") -> np.nda
     arr = np.asarray(vals)
     if not np.all(np.isfinite(arr)):
         raise InputError(f"--{name}: values must be finite, got {text!r}")
-    from kinestat.io._fields import MAX_MAGNITUDE
+    from kinestat.io._fields import MAX_MAGNITUDE  # lazy: a command's --help needs no reader
 
     big = np.flatnonzero(np.abs(arr) > MAX_MAGNITUDE)
     if big.size:

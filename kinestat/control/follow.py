@@ -1135,17 +1135,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
                and st.sticking)
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG and not growing
              else _turn(meas.s6, axis, math.radians(turn_limit)))
-    # on a convex surface the step itself turns the normal towards the travel, which raises
-    # S6's tilt from it: while S6 is short of its axis that is wanted, and that much of the
-    # turn is not fed forward (an early κ̂ read 2.4× too high turned S6 back inside the cone)
-    feed = 1.0
-    if st.tilting and step > 0.0 and st.curvature != 0.0:  # the surface turns by κ Δs
-        # the first estimates of κ are the noisiest (short span): fed in over CURVATURE_RAMP
-        ramp = min(1.0, st.curvature_cycles / CURVATURE_RAMP) if CURVATURE_RAMP else 1.0
-        feed = _feed_fraction(config, st, meas.s6, n, ramp * st.curvature * step,
-                              norm3(omega))
-        omega = _curvature_feedforward(n, t, feed * ramp * st.curvature * step, omega,
-                                       math.radians(config.max_turn_deg))
+    # the surface's turn under the step, fed forward but for what S6 is short of its axis
+    omega, feed = _surface_turn(config, st, meas.s6, n, t, step, omega)
     dlam = config.gain * err
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
         dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
@@ -1163,7 +1154,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
             # with the tool): S6 comes to lead it by BREAKAWAY_LEAD before both turn
             hold = (-meas.estimate(base.estimator), np.zeros(3))
         mu_c, slip_c = (st.friction_ratio, t) if sliding else (0.0, t)
-        if dlam < 0.0 and _lead_tracked(st) and phase == "travel":
+        if dlam < 0.0 and _lead_tracked(st) and phase == "travel":  # μ unknown: keep r
             mu_c, slip_c = _force_line(meas.estimate(base.estimator), n)
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
                         config.max_correction, mu_c, slip_c, hold)
@@ -1174,6 +1165,21 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     action = "follow" if phase == "travel" else "settle"
     return _command(config, st, meas, new, label, action, step,
                     math.degrees(norm3(omega)), kw)
+
+
+def _surface_turn(config: FollowConfig, st: FollowState, s6: np.ndarray, n: np.ndarray,
+                  t: np.ndarray, step: float, omega: np.ndarray) -> tuple[np.ndarray, float]:
+    """The turn ``omega`` with the surface's turn under the step fed forward (automatic tilt,
+    κ̂ known, a step), and the fraction of it fed (:func:`_feed_fraction`; 1 otherwise).
+    The first estimates of κ are the noisiest (short span): fed in over ``CURVATURE_RAMP``
+    cycles."""
+    if not (st.tilting and step > 0.0 and st.curvature != 0.0):
+        return omega, 1.0
+    ramp = min(1.0, st.curvature_cycles / CURVATURE_RAMP) if CURVATURE_RAMP else 1.0
+    angle = ramp * st.curvature * step
+    feed = _feed_fraction(config, st, s6, n, angle, norm3(omega))
+    return (_curvature_feedforward(n, t, feed * angle, omega, math.radians(config.max_turn_deg)),
+            feed)
 
 
 def _step_cap(config: FollowConfig, st: FollowState, tip: np.ndarray, t: np.ndarray) -> float:
