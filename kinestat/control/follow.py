@@ -867,13 +867,12 @@ def _force_line(F: np.ndarray, n: np.ndarray) -> tuple[float, np.ndarray]:
     the tool ``−F`` = F_n (n − ratio ŝ) (ŝ the direction of impending slip, against the
     tangential force on the tool). Relieving the normal force along this line scales the
     whole force down: the ratio is kept."""
-    f = -np.asarray(F, dtype=float)
-    fn = float(f @ n)
-    ft = f - fn * n
-    a = norm3(ft)
+    fn = float(-(F @ n))
+    g = F + fn * n  # the tangential part of F: that of the force on the tool, reversed
+    a = norm3(g)
     if fn <= 0.0 or a == 0.0:
         return 0.0, n
-    return a / fn, -ft / a
+    return a / fn, g / a
 
 
 def _tilt_deg(s6: np.ndarray, n: np.ndarray) -> float:
@@ -891,8 +890,7 @@ def _kept_breakaway(config: FollowConfig, s6: np.ndarray, n: np.ndarray, mu: flo
 def _stuck_ratio(F: np.ndarray, n: np.ndarray) -> float:
     """The tangential-to-normal ratio of the force ``F`` against the normal ``n`` (a stuck
     tip's ratio is a lower bound of μ)."""
-    fn = float(-(F @ n))
-    return norm3(F + fn * n) / fn if fn > 0.0 else 0.0
+    return _force_line(F, n)[0]
 
 
 def _unslipped(config: FollowConfig, st: FollowState, meas: Measurement) -> FollowState:
