@@ -263,12 +263,15 @@ ENGAGE_STEP = 2.0 * MIN_SLIP
 """With ``auto_tilt`` None (the default), the automatic tilt switches itself on when the tip
 advanced less than ``SLIDE_FRACTION`` of two travel steps in a row of at least this (mm), or of
 the full ``travel_step`` when that is shorter: the tip sticks (:func:`_engages`)."""
-BREAKAWAY_LEAD = 0.5
+BREAKAWAY_LEAD = AUTO_TILT_MARGIN_DEG
 """Before the first slip, with the probe's normal: the breakaway first turns S6 with the force
-held (degrees it leads the measured force by, along the travel), then turns both. A tip that
-breaks away with S6 behind its force runs ahead and drops the normal force (a 0.05° a cycle
-breakaway, S6 1° behind: 1.1 mm and −1.15 N); with S6 ahead, the slip is a creep
-(docs/control.md, "The breakaway with S6 ahead")."""
+held (degrees it leads the measured force by, along the travel), then turns both. A sliding
+tool's S6 leads its force (on the cone's edge) by the automatic tilt's margin; whatever S6
+lacks of that lead when the tip breaks away is taken up by the platform's soft mode: the tip
+runs ahead and the normal force drops (a 0.05° a cycle breakaway, S6 1° behind: 1.1 mm and
+−1.15 N; S6 0.7° ahead: 0.4 mm and −0.47 N on seed 101's R = 246 mm cylinder, ideal sensor).
+Leading by the margin, the tip breaks away into the sliding tool's pose (docs/control.md,
+"The breakaway with S6 ahead"; 0.5° until 2026-12-03)."""
 EDGE_STEP = 0.1
 """The travel steps just after the first slip measured against the probe's normal
 (fraction of ``travel_step``): ``EDGE_STEP`` of it in the slip's cycle, growing by as
@@ -956,10 +959,13 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
             stuck = (stuck and (ratio < st.friction_ratio - EDGE_TOL
                                 or _held_by_step(config, st, meas.s6, n0, pushed))
                      and not (st.cycle - st.slip_cycle > CREEP_WINDOW and _crept(path, tip, s)))
-        elif st.tilting and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG:
+        elif (st.tilting and not _lead_tracked(st)
+              and _tilt_past_force(meas.s6, F, s) >= AUTO_TILT_MARGIN_DEG):
             # S6 leans past the measured force by the margin: a stuck tip's force turns with
             # the tool, so this tip is on the cone's edge (creeping): more tilt would only
-            # turn the top; it travels (a step slides it)
+            # turn the top; it travels (a step slides it). While the lead is tracked the edge
+            # is the lead's own test above: the breakaway leads by the margin on purpose, and
+            # the lead's jitter read as the edge would push a stuck tip (+0.3 N)
             stuck = False
         # a tip creeping on under a turn alone (no travel commanded) is slipping already:
         # the breakaway tilt is held, not grown (it would run the tip ahead at the slip)
