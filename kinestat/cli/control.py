@@ -59,13 +59,19 @@ def _host_port(text: str) -> tuple[str, int]:
 
 
 def _run_dir(base: Path) -> Path:
+    """A new run directory ``base/<timestamp>[-k]``, created here: two runs started in the
+    same second each get their own (mkdir is atomic; checking for it first was not, and two
+    runs wrote one interleaved log)."""
     stamp = time.strftime("%Y%m%d-%H%M%S")
-    d = base / stamp
+    base.mkdir(parents=True, exist_ok=True)
     k = 1
-    while d.exists():
-        k += 1
-        d = base / f"{stamp}-{k}"
-    return d
+    while True:
+        d = base / (stamp if k == 1 else f"{stamp}-{k}")
+        try:
+            d.mkdir()
+            return d
+        except FileExistsError:
+            k += 1
 
 
 def _workpiece(text: str | None):
@@ -335,11 +341,6 @@ def control_command(
     if not (math.isfinite(force) and force > 0):
         raise InputError(f"--force must be a positive number of newtons, got {force}")
     p0 = parse_floats(start, 3, "start")
-    run_dir = None
-    if log is None or (plot is None and not no_plot):
-        run_dir = _run_dir(Path("kinestat-runs"))
-    log_path = log if log is not None else run_dir / "log.jsonl"
-    plot_dir = None if no_plot else (plot if plot is not None else run_dir)
 
     # lazy: start-up (the cell loads numba and scipy; `kinestat --help` should not)
     from kinestat.app.control_run import (
@@ -371,6 +372,11 @@ def control_command(
         with compiling_notice(*cold):
             warm_kernels(cold)
     prepared = prepare_control(req)
+    run_dir = None  # claimed only now: a refused request leaves nothing behind
+    if log is None or (plot is None and not no_plot):
+        run_dir = _run_dir(Path("kinestat-runs"))
+    log_path = log if log is not None else run_dir / "log.jsonl"
+    plot_dir = None if no_plot else (plot if plot is not None else run_dir)
 
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {procedure}, method "

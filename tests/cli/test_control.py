@@ -115,3 +115,15 @@ def test_real_device_options_drive_external_devices(tmp_path, capsys):
     out = _json(capsys)
     assert code == 0 and out["converged"] and out["true_force"] is None
     assert abs(np.linalg.norm(truth["tool_force"]) - 4.0) <= 0.6
+
+
+def test_runs_started_in_the_same_second_get_their_own_directories(tmp_path, monkeypatch):
+    """``_run_dir`` claims the directory (an atomic mkdir): two CLI runs started in the same
+    second wrote one interleaved log when it only checked that the name was free."""
+    from kinestat.cli import control as cli_control
+
+    monkeypatch.setattr(cli_control.time, "strftime", lambda fmt: "20261203-130150")
+    dirs = [cli_control._run_dir(tmp_path / "kinestat-runs") for _ in range(3)]
+    assert len(set(dirs)) == 3 and all(d.is_dir() for d in dirs)
+    assert [d.name for d in dirs] == ["20261203-130150", "20261203-130150-2",
+                                      "20261203-130150-3"]
