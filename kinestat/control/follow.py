@@ -263,24 +263,33 @@ ENGAGE_STEP = 2.0 * MIN_SLIP
 """With ``auto_tilt`` None (the default), the automatic tilt switches itself on when the tip
 advanced less than ``SLIDE_FRACTION`` of two travel steps in a row of at least this (mm), or of
 the full ``travel_step`` when that is shorter: the tip sticks (:func:`_engages`)."""
-BREAKAWAY_LEAD = AUTO_TILT_MARGIN_DEG
+EDGE_LEAD = 0.35
+"""Degrees the lead of S6 past the measured force must grow above its recent mean
+(``FollowState.lead_ref``) to show the tip on the cone's edge: a stuck tip's force turns with
+the tool, an edge's does not (the lead's jitter with the thesis's counts: ±0.1°)."""
+LEAD_BAND = 0.25
+"""Degrees the lead's recent mean may stray from ``BREAKAWAY_LEAD`` before the stuck phase's
+hold takes it back (:func:`_lead_hold`; the lead's jitter with the thesis's counts is ±0.3°
+a cycle, its mean's less)."""
+LEAD_GAIN = 0.5
+"""Fraction of the lead's excess beyond ``LEAD_BAND`` taken back per cycle (:func:`_lead_hold`)."""
+BREAKAWAY_LEAD = round(AUTO_TILT_MARGIN_DEG - EDGE_LEAD - LEAD_BAND, 9)
 """Before the first slip, with the probe's normal: the breakaway first turns S6 with the force
-held (degrees it leads the measured force by, along the travel), then turns both. A sliding
-tool's S6 leads its force (on the cone's edge) by the automatic tilt's margin; whatever S6
-lacks of that lead when the tip breaks away is taken up by the platform's soft mode: the tip
-runs ahead and the normal force drops (a 0.05° a cycle breakaway, S6 1° behind: 1.1 mm and
-−1.15 N; S6 0.7° ahead: 0.4 mm and −0.47 N on seed 101's R = 246 mm cylinder, ideal sensor).
-Leading by the margin, the tip breaks away into the sliding tool's pose (docs/control.md,
-"The breakaway with S6 ahead"; 0.5° until 2026-12-03)."""
+held (degrees it leads the measured force by, along the travel), then turns both
+(:func:`_lead_hold`). A sliding tool's S6 leads its force (on the cone's edge) by the
+automatic tilt's margin; whatever S6 lacks of that lead when the tip breaks away is taken up
+by the platform's soft mode: the tip runs ahead and the normal force drops (S6 1° behind:
+1.1 mm and −1.15 N; 0.7° ahead: 0.4 mm and −0.47 N on seed 101's R = 246 mm cylinder, ideal
+sensor), and a lead well past the margin runs it ahead too (3.5°: −0.6 N on the CLI's
+default plane). The stuck lead is held up to ``LEAD_BAND`` above this, and the edge is seen
+once the lead has grown ``EDGE_LEAD`` past its mean: the tip breaks away with S6 about the
+margin ahead (docs/control.md, "The breakaway at the sliding lead"; 0.5° until
+2026-12-03)."""
 EDGE_STEP = 0.1
 """The travel steps just after the first slip measured against the probe's normal
 (fraction of ``travel_step``): ``EDGE_STEP`` of it in the slip's cycle, growing by as
 much a cycle. The slip seen by the lead may leave the tip just inside the cone, and a step
 pushes a stuck tip along the tilted tool's axis (~1.2 N per mm)."""
-EDGE_LEAD = 0.35
-"""Degrees the lead of S6 past the measured force must grow above its recent mean
-(``FollowState.lead_ref``) to show the tip on the cone's edge: a stuck tip's force turns with
-the tool, an edge's does not (the lead's jitter with the thesis's counts: ±0.1°)."""
 LEAD_WINDOW = 4
 """``FollowState.lead_ref`` is the mean of the first ``LEAD_WINDOW`` leads, then an exponential
 mean with weight ``1/LEAD_WINDOW``: the stuck tip's lead drifts (0.9° to 1.15° over 10 cycles
@@ -803,6 +812,25 @@ def _track_lead(st: FollowState, lead: float) -> FollowState:
     return replace(st, lead_ref=st.lead_ref + w * (lead - st.lead_ref), lead_cycles=k)
 
 
+def _lead_hold(st: FollowState, omega: np.ndarray) -> float:
+    """The fraction of the breakaway's turn ``omega`` by which the stuck tip's force is held
+    (the control law's hold feed-forward scaled: 1 holds it, 0 lets it turn with S6, −0.5
+    turns it 1.5 times as far). Until S6 leads the force by ``BREAKAWAY_LEAD`` it is held
+    whole. Then both turn, but the stuck force turns a little less than S6 (on the CLI's
+    default plane the lead drifted from 1.9° to 3.5° over 90 cycles), and a tip that breaks
+    away with S6 past its sliding lead runs ahead as surely as one short of it (−0.6 N): a
+    recent mean (``lead_ref``) more than ``LEAD_BAND`` from ``BREAKAWAY_LEAD`` is taken back
+    at ``LEAD_GAIN`` of the excess a cycle."""
+    if st.lead_ref is None:
+        return 1.0
+    excess = st.lead_ref - BREAKAWAY_LEAD
+    turn = math.degrees(norm3(omega))
+    if abs(excess) <= LEAD_BAND or turn < 1e-6:
+        return 0.0
+    excess -= math.copysign(LEAD_BAND, excess)
+    return min(max(-LEAD_GAIN * excess / turn, -0.5), 1.0)
+
+
 def _crept(path: tuple, tip: np.ndarray, s: np.ndarray) -> bool:
     """Whether the tip advanced at least ``CREEP_SPAN`` along ``s`` over the last
     ``CREEP_WINDOW`` cycles (a slow slide, below ``MIN_SLIP`` a cycle: a stuck tip's measured
@@ -964,8 +992,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
             # S6 leans past the measured force by the margin: a stuck tip's force turns with
             # the tool, so this tip is on the cone's edge (creeping): more tilt would only
             # turn the top; it travels (a step slides it). While the lead is tracked the edge
-            # is the lead's own test above: the breakaway leads by the margin on purpose, and
-            # the lead's jitter read as the edge would push a stuck tip (+0.3 N)
+            # is the lead's own test above: the stuck lead is held near the margin on purpose,
+            # and its jitter read as the edge would push a stuck tip (+0.3 N)
             stuck = False
         # a tip creeping on under a turn alone (no travel commanded) is slipping already:
         # the breakaway tilt is held, not grown (it would run the tip ahead at the slip)
@@ -1153,10 +1181,10 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
             s6n = meas.s6 + cross3(omega - w_surf, meas.s6)
             if step > 0.0 or -float(s6n @ n) < -float(meas.s6 @ n):  # slides on / turns out
                 hold = (-meas.estimate(base.estimator), w_surf)  # the force on the tool
-        if growing and _lead_tracked(st) and st.lead_ref is None:
-            # the breakaway's first turns hold the force (a stuck tip's force would turn
-            # with the tool): S6 comes to lead it by BREAKAWAY_LEAD before both turn
-            hold = (-meas.estimate(base.estimator), np.zeros(3))
+        h = _lead_hold(st, omega) if growing and _lead_tracked(st) else 0.0
+        if h:  # the breakaway's first turns hold the force (a stuck tip's force would turn
+            # with the tool) until S6 leads it by BREAKAWAY_LEAD; then its drift is held off
+            hold = (-h * meas.estimate(base.estimator), np.zeros(3))
         mu_c, slip_c = (st.friction_ratio, t) if sliding else (0.0, t)
         if dlam < 0.0 and _lead_tracked(st) and phase == "travel":  # μ unknown: keep r
             mu_c, slip_c = _force_line(meas.estimate(base.estimator), n)
