@@ -6,18 +6,21 @@ the start tool point, normal tilted 0-8° from −F_req in a random azimuth) and
 cylinders (radius 150-400 mm, axis within ~20° of the fixed z axis), the initial travel
 direction within ~11° of +y; then the acceptance runs (the default plane and the R = 200 mm
 cylinder, thesis and ideal sensor). Prints one row per run (true figures from the simulator)
-and a summary. Options: ``--friction MU`` (Coulomb friction of every workpiece), ``--ideal``
-(1 nm leg encoders instead of the thesis's resolution), ``--auto-tilt auto|on|off`` (the
+and a summary. Options: ``--devices`` (through the simulated Galil and encoder stream, as
+``kinestat control`` without device options, instead of the in-process cell; about a minute
+of one core per run), ``--jobs N`` (runs in parallel processes), ``--friction MU`` (Coulomb
+friction of every workpiece), ``--ideal`` (1 nm leg encoders instead of the thesis's resolution), ``--auto-tilt auto|on|off`` (the
 follow task's automatic tilt; default auto, as the CLI: it switches itself on when the tip
 sticks; the friction studies before 2026-12-02 ran with it on from the start).
 
     .venv/bin/python scripts/follow_study.py [N] [--acceptance] [--friction MU] [--ideal]
-        [--auto-tilt auto|on|off] [--seed N] [--budget]
+        [--auto-tilt auto|on|off] [--seed N] [--budget] [--devices] [--jobs N]
 """
 
 from __future__ import annotations
 
 import argparse
+import concurrent.futures
 import dataclasses
 import functools
 import math
@@ -36,6 +39,7 @@ from kinestat.app.control_run import (  # noqa: E402
     SimulatedCell,
     prepare_control,
     report_dict,
+    run_control,
 )
 from kinestat.app.sim_cell import InProcessIO, start_counts  # noqa: E402
 from kinestat.control.controller import THESIS_FORCE_DIRECTION  # noqa: E402
@@ -67,15 +71,22 @@ AUTO_TILT = {"auto": None, "on": True, "off": False}
 
 
 def follow(cell: SimulatedCell, travel_dir, travel: float = 50.0,
-           auto_tilt: bool | None = None) -> dict:
+           auto_tilt: bool | None = None, devices: bool = False) -> dict:
+    """One follow run on ``cell``: in process, or (``devices``) through the simulated Galil
+    and encoder stream as ``kinestat control`` runs it."""
     req = ControlRequest(force=4.0 * F_HAT, start_tool_point=START, cell=cell, task="follow",
                          travel=travel, travel_dir=np.asarray(travel_dir, dtype=float),
                          auto_tilt=auto_tilt)
     prep = prepare_control(req)
-    io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
     t0 = time.perf_counter()
-    with tempfile.TemporaryDirectory() as tmp, CycleLog(Path(tmp) / "log.jsonl") as log:
-        rep = run(prep.config, io, log, decide_fn=functools.partial(decide_follow, prep.follow))
+    with tempfile.TemporaryDirectory() as tmp:
+        if devices:
+            rep = run_control(prep, Path(tmp) / "log.jsonl")
+        else:
+            io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
+            with CycleLog(Path(tmp) / "log.jsonl") as log:
+                rep = run(prep.config, io, log,
+                          decide_fn=functools.partial(decide_follow, prep.follow))
     out = report_dict(prep, rep)
     out["wall_s"] = time.perf_counter() - t0
     return out
@@ -118,18 +129,24 @@ HEAD = "| workpiece          | ok  | travel | RMS N  | max N  | lost | cycles | 
 
 
 def main(n: int = 20, friction: float = 0.0, ideal: bool = False,
-         auto_tilt: str = "auto", seed: int = 13, budget: bool = False) -> None:
+         auto_tilt: str = "auto", seed: int = 13, budget: bool = False,
+         devices: bool = False, jobs: int = 1) -> None:
     rng = np.random.default_rng(seed)
     print(f"friction {friction:g}, {'ideal' if ideal else 'thesis'} sensor, automatic tilt "
-          f"{auto_tilt}, seed {seed}")
+          f"{auto_tilt}, seed {seed}, "
+          + ("through the simulated devices" if devices else "in-process cell"))
     print(HEAD + (" error² before the first slip / cycles | after |" if budget else ""))
-    rows = []
+    draws = []  # drawn up front, in order: the same workpieces whatever --jobs
     for k in range(n):
         name, cell = random_cell(rng, k)
         cell = dataclasses.replace(cell, friction=friction, ideal_sensor=ideal)
-        out = follow(cell, Y + rng.uniform(-0.2, 0.2, 3), auto_tilt=AUTO_TILT[auto_tilt])
-        rows.append(out)
-        print(_row(name, out, budget), flush=True)
+        draws.append((name, cell, Y + rng.uniform(-0.2, 0.2, 3)))
+    run_one = functools.partial(_follow_drawn, auto_tilt=AUTO_TILT[auto_tilt], devices=devices)
+    with concurrent.futures.ProcessPoolExecutor(jobs) if jobs > 1 else _Serial() as pool:
+        rows = []
+        for (name, _, _), out in zip(draws, pool.map(run_one, draws), strict=True):
+            rows.append(out)
+            print(_row(name, out, budget), flush=True)
     done = [r for r in rows if r["completed"]]
     print(f"\ncompleted {len(done)}/{n}; "
           + (f"true normal-force RMS error median {np.median([r['true_normal_force_rms_error'] for r in done]):.3f} N, "  # noqa: E501
@@ -147,6 +164,25 @@ def main(n: int = 20, friction: float = 0.0, ideal: bool = False,
               f"the first slip, {tot[2]:.2f} N² in {int(tot[3])} cycles after")
 
 
+def _follow_drawn(draw, auto_tilt, devices) -> dict:
+    _, cell, travel_dir = draw
+    return follow(cell, travel_dir, auto_tilt=auto_tilt, devices=devices)
+
+
+class _Serial:
+    """``map`` in this process (``--jobs 1``), as a context manager like the process pool."""
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    @staticmethod
+    def map(fn, items):
+        return map(fn, items)
+
+
 def _passes(out: dict, ideal: bool) -> bool:
     """Issue 13's acceptance for one run (true figures)."""
     return bool(out["completed"] and out["contact_lost"] == 0
@@ -155,7 +191,7 @@ def _passes(out: dict, ideal: bool) -> bool:
                 and out["true_normal_force_max_error"] <= 0.5)
 
 
-def acceptance(friction: float = 0.0, auto_tilt: str = "auto") -> None:
+def acceptance(friction: float = 0.0, auto_tilt: str = "auto", devices: bool = False) -> None:
     print(f"acceptance runs (default plane and R = 200 mm cylinder), friction {friction:g}, "
           f"automatic tilt {auto_tilt}:")
     print(HEAD)
@@ -165,7 +201,8 @@ def acceptance(friction: float = 0.0, auto_tilt: str = "auto") -> None:
                        ("cyl R 200, thesis", SimulatedCell(cylinder=cyl)),
                        ("cyl R 200, ideal", SimulatedCell(ideal_sensor=True, cylinder=cyl))):
         cell = dataclasses.replace(cell, friction=friction)
-        print(_row(name, follow(cell, Y, auto_tilt=AUTO_TILT[auto_tilt])), flush=True)
+        print(_row(name, follow(cell, Y, auto_tilt=AUTO_TILT[auto_tilt], devices=devices)),
+              flush=True)
 
 
 if __name__ == "__main__":
@@ -181,8 +218,11 @@ if __name__ == "__main__":
                     help="also the squared error before the first slip and after, per run")
     ap.add_argument("--seed", type=int, default=13,
                     help="the random workpieces' draw (docs/control.md quotes 13, 29 and 57)")
+    ap.add_argument("--devices", action="store_true",
+                    help="through the simulated Galil and encoder stream (as the CLI runs it)")
+    ap.add_argument("--jobs", type=int, default=1, help="runs in parallel processes")
     a = ap.parse_args()
     if a.acceptance:
-        acceptance(a.friction, a.auto_tilt)
+        acceptance(a.friction, a.auto_tilt, a.devices)
     else:
-        main(a.n, a.friction, a.ideal, a.auto_tilt, a.seed, a.budget)
+        main(a.n, a.friction, a.ideal, a.auto_tilt, a.seed, a.budget, a.devices, a.jobs)

@@ -113,6 +113,7 @@ class DeviceIO:
         self._truth = truth
         self._clock = clock
         self._t_ready = clock()
+        self._axis5_carry = 0.0  # true axis 5 past its encoder (counts; see move)
         self.guard = guard
         self.position_tolerance = float(position_tolerance)
         self.max_stream_faults = max_stream_faults
@@ -126,7 +127,10 @@ class DeviceIO:
         """Move with the axis 4 -> 5 compensation (Vibhute App. D.9), keep reading the sensor
         stream while the axes move (so that the serial buffer never overflows), check the
         read-back positions, then reset the axis-5 encoder (``DP``) as
-        :meth:`GalilClient.move_compensated` does. Returns the move's plan:
+        :meth:`GalilClient.move_compensated` does. The fraction of a count the true axis 5 ends
+        past the reset is carried into the next move's compensation (the thesis discarded it;
+        over a long run of small axis-4 moves it added up to tenths of a degree). Returns the
+        move's plan:
         ``{"delta_counts", "speed", "accel", "rule"}`` (what was sent).
 
         The final command (axis 5 compensated from the axis-4 position just read) goes through
@@ -134,7 +138,7 @@ class DeviceIO:
         """
         c = np.asarray(axis_counts, dtype=np.int64)
         now = self.robot_counts()
-        corr = axis45_compensation(c[3], c[4], int(now[3]), self.coupling)
+        corr = axis45_compensation(c[3], c[4], int(now[3]), self.coupling, self._axis5_carry)
         cmd = c.copy()
         cmd[4] = int(corr.axis5_command)
         plan = move_plan(self.move_rule, now, cmd, self.profile.speed, self.profile.accel)
@@ -148,6 +152,7 @@ class DeviceIO:
             self.reader.poll()
         check_arrival(cmd, self.robot_counts(), self.position_tolerance)
         self.client.define_position({"E": int(corr.axis5_reset)})
+        self._axis5_carry = float(corr.residual)
         self._t_ready = self._clock() + self.settle
         return {"delta_counts": (cmd - now).tolist(), "speed": plan.speed.tolist(),
                 "accel": plan.accel.tolist(), "rule": self.move_rule}

@@ -159,6 +159,7 @@ class GalilClient:
         self._sock: socket.socket | None = None
         self._buf = b""
         self._in_flight: str | None = None  # a command sent whose reply was not read yet
+        self.axis5_residual = 0.0  # after move_compensated: true axis 5 past its encoder
 
     # -- connection
     def connect(self, timeout: float | None = None) -> GalilClient:
@@ -405,23 +406,28 @@ class GalilClient:
 
     def move_compensated(self, counts: Any, speed: Any, accel: Any, decel: Any | None = None,
                          *, timeout: float = 30.0, poll_interval: float = 0.01,
-                         coupling: float = AXIS4_TO_5_COUPLING) -> tuple[int, ...]:
+                         coupling: float = AXIS4_TO_5_COUPLING,
+                         carry: float = 0.0) -> tuple[int, ...]:
         """Move to ``counts`` with the axis 4 -> 5 compensation, wait, and reset axis 5 (``DP``).
 
         The sequence of ``Axis_4_5_Correction.m`` + ``galil_control.m``: read axis 4, command
         axis 5 to the corrected position, wait for the motion, then ``DP ,,,,<axis5 target>``
         so the axis-5 encoder reads the true position again — only after the read-back
         positions agreed with the command (:func:`~kinestat.devices.motion_check.check_arrival`,
-        else :class:`DeviceError` and no ``DP``). Returns the final ``TP``.
+        else :class:`DeviceError` and no ``DP``). Returns the final ``TP``. ``carry`` is the
+        fraction of a count the true axis 5 stood past its encoder before the move (the last
+        move's :attr:`axis5_residual`; :func:`~kinestat.hardware.puma762_axes.axis45_compensation`);
+        after the move :attr:`axis5_residual` holds the new one.
         """
         c = _per_axis(counts, "move_compensated counts", positive=False)
         d_now = self.axis_position("D")
-        corr = axis45_compensation(c[3], c[4], d_now, coupling)
+        corr = axis45_compensation(c[3], c[4], d_now, coupling, carry)
         c[4] = float(corr.axis5_command)
         self.move_absolute(c, speed, accel, decel)
         final = self.wait_motion_complete(timeout, poll_interval)
         check_arrival(c, final, what="compensated move")  # before DP: never hide a mismatch
         self.define_position({"E": int(corr.axis5_reset)})
+        self.axis5_residual = float(corr.residual)
         return self.position_counts()
 
     def define_position(self, counts: Any) -> None:

@@ -140,15 +140,18 @@ def joint_rad_to_counts(q: Any) -> np.ndarray:
 
 
 class Axis45Correction(NamedTuple):
-    """Result of :func:`axis45_compensation` (counts, int64 arrays or scalars)."""
+    """Result of :func:`axis45_compensation`: the axis-5 command and ``DP`` value (counts,
+    int64 arrays or scalars) and the fraction of a count the true axis 5 ends past the reset
+    value (float; the ``carry`` of the next move)."""
 
     axis5_command: np.ndarray
     axis5_reset: np.ndarray
+    residual: np.ndarray | float = 0.0
 
 
 def axis45_compensation(
     axis4_target: Any, axis5_target: Any, axis4_now: Any,
-    coupling: float = AXIS4_TO_5_COUPLING,
+    coupling: float = AXIS4_TO_5_COUPLING, carry: Any = 0.0,
 ) -> Axis45Correction:
     """Compensate the PUMA's axis 4 -> 5 coupling (Vibhute App. D.9 ``Axis_4_5_Correction.m``).
 
@@ -157,10 +160,30 @@ def axis45_compensation(
     ``axis5_target - coupling * d4`` (thesis: ``E_cmd + (D_cmd - D_now) * 11200/23962``) makes
     the true axis-5 position end at ``axis5_target``; afterwards the encoder reads the command,
     so it is reset with ``DP`` to ``axis5_reset = axis5_target``. All inputs are counts and may
-    carry a leading batch shape; the outputs are rounded (halves away from zero).
+    carry a leading batch shape; the command and reset are rounded (halves away from zero).
+
+    The command is a whole count, so the true axis 5 ends ``residual`` =
+    ``axis5_command + coupling * d4 - axis5_target`` (|·| ≤ 0.5) past the reset value. The
+    thesis discards it at every ``DP``; over many small axis-4 moves of one sense the
+    fractions add up (20 counts, 0.13°, over a 50 mm follow run: 0.6 mm at the tool).
+    ``carry`` is where the true axis 5 stood past its encoder before this move (the previous
+    move's ``residual``): the command takes it off, so the true position stays within half a
+    count of the encoder over any number of moves. Pass the returned ``residual`` to the next
+    move (0 after homing, when the encoder agrees with the true position).
+
+    >>> c = axis45_compensation(101, 0, 100)  # axis 4 by +1 count: axis 5 by -0.467
+    >>> int(c.axis5_command), int(c.axis5_reset), round(float(c.residual), 3)
+    (0, 0, -0.467)
+    >>> c2 = axis45_compensation(102, 0, 101, carry=c.residual)  # the next count: -0.935 ...
+    >>> int(c2.axis5_command), round(float(c2.residual), 3)  # ... so axis 5 is sent 1 count
+    (1, 0.065)
     """
     d4 = as_finite(axis4_target, "axis4_target") - as_finite(axis4_now, "axis4_now")
     e = as_finite(axis5_target, "axis5_target")
     if not math.isfinite(coupling):
         raise InputError(f"axis45_compensation: coupling must be finite, got {coupling!r}")
-    return Axis45Correction(round_half_away(e - coupling * d4), round_half_away(e))
+    r0 = as_finite(carry, "carry")
+    if np.any(np.abs(r0) > 0.5 + 1e-9):
+        raise InputError(f"axis45_compensation: carry must be within half a count, got {carry!r}")
+    cmd = round_half_away(e - coupling * d4 - r0)
+    return Axis45Correction(cmd, round_half_away(e), cmd + coupling * d4 + r0 - e)
