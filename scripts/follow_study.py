@@ -9,9 +9,10 @@ cylinder, thesis and ideal sensor). Prints one row per run (true figures from th
 and a summary. Options: ``--devices`` (through the simulated Galil and encoder stream, as
 ``kinestat control`` without device options, instead of the in-process cell; about a minute
 of one core per run), ``--jobs N`` (runs in parallel processes), ``--friction MU`` (Coulomb
-friction of every workpiece), ``--ideal`` (1 nm leg encoders instead of the thesis's resolution), ``--auto-tilt auto|on|off`` (the
-follow task's automatic tilt; default auto, as the CLI: it switches itself on when the tip
-sticks; the friction studies before 2026-12-02 ran with it on from the start).
+friction of every workpiece), ``--ideal`` (1 nm leg encoders instead of the thesis's
+resolution), ``--auto-tilt auto|on|off`` (the follow task's automatic tilt; default auto, as
+the CLI: it switches itself on when the tip sticks; the friction studies before 2026-12-02
+ran with it on from the start).
 
     .venv/bin/python scripts/follow_study.py [N] [--acceptance] [--friction MU] [--ideal]
         [--auto-tilt auto|on|off] [--seed N] [--budget] [--devices] [--jobs N]
