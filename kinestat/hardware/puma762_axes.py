@@ -163,7 +163,8 @@ def axis45_compensation(
     carry a leading batch shape; the command and reset are rounded (halves away from zero).
 
     The command is a whole count, so the true axis 5 ends ``residual`` =
-    ``axis5_command + coupling * d4 - axis5_target`` (|·| ≤ 0.5) past the reset value. The
+    ``axis5_command + coupling * d4 - axis5_target`` past the reset value (|·| ≤ 0.5 for a
+    whole-count target, as every move sends). The
     thesis discards it at every ``DP``; over many small axis-4 moves of one sense the
     fractions add up (20 counts, 0.13°, over a 50 mm follow run: 0.6 mm at the tool).
     ``carry`` is where the true axis 5 stood past its encoder before this move (the previous
