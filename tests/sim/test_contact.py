@@ -1,6 +1,19 @@
 """The simulated contact's solvers (kinestat.sim.contact)."""
 
+import math
+
 import numpy as np
+import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
+
+from kinestat.errors import UnreachableError
+from kinestat.parallel.platform import special_6_6
+from kinestat.sim.contact import DEFAULT_TOOL_POINT_6, equilibrium, make_cell
+
+PLAT = special_6_6()
+FLANGE = np.eye(4)  # frame 6 = fixed frame: the tool points along +z
+TIP0 = np.asarray(DEFAULT_TOOL_POINT_6)
 
 
 def test_the_damped_slide_converges_where_plain_newton_diverges():
@@ -21,3 +34,98 @@ def test_the_damped_slide_converges_where_plain_newton_diverges():
     d2, X = damped_slide(resid, x.copy(), np.eye(4), SLIDE_CONVERGED)
     assert np.max(np.abs(np.arctan(d2 - c))) <= SLIDE_CONVERGED
     assert np.allclose(d2, c, atol=1e-9) and np.array_equal(X, np.eye(4))
+
+
+@settings(max_examples=25, deadline=None)
+@given(depth=st.floats(0.002, 3.0), tilt=st.floats(2.0, 25.0), azimuth=st.floats(0.0, 360.0),
+       slip=st.floats(0.05, 0.95), off=st.tuples(st.floats(-0.5, 0.5), st.floats(-0.5, 0.5)))
+def test_the_one_newton_slide_is_the_secant_searchs_slide(depth, tilt, azimuth, slip, off):
+    # the sliding contact by the one Newton on (pose, force, slip) against the same slide found
+    # by the older search (a secant along the slip, then a 2-D Newton over whole stick solves),
+    # from light touches to 3 mm deep, anchors off the straight-ahead point
+    from kinestat.sim import contact
+
+    t, a = math.radians(tilt), math.radians(azimuth)
+    mu = slip * math.tan(t)  # below the tilt's slope: a straight push slides
+    n = -np.array([math.sin(t) * math.cos(a), math.sin(t) * math.sin(a), math.cos(t)])
+    cell = make_cell(PLAT, plane_point=TIP0 + depth * n, plane_normal=n, friction=mu)
+    anchor = (TIP0 + depth * n + off[0] * np.cross(n, [1.0, 0, 0])
+              + off[1] * np.cross(n, [0, 1.0, 0]))
+    anchor -= (anchor - cell.workpiece.point) @ n * n
+    used = []
+    newton = contact._solve_slide
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(contact, "_solve_slide", lambda *a, **k: used.append(newton(*a, **k))
+                   or used[-1])
+        try:
+            eq = equilibrium(cell, FLANGE, anchor=anchor)
+        except UnreachableError:
+            assume(False)
+    # compared where the one Newton settled the slide (a far snap is left to the search)
+    assume(eq.in_contact and not eq.sticking and used and used[-1] is not None)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(contact, "_solve_slide", lambda *a, **k: None)
+        ref = equilibrium(cell, FLANGE, anchor=anchor)
+    assert not ref.sticking
+    np.testing.assert_allclose(eq.anchor, ref.anchor, atol=1e-6)
+    np.testing.assert_allclose(eq.contact_force, ref.contact_force, atol=1e-7)
+    np.testing.assert_allclose(eq.leg_lengths, ref.leg_lengths, atol=1e-8)
+    fn = eq.contact_force @ n
+    ft = eq.contact_force - fn * n
+    np.testing.assert_allclose(np.linalg.norm(ft), mu * fn, rtol=1e-8, atol=1e-12)
+    assert ft @ (eq.anchor - anchor) < 0  # friction against the slip
+
+
+@pytest.mark.parametrize(("depth", "tilt", "mu"), [(0.005, 8.0, 0.05), (0.05, 20.0, 0.3),
+                                                   (1.0, 8.0, 0.05), (2.0, 25.0, 0.3)])
+def test_the_one_newton_settles_light_and_loaded_slides(depth, tilt, mu):
+    # the slides of a follow run, from a touch of hundredths of a newton to tens of newtons:
+    # the one Newton settles them (no secant search), on Coulomb's cone against the slip
+    from kinestat.sim import contact
+
+    t = math.radians(tilt)
+    n = -np.array([math.sin(t), 0.0, math.cos(t)])
+    cell = make_cell(PLAT, plane_point=TIP0 + depth * n, plane_normal=n, friction=mu)
+    anchor = TIP0 + depth * n
+    used = []
+    newton = contact._solve_slide
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(contact, "_solve_slide", lambda *a, **k: used.append(newton(*a, **k))
+                   or used[-1])
+        eq = equilibrium(cell, FLANGE, anchor=anchor)
+    assert not eq.sticking and used and used[-1] is not None
+    fn = eq.contact_force @ n
+    ft = eq.contact_force - fn * n
+    assert fn > 0
+    np.testing.assert_allclose(np.linalg.norm(ft), mu * fn, rtol=1e-8)
+    slip = eq.anchor - anchor
+    np.testing.assert_allclose(ft / np.linalg.norm(ft), -slip / np.linalg.norm(slip), atol=1e-8)
+
+
+def test_a_light_slide_that_first_runs_on_is_found_from_a_start_further_out():
+    # 0.018 N on a plane tilted 28°, the anchor 3 mm off the straight-ahead point: from the
+    # guessed slip the one Newton turns back (the tangential stiffness along the slip is
+    # negative there), from a start further out it settles where the secant search does
+    from kinestat.sim import contact
+
+    t, a = math.radians(27.86), math.radians(176.33)
+    n = -np.array([math.sin(t) * math.cos(a), math.sin(t) * math.sin(a), math.cos(t)])
+    cell = make_cell(PLAT, plane_point=TIP0 + 0.01166 * n, plane_normal=n, friction=0.4363)
+    anchor = (TIP0 + 0.01166 * n + 2.2065 * np.cross(n, [1.0, 0, 0])
+              - 2.3568 * np.cross(n, [0, 1.0, 0]))
+    anchor -= (anchor - cell.workpiece.point) @ n * n
+    used = []
+    newton = contact._solve_slide
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(contact, "_solve_slide", lambda *a, **k: used.append(newton(*a, **k))
+                   or used[-1])
+        eq = equilibrium(cell, FLANGE, anchor=anchor)
+    assert not eq.sticking and len(used) > 1 and used[0] is None and used[-1] is not None
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(contact, "_solve_slide", lambda *a, **k: None)
+        ref = equilibrium(cell, FLANGE, anchor=anchor)
+    np.testing.assert_allclose(eq.anchor, ref.anchor, atol=1e-6)
+    np.testing.assert_allclose(eq.contact_force, ref.contact_force, atol=1e-9)
+    fn = eq.contact_force @ n
+    assert 0 < fn < 0.05
+    np.testing.assert_allclose(np.linalg.norm(eq.contact_force - fn * n), 0.4363 * fn, rtol=1e-7)
