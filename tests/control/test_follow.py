@@ -713,17 +713,16 @@ def _first_slip(rep) -> tuple[list, int]:
     return trav, next(i for i, c in enumerate(trav) if c["friction_ratio"] > 0)
 
 
-def test_the_stuck_lead_does_not_drift_before_the_breakaway(tmp_path):
-    """The default plane (thesis sensor, μ = 0.3): after the hold, S6 and the stuck tip's
-    force turn together, but the force a little less, so S6's lead over it drifts up (+0.6°
-    over ~80 cycles here; to 3.5° on the CLI's run, where the tip then broke away with S6 far
-    past its sliding lead and ran ahead, −0.6 N). ``_lead_hold`` takes the drift back: the
-    true lead over the stuck cycles' last 20 exceeds its first 20 by less than 0.35°, and the
-    breakaway stays well inside the acceptance."""
+def test_the_tip_breaks_away_with_s6_about_the_sliding_lead_ahead(tmp_path):
+    """The default plane (thesis sensor, μ = 0.3): the breakaway holds the stuck tip's force
+    until S6 leads it by ``BREAKAWAY_LEAD`` (the automatic tilt's margin, a sliding tool's
+    lead), then turns both. The true lead reaches the margin and drifts about 0.6° on while the
+    tip sticks, ending about 1° past it (3.5° through the simulated devices while their axis 5
+    drifted, and the tip then ran ahead, −0.6 N); the breakaway stays well inside the
+    acceptance."""
     from kinestat.control import follow
 
-    assert follow.BREAKAWAY_LEAD + follow.EDGE_LEAD + follow.LEAD_BAND == pytest.approx(
-        follow.AUTO_TILT_MARGIN_DEG)  # the lead at the edge seen: the sliding tool's
+    assert follow.BREAKAWAY_LEAD == follow.AUTO_TILT_MARGIN_DEG
     prep, rep, out = _follow(tmp_path, cell=replace(SimulatedCell(), friction=0.3))
     assert out["completed"] and rep.converged, rep.stop_reason
     trav, first = _first_slip(rep)
@@ -736,31 +735,63 @@ def test_the_stuck_lead_does_not_drift_before_the_breakaway(tmp_path):
         return tilt - math.degrees(math.atan2(ft, fn))
 
     leads = [lead(c) for c in trav[:first]]
-    start = next(i for i, v in enumerate(leads) if v >= follow.BREAKAWAY_LEAD)
+    start = next(i for i, v in enumerate(leads) if v >= follow.BREAKAWAY_LEAD - 0.3)
     stuck = leads[start:first - 2]  # the hold done, before the edge
-    assert len(stuck) > 60  # the premise: a long stuck breakaway
-    assert np.mean(stuck[-20:]) - np.mean(stuck[:20]) < 0.35
+    assert len(stuck) > 30  # the premise: a long stuck breakaway
+    assert follow.BREAKAWAY_LEAD - 0.5 < np.mean(stuck[-10:]) < follow.BREAKAWAY_LEAD + 1.25
     assert out["true_normal_force_max_error"] <= 0.3
 
 
-def test_the_stuck_lead_is_held_near_the_breakaway_lead():
-    """``_lead_hold``: the fraction of the breakaway's turn by which the stuck force is held.
-    Whole until S6 leads by ``BREAKAWAY_LEAD``; then none while the lead's mean stays within
-    ``LEAD_BAND`` of it; beyond, the excess is taken back at ``LEAD_GAIN`` a cycle (a mean too
-    high turns the force further than S6, one too low holds it), never more than 0.5 back."""
+def test_the_stuck_force_is_held_until_s6_leads_it_by_the_breakaway_lead():
+    """``_lead_hold``: the fraction of the breakaway's turn by which the stuck force is held:
+    whole until the lead is tracked (it reached ``BREAKAWAY_LEAD``), then none."""
     from types import SimpleNamespace
 
     from kinestat.control import follow
 
-    turn = np.radians([0.0, 0.0, 0.2])  # the breakaway's 0.2° a cycle
-    L, band = follow.BREAKAWAY_LEAD, follow.LEAD_BAND
-    assert follow._lead_hold(SimpleNamespace(lead_ref=None), turn) == 1.0
-    for ref in (L, L + 0.9 * band, L - 0.9 * band):
-        assert follow._lead_hold(SimpleNamespace(lead_ref=ref), turn) == 0.0
-    for excess in (0.02, 0.05, 0.1, 1.0, 5.0):
-        hi = follow._lead_hold(SimpleNamespace(lead_ref=L + band + excess), turn)
-        lo = follow._lead_hold(SimpleNamespace(lead_ref=L - band - excess), turn)
-        # a hold h changes the lead by h × turn: the excess shrinks by LEAD_GAIN of itself
-        assert hi == pytest.approx(max(-follow.LEAD_GAIN * excess / 0.2, -0.5))
-        assert lo == pytest.approx(min(follow.LEAD_GAIN * excess / 0.2, 1.0))
-    assert follow._lead_hold(SimpleNamespace(lead_ref=L + 2.0), np.zeros(3)) == 0.0
+    assert follow._lead_hold(SimpleNamespace(lead_ref=None)) == 1.0
+    for ref in (follow.BREAKAWAY_LEAD, follow.BREAKAWAY_LEAD + 2.0):
+        assert follow._lead_hold(SimpleNamespace(lead_ref=ref)) == 0.0
+
+
+def test_the_breakaway_leads_by_the_sliding_margin_so_the_slip_does_not_run_ahead(tmp_path):
+    """Seed 101's workpiece 17 (R = 246 mm, ideal sensor, μ = 0.3): the tip sticks for ~90
+    cycles while the breakaway tilt grows. A sliding tool's S6 leads its force by the automatic
+    tilt's margin; with S6 only 0.7° ahead of the force when the tip broke away (the old
+    ``BREAKAWAY_LEAD``, 0.5°), the platform's soft mode took up the rest: the tip ran 0.4 mm
+    in one cycle and the normal force fell 0.47 N (RMS 0.049 N). Leading by the margin, the
+    slip starts in the sliding pose: the first slip and the cycles after it stay within
+    0.25 N of the request, and the run within the ideal sensor's acceptance."""
+    from kinestat.control import follow
+
+    assert follow.BREAKAWAY_LEAD == follow.AUTO_TILT_MARGIN_DEG
+    name, cell, travel_dir = _study_workpiece(17, seed=101)
+    assert name.startswith("cylinder")
+    prep, rep, out = _follow(tmp_path, cell=replace(cell, ideal_sensor=True, friction=0.3),
+                             travel_dir=travel_dir)
+    assert out["completed"] and rep.converged, rep.stop_reason
+    trav, first = _first_slip(rep)
+    assert first > 60  # the premise: a long stuck breakaway
+    around = [abs(_true_normal_force(c) - 4.0) for c in trav[first - 2:first + 6]]
+    assert max(around) <= 0.25
+    assert out["true_normal_force_rms_error"] <= 0.05
+    assert out["contact_lost"] == 0
+
+
+def test_while_the_lead_is_tracked_its_jitter_past_the_margin_does_not_step_a_stuck_tip(
+        tmp_path):
+    """Seed 13's workpiece 0 (a plane tilted 6.9°, thesis sensor, μ = 0.3): the breakaway
+    leads the force by the margin, and the measured lead jitters ±0.3° about it. The test
+    "S6 past the force by the margin: the tip is on the edge" read that jitter as the edge
+    and stepped the stuck tip (+0.25 and +0.31 N). While the lead is tracked the edge is the
+    lead's own test (it grows above its recent mean): before the first slip the true normal
+    force stays within 0.2 N of the request once travel started."""
+    name, cell, travel_dir = _study_workpiece(0, seed=13)
+    assert name.startswith("plane")
+    prep, rep, out = _follow(tmp_path, cell=replace(cell, friction=0.3), travel_dir=travel_dir)
+    assert out["completed"] and rep.converged, rep.stop_reason
+    trav, first = _first_slip(rep)
+    assert first > 60
+    stuck = [abs(_true_normal_force(c) - 4.0) for c in trav[5:first]]
+    assert max(stuck) <= 0.2
+    assert out["true_normal_force_max_error"] <= 0.3
