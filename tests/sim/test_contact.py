@@ -16,6 +16,30 @@ FLANGE = np.eye(4)  # frame 6 = fixed frame: the tool points along +z
 TIP0 = np.asarray(DEFAULT_TOOL_POINT_6)
 
 
+def _plane_cell(depth, tilt_deg, azimuth_deg, mu, off=(0.0, 0.0)):
+    """A plane ``depth`` mm into the unloaded tip, tilted, with friction ``mu``, and an anchor
+    on it ``off`` mm (along n × x, n × y) from the straight-ahead point."""
+    t, a = math.radians(tilt_deg), math.radians(azimuth_deg)
+    n = -np.array([math.sin(t) * math.cos(a), math.sin(t) * math.sin(a), math.cos(t)])
+    cell = make_cell(PLAT, plane_point=TIP0 + depth * n, plane_normal=n, friction=mu)
+    anchor = TIP0 + depth * n + off[0] * np.cross(n, [1.0, 0, 0]) + off[1] * np.cross(n, [0, 1, 0])
+    return cell, n, anchor - (anchor - cell.workpiece.point) @ n * n
+
+
+def _solve(cell, anchor, newton: bool):
+    """The equilibrium with the slide's one Newton (``newton``; its results recorded, None
+    where it gave up) or with the secant search alone. Returns ``(eq, results)``."""
+    from kinestat.sim import contact
+
+    results = []
+    one = contact._solve_slide
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(contact, "_solve_slide",
+                   (lambda *a, **k: results.append(one(*a, **k)) or results[-1]) if newton
+                   else (lambda *a, **k: None))
+        return equilibrium(cell, FLANGE, anchor=anchor), results
+
+
 def test_the_damped_slide_converges_where_plain_newton_diverges():
     # arctan's Newton iteration diverges from |x| > 1.39; the backtracking fallback of the
     # sliding contact must still reach the root (a property of the solver, no cell needed)
@@ -43,29 +67,15 @@ def test_the_one_newton_slide_is_the_secant_searchs_slide(depth, tilt, azimuth, 
     # the sliding contact by the one Newton on (pose, force, slip) against the same slide found
     # by the older search (a secant along the slip, then a 2-D Newton over whole stick solves),
     # from light touches to 3 mm deep, anchors off the straight-ahead point
-    from kinestat.sim import contact
-
-    t, a = math.radians(tilt), math.radians(azimuth)
-    mu = slip * math.tan(t)  # below the tilt's slope: a straight push slides
-    n = -np.array([math.sin(t) * math.cos(a), math.sin(t) * math.sin(a), math.cos(t)])
-    cell = make_cell(PLAT, plane_point=TIP0 + depth * n, plane_normal=n, friction=mu)
-    anchor = (TIP0 + depth * n + off[0] * np.cross(n, [1.0, 0, 0])
-              + off[1] * np.cross(n, [0, 1.0, 0]))
-    anchor -= (anchor - cell.workpiece.point) @ n * n
-    used = []
-    newton = contact._solve_slide
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(contact, "_solve_slide", lambda *a, **k: used.append(newton(*a, **k))
-                   or used[-1])
-        try:
-            eq = equilibrium(cell, FLANGE, anchor=anchor)
-        except UnreachableError:
-            assume(False)
+    mu = slip * math.tan(math.radians(tilt))  # below the tilt's slope: a straight push slides
+    cell, n, anchor = _plane_cell(depth, tilt, azimuth, mu, off)
+    try:
+        eq, used = _solve(cell, anchor, newton=True)
+    except UnreachableError:
+        assume(False)
     # compared where the one Newton settled the slide (a far snap is left to the search)
     assume(eq.in_contact and not eq.sticking and used and used[-1] is not None)
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(contact, "_solve_slide", lambda *a, **k: None)
-        ref = equilibrium(cell, FLANGE, anchor=anchor)
+    ref, _ = _solve(cell, anchor, newton=False)
     assert not ref.sticking
     np.testing.assert_allclose(eq.anchor, ref.anchor, atol=1e-6)
     np.testing.assert_allclose(eq.contact_force, ref.contact_force, atol=1e-7)
@@ -81,18 +91,8 @@ def test_the_one_newton_slide_is_the_secant_searchs_slide(depth, tilt, azimuth, 
 def test_the_one_newton_settles_light_and_loaded_slides(depth, tilt, mu):
     # the slides of a follow run, from a touch of hundredths of a newton to tens of newtons:
     # the one Newton settles them (no secant search), on Coulomb's cone against the slip
-    from kinestat.sim import contact
-
-    t = math.radians(tilt)
-    n = -np.array([math.sin(t), 0.0, math.cos(t)])
-    cell = make_cell(PLAT, plane_point=TIP0 + depth * n, plane_normal=n, friction=mu)
-    anchor = TIP0 + depth * n
-    used = []
-    newton = contact._solve_slide
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(contact, "_solve_slide", lambda *a, **k: used.append(newton(*a, **k))
-                   or used[-1])
-        eq = equilibrium(cell, FLANGE, anchor=anchor)
+    cell, n, anchor = _plane_cell(depth, tilt, 0.0, mu)
+    eq, used = _solve(cell, anchor, newton=True)
     assert not eq.sticking and used and used[-1] is not None
     fn = eq.contact_force @ n
     ft = eq.contact_force - fn * n
@@ -106,24 +106,10 @@ def test_a_light_slide_that_first_runs_on_is_found_from_a_start_further_out():
     # 0.018 N on a plane tilted 28°, the anchor 3 mm off the straight-ahead point: from the
     # guessed slip the one Newton turns back (the tangential stiffness along the slip is
     # negative there), from a start further out it settles where the secant search does
-    from kinestat.sim import contact
-
-    t, a = math.radians(27.86), math.radians(176.33)
-    n = -np.array([math.sin(t) * math.cos(a), math.sin(t) * math.sin(a), math.cos(t)])
-    cell = make_cell(PLAT, plane_point=TIP0 + 0.01166 * n, plane_normal=n, friction=0.4363)
-    anchor = (TIP0 + 0.01166 * n + 2.2065 * np.cross(n, [1.0, 0, 0])
-              - 2.3568 * np.cross(n, [0, 1.0, 0]))
-    anchor -= (anchor - cell.workpiece.point) @ n * n
-    used = []
-    newton = contact._solve_slide
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(contact, "_solve_slide", lambda *a, **k: used.append(newton(*a, **k))
-                   or used[-1])
-        eq = equilibrium(cell, FLANGE, anchor=anchor)
+    cell, n, anchor = _plane_cell(0.01166, 27.86, 176.33, 0.4363, (2.2065, -2.3568))
+    eq, used = _solve(cell, anchor, newton=True)
     assert not eq.sticking and len(used) > 1 and used[0] is None and used[-1] is not None
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(contact, "_solve_slide", lambda *a, **k: None)
-        ref = equilibrium(cell, FLANGE, anchor=anchor)
+    ref, _ = _solve(cell, anchor, newton=False)
     np.testing.assert_allclose(eq.anchor, ref.anchor, atol=1e-6)
     np.testing.assert_allclose(eq.contact_force, ref.contact_force, atol=1e-9)
     fn = eq.contact_force @ n
