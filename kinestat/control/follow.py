@@ -1169,7 +1169,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
                 hold = (-meas.estimate(base.estimator), w_surf)  # the force on the tool
         h = _lead_hold(st) if growing and _lead_tracked(st) else 0.0
         if h:  # the breakaway's first turns hold the force (a stuck tip's force would turn
-            # with the tool) until S6 leads it by BREAKAWAY_LEAD; then its drift is held off
+            # with the tool) until S6 leads it by BREAKAWAY_LEAD; then it turns with S6
             hold = (-h * meas.estimate(base.estimator), np.zeros(3))
         mu_c, slip_c = (st.friction_ratio, t) if sliding else (0.0, t)
         if dlam < 0.0 and _lead_tracked(st) and phase == "travel":  # μ unknown: keep r

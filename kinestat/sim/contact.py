@@ -411,7 +411,7 @@ def _solve_slide(cell: Cell, a: np.ndarray, E: np.ndarray, n: np.ndarray, X0: np
     equations at the slid anchor ``a + ρ (cos φ e1 + sin φ e2)`` (``E = [e1 e2]``, the plane's
     tangent basis, 3×2) and Coulomb's law on the slip, ``f·e_i + μ (f·n) (cos φ, sin φ)_i = 0``:
     friction at the cone's edge, against the slip. The slip is kept ahead of the anchor
-    (ρ > 0). Returns ``(X, f, ρ, φ, friction residual, iterations)`` once every equation holds
+    (ρ > 0). Returns ``(X, f, ρ, φ, wrench residual, iterations)`` once every equation holds
     (wrench and tip to ``tol``, friction to :data:`SLIDE_CONVERGED`), else None: the caller's
     secant and 2-D Newton (one stick solve per trial anchor) take over. None early when four
     steps running would shrink the slip past half: the tangential stiffness along the slip is
@@ -424,17 +424,18 @@ def _solve_slide(cell: Cell, a: np.ndarray, E: np.ndarray, n: np.ndarray, X0: np
     clamped = 0
     for it in range(1, max_iter + 1):
         r, p, A = _stick_system(cell, X, f)
-        c, cp = E @ [math.cos(phi), math.sin(phi)], E @ [-math.sin(phi), math.cos(phi)]
+        u, v = np.array([math.cos(phi), math.sin(phi)]), np.array([-math.sin(phi), math.cos(phi)])
+        c = E @ u
         fn = float(f @ n)
-        g = E.T @ f + mu * fn * np.array([math.cos(phi), math.sin(phi)])
+        g = E.T @ f + mu * fn * u
         res = (float(np.max(np.abs(r))), float(np.max(np.abs(p - a - rho * c))),
                float(np.max(np.abs(g))))
         if res[0] <= tol and res[1] <= tol and res[2] <= SLIDE_CONVERGED:
-            return X, f, rho, phi, res[2], it
+            return X, f, rho, phi, res[0], it
         B[:9, :9] = A
-        B[6:9, 9], B[6:9, 10] = -c, -rho * cp
-        B[9:, 6:9] = E.T + mu * np.outer([math.cos(phi), math.sin(phi)], n)
-        B[9:, 10] = mu * fn * np.array([-math.sin(phi), math.cos(phi)])
+        B[6:9, 9], B[6:9, 10] = -c, -rho * (E @ v)
+        B[9:, 6:9] = E.T + mu * np.outer(u, n)
+        B[9:, 10] = mu * fn * v
         try:
             d = np.linalg.solve(B, -np.concatenate([r, p - a - rho * c, g]))
         except np.linalg.LinAlgError:
@@ -686,14 +687,12 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter, guess=No
         if sl is not None:
             break
     if sl is not None:  # one Newton on the whole slide
-        Xs, fs, rho, phi, _, it = sl
+        Xs, fs, rho, phi, rs, it = sl
         iters += it
         d2 = rho * np.array([math.cos(phi), math.sin(phi)])
         fFs = apply_vector(TB, fs)
         fns = float(fFs @ nF)
         r = np.array([fFs @ e1, fFs @ e2]) + mu * fns * d2 / rho
-        rs = float(np.max(np.abs(spring_wrench(_springs(cell, Xs), Xs)
-                                 - np.concatenate([fs, np.cross(apply(Xs, cell.tool_tip), fs)]))))
     else:  # the slower search, one stick solve per trial anchor
         r, d2, Xs, fs, fFs, rs, fns = _slide_by_secant(resid, u, s0, X, (f, fF, res, fn))
     if fns < 0.0:
