@@ -185,6 +185,10 @@ CARRY_MARGIN = 1.0
 """Newtons above the requested force the platform must carry (control overshoot)."""
 SETTLE_ALIGN_DEG = 2.0
 """While settling, the force is raised only once S6 is within this of the normal estimate."""
+CONE_SLACK_DEG = 0.5
+"""Once μ̂ is measured, a normal estimate kept while the tip does not slide may lie at most
+``atan(μ̂)`` + this from the measured force's direction (:func:`_normal_in_cone`): the force's
+noise with the thesis's counts is 0.1-0.3°."""
 TURN_DEADBAND_DEG = 0.3
 """Misalignments of S6 below this are not corrected (the normal estimate's noise)."""
 CURVATURE_SPAN = 4.0
@@ -921,6 +925,24 @@ def _unslipped(config: FollowConfig, st: FollowState, meas: Measurement) -> Foll
                    stick_jitter=max(st.stick_jitter, st.direct_slip), direct_slip=0.0)
 
 
+def _normal_in_cone(n0: np.ndarray, u: np.ndarray, mu: float) -> np.ndarray:
+    """The normal estimate ``n0`` kept while the tip does not slide, brought into the friction
+    cone of the measured force: the force on the tool (direction ``u``) lies within
+    ``atan(μ)`` of the normal, so a kept estimate further than that (plus ``CONE_SLACK_DEG``
+    for the force's noise) from it is stale, and is turned towards ``u`` onto that bound.
+    Unchanged inside it (a stuck tip's force anywhere in the cone says no more).
+
+    >>> n = _normal_in_cone(np.array([0.0, 0.0, 1.0]), np.array([0.0, 0.1, 1.0]) / 1.01 ** 0.5,
+    ...                     0.0)
+    >>> round(math.degrees(math.acos(n[2])), 3), bool(n[1] > 0)
+    (5.211, True)
+    """
+    lim = math.atan(mu) + math.radians(CONE_SLACK_DEG)
+    if float(n0 @ u) >= math.cos(lim):
+        return n0
+    return cone_normal_one(u, n0, math.tan(lim))
+
+
 def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.ndarray,
              contact: bool) -> FollowState:
     """Update the travel, the friction ratio and the normal estimate from this measurement
@@ -987,8 +1009,10 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         # nor in the cycle a travel step stuck: the step pressed the tip along the tilted
         # tool's axis (the force rose); the force control relieves it first
         grow = grow and not (st.tilting and st.step > 0.0) and st.withdraw == 0.0
-        return replace(st, travel=travel, last_tip=tip, path=path, sticking=stuck, slid=False,
-                       stuck_travel=pushed if stuck else 0.0,
+        n = (_normal_in_cone(n0, -F / norm3(F), st.friction_ratio)
+             if st.friction_samples >= LEARN_CHORDS else n0)
+        return replace(st, travel=travel, normal=n, last_tip=tip, path=path, sticking=stuck,
+                       slid=False, stuck_travel=pushed if stuck else 0.0,
                        step_cap=0.0 if stuck else st.step_cap,
                        breakaway=st.breakaway + (_breakaway_step(st) if grow else 0.0))
     u = -F / norm3(F)  # the force on the tool's direction
