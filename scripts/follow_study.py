@@ -72,10 +72,11 @@ AUTO_TILT = {"auto": None, "on": True, "off": False}
 
 
 def follow(cell: SimulatedCell, travel_dir, travel: float = 50.0,
-           auto_tilt: bool | None = None, devices: bool = False) -> dict:
-    """One follow run on ``cell``: in process, or (``devices``) through the simulated Galil
-    and encoder stream as ``kinestat control`` runs it."""
-    req = ControlRequest(force=4.0 * F_HAT, start_tool_point=START, cell=cell, task="follow",
+           auto_tilt: bool | None = None, devices: bool = False, force: float = 4.0) -> dict:
+    """One follow run on ``cell`` (|F_req| = ``force`` N along the thesis's direction): in
+    process, or (``devices``) through the simulated Galil and encoder stream as
+    ``kinestat control`` runs it."""
+    req = ControlRequest(force=force * F_HAT, start_tool_point=START, cell=cell, task="follow",
                          travel=travel, travel_dir=np.asarray(travel_dir, dtype=float),
                          auto_tilt=auto_tilt)
     prep = prepare_control(req)
