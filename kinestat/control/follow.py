@@ -185,6 +185,9 @@ CARRY_MARGIN = 1.0
 """Newtons above the requested force the platform must carry (control overshoot)."""
 SETTLE_ALIGN_DEG = 2.0
 """While settling, the force is raised only once S6 is within this of the normal estimate."""
+ROLL_WEIGHT = 0.1
+"""Weight of the latest turn in the running mean of S6's roll per mm of travel
+(:func:`_track_roll`)."""
 CONE_SLACK_DEG = 0.5
 """Once μ̂ is measured, a normal estimate kept while the tip does not slide may lie at most
 ``atan(μ̂)`` + this from the measured force's direction (:func:`_normal_in_cone`): the force's
@@ -524,6 +527,7 @@ class FollowState(ControllerState):
     lead_ref: float | None = None
     lead_cycles: int = 0
     slip_cycle: int = 0
+    roll_rate: float = 0.0
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -925,6 +929,56 @@ def _unslipped(config: FollowConfig, st: FollowState, meas: Measurement) -> Foll
                    stick_jitter=max(st.stick_jitter, st.direct_slip), direct_slip=0.0)
 
 
+def _frictionless_hold(config: FollowConfig, st: FollowState, meas: Measurement,
+                       n: np.ndarray, t: np.ndarray, omega: np.ndarray,
+                       step: float) -> tuple[np.ndarray, np.ndarray] | None:
+    """The hold feed-forward of a frictionless slide (μ̂ measured below
+    ``FRICTION_HINT_RATIO``, no tilt) while S6 turns: the force on the tool is kept along the
+    surface's normal instead of turning with the base. A frictionless tip rests where the
+    force has no tangential part, so a turn that swings the force by δ swings the tip by about
+    F δ / (k_t − N/R) across the surface (k_t the top's tangential stiffness at the tip). On
+    a tight convex surface that is millimetres a degree, and the normal there turned further
+    than S6 had (about 4° for 1° at 5.2 N on R = 165 mm): chasing it was a limit cycle. The
+    force turns about the travel (roll) by the surface's own roll under the step (the running
+    mean of S6's roll, :func:`_track_roll`), not by the swings about it. The turn about
+    ``n̂ × t̂`` (pitch) follows the surface's measured turn ``κ̂ Δs`` when
+    the path's curvature is known and the tips used for it run along the travel
+    (:func:`_path_along`; tips drifting across it fit a spurious κ̂), else it is not held
+    (as before 2026-12-03). None when it does not apply."""
+    if (st.tilting or st.friction_samples < LEARN_CHORDS
+            or st.friction_ratio >= FRICTION_HINT_RATIO or not norm3(omega) > 0.0):
+        return None
+    model = config.base.model
+    b = cross3(n, t)
+    w_pitch = float(omega @ b) * b
+    if st.curvature_cycles >= HOLD_CURVATURE_CYCLES and _path_along(st.path, meas.tip(model),
+                                                                     t, b):
+        w_pitch = st.curvature * step * b
+    return -meas.estimate(config.base.estimator), w_pitch + st.roll_rate * step * t
+
+
+def _track_roll(st: FollowState, omega: np.ndarray, t: np.ndarray, step: float) -> FollowState:
+    """The running mean (weight ``ROLL_WEIGHT``) of S6's turn about the travel per mm of
+    travel (rad/mm): the surface's own roll under the step (its geodesic torsion, ``sin φ
+    cos φ / R`` on a cylinder travelled at φ from its circumference), which S6 follows turn by
+    turn, while a turn that swings back and forth averages out (:func:`_frictionless_hold`).
+    Unchanged without a step."""
+    if step <= 0.0:
+        return st
+    return replace(st, roll_rate=(1.0 - ROLL_WEIGHT) * st.roll_rate
+                   + ROLL_WEIGHT * float(omega @ t) / step)
+
+
+def _path_along(path: tuple, tip: np.ndarray, t: np.ndarray, b: np.ndarray) -> bool:
+    """The measured tips run along ``t``: their spread across it (along ``b``) is at most
+    a quarter of their span along it."""
+    if not path:
+        return False
+    P = np.asarray(path) - tip
+    x, y = P @ t, P @ b
+    return float(np.ptp(y)) <= 0.25 * float(max(np.ptp(x), abs(x).max()))
+
+
 def _normal_in_cone(n0: np.ndarray, u: np.ndarray, mu: float) -> np.ndarray:
     """The normal estimate ``n0`` kept while the tip does not slide, brought into the friction
     cone of the measured force: the force on the tool (direction ``u``) lies within
@@ -1179,12 +1233,13 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
              else _turn(meas.s6, axis, math.radians(turn_limit)))
     # the surface's turn under the step, fed forward but for what S6 is short of its axis
     omega, feed = _surface_turn(config, st, meas.s6, n, t, step, omega)
+    st = _track_roll(st, omega, t, step)
     dlam = config.gain * err
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
         dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
     try:
         sliding = phase == "travel" and st.friction_samples > 0
-        hold = None
+        hold = _frictionless_hold(config, st, meas, n, t, omega, step) if sliding else None
         if sliding and not st.sticking and st.tilting:
             kappa = feed * st.curvature if st.curvature_cycles >= HOLD_CURVATURE_CYCLES else 0.0
             w_surf = kappa * step * cross3(n, t)  # the surface's turn under the step
