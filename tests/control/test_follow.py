@@ -6,7 +6,7 @@ from __future__ import annotations
 import functools
 import math
 import tempfile
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -25,6 +25,7 @@ from kinestat.control.controller import THESIS_FORCE_DIRECTION, start
 from kinestat.control.follow import (
     CONE_SLACK_DEG,
     LEARN_CHORDS,
+    ROLL_WEIGHT,
     TRAVEL_TOL,
     FollowConfig,
     FollowState,
@@ -32,6 +33,7 @@ from kinestat.control.follow import (
     _engages,
     _friction_hint,
     _normal_in_cone,
+    _track_roll,
     decide_follow,
     estimate_normal,
 )
@@ -172,6 +174,48 @@ def test_a_frictionless_tip_pushed_back_across_the_travel_keeps_a_fresh_normal(t
     assert abs(_true_arc(prep, rep.cycles) - 35.0) <= 1.0
     err = np.array([_true_normal_force(c) - 4.1 for c in trav])
     assert math.sqrt(np.mean(err ** 2)) <= 0.2 and np.max(np.abs(err)) <= 0.5
+
+
+@dataclass(frozen=True)
+class _Roll:
+    roll_rate: float = 0.0
+
+
+def test_the_roll_rate_is_the_mean_turn_about_the_travel_per_mm():
+    t = np.array([0.0, 1.0, 0.0])
+    st = _Roll()
+    for _ in range(200):  # a steady roll (a surface's geodesic torsion): its rate per mm
+        st = _track_roll(st, 0.004 * 0.5 * t + np.array([0.003, 0.0, 0.0]), t, 0.5)
+    assert st.roll_rate == pytest.approx(0.004, rel=1e-9)
+    assert _track_roll(st, t, t, 0.0) is st  # no step: unchanged
+    st = _Roll()
+    for k in range(200):  # a swing back and forth averages out to ROLL_WEIGHT / (2 - w)
+        st = _track_roll(st, (-1.0) ** k * 0.017 * t, t, 1.0)
+    assert abs(st.roll_rate) == pytest.approx(ROLL_WEIGHT / (2.0 - ROLL_WEIGHT) * 0.017,
+                                              rel=1e-6)
+
+
+def test_a_frictionless_tip_does_not_swing_across_a_tight_cylinder_travelled_near_its_axis(
+        tmp_path):
+    # R = 165 mm, 5.2 N, frictionless, travelled 12° off the axis (a wider campaign's random
+    # workpiece, 2026-12-03): N/R is near the top's tangential stiffness at the tip, and each
+    # turn of S6 about the travel, with the force turning with the tool, swung the tip 15 mm
+    # round the cylinder and the normal ~4° (RMS 0.568 N, max 0.801 N). Held along the normal
+    # while S6 turns, the force keeps the tip on its line.
+    cyl = CylinderSpec(radius=165.4, axis=np.array([-0.1985, -0.3602, -0.9118]))
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(cylinder=cyl), travel=30.0,
+                             travel_dir=np.array([0.2958, 0.1596, 0.9439]), force=5.17)
+    assert out["completed"] and out["contact_lost"] == 0, rep.stop_reason
+    trav = [c for c in rep.cycles if c["phase"] == "travel"]
+    axis = prep.cell.workpiece.axis
+    swing = [float((np.asarray(b["true_tip"]) - np.asarray(a["true_tip"]))
+                   @ np.cross(np.asarray(b["true_normal"]), axis))
+             for a, b in zip(trav, trav[1:], strict=False)]
+    # mm a cycle round the cylinder, RMS: 3.5 mm now, 14 mm (±15 mm every cycle) without
+    assert math.sqrt(np.mean(np.square(swing))) < 6.0
+    err = np.array([_true_normal_force(c) - 5.17 for c in trav])
+    assert math.sqrt(np.mean(err ** 2)) <= 0.2 and np.max(np.abs(err)) <= 0.5
+    assert abs(_true_arc(prep, rep.cycles) - 30.0) <= 1.0
 
 
 def test_estimate_normal_removes_friction_along_the_path():
