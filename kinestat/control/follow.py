@@ -266,6 +266,10 @@ sensor, μ = 0.3) turned the top to the 4° limit after 3.9 mm."""
 UNSLIP_MARGIN = 0.03
 """A stuck tip whose force ratio exceeds the first slip's μ̂ by this much shows that slip
 false (:func:`_unslipped`)."""
+PRESS_TOL = 0.15
+"""N: a first slip after which the tip did not follow a travel step and the normal force rose
+this far past the target was false (:func:`_pressed`); about three times the thesis's
+normal-force jitter (±0.05 N)."""
 ENGAGE_STEP = 2.0 * MIN_SLIP
 """With ``auto_tilt`` None (the default), the automatic tilt switches itself on when the tip
 advanced less than ``SLIDE_FRACTION`` of two travel steps in a row of at least this (mm), or of
@@ -918,6 +922,23 @@ def _stuck_ratio(F: np.ndarray, n: np.ndarray) -> float:
     return _force_line(F, n)[0]
 
 
+def _pressed(config: FollowConfig, st: FollowState, advance: float, F: np.ndarray,
+             n: np.ndarray) -> bool:
+    """Whether the last travel step pressed a tip that a first slip had put on the cone's edge
+    (``direct_slip``, no chord since): the tip advanced less than ``SLIDE_FRACTION`` of the
+    step and the normal force rose ``PRESS_TOL`` past the target. A tip on the edge slides
+    under a step; one inside the cone is pushed along the tilted tool's axis instead.
+
+    On a μ = 0.5 cylinder at 2.5 N (thesis's counts) the stuck force's lead behind S6 drifted
+    up over 137 cycles of breakaway to 4.8°, faster near the end, and passed its running mean
+    by ``EDGE_LEAD``: a first slip read 0.6° inside the cone (μ̂ 0.443). The edge steps of
+    0.1, 0.2 and 0.3 mm then pressed the stuck tip +0.19, +0.41, +0.61 N before the force's
+    ratio, ``UNSLIP_MARGIN`` past μ̂, showed the slip false."""
+    if not (st.direct_slip and st.step > 0.0 and advance < SLIDE_FRACTION * st.step):
+        return False
+    return float(-(F @ n)) - config.base.force_target > PRESS_TOL
+
+
 def _unslipped(config: FollowConfig, st: FollowState, meas: Measurement) -> FollowState:
     """A first slip measured against the probe's normal, after which the stuck tip's force
     leans further from the normal than ``atan μ̂`` (by ``UNSLIP_MARGIN`` in ratio), was the
@@ -1022,7 +1043,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         return _slipped_on_probe_normal(config, st, meas, F, tip, travel, path)
     if advance < max(SLIDE_FRACTION * st.step, MIN_SLIP) and not _creeping(st, path, tip, advance):
         ratio = _stuck_ratio(F, n0) if st.probe_trusted else 0.0  # against the probe's normal
-        if st.direct_slip and ratio > st.friction_ratio + UNSLIP_MARGIN:
+        if st.direct_slip and (ratio > st.friction_ratio + UNSLIP_MARGIN
+                               or _pressed(config, st, advance, F, n0)):
             st = _unslipped(config, st, meas)  # a stuck tip's force beyond μ̂'s cone: no slip
         if not st.friction_samples:
             st = replace(st, stick_jitter=max(st.stick_jitter, abs(advance)),
@@ -1350,6 +1372,26 @@ def _friction_hint(st: FollowState) -> str:
             "which leans the tool onto the friction cone")
 
 
+def _tilt_hint(config: FollowConfig, st: FollowState, s6: np.ndarray) -> str:
+    """What a refusal during the automatic tilt's travel came from: the tool leans onto the
+    friction cone (and past it while the tip sticks), and the lean and the force together turn
+    the platform's top (at μ = 0.5 and 5.9 N on a plane the top reached its 4° range at a lean
+    of ~29° before the tip slid). Empty otherwise."""
+    if not (st.tilting and st.phase == "travel" and st.normal is not None):
+        return ""
+    lean = _tilt_deg(s6, st.normal)
+    if st.friction_samples:
+        why = f"friction ratio measured {st.friction_ratio:.2f}"
+    elif st.ratio_max > 0.0:
+        why = (f"the tip had not slid yet; its force's ratio reached {st.ratio_max:.2f}, so the "
+               f"friction ratio is at least that")
+    else:
+        why = "the tip had not slid yet"
+    return (f"; the automatic tilt leaned the tool {lean:.1f}° from the measured normal onto "
+            f"the friction cone ({why}); at {config.base.force_target:.3g} N the platform cannot "
+            "carry that lean: a lower --force (or less friction) keeps the top inside its range")
+
+
 def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Target, label: str,
              action: str, step: float, rotation_deg: float,
              kw: dict) -> tuple[Command, FollowState]:
@@ -1358,7 +1400,8 @@ def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Targ
     cmd = move_command(base.model, base.envelope, base.vernier, meas, new, st.axis_counts,
                        label=label, action=action, step=step, rotation_deg=rotation_deg, info=kw)
     if isinstance(cmd, Refusal):
-        return _stop(st, label, cmd.reason + _friction_hint(st), **cmd.extra, **kw)
+        hint = _friction_hint(st) or _tilt_hint(config, st, meas.s6)
+        return _stop(st, label, cmd.reason + hint, **cmd.extra, **kw)
     return cmd, replace(st, label=label, last_action=action, target=new,
                         axis_counts=cmd.axis_counts, step=step if action == "follow" else 0.0)
 
