@@ -266,6 +266,16 @@ sensor, μ = 0.3) turned the top to the 4° limit after 3.9 mm."""
 UNSLIP_MARGIN = 0.03
 """A stuck tip whose force ratio exceeds the first slip's μ̂ by this much shows that slip
 false (:func:`_unslipped`)."""
+LEAD_CAP = AUTO_TILT_MARGIN_DEG + 1.0
+"""Degrees: once the stuck lead's running mean (``lead_ref``) reaches this, the force control
+presses along the measured force's own line, not the normal (:func:`_force_line`), so the lead
+stops drifting. Below it the drift is left: S6 turning θ from the normal by δ lowers the stuck
+force's normal part by |F| sin θ δ, and pressed back along the normal the force turns back by
+sin²θ δ (the lead grows 0.02° a cycle at 17°, μ = 0.3; 0.04° at 25°). Pressed along its own
+line from the start (the lead held near ``BREAKAWAY_LEAD``), the μ = 0.3 studies got worse
+(seed 29, thesis sensor: max 0.944 N against 0.285 N; at a cap of 2° its median RMS rose
+0.032 → 0.039 N); uncapped, a μ = 0.5 breakaway of 160 cycles led by 4.6° and leaned the tool
+31° from the normal, past the top's range at 4.4 N."""
 PRESS_TOL = 0.15
 """N: a first slip after which the tip did not follow a travel step and the normal force rose
 this far past the target was false (:func:`_pressed`); about three times the thesis's
@@ -822,10 +832,11 @@ def _lead_hold(st: FollowState) -> float:
     """The fraction of the breakaway's turn by which the stuck tip's force is held
     (the control law's hold feed-forward scaled: 1 holds it, 0 lets it turn with S6): whole
     until S6 leads the force by ``BREAKAWAY_LEAD`` (``lead_ref`` set), then none. The stuck
-    force then turns a little less than S6, and the lead drifts up (+0.6° over 80 cycles on
-    the CLI's default plane in process); it is not held back: over 160 random workpieces
+    force then turns a little less than S6 (the force control presses it back along the
+    normal, ``LEAD_CAP``), and the lead drifts up (+0.6° over 80 cycles on the CLI's default
+    plane in process); the hold does not hold it back: over 160 random workpieces
     (docs/control.md, "The stuck lead at the margin") the runs were better without the hold
-    of that drift than with it."""
+    of that drift than with it. ``LEAD_CAP`` bounds it instead."""
     return 1.0 if st.lead_ref is None else 0.0
 
 
@@ -1273,7 +1284,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
             # with the tool) until S6 leads it by BREAKAWAY_LEAD; then it turns with S6
             hold = (-h * meas.estimate(base.estimator), np.zeros(3))
         mu_c, slip_c = (st.friction_ratio, t) if sliding else (0.0, t)
-        if dlam < 0.0 and _lead_tracked(st) and phase == "travel":  # μ unknown: keep r
+        if (_lead_tracked(st) and phase == "travel"
+                and (dlam < 0.0 or (st.lead_ref or 0.0) >= LEAD_CAP)):  # μ unknown: keep r
             mu_c, slip_c = _force_line(meas.estimate(base.estimator), n)
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
                         config.max_correction, mu_c, slip_c, hold)
