@@ -120,6 +120,9 @@ def cylinder_ahead(start_point, direction, distance: float, radius: float, axis)
     part of ``direction`` perpendicular to ``axis``."""
     d = _vec3(direction, "direction")
     a = _vec3(axis, "cylinder axis")
+    for v, name in ((d, "direction"), (a, "cylinder axis")):
+        if not np.linalg.norm(v) > 0.0:
+            raise InputError(f"{name} must be a nonzero vector, got {v.tolist()}")
     d = d / np.linalg.norm(d)
     a = a / np.linalg.norm(a)
     u = d - (d @ a) * a

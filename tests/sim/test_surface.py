@@ -102,6 +102,10 @@ def test_out_of_contact_and_placement():
         Cylinder([0, 0, 0], [0, 0, 1], -1.0)
     with pytest.raises(InputError, match="axis"):
         cylinder_ahead(np.zeros(3), F_HAT, 2.0, 100.0, F_HAT)
+    with pytest.raises(InputError, match="cylinder axis must be a nonzero vector"):
+        cylinder_ahead(np.zeros(3), F_HAT, 2.0, 100.0, [0.0, 0.0, 0.0])
+    with pytest.raises(InputError, match="direction must be a nonzero vector"):
+        cylinder_ahead(np.zeros(3), [0.0, 0.0, 0.0], 2.0, 100.0, [0.0, 0.0, 1.0])
 
 
 @pytest.mark.parametrize("name", ["stalled_slide", "wandering_slide", "snapping_slide"])
