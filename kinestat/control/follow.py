@@ -1271,22 +1271,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     if phase == "settle" and mis > SETTLE_ALIGN_DEG:
         dlam = min(dlam, 0.0)  # turn first: pressing with a tilted tool slides the tip away
     try:
-        sliding = phase == "travel" and st.friction_samples > 0
-        hold = _frictionless_hold(config, st, meas, n, t, omega, step) if sliding else None
-        if sliding and not st.sticking and st.tilting:
-            kappa = feed * st.curvature if st.curvature_cycles >= HOLD_CURVATURE_CYCLES else 0.0
-            w_surf = kappa * step * cross3(n, t)  # the surface's turn under the step
-            s6n = meas.s6 + cross3(omega - w_surf, meas.s6)
-            if step > 0.0 or -float(s6n @ n) < -float(meas.s6 @ n):  # slides on / turns out
-                hold = (-meas.estimate(base.estimator), w_surf)  # the force on the tool
-        h = _lead_hold(st) if growing and _lead_tracked(st) else 0.0
-        if h:  # the breakaway's first turns hold the force (a stuck tip's force would turn
-            # with the tool) until S6 leads it by BREAKAWAY_LEAD; then it turns with S6
-            hold = (-h * meas.estimate(base.estimator), np.zeros(3))
-        mu_c, slip_c = (st.friction_ratio, t) if sliding else (0.0, t)
-        if (_lead_tracked(st) and phase == "travel"
-                and (dlam < 0.0 or (st.lead_ref or 0.0) >= LEAD_CAP)):  # μ unknown: keep r
-            mu_c, slip_c = _force_line(meas.estimate(base.estimator), n)
+        hold, mu_c, slip_c = _contact_terms(config, st, meas, phase, n, t, omega, step, feed,
+                                            growing, dlam)
         T = _base_twist(model, meas, meas.tip(model), n, omega, travel_vec, dlam,
                         config.max_correction, mu_c, slip_c, hold)
     except (InputError, np.linalg.LinAlgError) as exc:
@@ -1296,6 +1282,35 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     action = "follow" if phase == "travel" else "settle"
     return _command(config, st, meas, new, label, action, step,
                     math.degrees(norm3(omega)), kw)
+
+
+def _contact_terms(config: FollowConfig, st: FollowState, meas: Measurement, phase: str,
+                   n: np.ndarray, t: np.ndarray, omega: np.ndarray, step: float, feed: float,
+                   growing: bool, dlam: float) -> tuple:
+    """The contact model of this cycle's twist: ``(hold, mu, slip)`` for :func:`_base_twist`.
+
+    ``hold`` is ``None`` or ``(force on the tool to hold, the surface's turn)``; ``mu`` and
+    ``slip`` are the friction ratio and slip direction of the contact (0 before the first slip;
+    the measured force's own line while the breakaway's lead is tracked and the tool backs off
+    or the lead reached ``LEAD_CAP``: μ is unknown there, the force's ratio is kept)."""
+    F = meas.estimate(config.base.estimator)
+    sliding = phase == "travel" and st.friction_samples > 0
+    hold = _frictionless_hold(config, st, meas, n, t, omega, step) if sliding else None
+    if sliding and not st.sticking and st.tilting:
+        kappa = feed * st.curvature if st.curvature_cycles >= HOLD_CURVATURE_CYCLES else 0.0
+        w_surf = kappa * step * cross3(n, t)  # the surface's turn under the step
+        s6n = meas.s6 + cross3(omega - w_surf, meas.s6)
+        if step > 0.0 or -float(s6n @ n) < -float(meas.s6 @ n):  # slides on / turns out
+            hold = (-F, w_surf)  # the force on the tool
+    h = _lead_hold(st) if growing and _lead_tracked(st) else 0.0
+    if h:  # the breakaway's first turns hold the force (a stuck tip's force would turn
+        # with the tool) until S6 leads it by BREAKAWAY_LEAD; then it turns with S6
+        hold = (-h * F, np.zeros(3))
+    mu, slip = (st.friction_ratio, t) if sliding else (0.0, t)
+    if (_lead_tracked(st) and phase == "travel"
+            and (dlam < 0.0 or (st.lead_ref or 0.0) >= LEAD_CAP)):  # μ unknown: keep r
+        mu, slip = _force_line(F, n)
+    return hold, mu, slip
 
 
 def _surface_turn(config: FollowConfig, st: FollowState, s6: np.ndarray, n: np.ndarray,
