@@ -234,6 +234,14 @@ HOLD_CURVATURE_CYCLES = 2
 surface's turn under the step, κ Δs, only once the path's curvature has been estimated this
 many cycles in a row: a fit read a false κ̂ = 1/138 mm⁻¹ for one cycle on a 5.2° plane, and the
 hold, unlike the ramped feed-forward, took it whole (+0.54 N)."""
+FEED_CURVATURE_CYCLES = CURVATURE_RAMP
+"""Without the automatic tilt (a frictionless slide), the surface's turn under the step is fed
+forward too, once the path's curvature has been estimated this many cycles in a row (the
+first estimates can read twice the curvature: fed forward from the second cycle, one turned S6
+ahead of the surface for 25 cycles and the tip crept at 0.4 mm a step). Without it, S6 waited
+for the dead band: it fell 0.3° behind, turned by up to 0.7° in one cycle, and the tip, held
+only by the top's soft tangential stiffness less N/R, ran ahead 3 mm and back (docs/control.md,
+"Frictionless slides: the surface's turn fed forward")."""
 CREEP_HOLD = 0.1
 """With the automatic tilt, a tip that advanced this far (mm) in a cycle without travel is
 slipping: the breakaway tilt is held, not grown."""
@@ -1315,11 +1323,13 @@ def _contact_terms(config: FollowConfig, st: FollowState, meas: Measurement, pha
 
 def _surface_turn(config: FollowConfig, st: FollowState, s6: np.ndarray, n: np.ndarray,
                   t: np.ndarray, step: float, omega: np.ndarray) -> tuple[np.ndarray, float]:
-    """The turn ``omega`` with the surface's turn under the step fed forward (automatic tilt,
-    κ̂ known, a step), and the fraction of it fed (:func:`_feed_fraction`; 1 otherwise).
+    """The turn ``omega`` with the surface's turn under the step fed forward (κ̂ known, a step;
+    without the automatic tilt once κ̂ has been estimated ``FEED_CURVATURE_CYCLES`` cycles in
+    a row), and the fraction of it fed (:func:`_feed_fraction`; 1 otherwise).
     The first estimates of κ are the noisiest (short span): fed in over ``CURVATURE_RAMP``
     cycles."""
-    if not (st.tilting and step > 0.0 and st.curvature != 0.0):
+    if not (step > 0.0 and st.curvature != 0.0
+            and (st.tilting or st.curvature_cycles >= FEED_CURVATURE_CYCLES)):
         return omega, 1.0
     ramp = min(1.0, st.curvature_cycles / CURVATURE_RAMP) if CURVATURE_RAMP else 1.0
     angle = ramp * st.curvature * step

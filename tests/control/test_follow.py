@@ -218,6 +218,55 @@ def test_a_frictionless_tip_does_not_swing_across_a_tight_cylinder_travelled_nea
     assert abs(_true_arc(prep, rep.cycles) - 30.0) <= 1.0
 
 
+@pytest.mark.parametrize("radius", [200.0, 300.0])
+def test_a_frictionless_slide_feeds_the_surface_turn_forward(tmp_path, radius):
+    # Frictionless, S6 used to wait for the 0.3° dead band behind the surface's turn, then
+    # turned up to 0.6° in one cycle, and the free tip (held by the top's soft tangential
+    # stiffness less N/R) ran ahead and back: over these 30 mm S6 was 0.54° off the true
+    # normal at worst (R = 200 mm) and the tip's advance a cycle varied by 0.35 mm (std,
+    # R = 300 mm). With κ̂ fed forward once it is known (FEED_CURVATURE_CYCLES) S6 turns with
+    # the surface every cycle.
+    cyl = CylinderSpec(radius, np.array([0.0, 0.0, 1.0]))
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(cylinder=cyl), travel=30.0)
+    assert out["completed"] and out["contact_lost"] == 0, rep.stop_reason
+    trav = [c for c in rep.cycles if c["phase"] == "travel"]
+    tilt = [_deg(-np.asarray(c["s6"]), np.asarray(c["true_normal"])) for c in trav[10:]]
+    tips = np.array([c["true_tip"] for c in trav])
+    advance = np.linalg.norm(np.diff(tips, axis=0), axis=1)[5:]
+    assert max(tilt) < 0.4
+    assert float(np.std(advance)) < 0.3
+    err = np.array([_true_normal_force(c) - 4.0 for c in trav])
+    assert math.sqrt(np.mean(err ** 2)) <= 0.05 and np.max(np.abs(err)) <= 0.3
+    assert abs(_true_arc(prep, rep.cycles) - 30.0) <= 1.0
+
+
+def test_the_frictionless_feedforward_waits_for_a_curvature_held_four_cycles():
+    """``_surface_turn`` without the automatic tilt: the turn is left alone until κ̂ has been
+    estimated ``FEED_CURVATURE_CYCLES`` cycles in a row; from then on S6 turns by κ̂ Δs about
+    n × t on top of the feedback turn (with the automatic tilt the ramp starts at once)."""
+    from types import SimpleNamespace
+
+    from kinestat.control import follow
+
+    config = SimpleNamespace(max_turn_deg=1.0)
+    n, t = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
+    s6 = -n
+    kappa, step = 1.0 / 250.0, 1.0
+    feedback = np.array([0.0, 0.0, 0.001])
+    need = follow.FEED_CURVATURE_CYCLES
+    for cycles in range(need + 3):
+        st = SimpleNamespace(tilting=False, friction_samples=3, friction_ratio=0.0,
+                             breakaway=0.0, curvature=kappa, curvature_cycles=cycles)
+        w, feed = follow._surface_turn(config, st, s6, n, t, step, feedback)
+        assert feed == 1.0
+        if cycles < need:
+            assert w is feedback
+        else:
+            np.testing.assert_allclose(w, feedback + kappa * step * np.cross(n, t), atol=1e-15)
+    st = SimpleNamespace(tilting=False, curvature=kappa, curvature_cycles=need)
+    assert follow._surface_turn(config, st, s6, n, t, 0.0, feedback)[0] is feedback  # no step
+
+
 def test_estimate_normal_removes_friction_along_the_path():
     rng = np.random.default_rng(0)
     for _ in range(20):
