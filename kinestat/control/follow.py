@@ -1294,7 +1294,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
 
 def _contact_terms(config: FollowConfig, st: FollowState, meas: Measurement, phase: str,
                    n: np.ndarray, t: np.ndarray, omega: np.ndarray, step: float, feed: float,
-                   growing: bool, dlam: float) -> tuple:
+                   growing: bool, dlam: float
+                   ) -> tuple[tuple[np.ndarray, np.ndarray] | None, float, np.ndarray]:
     """The contact model of this cycle's twist: ``(hold, mu, slip)`` for :func:`_base_twist`.
 
     ``hold`` is ``None`` or ``(force on the tool to hold, the surface's turn)``; ``mu`` and
