@@ -242,6 +242,16 @@ ahead of the surface for 25 cycles and the tip crept at 0.4 mm a step). Without 
 for the dead band: it fell 0.3° behind, turned by up to 0.7° in one cycle, and the tip, held
 only by the top's soft tangential stiffness less N/R, ran ahead 3 mm and back (docs/control.md,
 "Frictionless slides: the surface's turn fed forward")."""
+FRICTIONLESS_TURN_GAIN = 0.5
+"""A frictionless slide turns S6 by this fraction of its misalignment a cycle. The turn itself
+moves the tip: turned by δ, the tip swings back across the surface by about B δ (B = F L /
+(k_t − N/R), millimetres a degree near the soft mode's limit), where the normal differs by
+κ B δ. Turned onto the normal measured before the turn (δ = e), S6 lands κ B e off the new
+one, on the other side: with κ B near 1 the tip swung ±3 mm a cycle and ran 2.5 mm past the
+end (seed 4's 6 N, R = 285 mm cylinder, 2026-12-04). The turn that lands on the normal is
+e / (1 + κ B): half the misalignment is that turn at κ B = 1, and it converges (the
+misalignment shrinks by |1 − (1 + κ B)/2| a cycle) for any κ B < 3, where the whole turn
+needs κ B < 1. On a plane (κ = 0) the misalignment halves a cycle."""
 CREEP_HOLD = 0.1
 """With the automatic tilt, a tip that advanced this far (mm) in a cycle without travel is
 slipping: the breakaway tilt is held, not grown."""
@@ -985,8 +995,7 @@ def _frictionless_hold(config: FollowConfig, st: FollowState, meas: Measurement,
     the path's curvature is known and the tips used for it run along the travel
     (:func:`_path_along`; tips drifting across it fit a spurious κ̂), else it is not held
     (as before 2026-12-03). None when it does not apply."""
-    if (st.tilting or st.friction_samples < LEARN_CHORDS
-            or st.friction_ratio >= FRICTION_HINT_RATIO or not norm3(omega) > 0.0):
+    if not (_frictionless_slide(st) and norm3(omega) > 0.0):
         return None
     model = config.base.model
     b = cross3(n, t)
@@ -995,6 +1004,13 @@ def _frictionless_hold(config: FollowConfig, st: FollowState, meas: Measurement,
                                                                      t, b):
         w_pitch = st.curvature * step * b
     return -meas.estimate(config.base.estimator), w_pitch + st.roll_rate * step * t
+
+
+def _frictionless_slide(st: FollowState) -> bool:
+    """Whether the tip slides without the automatic tilt and with μ̂ measured below
+    ``FRICTION_HINT_RATIO`` (a frictionless slide: the hold and the damped turn apply)."""
+    return (not st.tilting and st.friction_samples >= LEARN_CHORDS
+            and st.friction_ratio < FRICTION_HINT_RATIO)
 
 
 def _track_roll(st: FollowState, omega: np.ndarray, t: np.ndarray, step: float) -> FollowState:
@@ -1272,6 +1288,8 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
                and st.sticking)
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG and not growing
              else _turn(meas.s6, axis, math.radians(turn_limit)))
+    if phase == "travel" and _frictionless_slide(st):
+        omega = FRICTIONLESS_TURN_GAIN * omega  # the tip's swing under the turn: damped
     # the surface's turn under the step, fed forward but for what S6 is short of its axis
     omega, feed = _surface_turn(config, st, meas.s6, n, t, step, omega)
     st = _track_roll(st, omega, t, step)

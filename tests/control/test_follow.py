@@ -240,6 +240,41 @@ def test_a_frictionless_slide_feeds_the_surface_turn_forward(tmp_path, radius):
     assert abs(_true_arc(prep, rep.cycles) - 30.0) <= 1.0
 
 
+def test_a_frictionless_slide_near_the_soft_limit_turns_s6_by_half_its_misalignment(tmp_path):
+    # 5.95 N on R = 285 mm, travelled 47° off the axis (the fourth campaign draw's run 17,
+    # 2026-12-04): near the soft mode's limit a turn of S6 swings the tip back across the
+    # surface, where the normal differs by about as much as the turn. Turned onto the whole
+    # misalignment, S6 overshot the new normal every time and the tip swung ±3 mm a cycle
+    # (over these 30 mm: advance std 1.52 mm, RMS 0.123 N, max 0.378 N; over the draw's 62 mm
+    # it ended 2.8 mm long). Half the misalignment a cycle (FRICTIONLESS_TURN_GAIN) converges.
+    cyl = CylinderSpec(284.63, np.array([-0.1255, -0.2186, -0.9739]))
+    prep, rep, out = _follow(tmp_path, cell=SimulatedCell(cylinder=cyl), travel=30.0,
+                             travel_dir=np.array([0.0575, 0.8616, 0.5085]), force=5.95)
+    assert out["completed"] and out["contact_lost"] == 0, rep.stop_reason
+    trav = [c for c in rep.cycles if c["phase"] == "travel"]
+    tips = np.array([c["true_tip"] for c in trav])
+    advance = np.linalg.norm(np.diff(tips, axis=0), axis=1)[5:]
+    assert float(np.std(advance)) < 1.0  # 0.58 mm now
+    err = np.array([_true_normal_force(c) - 5.95 for c in trav])
+    assert math.sqrt(np.mean(err ** 2)) <= 0.08 and np.max(np.abs(err)) <= 0.3
+    assert abs(_true_arc(prep, rep.cycles) - 30.0) <= 1.0
+
+
+def test_only_a_frictionless_slide_damps_the_turn():
+    from types import SimpleNamespace
+
+    from kinestat.control import follow
+
+    def st(**kw):
+        base = dict(tilting=False, friction_samples=follow.LEARN_CHORDS, friction_ratio=0.0)
+        return SimpleNamespace(**{**base, **kw})
+    assert follow._frictionless_slide(st())
+    assert not follow._frictionless_slide(st(tilting=True))  # the automatic tilt
+    assert not follow._frictionless_slide(st(friction_samples=0))  # not slid yet
+    assert not follow._frictionless_slide(st(friction_ratio=follow.FRICTION_HINT_RATIO))
+    assert 0.0 < follow.FRICTIONLESS_TURN_GAIN < 1.0
+
+
 def test_the_frictionless_feedforward_waits_for_a_curvature_held_four_cycles():
     """``_surface_turn`` without the automatic tilt: the turn is left alone until κ̂ has been
     estimated ``FEED_CURVATURE_CYCLES`` cycles in a row; from then on S6 turns by κ̂ Δs about
