@@ -803,7 +803,8 @@ def _slipped_on_probe_normal(config: FollowConfig, st: FollowState, meas: Measur
     tilt is kept (the breakaway tilt is what it leans past the new cone edge and margin)."""
     n = st.normal
     ratio = _stuck_ratio(F, n)
-    mu = min(max(ratio, st.ratio_max), MAX_FRICTION)
+    mu = 0.0 if _propelled(F, n, tip - st.last_tip) else min(max(ratio, st.ratio_max),
+                                                              MAX_FRICTION)
     # the tip slipped and stuck again (its force back inside the cone: the force control
     # raised the normal force after the slip): μ is the largest ratio seen, and the tip is
     # stuck now (no travel step until it slides)
@@ -817,6 +818,21 @@ def _slipped_on_probe_normal(config: FollowConfig, st: FollowState, meas: Measur
                    sticking=stuck, breakaway=_kept_breakaway(config, meas.s6, n, mu),
                    slid=not stuck,
                    stuck_travel=0.0, direct_slip=max(advance, CREEP_MIN), slip_cycle=st.cycle)
+
+
+def _propelled(F: np.ndarray, n: np.ndarray, slip: np.ndarray) -> bool:
+    """Whether the tool's force ``F`` on the workpiece, measured against the normal ``n``,
+    leans against the tip's ``slip`` (``F_t · slip < 0``) over a slide of at least
+    ``CHORD_LENGTH`` (whose direction the thesis's counts, ~0.1 mm, leave within ~3°): the
+    force on the tool then pushed the tip along its slide, which friction cannot do (it
+    opposes the slip), so its tangential part is not friction but the normal's error. On a
+    convex surface a tip that ran d round from the probe's touches meets a normal turned by
+    about d/R towards its run: a frictionless tip's force, all along that normal, leaned 1.2°
+    against the probe's one after a 7 mm swing (R = 211 mm), and read as μ̂ = 0.021 it set
+    the cone's normal 1.2° off the force for the rest of the run (seed 6's 5.9 N run,
+    2026-12-04). A shorter "slide" is not tested: a first slip at μ = 0.3 measured 0.1 mm
+    back against its force (the tip's recoil), and its ratio (0.294) was μ."""
+    return norm3(slip) >= CHORD_LENGTH and float((F - float(F @ n) * n) @ slip) < 0.0
 
 
 def _lead_tracked(st: FollowState) -> bool:

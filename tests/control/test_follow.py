@@ -275,6 +275,29 @@ def test_only_a_frictionless_slide_damps_the_turn():
     assert 0.0 < follow.FRICTIONLESS_TURN_GAIN < 1.0
 
 
+def test_a_force_that_pushed_the_tip_along_its_slide_is_not_friction():
+    from kinestat.control import follow
+
+    rng = np.random.default_rng(7)
+    for _ in range(50):
+        n = rng.normal(size=3)
+        n /= np.linalg.norm(n)
+        g = np.cross(n, rng.normal(size=3))
+        g /= np.linalg.norm(g)
+        fn, mu = rng.uniform(1.0, 8.0), rng.uniform(0.05, 0.6)
+        slide = rng.uniform(follow.CHORD_LENGTH, 10.0) * g
+        # Coulomb friction opposes the slip: the tool drags the workpiece along it
+        assert not follow._propelled(-fn * n + mu * fn * g, n, slide)
+        # a frictionless tip that ran d round a convex surface of radius R: its force lies
+        # along the normal there, turned by d/R towards the run from the normal it is
+        # measured against
+        d, radius = float(np.linalg.norm(slide)), rng.uniform(100.0, 500.0)
+        n_there = math.cos(d / radius) * n + math.sin(d / radius) * g
+        assert follow._propelled(-fn * n_there, n, slide)
+        # too short a slide (the counts' jitter, a recoil) is not tested
+        assert not follow._propelled(-fn * n_there, n, 0.1 * g)
+
+
 def test_the_frictionless_feedforward_waits_for_a_curvature_held_four_cycles():
     """``_surface_turn`` without the automatic tilt: the turn is left alone until κ̂ has been
     estimated ``FEED_CURVATURE_CYCLES`` cycles in a row; from then on S6 turns by κ̂ Δs about
