@@ -275,15 +275,20 @@ def test_only_a_frictionless_slide_damps_the_turn():
     assert 0.0 < follow.FRICTIONLESS_TURN_GAIN < 1.0
 
 
+def _normal_and_tangent(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """A random unit normal and a random unit tangent to it."""
+    n = rng.normal(size=3)
+    n /= np.linalg.norm(n)
+    t = np.cross(n, rng.normal(size=3))
+    return n, t / np.linalg.norm(t)
+
+
 def test_a_force_that_pushed_the_tip_along_its_slide_is_not_friction():
     from kinestat.control import follow
 
     rng = np.random.default_rng(7)
     for _ in range(50):
-        n = rng.normal(size=3)
-        n /= np.linalg.norm(n)
-        g = np.cross(n, rng.normal(size=3))
-        g /= np.linalg.norm(g)
+        n, g = _normal_and_tangent(rng)
         fn, mu = rng.uniform(1.0, 8.0), rng.uniform(0.05, 0.6)
         slide = rng.uniform(follow.CHORD_LENGTH, 10.0) * g
         # Coulomb friction opposes the slip: the tool drags the workpiece along it
@@ -328,10 +333,7 @@ def test_the_frictionless_feedforward_waits_for_a_curvature_held_four_cycles():
 def test_estimate_normal_removes_friction_along_the_path():
     rng = np.random.default_rng(0)
     for _ in range(20):
-        n = rng.normal(size=3)
-        n /= np.linalg.norm(n)
-        t = np.cross(n, rng.normal(size=3))
-        t /= np.linalg.norm(t)
+        n, t = _normal_and_tangent(rng)
         fn, mu = rng.uniform(1, 8), rng.uniform(0, 0.5)
         F = -fn * n + mu * fn * t  # the tool drags the workpiece along t
         np.testing.assert_allclose(estimate_normal(F, t), n, atol=1e-12)
