@@ -244,14 +244,15 @@ only by the top's soft tangential stiffness less N/R, ran ahead 3 mm and back (d
 "Frictionless slides: the surface's turn fed forward")."""
 FRICTIONLESS_TURN_GAIN = 0.5
 """A frictionless slide turns S6 by this fraction of its misalignment a cycle. The turn itself
-moves the tip: turned by δ, the tip swings back across the surface by about B δ (B = F L /
-(k_t − N/R), millimetres a degree near the soft mode's limit), where the normal differs by
-κ B δ. Turned onto the normal measured before the turn (δ = e), S6 lands κ B e off the new
-one, on the other side: with κ B near 1 the tip swung ±3 mm a cycle and ran 2.5 mm past the
-end (seed 4's 6 N, R = 285 mm cylinder, 2026-12-04). The turn that lands on the normal is
-e / (1 + κ B): half the misalignment is that turn at κ B = 1, and it converges (the
-misalignment shrinks by |1 − (1 + κ B)/2| a cycle) for any κ B < 3, where the whole turn
-needs κ B < 1. On a plane (κ = 0) the misalignment halves a cycle."""
+moves the tip: turned by δ, the tip swings back across the surface by about B δ (B =
+F / (k_t − N/R): the force turned by δ pushes the tip with F δ against the top's tangential
+stiffness less N/R; millimetres a degree near the soft mode's limit), where the normal
+differs by κ B δ. Turned onto the normal measured before the turn (δ = e), S6 lands κ B e
+off the new one, on the other side: with κ B near 1 the tip swung ±3 mm a cycle and ran
+2.5 mm past the end (seed 4's 6 N, R = 285 mm cylinder, 2026-12-04). The turn that lands on
+the normal is e / (1 + κ B): half the misalignment is that turn at κ B = 1, and it converges
+(the misalignment shrinks by |1 − (1 + κ B)/2| a cycle) for any κ B < 3, where the whole
+turn needs κ B < 1. On a plane (κ = 0) the misalignment halves a cycle."""
 CREEP_HOLD = 0.1
 """With the automatic tilt, a tip that advanced this far (mm) in a cycle without travel is
 slipping: the breakaway tilt is held, not grown."""
