@@ -252,7 +252,15 @@ off the new one, on the other side: with κ B near 1 the tip swung ±3 mm a cycl
 2.5 mm past the end (seed 4's 6 N, R = 285 mm cylinder, 2026-12-04). The turn that lands on
 the normal is e / (1 + κ B): half the misalignment is that turn at κ B = 1, and it converges
 (the misalignment shrinks by |1 − (1 + κ B)/2| a cycle) for any κ B < 3, where the whole
-turn needs κ B < 1. On a plane (κ = 0) the misalignment halves a cycle."""
+turn needs κ B < 1. On a plane (κ = 0) the misalignment halves a cycle. κ B is not
+measured, and across the travel it can exceed 3 (the tip swung 6-8 mm round an R = 211 mm
+cylinder at 5.9 N): the gain about each axis (pitch about n̂ × t̂, roll about t̂) halves
+whenever its misalignment changed sign after a turn, i.e. the turn overshot (g (1 + κ B) > 1),
+down to ``MIN_TURN_GAIN``, and grows back by a quarter a cycle up to this value
+(:func:`_damped_turn`)."""
+MIN_TURN_GAIN = 0.1
+"""The smallest gain a frictionless slide's turn about one axis is halved to
+(:func:`_damped_turn`)."""
 CREEP_HOLD = 0.1
 """With the automatic tilt, a tip that advanced this far (mm) in a cycle without travel is
 slipping: the breakaway tilt is held, not grown."""
@@ -561,6 +569,8 @@ class FollowState(ControllerState):
     lead_cycles: int = 0
     slip_cycle: int = 0
     roll_rate: float = 0.0
+    turn_gain: tuple[float, float] = (FRICTIONLESS_TURN_GAIN, FRICTIONLESS_TURN_GAIN)
+    last_turn: tuple[float, float] = (0.0, 0.0)
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -1023,6 +1033,26 @@ def _frictionless_hold(config: FollowConfig, st: FollowState, meas: Measurement,
     return -meas.estimate(config.base.estimator), w_pitch + st.roll_rate * step * t
 
 
+def _damped_turn(st: FollowState, omega: np.ndarray, n: np.ndarray,
+                 t: np.ndarray) -> tuple[np.ndarray, FollowState]:
+    """A frictionless slide's turn: ``omega`` (onto the measured normal) scaled about
+    ``n̂ × t̂`` (pitch) and ``t̂`` (roll) by the gains in ``st.turn_gain``. A misalignment that
+    changed sign after a turn about that axis was overshot: its gain halves (down to
+    ``MIN_TURN_GAIN``); one that kept its sign grows it by a quarter (up to
+    ``FRICTIONLESS_TURN_GAIN``)."""
+    b = cross3(n, t)
+    e = (float(omega @ b), float(omega @ t))
+    gains = list(st.turn_gain)
+    for i in range(2):
+        if st.last_turn[i] != 0.0 and e[i] != 0.0:
+            if e[i] * st.last_turn[i] < 0.0:
+                gains[i] = max(0.5 * gains[i], MIN_TURN_GAIN)
+            else:
+                gains[i] = min(1.25 * gains[i], FRICTIONLESS_TURN_GAIN)
+    w = gains[0] * e[0] * b + gains[1] * e[1] * t
+    return w, replace(st, turn_gain=(gains[0], gains[1]), last_turn=e)
+
+
 def _frictionless_slide(st: FollowState) -> bool:
     """Whether the tip slides without the automatic tilt and with μ̂ measured below
     ``FRICTION_HINT_RATIO`` (a frictionless slide: the hold and the damped turn apply)."""
@@ -1306,7 +1336,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     omega = (np.zeros(3) if mis < TURN_DEADBAND_DEG and not growing
              else _turn(meas.s6, axis, math.radians(turn_limit)))
     if phase == "travel" and _frictionless_slide(st):
-        omega = FRICTIONLESS_TURN_GAIN * omega  # the tip's swing under the turn: damped
+        omega, st = _damped_turn(st, omega, n, t)  # the tip's swing under the turn: damped
     # the surface's turn under the step, fed forward but for what S6 is short of its axis
     omega, feed = _surface_turn(config, st, meas.s6, n, t, step, omega)
     st = _track_roll(st, omega, t, step)

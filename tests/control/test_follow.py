@@ -283,6 +283,36 @@ def _normal_and_tangent(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarra
     return n, t / np.linalg.norm(t)
 
 
+def test_a_frictionless_turn_halves_its_gain_about_an_axis_it_overshot():
+    from dataclasses import dataclass
+
+    from kinestat.control import follow
+
+    @dataclass(frozen=True)
+    class _St:
+        turn_gain: tuple = (follow.FRICTIONLESS_TURN_GAIN, follow.FRICTIONLESS_TURN_GAIN)
+        last_turn: tuple = (0.0, 0.0)
+
+    n, t = np.array([0.0, 0.0, 1.0]), np.array([0.0, 1.0, 0.0])
+    b = np.cross(n, t)
+    g0 = follow.FRICTIONLESS_TURN_GAIN
+    w, st = follow._damped_turn(_St(), 0.004 * b + 0.002 * t, n, t)  # no turn before
+    np.testing.assert_allclose(w, g0 * (0.004 * b + 0.002 * t), atol=1e-15)
+    assert st.turn_gain == (g0, g0) and st.last_turn == pytest.approx((0.004, 0.002))
+    # the pitch misalignment changed sign (the turn overshot it): its gain halves; the roll
+    # kept its sign: its gain stays at the cap
+    w, st = follow._damped_turn(st, -0.003 * b + 0.001 * t, n, t)
+    assert st.turn_gain == (0.5 * g0, g0)
+    np.testing.assert_allclose(w, -0.003 * 0.5 * g0 * b + 0.001 * g0 * t, atol=1e-15)
+    for k in range(10):  # overshot every time: down to the floor, not below
+        w, st = follow._damped_turn(st, (-1.0) ** k * 0.003 * b, n, t)
+    assert st.turn_gain[0] == follow.MIN_TURN_GAIN
+    # the roll had no turn in those cycles: its gain is kept
+    assert st.turn_gain[1] == g0
+    w, st = follow._damped_turn(st, st.last_turn[0] * b, n, t)  # same sign again: it grows
+    assert st.turn_gain[0] == pytest.approx(1.25 * follow.MIN_TURN_GAIN)
+
+
 def test_a_force_that_pushed_the_tip_along_its_slide_is_not_friction():
     from kinestat.control import follow
 
