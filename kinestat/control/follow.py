@@ -1036,8 +1036,9 @@ def _frictionless_hold(config: FollowConfig, st: FollowState, meas: Measurement,
 def _damped_turn(st: FollowState, omega: np.ndarray, n: np.ndarray,
                  t: np.ndarray) -> tuple[np.ndarray, FollowState]:
     """A frictionless slide's turn: ``omega`` (onto the measured normal) scaled about
-    ``n̂ × t̂`` (pitch) and ``t̂`` (roll) by the gains in ``st.turn_gain``. A misalignment that
-    changed sign after a turn about that axis was overshot: its gain halves (down to
+    ``n̂ × t̂`` (pitch) and across it (roll: the rest of ``omega``, about ``t̂`` when S6 is not
+    tilted from the normal) by the gains in ``st.turn_gain``. A misalignment that changed
+    sign after a turn about that axis was overshot: its gain halves (down to
     ``MIN_TURN_GAIN``); one that kept its sign grows it by a quarter (up to
     ``FRICTIONLESS_TURN_GAIN``)."""
     b = cross3(n, t)
@@ -1049,7 +1050,8 @@ def _damped_turn(st: FollowState, omega: np.ndarray, n: np.ndarray,
                 gains[i] = max(0.5 * gains[i], MIN_TURN_GAIN)
             else:
                 gains[i] = min(1.25 * gains[i], FRICTIONLESS_TURN_GAIN)
-    w = gains[0] * e[0] * b + gains[1] * e[1] * t
+    pitch = e[0] * b
+    w = gains[0] * pitch + gains[1] * (omega - pitch)  # a commanded tilt keeps its roll axis
     return w, replace(st, turn_gain=(gains[0], gains[1]), last_turn=e)
 
 
