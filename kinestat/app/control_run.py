@@ -53,7 +53,7 @@ from kinestat.errors import InputError
 from kinestat.parallel.platform import Platform
 from kinestat.sim.contact import Cell, make_cell
 from kinestat.sim.sensor import Sensor
-from kinestat.sim.surface import Cylinder, cylinder_ahead
+from kinestat.sim.surface import Cylinder, approach_distance, cylinder_ahead
 
 __all__ = [
     "MAX_ITERATIONS",
@@ -81,6 +81,10 @@ FOLLOW_APPROACH_STEP = 0.25
 """The follow task's default approach step (mm): its first contact force stays below 3 N."""
 FOLLOW_MAX_ITERATIONS = MAX_ITERATIONS
 """The follow task's default cycle budget."""
+MAX_APPROACH = 50.0
+"""Default ``--max-approach`` (mm): how far from the start tool point an approach without
+contact may carry the tool before the run stops (the default workpiece is
+``DEFAULT_PLANE_DISTANCE`` ahead)."""
 
 def default_plane(start_point: np.ndarray, direction: np.ndarray, distance: float,
                   tilt_deg: float) -> tuple[np.ndarray, np.ndarray]:
@@ -166,6 +170,7 @@ class ControlRequest:
     auto_tilt: bool | None = None
     arm: ArmSpec | None = None
     probe_span: float | None = None
+    max_approach: float = MAX_APPROACH
 
 
 def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: np.ndarray,
@@ -212,7 +217,7 @@ def _config(req: ControlRequest, model: ControlModel) -> ControllerConfig:
         step=req.step, approach_step=_or(req.approach_step, FOLLOW_APPROACH_STEP, 1.0, req),
         estimator=req.estimator,
         max_iterations=_or(req.max_iterations, FOLLOW_MAX_ITERATIONS, 60, req),
-        envelope=Envelope(), procedure=req.procedure)
+        max_approach=req.max_approach, envelope=Envelope(), procedure=req.procedure)
 
 
 def _or(value, follow_default, press_default, req: ControlRequest):
@@ -287,6 +292,7 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
             config, placed_arm = _with_arm(req.arm, config)
             header["arm"] = placed_arm.header()
         wp = cell.workpiece
+        _check_ahead(wp, req.start_tool_point, direction, config.max_approach)
         header.update({"plane_point": wp.point, "plane_normal": wp.normal} if s.cylinder is None
                       else {"workpiece": {"kind": "cylinder", "radius": wp.radius,
                                           "axis": wp.axis, "point": wp.point}})
@@ -301,6 +307,25 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
     header.update({"galil": f"{d.host}:{d.port}", "serial": d.serial,
                    "serial_format": d.serial_format})
     return PreparedRun(req, _config(req, calibrated_model(platform, cal)), header)
+
+
+def _check_ahead(workpiece, start_point, direction, max_approach: float) -> None:
+    """Refuse a simulated workpiece that the approach from the start tool point along F_req
+    would not meet within ``max_approach`` (before anything moves)."""
+    kind = "cylinder" if isinstance(workpiece, Cylinder) else "plane"
+    gap = float(workpiece.gap(start_point))
+    if gap < 0.0:
+        raise InputError(f"the start tool point lies {-gap:.3g} mm inside the simulated {kind}: "
+                         "the run starts unloaded, with the tool clear of the workpiece (move "
+                         "the workpiece, or the start with --start)")
+    dist = approach_distance(workpiece, start_point, direction)
+    if dist <= max_approach:
+        return
+    where = ("never meets it" if math.isinf(dist)
+             else f"meets it only {dist:.1f} mm ahead")
+    raise InputError(f"the simulated {kind} is not ahead of the tool: the approach from the "
+                     f"start tool point along F_req {where}, beyond --max-approach "
+                     f"{max_approach:g} mm (move the workpiece, or the start with --start)")
 
 
 def _with_arm(spec: ArmSpec, config: ControllerConfig) -> tuple[ControllerConfig, PlacedArm]:

@@ -235,6 +235,10 @@ def control_command(
         1, "--samples", help=f"Sensor packets averaged per measurement (1..{MAX_SAMPLES})."),
     rate: float = typer.Option(200.0, "--rate", help="Simulated encoder packet rate (Hz)."),
     seed: int = typer.Option(0, "--seed", help="Seed of the simulated sensor noise."),
+    max_approach: float = typer.Option(
+        50.0, "--max-approach", metavar="MM", help="Farthest an approach without contact may "
+        "carry the tool point from the start (mm); beyond it the run stops (a simulated "
+        "workpiece the approach would not meet within it is refused before any motion)."),
     max_iterations: int = typer.Option(
         None, "--max-iterations",
         help=f"Measurement cycles before giving up (1..{MAX_ITERATIONS}; default 60 for press, "
@@ -276,16 +280,17 @@ def control_command(
     task: str = typer.Option(
         "press", "--task", help=f"{' or '.join(TASKS)}: press the tool on the workpiece "
         "(default), or slide it along the workpiece holding the normal force at --force."),
-    travel: float = typer.Option(50.0, "--travel",
-                                 help="follow: distance to travel along the surface (mm)."),
+    travel: float = typer.Option(None, "--travel", metavar="MM",
+                                 help="follow: distance to travel along the surface (mm; "
+                                 "default 50)."),
     travel_dir: str = typer.Option(
         None, "--travel-dir", help="follow: initial direction of travel x,y,z (fixed frame), "
         "projected onto the tangent plane as the surface is discovered."),
-    travel_step: float = typer.Option(1.0, "--travel-step",
-                                      help="follow: largest travel per cycle (mm)."),
+    travel_step: float = typer.Option(None, "--travel-step", metavar="MM",
+                                      help="follow: largest travel per cycle (mm; default 1)."),
     tilt_deg: float = typer.Option(
-        0.0, "--tilt-deg", help="follow: tool axis tilted from the measured normal towards "
-        "the travel direction (degrees)."),
+        None, "--tilt-deg", help="follow: tool axis tilted from the measured normal towards "
+        "the travel direction (degrees; default 0)."),
     auto_tilt: bool | None = typer.Option(
         None, "--auto-tilt/--no-auto-tilt", metavar="", help="follow: tilt the tool axis onto "
         "the friction cone's edge (estimated), more while the tip sticks: --auto-tilt from "
@@ -353,6 +358,10 @@ def control_command(
     )
     from kinestat.cli._compile import KERNELS, compiling_notice, is_cold, warm_kernels
 
+    _check_task_options(task, travel=travel, travel_dir=travel_dir, travel_step=travel_step,
+                        tilt_deg=tilt_deg, auto_tilt=auto_tilt, probe_span=probe_span)
+    if not (math.isfinite(max_approach) and max_approach > 0):
+        raise InputError(f"--max-approach must be a positive number of mm, got {max_approach}")
     arm_spec = _arm(arm, tip, base, scale, length_unit, arm_base, galil, serial)
     cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
                  friction, rate, seed, sim_legs, workpiece)
@@ -362,11 +371,13 @@ def control_command(
                          approach_step=approach_step, estimator=estimator, samples=samples,
                          max_iterations=max_iterations, calibration=calibration,
                          platform=platform, procedure=procedure, move_rule=move_rule,
-                         assume_homed=assume_homed, task=task, travel=travel,
+                         assume_homed=assume_homed, task=task,
+                         travel=50.0 if travel is None else travel,
                          travel_dir=(None if travel_dir is None
                                      else parse_floats(travel_dir, 3, "travel-dir")),
-                         travel_step=travel_step, tilt_deg=tilt_deg, auto_tilt=auto_tilt,
-                         arm=arm_spec, probe_span=probe_span)
+                         travel_step=1.0 if travel_step is None else travel_step,
+                         tilt_deg=0.0 if tilt_deg is None else tilt_deg, auto_tilt=auto_tilt,
+                         arm=arm_spec, probe_span=probe_span, max_approach=max_approach)
     cold = tuple(g for g in KERNELS if is_cold(g))
     if cold:  # compile before the run, so that its timing is the loop's own
         with compiling_notice(*cold):
@@ -418,6 +429,17 @@ def _arm_words(placed) -> str:
     b = ", ".join(f"{v:g}" for v in placed.base)
     how = "placed automatically" if placed.placement == "auto" else "--arm-base"
     return f", arm {placed.source_name} (base at {b} mm, {how})"
+
+
+def _check_task_options(task: str, **given) -> None:
+    """The follow task's options given to another task: one clear error naming them (they
+    would be ignored)."""
+    if task != "press":  # follow, or an unknown task (refused with its own error)
+        return
+    named = [f"--{k.replace('_', '-')}" for k, v in given.items() if v is not None]
+    if named:
+        raise InputError(f"{', '.join(named)} only apply to --task follow (this run is "
+                         f"--task {task})")
 
 
 def _check_counts(samples: int, max_iterations: int | None) -> None:

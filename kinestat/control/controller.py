@@ -70,6 +70,7 @@ from kinestat.control.vernier import (
 )
 from kinestat.control.wrench import Estimator, Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
+from kinestat.spatial.se3 import rotvec_matrix_one
 
 # names this module had before the vernier moved out (used by tests and the reference path)
 _OFFSETS, _axis5_residual, _q_to_axis_counts = OFFSETS, axis5_residual, q_to_axis_counts
@@ -185,6 +186,8 @@ class ControllerConfig:
             ``"wrench"`` (the equivalent wrench's force, as the thesis), see
             :meth:`kinestat.control.wrench.Measurement.estimate`.
         repeat_limit: a target commanded this many times means a limit cycle → stop.
+        max_approach: the farthest an approach without contact may carry the tool point from
+            the start tool point (mm); beyond it the run stops (:func:`approach_refusal`).
         envelope: the safety envelope.
         procedure: "kinestat" (default) or "thesis" (ForceCorrection.m's steps as written).
     """
@@ -204,6 +207,7 @@ class ControllerConfig:
     vernier: bool = True
     estimator: Estimator = "point"
     repeat_limit: int = 3
+    max_approach: float = 50.0
     envelope: Envelope = field(default_factory=Envelope)
     procedure: Procedure = "kinestat"
 
@@ -236,6 +240,9 @@ class ControllerConfig:
                 raise InputError(f"{name} must be a positive number, got {getattr(self, name)!r}")
         if not (math.isfinite(self.approach_step) and self.approach_step > 0):
             raise InputError(f"approach_step must be positive, got {self.approach_step!r}")
+        if not (math.isfinite(self.max_approach) and self.max_approach > 0):
+            raise InputError(f"max_approach must be a positive number of mm, got "
+                             f"{self.max_approach!r}")
         if not 1 <= int(self.max_iterations) <= MAX_ITERATIONS:
             raise InputError(f"max_iterations must be in 1..{MAX_ITERATIONS}, got "
                              f"{self.max_iterations!r}")
@@ -267,6 +274,9 @@ class ControllerState:
         history: keys of the targets commanded so far (limit-cycle detection).
         done: the run is over (goal reached or stopped).
         reoriented: the thesis's procedure made (or no longer needs) its one reorientation.
+        align_gain: the fraction of the misalignment the next align turn makes (1: the whole
+            turn; halved each time a turn overshot, see :func:`align_gain`).
+        align_turn: (3,) the last align turn's rotation vector (radians), None before one.
     """
 
     cycle: int
@@ -278,6 +288,8 @@ class ControllerState:
     history: tuple = ()
     done: bool = False
     reoriented: bool = False
+    align_gain: float = 1.0
+    align_turn: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -360,6 +372,81 @@ def _rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     ang = math.atan2(s, c)
     return (v * math.cos(ang) + cross3(k, v) * math.sin(ang)
             + k * (k @ v) * (1.0 - math.cos(ang)))
+
+
+def approach_refusal(config: ControllerConfig, tool_point) -> str:
+    """Why an approach without contact to ``tool_point`` is refused ("" when it is not): it
+    would carry the tool point more than ``config.max_approach`` from the start tool point, so
+    the workpiece is not where the request put it (or the sensor does not see the contact).
+
+    >>> cfg = ControllerConfig(model=None, force=[4.0, 0.0, 0.0], start_tool_point=[0, 0, 0],
+    ...                        max_approach=10.0)
+    >>> approach_refusal(cfg, [9.5, 0.0, 0.0])
+    ''
+    >>> approach_refusal(cfg, [10.5, 0.0, 0.0])[:62]
+    'no contact: the approach would carry the tool point 10.50 mm f'
+    """
+    far = float(np.linalg.norm(np.asarray(tool_point, dtype=float) - config.start_tool_point))
+    if far <= config.max_approach:
+        return ""
+    return (f"no contact: the approach would carry the tool point {far:.2f} mm from the start "
+            f"tool point, beyond max_approach = {config.max_approach:g} mm; is the workpiece "
+            "ahead of the tool along F_req?")
+
+
+def _turn_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The rotation vector (3,) (radians) of the smallest rotation taking unit ``a`` onto
+    unit ``b`` (zero when they are parallel)."""
+    axis = cross3(a, b)
+    s = float(np.linalg.norm(axis))
+    if s < 1e-15:
+        return np.zeros(3)
+    return axis * (math.atan2(s, float(a @ b)) / s)
+
+
+MAX_ALIGN_TURN_DEG = 20.0
+"""The largest align turn of S6 in one cycle (degrees): a workpiece met far off the tool axis is
+turned onto in steps (a 40° turn at once moves the wrist beyond the envelope's 30° per
+command). The default plane's first turn, 13.5° at a light first contact, is made at once."""
+OVERSHOOT_RATIO = 0.5
+"""An align turn overshot when the next misalignment points back against it by more than this
+fraction of the turn (:func:`align_gain`)."""
+MIN_ALIGN_GAIN = 0.125
+"""The smallest fraction of the misalignment an align turn makes (three halvings)."""
+
+
+def align_gain(gain: float, last_turn, misalignment) -> float:
+    """The fraction of the misalignment ``misalignment`` (rotation vector from S6 onto the
+    measured force, radians) that the next align turn makes, after the turn ``last_turn``
+    (rotation vector, or None when the last move was not an align turn) made with ``gain``.
+
+    On a plane a turn of S6 about the tool point onto the force lands on it: the normal does
+    not move. On a frictionless curved surface of curvature κ the turn δ also slides the free
+    tip across the surface by about B δ (the platform's soft mode), where the normal differs by
+    κ B δ; the whole turn then lands κ B e past the normal, and for κ B ≥ 1 the turns alternate
+    for good (a frictionless R = 200 mm cylinder at 4 N: ±2.35° a cycle, docs/control.md
+    "The press on a curved workpiece"). The turn that lands on the normal is e / (1 + κ B).
+    Without measuring κ B: a turn overshot when the new misalignment points back along it by
+    more than ``OVERSHOOT_RATIO`` of the turn (κ B > ½ at the whole turn); the gain then halves
+    (down to ``MIN_ALIGN_GAIN``), otherwise it grows back by a quarter (up to 1).
+
+    >>> align_gain(1.0, [0.0, 0.0, 0.04], [0.0, 0.0, -0.04])   # overshot by the whole turn
+    0.5
+    >>> align_gain(0.5, [0.0, 0.0, 0.04], [0.0, 0.0, 0.01])    # short of it: grows back
+    0.625
+    >>> align_gain(1.0, None, [0.0, 0.0, 0.04])                 # no turn before
+    1.0
+    """
+    if last_turn is None:
+        return float(gain)
+    t = np.asarray(last_turn, dtype=float)
+    size = float(np.linalg.norm(t))
+    if not size > 0.0:
+        return float(gain)
+    back = -float(np.asarray(misalignment, dtype=float) @ t) / size
+    if back > OVERSHOOT_RATIO * size:
+        return max(0.5 * float(gain), MIN_ALIGN_GAIN)
+    return min(1.25 * float(gain), 1.0)
 
 
 # -- the procedure ---------------------------------------------------------------------------------
@@ -481,19 +568,38 @@ def decide(config: ControllerConfig, state: ControllerState,
     tgt = state.target
     rotation = 0.0
     step = 0.0
+    gain, turn = state.align_gain, None
     if not contact:
         action = "approach"
         step = config.approach
         new = Target(tgt.tool_point + step * tgt.s6, tgt.s6, tgt.a67)
+        refused = approach_refusal(config, new.tool_point)
+        if refused:
+            return _stop(st(label=label), label, refused, **info)
     else:
         if mis > config.align_tol_deg:
-            # reorient S6 along the force about the tool point (the torque about it vanishes)
+            # reorient S6 along the force about the tool point (the torque about it vanishes);
+            # a fraction of the turn where the last one overshot (align_gain), at most
+            # MAX_ALIGN_TURN_DEG
             action = "align"
             axis = F / Fmag
-            a67 = _rotate_onto(tgt.a67, tgt.s6, axis)
+            full = _turn_vector(tgt.s6, axis)
+            gain = align_gain(state.align_gain,
+                              state.align_turn if state.last_action == "align" else None, full)
+            frac = min(gain, math.radians(MAX_ALIGN_TURN_DEG) / max(float(np.linalg.norm(full)),
+                                                                     1e-300))
+            if frac < 1.0:
+                turn = frac * full
+                R = rotvec_matrix_one(turn)
+                axis = R @ tgt.s6
+                axis /= np.linalg.norm(axis)
+                a67 = R @ tgt.a67
+            else:
+                turn = full
+                a67 = _rotate_onto(tgt.a67, tgt.s6, axis)
             a67 = a67 - (a67 @ axis) * axis
             a67 /= np.linalg.norm(a67)
-            rotation = mis
+            rotation = frac * mis if frac < 1.0 else mis
         else:
             action = "force"
             axis, a67 = s6, tgt.a67
@@ -517,5 +623,6 @@ def decide(config: ControllerConfig, state: ControllerState,
     if isinstance(cmd, Refusal):
         return _stop(st(label=label), label, cmd.reason, **cmd.extra, **info)
     new_state = st(label=label, last_action=action, target=new,
-                        axis_counts=cmd.axis_counts, history=state.history + (key,))
+                   axis_counts=cmd.axis_counts, history=state.history + (key,),
+                   align_gain=gain, align_turn=turn)
     return cmd, new_state

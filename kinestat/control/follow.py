@@ -100,6 +100,7 @@ from kinestat.control.controller import (
     ControllerState,
     Refusal,
     Target,
+    approach_refusal,
     move_command,
 )
 from kinestat.control.cycle import cross3, cycle_data, mount_inverse, norm3, replace
@@ -1283,6 +1284,9 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
         else:
             d = tgt.s6
         new = Target(tgt.tool_point + base.approach_step * d, tgt.s6, tgt.a67)
+        refused = approach_refusal(base, new.tool_point) if st.phase == "approach" else ""
+        if refused:
+            return _stop(st, label, refused, **kw)
         return _command(config, st, meas, new, label, "approach", base.approach_step, 0.0, kw)
     n = st.normal
     t0 = st.tangent if st.tangent is not None else config.travel_dir

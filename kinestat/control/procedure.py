@@ -29,7 +29,8 @@ the MATLAB, each forced by a gap in it:
   the command keeps that rounding from accumulating over the steps;
 * "cannot settle": a translation target commanded before means the fixed step jumps across
   the tolerance band (|F| alternates above and below it) — the MATLAB would loop forever; the
-  run stops and says so. Likewise after ``max_iterations`` cycles.
+  run stops and says so. Likewise after ``max_iterations`` cycles, and when the steps
+  without contact would carry the tool point beyond ``max_approach`` from the start.
 
 Every command passes the same envelope checks as the improved procedure.
 """
@@ -48,6 +49,7 @@ from kinestat.control.controller import (
     Refusal,
     Target,
     _stop,
+    approach_refusal,
     move_command,
 )
 from kinestat.control.envelope import check_measurement
@@ -112,6 +114,9 @@ def decide_thesis(config: ControllerConfig, state: ControllerState,
     else:
         action, step = "translate", math.copysign(config.step, err)
         new = Target(tgt.tool_point + step * tgt.s6, tgt.s6, tgt.a67)
+        refused = "" if contact else approach_refusal(config, new.tool_point)
+        if refused:
+            return _stop(replace(st, label=label), label, refused, **info)
     key = new.key()
     if action == "translate" and key in state.history:
         return _stop(replace(st, label=label), label,

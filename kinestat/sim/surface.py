@@ -29,7 +29,7 @@ from kinestat.sim.contact import Cell, Equilibrium, Workpiece, equilibrium, unlo
 from kinestat.spatial.transforms import as_array
 from kinestat.spatial.validate import frozen
 
-__all__ = ["Cylinder", "solve", "surface_normal", "cylinder_ahead"]
+__all__ = ["Cylinder", "solve", "surface_normal", "cylinder_ahead", "approach_distance"]
 
 _FIXED_POINT_TOL = 1e-10  # mm: the contact point has settled on the surface
 _FIXED_POINT_ITER = 60
@@ -132,6 +132,41 @@ def cylinder_ahead(start_point, direction, distance: float, radius: float, axis)
     u /= np.linalg.norm(u)
     c0 = np.asarray(start_point, dtype=float) + distance * d
     return Cylinder(point=c0 + float(radius) * u, axis=a, radius=radius)
+
+def approach_distance(workpiece, start_point, direction) -> float:
+    """How far (mm) a point moving from ``start_point`` along ``direction`` goes before it
+    meets the surface of a plane or cylinder ``workpiece``: 0 when it starts on or inside the
+    material, ``inf`` when the line never meets the surface ahead.
+
+    >>> c = Cylinder(point=[0, 0, 0], axis=[0, 0, 1], radius=200.0)
+    >>> approach_distance(c, [-250.0, 0.0, 0.0], [1.0, 0.0, 0.0])
+    50.0
+    >>> approach_distance(c, [-250.0, 0.0, 0.0], [0.0, 0.0, 1.0])   # along the axis
+    inf
+    >>> approach_distance(Workpiece([0, 0, 0], [0, 0, 1]), [0, 0, 5.0], [0, 0.6, -0.8])
+    6.25
+    """
+    p = _vec3(start_point, "start point")
+    d = _vec3(direction, "direction")
+    nd = float(np.linalg.norm(d))
+    if not nd > 0.0:
+        raise InputError(f"direction must be a nonzero vector, got {d.tolist()}")
+    d = d / nd
+    if float(workpiece.gap(p)) <= 0.0:
+        return 0.0
+    if isinstance(workpiece, Workpiece):
+        rate = float(d @ workpiece.normal)
+        return float(workpiece.gap(p)) / -rate if rate < 0.0 else math.inf
+    r0 = workpiece._radial(p)
+    u = d - float(d @ workpiece.axis) * workpiece.axis
+    a = float(u @ u)
+    b = float(r0 @ u)
+    c = float(r0 @ r0) - workpiece.radius ** 2
+    disc = b * b - a * c
+    if a < 1e-18 or disc < 0.0 or b >= 0.0:  # parallel to the axis, missing, or moving away
+        return math.inf
+    return (-b - math.sqrt(disc)) / a
+
 
 _BRANCH_PASSES = 10
 """Passes after which a slide that has not settled, and whose last four passes did not halve

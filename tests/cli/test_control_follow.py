@@ -48,6 +48,16 @@ def test_follow_cylinder_json_and_plots(tmp_path, capsys):
     (["--travel-dir", "0,1,0", "--task", "slide"], "--task"),
     (["--travel-dir", "0,1,0", "--probe-span", "-1"], "probe_span"),
     (["--travel-dir", "0,1,0", "--probe-span", "30"], "probe_span"),
+    (["--task", "press", "--travel", "30"], "--travel only apply to --task follow"),
+    (["--task", "press", "--tilt-deg", "5", "--no-auto-tilt"],
+     "--tilt-deg, --auto-tilt only apply to --task follow"),
+    (["--travel-dir", "0,1,0", "--max-approach", "0"], "--max-approach"),
+    (["--travel-dir", "0,1,0", "--workpiece", "cylinder:radius=200,axis=0,0,1,point=0,0,0"],
+     "not ahead of the tool"),
+    (["--task", "press", "--plane-point", "0,0,0", "--plane-normal", "0,0,1"],
+     "inside the simulated plane"),
+    (["--task", "press", "--plane-point", "0,0,0", "--plane-normal", "0,0,-1"],
+     "not ahead of the tool"),
 ])
 def test_bad_follow_requests_fail_before_any_motion(tmp_path, capsys, args, message):
     argv = ["control", "--log", str(tmp_path / "log.jsonl"), "--no-plot"]

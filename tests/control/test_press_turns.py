@@ -1,0 +1,144 @@
+"""The press task's align turn off the default plane: a frictionless curved workpiece (the turn
+that overshoots is damped), a workpiece met far off the tool axis (the turn is made in steps),
+and an approach that meets nothing (it stops at ``max_approach``)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from kinestat.app.control_run import ControlRequest, CylinderSpec, SimulatedCell, prepare_control
+from kinestat.app.sim_cell import InProcessIO, start_counts
+from kinestat.control.controller import (
+    MAX_ALIGN_TURN_DEG,
+    MIN_ALIGN_GAIN,
+    ControllerConfig,
+    align_gain,
+)
+from kinestat.control.log import CycleLog, read_log
+from kinestat.control.loop import run
+from kinestat.errors import InputError
+from kinestat.sim.surface import approach_distance
+
+from .conftest import F_HAT, START, run_in_process, scenario
+
+
+def _press(tmp_path, cell: SimulatedCell, **kw):
+    """The press task as ``kinestat control`` runs it (the thesis's calibrated cell), in
+    process."""
+    prep = prepare_control(ControlRequest(force=4.0 * F_HAT, start_tool_point=START,
+                                          cell=cell, **kw))
+    io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
+    with CycleLog(tmp_path / "log.jsonl") as log:
+        rep = run(prep.config, io, log)
+    return rep, read_log(tmp_path / "log.jsonl"), io
+
+
+@pytest.mark.parametrize("radius", [150.0, 200.0])
+def test_the_press_settles_on_a_frictionless_cylinder(tmp_path, radius):
+    # the whole turn onto the force lands past the new normal (the free tip slides round the
+    # cylinder); before the damped turn R = 200 mm alternated ±2.35° for all 60 cycles and
+    # R = 150 mm pushed the simulated tip off its equilibrium
+    cyl = CylinderSpec(radius=radius, axis=np.array([0.0, 0.0, 1.0]))
+    rep, recs, _ = _press(tmp_path, SimulatedCell(cylinder=cyl))
+    assert rep.converged, rep.stop_reason
+    assert abs(rep.true_force_magnitude - 4.0) <= 0.5
+    assert rep.axis_error_deg <= 1.0
+    assert rep.iterations <= 15
+
+
+@pytest.mark.parametrize("tilt", [35.0, 45.0])
+def test_a_plane_met_far_off_the_tool_axis_is_turned_onto_in_steps(tmp_path, tilt):
+    # a 35-45° turn at once moved the wrist more than the envelope's 30° per command
+    scn = scenario(tilt_deg=tilt)
+    rep, recs, _ = run_in_process(scn, scn.config(), tmp_path / "log.jsonl")
+    assert rep.converged, rep.stop_reason
+    assert abs(rep.true_force_magnitude - 4.0) <= 0.5 and rep.axis_error_deg <= 1.0
+    turns = [r["commanded"]["rotation_deg"] for r in recs
+             if r.get("type") == "cycle" and r["action"] == "align"]
+    assert turns and max(turns) <= MAX_ALIGN_TURN_DEG + 1e-9
+    assert sum(turns) >= tilt - 5.0  # it did turn onto the plane, in several turns
+
+
+@settings(max_examples=200, deadline=None)
+@given(kb=st.floats(0.0, 6.0), e0=st.floats(0.01, 0.3), sign=st.sampled_from([-1.0, 1.0]))
+def test_the_damped_turn_converges_where_the_whole_turn_alternates(kb, e0, sign):
+    # the misalignment after a turn g e is e (1 − g (1 + κB)) (the free tip's slide moves the
+    # normal by κB times the turn); the sign rule must bring it below 0.01 rad for any κB up to
+    # 6 (the whole turn alone diverges past κB = 1)
+    gain, last, e = 1.0, None, sign * e0
+    for _ in range(40):
+        gain = align_gain(gain, last, np.array([0.0, 0.0, e]))
+        assert MIN_ALIGN_GAIN <= gain <= 1.0
+        if abs(e) < 1e-2:
+            break
+        last = np.array([0.0, 0.0, gain * e])
+        e = e * (1.0 - gain * (1.0 + kb))
+    assert abs(e) < 1e-2, (kb, gain, e)
+
+
+def test_the_whole_turn_is_kept_on_a_plane():
+    # a turn short of the force (or a noisy reading back against it by less than half the
+    # turn) keeps the whole turn: the default plane's runs are unchanged
+    assert align_gain(1.0, [0.0, 0.0, 0.2], [0.0, 0.0, 0.01]) == 1.0
+    assert align_gain(1.0, [0.0, 0.0, 0.2], [0.0, 0.0, -0.09]) == 1.0
+    assert align_gain(1.0, [0.0, 0.0, 0.2], [0.0, 0.0, -0.11]) == 0.5
+    assert align_gain(0.125, [0.0, 0.0, 0.2], [0.0, 0.0, -0.3]) == MIN_ALIGN_GAIN
+
+
+def test_an_approach_that_meets_nothing_stops_at_max_approach(tmp_path):
+    scn = scenario(distance=30.0)
+    cfg = scn.config(max_approach=10.0)
+    rep, recs, io = run_in_process(scn, cfg, tmp_path / "log.jsonl")
+    assert not rep.converged and "max_approach = 10 mm" in rep.stop_reason
+    assert io.stopped
+    far = max(float(np.linalg.norm(np.asarray(r["commanded"]["tool_point"]) - START))
+              for r in recs if r.get("type") == "cycle" and r["commanded"])
+    assert 9.0 <= far <= 10.0
+
+
+def test_max_approach_must_be_positive():
+    with pytest.raises(InputError, match="max_approach"):
+        ControllerConfig(model=None, force=4.0 * F_HAT, start_tool_point=START,
+                         max_approach=0.0)
+
+
+@pytest.mark.parametrize("spec, why", [
+    (CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]),
+                  point=START + np.array([500.0, 0.0, 0.0])), "meets it only"),
+    (CylinderSpec(radius=200.0, axis=np.array([0.0, 1.0, 0.0]),
+                  point=START + np.array([0.0, 0.0, 500.0])), "never meets it"),
+])
+def test_a_simulated_workpiece_out_of_the_approach_is_refused_before_any_motion(spec, why):
+    req = ControlRequest(force=4.0 * F_HAT, start_tool_point=START,
+                         cell=SimulatedCell(cylinder=spec))
+    with pytest.raises(InputError, match=why):
+        prepare_control(req)
+
+
+@settings(max_examples=100, deadline=None)
+@given(radius=st.floats(50.0, 1000.0), ax=st.tuples(*[st.floats(-1, 1)] * 3),
+       d=st.tuples(*[st.floats(-1, 1)] * 3), off=st.tuples(*[st.floats(-500, 500)] * 3))
+def test_approach_distance_lands_on_the_surface(radius, ax, d, off):
+    from kinestat.sim.surface import Cylinder
+
+    a, u = np.asarray(ax), np.asarray(d)
+    if np.linalg.norm(a) < 0.1 or np.linalg.norm(u) < 0.1:
+        return
+    cyl = Cylinder(point=np.zeros(3), axis=a, radius=radius)
+    p = np.asarray(off)
+    u = u / np.linalg.norm(u)
+    t = approach_distance(cyl, p, u)
+    ts = np.linspace(0.0, min(t, 3000.0), 400)
+    gaps = cyl.gap(p + ts[:, None] * u)
+    if math.isinf(t):  # never meets it: the sampled line stays outside (or starts inside: 0)
+        assert np.all(gaps > -1e-9)
+    elif t == 0.0:
+        assert float(cyl.gap(p)) <= 0.0
+    else:
+        assert abs(float(cyl.gap(p + t * u))) < 1e-6 * max(1.0, t)
+        assert np.all(gaps[:-1] > -1e-9)  # nothing met before it
