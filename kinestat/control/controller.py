@@ -34,6 +34,12 @@ this platform; the search resolves the target to ~0.1 µm.
 When S6 is misaligned AND the force is out of tolerance, the reorientation and the step along
 the new axis are commanded together (at light contact the measured direction is noisy; pushing
 towards the target force makes it precise).
+
+The turn is at most ``MAX_ALIGN_TURN_DEG`` a cycle (a workpiece met far off the tool axis is
+turned onto in steps, without pushing along an axis still far from the force), and a turn
+that overshot the force makes the next ones a fraction of the misalignment
+(:func:`align_gain`): on a frictionless curved surface the free tip slides as S6 turns, and
+the whole turn then lands past the new normal.
 """
 
 from __future__ import annotations
@@ -568,7 +574,7 @@ def decide(config: ControllerConfig, state: ControllerState,
     tgt = state.target
     rotation = 0.0
     step = 0.0
-    gain, turn = state.align_gain, None
+    gain, turn, far = state.align_gain, None, False
     if not contact:
         action = "approach"
         step = config.approach
@@ -600,6 +606,7 @@ def decide(config: ControllerConfig, state: ControllerState,
             a67 = a67 - (a67 @ axis) * axis
             a67 /= np.linalg.norm(a67)
             rotation = frac * mis if frac < 1.0 else mis
+            far = mis * (1.0 - frac) > MAX_ALIGN_TURN_DEG / 4.0
         else:
             action = "force"
             axis, a67 = s6, tgt.a67
@@ -609,6 +616,8 @@ def decide(config: ControllerConfig, state: ControllerState,
             else:
                 k_axial = float(axis @ tip_stiffness(model, meas) @ axis)
                 step = float(np.clip(err / k_axial, -config.step, config.step))
+            if far and step > 0.0:  # far off the force: turn before pushing along the new axis
+                step = 0.0
         new = Target(tgt.tool_point + step * axis, axis, a67)
     key = new.key()
     if state.history.count(key) + 1 >= config.repeat_limit:
