@@ -13,12 +13,8 @@ from hypothesis import strategies as st
 
 from kinestat.app.control_run import ControlRequest, CylinderSpec, SimulatedCell, prepare_control
 from kinestat.app.sim_cell import InProcessIO, start_counts
-from kinestat.control.controller import (
-    MAX_ALIGN_TURN_DEG,
-    MIN_ALIGN_GAIN,
-    ControllerConfig,
-    align_gain,
-)
+from kinestat.control.align import MAX_ALIGN_TURN_DEG, MIN_ALIGN_GAIN, align_gain
+from kinestat.control.controller import ControllerConfig
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import run
 from kinestat.errors import InputError

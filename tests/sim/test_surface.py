@@ -22,6 +22,7 @@ from kinestat.spatial.transforms import apply_vector, inv
 
 PLATFORM = special_6_6()
 F_HAT = np.array([0.9713, 0.0, -0.2375]) / math.hypot(0.9713, 0.2375)
+START = np.array([-400.0, 800.0, -100.0])  # the CLI's default start (mm)
 
 
 def _flange(push: float, turn: float = 0.0) -> np.ndarray:
@@ -144,7 +145,7 @@ def _recorded_state(name: str):
     d = json.loads((Path(__file__).parent / "data" / f"{name}.json").read_text())
     spec = CylinderSpec(radius=d["radius"], axis=np.array(d["axis"]), point=np.array(d["point"]))
     prep = prepare_control(ControlRequest(
-        force=4.0 * F_HAT, start_tool_point=np.array([0.0, 0.0, 0.0]), task="follow",
+        force=4.0 * F_HAT, start_tool_point=START, task="follow",
         travel_dir=np.array([0.0, 1.0, 0.0]),
         cell=SimulatedCell(friction=d["friction"], cylinder=spec)))
     cell = prep.cell
