@@ -1,7 +1,11 @@
-"""The press's align turn: S6 onto the measured force about the tool point, damped where a
-turn overshot and capped per cycle (:func:`kinestat.control.controller.decide`).
+"""The press's move in contact (:func:`kinestat.control.controller.decide`): the align turn of
+S6 onto the measured force about the tool point, damped where a turn overshot and capped per
+cycle, the shed across S6 where a stuck tip carries the turns, and the step along the axis.
 
-Pure functions of vectors; rotation vectors in radians, fixed frame.
+Pure functions; rotation vectors in radians, fixed frame. ``config`` and ``state`` are the
+press's :class:`~kinestat.control.controller.ControllerConfig` and
+:class:`~kinestat.control.controller.ControllerState`; targets are returned as
+``(tool_point, s6, a67)``.
 """
 
 from __future__ import annotations
@@ -11,9 +15,12 @@ import math
 import numpy as np
 
 from kinestat.control.cycle import cross3
+from kinestat.control.envelope import tip_stiffness
+from kinestat.spatial.se3 import rotvec_matrix_one
 
-__all__ = ["MAX_ALIGN_TURN_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN", "turn_vector",
-           "align_gain"]
+__all__ = ["MAX_ALIGN_TURN_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN", "STUCK_RATIO",
+           "turn_vector", "rotate_onto", "align_gain", "turn_was_carried", "contact_move",
+           "stuck", "shed"]
 
 
 def turn_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -69,3 +76,132 @@ def align_gain(gain: float, last_turn, misalignment) -> float:
     if back > OVERSHOOT_RATIO * size:
         return max(0.5 * float(gain), MIN_ALIGN_GAIN)
     return min(1.25 * float(gain), 1.0)
+
+
+STUCK_RATIO = 0.5
+"""An align turn found the tip stuck when it removed less than this fraction of itself from
+the misalignment (:func:`turn_was_carried`)."""
+
+
+def turn_was_carried(before, turn, after) -> bool:
+    """Whether the align turn ``turn`` (rotation vector, radians), made from the misalignment
+    ``before``, was carried by the force instead of closing the gap: the misalignment
+    ``after`` it is less than ``STUCK_RATIO`` of the turn smaller along it.
+
+    A tip that sticks on the workpiece holds the top: turning S6 about the tool point then
+    turns the platform rigidly about the tip, its legs do not change, and the force turns with
+    the tool (the default plane with μ = 0.3: 0.74° before a 0.74° turn, 0.72° after it). Only
+    a change of the platform's deflection turns the force relative to the tool (the shed of
+    :func:`kinestat.control.controller.decide`). On a plane or a frictionless surface a turn
+    removes at least itself (``align_gain``).
+
+    >>> turn_was_carried([0, 0, 0.0129], [0, 0, 0.0129], [0, 0, 0.0126])
+    True
+    >>> turn_was_carried([0, 0, 0.0129], [0, 0, 0.0129], [0, 0, 0.0002])
+    False
+    >>> turn_was_carried(None, [0, 0, 0.0129], [0, 0, 0.0126])
+    False
+    """
+    if before is None or turn is None:
+        return False
+    t = np.asarray(turn, dtype=float)
+    size = float(np.linalg.norm(t))
+    if not size > 0.0:
+        return False
+    closed = float((np.asarray(before, dtype=float) - np.asarray(after, dtype=float)) @ t) / size
+    return closed < STUCK_RATIO * size
+
+
+def rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Rotate ``v`` by the smallest rotation taking unit ``a`` onto unit ``b``."""
+    axis = cross3(a, b)
+    s = float(np.linalg.norm(axis))
+    c = float(a @ b)
+    if s < 1e-15:
+        return v.copy()
+    k = axis / s
+    ang = math.atan2(s, c)
+    return (v * math.cos(ang) + cross3(k, v) * math.sin(ang)
+            + k * (k @ v) * (1.0 - math.cos(ang)))
+
+
+def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float):
+    """The move of a cycle in contact: (action, target, step along the axis, turn in degrees,
+    the state's align memory). Misaligned: turn S6 onto the force about the tool point (the
+    torque about it vanishes) — a fraction of the turn where the last one overshot
+    (:func:`~kinestat.control.align.align_gain`), at most ``MAX_ALIGN_TURN_DEG`` — or, where
+    the turns are carried by a stuck tip, shed the force across S6 (:func:`shed`). Then the
+    step along the axis when the force is out of tolerance."""
+    model, tgt = config.model, state.target
+    Fmag = float(np.linalg.norm(F))
+    step, rotation, far = 0.0, 0.0, False
+    memo: dict = {"align_gain": state.align_gain}
+    if mis > config.align_tol_deg:
+        full = turn_vector(tgt.s6, F / Fmag)
+        if stuck(config, state, full, mis):
+            return shed(config, state, meas, F, mis, err)
+        action = "align"
+        gain = align_gain(state.align_gain,
+                          state.align_turn if state.last_action == "align" else None, full)
+        frac = min(gain, math.radians(MAX_ALIGN_TURN_DEG) / max(float(np.linalg.norm(full)),
+                                                                 1e-300))
+        if frac < 1.0:
+            turn = frac * full
+            R = rotvec_matrix_one(turn)
+            axis = R @ tgt.s6
+            axis /= np.linalg.norm(axis)
+            a67 = R @ tgt.a67
+        else:
+            turn, axis = full, F / Fmag
+            a67 = rotate_onto(tgt.a67, tgt.s6, axis)
+        a67 = a67 - (a67 @ axis) * axis
+        a67 /= np.linalg.norm(a67)
+        rotation = frac * mis if frac < 1.0 else mis
+        far = mis * (1.0 - frac) > MAX_ALIGN_TURN_DEG / 4.0
+        memo = {"align_gain": gain, "align_turn": turn, "align_from": full}
+    else:
+        action = "force"
+        axis, a67 = tgt.s6, tgt.a67
+    if abs(err) > config.force_tol:
+        if config.method == "fixed":
+            step = math.copysign(config.step, err)
+        else:
+            k_axial = float(axis @ tip_stiffness(model, meas) @ axis)
+            step = float(np.clip(err / k_axial, -config.step, config.step))
+        if far and step > 0.0:  # far off the force: turn before pushing along the new axis
+            step = 0.0
+    return action, (tgt.tool_point + step * axis, axis, a67), step, rotation, memo
+
+
+def stuck(config, state, full: np.ndarray, mis: float) -> bool:
+    """Whether the tip holds the platform, so that turning S6 cannot align it: the last turn
+    was carried by the force (:func:`~kinestat.control.align.turn_was_carried`), or the last
+    shed did what a held tip does (the misalignment fell at least half as much as it
+    aimed). The stiffness method only (the shed needs the tip's stiffness)."""
+    if config.method != "stiffness":
+        return False
+    if state.last_action == "align":
+        return turn_was_carried(state.align_from, state.align_turn, full)
+    return state.last_action == "shed" and mis <= state.shed_expect_deg
+
+
+def shed(config, state, meas, F: np.ndarray, mis: float, err: float):
+    """Move the flange, S6 kept, so that a held tip's force lies along S6: ``δ = K_tip⁻¹ δF``
+    with ``δF = −F⊥`` (the force across S6; plus the error along S6 when out of tolerance),
+    ``K_tip`` the platform's point stiffness at the tip (:func:`tip_stiffness`: moving the
+    flange by ``δ`` with the tip held changes the force by ``K_tip δ``), scaled to at most
+    ``config.step``. The platform is soft across the tool at the tip (about 0.05 N/mm), so a
+    0.7° misalignment at 4 N is a shed of about 1 mm."""
+    tgt = state.target
+    s6 = tgt.s6
+    along = float(F @ s6)
+    dF = -(F - along * s6)
+    if abs(err) > config.force_tol:
+        dF = dF + (config.force_target - along) * s6
+    delta = np.linalg.solve(tip_stiffness(config.model, meas), dF)
+    size = float(np.linalg.norm(delta))
+    frac = min(1.0, config.step / size) if size > 0.0 else 1.0
+    delta = frac * delta
+    memo = {"align_gain": state.align_gain, "shed_expect_deg": mis * (1.0 - 0.5 * frac)}
+    return ("shed", (tgt.tool_point + delta, s6.copy(), tgt.a67.copy()), float(delta @ s6),
+            0.0, memo)

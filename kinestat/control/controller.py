@@ -50,11 +50,10 @@ from typing import Literal, get_args
 
 import numpy as np
 
-from kinestat.control.align import MAX_ALIGN_TURN_DEG, align_gain, turn_vector
+from kinestat.control.align import contact_move
 from kinestat.control.approach import approach_waypoints, check_approach
 from kinestat.control.arm import Puma762Arm
 from kinestat.control.ceilings import MAX_ITERATIONS
-from kinestat.control.cycle import cross3
 from kinestat.control.envelope import (
     Envelope,
     Prediction,
@@ -62,7 +61,6 @@ from kinestat.control.envelope import (
     check_measurement,
     check_target,
     predict,
-    tip_stiffness,
 )
 from kinestat.control.model import ControlModel
 from kinestat.control.vernier import (
@@ -77,7 +75,6 @@ from kinestat.control.vernier import (
 )
 from kinestat.control.wrench import Estimator, Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
-from kinestat.spatial.se3 import rotvec_matrix_one
 
 # names this module had before the vernier moved out (used by tests and the reference path)
 _OFFSETS, _axis5_residual, _q_to_axis_counts = OFFSETS, axis5_residual, q_to_axis_counts
@@ -123,7 +120,8 @@ METHODS: tuple[str, ...] = get_args(StepMethod)
 CommandKind = Literal["move", "measure", "done", "stop"]
 """What a :class:`Command` asks for: send axis counts, measure again without moving (the
 thesis's procedure, :mod:`kinestat.control.procedure`), report the goal, or stop safely."""
-Action = Literal["start", "approach", "align", "force", "measure", "reorient", "translate", ""]
+Action = Literal["start", "approach", "align", "shed", "force", "measure", "reorient", "translate",
+                 ""]
 """Why a move is made (Vibhute Fig. 5-2 steps; "measure", "reorient", "translate" are the steps
 of ForceCorrection.m as written); "" for done/stop."""
 Procedure = Literal["kinestat", "thesis"]
@@ -284,6 +282,10 @@ class ControllerState:
         align_gain: the fraction of the misalignment the next align turn makes (1: the whole
             turn; halved each time a turn overshot, see :func:`align_gain`).
         align_turn: (3,) the last align turn's rotation vector (radians), None before one.
+        align_from: (3,) the misalignment (rotation vector from S6 onto the force) it was
+            made from.
+        shed_expect_deg: the misalignment the last shed (a move across S6 that turns a held
+            tip's force onto S6) should leave at most (degrees).
     """
 
     cycle: int
@@ -297,6 +299,8 @@ class ControllerState:
     reoriented: bool = False
     align_gain: float = 1.0
     align_turn: np.ndarray | None = None
+    align_from: np.ndarray | None = None
+    shed_expect_deg: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)
@@ -366,19 +370,6 @@ def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
 def _flange_pose(model: ControlModel, q) -> np.ndarray:
     """``F_6T`` of the joint angles ``q``: the arm's flange pose (compiled for the PUMA 762)."""
     return model.arm.flange_pose(q)
-
-
-def _rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Rotate ``v`` by the smallest rotation taking unit ``a`` onto unit ``b``."""
-    axis = cross3(a, b)
-    s = float(np.linalg.norm(axis))
-    c = float(a @ b)
-    if s < 1e-15:
-        return v.copy()
-    k = axis / s
-    ang = math.atan2(s, c)
-    return (v * math.cos(ang) + cross3(k, v) * math.sin(ang)
-            + k * (k @ v) * (1.0 - math.cos(ang)))
 
 
 def approach_refusal(config: ControllerConfig, tool_point) -> str:
@@ -520,7 +511,7 @@ def decide(config: ControllerConfig, state: ControllerState,
     tgt = state.target
     rotation = 0.0
     step = 0.0
-    gain, turn, far = state.align_gain, None, False
+    memo: dict = {}
     if not contact:
         action = "approach"
         step = config.approach
@@ -529,42 +520,9 @@ def decide(config: ControllerConfig, state: ControllerState,
         if refused:
             return _stop(st(label=label), label, refused, **info)
     else:
-        if mis > config.align_tol_deg:
-            # reorient S6 along the force about the tool point (the torque about it vanishes);
-            # a fraction of the turn where the last one overshot (align_gain), at most
-            # MAX_ALIGN_TURN_DEG
-            action = "align"
-            axis = F / Fmag
-            full = turn_vector(tgt.s6, axis)
-            gain = align_gain(state.align_gain,
-                              state.align_turn if state.last_action == "align" else None, full)
-            frac = min(gain, math.radians(MAX_ALIGN_TURN_DEG) / max(float(np.linalg.norm(full)),
-                                                                     1e-300))
-            if frac < 1.0:
-                turn = frac * full
-                R = rotvec_matrix_one(turn)
-                axis = R @ tgt.s6
-                axis /= np.linalg.norm(axis)
-                a67 = R @ tgt.a67
-            else:
-                turn = full
-                a67 = _rotate_onto(tgt.a67, tgt.s6, axis)
-            a67 = a67 - (a67 @ axis) * axis
-            a67 /= np.linalg.norm(a67)
-            rotation = frac * mis if frac < 1.0 else mis
-            far = mis * (1.0 - frac) > MAX_ALIGN_TURN_DEG / 4.0
-        else:
-            action = "force"
-            axis, a67 = s6, tgt.a67
-        if abs(err) > config.force_tol:
-            if config.method == "fixed":
-                step = math.copysign(config.step, err)
-            else:
-                k_axial = float(axis @ tip_stiffness(model, meas) @ axis)
-                step = float(np.clip(err / k_axial, -config.step, config.step))
-            if far and step > 0.0:  # far off the force: turn before pushing along the new axis
-                step = 0.0
-        new = Target(tgt.tool_point + step * axis, axis, a67)
+        action, (point, axis, a67), step, rotation, memo = contact_move(config, state, meas, F,
+                                                                         mis, err)
+        new = Target(point, axis, a67)
     key = new.key()
     if state.history.count(key) + 1 >= config.repeat_limit:
         return _stop(st(label=label), label,
@@ -578,6 +536,5 @@ def decide(config: ControllerConfig, state: ControllerState,
     if isinstance(cmd, Refusal):
         return _stop(st(label=label), label, cmd.reason, **cmd.extra, **info)
     new_state = st(label=label, last_action=action, target=new,
-                   axis_counts=cmd.axis_counts, history=state.history + (key,),
-                   align_gain=gain, align_turn=turn)
+                   axis_counts=cmd.axis_counts, history=state.history + (key,), **memo)
     return cmd, new_state

@@ -1,6 +1,7 @@
-"""The press task's align turn off the default plane: a frictionless curved workpiece (the turn
-that overshoots is damped), a workpiece met far off the tool axis (the turn is made in steps),
-and an approach that meets nothing (it stops at ``max_approach``)."""
+"""The press task's move in contact off the default plane: a frictionless curved workpiece (the
+turn that overshoots is damped), a workpiece met far off the tool axis (the turn is made in
+steps), a stuck tip (the force is shed across S6), and an approach that meets nothing (it
+stops at ``max_approach``)."""
 
 from __future__ import annotations
 
@@ -45,6 +46,22 @@ def test_the_press_settles_on_a_frictionless_cylinder(tmp_path, radius):
     assert abs(rep.true_force_magnitude - 4.0) <= 0.5
     assert rep.axis_error_deg <= 1.0
     assert rep.iterations <= 15
+
+
+@pytest.mark.parametrize("cylinder", [None, CylinderSpec(radius=200.0,
+                                                          axis=np.array([0.0, 0.0, 1.0]))])
+def test_a_stuck_tip_is_aligned_by_shedding_the_force_across_s6(tmp_path, cylinder):
+    # with μ = 0.3 the tip sticks where it touched, every turn of S6 about the tool point
+    # turned the platform rigidly about it and the force turned along (0.74° before a 0.74°
+    # turn, 0.72° after): 26 cycles on the plane, 38 on the cylinder, until a slip
+    rep, recs, _ = _press(tmp_path, SimulatedCell(friction=0.3, cylinder=cylinder))
+    assert rep.converged, rep.stop_reason
+    assert rep.iterations <= 10
+    assert abs(rep.true_force_magnitude - 4.0) <= 0.5 and rep.axis_error_deg <= 0.5
+    actions = [r["action"] for r in recs if r.get("type") == "cycle"]
+    assert "shed" in actions
+    shed = next(r for r in recs if r.get("type") == "cycle" and r["action"] == "shed")
+    assert shed["true"]["sticking"]  # it was stuck when the shed was chosen
 
 
 @pytest.mark.parametrize("tilt", [35.0, 45.0])
