@@ -18,9 +18,11 @@ from kinestat.control.cycle import cross3
 from kinestat.control.envelope import tip_stiffness
 from kinestat.spatial.se3 import rotvec_matrix_one
 
-__all__ = ["MAX_ALIGN_TURN_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN", "STUCK_RATIO",
-           "turn_vector", "rotate_onto", "align_gain", "turn_was_carried", "contact_move",
-           "stuck", "shed"]
+__all__ = [
+    "MAX_ALIGN_TURN_DEG", "PUSH_TURN_DEG", "PUSH_LEFT_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN",
+    "STUCK_RATIO", "turn_vector", "rotate_onto", "align_gain", "turn_was_carried",
+    "contact_move", "stuck", "shed",
+]
 
 
 def turn_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -37,6 +39,14 @@ MAX_ALIGN_TURN_DEG = 20.0
 """The largest align turn of S6 in one cycle (degrees): a workpiece met far off the tool axis is
 turned onto in steps (a 40° turn at once moves the wrist beyond the envelope's 30° per
 command). The default plane's first turn, 13.5° at a light first contact, is made at once."""
+PUSH_TURN_DEG = 10.0
+PUSH_LEFT_DEG = 5.0
+"""An align turn larger than ``PUSH_TURN_DEG``, or one that leaves more than ``PUSH_LEFT_DEG``
+of misalignment (a turn cut at ``MAX_ALIGN_TURN_DEG``), is made without the force step's push
+along the new axis (stepping back is still made): the Newton step was computed at the old
+axis and the light first contact, and on a frictionless surface met far off the tool axis the
+push and the large turn together drove the force from about 1 N to 5–7 N in one cycle and the
+top past its 4° range (docs/control.md "The press on curved and steep workpieces")."""
 OVERSHOOT_RATIO = 0.5
 """An align turn overshot when the next misalignment points back against it by more than this
 fraction of the turn (:func:`align_gain`)."""
@@ -157,7 +167,7 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float):
         a67 = a67 - (a67 @ axis) * axis
         a67 /= np.linalg.norm(a67)
         rotation = frac * mis if frac < 1.0 else mis
-        far = mis * (1.0 - frac) > MAX_ALIGN_TURN_DEG / 4.0
+        far = rotation > PUSH_TURN_DEG or mis * (1.0 - frac) > PUSH_LEFT_DEG
         memo = {"align_gain": gain, "align_turn": turn, "align_from": full}
     else:
         action = "force"
@@ -168,7 +178,7 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float):
         else:
             k_axial = float(axis @ tip_stiffness(model, meas) @ axis)
             step = float(np.clip(err / k_axial, -config.step, config.step))
-        if far and step > 0.0:  # far off the force: turn before pushing along the new axis
+        if far and step > 0.0:  # a large turn, or far off the force: turn before pushing
             step = 0.0
     return action, (tgt.tool_point + step * axis, axis, a67), step, rotation, memo
 

@@ -14,7 +14,7 @@ from hypothesis import strategies as st
 
 from kinestat.app.control_run import ControlRequest, CylinderSpec, SimulatedCell, prepare_control
 from kinestat.app.sim_cell import InProcessIO, start_counts
-from kinestat.control.align import MAX_ALIGN_TURN_DEG, MIN_ALIGN_GAIN, align_gain
+from kinestat.control.align import MAX_ALIGN_TURN_DEG, MIN_ALIGN_GAIN, PUSH_TURN_DEG, align_gain
 from kinestat.control.controller import ControllerConfig
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import run
@@ -27,8 +27,8 @@ from .conftest import F_HAT, START, run_in_process, scenario
 def _press(tmp_path, cell: SimulatedCell, **kw):
     """The press task as ``kinestat control`` runs it (the thesis's calibrated cell), in
     process."""
-    prep = prepare_control(ControlRequest(force=4.0 * F_HAT, start_tool_point=START,
-                                          cell=cell, **kw))
+    kw.setdefault("force", 4.0 * F_HAT)
+    prep = prepare_control(ControlRequest(start_tool_point=START, cell=cell, **kw))
     io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
     with CycleLog(tmp_path / "log.jsonl") as log:
         rep = run(prep.config, io, log)
@@ -46,6 +46,24 @@ def test_the_press_settles_on_a_frictionless_cylinder(tmp_path, radius):
     assert abs(rep.true_force_magnitude - 4.0) <= 0.5
     assert rep.axis_error_deg <= 1.0
     assert rep.iterations <= 15
+
+
+@pytest.mark.parametrize("radius, axis, force", [
+    (297.4, (0.7849, -0.1143, 0.6090), 3.05),
+    (419.7, (0.7954, -0.4450, 0.4116), 4.25),
+])
+def test_a_large_turn_is_made_before_pushing(tmp_path, radius, axis, force):
+    # frictionless cylinders met 30-45° off the tool axis (two draws of the random press
+    # study): an 18-20° turn made together with the Newton step's push drove the force from
+    # about 1 N to 6-7 N in one cycle and the top past its 4° range
+    cyl = CylinderSpec(radius=radius, axis=np.array(axis))
+    rep, recs, _ = _press(tmp_path, SimulatedCell(cylinder=cyl), force=force * F_HAT)
+    assert rep.converged, rep.stop_reason
+    assert abs(rep.true_force_magnitude - force) <= 0.5 and rep.axis_error_deg <= 1.0
+    for r in recs:
+        if r.get("type") == "cycle" and r["action"] == "align":
+            if r["commanded"]["rotation_deg"] > PUSH_TURN_DEG:
+                assert r["commanded"]["step"] <= 0.0
 
 
 @pytest.mark.parametrize("cylinder", [None, CylinderSpec(radius=200.0,
