@@ -38,7 +38,8 @@ def turn_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 MAX_ALIGN_TURN_DEG = 20.0
 """The largest align turn of S6 in one cycle (degrees): a workpiece met far off the tool axis is
 turned onto in steps (a 40° turn at once moves the wrist beyond the envelope's 30° per
-command). The default plane's first turn, 13.5° at a light first contact, is made at once."""
+command). The default plane's first turn (4.8°) and the R = 200 mm cylinder's (13.5°, at a
+light first contact) are made at once."""
 PUSH_TURN_DEG = 10.0
 PUSH_LEFT_DEG = 5.0
 """An align turn larger than ``PUSH_TURN_DEG``, or one that leaves more than ``PUSH_LEFT_DEG``
@@ -64,7 +65,7 @@ def align_gain(gain: float, last_turn, misalignment) -> float:
     tip across the surface by about B δ (the platform's soft mode), where the normal differs by
     κ B δ; the whole turn then lands κ B e past the normal, and for κ B ≥ 1 the turns alternate
     for good (a frictionless R = 200 mm cylinder at 4 N: ±2.35° a cycle, docs/control.md
-    "The press on a curved workpiece"). The turn that lands on the normal is e / (1 + κ B).
+    "The press on curved and steep workpieces"). The turn that lands on the normal is e / (1 + κ B).
     Without measuring κ B: a turn overshot when the new misalignment points back along it by
     more than ``OVERSHOOT_RATIO`` of the turn (κ B > ½ at the whole turn); the gain then halves
     (down to ``MIN_ALIGN_GAIN``), otherwise it grows back by a quarter (up to 1).
@@ -101,8 +102,8 @@ def turn_was_carried(before, turn, after) -> bool:
     A tip that sticks on the workpiece holds the top: turning S6 about the tool point then
     turns the platform rigidly about the tip, its legs do not change, and the force turns with
     the tool (the default plane with μ = 0.3: 0.74° before a 0.74° turn, 0.72° after it). Only
-    a change of the platform's deflection turns the force relative to the tool (the shed of
-    :func:`kinestat.control.controller.decide`). On a plane or a frictionless surface a turn
+    a change of the platform's deflection turns the force relative to the tool
+    (:func:`shed`). On a plane or a frictionless surface a turn
     removes at least itself (``align_gain``).
 
     >>> turn_was_carried([0, 0, 0.0129], [0, 0, 0.0129], [0, 0, 0.0126])
@@ -145,7 +146,7 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float):
     model, tgt = config.model, state.target
     Fmag = float(np.linalg.norm(F))
     step, rotation, far = 0.0, 0.0, False
-    memo: dict = {"align_gain": state.align_gain}
+    memo: dict = {}
     if mis > config.align_tol_deg:
         full = turn_vector(tgt.s6, F / Fmag)
         if stuck(config, state, full, mis):
@@ -166,7 +167,7 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float):
             a67 = rotate_onto(tgt.a67, tgt.s6, axis)
         a67 = a67 - (a67 @ axis) * axis
         a67 /= np.linalg.norm(a67)
-        rotation = frac * mis if frac < 1.0 else mis
+        rotation = frac * mis  # frac <= 1: exactly mis for the whole turn
         far = rotation > PUSH_TURN_DEG or mis * (1.0 - frac) > PUSH_LEFT_DEG
         memo = {"align_gain": gain, "align_turn": turn, "align_from": full}
     else:
@@ -212,6 +213,6 @@ def shed(config, state, meas, F: np.ndarray, mis: float, err: float):
     size = float(np.linalg.norm(delta))
     frac = min(1.0, config.step / size) if size > 0.0 else 1.0
     delta = frac * delta
-    memo = {"align_gain": state.align_gain, "shed_expect_deg": mis * (1.0 - 0.5 * frac)}
+    memo = {"shed_expect_deg": mis * (1.0 - 0.5 * frac)}
     return ("shed", (tgt.tool_point + delta, s6.copy(), tgt.a67.copy()), float(delta @ s6),
             0.0, memo)

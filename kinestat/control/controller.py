@@ -35,11 +35,11 @@ When S6 is misaligned AND the force is out of tolerance, the reorientation and t
 the new axis are commanded together (at light contact the measured direction is noisy; pushing
 towards the target force makes it precise).
 
-The turn is at most ``MAX_ALIGN_TURN_DEG`` a cycle (a workpiece met far off the tool axis is
-turned onto in steps, without pushing along an axis still far from the force), and a turn
-that overshot the force makes the next ones a fraction of the misalignment
-(:func:`align_gain`): on a frictionless curved surface the free tip slides as S6 turns, and
-the whole turn then lands past the new normal.
+The move in contact is :func:`kinestat.control.align.contact_move`: the turn is at most
+``MAX_ALIGN_TURN_DEG`` a cycle and a large one is made before pushing along the new axis; a
+turn that overshot the force makes the next ones a fraction of the misalignment (on a
+frictionless curved surface the free tip slides as S6 turns, and the whole turn lands past the
+new normal); and where a stuck tip carries the turns, the force is shed across S6 instead.
 """
 
 from __future__ import annotations
@@ -280,7 +280,8 @@ class ControllerState:
         done: the run is over (goal reached or stopped).
         reoriented: the thesis's procedure made (or no longer needs) its one reorientation.
         align_gain: the fraction of the misalignment the next align turn makes (1: the whole
-            turn; halved each time a turn overshot, see :func:`align_gain`).
+            turn; halved each time a turn overshot, see
+            :func:`kinestat.control.align.align_gain`).
         align_turn: (3,) the last align turn's rotation vector (radians), None before one.
         align_from: (3,) the misalignment (rotation vector from S6 onto the force) it was
             made from.

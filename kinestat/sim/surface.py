@@ -152,11 +152,12 @@ def approach_distance(workpiece, start_point, direction) -> float:
     if not nd > 0.0:
         raise InputError(f"direction must be a nonzero vector, got {d.tolist()}")
     d = d / nd
-    if float(workpiece.gap(p)) <= 0.0:
+    gap = float(workpiece.gap(p))
+    if gap <= 0.0:
         return 0.0
     if isinstance(workpiece, Workpiece):
         rate = float(d @ workpiece.normal)
-        return float(workpiece.gap(p)) / -rate if rate < 0.0 else math.inf
+        return gap / -rate if rate < 0.0 else math.inf
     r0 = workpiece._radial(p)
     u = d - float(d @ workpiece.axis) * workpiece.axis
     a = float(u @ u)
