@@ -82,7 +82,9 @@ def test_the_one_newton_slide_is_the_secant_searchs_slide(depth, tilt, azimuth, 
     np.testing.assert_allclose(eq.leg_lengths, ref.leg_lengths, atol=1e-8)
     fn = eq.contact_force @ n
     ft = eq.contact_force - fn * n
-    np.testing.assert_allclose(np.linalg.norm(ft), mu * fn, rtol=1e-8, atol=1e-12)
+    # on the cone's edge to 1e-10 N (the Newton stops on an absolute residual: at a 0.008 mm
+    # touch, fn 0.08 N, it left 2e-11 N, 1.5e-8 relative; seen 2026-12-04)
+    np.testing.assert_allclose(np.linalg.norm(ft), mu * fn, rtol=1e-8, atol=1e-10)
     assert ft @ (eq.anchor - anchor) < 0  # friction against the slip
 
 
