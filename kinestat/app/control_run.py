@@ -38,7 +38,12 @@ from kinestat.app.control_defaults import (
 from kinestat.app.sim_cell import SimHarness, start_counts
 from kinestat.control.controller import MAX_ITERATIONS, ControllerConfig, Procedure, StepMethod
 from kinestat.control.envelope import Envelope, sent_command_guard
-from kinestat.control.follow import FollowConfig, decide_follow, follow_summary
+from kinestat.control.follow import (
+    FollowConfig,
+    decide_follow,
+    default_travel_dir,
+    follow_summary,
+)
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, refuse, run
 from kinestat.control.model import ControlModel
@@ -252,9 +257,9 @@ def prepare_control(req: ControlRequest) -> PreparedRun:
     prepared = _prepare_cell(req)
     if req.task != "follow":
         return prepared
-    if req.travel_dir is None:
-        raise InputError("the follow task needs a travel direction (--travel-dir x,y,z)")
-    follow = FollowConfig(base=prepared.config, travel=req.travel, travel_dir=req.travel_dir,
+    travel_dir = (default_travel_dir(prepared.config.start_s6) if req.travel_dir is None
+                  else req.travel_dir)
+    follow = FollowConfig(base=prepared.config, travel=req.travel, travel_dir=travel_dir,
                           travel_step=req.travel_step, tilt_deg=req.tilt_deg,
                           auto_tilt=req.auto_tilt,
                           probe_span=PROBE_SPAN if req.probe_span is None else req.probe_span)
@@ -389,13 +394,15 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
 def report_dict(prepared: PreparedRun, report: RunReport) -> dict:
     """The run's JSON report: :meth:`RunReport.as_dict`, and for the follow task ``completed``,
     ``travel`` (mm along the surface), ``normal_force_rms_error``/``normal_force_max_error``
-    (N, over the travel cycles), ``contact_lost`` (and the true errors when simulated)."""
+    (N, over the travel cycles), ``contact_lost`` (and the true errors when simulated),
+    ``travel_dir`` (the initial travel direction, unit: given, or the default)."""
     out = report.as_dict()
     if prepared.follow is not None:
         out["task"] = "follow"
         out["completed"] = report.converged
         out.update(follow_summary(report.cycles, prepared.config.force_target,
                                   prepared.follow.travel))
+        out["travel_dir"] = prepared.follow.travel_dir.tolist()  # the initial one (unit)
     if prepared.arm is not None:
         out["arm"] = prepared.arm.header()
     return out

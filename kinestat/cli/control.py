@@ -285,7 +285,8 @@ def control_command(
                                  "default 50)."),
     travel_dir: str = typer.Option(
         None, "--travel-dir", help="follow: initial direction of travel x,y,z (fixed frame), "
-        "projected onto the tangent plane as the surface is discovered."),
+        "projected onto the tangent plane as the surface is discovered (default: +y made "
+        "perpendicular to F_req; +x when F_req is within 30° of ±y)."),
     travel_step: float = typer.Option(None, "--travel-step", metavar="MM",
                                       help="follow: largest travel per cycle (mm; default 1)."),
     tilt_deg: float = typer.Option(

@@ -130,6 +130,7 @@ __all__ = [
     "estimate_normal",
     "carry_check",
     "follow_summary",
+    "default_travel_dir",
 ]
 
 FOLLOW_STATES = {
@@ -350,6 +351,30 @@ def _unit3(v, name: str) -> np.ndarray:
         raise InputError(f"{name} must be 3 finite numbers, not all zero, got "
                          f"{np.asarray(v).tolist()}")
     return a / np.linalg.norm(a)
+
+
+DEFAULT_TRAVEL_AXES = ((0.0, 1.0, 0.0), (1.0, 0.0, 0.0))
+"""The fixed-frame axes the default travel direction is made from, in order of preference."""
+
+
+def default_travel_dir(approach) -> np.ndarray:
+    """The follow task's travel direction when none is given: the fixed frame's +y made
+    perpendicular to the approach direction ``approach`` (F_req), or +x when F_req is within
+    30° of ±y. (3,) unit vector, at 90° from F_req: the tangent of a surface met head on.
+
+    >>> default_travel_dir([0.9713, 0.0, -0.2375]).tolist()  # the thesis's F_req
+    [0.0, 1.0, 0.0]
+    >>> default_travel_dir([0.0, 1.0, 0.0]).tolist()  # F_req along y: +x
+    [1.0, 0.0, 0.0]
+    """
+    d = _unit3(approach, "approach direction")
+    for axis in DEFAULT_TRAVEL_AXES:
+        a = np.asarray(axis)
+        t = a - (a @ d) * d
+        n = float(np.linalg.norm(t))
+        if n >= 0.5:  # the axis is at least 30° from ±F_req
+            return t / n
+    raise AssertionError("unreachable: +x and +y cannot both be within 30° of one line")
 
 
 def _tip_load_pose(platform, tip_top: np.ndarray, f_ext: np.ndarray, steps: int = 8,

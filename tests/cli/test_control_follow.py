@@ -18,7 +18,8 @@ def fast_robot(monkeypatch):
 
 
 def test_follow_cylinder_json_and_plots(tmp_path, capsys):
-    rc = main(["control", "--task", "follow", "--travel", "6", "--travel-dir", "0,1,0",
+    # no --travel-dir: the default, +y made perpendicular to the thesis's F_req (+y itself)
+    rc = main(["control", "--task", "follow", "--travel", "6",
                "--workpiece", "cylinder:radius=200,axis=0,0,1", "--json",
                "--log", str(tmp_path / "log.jsonl"), "--plot", str(tmp_path / "plots")])
     out = capsys.readouterr().out
@@ -26,6 +27,7 @@ def test_follow_cylinder_json_and_plots(tmp_path, capsys):
     assert rc == 0 and rep["completed"] is True
     assert rep["travel"] == pytest.approx(6.0, abs=1.0)
     assert rep["contact_lost"] == 0
+    assert rep["travel_dir"] == pytest.approx([0.0, 1.0, 0.0], abs=1e-12)
     assert rep["normal_force_max_error"] <= 0.5
     for key in ("converged", "force", "true_force", "stop_reason", "states", "cycles"):
         assert key in rep
@@ -43,7 +45,7 @@ def test_follow_cylinder_json_and_plots(tmp_path, capsys):
 @pytest.mark.parametrize("args, message", [
     (["--travel-dir", "0.9713,0,-0.2375"], "approach direction"),
     (["--travel-dir", "0,1,0", "--force", "40"], "cannot be carried"),
-    ([], "travel direction"),
+    (["--travel-dir", "0,0,0"], "travel direction"),
     (["--travel-dir", "0,1,0", "--workpiece", "sphere:radius=3"], "--workpiece"),
     (["--travel-dir", "0,1,0", "--task", "slide"], "--task"),
     (["--travel-dir", "0,1,0", "--probe-span", "-1"], "probe_span"),

@@ -35,6 +35,7 @@ from kinestat.control.follow import (
     _normal_in_cone,
     _track_roll,
     decide_follow,
+    default_travel_dir,
     estimate_normal,
 )
 from kinestat.control.log import CycleLog
@@ -385,9 +386,26 @@ def test_bad_requests_are_refused_before_any_motion(tmp_path):
         FollowConfig(base=base, travel=-1.0, travel_dir=Y)
     with pytest.raises(InputError, match="travel direction"):
         FollowConfig(base=base, travel=10.0, travel_dir=[0.0, 0.0, 0.0])
-    with pytest.raises(InputError, match="travel direction"):
-        prepare_control(ControlRequest(force=4.0 * F_HAT, start_tool_point=START,
-                                       cell=SimulatedCell(), task="follow"))
+
+
+def test_the_default_travel_direction_is_across_the_approach():
+    """No --travel-dir: +y made perpendicular to F_req, +x when F_req is within 30° of ±y;
+    always a unit vector at 90° from F_req, in the plane of F_req and the axis used."""
+    prep = prepare_control(ControlRequest(force=4.0 * F_HAT, start_tool_point=START,
+                                          cell=SimulatedCell(), task="follow"))
+    t = prep.follow.travel_dir
+    assert np.allclose(t, default_travel_dir(F_HAT)) and prep.header["travel_dir"] is not None
+    rng = np.random.default_rng(7)
+    for d in rng.normal(size=(500, 3)):
+        d /= np.linalg.norm(d)
+        t = default_travel_dir(d)
+        assert abs(np.linalg.norm(t) - 1.0) < 1e-12 and abs(t @ d) < 1e-12
+        near_y = abs(d[1]) > math.cos(math.radians(30.0))
+        axis = np.array([1.0, 0.0, 0.0]) if near_y else np.array([0.0, 1.0, 0.0])
+        assert abs(np.linalg.det(np.stack([t, d, axis]))) < 1e-12  # in span{F_req, axis}
+        assert t @ axis > 0.0  # towards the axis, not away from it
+    with pytest.raises(InputError, match="approach direction"):
+        default_travel_dir([0.0, 0.0, 0.0])
 
 
 def test_travel_into_the_surface_stops_at_contact_with_a_reason(tmp_path):
