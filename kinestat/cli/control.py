@@ -395,7 +395,10 @@ def control_command(
                       f"{method}, calibration {calibration}, "
                       + ("simulated cell" if simulated
                          else literal(f"Galil {galil}, sensor {serial}"))
-                      + ("" if prepared.arm is None else literal(_arm_words(prepared.arm))))
+                      + ("" if prepared.arm is None else literal(_arm_words(prepared.arm)))
+                      + ("" if prepared.follow is None else
+                         "; follow {:g} mm, first along ({:.4f}, {:.4f}, {:.4f})".format(
+                             prepared.follow.travel, *prepared.follow.travel_dir)))
     # SIGTERM / SIGHUP stop the cell as Ctrl-C does: ST, a fault and an end record, status 2
     with stop_on_signals():
         try:
