@@ -466,6 +466,22 @@ def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target
                    prediction=pred, **info)
 
 
+def contact_at_start(force_magnitude: float) -> str:
+    """The stop reason for a contact force measured right after the start move, before any
+    approach step. Every procedure starts out of contact (Vibhute Fig. 5-2, state a: the
+    platform at rest, unloaded) and approaches along S6; a force there means the tool already
+    touches something, or the leg calibration does not match the platform (the design springs'
+    map on the 2011 prototype reads 0.70 N at rest), and aligning on it would turn the tool
+    about a force no contact exerts.
+
+    >>> contact_at_start(0.7013)[:60]
+    'a force of 0.701 N is measured at the start pose, before any'
+    """
+    return (f"a force of {force_magnitude:.3g} N is measured at the start pose, before any "
+            "approach: the tool already touches something, or the leg calibration does not "
+            "match the platform (--calibration); the procedure starts out of contact")
+
+
 def decide(config: ControllerConfig, state: ControllerState,
            meas: Measurement) -> tuple[Command, ControllerState]:
     """One cycle of the kinestatic procedure: the next command and the new state.
@@ -501,6 +517,8 @@ def decide(config: ControllerConfig, state: ControllerState,
     if bad:
         return _stop(st(label=label), label, "measurement outside the envelope: "
                      + "; ".join(bad), violations=tuple(bad), **info)
+    if contact and state.last_action == "start":
+        return _stop(st(label=label), label, contact_at_start(Fmag), **info)
     if contact and abs(err) <= config.force_tol and mis <= config.align_tol_deg:
         return (Command(kind="done", label="e", reason="goal attained", **info),
                 st(label="e", done=True))

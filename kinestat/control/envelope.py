@@ -63,6 +63,8 @@ __all__ = [
     "tip_compliance",
     "tip_stiffness",
     "predict",
+    "predict_sliding",
+    "sliding_force",
     "check_target",
     "check_measurement",
     "check_command",
@@ -190,6 +192,83 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     top[:3, 3] = Rd @ meas.top_pose[:3, 3] + D[3:]
     return Prediction(force=force, deflections=defl, tip_motion=apply(Tn @ inv(meas.flange_pose),
                                                                       tip_F) - tip_F,
+                      top_pose=top)
+
+
+def _slide(model: ControlModel, meas: Measurement, Tn: np.ndarray):
+    """The first-order frictionless slide of :func:`predict_sliding`: ``(f + δf, n', v, F,
+    TB_new, data)``, or None out of contact (|F| ≤ 1e-9 N)."""
+    est = meas.estimate("point")  # force on the workpiece, fixed frame
+    f = math.sqrt(float(est @ est))
+    if not f > 1e-9:
+        return None
+    R = meas.base_pose[:3, :3]
+    F = -(R.T @ est)  # external force on the tip, base frame
+    TB_new = Tn @ model.mount
+    Rn = TB_new[:3, :3]
+    data = cycle_data(model, meas)
+    p = data.tip_base
+    u = Rn.T @ (data.tip_fixed - TB_new[:3, 3]) - p  # the pinned tip's motion, new base frame
+    n_new = Rn.T @ (-est / f)  # the normal (fixed frame) in the new base frame
+    KiZ = np.linalg.solve(data.K, np.vstack([np.zeros((3, 3)), skew(F)]))
+    M = np.eye(3) + KiZ[3:] - skew(p) @ KiZ[:3]  # M v = v − B K⁻¹ [0; v × F]
+    pick = np.zeros(3)
+    pick[int(np.argmin(np.abs(n_new)))] = 1.0
+    t1 = cross3(n_new, pick)
+    t1 = t1 / math.sqrt(float(t1 @ t1))
+    t2 = cross3(n_new, t1)
+    C_tip = data.C_tip
+    lhs = np.empty((3, 3))
+    lhs[:, 0], lhs[:, 1], lhs[:, 2] = M @ t1, M @ t2, -(C_tip @ n_new)
+    sol = np.linalg.solve(lhs, C_tip @ (f * n_new - F) - M @ u)
+    return f + float(sol[2]), n_new, u + sol[0] * t1 + sol[1] * t2, F, TB_new, data
+
+
+def sliding_force(model: ControlModel, meas: Measurement, flange_pose_new) -> float:
+    """|F| (N) after moving the flange to ``flange_pose_new`` with the tip sliding freely:
+    :func:`predict_sliding`'s force magnitude without the rest of the prediction (the press's
+    step, :func:`kinestat.control.align.turned_force`). Out of contact, :func:`predict`'s."""
+    Tn = np.asarray(flange_pose_new, dtype=float)
+    out = _slide(model, meas, Tn)
+    if out is None:
+        return predict(model, meas, Tn).force_magnitude
+    return abs(out[0])
+
+
+def predict_sliding(model: ControlModel, meas: Measurement, flange_pose_new) -> Prediction:
+    """Predict the state after moving the flange to ``flange_pose_new`` with the tip SLIDING
+    freely (a frictionless contact) on the surface whose normal is the measured force's
+    direction: the force stays along that normal in the fixed frame, the tip moves only in the
+    tangent plane. (:func:`predict` pins the tip: the worst case for the load of a sticking
+    contact; on a frictionless surface met far off the tool axis it overstates the load of a
+    turn several times, and understates the top's motion.)
+
+    To first order, with ``M v = v + B K⁻¹ [0; [F]× v]`` the map from the tip's displacement
+    ``v`` relative to the top (base frame) to ``C_tip δF`` (:func:`predict`'s relation
+    ``M u = C_tip δF``): the tip's displacement is ``u + T τ`` (``u`` as for the pinned tip,
+    ``T`` (3, 2) the tangent plane of the normal ``n'`` in the new base frame) and the force
+    ``(f + δf) n'``, so ``[M T, −C_tip n'] [τ; δf] = C_tip (f n' − F) − M u``. Out of contact
+    (|F| below 1e-9 N) it returns :func:`predict`'s (pinned) prediction. NumPy, not compiled.
+    """
+    Tn = np.asarray(flange_pose_new, dtype=float)
+    out = _slide(model, meas, Tn)
+    if out is None:
+        return predict(model, meas, Tn)
+    f_new, n_new, v, F, TB_new, data = out
+    p = data.tip_base
+    dF = f_new * n_new - F
+    A = np.vstack([np.eye(3), skew(p)])
+    D = np.linalg.solve(data.K, A @ dF + np.concatenate([np.zeros(3), cross3(v, F)]))
+    S, _ = data.leg_directions
+    dl = cross_rows(model.platform.base_points, S) @ D[:3] + S @ D[3:]
+    top = np.eye(4)
+    Rd = rotvec_matrix_one(D[:3])
+    top[:3, :3] = Rd @ meas.top_pose[:3, :3]
+    top[:3, 3] = Rd @ meas.top_pose[:3, 3] + D[3:]
+    tip_F = data.tip_fixed
+    return Prediction(force=-(TB_new[:3, :3] @ (F + dF)),
+                      deflections=meas.deflections(model) + dl,
+                      tip_motion=apply(Tn @ inv(meas.flange_pose), tip_F) - tip_F,
                       top_pose=top)
 
 

@@ -101,6 +101,7 @@ from kinestat.control.controller import (
     Refusal,
     Target,
     approach_refusal,
+    contact_at_start,
     move_command,
 )
 from kinestat.control.cycle import cross3, cycle_data, mount_inverse, norm3, replace
@@ -1265,6 +1266,8 @@ def decide_follow(config: FollowConfig, state: ControllerState,
     if bad:
         return _stop(st, label, "measurement outside the envelope: " + "; ".join(bad),
                      violations=tuple(bad), **kw)
+    if contact and state.last_action == "start":
+        return _stop(st, label, contact_at_start(norm3(F)), **kw)
     if st.cycle >= base.max_iterations:
         return _stop(st, label, f"travel not completed after {st.cycle} cycles "
                      f"({st.travel:.3f} of {config.travel:g} mm)", **kw)

@@ -50,6 +50,7 @@ from kinestat.control.controller import (
     Target,
     _stop,
     approach_refusal,
+    contact_at_start,
     move_command,
 )
 from kinestat.control.envelope import check_measurement
@@ -98,6 +99,8 @@ def decide_thesis(config: ControllerConfig, state: ControllerState,
     if bad:
         return _stop(replace(st, label=label), label, "measurement outside the envelope: "
                      + "; ".join(bad), violations=tuple(bad), **info)
+    if contact and state.last_action == "start":
+        return _stop(replace(st, label=label), label, contact_at_start(Fmag), **info)
     if state.last_action == "start":  # step 2: measure W_eq; step 4 measures afresh
         return (Command(kind="measure", label=label, action="measure", **info),
                 replace(st, label=label, last_action="measure"))

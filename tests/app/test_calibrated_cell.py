@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
+import pytest
 
 from kinestat.app.calibrations import NamedCalibration, calibrated_model
 from kinestat.app.control_run import ControlRequest, SimulatedCell, prepare_control
@@ -53,6 +56,24 @@ def test_nominal_calibration_reads_a_phantom_force_on_the_thesis_legs(tmp_path):
     assert rep.true_force_magnitude is not None
     assert not rep.converged or np.linalg.norm(rep.force - rep.true_force) > 0.1
     assert np.linalg.norm(rep.equivalent_wrench[:3]) > 2.0
+
+
+@pytest.mark.parametrize("kw", [{}, {"procedure": "thesis"},
+                                {"task": "follow", "travel_dir": np.array([0.0, 1.0, 0.0])}])
+def test_a_phantom_force_at_the_start_stops_before_any_turn(tmp_path, kw):
+    """The nominal calibration on the thesis legs reads a force at rest, out of contact. On
+    1cb8fd6 the press turned the tool 20° about it and shed it back for 60 cycles, and the
+    follow task probed for 150; now the first measurement stops the run, naming the
+    calibration, with nothing but the start move commanded."""
+    prep, rep, io = _run(tmp_path, calibration="nominal", **kw)
+    assert not rep.converged and rep.iterations == 1
+    assert "measured at the start pose" in rep.stop_reason
+    assert "--calibration" in rep.stop_reason
+    recs = [json.loads(line) for line in (tmp_path / "log.jsonl").read_text().splitlines()]
+    assert [r["type"] for r in recs][-2:] == ["fault", "end"]
+    cycles = [r for r in recs if r["type"] == "cycle"]
+    assert len(cycles) == 1 and cycles[0]["commanded"] is None  # nothing after the start move
+    assert rep.true_force_magnitude is not None and rep.true_force_magnitude < 1e-9
 
 
 def test_nominal_reading_of_thesis_counts_is_biased_at_every_load(tmp_path):

@@ -40,9 +40,10 @@ def test_default_run_reproduces_the_thesis_experiment(tmp_path):
     rep, recs, _ = run_in_process(scn, scn.config(), tmp_path / "log.jsonl")
     assert rep.converged, rep.stop_reason
     s = "".join(rep.states)
-    # unloaded approach, impact, reorientation along the wrench, then (maybe) force control
-    assert s[0] == "a" and "b" in s and "c" in s and s[-1] == "e"
-    assert s.index("a") < s.index("b") < s.index("c")
+    # unloaded approach, impact, reorientation along the wrench (with its force step: when that
+    # lands within tolerance the next state is already e), then (maybe) force control
+    assert s[0] == "a" and "b" in s and s[-1] == "e"
+    assert s.index("a") < s.index("b") and ("c" not in s or s.index("b") < s.index("c"))
     assert abs(rep.force_magnitude - 4.0) <= 0.5
     assert abs(rep.true_force_magnitude - 4.0) <= 0.5 + 0.1
     # the reorientation turned S6 by the plane's 5° tilt
