@@ -196,7 +196,8 @@ def _task_row(task: str, repeat: int) -> dict:
     # the cycles in contact (the press's align, force and shed moves; for the follow task the
     # timed cycles are already its settle and follow ones): the press's approach steps are
     # cheaper and make most of its moving cycles
-    contact = [t for t, (_, _, c) in zip(alone, moving) if c.action not in ("approach", "probe")]
+    contact = [t for t, (_, _, c) in zip(alone, moving, strict=True)
+               if c.action not in ("approach", "probe")]
     t_meas = _single(lambda s, m: measure(model, m.q, m.counts, s.top_pose), decisions, repeat)
     return {"task": task, "cycles": len(pairs), "moves_timed": len(moving),
             "decide_us": 1e6 * t_full, "reference_decide_us": 1e6 * t_full_ref,
