@@ -321,7 +321,7 @@ def stiffness_command(
 
 
 CONTACT_HELP = ("A wrench the contact can exert, fx,fy,fz,mx,my,mz (moment about O0, base "
-                "frame); repeat for 1 to 5 independent wrenches.")
+                "frame); repeat for 1 to 6 independent wrenches.")
 DECOMPOSE_TWIST_HELP = help_text("Twist wx,wy,wz,vx,vy,vz: [omega; v_O] (rad, length unit), "
                                  "base frame.")
 
@@ -348,8 +348,8 @@ def decompose_command(
         platform_stiffness_axis,
     )
 
-    if not 1 <= len(contact) <= 5:
-        raise InputError(f"--contact: give 1 to 5 contact wrenches, got {len(contact)}")
+    if not 1 <= len(contact) <= 6:
+        raise InputError(f"--contact: give 1 to 6 contact wrenches, got {len(contact)}")
     W = np.stack([parse_floats(c, 6, "contact") for c in contact], axis=1)
     T_axis = parse_floats(twist, 6, "twist")
     p = _load(platform)

@@ -44,9 +44,9 @@ is not symmetric (:func:`~kinestat.parallel.stiffness.load_asymmetry`), the prod
 the orthogonality is one-sided: ``T_fᵀ Δ K T_c = 0`` holds, ``T_cᵀ Δ K T_f`` in general does not
 (tests/parallel/test_kinestatic.py checks both).
 
-Shapes: ``K`` (..., 6, 6), ``W`` (..., 6, m) with 1 ≤ m ≤ 5 (a single wrench may be given as
+Shapes: ``K`` (..., 6, 6), ``W`` (..., 6, m) with 1 ≤ m ≤ 6 (a single wrench may be given as
 (6,)), ``T`` (..., 6); leading batch dimensions broadcast. Degenerate inputs raise
-:class:`~kinestat.errors.InputError` (bad shapes, m outside 1..5, linearly dependent contact
+:class:`~kinestat.errors.InputError` (bad shapes, m outside 1..6, linearly dependent contact
 wrenches, a twist of freedom that is not reciprocal, a wrench change outside span W) or
 :class:`~kinestat.errors.SingularityError` (K singular, ``Wᵀ Δ K⁻¹ W`` singular).
 """
@@ -125,7 +125,9 @@ def axis_stiffness(K, twist_order: str = "ray") -> np.ndarray:
 
 
 def contact_basis(W) -> np.ndarray:
-    """The contact wrenches as a (..., 6, m) array, checked: 1 ≤ m ≤ 5, linearly independent.
+    """The contact wrenches as a (..., 6, m) array, checked: 1 ≤ m ≤ 6, linearly independent.
+    Six independent wrenches constrain every twist: the twist of freedom is zero and the whole
+    twist is compliance (a tool held fast).
 
     A single wrench may be given as (6,). Columns are ray-order wrenches ``[f; m_O]``.
     """
@@ -136,9 +138,10 @@ def contact_basis(W) -> np.ndarray:
         raise InputError(f"contact wrenches W must have shape (..., 6, m) (columns [f; m_O]), "
                          f"got {W.shape}")
     m = W.shape[-1]
-    if not 1 <= m <= 5:
-        raise InputError(f"the contact must exert 1 to 5 independent wrenches, got m = {m} "
-                         "(m = 0 leaves nothing to decompose; m = 6 leaves no twist of freedom)")
+    if not 1 <= m <= 6:
+        raise InputError(f"the contact must exert 1 to 6 independent wrenches, got m = {m} "
+                         "(m = 0 leaves nothing to decompose; more than 6 cannot be "
+                         "independent)")
     norms = np.linalg.norm(W, axis=-2)
     zero = norms == 0.0
     if np.any(zero):

@@ -226,9 +226,9 @@ def test_degenerate_contact_sets():
     K = stiffness(P, P.home_pose, twist_order="axis")
     T = np.r_[0.0, 0, 0, 1, 0, 0]
     w = np.r_[0, 0, 1.0, 0, 0, 0]
-    with pytest.raises(InputError, match="1 to 5"):
-        decompose_twist(K, np.eye(6), T)
-    with pytest.raises(InputError, match="1 to 5"):
+    with pytest.raises(InputError, match="1 to 6"):
+        decompose_twist(K, np.eye(6, 7), T)
+    with pytest.raises(InputError, match="1 to 6"):
         decompose_twist(K, np.zeros((6, 0)), T)
     with pytest.raises(InputError, match="linearly dependent"):
         decompose_twist(K, np.stack([w, 2 * w], axis=1), T)
@@ -271,3 +271,21 @@ def test_compose_rejects_bad_inputs():
         compose_twist(K, w, np.r_[0, 0, 0, 0, 0, 1.0], 3 * w)  # v_O,z pushes along the force
     with pytest.raises(InputError, match="not one the contact can exert"):
         compose_twist(K, w, np.r_[0, 0, 0, 1.0, 0, 0], np.r_[1.0, 0, 0, 0, 0, 0])
+
+
+def test_six_contact_wrenches_leave_no_twist_of_freedom():
+    """A tool held fast (six independent contact wrenches): T_f = 0, T_c = T, λ = W⁻¹ K T,
+    and the freedom basis is empty; compose_twist takes only the zero twist of freedom."""
+    rng = np.random.default_rng(3)
+    K = stiffness(P, P.home_pose, twist_order="axis")
+    for _ in range(20):
+        W = rng.normal(size=(6, 6))
+        T = rng.normal(size=6) * np.r_[0.01, 0.01, 0.01, 1.0, 1.0, 1.0]
+        s = decompose_twist(K, W, T)
+        assert np.linalg.norm(s.freedom) <= 1e-12 * np.linalg.norm(T)
+        np.testing.assert_allclose(s.compliance, T, rtol=0, atol=1e-12 * np.linalg.norm(T))
+        np.testing.assert_allclose(W @ s.lam, K @ T, rtol=1e-9, atol=1e-9)
+        assert freedom_basis(W).shape == (6, 0)
+        dw = W @ rng.normal(size=6)
+        np.testing.assert_allclose(compose_twist(K, W, np.zeros(6), dw), np.linalg.solve(K, dw),
+                                   rtol=1e-12, atol=1e-15)

@@ -57,7 +57,7 @@ def test_decompose_human_table(capsys):
 @pytest.mark.parametrize("args, message", [
     (["--contact", "0,0,1,0,0,0", "--contact", "0,0,2,0,0,0"], "linearly dependent"),
     (["--contact", "0,0,1,0,0"], "expected 6"),
-    (["--contact", "1,0,0,0,0,0"] * 6, "1 to 5"),
+    (["--contact", "1,0,0,0,0,0"] * 7, "1 to 6"),
     (["--contact", "0,0,1,0,0,0", "--wrench", "0,0,1"], "--wrench"),
     (["--contact", "0,0,1,0,0,0", "--pose", "1,2,3"], "--pose"),
 ])
@@ -65,3 +65,15 @@ def test_decompose_errors_are_one_line(capsys, args, message):
     assert main(["platform", "decompose", "--twist", "0,0,0,1,0,0", *args]) == 2
     err = capsys.readouterr().err.strip()
     assert message in err and "\n" not in err and err.startswith("kinestat: error:")
+
+
+def test_decompose_six_contacts_hold_the_tool_fast(capsys):
+    """Six independent contact wrenches: no twist of freedom, the whole twist is compliance."""
+    args = ["platform", "decompose", "--twist", "0.01,0.02,0,1,0,2", "--json"]
+    for row in np.eye(6):
+        args += ["--contact", ",".join(str(v) for v in row)]
+    assert main(args) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert np.allclose(out["freedom"], 0.0, atol=1e-12)
+    assert np.allclose(out["compliance"], [0.01, 0.02, 0, 1, 0, 2], atol=1e-12)
+    assert len(out["lambda"]) == 6
