@@ -31,7 +31,7 @@ from kinestat.devices.cell_io import DeviceIO, SensorSample
 from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.devices.motion import coordinated_move_plan
-from kinestat.errors import DeviceError, KinestatError, UnreachableError
+from kinestat.errors import DeviceError, JointLimitError, KinestatError, UnreachableError
 from kinestat.hardware.puma762_axes import (
     AXIS4_TO_5_COUPLING,
     AXIS_DEG_PER_COUNT,
@@ -59,13 +59,25 @@ def control_model(cell: Cell, sensor: Sensor, *, coupling: float = AXIS4_TO_5_CO
                         calibration=sensor.calibration, coupling=coupling, **kw)
 
 
+_LEAVE_IT = "; leave the robot where it is or choose another pose"
+"""The PUMA 762 selection's advice, replaced by the start pose's (:func:`start_counts`)."""
+
+
 def start_counts(config: ControllerConfig, current_counts=(0, 0, 0, 0, 0, 0)) -> np.ndarray:
     """Axis counts of the start pose (the solution nearest ``current_counts``), where a
     simulated robot is placed before the run so that the first move is short."""
     model = config.model
     c = np.asarray(current_counts, dtype=np.int64)
-    axis = model.arm.solve_axis(config.start_tool_point, config.start_s6, config.start_a67,
-                                model.tool_point_6, axis_counts_to_q(model, c), model.limits_deg)
+    try:
+        axis = model.arm.solve_axis(config.start_tool_point, config.start_s6, config.start_a67,
+                                    model.tool_point_6, axis_counts_to_q(model, c),
+                                    model.limits_deg)
+    except (UnreachableError, JointLimitError) as exc:
+        p = ", ".join(f"{v:g}" for v in np.round(config.start_tool_point, 3))
+        d = ", ".join(f"{v:.4f}" for v in config.start_s6)
+        why = str(exc).removesuffix(_LEAVE_IT)
+        raise type(exc)(f"the start pose (tool point ({p}) mm, tool axis along F_req ({d})) "
+                        f"is out of reach: {why}; choose another --start or --direction") from exc
     return axis_deg_to_counts(np.degrees(axis))
 
 

@@ -60,6 +60,8 @@ def test_follow_cylinder_json_and_plots(tmp_path, capsys):
      "inside the simulated plane"),
     (["--task", "press", "--plane-point", "0,0,0", "--plane-normal", "0,0,-1"],
      "not ahead of the tool"),
+    (["--task", "press", "--direction", "0,1,0"], "the start pose (tool point (-400, 800, -100)"),
+    (["--direction", "0,1,0"], "choose another --start or --direction"),
 ])
 def test_bad_follow_requests_fail_before_any_motion(tmp_path, capsys, args, message):
     argv = ["control", "--log", str(tmp_path / "log.jsonl"), "--no-plot"]
