@@ -65,6 +65,7 @@ __all__ = [
     "predict",
     "predict_sliding",
     "sliding_force",
+    "sliding_push",
     "check_target",
     "check_measurement",
     "check_command",
@@ -195,9 +196,12 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
                       top_pose=top)
 
 
-def _slide(model: ControlModel, meas: Measurement, Tn: np.ndarray):
+def _slide(model: ControlModel, meas: Measurement, Tn: np.ndarray, push=None):
     """The first-order frictionless slide of :func:`predict_sliding`: ``(f + δf, n', v, F,
-    TB_new, data)``, or None out of contact (|F| ≤ 1e-9 N)."""
+    TB_new, data, rate)``, or None out of contact (|F| ≤ 1e-9 N). ``rate`` is ``d(f + δf)/ds``
+    (N/mm) for a further translation ``s`` of the flange along the unit vector ``push`` (fixed
+    frame; None: not computed): the slide is linear in the tip's motion ``u``, which such a
+    translation changes by ``−s R'ᵀ push``."""
     est = meas.estimate("point")  # force on the workpiece, fixed frame
     f = math.sqrt(float(est @ est))
     if not f > 1e-9:
@@ -220,8 +224,14 @@ def _slide(model: ControlModel, meas: Measurement, Tn: np.ndarray):
     C_tip = data.C_tip
     lhs = np.empty((3, 3))
     lhs[:, 0], lhs[:, 1], lhs[:, 2] = M @ t1, M @ t2, -(C_tip @ n_new)
-    sol = np.linalg.solve(lhs, C_tip @ (f * n_new - F) - M @ u)
-    return f + float(sol[2]), n_new, u + sol[0] * t1 + sol[1] * t2, F, TB_new, data
+    rhs = C_tip @ (f * n_new - F) - M @ u
+    if push is None:
+        sol = np.linalg.solve(lhs, rhs)
+        rate = None
+    else:
+        both = np.linalg.solve(lhs, np.stack([rhs, M @ (Rn.T @ push)], axis=1))
+        sol, rate = both[:, 0], float(both[2, 1])
+    return f + float(sol[2]), n_new, u + sol[0] * t1 + sol[1] * t2, F, TB_new, data, rate
 
 
 def sliding_force(model: ControlModel, meas: Measurement, flange_pose_new) -> float:
@@ -233,6 +243,20 @@ def sliding_force(model: ControlModel, meas: Measurement, flange_pose_new) -> fl
     if out is None:
         return predict(model, meas, Tn).force_magnitude
     return abs(out[0])
+
+
+def sliding_push(model: ControlModel, meas: Measurement, flange_pose_new,
+                 axis) -> tuple[float, float] | None:
+    """``(f, k)``: the force magnitude (N) :func:`predict_sliding` gives after moving the flange
+    to ``flange_pose_new``, and its rate ``k = df/ds`` (N/mm) for a further translation ``s``
+    of the flange along the unit vector ``axis`` (fixed frame): with the tip sliding freely the
+    force after the move and a push ``s`` is ``f + k s`` to first order. None out of contact.
+    The press's step after a turn (:func:`kinestat.control.align.contact_move`)."""
+    out = _slide(model, meas, np.asarray(flange_pose_new, dtype=float),
+                 push=np.asarray(axis, dtype=float))
+    if out is None:
+        return None
+    return out[0], out[6]
 
 
 def predict_sliding(model: ControlModel, meas: Measurement, flange_pose_new) -> Prediction:
@@ -254,7 +278,7 @@ def predict_sliding(model: ControlModel, meas: Measurement, flange_pose_new) -> 
     out = _slide(model, meas, Tn)
     if out is None:
         return predict(model, meas, Tn)
-    f_new, n_new, v, F, TB_new, data = out
+    f_new, n_new, v, F, TB_new, data, _ = out
     p = data.tip_base
     dF = f_new * n_new - F
     A = np.vstack([np.eye(3), skew(p)])

@@ -17,6 +17,7 @@ from kinestat.control.envelope import (
     predict_sliding,
     require,
     sliding_force,
+    sliding_push,
     tip_compliance,
     tip_stiffness,
 )
@@ -128,6 +129,28 @@ def test_sliding_prediction_matches_a_frictionless_contact(move, tilt):
     # the force stays along the measured normal (the force direction): no friction to tilt it
     n = m.force / np.linalg.norm(m.force)
     assert np.linalg.norm(np.cross(pred.force, n)) <= 1e-9 * np.linalg.norm(pred.force)
+
+
+@pytest.mark.parametrize("tilt", [4.0, 30.0])
+def test_sliding_push_rate_is_the_force_change_of_a_push(tilt):
+    """``sliding_push``'s rate: a further push ``s`` along an axis changes the predicted force
+    by ``k s`` (the slide is linear in the flange's translation), and matches the simulator's
+    frictionless contact to the model's accuracy."""
+    scn = scenario(tilt_deg=tilt, friction=0.0)
+    T, eq, m = _loaded(scn, push=0.3)
+    R = np.eye(4)
+    R[:3, :3] = Rotation.from_rotvec(np.radians(1.0) * np.array([0, 1.0, 0])).as_matrix()
+    Tn = trans(m.tool_point) @ R @ trans(-m.tool_point) @ T  # a 1° turn about the tool point
+    axis = R[:3, :3] @ m.s6
+    f0, k = sliding_push(scn.model, m, Tn, axis)
+    assert f0 == pytest.approx(sliding_force(scn.model, m, Tn), rel=1e-12)
+    s = 0.05
+    f1 = sliding_force(scn.model, m, trans(s * axis) @ Tn)
+    assert f1 == pytest.approx(f0 + k * s, rel=1e-9)
+    true0 = np.linalg.norm(equilibrium(scn.cell, Tn).tool_force)
+    true1 = np.linalg.norm(equilibrium(scn.cell, trans(s * axis) @ Tn).tool_force)
+    assert (true1 - true0) / s == pytest.approx(k, rel=0.08)
+    assert 0.0 < k <= float(axis @ tip_stiffness(scn.model, m) @ axis) * (1 + 1e-9)
 
 
 def test_command_checks():
