@@ -20,7 +20,7 @@ from kinestat.spatial.se3 import rotvec_matrix_one
 
 __all__ = [
     "MAX_ALIGN_TURN_DEG", "PUSH_TURN_DEG", "PUSH_LEFT_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN",
-    "MIN_PUSH_RATE",
+    "MIN_PUSH_RATE", "TURN_RETRIES",
     "STUCK_RATIO", "turn_vector", "rotate_onto", "align_gain", "turn_was_carried",
     "contact_move", "turned_force", "stuck", "shed",
 ]
@@ -41,6 +41,11 @@ MAX_ALIGN_TURN_DEG = 20.0
 turned onto in steps (a 40° turn at once moves the wrist beyond the envelope's 30° per
 command). The default plane's first turn (4.8°) and the R = 200 mm cylinder's (13.5°, at a
 light first contact) are made at once."""
+TURN_RETRIES = 3
+"""An align turn the envelope refuses because an axis would move more than its per-command
+step (a wrist near its singular pose swings axis 4 by 30–42° for a 20° turn of S6) is tried
+again within the cycle at half the turn, up to this many times
+(:func:`~kinestat.control.controller.decide`)."""
 PUSH_TURN_DEG = 10.0
 PUSH_LEFT_DEG = 5.0
 """An align turn larger than ``PUSH_TURN_DEG``, or one that leaves more than ``PUSH_LEFT_DEG``
@@ -141,11 +146,12 @@ def rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
             + k * (k @ v) * (1.0 - math.cos(ang)))
 
 
-def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float):
+def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float,
+                 max_turn_deg: float = MAX_ALIGN_TURN_DEG):
     """The move of a cycle in contact: (action, target, step along the axis, turn in degrees,
     the state's align memory). Misaligned: turn S6 onto the force about the tool point (the
     torque about it vanishes) — a fraction of the turn where the last one overshot
-    (:func:`~kinestat.control.align.align_gain`), at most ``MAX_ALIGN_TURN_DEG`` — or, where
+    (:func:`~kinestat.control.align.align_gain`), at most ``max_turn_deg`` — or, where
     the turns are carried by a stuck tip, shed the force across S6 (:func:`shed`). Then the
     step along the axis when the force is out of tolerance."""
     model, tgt = config.model, state.target
@@ -159,7 +165,7 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float):
         action = "align"
         gain = align_gain(state.align_gain,
                           state.align_turn if state.last_action == "align" else None, full)
-        frac = min(gain, math.radians(MAX_ALIGN_TURN_DEG) / max(float(np.linalg.norm(full)),
+        frac = min(gain, math.radians(max_turn_deg) / max(float(np.linalg.norm(full)),
                                                                  1e-300))
         if frac < 1.0:
             turn = frac * full

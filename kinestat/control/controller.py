@@ -50,7 +50,7 @@ from typing import Literal, get_args
 
 import numpy as np
 
-from kinestat.control.align import contact_move
+from kinestat.control.align import MAX_ALIGN_TURN_DEG, TURN_RETRIES, contact_move
 from kinestat.control.approach import approach_waypoints, check_approach
 from kinestat.control.arm import Puma762Arm
 from kinestat.control.ceilings import MAX_ITERATIONS
@@ -482,6 +482,30 @@ def contact_at_start(force_magnitude: float) -> str:
             "match the platform (--calibration); the procedure starts out of contact")
 
 
+def _contact_command(config: ControllerConfig, state: ControllerState, meas, F, mis, err,
+                     label: str, info: dict):
+    """The move of a cycle in contact (:func:`~kinestat.control.align.contact_move`) and its
+    command: ``(command or Refusal, target, action, step, rotation, memo)``. An align turn
+    refused because an axis would move more than its per-command step is made smaller, half
+    the turn at a time, up to ``TURN_RETRIES`` times (a wrist near its singular pose: a 20°
+    turn of S6 swung axis 4 by 30–42°)."""
+    cap = MAX_ALIGN_TURN_DEG
+    for attempt in range(TURN_RETRIES + 1):
+        action, (point, axis, a67), step, rotation, memo = contact_move(
+            config, state, meas, F, mis, err, max_turn_deg=cap)
+        new = Target(point, axis, a67)
+        cmd = move_command(config.model, config.envelope, config.vernier, meas, new,
+                           state.axis_counts, label=label, action=action, step=step,
+                           rotation_deg=rotation, info=info)
+        refused_step = (isinstance(cmd, Refusal) and action == "align"
+                        and any("in one command" in v
+                                for v in cmd.extra.get("violations", ())))
+        if not refused_step or attempt == TURN_RETRIES:
+            return cmd, new, action, step, rotation, memo
+        cap = 0.5 * rotation
+    raise AssertionError("unreachable")
+
+
 def decide(config: ControllerConfig, state: ControllerState,
            meas: Measurement) -> tuple[Command, ControllerState]:
     """One cycle of the kinestatic procedure: the next command and the new state.
@@ -538,10 +562,10 @@ def decide(config: ControllerConfig, state: ControllerState,
         refused = approach_refusal(config, new.tool_point)
         if refused:
             return _stop(st(label=label), label, refused, **info)
+        cmd = None
     else:
-        action, (point, axis, a67), step, rotation, memo = contact_move(config, state, meas, F,
-                                                                         mis, err)
-        new = Target(point, axis, a67)
+        cmd, new, action, step, rotation, memo = _contact_command(config, state, meas, F, mis,
+                                                                  err, label, info)
     key = new.key()
     if state.history.count(key) + 1 >= config.repeat_limit:
         return _stop(st(label=label), label,
@@ -550,8 +574,10 @@ def decide(config: ControllerConfig, state: ControllerState,
                      + (f"; the fixed {config.step:g} mm step is too coarse for this stiffness "
                         "— use method 'stiffness' or a smaller step"
                         if config.method == "fixed" else ""), **info)
-    cmd = move_command(model, env, config.vernier, meas, new, state.axis_counts, label=label,
-                       action=action, step=step, rotation_deg=rotation, info=info)
+    if cmd is None:
+        cmd = move_command(model, env, config.vernier, meas, new, state.axis_counts,
+                           label=label, action=action, step=step, rotation_deg=rotation,
+                           info=info)
     if isinstance(cmd, Refusal):
         return _stop(st(label=label), label, cmd.reason, **cmd.extra, **info)
     new_state = st(label=label, last_action=action, target=new,

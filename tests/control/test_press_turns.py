@@ -93,6 +93,23 @@ def test_the_force_a_turn_raises_is_not_pushed_on_top_of(tmp_path, radius, axis,
         assert abs(rep.true_force_magnitude - force) <= 0.5 and rep.axis_error_deg <= 1.0
 
 
+@pytest.mark.parametrize("radius, axis, force", [
+    (430.4, (-0.7496, -0.5976, -0.2846), 2.95),
+    (419.8, (0.8368, 0.1842, 0.5156), 4.54),
+])
+def test_a_turn_the_wrist_cannot_make_at_once_is_halved(tmp_path, radius, axis, force):
+    # two draws of a fresh random press study (seeds 3 and 4, 2026-12-04): the second 20°
+    # turn would have swung axis 4 by 30-42° in one command, and the envelope's refusal
+    # stopped the run; the turn is now halved within the cycle until the wrist can make it
+    cyl = CylinderSpec(radius=radius, axis=np.array(axis))
+    rep, recs, _ = _press(tmp_path, SimulatedCell(cylinder=cyl), force=force * F_HAT)
+    assert rep.converged, rep.stop_reason
+    assert abs(rep.true_force_magnitude - force) <= 0.5 + 0.1 and rep.axis_error_deg <= 1.0
+    turns = [r["commanded"]["rotation_deg"] for r in recs
+             if r.get("type") == "cycle" and r["action"] == "align" and r["commanded"]]
+    assert any(t == pytest.approx(MAX_ALIGN_TURN_DEG / 2) for t in turns)
+
+
 @pytest.mark.parametrize("cylinder", [None, CylinderSpec(radius=200.0,
                                                           axis=np.array([0.0, 0.0, 1.0]))])
 def test_a_stuck_tip_is_aligned_by_shedding_the_force_across_s6(tmp_path, cylinder):
