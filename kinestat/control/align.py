@@ -44,8 +44,8 @@ light first contact) are made at once."""
 TURN_RETRIES = 3
 """An align turn the envelope refuses because an axis would move more than its per-command
 step (a wrist near its singular pose swings axis 4 by 30–42° for a 20° turn of S6) is tried
-again within the cycle at half the turn, up to this many times
-(:func:`~kinestat.control.controller.decide`)."""
+again within the cycle at half the turn, up to this many times (the press's
+:func:`~kinestat.control.controller.decide`)."""
 PUSH_TURN_DEG = 10.0
 PUSH_LEFT_DEG = 5.0
 """An align turn larger than ``PUSH_TURN_DEG``, or one that leaves more than ``PUSH_LEFT_DEG``
