@@ -14,9 +14,11 @@ import math
 
 import numpy as np
 
+from kinestat.control.arm import frame_from_tool
 from kinestat.control.cycle import cross3
 from kinestat.control.envelope import sliding_push, tip_stiffness
 from kinestat.spatial.se3 import rotvec_matrix_one
+from kinestat.spatial.transforms import inv
 
 __all__ = [
     "MAX_ALIGN_TURN_DEG", "PUSH_TURN_DEG", "PUSH_LEFT_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN",
@@ -35,6 +37,8 @@ def turn_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         return np.zeros(3)
     return axis * (math.atan2(s, float(a @ b)) / s)
 
+
+_ORIGIN = np.zeros(3)
 
 MAX_ALIGN_TURN_DEG = 20.0
 """The largest align turn of S6 in one cycle (degrees): a workpiece met far off the tool axis is
@@ -201,13 +205,6 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float,
     return action, (tgt.tool_point + step * axis, axis, a67), step, rotation, memo
 
 
-def _frame(tool_point, s6, a67) -> np.ndarray:
-    """The tool frame (4, 4) of a target: x along a67, z along S6, origin at the tool point."""
-    T = np.eye(4)
-    T[:3, 0], T[:3, 1], T[:3, 2], T[:3, 3] = a67, cross3(s6, a67), s6, tool_point
-    return T
-
-
 def turned_force(config, state, meas, s6, a67) -> tuple[float, float] | None:
     """``(f, k)``: |F| (N) predicted after turning the tool onto ``s6``, ``a67`` about the
     tool point, no step along the axis, with the tip sliding freely, and its rate ``k``
@@ -222,11 +219,10 @@ def turned_force(config, state, meas, s6, a67) -> tuple[float, float] | None:
     rate ``k`` (the default plane's first turn: predicted 2.10 N, true 2.07 N; the turn and
     push 3.95 N, true 3.90 N, before ``k`` was used)."""
     tgt = state.target
-    old = _frame(tgt.tool_point, tgt.s6, tgt.a67)
-    old_inv = np.eye(4)  # a rigid frame's inverse: [Rᵀ, −Rᵀ t]
-    old_inv[:3, :3] = old[:3, :3].T
-    old_inv[:3, 3] = -(old[:3, :3].T @ old[:3, 3])
-    move = _frame(tgt.tool_point, s6, a67) @ old_inv
+    # the rigid motion from the commanded tool frame to the turned one, applied to the flange
+    # where it was measured (the tool frames' origins at the tool point)
+    move = (frame_from_tool(tgt.tool_point, s6, a67, _ORIGIN)
+            @ inv(frame_from_tool(tgt.tool_point, tgt.s6, tgt.a67, _ORIGIN)))
     return sliding_push(config.model, meas, move @ meas.flange_pose, s6)
 
 

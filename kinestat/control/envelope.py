@@ -182,17 +182,25 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     b = np.concatenate([np.zeros(3), cross3(u, F)])
     dF = np.linalg.solve(C_tip, u - B @ np.linalg.solve(K, b))
     D = np.linalg.solve(K, A @ dF + b)  # top twist [δφ; δx_O] relative to the base
+    return _prediction(model, meas, data, Tn, TB_new, F + dF, D)
+
+
+def _prediction(model: ControlModel, meas: Measurement, data, Tn: np.ndarray,
+                TB_new: np.ndarray, F_new: np.ndarray, D: np.ndarray) -> Prediction:
+    """The :class:`Prediction` of a move to the flange pose ``Tn`` (base ``TB_new``) after
+    which the springs carry the external force ``F_new`` (base frame) and the top has turned
+    by the small twist ``D = [δφ; δx_O]`` relative to the base (:func:`predict`,
+    :func:`predict_sliding`)."""
     S, _ = data.leg_directions
-    Bp = model.platform.base_points
-    dl = cross_rows(Bp, S) @ D[:3] + S @ D[3:]
-    force = -(TB_new[:3, :3] @ (F + dF))
-    defl = meas.deflections(model) + dl
+    dl = cross_rows(model.platform.base_points, S) @ D[:3] + S @ D[3:]
     top = np.eye(4)
     Rd = rotvec_matrix_one(D[:3])  # Rotation.from_rotvec(·).as_matrix(), to rounding
     top[:3, :3] = Rd @ meas.top_pose[:3, :3]
     top[:3, 3] = Rd @ meas.top_pose[:3, 3] + D[3:]
-    return Prediction(force=force, deflections=defl, tip_motion=apply(Tn @ inv(meas.flange_pose),
-                                                                      tip_F) - tip_F,
+    tip_F = data.tip_fixed
+    return Prediction(force=-(TB_new[:3, :3] @ F_new),
+                      deflections=meas.deflections(model) + dl,
+                      tip_motion=apply(Tn @ inv(meas.flange_pose), tip_F) - tip_F,
                       top_pose=top)
 
 
@@ -283,17 +291,7 @@ def predict_sliding(model: ControlModel, meas: Measurement, flange_pose_new) -> 
     dF = f_new * n_new - F
     A = np.vstack([np.eye(3), skew(p)])
     D = np.linalg.solve(data.K, A @ dF + np.concatenate([np.zeros(3), cross3(v, F)]))
-    S, _ = data.leg_directions
-    dl = cross_rows(model.platform.base_points, S) @ D[:3] + S @ D[3:]
-    top = np.eye(4)
-    Rd = rotvec_matrix_one(D[:3])
-    top[:3, :3] = Rd @ meas.top_pose[:3, :3]
-    top[:3, 3] = Rd @ meas.top_pose[:3, 3] + D[3:]
-    tip_F = data.tip_fixed
-    return Prediction(force=-(TB_new[:3, :3] @ (F + dF)),
-                      deflections=meas.deflections(model) + dl,
-                      tip_motion=apply(Tn @ inv(meas.flange_pose), tip_F) - tip_F,
-                      top_pose=top)
+    return _prediction(model, meas, data, Tn, TB_new, F + dF, D)
 
 
 def _c(a) -> np.ndarray:
