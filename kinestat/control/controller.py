@@ -55,6 +55,7 @@ from kinestat.control.approach import approach_waypoints, check_approach
 from kinestat.control.arm import Puma762Arm
 from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.control.envelope import (
+    AXIS_STEP_VIOLATION,
     Envelope,
     Prediction,
     check_command,
@@ -498,7 +499,7 @@ def _contact_command(config: ControllerConfig, state: ControllerState, meas, F, 
                            state.axis_counts, label=label, action=action, step=step,
                            rotation_deg=rotation, info=info)
         refused_step = (isinstance(cmd, Refusal) and action == "align"
-                        and any("in one command" in v
+                        and any(AXIS_STEP_VIOLATION in v
                                 for v in cmd.extra.get("violations", ())))
         if not refused_step or attempt == TURN_RETRIES:
             return cmd, new, action, step, rotation, memo
@@ -562,7 +563,9 @@ def decide(config: ControllerConfig, state: ControllerState,
         refused = approach_refusal(config, new.tool_point)
         if refused:
             return _stop(st(label=label), label, refused, **info)
-        cmd = None
+        cmd = move_command(model, env, config.vernier, meas, new, state.axis_counts,
+                           label=label, action=action, step=step, rotation_deg=rotation,
+                           info=info)
     else:
         cmd, new, action, step, rotation, memo = _contact_command(config, state, meas, F, mis,
                                                                   err, label, info)
@@ -574,10 +577,6 @@ def decide(config: ControllerConfig, state: ControllerState,
                      + (f"; the fixed {config.step:g} mm step is too coarse for this stiffness "
                         "— use method 'stiffness' or a smaller step"
                         if config.method == "fixed" else ""), **info)
-    if cmd is None:
-        cmd = move_command(model, env, config.vernier, meas, new, state.axis_counts,
-                           label=label, action=action, step=step, rotation_deg=rotation,
-                           info=info)
     if isinstance(cmd, Refusal):
         return _stop(st(label=label), label, cmd.reason, **cmd.extra, **info)
     new_state = st(label=label, last_action=action, target=new,

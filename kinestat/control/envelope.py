@@ -56,6 +56,7 @@ __all__ = [
     "MAX_DEFLECTION",
     "MAX_LOAD",
     "MOTION_RANGE",
+    "AXIS_STEP_VIOLATION",
     "Envelope",
     "top_motion",
     "check_motion",
@@ -74,6 +75,11 @@ __all__ = [
     "require",
 ]
 
+
+
+AXIS_STEP_VIOLATION = " in one command"
+"""The words that mark a violation of the per-command axis step in :func:`check_command`'s
+list (a caller that can make the command smaller looks for them)."""
 
 
 @dataclass(frozen=True)
@@ -513,7 +519,7 @@ def check_command(envelope: Envelope, model: ControlModel, axis_deg_new, axis_de
         step = [abs(x - y) for x, y in zip(a, now, strict=True)]
         j = _largest(step)
         if step[j] > envelope.max_joint_step_deg:
-            out.append(f"axis {j + 1} would move {step[j]:.3f}° in one command, more than "
+            out.append(f"axis {j + 1} would move {step[j]:.3f}°{AXIS_STEP_VIOLATION}, more than "
                        f"{envelope.max_joint_step_deg:g}°")
     if prediction is not None:
         defl = prediction.deflections.tolist()
