@@ -152,11 +152,13 @@ def _warm_kinestatic() -> None:
 
 def _warm_control() -> None:
     """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
-    vernier_pick), the envelope's prediction (envelope.predict) and the follow task's path
-    curvature (contact_estimate.path_curvature_one) and base twist (follow._base_twist)."""
+    vernier_pick), the envelope's predictions (envelope.predict, envelope.sliding_push) and
+    the follow task's path curvature (contact_estimate.path_curvature_one) and base twist
+    (follow._base_twist)."""
     from kinestat.control._cycle_kernels import (  # lazy: start-up (numba)
         base_twist_kernel,
         predict_kernel,
+        slide_kernel,
         vernier_tables_kernel,
     )
     from kinestat.control.contact_estimate import path_curvature_one  # lazy: numba
@@ -176,6 +178,10 @@ def _warm_control() -> None:
     predict_kernel(e4, e4.copy(), v3, v3.copy(), e4.copy(), np.ones(3), B, P_top, T,
                    K, e4.copy(), v6, v6.copy(), np.empty(3),
                    np.empty(6), np.empty(3), np.empty((4, 4)))
+
+    C3 = np.eye(3)
+    slide_kernel(e4, e4.copy(), v3, v3.copy(), np.eye(3), np.ones(3), K, C3, np.zeros(3), True,
+                 np.empty(2))
 
     z3 = np.zeros(3)
     base_twist_kernel(e4, K, v3, np.array([0.0, 0.0, 1.0]), z3, z3, 0.1, 0.5, 4.0, 0.0, z3,

@@ -20,10 +20,11 @@ import numpy as np
 
 from kinestat.parallel._kinestatic_kernels import singular_ratio6, solve6
 from kinestat.parallel._stiffness_kernels import pinned_tip_step_one
+from kinestat.spatial._elimination import eliminate
 
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
-__all__ = ["base_twist_kernel", "path_curvature_kernel", "predict_kernel",
+__all__ = ["base_twist_kernel", "path_curvature_kernel", "predict_kernel", "slide_kernel",
            "vernier_tables_kernel"]
 
 _PI = math.pi
@@ -227,6 +228,92 @@ def predict_kernel(Tn, mount, tip_F, p, base_R, f_point, B, P_top, T, K, flange,
         tip_motion[r] = (Tn[r, 0] * loc[0] + Tn[r, 1] * loc[1] + Tn[r, 2] * loc[2]
                          + Tn[r, 3]) - tip_F[r]
     return True
+
+
+@nb.njit(**_OPTS)
+def slide_kernel(Tn, mount, tip_F, p, base_R, est, K, C, push, has_push, out):
+    """:func:`kinestat.control.envelope.sliding_push`'s first-order frictionless slide for one
+    measurement and one new flange pose ``Tn`` (4, 4), in one call: ``out[0]`` the force
+    magnitude ``f + δf`` (N) after the move and, when ``has_push``, ``out[1]`` its rate
+    ``d(f + δf)/ds`` (N/mm) for a further translation ``s`` of the flange along ``push`` (3,,
+    fixed frame). With ``F = −R_Bᵀ est`` the external force on the tip (base frame),
+    ``n' = −R_newᵀ est / f`` the normal in the new base frame, ``u`` the pinned tip's motion,
+    ``M = I + (K⁻¹ Z)[3:] − [p]× (K⁻¹ Z)[:3]`` with ``Z = [0; [F]×]`` and ``t1, t2`` the tangent
+    plane of ``n'``: ``[M t1, M t2, −C n'] [τ; δf] = C (f n' − F) − M u`` (and ``M R_newᵀ push``
+    as a second right-hand side). ``tip_F``/``p`` (3,) the measured tip (fixed/base frame),
+    ``base_R`` (3, 3) the measured base rotation, ``est`` (3,) the measured force on the
+    workpiece (fixed frame), ``K`` (6, 6) the stiffness (axis order), ``C`` (3, 3) the tip's
+    compliance (base frame). Returns 1, 0 out of contact (``f`` ≤ 1e-9 N: ``out`` unset) or
+    −1 where an elimination meets a zero pivot (the NumPy formulation then raises)."""
+    f = math.sqrt(est[0] * est[0] + est[1] * est[1] + est[2] * est[2])
+    if not f > 1e-9:
+        return 0
+    TB = np.empty((3, 4))
+    for r in range(3):
+        for c in range(4):
+            TB[r, c] = (Tn[r, 0] * mount[0, c] + Tn[r, 1] * mount[1, c]
+                        + Tn[r, 2] * mount[2, c] + Tn[r, 3] * mount[3, c])
+    F = np.empty(3)
+    u = np.empty(3)
+    n = np.empty(3)
+    for j in range(3):
+        F[j] = -(base_R[0, j] * est[0] + base_R[1, j] * est[1] + base_R[2, j] * est[2])
+        u[j] = (TB[0, j] * (tip_F[0] - TB[0, 3]) + TB[1, j] * (tip_F[1] - TB[1, 3])
+                + TB[2, j] * (tip_F[2] - TB[2, 3])) - p[j]
+        n[j] = (TB[0, j] * (-est[0] / f) + TB[1, j] * (-est[1] / f)
+                + TB[2, j] * (-est[2] / f))
+    # K⁻¹ Z, Z = [0; [F]×] (6, 3)
+    A = np.zeros((6, 9))
+    for r in range(6):
+        for c in range(6):
+            A[r, c] = K[r, c]
+    A[3, 7], A[3, 8] = -F[2], F[1]
+    A[4, 6], A[4, 8] = F[2], -F[0]
+    A[5, 6], A[5, 7] = -F[1], F[0]
+    if not eliminate(A, 6, 0.0, None) > 0.0:
+        return -1
+    M = np.empty((3, 3))  # I + X[3:] − [p]× X[:3], X = K⁻¹ Z
+    for c in range(3):
+        x0, x1, x2 = A[0, 6 + c], A[1, 6 + c], A[2, 6 + c]
+        M[0, c] = A[3, 6 + c] - (-p[2] * x1 + p[1] * x2)
+        M[1, c] = A[4, 6 + c] - (p[2] * x0 - p[0] * x2)
+        M[2, c] = A[5, 6 + c] - (-p[1] * x0 + p[0] * x1)
+        M[c, c] += 1.0
+    k = 0  # the normal's smallest component (numpy.argmin: the first of equals)
+    for j in range(1, 3):
+        if abs(n[j]) < abs(n[k]):
+            k = j
+    e = np.zeros(3)
+    e[k] = 1.0
+    t1 = np.empty(3)
+    t1[0] = n[1] * e[2] - n[2] * e[1]
+    t1[1] = n[2] * e[0] - n[0] * e[2]
+    t1[2] = n[0] * e[1] - n[1] * e[0]
+    s = math.sqrt(t1[0] * t1[0] + t1[1] * t1[1] + t1[2] * t1[2])
+    for j in range(3):
+        t1[j] = t1[j] / s
+    t2 = np.empty(3)
+    t2[0] = n[1] * t1[2] - n[2] * t1[1]
+    t2[1] = n[2] * t1[0] - n[0] * t1[2]
+    t2[2] = n[0] * t1[1] - n[1] * t1[0]
+    pb = np.empty(3)  # R_newᵀ push
+    for j in range(3):
+        pb[j] = TB[0, j] * push[0] + TB[1, j] * push[1] + TB[2, j] * push[2]
+    L = np.empty((3, 5))
+    for r in range(3):
+        L[r, 0] = M[r, 0] * t1[0] + M[r, 1] * t1[1] + M[r, 2] * t1[2]
+        L[r, 1] = M[r, 0] * t2[0] + M[r, 1] * t2[1] + M[r, 2] * t2[2]
+        L[r, 2] = -(C[r, 0] * n[0] + C[r, 1] * n[1] + C[r, 2] * n[2])
+        L[r, 3] = ((C[r, 0] * (f * n[0] - F[0]) + C[r, 1] * (f * n[1] - F[1])
+                    + C[r, 2] * (f * n[2] - F[2]))
+                   - (M[r, 0] * u[0] + M[r, 1] * u[1] + M[r, 2] * u[2]))
+        L[r, 4] = M[r, 0] * pb[0] + M[r, 1] * pb[1] + M[r, 2] * pb[2]
+    if not eliminate(L, 3, 0.0, None) > 0.0:
+        return -1
+    out[0] = f + L[2, 3]
+    if has_push:
+        out[1] = L[2, 4]
+    return 1
 
 
 @nb.njit(**_OPTS)

@@ -75,7 +75,8 @@ def reference_cycle() -> Iterator[None]:
     the NumPy vernier and selection (:func:`solve_counts_reference`), the NumPy forward
     analysis for the flange pose, the NumPy stiffness recomputed on every use, the batched
     ``compose_twist`` and ``twist_exp`` in the follow law (not its compiled base twist),
-    NumPy's solves and SciPy's rotations in the prediction, NumPy's tip compliance and SciPy's
+    NumPy's solves and SciPy's rotations in the prediction (and NumPy's in the press's sliding
+    prediction of a turn), NumPy's tip compliance and SciPy's
     rotation vector on every motion check; in the follow task's estimator and law the batched
     NumPy ``cone_normal``,
     ``friction_sample`` and ``path_curvature`` (``lstsq``), ``numpy.linalg.norm`` and
@@ -98,7 +99,8 @@ def reference_cycle() -> Iterator[None]:
              (envelope, "rotvec_matrix_one",
               lambda r: Rotation.from_rotvec(r).as_matrix()),
              (envelope, "_rotation_clear", lambda *a: False),
-             (envelope, "_predict_fast", lambda *a: None)]
+             (envelope, "_predict_fast", lambda *a: None),
+             (envelope, "_slide_fast", lambda *a: None)]
     old = [(mod, name, getattr(mod, name)) for mod, name, _ in saved]
     try:
         for mod, name, new in saved:

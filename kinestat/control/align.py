@@ -18,7 +18,6 @@ from kinestat.control.arm import frame_from_tool
 from kinestat.control.cycle import cross3
 from kinestat.control.envelope import sliding_push, tip_stiffness
 from kinestat.spatial.se3 import rotvec_matrix_one
-from kinestat.spatial.transforms import inv
 
 __all__ = [
     "MAX_ALIGN_TURN_DEG", "PUSH_TURN_DEG", "PUSH_LEFT_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN",
@@ -220,9 +219,12 @@ def turned_force(config, state, meas, s6, a67) -> tuple[float, float] | None:
     push 3.95 N, true 3.90 N, before ``k`` was used)."""
     tgt = state.target
     # the rigid motion from the commanded tool frame to the turned one, applied to the flange
-    # where it was measured (the tool frames' origins at the tool point)
-    move = (frame_from_tool(tgt.tool_point, s6, a67, _ORIGIN)
-            @ inv(frame_from_tool(tgt.tool_point, tgt.s6, tgt.a67, _ORIGIN)))
+    # where it was measured: the turn R_new R_nowᵀ about the tool point
+    R = (frame_from_tool(_ORIGIN, s6, a67, _ORIGIN)[:3, :3]
+         @ frame_from_tool(_ORIGIN, tgt.s6, tgt.a67, _ORIGIN)[:3, :3].T)
+    move = np.eye(4)
+    move[:3, :3] = R
+    move[:3, 3] = tgt.tool_point - R @ tgt.tool_point
     return sliding_push(config.model, meas, move @ meas.flange_pose, s6)
 
 

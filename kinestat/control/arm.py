@@ -31,6 +31,7 @@ from kinestat.errors import JointLimitError, ModelError, UnreachableError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import puma762
 from kinestat.serial.fk import fk
+from kinestat.spatial.transforms import cross3
 from kinestat.spatial.validate import frozen
 
 if TYPE_CHECKING:
@@ -149,8 +150,9 @@ def frame_from_tool(tool_point, s6, a67, tool_point_6) -> np.ndarray:
     z = z / np.linalg.norm(z)
     x = x - (x @ z) * z
     x = x / np.linalg.norm(x)
-    T = np.eye(4)
-    T[:3, 0], T[:3, 1], T[:3, 2] = x, np.cross(z, x), z
+    T = np.zeros((4, 4))
+    T[3, 3] = 1.0
+    T[:3, 0], T[:3, 1], T[:3, 2] = x, cross3(z, x), z
     T[:3, 3] = np.asarray(tool_point, dtype=float) - T[:3, :3] @ np.asarray(tool_point_6, float)
     return T
 

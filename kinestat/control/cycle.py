@@ -33,18 +33,10 @@ from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.parallel.legs import leg_directions_trusted
 from kinestat.parallel.stiffness import stiffness_axis_trusted, tip_compliance_one
-from kinestat.spatial.transforms import apply, inv
+from kinestat.spatial.transforms import apply, cross3, inv
 
 __all__ = ["CycleData", "cycle_data", "cross3", "cross_rows", "norm3", "replace",
            "mount_inverse"]
-
-
-def cross3(a, b) -> np.ndarray:
-    """``a × b`` of two 3-vectors: :func:`numpy.cross`'s products and differences, the same
-    values, without its broadcasting set-up (~1 µs instead of ~8 µs)."""
-    a0, a1, a2 = np.asarray(a, dtype=float).tolist()
-    b0, b1, b2 = np.asarray(b, dtype=float).tolist()
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def cross_rows(a, b) -> np.ndarray:

@@ -41,7 +41,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from kinestat.control._cycle_kernels import predict_kernel
+from kinestat.control._cycle_kernels import predict_kernel, slide_kernel
 from kinestat.control.cycle import cross3, cross_rows, cycle_data
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
@@ -253,6 +253,9 @@ def sliding_force(model: ControlModel, meas: Measurement, flange_pose_new) -> fl
     :func:`predict_sliding`'s force magnitude without the rest of the prediction (the press's
     step, :func:`kinestat.control.align.turned_force`). Out of contact, :func:`predict`'s."""
     Tn = np.asarray(flange_pose_new, dtype=float)
+    fast = _slide_fast(model, meas, Tn, None)
+    if fast is not None:
+        return abs(fast[0]) if fast else predict(model, meas, Tn).force_magnitude
     out = _slide(model, meas, Tn)
     if out is None:
         return predict(model, meas, Tn).force_magnitude
@@ -266,11 +269,39 @@ def sliding_push(model: ControlModel, meas: Measurement, flange_pose_new,
     of the flange along the unit vector ``axis`` (fixed frame): with the tip sliding freely the
     force after the move and a push ``s`` is ``f + k s`` to first order. None out of contact.
     The press's step after a turn (:func:`kinestat.control.align.contact_move`)."""
-    out = _slide(model, meas, np.asarray(flange_pose_new, dtype=float),
-                 push=np.asarray(axis, dtype=float))
+    Tn = np.asarray(flange_pose_new, dtype=float)
+    push = np.asarray(axis, dtype=float)
+    fast = _slide_fast(model, meas, Tn, push)
+    if fast is not None:
+        return fast or None
+    out = _slide(model, meas, Tn, push=push)
     if out is None:
         return None
     return out[0], out[6]
+
+
+def _slide_compiled(model: ControlModel, meas: Measurement, Tn: np.ndarray,
+                    push: np.ndarray | None) -> tuple[float, float | None] | tuple | None:
+    """:func:`_slide`'s force and rate compiled for the one pose, in one call
+    (:func:`kinestat.control._cycle_kernels.slide_kernel`; equal to the NumPy formulation to
+    rounding): ``(f + δf, rate)`` (``rate`` None without ``push``), ``()`` out of contact, or
+    None where the kernel meets a singular matrix (the NumPy formulation then runs and
+    raises)."""
+    data = cycle_data(model, meas)
+    out = np.empty(2)
+    got = slide_kernel(_c(Tn), _consts(model).mount, _c(data.tip_fixed), _c(data.tip_base),
+                       _c(meas.base_pose[:3, :3]), _c(meas.estimate("point")), _c(data.K),
+                       _c(data.C_tip), np.zeros(3) if push is None else _c(push), push is not None,
+                       out)
+    if got < 0:
+        return None
+    if got == 0:
+        return ()
+    return float(out[0]), (float(out[1]) if push is not None else None)
+
+
+#: the sliding prediction's compiled path (None on the reference path: NumPy only)
+_slide_fast = _slide_compiled
 
 
 def predict_sliding(model: ControlModel, meas: Measurement, flange_pose_new) -> Prediction:

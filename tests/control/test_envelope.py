@@ -2,11 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 from kinestat.app.sim_cell import start_counts
+from kinestat.control._reference import reference_cycle
 from kinestat.control.controller import axis_counts_to_q
 from kinestat.control.envelope import (
     Envelope,
@@ -151,6 +154,37 @@ def test_sliding_push_rate_is_the_force_change_of_a_push(tilt):
     true1 = np.linalg.norm(equilibrium(scn.cell, trans(s * axis) @ Tn).tool_force)
     assert (true1 - true0) / s == pytest.approx(k, rel=0.08)
     assert 0.0 < k <= float(axis @ tip_stiffness(scn.model, m) @ axis) * (1 + 1e-9)
+
+
+@pytest.mark.parametrize("tilt", [4.0, 30.0])
+def test_compiled_sliding_push_equals_the_numpy_formulation(tilt):
+    """The compiled slide (``slide_kernel``) gives the NumPy formulation's force and rate (the
+    reference path) to rounding, for random turns about the tool point and pushes; out of
+    contact both give None."""
+    scn = scenario(tilt_deg=tilt, friction=0.0)
+    T, _, m = _loaded(scn, push=0.3)
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        R = np.eye(4)
+        R[:3, :3] = Rotation.from_rotvec(np.radians(rng.uniform(0, 20)) * _unit(rng)).as_matrix()
+        Tn = trans(rng.uniform(-0.5, 0.5, 3)) @ trans(m.tool_point) @ R @ trans(-m.tool_point) @ T
+        axis = _unit(rng)
+        fast = sliding_push(scn.model, m, Tn, axis)
+        fast_f = sliding_force(scn.model, m, Tn)
+        with reference_cycle():
+            ref = sliding_push(scn.model, m, Tn, axis)
+            ref_f = sliding_force(scn.model, m, Tn)
+        assert fast == pytest.approx(ref, rel=1e-9, abs=1e-12)
+        assert fast_f == pytest.approx(ref_f, rel=1e-9)
+    m0 = dataclasses.replace(m, point_force=np.zeros(3))  # no force: out of contact
+    assert sliding_push(scn.model, m0, T, [0, 0, 1.0]) is None
+    with reference_cycle():
+        assert sliding_push(scn.model, m0, T, [0, 0, 1.0]) is None
+
+
+def _unit(rng) -> np.ndarray:
+    v = rng.normal(size=3)
+    return v / np.linalg.norm(v)
 
 
 def test_command_checks():
