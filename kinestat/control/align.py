@@ -21,7 +21,8 @@ from kinestat.spatial.se3 import rotvec_matrix_one
 
 __all__ = [
     "MAX_ALIGN_TURN_DEG", "PUSH_TURN_DEG", "PUSH_LEFT_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN",
-    "MIN_PUSH_RATE", "TURN_RETRIES",
+    "MIN_PUSH_RATE", "TURN_RETRIES", "ALIGN_PROGRESS", "ALIGN_STALL_CYCLES", "align_stalled",
+    "align_stall_reason",
     "STUCK_RATIO", "turn_vector", "rotate_onto", "align_gain", "turn_was_carried",
     "contact_move", "turned_force", "stuck", "shed",
 ]
@@ -64,8 +65,17 @@ MIN_PUSH_RATE = 0.2
 """The turned tool's push rate (:func:`turned_force`) is used for the step when it lies
 between this fraction of the axial point stiffness ``s6ᵀ K_tip s6`` and that stiffness (a
 sliding tip loads less than a pinned one); outside, the axial stiffness is kept."""
-MIN_ALIGN_GAIN = 0.125
-"""The smallest fraction of the misalignment an align turn makes (three halvings)."""
+MIN_ALIGN_GAIN = 1.0 / 32.0
+"""The smallest fraction of the misalignment an align turn makes (five halvings). A
+frictionless R = 172 mm cylinder at 5.5 N lands a turn about 16 times its size past the
+normal (κ B ≈ 16): only a turn of about 1/17 of the misalignment lands on it (the floor was
+1/8 until 2026-12-04, and that run turned to and fro for 60 cycles)."""
+ALIGN_PROGRESS = 0.8
+"""A misalignment below this fraction of the one at the last progress is progress
+(:func:`align_stalled`)."""
+ALIGN_STALL_CYCLES = 12
+"""Contact cycles without progress after which turns cut to their floor stop the run
+(:func:`align_stalled`)."""
 
 
 def align_gain(gain: float, last_turn, misalignment) -> float:
@@ -100,6 +110,38 @@ def align_gain(gain: float, last_turn, misalignment) -> float:
     if back > OVERSHOOT_RATIO * size:
         return max(0.5 * float(gain), MIN_ALIGN_GAIN)
     return min(1.25 * float(gain), 1.0)
+
+
+def align_stalled(stall: int, gain: float) -> bool:
+    """Whether the align turns cannot settle the force on S6: ``stall`` contact cycles (at
+    least ``ALIGN_STALL_CYCLES``) went by without the misalignment falling below
+    ``ALIGN_PROGRESS`` of its value at the last progress, while the turns overshot so often
+    that their gain is within a halving of its floor ``MIN_ALIGN_GAIN``. On a frictionless
+    convex surface at a high force the tip's equilibrium where the force would lie along S6
+    can be unstable: the smallest turn snaps the tip from one side of it to the other (a
+    frictionless R = 200 mm cylinder at 5.8 N: 1.18° off on one side at a 0.078° turn, 2.75°
+    off on the other at 0.104°), and no turn aligns it.
+
+    >>> align_stalled(12, MIN_ALIGN_GAIN), align_stalled(12, 0.5), align_stalled(3, MIN_ALIGN_GAIN)
+    (True, False, False)
+    """
+    return stall >= ALIGN_STALL_CYCLES and gain <= 2.0 * MIN_ALIGN_GAIN
+
+
+def align_stall_reason(stall: int, ref_deg: float, mis_deg: float) -> str:
+    """The stop reason of :func:`align_stalled`: ``ref_deg`` the misalignment at the last
+    progress, ``mis_deg`` the present one.
+
+    >>> align_stall_reason(12, 2.31, 2.08)[:64]
+    'the force does not settle on the tool axis: in 12 cycles in cont'
+    """
+    return (f"the force does not settle on the tool axis: in {stall} cycles in contact the "
+            f"misalignment did not fall {100 * (1 - ALIGN_PROGRESS):.0f} % below "
+            f"{ref_deg:.3g}° (now {mis_deg:.3g}°), and the align turns, cut to a few "
+            "hundredths of it, still overshoot across S6. The contact is unstable where its "
+            "force would lie along S6, and the tip snaps from one side to the other (seen on "
+            "frictionless convex workpieces of small radius at a high force): a lower --force, "
+            f"or an --align-tol-deg above {max(ref_deg, mis_deg):.2g}°")
 
 
 STUCK_RATIO = 0.5

@@ -50,7 +50,14 @@ from typing import Literal, get_args
 
 import numpy as np
 
-from kinestat.control.align import MAX_ALIGN_TURN_DEG, TURN_RETRIES, contact_move
+from kinestat.control.align import (
+    ALIGN_PROGRESS,
+    MAX_ALIGN_TURN_DEG,
+    TURN_RETRIES,
+    align_stall_reason,
+    align_stalled,
+    contact_move,
+)
 from kinestat.control.approach import approach_waypoints, check_approach
 from kinestat.control.arm import Puma762Arm
 from kinestat.control.ceilings import MAX_ITERATIONS
@@ -288,6 +295,11 @@ class ControllerState:
             made from.
         shed_expect_deg: the misalignment the last shed (a move across S6 that turns a held
             tip's force onto S6) should leave at most (degrees).
+        align_best_deg: the misalignment measured at the align turns' last progress (degrees;
+            None before contact): the first contact, a misalignment within tolerance or one
+            below ``ALIGN_PROGRESS`` of the previous value.
+        align_stall: contact cycles since that progress
+            (:func:`~kinestat.control.align.align_stalled`).
     """
 
     cycle: int
@@ -303,6 +315,8 @@ class ControllerState:
     align_turn: np.ndarray | None = None
     align_from: np.ndarray | None = None
     shed_expect_deg: float = 0.0
+    align_best_deg: float | None = None
+    align_stall: int = 0
 
 
 @dataclass(frozen=True, eq=False)
@@ -552,10 +566,20 @@ def decide(config: ControllerConfig, state: ControllerState,
                      f"not converged after {cycle} cycles (|F| = {Fmag:.4g} N, error "
                      f"{err:+.4g} N" + (f", misalignment {mis:.3g}°)" if mis is not None else ")"),
                      **info)
+    best, stall = state.align_best_deg, state.align_stall
+    if contact:  # the align turns' progress (align_stalled)
+        if mis <= config.align_tol_deg or best is None or mis < ALIGN_PROGRESS * best:
+            best, stall = mis, 0
+        else:
+            stall += 1
+        if align_stalled(stall, state.align_gain):
+            return _stop(st(label=label, align_best_deg=best, align_stall=stall), label,
+                         align_stall_reason(stall, best, mis)
+                         + f" (|F| = {Fmag:.4g} N, error {err:+.4g} N)", **info)
     tgt = state.target
     rotation = 0.0
     step = 0.0
-    memo: dict = {}
+    memo: dict = {"align_best_deg": best, "align_stall": stall}
     if not contact:
         action = "approach"
         step = config.approach
@@ -567,8 +591,9 @@ def decide(config: ControllerConfig, state: ControllerState,
                            label=label, action=action, step=step, rotation_deg=rotation,
                            info=info)
     else:
-        cmd, new, action, step, rotation, memo = _contact_command(config, state, meas, F, mis,
-                                                                  err, label, info)
+        cmd, new, action, step, rotation, move_memo = _contact_command(config, state, meas, F,
+                                                                       mis, err, label, info)
+        memo.update(move_memo)
     key = new.key()
     if state.history.count(key) + 1 >= config.repeat_limit:
         return _stop(st(label=label), label,
