@@ -152,12 +152,14 @@ def _warm_kinestatic() -> None:
 
 def _warm_control() -> None:
     """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
-    vernier_pick), the envelope's predictions (envelope.predict, envelope.sliding_push) and
+    vernier_pick), the PUMA 762's move in one call (vernier.puma_move_one), the envelope's
+    predictions (envelope.predict, envelope.sliding_push) and
     the follow task's path curvature (contact_estimate.path_curvature_one) and base twist
     (follow._base_twist)."""
     from kinestat.control._cycle_kernels import (  # lazy: start-up (numba)
         base_twist_kernel,
         predict_kernel,
+        puma_counts_kernel,
         slide_kernel,
         vernier_tables_kernel,
     )
@@ -170,6 +172,19 @@ def _warm_control() -> None:
 
     vernier_tables_kernel(np.zeros(6, dtype=np.int64), np.zeros((1, 6), dtype=np.int64),
                           1, 1, 1, 1, 1, 0.0, 0.0, np.ones(6), np.zeros(6))
+    from kinestat.control.vernier import AXIS_OFFSETS, VERNIER_SCALES, grid_rows  # lazy
+    from kinestat.serial import puma762  # lazy: start-up (numba)
+
+    q = np.full(6, 0.3)
+    f = puma762.forward(q, np.array([0.0, 0.0, 235.0]))
+    off, centre = grid_rows(AXIS_OFFSETS)
+    lims = np.radians(puma762.AXIS_LIMITS_DEG)
+    puma_counts_kernel(f.tool_point.copy(), f.s6.copy(), f.a67.copy(),
+                       np.array([0.0, 0.0, 235.0]), q, np.array(puma762.AXIS_OFFSET),
+                       np.ascontiguousarray(lims[:, 0]), np.ascontiguousarray(lims[:, 1]),
+                       np.full(6, 0.01), 0.1, 0.0, off, 9, 9, 9, 3, 3, centre,
+                       *VERNIER_SCALES, np.empty(6, dtype=np.int64), np.empty(6),
+                       np.empty((4, 4)))
     pf = prototype()
     B, P_top, _, l0 = platform_arrays(pf)
     T = pf.home_pose.copy()

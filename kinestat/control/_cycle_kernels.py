@@ -20,16 +20,18 @@ import numpy as np
 
 from kinestat.parallel._kinestatic_kernels import singular_ratio6, solve6
 from kinestat.parallel._stiffness_kernels import pinned_tip_step_one
+from kinestat.serial.puma762._cycle_kernels import grid_nearest, pose_one, reverse_select_one
 from kinestat.spatial._elimination import eliminate
 
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
-__all__ = ["base_twist_kernel", "path_curvature_kernel", "predict_kernel", "slide_kernel",
-           "vernier_tables_kernel"]
+__all__ = ["base_twist_kernel", "path_curvature_kernel", "predict_kernel",
+           "puma_counts_kernel", "slide_kernel", "vernier_tables_kernel"]
 
 _PI = math.pi
 _TWO_PI = 2.0 * math.pi
 _DEG = math.pi / 180.0  # numpy.radians(x) is x * (π/180)
+_PER_RAD = 180.0 / math.pi  # numpy.degrees(x) is x * (180/π)
 
 
 @nb.njit(**_OPTS)
@@ -78,6 +80,62 @@ def vernier_tables_kernel(c0, off, n1, n2, n3, n4, n5, now3, coupling, res, axis
     cs6 = np.empty(2)
     cs6[0], cs6[1] = math.cos(q[0, 5]), math.sin(q[0, 5])
     return cs1, cs2, cs3, cs4, cs5, cs6
+
+@nb.njit(**_OPTS)
+def puma_counts_kernel(p, z, x, p6, q_now, axis_offset, lo, hi, res, coupling, now3, off, n1,
+                       n2, n3, n4, n5, centre, w_along, w_lat, w_tilt, counts, q_new, T):
+    """The PUMA 762's move onto a target in one call (one dispatch): the axis angles of the
+    least-motion solution within ``[lo, hi]`` (:func:`~kinestat.serial.puma762._cycle_kernels.
+    reverse_select_one`), their counts (``round_half_away(degrees(axis) / res)``), the
+    vernier's grid search around them (:func:`vernier_tables_kernel`,
+    :func:`~kinestat.serial.puma762._cycle_kernels.grid_nearest`; the grid rows ``off`` and
+    sizes ``n1..n5`` of :func:`kinestat.control.vernier.grid_rows`, ``centre`` its centre
+    index), the chosen counts into ``counts`` (6,) int64, their joint angles into ``q_new``
+    (6,) (``radians(counts · res) − axis_offset``, joint 1 wrapped to [−π, π)) and the flange
+    pose ``F_6T`` into ``T`` (4, 4) (:func:`~kinestat.serial.puma762._cycle_kernels.pose_one`):
+    :func:`kinestat.control.controller._solve_counts`, ``axis_counts_to_q`` and
+    ``_flange_pose`` in the same operations and order (the cos and sin are the kernel's).
+    ``p, z, x`` the target's tool point, S6 and a67, ``p6`` the tool point in frame 6,
+    ``q_now`` (6,) the present joint angles, ``now3`` the present axis-4 count.
+
+    Returns ``(ok, along)``: False where the reverse analysis or the selection fails (the
+    caller runs the NumPy path for its error), ``along`` the chosen tool point's offset from
+    the target along S6 (mm).
+    """
+    axis = np.empty(6)
+    if not reverse_select_one(p, z, x, p6, q_now, axis_offset, lo, hi, axis):
+        return False, 0.0
+    c0 = np.empty(6, dtype=np.int64)
+    for j in range(6):
+        a = axis[j] * _PER_RAD / res[j]
+        sgn = 1.0 if a > 0.0 else (-1.0 if a < 0.0 else 0.0)
+        c0[j] = np.int64(sgn * math.floor(abs(a) + 0.5))
+    cs1, cs2, cs3, cs4, cs5, cs6 = vernier_tables_kernel(c0, off, n1, n2, n3, n4, n5, now3,
+                                                         coupling, res, axis_offset)
+    k, along, _ = grid_nearest(cs1, cs2, cs3, cs4, cs5, cs6, p6, p, z, w_along, w_lat, w_tilt,
+                               centre)
+    i5 = k % n5
+    i4 = (k // n5) % n4
+    i3 = (k // (n5 * n4)) % n3
+    i2 = (k // (n5 * n4 * n3)) % n2
+    i1 = k // (n5 * n4 * n3 * n2)
+    w0 = off.shape[0] - n4 * n5
+    counts[0] = c0[0] + off[i1, 0]
+    counts[1] = c0[1] + off[i2, 1]
+    counts[2] = c0[2] + off[i3, 2]
+    counts[3] = c0[3] + off[w0 + i4 * n5, 3]
+    counts[4] = c0[4] + off[w0 + i4 * n5 + i5, 4]
+    counts[5] = c0[5]
+    cs = np.empty((6, 2))
+    for j in range(6):
+        v = float(counts[j]) * res[j] * _DEG - axis_offset[j]
+        if j == 0:
+            v = (v + _PI) % _TWO_PI - _PI
+        q_new[j] = v
+        cs[j, 0], cs[j, 1] = math.cos(v), math.sin(v)
+    pose_one(cs, T)
+    return True, along
+
 
 #: smallest |R_kk| / max |R_jj| of the QR factor the kernel solves with (else: NumPy's lstsq)
 RANK_TOL = 1e-10

@@ -82,7 +82,8 @@ def reference_cycle() -> Iterator[None]:
     ``friction_sample`` and ``path_curvature`` (``lstsq``), ``numpy.linalg.norm`` and
     ``numpy.linalg.solve``, ``dataclasses.replace`` and the mount's inverse on every use. Not
     thread-safe (it swaps module attributes)."""
-    saved = [(controller, "_solve_counts", solve_counts_reference),
+    saved = [(controller, "_puma_move", lambda *a: None),
+             (controller, "_solve_counts", solve_counts_reference),
              (controller, "_flange_pose", lambda model, q: puma762.forward(q).pose),
              (envelope, "cycle_data", UncachedCycleData),
              (follow, "cycle_data", UncachedCycleData),

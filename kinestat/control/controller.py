@@ -77,6 +77,7 @@ from kinestat.control.vernier import (
     ZERO_OFFSETS,
     axis5_residual,
     axis_counts_to_q,
+    puma_move_one,
     q_to_axis_counts,
     vernier_generic,
     vernier_pick,
@@ -383,6 +384,17 @@ def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
     return c0 + OFFSETS[k], along
 
 
+def _puma_move(model: ControlModel, target: Target, q_now, counts_now,
+               vernier: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """``(counts, q, F_6T)`` of :func:`_solve_counts`, ``axis_counts_to_q`` and
+    :func:`_flange_pose` in one compiled call for the thesis's PUMA 762
+    (:func:`~kinestat.control.vernier.puma_move_one`); None for any other arm, where that
+    call fails (the three steps then run and raise) and on the reference path."""
+    if type(model.arm) is not Puma762Arm:
+        return None
+    return puma_move_one(model, target, q_now, counts_now, vernier)
+
+
 def _flange_pose(model: ControlModel, q) -> np.ndarray:
     """``F_6T`` of the joint angles ``q``: the arm's flange pose (compiled for the PUMA 762)."""
     return model.arm.flange_pose(q)
@@ -465,13 +477,18 @@ def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target
     the vernier when asked), checked against the envelope's joint limits, per-command step and
     predicted platform state (:func:`~kinestat.control.envelope.check_command`); or the
     :class:`Refusal` that stops the run. One path for every task and procedure."""
-    try:
-        counts, _ = _solve_counts(model, new, meas.q, counts_now, vernier)
-    except (UnreachableError, JointLimitError) as exc:
-        return Refusal(f"{action} target not reachable: {exc}", {})
+    fast = _puma_move(model, new, meas.q, counts_now, vernier)
+    if fast is not None:  # the thesis's arm: the three steps below in one compiled call
+        counts, q_new, T_new = fast
+    else:
+        try:
+            counts, _ = _solve_counts(model, new, meas.q, counts_now, vernier)
+        except (UnreachableError, JointLimitError) as exc:
+            return Refusal(f"{action} target not reachable: {exc}", {})
+        q_new = axis_counts_to_q(model, counts)
+        T_new = _flange_pose(model, q_new)
     axis_deg = counts * model.axis_deg_per_count
-    q_new = axis_counts_to_q(model, counts)
-    pred = predict(model, meas, _flange_pose(model, q_new))
+    pred = predict(model, meas, T_new)
     bad = check_command(envelope, model, axis_deg, counts_now * model.axis_deg_per_count, pred)
     if bad:
         return Refusal(f"{action} command refused by the envelope: " + "; ".join(bad),

@@ -33,7 +33,7 @@ from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.parallel.legs import leg_directions_trusted
 from kinestat.parallel.stiffness import stiffness_axis_trusted, tip_compliance_one
-from kinestat.spatial.transforms import apply, cross3, inv
+from kinestat.spatial.transforms import apply_one, cross3, inv
 
 __all__ = ["CycleData", "cycle_data", "cross3", "cross_rows", "norm3", "replace",
            "mount_inverse"]
@@ -151,7 +151,7 @@ class CycleData:
 
     @_once
     def tip_base(self) -> np.ndarray:
-        return apply(self.top_pose, self.model.tool_tip_top)
+        return apply_one(self.top_pose, self.model.tool_tip_top)
 
     @_once
     def tip_fixed(self) -> np.ndarray:

@@ -50,7 +50,7 @@ from kinestat.hardware.platform_spec import MAX_DEFLECTION, MAX_LOAD, MOTION_RAN
 from kinestat.parallel.stiffness import pinned_tip_step, platform_arrays
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
 from kinestat.spatial.se3 import rotvec_matrix_one
-from kinestat.spatial.transforms import apply, inv, skew
+from kinestat.spatial.transforms import apply, apply_one, inv, skew
 
 __all__ = [
     "MAX_DEFLECTION",
@@ -138,7 +138,7 @@ class Prediction:
 
 
 def _tip_base(model: ControlModel, meas: Measurement) -> np.ndarray:
-    return apply(meas.top_pose, model.tool_tip_top)
+    return apply_one(meas.top_pose, model.tool_tip_top)
 
 
 def tip_compliance(model: ControlModel, meas: Measurement) -> np.ndarray:

@@ -121,7 +121,7 @@ from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
 from kinestat.spatial.se3 import twist_exp, twist_exp_one
-from kinestat.spatial.transforms import apply, skew
+from kinestat.spatial.transforms import apply, apply_one, skew
 
 __all__ = [
     "FollowConfig",
@@ -703,7 +703,7 @@ def _base_twist_numpy(model: ControlModel, meas: Measurement, tip: np.ndarray,
 def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
     TB_new = meas.base_pose @ twist_exp_one(T_base)
     T6 = TB_new @ mount_inverse(model)
-    return Target(apply(T6, model.tool_point_6), T6[:3, 2].copy(), T6[:3, 0].copy())
+    return Target(apply_one(T6, model.tool_point_6), T6[:3, 2].copy(), T6[:3, 0].copy())
 
 
 def _stop(st: FollowState, label: str, reason: str, **kw) -> tuple[Command, FollowState]:

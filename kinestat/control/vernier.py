@@ -13,11 +13,12 @@ from __future__ import annotations
 
 import itertools
 import math
+import weakref
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from kinestat.control._cycle_kernels import vernier_tables_kernel
+from kinestat.control._cycle_kernels import puma_counts_kernel, vernier_tables_kernel
 from kinestat.control.model import ControlModel
 from kinestat.hardware.puma762_axes import round_half_away
 from kinestat.serial.puma762._cycle_kernels import grid_nearest
@@ -28,7 +29,7 @@ if TYPE_CHECKING:
 
 __all__ = ["AXIS_OFFSETS", "OFFSETS", "VERNIER_SCALES", "ZERO_OFFSETS", "axis5_residual",
            "axis_counts_to_q", "q_to_axis_counts", "vernier_costs", "vernier_generic",
-           "vernier_pick", "vernier_tables", "vernier_tables_one"]
+           "vernier_pick", "vernier_tables", "vernier_tables_one", "puma_move_one"]
 
 
 def axis_counts_to_q(model: ControlModel, counts) -> np.ndarray:
@@ -136,6 +137,45 @@ def vernier_pick(model: ControlModel, target: Target, c0: np.ndarray, counts_now
     k, along, _ = grid_nearest(*vernier_tables_one(model, c0, counts_now, offsets), p6, tp, ts,
                                *VERNIER_SCALES, centre)
     return int(k), float(along)
+
+
+_LIMITS_RAD: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def _limits_rad(model: ControlModel) -> tuple[np.ndarray, np.ndarray]:
+    """The model's axis limits in radians, (lower (6,), upper (6,)), made once per model (its
+    limits are frozen and checked by :class:`ControlModel`)."""
+    got = _LIMITS_RAD.get(model)
+    if got is None:
+        L = np.asarray(model.limits_deg, dtype=float)
+        got = _LIMITS_RAD[model] = (np.ascontiguousarray(np.radians(L[:, 0])),
+                                    np.ascontiguousarray(np.radians(L[:, 1])))
+    return got
+
+
+def puma_move_one(model: ControlModel, target: Target, q_now, counts_now,
+                  vernier: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The thesis's PUMA 762 moved onto ``target`` in one compiled call
+    (:func:`kinestat.control._cycle_kernels.puma_counts_kernel`): ``(counts, q, F_6T)``, the
+    axis counts :func:`kinestat.control.controller._solve_counts` chooses (with the vernier
+    when asked), their joint angles (:func:`axis_counts_to_q`) and the flange pose. None
+    where the reverse analysis or the selection fails: the caller's NumPy path then raises
+    its error. Equal to the three calls it replaces where the kernel's cos and sin are
+    NumPy's (as on the reference machine), and to the last bits otherwise."""
+    lo, hi = _limits_rad(model)
+    offsets = AXIS_OFFSETS if vernier else ZERO_OFFSETS
+    off, centre = grid_rows(offsets)
+    counts = np.empty(6, dtype=np.int64)
+    q_new = np.empty(6)
+    T = np.empty((4, 4))
+    p6, tp, ts, ta, q = (np.array(v, dtype=float) for v in (
+        model.tool_point_6, target.tool_point, target.s6, target.a67, q_now))
+    ok, _ = puma_counts_kernel(tp, ts, ta, p6, q, _AXIS_OFFSET, lo, hi, _resolution(model),
+                               float(model.coupling), float(counts_now[3]), off,
+                               len(offsets[0]), len(offsets[1]), len(offsets[2]),
+                               len(offsets[3]), len(offsets[4]), centre, *VERNIER_SCALES,
+                               counts, q_new, T)
+    return (counts, q_new, T) if ok else None
 
 
 def vernier_costs(model: ControlModel, target: Target, c0, counts_now,

@@ -38,7 +38,7 @@ from kinestat.errors import InputError
 from kinestat.hardware.leg_calibration import counts_to_forces, counts_to_lengths
 from kinestat.parallel.statics import line_jacobian, spring_forces, wrench_from_leg_lengths
 from kinestat.spatial.screws import transform_wrench
-from kinestat.spatial.transforms import apply, skew
+from kinestat.spatial.transforms import apply, apply_one, skew
 
 __all__ = ["Estimator", "Measurement", "measure", "tool_frame"]
 
@@ -116,7 +116,7 @@ class Measurement:
         got = self.__dict__.get("_tip")
         if got is not None and got[0] is model:
             return got[1]
-        p = apply(self.base_pose @ self.top_pose, model.tool_tip_top)
+        p = apply_one(self.base_pose @ self.top_pose, model.tool_tip_top)
         p.setflags(write=False)
         self.__dict__["_tip"] = (model, p)  # a cache, not a field: the instance stays frozen
         return p

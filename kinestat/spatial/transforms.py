@@ -28,6 +28,7 @@ __all__ = [
     "is_rotation",
     "skew",
     "cross3",
+    "apply_one",
 ]
 
 
@@ -243,3 +244,18 @@ def cross3(a, b) -> np.ndarray:
     a0, a1, a2 = np.asarray(a, dtype=float).tolist()
     b0, b1, b2 = np.asarray(b, dtype=float).tolist()
     return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
+def apply_one(T, point) -> np.ndarray:
+    """:func:`apply` for ONE pose (4, 4) and ONE point (3,) (no batch), in scalars: each row
+    summed as ``(r0 x + r2 z) + r1 y``, the order NumPy's ``einsum`` sums a 3-term row in on
+    the reference machine (x86-64), so equal to :func:`apply` bit for bit there and to
+    rounding elsewhere; ~0.8 µs instead of ~2 µs (the control cycle's hot path).
+
+    >>> apply_one(trans([1.0, 0.0, 0.0]), [1.0, 1.0, 1.0]).tolist()
+    [2.0, 1.0, 1.0]
+    """
+    (a, b, c, d), (e, f, g, h), (i, j, k, m) = np.asarray(T, dtype=float)[:3].tolist()
+    x, y, z = np.asarray(point, dtype=float).tolist()
+    return np.array([(a * x + c * z) + b * y + d, (e * x + g * z) + f * y + h,
+                     (i * x + k * z) + j * y + m])

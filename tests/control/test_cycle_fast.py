@@ -129,6 +129,48 @@ def test_vernier_and_selection_match_the_numpy_reference_on_random_targets(model
     assert checked > 200
 
 
+def test_the_puma_move_in_one_call_is_the_three_steps(model_and_counts):
+    """``puma_move_one`` (one compiled call) gives the counts of ``_solve_counts``, their joint
+    angles and the flange pose; where the reverse analysis or selection fails it gives None
+    and the three steps raise."""
+    from kinestat.control.vernier import puma_move_one
+
+    model, rng = model_and_counts
+    moved = refused = 0
+    for i in range(200):
+        target, q = _random_target(rng)
+        if i % 10 == 0:  # out of reach
+            target = Target(target.tool_point * 4.0, target.s6, target.a67)
+        counts_now = ctl._q_to_axis_counts(model, puma762.to_axis_angles(q))
+        counts_now = counts_now + rng.integers(-200, 200, 6)
+        for vernier in (True, False):
+            got = puma_move_one(model, target, q, counts_now, vernier)
+            if got is None:
+                with pytest.raises((UnreachableError, JointLimitError)):
+                    ctl._solve_counts(model, target, q, counts_now, vernier)
+                refused += 1
+                continue
+            counts, q_new, T = got
+            ref, _ = ctl._solve_counts(model, target, q, counts_now, vernier)
+            np.testing.assert_array_equal(counts, ref)
+            np.testing.assert_array_equal(q_new, ctl.axis_counts_to_q(model, ref))
+            np.testing.assert_allclose(T, ctl._flange_pose(model, q_new), rtol=0, atol=1e-12)
+            moved += 1
+    assert moved > 300 and refused >= 20
+
+
+def test_apply_one_is_apply():
+    from kinestat.spatial.transforms import apply, apply_one
+
+    rng = np.random.default_rng(11)
+    for _ in range(2000):
+        T = rng.normal(size=(4, 4)) * 10.0 ** rng.uniform(-3, 3)
+        p = rng.normal(size=3) * 10.0 ** rng.uniform(-3, 3)
+        ref = apply(T, p)
+        np.testing.assert_allclose(apply_one(T, p), ref, rtol=0,
+                                   atol=1e-15 * (np.abs(T).max() * np.abs(p).max() + 1.0))
+
+
 def test_selection_matches_select_including_wrist_singular_poses(model_and_counts):
     model, rng = model_and_counts
     for i in range(300):
