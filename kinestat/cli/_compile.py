@@ -172,7 +172,11 @@ def _warm_control() -> None:
 
     vernier_tables_kernel(np.zeros(6, dtype=np.int64), np.zeros((1, 6), dtype=np.int64),
                           1, 1, 1, 1, 1, 0.0, 0.0, np.ones(6), np.zeros(6))
-    from kinestat.control.vernier import AXIS_OFFSETS, VERNIER_SCALES, grid_rows  # lazy
+    from kinestat.control.vernier import (  # lazy: start-up
+        AXIS_OFFSETS,
+        VERNIER_SCALES,
+        grid_rows,
+    )
     from kinestat.serial import puma762  # lazy: start-up (numba)
 
     q = np.full(6, 0.3)

@@ -21,8 +21,8 @@ from kinestat.spatial.se3 import rotvec_matrix_one
 
 __all__ = [
     "MAX_ALIGN_TURN_DEG", "PUSH_TURN_DEG", "PUSH_LEFT_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN",
-    "MIN_PUSH_RATE", "TURN_RETRIES", "ALIGN_PROGRESS", "ALIGN_STALL_CYCLES", "align_stalled",
-    "align_stall_reason",
+    "MIN_PUSH_RATE", "TURN_RETRIES", "ALIGN_PROGRESS", "ALIGN_STALL_CYCLES", "align_progress",
+    "align_stalled", "align_stall_reason",
     "STUCK_RATIO", "turn_vector", "rotate_onto", "align_gain", "turn_was_carried",
     "contact_move", "turned_force", "stuck", "shed",
 ]
@@ -110,6 +110,23 @@ def align_gain(gain: float, last_turn, misalignment) -> float:
     if back > OVERSHOOT_RATIO * size:
         return max(0.5 * float(gain), MIN_ALIGN_GAIN)
     return min(1.25 * float(gain), 1.0)
+
+
+def align_progress(ref_deg: float | None, stall: int, mis_deg: float,
+                   tol_deg: float) -> tuple[float, int]:
+    """The align turns' progress after a contact cycle measured ``mis_deg``: ``(ref, stall)``,
+    the misalignment at the last progress and the cycles since. Progress is the first contact,
+    a misalignment within ``tol_deg`` or one below ``ALIGN_PROGRESS`` of ``ref_deg``
+    (:func:`align_stalled`).
+
+    >>> align_progress(None, 0, 2.0, 0.5), align_progress(2.0, 0, 1.7, 0.5)
+    ((2.0, 0), (2.0, 1))
+    >>> align_progress(2.0, 5, 1.5, 0.5)
+    (1.5, 0)
+    """
+    if ref_deg is None or mis_deg <= tol_deg or mis_deg < ALIGN_PROGRESS * ref_deg:
+        return mis_deg, 0
+    return ref_deg, stall + 1
 
 
 def align_stalled(stall: int, gain: float) -> bool:

@@ -1,5 +1,10 @@
 """The kinestatic controller: pure decision logic, no I/O (Vibhute 2011 ch. 4, App. D.1).
 
+Over 600 lines on purpose: the procedure's types (configuration, state, command), its one
+decision per cycle and the move path every task and procedure shares (:func:`move_command`)
+are one unit; the rules of the turn and the step live in :mod:`kinestat.control.align`, the
+counts in :mod:`kinestat.control.vernier` and the checks in :mod:`kinestat.control.envelope`.
+
 One call per cycle, :func:`decide`, takes the controller's state and the cycle's
 :class:`~kinestat.control.wrench.Measurement` and returns the next :class:`Command` and the new
 state. The procedure is the thesis's ForceCorrection.m:
@@ -51,9 +56,9 @@ from typing import Literal, get_args
 import numpy as np
 
 from kinestat.control.align import (
-    ALIGN_PROGRESS,
     MAX_ALIGN_TURN_DEG,
     TURN_RETRIES,
+    align_progress,
     align_stall_reason,
     align_stalled,
     contact_move,
@@ -384,15 +389,9 @@ def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
     return c0 + OFFSETS[k], along
 
 
-def _puma_move(model: ControlModel, target: Target, q_now, counts_now,
-               vernier: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
-    """``(counts, q, F_6T)`` of :func:`_solve_counts`, ``axis_counts_to_q`` and
-    :func:`_flange_pose` in one compiled call for the thesis's PUMA 762
-    (:func:`~kinestat.control.vernier.puma_move_one`); None for any other arm, where that
-    call fails (the three steps then run and raise) and on the reference path."""
-    if type(model.arm) is not Puma762Arm:
-        return None
-    return puma_move_one(model, target, q_now, counts_now, vernier)
+#: the thesis's PUMA 762 moved onto a target in one compiled call (None for any other arm, on
+#: failure, and on the reference path): :func:`~kinestat.control.vernier.puma_move_one`
+_puma_move = puma_move_one
 
 
 def _flange_pose(model: ControlModel, q) -> np.ndarray:
@@ -584,11 +583,8 @@ def decide(config: ControllerConfig, state: ControllerState,
                      f"{err:+.4g} N" + (f", misalignment {mis:.3g}°)" if mis is not None else ")"),
                      **info)
     best, stall = state.align_best_deg, state.align_stall
-    if contact:  # the align turns' progress (align_stalled)
-        if mis <= config.align_tol_deg or best is None or mis < ALIGN_PROGRESS * best:
-            best, stall = mis, 0
-        else:
-            stall += 1
+    if contact:  # the align turns' progress
+        best, stall = align_progress(best, stall, mis, config.align_tol_deg)
         if align_stalled(stall, state.align_gain):
             return _stop(st(label=label, align_best_deg=best, align_stall=stall), label,
                          align_stall_reason(stall, best, mis)

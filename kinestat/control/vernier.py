@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from kinestat.control._cycle_kernels import puma_counts_kernel, vernier_tables_kernel
+from kinestat.control.arm import Puma762Arm
 from kinestat.control.model import ControlModel
 from kinestat.hardware.puma762_axes import round_half_away
 from kinestat.serial.puma762._cycle_kernels import grid_nearest
@@ -159,9 +160,11 @@ def puma_move_one(model: ControlModel, target: Target, q_now, counts_now,
     (:func:`kinestat.control._cycle_kernels.puma_counts_kernel`): ``(counts, q, F_6T)``, the
     axis counts :func:`kinestat.control.controller._solve_counts` chooses (with the vernier
     when asked), their joint angles (:func:`axis_counts_to_q`) and the flange pose. None
-    where the reverse analysis or the selection fails: the caller's NumPy path then raises
-    its error. Equal to the three calls it replaces where the kernel's cos and sin are
-    NumPy's (as on the reference machine), and to the last bits otherwise."""
+    where the reverse analysis or the selection fails (the caller's NumPy path then raises
+    its error) and for any other arm. Equal to the three calls it replaces where the kernel's
+    cos and sin are NumPy's (as on the reference machine), and to the last bits otherwise."""
+    if type(model.arm) is not Puma762Arm:  # the thesis's arm only (its kernels)
+        return None
     lo, hi = _limits_rad(model)
     offsets = AXIS_OFFSETS if vernier else ZERO_OFFSETS
     off, centre = grid_rows(offsets)
