@@ -137,7 +137,9 @@ def align_stalled(stall: int, gain: float) -> bool:
     convex surface at a high force the tip's equilibrium where the force would lie along S6
     can be unstable: the smallest turn snaps the tip from one side of it to the other (a
     frictionless R = 200 mm cylinder at 5.8 N: 1.18° off on one side at a 0.078° turn, 2.75°
-    off on the other at 0.104°), and no turn aligns it.
+    off on the other at 0.104°), and no turn aligns it. The controller applies it to the
+    stiffness method only: the fixed step's jumps of several newtons (``--method fixed``)
+    also keep the turns from settling, and that run stops on its own reasons.
 
     >>> align_stalled(12, MIN_ALIGN_GAIN), align_stalled(12, 0.5), align_stalled(3, MIN_ALIGN_GAIN)
     (True, False, False)

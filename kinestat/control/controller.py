@@ -585,7 +585,7 @@ def decide(config: ControllerConfig, state: ControllerState,
     best, stall = state.align_best_deg, state.align_stall
     if contact:  # the align turns' progress
         best, stall = align_progress(best, stall, mis, config.align_tol_deg)
-        if align_stalled(stall, state.align_gain):
+        if config.method == "stiffness" and align_stalled(stall, state.align_gain):
             return _stop(st(label=label, align_best_deg=best, align_stall=stall), label,
                          align_stall_reason(stall, best, mis)
                          + f" (|F| = {Fmag:.4g} N, error {err:+.4g} N)", **info)

@@ -201,6 +201,17 @@ def test_a_contact_that_snaps_across_the_axis_stops_with_its_reason(tmp_path):
     assert recs[-1]["type"] == "end"
 
 
+def test_the_fixed_step_is_not_taken_for_a_snapping_contact(tmp_path):
+    # a CLI fuzz draw: --method fixed with friction 0.1 on the default plane kept its turns
+    # from settling (the 1 mm step's force jumps), and the snap's stop named a frictionless
+    # convex workpiece; the stop is the stiffness method's only
+    d = np.array([0.9710, 0.0298, -0.2374])
+    rep, _, io = _press(tmp_path, SimulatedCell(friction=0.1), method="fixed",
+                        force=4.0 * d / np.linalg.norm(d))
+    assert not rep.converged and io.stopped
+    assert "does not settle on the tool axis" not in rep.stop_reason
+
+
 def test_align_stalled_needs_both_no_progress_and_turns_at_their_floor():
     assert align_stalled(ALIGN_STALL_CYCLES, MIN_ALIGN_GAIN)
     assert align_stalled(ALIGN_STALL_CYCLES, 2 * MIN_ALIGN_GAIN)
