@@ -490,11 +490,24 @@ def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target
     pred = predict(model, meas, T_new)
     bad = check_command(envelope, model, axis_deg, counts_now * model.axis_deg_per_count, pred)
     if bad:
-        return Refusal(f"{action} command refused by the envelope: " + "; ".join(bad),
+        jump = float(np.max(np.abs(axis_deg - counts_now * model.axis_deg_per_count)))
+        hint = (BRANCH_CHANGE_HINT if jump > BRANCH_CHANGE_DEG
+                and any(AXIS_STEP_VIOLATION in b for b in bad) else "")
+        return Refusal(f"{action} command refused by the envelope: " + "; ".join(bad) + hint,
                        {"violations": tuple(bad), "prediction": pred})
     return Command(kind="move", label=label, action=action, target=new, axis_counts=counts,
                    axis_deg=axis_deg, q=q_new, step=step, rotation_deg=rotation_deg,
                    prediction=pred, **info)
+
+
+BRANCH_CHANGE_DEG = 90.0
+"""An axis that would move more than this in one command for a small move of the tool has
+changed inverse-kinematics branch (:data:`BRANCH_CHANGE_HINT`)."""
+BRANCH_CHANGE_HINT = (" (the nearest solution within the axis limits is far from the present "
+                      "pose: a change of the arm's inverse-kinematics branch, such as a wrist "
+                      "flip where the continuous one leaves the limits, or a pass near a "
+                      "singular wrist; the arm is at the edge of its workspace here: choose "
+                      "another --start or --direction)")
 
 
 def contact_at_start(force_magnitude: float) -> str:

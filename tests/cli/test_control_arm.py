@@ -97,3 +97,20 @@ def test_a_seven_joint_urdf_is_one_error(tmp_path, capsys):
                  "--no-plot", "--log", str(log)]) == 2
     assert "has 7 joints" in capsys.readouterr().err
     assert not log.exists()
+
+
+def test_a_wrist_flip_at_a_joint_limit_is_named(tmp_path, capsys):
+    # a CLI fuzz draw: the PUMA 560's axis 4 at its lower limit (−109.9° of −110°); the turn's
+    # continuous solution needs −110.3°, and the only one within the limits flips the wrist
+    # (axes 4 and 6 by 180°): the envelope refuses the 180° step, and the reason says why
+    rc = main(["control", "--arm", "puma560", "--task", "press", "--direction",
+               "0.9461,0.1944,-0.2592", "--force", "3.1", "--workpiece",
+               "cylinder:radius=524.2,axis=-0.6894,0.7211,0.0687", "--method", "fixed",
+               "--estimator", "wrench", "--noise", "0.0009", "--step", "0.61", "--json",
+               "--no-plot",
+               "--log", str(tmp_path / "log.jsonl")])
+    out = capsys.readouterr().out
+    rep = json.loads(out[out.index("{"):])
+    assert rc == 2 and not rep["converged"]
+    assert "in one command" in rep["stop_reason"], rep["stop_reason"]
+    assert "inverse-kinematics branch" in rep["stop_reason"]
