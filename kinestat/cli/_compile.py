@@ -153,11 +153,13 @@ def _warm_kinestatic() -> None:
 def _warm_control() -> None:
     """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
     vernier_pick), the PUMA 762's move in one call (vernier.puma_move_one), the envelope's
-    predictions (envelope.predict, envelope.sliding_push) and
+    pre-checks and predictions (envelope.predict, envelope.sliding_push) and
     the follow task's path curvature (contact_estimate.path_curvature_one) and base twist
     (follow._base_twist)."""
     from kinestat.control._cycle_kernels import (  # lazy: start-up (numba)
         base_twist_kernel,
+        command_clear_kernel,
+        measurement_clear_kernel,
         predict_kernel,
         puma_counts_kernel,
         slide_kernel,
@@ -198,6 +200,12 @@ def _warm_control() -> None:
                    K, e4.copy(), v6, v6.copy(), np.empty(3),
                    np.empty(6), np.empty(3), np.empty((4, 4)))
 
+    v6, r6 = np.zeros(6), np.full(6, 4.0)
+    measurement_clear_kernel(v6, v6.copy(), v6.copy(), e4.copy(), np.eye(3), np.zeros(3),
+                             np.zeros(3), r6, 4.0, 50.0, 5.0)
+    command_clear_kernel(v6.copy(), v6.copy(), True, v6 - 1.0, v6 + 1.0, 30.0, np.zeros(3),
+                         v6.copy(), e4.copy(), True, True, np.eye(3), np.zeros(3), np.zeros(3),
+                         r6, 4.0, 50.0, 5.0)
     C3 = np.eye(3)
     slide_kernel(e4, e4.copy(), v3, v3.copy(), np.eye(3), np.ones(3), K, C3, np.zeros(3), True,
                  np.empty(2))

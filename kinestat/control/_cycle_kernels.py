@@ -25,8 +25,9 @@ from kinestat.spatial._elimination import eliminate
 
 _OPTS = {"cache": True, "fastmath": False, "nogil": True, "error_model": "numpy"}
 
-__all__ = ["base_twist_kernel", "path_curvature_kernel", "predict_kernel",
-           "puma_counts_kernel", "slide_kernel", "vernier_tables_kernel"]
+__all__ = ["base_twist_kernel", "command_clear_kernel", "measurement_clear_kernel",
+           "path_curvature_kernel", "predict_kernel", "puma_counts_kernel", "slide_kernel",
+           "vernier_tables_kernel"]
 
 _PI = math.pi
 _TWO_PI = 2.0 * math.pi
@@ -135,6 +136,94 @@ def puma_counts_kernel(p, z, x, p6, q_now, axis_offset, lo, hi, res, coupling, n
         cs[j, 0], cs[j, 1] = math.cos(v), math.sin(v)
     pose_one(cs, T)
     return True, along
+
+
+#: the relative margin by which a value must lie inside its limit for the compiled pre-checks
+#: to call it clear (:func:`measurement_clear_kernel`, :func:`command_clear_kernel`): a value
+#: nearer its limit goes to the checks in Python, whatever the rounding
+CLEAR_MARGIN = 1e-9
+
+
+@nb.njit(**_OPTS)
+def _inside(v, lim):
+    """``|v|`` at least ``CLEAR_MARGIN`` (relative) inside ``lim`` (False for NaN)."""
+    return abs(v) <= lim - CLEAR_MARGIN * (1.0 + abs(lim))
+
+
+@nb.njit(**_OPTS)
+def _motion_clear(T, H, c, hc, mr, rot_min):
+    """The top pose ``T`` (4, 4) clearly inside the motion ranges ``mr`` (6,): its rotation
+    from home (``H`` (3, 3) the home rotation) bounded by the trace's angle below the least
+    rotation range ``rot_min`` (degrees) by more than 1e-6°, and its centroid's displacement
+    (``c`` (3,) the top's centroid, ``hc`` (3,) its home position) inside x, y, z
+    (:func:`kinestat.control.envelope.check_motion`'s shortcut); False otherwise (the checks
+    in Python then decide)."""
+    tr = 0.0
+    for r in range(3):
+        tr += T[r, 0] * H[r, 0] + T[r, 1] * H[r, 1] + T[r, 2] * H[r, 2]
+    cth = min(1.0, max(-1.0, (tr - 1.0) / 2.0))
+    angle = math.degrees(math.acos(cth))
+    if not angle + 1e-6 < rot_min - CLEAR_MARGIN * (1.0 + rot_min):
+        return False
+    for r in range(3):
+        m = (T[r, 0] * c[0] + T[r, 1] * c[1] + T[r, 2] * c[2] + T[r, 3]) - hc[r]
+        if not _inside(m, mr[r]):
+            return False
+    return True
+
+
+@nb.njit(**_OPTS)
+def measurement_clear_kernel(wrench, lengths, free_lengths, T, H, c, hc, mr, rot_min,
+                             max_load, max_deflection):
+    """True when a measurement is clearly inside the envelope
+    (:func:`kinestat.control.envelope.check_measurement` finds nothing, with a margin): the
+    wrench (6,) and leg lengths (6,) finite, the force under ``max_load``, every deflection
+    ``l − l0`` under ``max_deflection`` and the top pose ``T`` inside the motion ranges
+    (:func:`_motion_clear`). False does not mean a violation: the checks in Python decide."""
+    for i in range(6):
+        if not (math.isfinite(wrench[i]) and math.isfinite(lengths[i])):
+            return False
+    f = math.sqrt(wrench[0] * wrench[0] + wrench[1] * wrench[1] + wrench[2] * wrench[2])
+    if not _inside(f, max_load):
+        return False
+    for i in range(6):
+        if not _inside(lengths[i] - free_lengths[i], max_deflection):
+            return False
+    return _motion_clear(T, H, c, hc, mr, rot_min)
+
+
+@nb.njit(**_OPTS)
+def command_clear_kernel(a, now, has_now, lo, hi, max_step, force, defl, T, has_pred, has_top,
+                         H, c, hc, mr, rot_min, max_load, max_deflection):
+    """True when a command is clearly inside the envelope
+    (:func:`kinestat.control.envelope.check_command` finds nothing, with a margin): the axis
+    angles ``a`` (6,, degrees) finite and inside ``[lo, hi]``, each within ``max_step`` of
+    ``now`` (when ``has_now``), and (when ``has_pred``) the predicted force (3,) and
+    deflections (6,) finite and under the load and deflection limits and (when ``has_top``)
+    the predicted top pose ``T`` inside the motion ranges. False does not mean a violation:
+    the checks in Python decide."""
+    for j in range(6):
+        if not math.isfinite(a[j]):
+            return False
+        if not (lo[j] + CLEAR_MARGIN * (1.0 + abs(lo[j])) <= a[j]
+                <= hi[j] - CLEAR_MARGIN * (1.0 + abs(hi[j]))):
+            return False
+        if has_now and not _inside(a[j] - now[j], max_step):
+            return False
+    if not has_pred:
+        return True
+    for i in range(6):
+        if not math.isfinite(defl[i]):
+            return False
+        if not _inside(defl[i], max_deflection):
+            return False
+    for i in range(3):
+        if not math.isfinite(force[i]):
+            return False
+    f = math.sqrt(force[0] * force[0] + force[1] * force[1] + force[2] * force[2])
+    if not _inside(f, max_load):
+        return False
+    return _motion_clear(T, H, c, hc, mr, rot_min) if has_top else True
 
 
 #: smallest |R_kk| / max |R_jj| of the QR factor the kernel solves with (else: NumPy's lstsq)

@@ -101,7 +101,9 @@ def reference_cycle() -> Iterator[None]:
               lambda r: Rotation.from_rotvec(r).as_matrix()),
              (envelope, "_rotation_clear", lambda *a: False),
              (envelope, "_predict_fast", lambda *a: None),
-             (envelope, "_slide_fast", lambda *a: None)]
+             (envelope, "_slide_fast", lambda *a: None),
+             (envelope, "_measurement_clear", lambda *a: False),
+             (envelope, "_command_clear", lambda *a: False)]
     old = [(mod, name, getattr(mod, name)) for mod, name, _ in saved]
     try:
         for mod, name, new in saved:
