@@ -1,5 +1,10 @@
 """The safety envelope of the kinestatic controller: limits, predictions, verdicts.
 
+Over 600 lines on purpose: the checks, the predictions they judge and the compiled paths of
+both share the model's constants (``_Consts``) and the array conventions of the kernels, and
+the Python checks are the authority the compiled pre-checks defer to; kept in one place so
+that a change to a limit cannot miss one of them.
+
 What the cell must never do (Vibhute 2011 Table 3-1 and the PUMA 762's axis limits):
 
 * command an axis outside its limits (every commanded configuration is checked as the absolute
