@@ -259,7 +259,7 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float,
             k = float(axis @ tip_stiffness(model, meas) @ axis)
             if k_push is not None and MIN_PUSH_RATE * k <= k_push <= k:
                 k = k_push  # the turned tool's push, with the tip sliding (turned_force)
-            step = float(np.clip(err / k, -config.step, config.step))
+            step = float(min(max(err / k, -config.step), config.step))  # numpy.clip, in floats
         if far and step > 0.0:  # a large turn, or far off the force: turn before pushing
             step = 0.0
     return action, (tgt.tool_point + step * axis, axis, a67), step, rotation, memo

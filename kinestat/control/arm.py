@@ -22,6 +22,7 @@ an arm without it).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Protocol, runtime_checkable
 
@@ -31,7 +32,6 @@ from kinestat.errors import JointLimitError, ModelError, UnreachableError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import puma762
 from kinestat.serial.fk import fk
-from kinestat.spatial.transforms import cross3
 from kinestat.spatial.validate import frozen
 
 if TYPE_CHECKING:
@@ -145,14 +145,19 @@ def frame_from_tool(tool_point, s6, a67, tool_point_6) -> np.ndarray:
     >>> T[:3, 3].tolist()
     [0.0, 0.0, 200.0]
     """
-    z = np.asarray(s6, dtype=float)
-    x = np.asarray(a67, dtype=float)
-    z = z / np.linalg.norm(z)
-    x = x - (x @ z) * z
-    x = x / np.linalg.norm(x)
-    T = np.zeros((4, 4))
-    T[3, 3] = 1.0
-    T[:3, 0], T[:3, 1], T[:3, 2] = x, cross3(z, x), z
+    # in scalars (a control cycle builds two frames): the norms and the dot product sum in
+    # order, as NumPy's do on the reference machine
+    z0, z1, z2 = np.asarray(s6, dtype=float).tolist()
+    x0, x1, x2 = np.asarray(a67, dtype=float).tolist()
+    n = math.sqrt(z0 * z0 + z1 * z1 + z2 * z2)
+    z0, z1, z2 = z0 / n, z1 / n, z2 / n
+    d = x0 * z0 + x1 * z1 + x2 * z2
+    x0, x1, x2 = x0 - d * z0, x1 - d * z1, x2 - d * z2
+    n = math.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
+    x0, x1, x2 = x0 / n, x1 / n, x2 / n
+    y0, y1, y2 = z1 * x2 - z2 * x1, z2 * x0 - z0 * x2, z0 * x1 - z1 * x0
+    T = np.array([[x0, y0, z0, 0.0], [x1, y1, z1, 0.0], [x2, y2, z2, 0.0],
+                  [0.0, 0.0, 0.0, 1.0]])
     T[:3, 3] = np.asarray(tool_point, dtype=float) - T[:3, :3] @ np.asarray(tool_point_6, float)
     return T
 
