@@ -36,7 +36,9 @@ import numpy as np
 from kinestat.control.model import ControlModel
 from kinestat.errors import InputError
 from kinestat.hardware.leg_calibration import counts_to_forces, counts_to_lengths
-from kinestat.parallel.statics import line_jacobian, spring_forces, wrench_from_leg_lengths
+from kinestat.parallel.fk import fk_tracking
+from kinestat.parallel.legs import line_jacobian_trusted
+from kinestat.parallel.statics import spring_forces
 from kinestat.spatial.screws import transform_wrench
 from kinestat.spatial.transforms import apply, apply_one, skew
 
@@ -155,8 +157,9 @@ def measure(model: ControlModel, q, counts, previous_top_pose, *, seq: int | Non
     # from the calibration's force maps or the springs k (l - l0)
     tension = (counts_to_forces(c, model.calibration, plat.leg_names)
                if model.force_source == "calibration" else spring_forces(plat, lengths))
-    top, w_ext = wrench_from_leg_lengths(plat, lengths, previous_top_pose, forces=tension)
-    j = line_jacobian(plat, top)
+    top = fk_tracking(plat, lengths, previous_top_pose)
+    j = line_jacobian_trusted(plat, top)  # a pose fk_tracking returned: rigid, finite
+    w_ext = j @ tension
     tool, s6, a67, T6 = tool_frame(q, model)
     TB = T6 @ model.mount
     w_fixed = transform_wrench(TB, -w_ext)

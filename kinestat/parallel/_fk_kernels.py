@@ -325,10 +325,8 @@ def _legs(base, top, L, T, r, J, with_jacobian):
 
 
 @nb.njit(**_OPTS)
-def _newton_step(base, top, L, T, r, J, A, x):
-    """One ``_refine.refine`` step: ``(JᵀJ + λI) s = −Jᵀ r`` (λ = 1e-14 tr + 1e-300), non-finite
-    components of s set to 0, then ``apply_twist``."""
-    _legs(base, top, L, T, r, J, True)
+def _normal_equations(J, r, A, x):
+    """``A = JᵀJ`` (lower triangle) and ``x = −Jᵀ r`` of a (6, 6) Jacobian; returns tr(JᵀJ)."""
     tr = 0.0
     for a in range(6):
         for b in range(a + 1):
@@ -341,15 +339,20 @@ def _newton_step(base, top, L, T, r, J, A, x):
         for i in range(6):
             g += J[i, a] * r[i]
         x[a] = -g
-    lam = 1e-14 * tr + 1e-300
-    ok = True
-    for j in range(6):  # L D Lᵀ of A + λ I (lower triangle)
+    return tr
+
+
+@nb.njit(**_OPTS)
+def _ldl_solve(A, x, lam):
+    """Solve ``(A + λ I) s = x`` in place (``x`` becomes ``s``) by L D Lᵀ of the lower
+    triangle of the symmetric (6, 6) ``A`` (overwritten); False (``x`` untouched) where a pivot
+    is not positive."""
+    for j in range(6):
         d = A[j, j] + lam
         for k in range(j):
             d -= A[j, k] * A[j, k] * A[k, k]
         if not d > 0.0:
-            ok = False
-            break
+            return False
         inv_d = 1.0 / d
         for i in range(j + 1, 6):
             s = A[i, j]
@@ -357,8 +360,6 @@ def _newton_step(base, top, L, T, r, J, A, x):
                 s -= A[i, k] * A[j, k] * A[k, k]
             A[i, j] = s * inv_d
         A[j, j] = d
-    if not ok:
-        return
     for i in range(6):
         s = x[i]
         for k in range(i):
@@ -371,10 +372,13 @@ def _newton_step(base, top, L, T, r, J, A, x):
         for k in range(i + 1, 6):
             s -= A[k, i] * x[k]
         x[i] = s
-    for i in range(6):
-        if not math.isfinite(x[i]):
-            x[i] = 0.0
-    # apply_twist: X' = Rot(δφ) X + δx (Rodrigues, series below 1e-8 rad)
+    return True
+
+
+@nb.njit(**_OPTS)
+def _apply_twist(T, x):
+    """``_refine.apply_twist`` in place: ``X' = Rot(δφ) X + δx`` for the twist ``x`` (6,)
+    ``[δφ; δx_O]`` (Rodrigues, series below 1e-8 rad)."""
     w0, w1, w2 = x[0], x[1], x[2]
     th = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
     if th < 1e-8:
@@ -400,6 +404,20 @@ def _newton_step(base, top, L, T, r, J, A, x):
 
 
 @nb.njit(**_OPTS)
+def _newton_step(base, top, L, T, r, J, A, x):
+    """One ``_refine.refine`` step: ``(JᵀJ + λI) s = −Jᵀ r`` (λ = 1e-14 tr + 1e-300), non-finite
+    components of s set to 0, then ``apply_twist``."""
+    _legs(base, top, L, T, r, J, True)
+    tr = _normal_equations(J, r, A, x)
+    if not _ldl_solve(A, x, 1e-14 * tr + 1e-300):
+        return
+    for i in range(6):
+        if not math.isfinite(x[i]):
+            x[i] = 0.0
+    _apply_twist(T, x)
+
+
+@nb.njit(**_OPTS)
 def _polish(base, top, L, T, tol, iterations, r, J, A, x):
     """``_refine.refine_where`` for one pose: Newton steps while the leg error exceeds ``tol``;
     returns the final max |leg error| (inf if not finite)."""
@@ -410,6 +428,128 @@ def _polish(base, top, L, T, tol, iterations, r, J, A, x):
         _newton_step(base, top, L, T, r, J, A, x)
         err = _legs(base, top, L, T, r, J, False)
     return err
+
+
+#: the least ``|det j|`` relative to Hadamard's bound (the product of its column norms) at which
+#: the compiled tracking reads the determinant's sign (:func:`_det_sign`); nearer a singular
+#: configuration the sign is left to the NumPy path (``fk._newton``), whatever the rounding
+TRACK_DET_MARGIN = 1e-9
+
+
+@nb.njit(**_OPTS)
+def _det_sign(J, M):
+    """The sign (+1 or −1) of ``det J`` (6, 6), by LU with partial pivoting of a copy in ``M``;
+    0 where ``|det J|`` is below :data:`TRACK_DET_MARGIN` times the product of J's column norms
+    (or not finite): too near a singular configuration to trust the sign."""
+    bound = 1.0
+    for j in range(6):
+        s = 0.0
+        for i in range(6):
+            M[i, j] = J[i, j]
+            s += J[i, j] * J[i, j]
+        bound *= math.sqrt(s)
+    sign = 1
+    size = 1.0
+    for k in range(6):
+        p = k
+        big = abs(M[k, k])
+        for i in range(k + 1, 6):
+            if abs(M[i, k]) > big:
+                big = abs(M[i, k])
+                p = i
+        if not big > 0.0:
+            return 0
+        if p != k:
+            for j in range(6):
+                M[k, j], M[p, j] = M[p, j], M[k, j]
+            sign = -sign
+        piv = M[k, k]
+        if piv < 0.0:
+            sign = -sign
+        size *= big
+        for i in range(k + 1, 6):
+            f = M[i, k] / piv
+            for j in range(k + 1, 6):
+                M[i, j] -= f * M[k, j]
+    if not (math.isfinite(size) and size > TRACK_DET_MARGIN * bound):
+        return 0
+    return sign
+
+
+@nb.njit(**_OPTS)
+def _track_one(base, top, L, T, tol, max_iter, scale, r, J, A, x, M):
+    """``fk._newton`` for one pose ``T`` (4, 4), in place: damped Newton steps (λ = 1e-12 tr +
+    1e-300, at most 0.2 rad and 0.2·scale per step) until every leg is within ``tol``·1e-3 or
+    ``max_iter`` steps; True only where the legs end within ``tol`` and the determinant of the
+    line Jacobian read the same clear sign (:func:`_det_sign`) at the start and every iterate.
+    False (a non-finite or unsolvable step, a sign change or an unclear one, no convergence):
+    the caller runs the NumPy path, which names the failure."""
+    worst = _legs(base, top, L, T, r, J, True)
+    s0 = _det_sign(J, M)
+    if s0 == 0:
+        return False
+    it = 0
+    while not worst <= tol * 1e-3 and it < max_iter:
+        tr = _normal_equations(J, r, A, x)
+        if not _ldl_solve(A, x, 1e-12 * tr + 1e-300):
+            return False
+        fr = math.sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]) / 0.2
+        ft = math.sqrt(x[3] * x[3] + x[4] * x[4] + x[5] * x[5]) / (0.2 * scale)
+        if not (math.isfinite(fr) and math.isfinite(ft)):
+            return False
+        f = max(1.0, max(fr, ft))
+        for i in range(6):
+            x[i] = x[i] / f
+        _apply_twist(T, x)
+        worst = _legs(base, top, L, T, r, J, True)
+        if _det_sign(J, M) != s0:
+            return False
+        it += 1
+    return worst <= tol
+
+
+@nb.njit(**_OPTS)
+def track_kernel(base, top, L, T, tol, max_iter, scale, ok):
+    """:func:`_track_one` over a batch: ``L`` (N, 6) leg lengths, ``T`` (N, 4, 4) the previous
+    poses, moved in place to the tracked ones; ``ok`` (N,) bool, see :func:`_track_one`."""
+    r = np.empty(6)
+    J = np.empty((6, 6))
+    A = np.empty((6, 6))
+    x = np.empty(6)
+    M = np.empty((6, 6))
+    for b in range(L.shape[0]):
+        ok[b] = _track_one(base, top, L[b], T[b], tol, max_iter, scale, r, J, A, x, M)
+
+
+@nb.njit(**_OPTS)
+def _pose_gap(a, b, scale):
+    """``fk._pose_distance`` of two poses (4, 4): the largest rotation-entry difference and
+    translation difference over ``scale``."""
+    dr = 0.0
+    for i in range(3):
+        for j in range(3):
+            dr = max(dr, abs(a[i, j] - b[i, j]))
+    dp = 0.0
+    for i in range(3):
+        dp = max(dp, abs(a[i, 3] - b[i, 3]))
+    return max(dr, dp / scale)
+
+
+@nb.njit(**_OPTS)
+def nearest_moved_kernel(poses, valid, prev, pose, scale, moved):
+    """``fk._verify_nearest``'s test over a batch: ``moved[b]`` where the valid mode of
+    ``poses[b]`` (16, 4, 4) nearest ``prev[b]`` (the first of equals) is more than 1e-6 from
+    ``pose[b]`` (``fk._pose_distance``); False where no mode is valid, as the NumPy test."""
+    for b in range(poses.shape[0]):
+        best = np.inf
+        k = -1
+        for m in range(poses.shape[1]):
+            if valid[b, m]:
+                d = _pose_gap(poses[b, m], prev[b], scale)
+                if d < best or k < 0:
+                    best = d
+                    k = m
+        moved[b] = k >= 0 and _pose_gap(poses[b, k], pose[b], scale) > 1e-6
 
 
 @nb.njit(**_OPTS)
@@ -630,3 +770,17 @@ def fk_all_arrays(constants: tuple, L: np.ndarray, tol: float = 1e-9,
                                              Mb, Mt, base, top, part, flags, roots, float(tol),
                                              int(polish), poses[rows], valid[rows], res[rows])
     return poses, valid, res
+
+
+def track_arrays(base: np.ndarray, top: np.ndarray, L: np.ndarray, previous: np.ndarray,
+                 tol: float, max_iter: int, scale: float) -> np.ndarray | None:
+    """The tracked poses (..., 4, 4) of validated leg lengths ``L`` (..., 6) from the poses
+    ``previous`` (..., 4, 4) (:func:`track_kernel`), or None unless every one converged with a
+    clear determinant sign kept throughout (the caller then runs ``fk._newton``)."""
+    shape = L.shape[:-1]
+    T = np.array(previous, dtype=float, order="C").reshape(-1, 4, 4)
+    ok = np.empty(T.shape[0], dtype=bool)
+    track_kernel(np.ascontiguousarray(base, dtype=float), np.ascontiguousarray(top, dtype=float),
+                 np.ascontiguousarray(L, dtype=float).reshape(-1, 6), T, float(tol),
+                 int(max_iter), float(scale), ok)
+    return T.reshape(shape + (4, 4)) if ok.all() else None

@@ -355,7 +355,8 @@ def fk_numeric(platform: Platform, lengths, guess=None, *, tol: float = 1e-9,
 
 
 def fk_tracking(platform: Platform, lengths, previous_pose, *, tol: float = 1e-9,
-                max_iter: int = 20, verify: bool | None = None) -> np.ndarray:
+                max_iter: int = 20, verify: bool | None = None,
+                backend: Backend = "numba") -> np.ndarray:
     """The assembly mode continuous with ``previous_pose`` (Newton from it), checked.
 
     Checks that the iteration converged and that the determinant of the line Jacobian kept its
@@ -363,14 +364,37 @@ def fk_tracking(platform: Platform, lengths, previous_pose, *, tol: float = 1e-9
     True for a special 6-6) it also solves all modes and checks that the result is the mode
     nearest the previous pose.
 
+    ``backend``: ``"numba"`` (default) runs the Newton iteration compiled
+    (:func:`kinestat.parallel._fk_kernels.track_kernel`, the same steps solved by L D Lᵀ: the
+    poses agree with the NumPy iteration's to rounding). It decides only the clear cases: where
+    any pose fails to converge or the determinant's sign changes or comes within 1e-9
+    (relative) of zero, the whole batch is re-run by ``"numpy"`` (``_newton``), which decides
+    and names the failure.
+
     Raises:
         UnreachableError: no convergence.
         SingularityError: the path crossed a singularity or landed in another mode; the
             assembly mode is ambiguous — re-initialise from :func:`fk_list`.
     """
+    if backend not in ("numba", "numpy"):
+        raise InputError(f"backend must be 'numba' or 'numpy', got {backend!r}")
     L = check_lengths(lengths)
     prev = as_pose(previous_pose, "previous_pose")
     prev = np.broadcast_to(prev, L.shape[:-1] + (4, 4)).copy()
+    pose = (_fk_kernels.track_arrays(platform.base_points, platform.top_points, L, prev, tol,
+                                     max_iter, platform.scale) if backend == "numba" else None)
+    if pose is None:
+        pose = _newton_checked(platform, L, prev, tol, max_iter)
+    if verify is None:
+        verify = platform.layout is not None
+    if verify:
+        _verify_nearest(platform, L, prev, pose, tol, backend)
+    return pose
+
+
+def _newton_checked(platform: Platform, L: np.ndarray, prev: np.ndarray, tol: float,
+                    max_iter: int) -> np.ndarray:
+    """:func:`_newton` from ``prev``, its convergence and determinant signs checked."""
     pose, res, signs = _newton(platform, L, prev, tol, max_iter)
     if np.any(~(res <= tol)):
         raise UnreachableError(
@@ -383,19 +407,31 @@ def fk_tracking(platform: Platform, lengths, previous_pose, *, tol: float = 1e-9
             "tracking crossed a singular configuration (the line Jacobian's determinant changed "
             "sign between the previous pose and the solution): the assembly mode is ambiguous; "
             "re-initialise with fk_list")
-    if verify is None:
-        verify = platform.layout is not None
-    if verify:
-        sol = fk_all(platform, L, tol=max(tol, 1e-9))
+    return pose
+
+
+def _verify_nearest(platform: Platform, L: np.ndarray, prev: np.ndarray, pose: np.ndarray,
+                    tol: float, backend: Backend = "numpy") -> None:
+    """Raise :class:`SingularityError` unless ``pose`` is the assembly mode nearest ``prev``
+    (``backend="numba"``: the distances compiled, :func:`_fk_kernels.nearest_moved_kernel`)."""
+    sol = fk_all(platform, L, tol=max(tol, 1e-9))
+    if backend == "numba":
+        n = sol.valid.shape[-1]
+        moved = np.empty(int(np.prod(L.shape[:-1], dtype=np.int64)), dtype=bool)
+        _fk_kernels.nearest_moved_kernel(
+            np.ascontiguousarray(sol.poses).reshape(-1, n, 4, 4), sol.valid.reshape(-1, n),
+            np.ascontiguousarray(prev).reshape(-1, 4, 4),
+            np.ascontiguousarray(pose, dtype=float).reshape(-1, 4, 4), float(platform.scale),
+            moved)
+    else:
         d = _pose_distance(sol.poses, prev[..., None, :, :], platform.scale)
         d = np.where(sol.valid, d, np.inf)
         nearest = np.take_along_axis(sol.poses, np.argmin(d, axis=-1)[..., None, None, None],
                                      axis=-3)[..., 0, :, :]
         moved = _pose_distance(nearest, pose, platform.scale) > 1e-6
-        if np.any(moved):
-            raise SingularityError(
-                "tracking converged to an assembly mode that is not the one nearest the "
-                "previous pose: the motion between samples was too large; re-initialise with "
-                "fk_list")
-    return pose
+    if np.any(moved):
+        raise SingularityError(
+            "tracking converged to an assembly mode that is not the one nearest the "
+            "previous pose: the motion between samples was too large; re-initialise with "
+            "fk_list")
 

@@ -22,7 +22,8 @@ if TYPE_CHECKING:  # the platform module imports this one (its design check)
 _LAST_ROW_TOL = 1e-12  # poses computed here carry rounding in their last row at most
 
 __all__ = ["as_pose", "top_points_in_base", "leg_vectors", "leg_lengths", "leg_directions",
-           "leg_directions_trusted", "leg_lines", "line_jacobian"]
+           "leg_directions_trusted", "leg_lines", "line_jacobian",
+           "line_jacobian_trusted"]
 
 
 def as_pose(pose, name: str = "pose") -> np.ndarray:
@@ -86,3 +87,10 @@ def line_jacobian(platform: Platform, pose) -> np.ndarray:
     (6, 6)
     """
     return np.swapaxes(leg_lines(platform, pose), -1, -2)
+
+
+def line_jacobian_trusted(platform: Platform, T: np.ndarray) -> np.ndarray:
+    """:func:`line_jacobian` of poses ``T`` (..., 4, 4) the caller has checked (float arrays,
+    rigid; e.g. the pose forward kinematics just returned): no validation, the same values."""
+    S, _ = leg_directions_trusted(platform, T)
+    return np.swapaxes(np.concatenate([S, np.cross(platform.base_points, S)], axis=-1), -1, -2)

@@ -181,6 +181,71 @@ def test_tracking_refuses_a_jump_to_another_mode():
     assert np.argmin(d) == np.argmin(dist_prev)
 
 
+def _tracked(p, L, prev, backend):
+    """fk_tracking's pose, or the class of the error it raised."""
+    try:
+        return fk_tracking(p, L, prev, backend=backend)
+    except (SingularityError, UnreachableError) as exc:
+        return type(exc)
+
+
+@pytest.mark.parametrize("platform", ["prototype", "general"])
+def test_compiled_tracking_agrees_with_numpy(platform):
+    """The compiled Newton (backend "numba", the default) against the NumPy iteration: the same
+    pose to rounding or the same error, from small moves to jumps between modes, near and across
+    singular configurations (lengths from poses far from home), for a special and a general
+    6-6; and the compiled path decides most small moves itself (it is not always falling back)."""
+    import kinestat.parallel.fk as fk_mod
+
+    p = prototype() if platform == "prototype" else _non_special()
+    rng = np.random.default_rng(31)
+    calls = []
+    real_newton = fk_mod._newton
+
+    def counting(*a):
+        calls.append(1)
+        return real_newton(*a)
+
+    errors = 0
+    small = 0
+    fallbacks = 0
+    for k in range(300):
+        scale = [0.002, 0.05, 0.3, 1.0][k % 4]
+        prev = near_home(rng, rot=0.3 * scale, trans=20.0 * scale)
+        target = apply_twist(prev, rng.normal(size=6) * np.r_[[0.05 * scale] * 3,
+                                                               [3.0 * scale] * 3])
+        L = leg_lengths(p, target) + rng.normal(size=6) * (0.0 if k % 3 else 1e-3)
+        if np.any(L <= 0):
+            continue
+        want = _tracked(p, L, prev, "numpy")
+        calls.clear()
+        fk_mod._newton = counting
+        try:
+            got = _tracked(p, L, prev, "numba")
+        finally:
+            fk_mod._newton = real_newton
+        if isinstance(want, type):
+            errors += 1
+            assert got is want, (k, want, got)
+        else:
+            assert not isinstance(got, type), (k, got)
+            np.testing.assert_allclose(got[:3, :3], want[:3, :3], atol=1e-12)
+            np.testing.assert_allclose(got[:3, 3], want[:3, 3], atol=1e-9)
+        if scale == 0.002:
+            small += 1
+            fallbacks += bool(calls)
+    assert errors > 0  # the draw reaches the refusals too
+    assert fallbacks <= 0.05 * small
+    # a batch with one pose the compiled path cannot decide: the whole batch by NumPy, the
+    # same error
+    L = np.stack([leg_lengths(p, p.home_pose), np.full(6, 1.0)])
+    for backend in ("numba", "numpy"):
+        with pytest.raises(UnreachableError, match="did not converge"):
+            fk_tracking(p, L, np.stack([p.home_pose] * 2), backend=backend)
+    with pytest.raises(InputError, match="backend"):
+        fk_tracking(p, L[0], p.home_pose, backend="fortran")
+
+
 def _non_special():
     p = prototype()
     base = p.base_points.copy()
