@@ -131,12 +131,14 @@ def _warm_stiffness() -> None:
 
 
 def _warm_platform() -> None:
+    """All-mode FK (fk_list) and tracking FK with its nearest-mode test (fk_tracking)."""
     from kinestat.io.library import prototype  # lazy: start-up
-    from kinestat.parallel.fk import fk_list  # lazy: start-up (numba)
+    from kinestat.parallel.fk import fk_list, fk_tracking  # lazy: start-up (numba)
     from kinestat.parallel.legs import leg_lengths  # lazy: start-up
 
     p = prototype()
     fk_list(p, leg_lengths(p, p.home_pose))
+    fk_tracking(p, leg_lengths(p, p.home_pose), p.home_pose)
 
 
 def _warm_kinestatic() -> None:
