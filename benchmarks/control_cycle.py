@@ -17,12 +17,12 @@ decision alone (the fast path's calls back to back on the same inputs, the cache
 lower bound; the alternating runs let the reference path's large arrays evict the caches
 before every fast call), the measurement chain (``measure``, not part of the decision) and
 the decision as the control loop makes it ("in loop": each call right after the ``measure``
-that makes its Measurement, whose ~0.7 ms of NumPy leaves the caches cold: the closest
-figure to a real cycle). Figures are medians over the moving cycles (the follow task's settle
-and follow cycles: not its approach or surface-probe moves) of the median of repeats; every
-call gets a fresh copy of its Measurement (no per-cycle data is reused between calls). The
-kernels are compiled (or loaded from the cache) before anything is timed; that first load is
-reported on its own.
+that makes its Measurement, whose NumPy (~0.25 ms since its tracking FK was compiled on
+2026-12-04; ~0.85 ms before) leaves the caches cold: the closest figure to a real cycle).
+Figures are medians over the moving cycles (the follow task's settle and follow cycles: not
+its approach or surface-probe moves) of the median of repeats; every call gets a fresh copy
+of its Measurement (no per-cycle data is reused between calls). The kernels are compiled (or
+loaded from the cache) before anything is timed; that first load is reported on its own.
 
     .venv/bin/python benchmarks/control_cycle.py [--json] [--repeat N] [--clock wall|cpu]
 """
@@ -166,7 +166,8 @@ def _per_cycle(fn, pairs, repeat: int) -> list[float]:
 def _in_loop(fn, model, pairs, repeat: int) -> list[float]:
     """Per pair, the median of ``repeat`` calls each made right after the measurement chain
     that makes its Measurement (``measure`` on the recorded counts, as the control loop
-    calls it before every decision: ~0.7 ms of NumPy that leaves the caches cold), seconds.
+    calls it before every decision: ~0.25 ms, mostly NumPy, that leaves the caches cold),
+    seconds.
     The closest of these figures to a cycle of the real loop (which also reads the devices
     and writes the log between decisions)."""
     per = []

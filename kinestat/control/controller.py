@@ -49,6 +49,7 @@ new normal); and where a stuck tip carries the turns, the force is shed across S
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field, replace
 from typing import Literal, get_args
@@ -269,9 +270,9 @@ class ControllerConfig:
             raise InputError(f"the contact threshold {self.contact_force} N must be below the "
                              f"requested force {np.linalg.norm(F):.3g} N")
 
-    @property
+    @functools.cached_property
     def force_target(self) -> float:
-        """|F_req| (N)."""
+        """|F_req| (N); computed once per config (the cycle reads it several times)."""
         return float(np.linalg.norm(self.force))
 
     @property

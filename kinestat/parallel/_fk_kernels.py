@@ -553,6 +553,32 @@ def nearest_moved_kernel(poses, valid, prev, pose, scale, moved):
 
 
 @nb.njit(**_OPTS)
+def line_jacobian_kernel(base, top, T, j):
+    """``legs.line_jacobian`` of poses ``T`` (N, 4, 4) into ``j`` (N, 6, 6): column i is
+    ``[S_i; B_i × S_i]``, ``S_i`` the unit leg direction from ``B_i`` (``base`` (6, 3)) to the
+    top point ``top[i]`` carried by ``T``. Returns False where a leg has zero length."""
+    for b in range(T.shape[0]):
+        for i in range(6):
+            d0 = T[b, 0, 0] * top[i, 0] + T[b, 0, 1] * top[i, 1] + T[b, 0, 2] * top[i, 2] \
+                + T[b, 0, 3] - base[i, 0]
+            d1 = T[b, 1, 0] * top[i, 0] + T[b, 1, 1] * top[i, 1] + T[b, 1, 2] * top[i, 2] \
+                + T[b, 1, 3] - base[i, 1]
+            d2 = T[b, 2, 0] * top[i, 0] + T[b, 2, 1] * top[i, 1] + T[b, 2, 2] * top[i, 2] \
+                + T[b, 2, 3] - base[i, 2]
+            n = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
+            if not n > 0.0:
+                return False
+            s0, s1, s2 = d0 / n, d1 / n, d2 / n
+            j[b, 0, i] = s0
+            j[b, 1, i] = s1
+            j[b, 2, i] = s2
+            j[b, 3, i] = base[i, 1] * s2 - base[i, 2] * s1
+            j[b, 4, i] = base[i, 2] * s0 - base[i, 0] * s2
+            j[b, 5, i] = base[i, 0] * s1 - base[i, 1] * s0
+    return True
+
+
+@nb.njit(**_OPTS)
 def _signature(T, scale, out):
     out[0] = T[0, 3] / scale
     out[1] = T[1, 3] / scale

@@ -17,6 +17,7 @@ determinant ``Π(1 − t) − Π t`` — zero for an architecturally singular la
 
 from __future__ import annotations
 
+import math
 import weakref
 from dataclasses import dataclass
 from functools import lru_cache
@@ -417,7 +418,7 @@ def _verify_nearest(platform: Platform, L: np.ndarray, prev: np.ndarray, pose: n
     sol = fk_all(platform, L, tol=max(tol, 1e-9))
     if backend == "numba":
         n = sol.valid.shape[-1]
-        moved = np.empty(int(np.prod(L.shape[:-1], dtype=np.int64)), dtype=bool)
+        moved = np.empty(math.prod(L.shape[:-1]), dtype=bool)
         _fk_kernels.nearest_moved_kernel(
             np.ascontiguousarray(sol.poses).reshape(-1, n, 4, 4), sol.valid.reshape(-1, n),
             np.ascontiguousarray(prev).reshape(-1, 4, 4),

@@ -91,6 +91,17 @@ def line_jacobian(platform: Platform, pose) -> np.ndarray:
 
 def line_jacobian_trusted(platform: Platform, T: np.ndarray) -> np.ndarray:
     """:func:`line_jacobian` of poses ``T`` (..., 4, 4) the caller has checked (float arrays,
-    rigid; e.g. the pose forward kinematics just returned): no validation, the same values."""
-    S, _ = leg_directions_trusted(platform, T)
-    return np.swapaxes(np.concatenate([S, np.cross(platform.base_points, S)], axis=-1), -1, -2)
+    rigid; e.g. the pose forward kinematics just returned): no validation, compiled
+    (:func:`kinestat.parallel._fk_kernels.line_jacobian_kernel`; equal to it to rounding).
+
+    Raises:
+        SingularityError: a leg has zero length (its line is undefined).
+    """
+    from kinestat.parallel import _fk_kernels  # lazy: numba (~0.5 s) at start-up
+
+    T = np.ascontiguousarray(T, dtype=float)
+    j = np.empty(T.shape[:-2] + (6, 6))
+    if not _fk_kernels.line_jacobian_kernel(platform.base_points, platform.top_points,
+                                            T.reshape(-1, 4, 4), j.reshape(-1, 6, 6)):
+        raise SingularityError("a leg has zero length at this pose: its line is undefined")
+    return j

@@ -8,6 +8,8 @@ caller passes (``ModelError`` for data that is part of a model).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from kinestat.errors import InputError
@@ -38,6 +40,21 @@ def _pose_index(mask: np.ndarray) -> str:
     return f" (pose {tuple(int(i) for i in np.argwhere(mask)[0])})"
 
 
+def _one_pose_clear(rows: list, tol: float, last_row_tol: float) -> bool:
+    """True when ONE pose (its rows as lists) passes :func:`as_pose`'s checks by half their
+    tolerances or more, in scalars (a control cycle validates a pose every cycle); False sends
+    it through the full checks, which decide and say what is wrong."""
+    (a, b, c, _), (d, e, f, _), (g, h, i, _), last = rows
+    if not all(map(math.isfinite, (*rows[0], *rows[1], *rows[2], *last))):
+        return False
+    ortho = max(abs(a * a + b * b + c * c - 1.0), abs(d * d + e * e + f * f - 1.0),
+                abs(g * g + h * h + i * i - 1.0), abs(a * d + b * e + c * f),
+                abs(a * g + b * h + c * i), abs(d * g + e * h + f * i))
+    det = a * (e * i - f * h) - b * (d * i - f * g) + c * (d * h - e * g)
+    row = max(abs(last[0]), abs(last[1]), abs(last[2]), abs(last[3] - 1.0))
+    return ortho <= 0.5 * tol and abs(det - 1.0) <= 0.5 * tol and row <= 0.5 * last_row_tol
+
+
 def as_pose(T, name: str = "pose", *, tol: float = ORTHO_TOL,
             last_row_tol: float = LAST_ROW_TOL, single: bool = False,
             error: type[Exception] = InputError) -> np.ndarray:
@@ -59,6 +76,8 @@ orthonormal with determinant +1 (max|R Rᵀ − I| = 3, det = 8, tolerance 1e-06
         T = np.asarray(T, dtype=float)
     except (TypeError, ValueError) as exc:
         raise error(f"{name} must be a 4x4 homogeneous transform of numbers: {exc}") from exc
+    if T.shape == (4, 4) and _one_pose_clear(T.tolist(), tol, last_row_tol):
+        return T
     if (T.shape != (4, 4)) if single else (T.ndim < 2 or T.shape[-2:] != (4, 4)):
         want = "(4, 4)" if single else "(..., 4, 4)"
         raise error(f"{name} must be a 4x4 homogeneous transform of shape {want}, "

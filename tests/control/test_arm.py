@@ -120,3 +120,21 @@ def test_ur5_limits_and_unreachable_stop():
                        arm.limits_deg)
     with pytest.raises(ModelError):
         ChainArm(from_standard_dh(np.tile([0.0, 0.1, 0.2, 0.5], (5, 1))))
+
+
+@pytest.mark.parametrize("arm", [THESIS_ARM, ChainArm(ur5_mm())], ids=["puma762", "ur5"])
+def test_the_measured_tool_frame_is_the_arms_forward_analysis(arm):
+    """measure's tool frame (the arm's single-pose flange_pose and the tool point carried by
+    it) against the arm's batched forward analysis, at random joint values."""
+    from kinestat.control.wrench import tool_frame
+
+    scn = scenario()
+    model = replace(scn.model, arm=arm)
+    rng = np.random.default_rng(12)
+    for q in rng.uniform(-PI, PI, size=(20, 6)):
+        tool, s6, a67, T = tool_frame(q, model)
+        want = arm.forward(q, model.tool_point_6)
+        np.testing.assert_allclose(T, want.pose, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(tool, want.tool_point, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(s6, want.s6, rtol=0, atol=1e-12)
+        np.testing.assert_allclose(a67, want.a67, rtol=0, atol=1e-12)

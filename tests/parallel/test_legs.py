@@ -62,3 +62,23 @@ def test_non_rigid_pose_messages_say_what_is_wrong():
     T[3, 2] = 1.0
     with pytest.raises(InputError, match=r"the last row of a pose must be \[0, 0, 0, 1\]"):
         leg_lengths(p, T)
+
+
+def test_the_compiled_line_jacobian_is_the_numpy_one():
+    """line_jacobian_trusted (compiled, unvalidated) against line_jacobian (validated, NumPy)
+    over a batch of random poses (leading dimensions kept), to rounding; a zero-length leg is
+    refused."""
+    from kinestat.errors import SingularityError
+    from kinestat.parallel.legs import line_jacobian, line_jacobian_trusted
+
+    p = prototype()
+    rng = np.random.default_rng(3)
+    R = Rotation.from_rotvec(rng.normal(size=(4, 5, 3)) * 0.3).as_matrix()
+    T = make_pose(R, np.array([0.0, 0.0, 60.0]) + rng.normal(size=(4, 5, 3)) * 10.0)
+    got = line_jacobian_trusted(p, T)
+    assert got.shape == (4, 5, 6, 6)
+    np.testing.assert_allclose(got, line_jacobian(p, T), rtol=0, atol=1e-12)
+    T0 = np.eye(4)
+    T0[:3, 3] = p.base_points[0] - p.top_points[0]  # top point 0 on base point 0
+    with pytest.raises(SingularityError, match="zero length"):
+        line_jacobian_trusted(p, T0)
