@@ -131,14 +131,16 @@ def _warm_stiffness() -> None:
 
 
 def _warm_platform() -> None:
-    """All-mode FK (fk_list) and tracking FK with its nearest-mode test (fk_tracking)."""
+    """All-mode FK (fk_list), tracking FK with its nearest-mode test (fk_tracking) and the
+    compiled line Jacobian (line_jacobian_trusted)."""
     from kinestat.io.library import prototype  # lazy: start-up
     from kinestat.parallel.fk import fk_list, fk_tracking  # lazy: start-up (numba)
-    from kinestat.parallel.legs import leg_lengths  # lazy: start-up
+    from kinestat.parallel.legs import leg_lengths, line_jacobian_trusted  # lazy: start-up
 
     p = prototype()
     fk_list(p, leg_lengths(p, p.home_pose))
     fk_tracking(p, leg_lengths(p, p.home_pose), p.home_pose)
+    line_jacobian_trusted(p, p.home_pose)
 
 
 def _warm_kinestatic() -> None:
