@@ -51,7 +51,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Literal, get_args
 
 import numpy as np
@@ -67,6 +67,7 @@ from kinestat.control.align import (
 from kinestat.control.approach import approach_waypoints, check_approach
 from kinestat.control.arm import Puma762Arm
 from kinestat.control.ceilings import MAX_ITERATIONS
+from kinestat.control.cycle import norm3, replace
 from kinestat.control.envelope import (
     AXIS_STEP_VIOLATION,
     Envelope,
@@ -176,9 +177,13 @@ class Target:
     a67: np.ndarray
 
     def key(self) -> tuple:
-        """Hashable rounding (1 nm, 1e-9) used to spot a repeated target (a limit cycle)."""
-        return tuple(np.round(np.concatenate([self.tool_point * 1e6, self.s6 * 1e9,
-                                              self.a67 * 1e9])).astype(np.int64).tolist())
+        """Hashable rounding (1 nm, 1e-9) used to spot a repeated target (a limit cycle):
+        the nearest integers, ties to even (as ``numpy.round``)."""
+        v = ([x * 1e6 for x in self.tool_point.tolist()] + [x * 1e9 for x in self.s6.tolist()]
+             + [x * 1e9 for x in self.a67.tolist()])
+        if all(map(math.isfinite, v)):
+            return tuple(int(round(x)) for x in v)
+        return tuple(np.round(np.asarray(v)).astype(np.int64).tolist())  # NaN: as NumPy casts it
 
 
 
@@ -568,7 +573,7 @@ def decide(config: ControllerConfig, state: ControllerState,
         return replace(state, cycle=cycle, top_pose=meas.top_pose, **kw)
 
     F = meas.estimate(config.estimator)
-    Fmag = float(np.linalg.norm(F))
+    Fmag = norm3(F)
     contact = Fmag >= config.contact_force
     err = config.force_target - Fmag
     s6 = state.target.s6

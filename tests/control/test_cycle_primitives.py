@@ -218,3 +218,24 @@ def test_compiled_prediction_wrapping_equals_the_numpy_wrapping():
                 np.testing.assert_allclose(x, y, rtol=1e-12, atol=1e-12)
             compared += 1
     assert compared >= 30
+
+
+def test_target_key_is_numpys_rounding():
+    """Target.key (scalars) against the NumPy rounding it replaced (ties to even, int64), on
+    random targets, ties and values near the rounding's halves; non-finite values keep NumPy's
+    cast instead of raising."""
+    rng = np.random.default_rng(5)
+
+    def numpy_key(t):
+        return tuple(np.round(np.concatenate([t.tool_point * 1e6, t.s6 * 1e9, t.a67 * 1e9]))
+                     .astype(np.int64).tolist())
+
+    cases = [Target(rng.normal(size=3) * 10.0 ** rng.integers(-9, 4), rng.normal(size=3),
+                    rng.normal(size=3)) for _ in range(500)]
+    cases.append(Target(np.array([0.5e-6, 1.5e-6, -2.5e-6]), np.array([0.5e-9, 0.0, -1.0]),
+                        np.array([1.0, 2.5e-9, 0.0])))
+    for t in cases:
+        assert t.key() == numpy_key(t)
+    with np.errstate(invalid="ignore"):
+        bad = Target(np.array([np.nan, 0.0, 1.0]), np.zeros(3), np.zeros(3))
+        assert t.key() is not None and bad.key() == numpy_key(bad)
