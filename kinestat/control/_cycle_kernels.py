@@ -331,6 +331,18 @@ def path_curvature_kernel(points, tip, normal, tangent, min_span):
 
 
 @nb.njit(**_OPTS)
+def _base_pose(Tn, mount):
+    """The top three rows (3, 4) of ``Tn @ mount``: the platform base's pose for the flange
+    pose ``Tn`` (4, 4), each entry summed left to right."""
+    TB = np.empty((3, 4))
+    for r in range(3):
+        for c in range(4):
+            TB[r, c] = (Tn[r, 0] * mount[0, c] + Tn[r, 1] * mount[1, c]
+                        + Tn[r, 2] * mount[2, c] + Tn[r, 3] * mount[3, c])
+    return TB
+
+
+@nb.njit(**_OPTS)
 def predict_kernel(Tn, mount, tip_F, p, base_R, f_point, B, P_top, T, K, flange, lengths,
                    free_lengths, force, defl, tip_motion, top):
     """:func:`kinestat.control.envelope.predict`'s compiled path for one measurement and one
@@ -344,11 +356,7 @@ def predict_kernel(Tn, mount, tip_F, p, base_R, f_point, B, P_top, T, K, flange,
     ``flange`` (4, 4) the measured flange pose, ``B``/``P_top`` (6, 3) the platform's points,
     ``T`` the measured top pose, ``K`` its stiffness (axis order), ``lengths``/``free_lengths``
     (6,). False when the platform kernel meets a singular matrix (outputs then unset)."""
-    TB = np.empty((3, 4))
-    for r in range(3):
-        for c in range(4):
-            TB[r, c] = (Tn[r, 0] * mount[0, c] + Tn[r, 1] * mount[1, c]
-                        + Tn[r, 2] * mount[2, c] + Tn[r, 3] * mount[3, c])
+    TB = _base_pose(Tn, mount)
     u = np.empty(3)
     F = np.empty(3)
     for j in range(3):
@@ -395,11 +403,7 @@ def slide_kernel(Tn, mount, tip_F, p, base_R, est, K, C, push, has_push, out):
     f = math.sqrt(est[0] * est[0] + est[1] * est[1] + est[2] * est[2])
     if not f > 1e-9:
         return 0
-    TB = np.empty((3, 4))
-    for r in range(3):
-        for c in range(4):
-            TB[r, c] = (Tn[r, 0] * mount[0, c] + Tn[r, 1] * mount[1, c]
-                        + Tn[r, 2] * mount[2, c] + Tn[r, 3] * mount[3, c])
+    TB = _base_pose(Tn, mount)
     F = np.empty(3)
     u = np.empty(3)
     n = np.empty(3)
