@@ -20,7 +20,14 @@ from pathlib import Path
 
 import numpy as np
 
-from kinestat.app.arm_cell import ArmSpec, PlacedArm, arm_control_model, arm_io, place_arm
+from kinestat.app.arm_cell import (
+    ArmSpec,
+    PlacedArm,
+    arm_control_model,
+    arm_io,
+    arm_start_counts,
+    place_arm,
+)
 from kinestat.app.calibrations import (
     NamedCalibration,
     calibrated_model,
@@ -82,6 +89,9 @@ __all__ = [
     "plot_run",
 ]
 
+PLANTS = ("kinestat", "mujoco")
+"""The simulated cell's physics (``--sim``): the built-in contact simulator or MuJoCo."""
+
 FOLLOW_APPROACH_STEP = 0.25
 """The follow task's default approach step (mm): its first contact force stays below 3 N."""
 FOLLOW_MAX_ITERATIONS = MAX_ITERATIONS
@@ -122,8 +132,10 @@ class SimulatedCell:
     """Settings of the simulated cell (``kinestat control`` without devices).
 
     ``cylinder`` None: a plane workpiece; ``plane_point``/``plane_normal`` None:
-    :func:`default_plane`. ``noise``: leg-length noise
-    (mm, standard deviation); ``ideal_sensor``: 1 nm leg encoders; ``rate_hz``: packet rate.
+    :func:`default_plane`. ``plant``: "kinestat" (the built-in contact simulator behind the
+    simulated devices) or "mujoco" (:mod:`kinestat.app.mujoco_cell`, in process). ``noise``:
+    leg-length noise (mm, standard deviation); ``ideal_sensor``: 1 nm leg encoders;
+    ``rate_hz``: packet rate.
     """
 
     plane_point: np.ndarray | None = None
@@ -135,6 +147,7 @@ class SimulatedCell:
     seed: int = 0
     sim_legs: str = "thesis"
     cylinder: CylinderSpec | None = None
+    plant: str = "kinestat"
 
 
 @dataclass(frozen=True)
@@ -244,6 +257,7 @@ class PreparedRun:
     sensor: Sensor | None = None
     follow: FollowConfig | None = None
     arm: PlacedArm | None = None
+    plant: object | None = None  # the MuJoCo plant (--sim mujoco), built and at rest
 
 
 def prepare_control(req: ControlRequest) -> PreparedRun:
@@ -286,6 +300,9 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
     header["platform"] = req.platform or "prototype"
     if isinstance(req.cell, SimulatedCell):
         s = req.cell
+        if s.plant not in PLANTS:
+            raise InputError(f"--sim must be one of {', '.join(PLANTS)}, got {s.plant!r}")
+        header["plant"] = s.plant
         truth = resolve_calibration(s.sim_legs, platform, option="--sim-legs")
         if s.ideal_sensor:  # the controller reads the same fine counts
             _, fine = ideal_counts(truth.calibration, cal.calibration)
@@ -303,7 +320,10 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
                                           "axis": wp.axis, "point": wp.point}})
         header.update({"friction": s.friction, "ideal_sensor": s.ideal_sensor, "noise": s.noise,
                        "rate_hz": s.rate_hz, "sim_legs": truth.name})
-        return PreparedRun(req, config, header, cell, sensor, arm=placed_arm)
+        prepared = PreparedRun(req, config, header, cell, sensor, arm=placed_arm)
+        if s.plant == "mujoco":  # the scene is built now: a model MuJoCo refuses stops here
+            prepared = replace(prepared, plant=_mujoco_plant(prepared))
+        return prepared
     if req.arm is not None:
         raise InputError("--arm: another arm runs on the in-process simulated cell only; the "
                          "Galil and encoder protocols are the PUMA 762's hardware (drop "
@@ -360,6 +380,8 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
     safety = {"guard": sent_command_guard(config.envelope, config.model),
               "max_stream_faults": config.envelope.max_stream_faults,
               "move_rule": req.move_rule}
+    if prepared.plant is not None:
+        return _run_mujoco(prepared, log_path, safety, progress, decide_fn)
     if prepared.arm is not None:
         io = arm_io(prepared.cell, prepared.sensor, prepared.arm, seed=req.cell.seed,
                     guard=safety["guard"])
@@ -391,18 +413,54 @@ def run_control(prepared: PreparedRun, log_path: Path, *,
         client.close()
 
 
+def _mujoco_plant(prepared: PreparedRun):
+    """The MuJoCo plant of a prepared simulated cell at its start pose (at rest)."""
+    from kinestat.app.mujoco_cell import mujoco_plant  # lazy: mujoco only for --sim mujoco
+
+    config = prepared.config
+    counts = (arm_start_counts(prepared.arm) if prepared.arm is not None
+              else start_counts(config))
+    return mujoco_plant(prepared.cell, config.model, counts)
+
+
+def _run_mujoco(prepared: PreparedRun, log_path: Path, safety: dict, progress, decide_fn
+                ) -> RunReport:
+    """The run on the MuJoCo plant, in process; the report carries its simulated time."""
+    from kinestat.app.mujoco_cell import MujocoIO  # lazy: mujoco only for --sim mujoco
+
+    req = prepared.request
+    io = MujocoIO(prepared.plant, prepared.config.model, prepared.sensor,
+                  move_rule=req.move_rule, guard=safety["guard"], seed=req.cell.seed)
+    with CycleLog(log_path) as cycle_log:
+        report = run(prepared.config, io, cycle_log, progress=progress,
+                     extra_header=prepared.header, decide_fn=decide_fn)
+    figures = io.figures()
+    if report.iterations:
+        figures["sim_seconds_per_cycle"] = figures["sim_time_s"] / report.iterations
+    report.plant_figures = figures
+    return report
+
+
 def report_dict(prepared: PreparedRun, report: RunReport) -> dict:
     """The run's JSON report: :meth:`RunReport.as_dict`, and for the follow task ``completed``,
     ``travel`` (mm along the surface), ``normal_force_rms_error``/``normal_force_max_error``
     (N, over the travel cycles), ``contact_lost`` (and the true errors when simulated),
     ``travel_dir`` (the initial travel direction, unit: given, or the default)."""
     out = report.as_dict()
+    if prepared.cell is not None:
+        out["plant"] = prepared.header.get("plant", "kinestat")
+        figures = getattr(report, "plant_figures", None) or {}
+        out.update(figures)
+        if prepared.follow is not None and figures.get("sim_time_s"):
+            out["travel_speed_mm_s"] = None  # filled below from the travel
     if prepared.follow is not None:
         out["task"] = "follow"
         out["completed"] = report.converged
         out.update(follow_summary(report.cycles, prepared.config.force_target,
                                   prepared.follow.travel))
         out["travel_dir"] = prepared.follow.travel_dir.tolist()  # the initial one (unit)
+        if "travel_speed_mm_s" in out and out.get("travel") is not None:
+            out["travel_speed_mm_s"] = out["travel"] / out["sim_time_s"]
     if prepared.arm is not None:
         out["arm"] = prepared.arm.header()
     return out

@@ -108,9 +108,20 @@ def _workpiece(text: str | None):
 
 
 def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise, friction,
-          rate, seed, sim_legs="thesis", workpiece=None):
+          rate, seed, sim_legs="thesis", workpiece=None, sim="kinestat"):
     """The cell the options describe: simulated (no device options) or the real devices."""
-    from kinestat.app.control_run import RealDevices, SimulatedCell  # lazy: start-up (numba)
+    from kinestat.app.control_run import (  # lazy: start-up (numba)
+        PLANTS,
+        RealDevices,
+        SimulatedCell,
+    )
+
+    if sim not in PLANTS:
+        raise InputError(f"--sim must be one of {', '.join(PLANTS)}, got {sim!r}")
+    if galil is not None and sim != "kinestat":
+        raise InputError("--sim chooses the simulated cell's physics; with real devices "
+                         "(--galil/--serial) run `kinestat sim galil --plant mujoco` and give "
+                         "its addresses instead")
 
     if (galil is None) != (serial is None):
         raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
@@ -136,7 +147,7 @@ def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor,
             plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
             plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
             friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed,
-            sim_legs=sim_legs, cylinder=cylinder)
+            sim_legs=sim_legs, cylinder=cylinder, plant=sim)
     host, port = _host_port(galil)
     return RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
 
@@ -259,6 +270,11 @@ def control_command(
     platform: str = typer.Option(
         None, "--platform", help="Platform TOML file (default the 2011 prototype).",
         metavar="FILE"),
+    sim: str = typer.Option(
+        "kinestat", "--sim",
+        help="The simulated cell's physics: 'kinestat' (the built-in contact simulator behind "
+        "the simulated Galil and encoder box) or 'mujoco' (MuJoCo's rigid-body dynamics and "
+        "contact, in process; docs/mujoco.md).", metavar="kinestat|mujoco"),
     sim_legs: str = typer.Option(
         "thesis", "--sim-legs",
         help="The simulated legs' TRUE law: 'thesis', 'nominal' or a calibration TOML file "
@@ -333,7 +349,9 @@ def control_command(
     tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
     torque_about_tool, torque_about_base (N·mm, fixed frame), equivalent_force (the
     equivalent wrench's force, N: base − tool torque = tool_point × it), procedure,
-    calibration, cycles; with --task follow also task, completed, travel,
+    calibration, cycles, plant (simulated: kinestat or mujoco; with mujoco also sim_time_s,
+    sim_seconds_per_cycle, sim_move_s, sim_settle_s, moves_unsettled); with --task follow also
+    task, travel_speed_mm_s (mujoco), completed, travel,
     normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
     simulated); with --arm also arm (name, joints, base, placement, limits_deg).
     """
@@ -365,7 +383,7 @@ def control_command(
         raise InputError(f"--max-approach must be a positive number of mm, got {max_approach}")
     arm_spec = _arm(arm, tip, base, scale, length_unit, arm_base, galil, serial)
     cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
-                 friction, rate, seed, sim_legs, workpiece)
+                 friction, rate, seed, sim_legs, workpiece, sim)
     simulated = isinstance(cell, SimulatedCell)
     req = ControlRequest(force=force * d, start_tool_point=p0, cell=cell, force_tol=force_tol,
                          align_tol_deg=align_tol_deg, method=method, step=step,
@@ -393,7 +411,7 @@ def control_command(
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {procedure}, method "
                       f"{method}, calibration {calibration}, "
-                      + ("simulated cell" if simulated
+                      + (f"simulated cell ({sim})" if simulated
                          else literal(f"Galil {galil}, sensor {serial}"))
                       + ("" if prepared.arm is None else literal(_arm_words(prepared.arm)))
                       + ("" if prepared.follow is None else
