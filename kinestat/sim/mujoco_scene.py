@@ -148,7 +148,7 @@ def _pose_attr(T: np.ndarray, k: float) -> str:
 def _check_arm(arm: ChainModel) -> None:
     if not isinstance(arm, ChainModel) or arm.n != 6:
         raise ModelError("MuJoCo scene: a 6-joint ChainModel is needed")
-    screw = [i + 1 for i, j in enumerate(arm.joints) if j.kind == JointKind.SCREW]
+    screw = [i + 1 for i, c in enumerate(arm.kind_codes) if c == JointKind.SCREW]
     if screw:
         raise ModelError(f"MuJoCo cannot load arm {arm.name!r}: joint(s) {screw} are screw "
                          "joints (pitch != 0), which MuJoCo has no joint for")
@@ -162,8 +162,8 @@ def _arm_xml(arm: ChainModel, p: SceneParams, inner: str) -> str:
     body_T = [arm.base @ C[0]] + [C[i] for i in range(1, 6)]
     xml_close = ""
     out = []
+    pris = np.asarray(arm.prismatic, dtype=bool)
     for i in range(6):
-        j = arm.joints[i]
         nxt = C[i + 1][:3, 3] * k
         if np.linalg.norm(nxt) > 1e-9:
             geom = (f'<geom type="capsule" fromto="0 0 0 {_f(nxt)}" size="{p.link_radius:g}" '
@@ -171,10 +171,10 @@ def _arm_xml(arm: ChainModel, p: SceneParams, inner: str) -> str:
         else:
             geom = (f'<geom type="sphere" size="{p.link_radius:g}" density="{p.link_density:g}"'
                     ' contype="0" conaffinity="0" group="1"/>')
-        scale = 1.0 if j.kind != JointKind.PRISMATIC else k
+        scale = k if pris[i] else 1.0
         limited = np.isfinite(lo[i]) and np.isfinite(hi[i])
         rng = f' range="{lo[i] * scale:.17g} {hi[i] * scale:.17g}"' if limited else ""
-        jtype = "slide" if j.kind == JointKind.PRISMATIC else "hinge"
+        jtype = "slide" if pris[i] else "hinge"
         grav = ' gravcomp="1"' if p.link_gravcomp else ""
         out.append(f'<body name="link{i + 1}" {_pose_attr(body_T[i], k)}{grav}>'
                    f'<joint name="q{i + 1}" type="{jtype}" axis="0 0 1" limited='

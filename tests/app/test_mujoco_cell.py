@@ -1,0 +1,83 @@
+"""``kinestat control --sim mujoco``: the controller on MuJoCo's physics, judged by MuJoCo's
+own contact force (``mj_contactForce``), never the controller's estimate."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from kinestat.app.control_run import (
+    ControlRequest,
+    SimulatedCell,
+    prepare_control,
+    report_dict,
+    run_control,
+)
+from kinestat.control.controller import THESIS_FORCE_DIRECTION
+from kinestat.errors import InputError
+from kinestat.sim.mujoco_plant import MujocoPlant
+from kinestat.sim.mujoco_scene import M_PER_MM, build_scene
+
+pytest.importorskip("mujoco")
+
+START = np.array([-400.0, 800.0, -100.0])
+
+
+def _request(**cell_kw) -> ControlRequest:
+    return ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START,
+                          cell=SimulatedCell(plant="mujoco", **cell_kw))
+
+
+@pytest.mark.parametrize("friction", [0.0, 0.3])
+def test_press_converges_on_mujoco_and_measures_its_true_force(tmp_path, friction):
+    prep = prepare_control(_request(friction=friction))
+    rep = run_control(prep, tmp_path / "log.jsonl")
+    out = report_dict(prep, rep)
+    assert rep.converged, rep.stop_reason
+    assert out["plant"] == "mujoco"
+    assert abs(rep.true_force_magnitude - 4.0) <= prep.config.force_tol
+    assert rep.axis_error_deg < 1.0
+    assert np.linalg.norm(rep.force - rep.true_force) <= 0.1
+    assert out["sim_time_s"] > 0 and out["moves_unsettled"] == 0
+    header = json.loads((tmp_path / "log.jsonl").read_text().splitlines()[0])
+    assert header["plant"] == "mujoco"
+
+
+def test_compliant_workpiece_yields_by_its_stiffness():
+    """A plane on a spring of k N/mm: the contact force over the surface's retreat is k."""
+    prep = prepare_control(_request())
+    k = 5.0  # N/mm, a soft wood's order
+    plant0 = prep.plant
+    scene0 = plant0.scene
+    scene = build_scene(prep.cell, scene0.arm, scene0.q_start, scene0.top_pose_start,
+                        workpiece_stiffness=k)
+    plant = MujocoPlant(scene)
+    # push the tool 3 mm beyond the plane along its normal, S6 and a67 kept
+    wp = prep.cell.workpiece
+    n = np.asarray(wp.normal)
+    gap = float(wp.gap(plant.truth()["tip"]))
+    model = prep.config.model
+    T = plant.flange_pose()
+    tool_point = T[:3, :3] @ model.tool_point_6 + T[:3, 3] - (gap + 3.0) * n
+    axis = model.arm.solve_axis(tool_point, T[:3, 2], T[:3, 0], model.tool_point_6,
+                                plant.joints(), model.limits_deg)
+    plant.set_reference(model.arm.q_from_axis(axis))
+    t, rested = plant.settle(5.0)
+    assert rested
+    f = plant.truth()["true_force"]
+    import mujoco
+
+    j = mujoco.mj_name2id(scene.model, mujoco.mjtObj.mjOBJ_JOINT, "wp0")
+    retreat = -plant.data.qpos[scene.model.jnt_qposadr[j]] / M_PER_MM  # mm into the material
+    fn = float(f @ -np.asarray(wp.normal))
+    assert fn > 1.0
+    assert math.isclose(fn / retreat, k, rel_tol=0.01)
+
+
+def test_unknown_plant_is_refused_before_anything_moves():
+    with pytest.raises(InputError, match="--sim must be one of kinestat, mujoco"):
+        prepare_control(ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START,
+                                       cell=SimulatedCell(plant="bullet")))
