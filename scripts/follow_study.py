@@ -12,10 +12,13 @@ of one core per run), ``--jobs N`` (runs in parallel processes), ``--friction MU
 friction of every workpiece), ``--ideal`` (1 nm leg encoders instead of the thesis's
 resolution), ``--auto-tilt auto|on|off`` (the follow task's automatic tilt; default auto, as
 the CLI: it switches itself on when the tip sticks; the friction studies before 2026-12-02
-ran with it on from the start).
+ran with it on from the start), ``--sim kinestat|mujoco`` (the plant: the built-in simulator,
+or MuJoCo in process as ``kinestat control --sim mujoco``; true figures from MuJoCo's contact
+force).
 
     .venv/bin/python scripts/follow_study.py [N] [--acceptance] [--friction MU] [--ideal]
         [--auto-tilt auto|on|off] [--seed N] [--budget] [--devices] [--jobs N]
+        [--sim kinestat|mujoco]
 """
 
 from __future__ import annotations
@@ -82,7 +85,7 @@ def follow(cell: SimulatedCell, travel_dir, travel: float = 50.0,
     prep = prepare_control(req)
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
-        if devices:
+        if devices or prep.plant is not None:  # the MuJoCo plant runs as the CLI runs it
             rep = run_control(prep, Path(tmp) / "log.jsonl")
         else:
             io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
@@ -132,16 +135,17 @@ HEAD = "| workpiece          | ok  | travel | RMS N  | max N  | lost | cycles | 
 
 def main(n: int = 20, friction: float = 0.0, ideal: bool = False,
          auto_tilt: str = "auto", seed: int = 13, budget: bool = False,
-         devices: bool = False, jobs: int = 1) -> None:
+         devices: bool = False, jobs: int = 1, sim: str = "kinestat") -> None:
     rng = np.random.default_rng(seed)
     print(f"friction {friction:g}, {'ideal' if ideal else 'thesis'} sensor, automatic tilt "
           f"{auto_tilt}, seed {seed}, "
-          + ("through the simulated devices" if devices else "in-process cell"))
+          + ("through the simulated devices" if devices else "in-process cell")
+          + f", plant {sim}")
     print(HEAD + (" error² before the first slip / cycles | after |" if budget else ""))
     draws = []  # drawn up front, in order: the same workpieces whatever --jobs
     for k in range(n):
         name, cell = random_cell(rng, k)
-        cell = dataclasses.replace(cell, friction=friction, ideal_sensor=ideal)
+        cell = dataclasses.replace(cell, friction=friction, ideal_sensor=ideal, plant=sim)
         draws.append((name, cell, Y + rng.uniform(-0.2, 0.2, 3)))
     run_one = functools.partial(_follow_drawn, auto_tilt=AUTO_TILT[auto_tilt], devices=devices)
     with concurrent.futures.ProcessPoolExecutor(jobs) if jobs > 1 else _Serial() as pool:
@@ -193,16 +197,17 @@ def _passes(out: dict, ideal: bool) -> bool:
                 and out["true_normal_force_max_error"] <= 0.5)
 
 
-def acceptance(friction: float = 0.0, auto_tilt: str = "auto", devices: bool = False) -> None:
+def acceptance(friction: float = 0.0, auto_tilt: str = "auto", devices: bool = False,
+               sim: str = "kinestat") -> None:
     print(f"acceptance runs (default plane and R = 200 mm cylinder), friction {friction:g}, "
-          f"automatic tilt {auto_tilt}:")
+          f"automatic tilt {auto_tilt}, plant {sim}:")
     print(HEAD)
     cyl = CylinderSpec(radius=200.0, axis=np.array([0.0, 0.0, 1.0]))
     for name, cell in (("plane 5°, thesis", SimulatedCell()),
                        ("plane 5°, ideal", SimulatedCell(ideal_sensor=True)),
                        ("cyl R 200, thesis", SimulatedCell(cylinder=cyl)),
                        ("cyl R 200, ideal", SimulatedCell(ideal_sensor=True, cylinder=cyl))):
-        cell = dataclasses.replace(cell, friction=friction)
+        cell = dataclasses.replace(cell, friction=friction, plant=sim)
         print(_row(name, follow(cell, Y, auto_tilt=AUTO_TILT[auto_tilt], devices=devices)),
               flush=True)
 
@@ -223,8 +228,10 @@ if __name__ == "__main__":
     ap.add_argument("--devices", action="store_true",
                     help="through the simulated Galil and encoder stream (as the CLI runs it)")
     ap.add_argument("--jobs", type=int, default=1, help="runs in parallel processes")
+    ap.add_argument("--sim", choices=("kinestat", "mujoco"), default="kinestat",
+                    help="the plant: the built-in simulator or MuJoCo (in process)")
     a = ap.parse_args()
     if a.acceptance:
-        acceptance(a.friction, a.auto_tilt, a.devices)
+        acceptance(a.friction, a.auto_tilt, a.devices, a.sim)
     else:
-        main(a.n, a.friction, a.ideal, a.auto_tilt, a.seed, a.budget, a.devices, a.jobs)
+        main(a.n, a.friction, a.ideal, a.auto_tilt, a.seed, a.budget, a.devices, a.jobs, a.sim)
