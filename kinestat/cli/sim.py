@@ -89,10 +89,49 @@ def galil(
                              "position drawn with this seed (encoders read 0 at power-up; "
                              "home it with `kinestat home`)."),
     as_json: bool = flag(False, "--json", help="Print the address as JSON."),
+    plant: str = typer.Option(
+        "none", "--plant", metavar="none|mujoco",
+        help="'mujoco': the Galil drives a MuJoCo cell (the arm, the platform, the workpiece) "
+        "and an encoder stream on a pty reads its legs, for `kinestat control --galil "
+        "--serial` (the cell's options below; docs/mujoco.md)."),
+    start: str = typer.Option(None, "--start", help="--plant mujoco: the start tool point "
+                              "(mm), where the robot is placed (default as kinestat control)."),
+    direction: str = typer.Option(None, "--direction", help="--plant mujoco: the force's "
+                                  "direction (places the default workpiece and the start)."),
+    friction: float = typer.Option(0.0, "--friction", help="--plant mujoco: Coulomb friction "
+                                   "of the workpiece."),
+    workpiece: str = typer.Option(None, "--workpiece", help="--plant mujoco: "
+                                  "cylinder:radius=R,axis=x,y,z[,point=x,y,z] (default a plane)."),
+    plane_point: str = typer.Option(None, "--plane-point", help="--plant mujoco: a point of "
+                                    "the plane workpiece (mm)."),
+    plane_normal: str = typer.Option(None, "--plane-normal", help="--plant mujoco: the plane's "
+                                     "outward normal."),
+    sim_legs: str = typer.Option("thesis", "--sim-legs", help="--plant mujoco: the legs' TRUE "
+                                 "law ('thesis', 'nominal' or a calibration TOML file)."),
+    rate: float = typer.Option(200.0, "--rate", help="--plant mujoco: encoder packets per "
+                               "second."),
 ) -> None:
     """Run a simulated Galil DMC (six axes, trapezoidal profiles) until Ctrl-C."""
     _check_duration(duration)
     check_seed(seed)
+    if plant not in ("none", "mujoco"):
+        raise InputError(f"--plant must be 'none' or 'mujoco', got {plant!r}")
+    if plant == "mujoco":
+        if seed is not None or initial_counts != "0,0,0,0,0,0" or no_coupling:
+            raise InputError("--plant mujoco places the robot at the start pose of the cell "
+                             "(--start, --direction); --seed, --initial-counts and "
+                             "--no-coupling do not apply")
+        _galil_mujoco(host, port, allow_remote, duration, as_json,
+                      dict(start=start, direction=direction, friction=friction,
+                           workpiece=workpiece, plane_point=plane_point,
+                           plane_normal=plane_normal, sim_legs=sim_legs, rate=rate))
+        return
+    cell_opts = {"--start": start, "--direction": direction, "--workpiece": workpiece,
+                 "--plane-point": plane_point, "--plane-normal": plane_normal}
+    given = [k for k, v in cell_opts.items() if v is not None]
+    if given or friction or sim_legs != "thesis":
+        raise InputError(f"{', '.join(given) or '--friction/--sim-legs'}: options of "
+                         "--plant mujoco")
     c0 = _int_counts(initial_counts, "initial-counts")
     kw = {"coupling": 0.0} if no_coupling else {}
     if seed is not None:
@@ -150,6 +189,41 @@ def encoders(
             raise InputError(f"the encoder emitter stopped: {emitter.error}")
     if not as_json:
         console.print(f"Encoder emitter stopped after {emitter.sent} packets.")
+
+
+def _galil_mujoco(host: str, port: int, allow_remote: bool, duration: float | None,
+                  as_json: bool, opts: dict) -> None:
+    """The simulated Galil and encoder stream on a MuJoCo cell, until Ctrl-C."""
+    from kinestat.app.control_defaults import DEFAULT_DIRECTION, DEFAULT_START
+    from kinestat.app.control_run import ControlRequest, prepare_control
+    from kinestat.app.mujoco_harness import MujocoHarness  # lazy: mujoco
+    from kinestat.app.sim_cell import start_counts
+    from kinestat.cli.control import _cell
+
+    d = parse_floats(opts["direction"] or DEFAULT_DIRECTION, 3, "direction")
+    if not np.linalg.norm(d) > 0:
+        raise InputError("--direction must not be the zero vector")
+    p0 = parse_floats(opts["start"] or DEFAULT_START, 3, "start")
+    if not (0 < opts["rate"] <= 5000):
+        raise InputError(f"--rate must be in (0, 5000] packets per second, got {opts['rate']}")
+    cell = _cell(None, None, "ks", opts["plane_point"], opts["plane_normal"], False, 0.0,
+                 opts["friction"], opts["rate"], 0, opts["sim_legs"], opts["workpiece"],
+                 "mujoco")
+    prep = prepare_control(ControlRequest(force=4.0 * d / np.linalg.norm(d),
+                                          start_tool_point=p0, cell=cell))
+    harness = MujocoHarness(prep.plant, prep.config.model, prep.sensor,
+                            start_counts=start_counts(prep.config), host=host, port=port,
+                            allow_remote=allow_remote, rate_hz=opts["rate"])
+    with _until_stopped(), harness:
+        info = harness.describe()
+        if as_json:
+            print_json(dict(info, axes="ABCDEF"))
+        else:
+            console.print(f"Galil DMC simulator on a MuJoCo cell: {literal(info['galil'])}, "
+                          f"encoder stream on {literal(info['serial'])}. Ctrl-C to stop.")
+        _run_until_stopped(duration)
+    if harness.error is not None:
+        raise InputError(f"the MuJoCo cell stopped: {harness.error}")
 
 
 def register(app: typer.Typer) -> None:

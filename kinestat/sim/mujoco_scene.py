@@ -20,10 +20,11 @@ on first use: only ``kinestat control --sim mujoco`` pays for it):
   :attr:`SceneParams.tip_radius` whose foremost point along the tool axis is the cell's tip.
 * the workpiece: ``Workpiece`` (a plane) as a box whose face is the plane, ``Cylinder`` as a
   cylinder geom; MuJoCo's own contact with Coulomb friction μ (elliptic cone, ``condim`` 3,
-  or 1 when μ = 0; the no-slip solver so that a tip inside the cone sticks). Rigid: a stiff contact (:attr:`SceneParams.contact_timeconst`). With a
-  ``stiffness`` (N/mm, the workpiece's attribute or :func:`build_scene`'s argument) the
-  workpiece body rides on slide joints with that spring along its normal (plane) or across its
-  axis (cylinder), critically damped with :attr:`SceneParams.workpiece_mass`.
+  or 1 when μ = 0; the no-slip solver so that a tip inside the cone sticks). Rigid: a stiff
+  contact (:attr:`SceneParams.contact_timeconst`). With a ``stiffness`` (N/mm, the
+  workpiece's attribute or :func:`build_scene`'s argument) the workpiece body rides on slide
+  joints with that spring along its normal (plane) or across its axis (cylinder), critically
+  damped with :attr:`SceneParams.workpiece_mass`.
 
 Units: SI inside MuJoCo (m, kg, s, N); kinestat's mm and N are converted at this boundary
 (:data:`M_PER_MM`). Gravity is on (−z of the fixed frame).
@@ -89,6 +90,8 @@ class SceneParams:
     """Corner of the servos' integral action (Hz): removes the static error under load."""
     contact_timeconst: float = 2e-3
     """Time constant of a rigid workpiece's contact (s, MuJoCo ``solref``)."""
+    impratio: float = 1.0
+    """MuJoCo's ratio of frictional to normal constraint impedance (elliptic cones)."""
     noslip_iterations: int = 10
     """MuJoCo's no-slip solver passes: its soft friction otherwise creeps under a steady
     tangential load inside the cone (0.02 mm/s at |f_t| = 0.2 f_n, μ = 0.3), where a metal
@@ -294,7 +297,8 @@ def scene_xml(cell: Cell, arm: ChainModel, q_start, top_pose_world, *,
                     'ctrllimited="false"/>' for i in range(6))
     return (f'<mujoco model="kinestat-cell"><compiler angle="radian" autolimits="true"/>'
             f'<option timestep="{p.timestep:g}" integrator="implicitfast" cone="elliptic" '
-            f'noslip_iterations="{int(p.noslip_iterations)}" gravity="0 0 -9.81"/><default><geom {solref}/></default><worldbody>'
+            f'noslip_iterations="{int(p.noslip_iterations)}" impratio="{p.impratio:g}" '
+            f'gravity="0 0 -9.81"/><default><geom {solref}/></default><worldbody>'
             f'{_arm_xml(arm, p, base)}{top}'
             f'{_workpiece_xml(wp, stiff, p, fr)}</worldbody><tendon>{tendons}</tendon>'
             f'<actuator>{acts}</actuator></mujoco>')
