@@ -11,10 +11,11 @@ acceptance (completed, no contact lost, travel within 1 mm of the request, measu
 (:func:`true_travel`), true normal-force
 RMS ≤ 0.2 N, or 0.05 N with the ideal sensor, and max ≤ 0.5 N); requests the controller
 refuses before any motion (a force the platform cannot carry) are counted apart. In process;
-``--devices`` runs through the simulated Galil and encoder stream as the CLI does.
+``--devices`` runs through the simulated Galil and encoder stream as the CLI does;
+``--sim mujoco`` on the MuJoCo cell (in process; true figures from MuJoCo's contact force).
 
     .venv/bin/python scripts/follow_campaign.py [N] [--seed S] [--max-force F]
-        [--min-radius R] [--friction MU ...] [--devices] [--jobs J]
+        [--min-radius R] [--friction MU ...] [--devices] [--jobs J] [--sim kinestat|mujoco]
 """
 
 from __future__ import annotations
@@ -140,11 +141,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--friction", type=float, nargs="+", default=[0.0, 0.3, 0.5])
     ap.add_argument("--devices", action="store_true")
     ap.add_argument("--jobs", type=int, default=2)
+    ap.add_argument("--sim", choices=("kinestat", "mujoco"), default="kinestat")
     a = ap.parse_args(argv)
     rng = np.random.default_rng(a.seed)
     draws = [draw(rng, k, a.max_force, a.min_radius, tuple(a.friction)) for k in range(a.n)]
+    for d in draws:
+        d["cell"] = dataclasses.replace(d["cell"], plant=a.sim)
     print(f"seed {a.seed}, |F_req| 2-{a.max_force:g} N, cylinders R >= {a.min_radius:g} mm, "
-          f"friction {a.friction}, " + ("through the devices" if a.devices else "in process"))
+          f"friction {a.friction}, plant {a.sim}, "
+          + ("through the devices" if a.devices else "in process"))
     print("| run | workpiece | F N | travel mm | μ | sensor | verdict | travelled (true) | "
           "RMS N | max N | stop |")
     counts: dict[str, int] = {}

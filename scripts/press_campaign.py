@@ -5,20 +5,22 @@ even runs a plane 1.5-4 mm ahead whose normal is tilted 0-45° from F_req in any
 runs a cylinder of radius uniform in 150-500 mm whose axis makes 45-90° with F_req (so the
 surface is met up to 45° off the tool axis), placed as ``--workpiece cylinder`` places it (the
 surface 2.5 mm ahead). Through the simulated Galil and encoder stream (as the CLI runs it), or in
-process with ``--in-process``. Printed per run: whether the goal was attained (|F| within
-``force_tol`` of the request and the tool axis within ``align_tol_deg`` of the measured force),
-the cycles, the true force's error and the true force's angle to the tool axis, the stop reason;
-then the counts by workpiece kind. docs/control.md ("The press on curved and steep workpieces")
-quotes its draws.
+process with ``--in-process``; ``--sim mujoco`` runs each on the MuJoCo cell (in process, as
+``kinestat control --sim mujoco``: true figures from MuJoCo's contact force). Printed per run:
+whether the goal was attained (|F| within ``force_tol`` of the request and the tool axis within
+``align_tol_deg`` of the measured force), the cycles, the true force's error and the true
+force's angle to the tool axis, the stop reason; then the counts by workpiece kind.
+docs/control.md ("The press on curved and steep workpieces") quotes its draws.
 
     .venv/bin/python scripts/press_campaign.py [N] [--seed S] [--friction MU ...] [--in-process]
-        [--jobs J]
+        [--jobs J] [--sim kinestat|mujoco]
 """
 
 from __future__ import annotations
 
 import argparse
 import concurrent.futures
+import dataclasses
 import functools
 import math
 import sys
@@ -77,7 +79,7 @@ def press(req: dict, devices: bool = True) -> dict:
     prep = prepare_control(ControlRequest(force=req["force"] * F_HAT, start_tool_point=START,
                                           cell=req["cell"], task="press"))
     with tempfile.TemporaryDirectory() as tmp:
-        if devices:
+        if devices or prep.plant is not None:  # the MuJoCo cell runs as the CLI runs it
             rep = run_control(prep, Path(tmp) / "log.jsonl")
         else:
             io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
@@ -103,11 +105,15 @@ def main() -> None:
     ap.add_argument("--friction", type=float, nargs="+", default=[0.0, 0.3])
     ap.add_argument("--in-process", action="store_true")
     ap.add_argument("--jobs", type=int, default=1)
+    ap.add_argument("--sim", choices=("kinestat", "mujoco"), default="kinestat")
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
     reqs = [draw(rng, k, tuple(a.friction)) for k in range(a.n)]
-    print(f"seed {a.seed}, {a.n} runs, |F_req| 2-6 N, friction {a.friction}, "
-          + ("in process" if a.in_process else "through the simulated devices"))
+    for r in reqs:
+        r["cell"] = dataclasses.replace(r["cell"], plant=a.sim)
+    print(f"seed {a.seed}, {a.n} runs, |F_req| 2-6 N, friction {a.friction}, plant {a.sim}, "
+          + ("in process" if a.in_process or a.sim == "mujoco"
+             else "through the simulated devices"))
     print("| run | workpiece | F N | μ | verdict | cycles | true |F| error N | axis error ° "
           "| stop |")
     fn = functools.partial(press, devices=not a.in_process)
