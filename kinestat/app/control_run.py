@@ -133,9 +133,10 @@ class SimulatedCell:
 
     ``cylinder`` None: a plane workpiece; ``plane_point``/``plane_normal`` None:
     :func:`default_plane`. ``plant``: "kinestat" (the built-in contact simulator behind the
-    simulated devices) or "mujoco" (:mod:`kinestat.app.mujoco_cell`, in process). ``noise``:
-    leg-length noise (mm, standard deviation); ``ideal_sensor``: 1 nm leg encoders;
-    ``rate_hz``: packet rate.
+    simulated devices) or "mujoco" (:mod:`kinestat.app.mujoco_cell`, in process).
+    ``workpiece_stiffness``: the workpiece's normal stiffness (N/mm,
+    :attr:`kinestat.sim.contact.Workpiece.stiffness`; None: rigid). ``noise``: leg-length noise
+    (mm, standard deviation); ``ideal_sensor``: 1 nm leg encoders; ``rate_hz``: packet rate.
     """
 
     plane_point: np.ndarray | None = None
@@ -148,6 +149,7 @@ class SimulatedCell:
     sim_legs: str = "thesis"
     cylinder: CylinderSpec | None = None
     plant: str = "kinestat"
+    workpiece_stiffness: float | None = None
 
 
 @dataclass(frozen=True)
@@ -211,12 +213,13 @@ def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: 
     if settings.plane_normal is not None:
         pn = settings.plane_normal
     cell = make_cell(platform, plane_point=pp, plane_normal=pn, friction=settings.friction,
-                     legs=truth.calibration)
+                     stiffness=settings.workpiece_stiffness, legs=truth.calibration)
     cyl = settings.cylinder
     if cyl is not None:
         wp = (cylinder_ahead(start_point, direction, DEFAULT_PLANE_DISTANCE, cyl.radius, cyl.axis)
               if cyl.point is None else Cylinder(cyl.point, cyl.axis, cyl.radius))
-        cell = replace(cell, workpiece=replace(wp, friction=settings.friction))
+        cell = replace(cell, workpiece=replace(wp, friction=settings.friction,
+                                               stiffness=settings.workpiece_stiffness))
     return cell, sensor
 
 
@@ -318,7 +321,8 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
         header.update({"plane_point": wp.point, "plane_normal": wp.normal} if s.cylinder is None
                       else {"workpiece": {"kind": "cylinder", "radius": wp.radius,
                                           "axis": wp.axis, "point": wp.point}})
-        header.update({"friction": s.friction, "ideal_sensor": s.ideal_sensor, "noise": s.noise,
+        header.update({"friction": s.friction, "workpiece_stiffness": s.workpiece_stiffness,
+                       "ideal_sensor": s.ideal_sensor, "noise": s.noise,
                        "rate_hz": s.rate_hz, "sim_legs": truth.name})
         prepared = PreparedRun(req, config, header, cell, sensor, arm=placed_arm)
         if s.plant == "mujoco":  # the scene is built now: a model MuJoCo refuses stops here

@@ -108,7 +108,8 @@ def _workpiece(text: str | None):
 
 
 def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise, friction,
-          rate, seed, sim_legs="thesis", workpiece=None, sim="kinestat"):
+          rate, seed, sim_legs="thesis", workpiece=None, sim="kinestat",
+          workpiece_stiffness=None):
     """The cell the options describe: simulated (no device options) or the real devices."""
     from kinestat.app.control_run import (  # lazy: start-up (numba)
         PLANTS,
@@ -127,9 +128,11 @@ def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor,
         raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
                          "neither to run the simulated cell")
     if galil is not None and (plane_point or plane_normal or ideal_sensor or noise or friction
-                              or sim_legs != "thesis" or workpiece is not None):
+                              or sim_legs != "thesis" or workpiece is not None
+                              or workpiece_stiffness is not None):
         raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction/"
-                         "--sim-legs/--workpiece describe the simulated cell; they cannot be used "
+                         "--sim-legs/--workpiece/--workpiece-stiffness describe the simulated "
+                         "cell; they cannot be used "
                          "with real devices")
     cylinder = _workpiece(workpiece)
     if cylinder is not None and (plane_point or plane_normal):
@@ -141,13 +144,18 @@ def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor,
         raise InputError("--ideal-sensor and --noise exclude each other")
     if not (math.isfinite(noise) and noise >= 0):
         raise InputError(f"--noise must be >= 0 mm, got {noise}")
+    if workpiece_stiffness is not None and not (math.isfinite(workpiece_stiffness)
+                                                and workpiece_stiffness > 0):
+        raise InputError(f"--workpiece-stiffness must be a finite number of N/mm > 0, got "
+                         f"{workpiece_stiffness}")
 
     if galil is None:
         return SimulatedCell(
             plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
             plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
             friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed,
-            sim_legs=sim_legs, cylinder=cylinder, plant=sim)
+            sim_legs=sim_legs, cylinder=cylinder, plant=sim,
+            workpiece_stiffness=workpiece_stiffness)
     host, port = _host_port(galil)
     return RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
 
@@ -322,6 +330,10 @@ def control_command(
         None, "--workpiece", help="Simulated workpiece: 'plane' (default, --plane-point/"
         "--plane-normal) or 'cylinder:radius=R,axis=x,y,z[,point=x,y,z]' (without point: its "
         f"surface {DEFAULT_PLANE_DISTANCE} mm ahead of the start tool point along F_req)."),
+    workpiece_stiffness: float = typer.Option(
+        None, "--workpiece-stiffness", metavar="N/MM", help="Normal stiffness of the simulated "
+        "workpiece (N/mm): the tip sinks f_n/k into it (e.g. wood, docs/control.md). Default: "
+        "rigid."),
     arm: str = typer.Option(
         None, "--arm", metavar="MODEL", help="The robot: an embedded model name (e.g. "
         "puma560), a TOML model or a URDF file, any 6-joint arm with an analytic solver; "
@@ -383,7 +395,7 @@ def control_command(
         raise InputError(f"--max-approach must be a positive number of mm, got {max_approach}")
     arm_spec = _arm(arm, tip, base, scale, length_unit, arm_base, galil, serial)
     cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
-                 friction, rate, seed, sim_legs, workpiece, sim)
+                 friction, rate, seed, sim_legs, workpiece, sim, workpiece_stiffness)
     simulated = isinstance(cell, SimulatedCell)
     req = ControlRequest(force=force * d, start_tool_point=p0, cell=cell, force_tol=force_tol,
                          align_tol_deg=align_tol_deg, method=method, step=step,

@@ -76,8 +76,12 @@ def info_command(
 
     JSON: {"name", "length_unit", "force_unit", "leg_names", "base_points", "top_points",
     "stiffness", "free_lengths", "home_pose", "special", "edge_fractions", "jacobian_det_home",
-    "singularity_measure_home", "design"}.
+    "singularity_measure_home", "design", "mobility"}; "mobility" is the Grübler–Kutzbach
+    count (Vibhute eq. 1-1) per leg chain: {"structure", "space", "links", "joints", "formula",
+    "chains": {"UPS"|"SPS": {"joint_counts", "mobility", "idle", "top"}}, "chain",
+    "mobility"}.
     """
+    from kinestat.parallel.mobility import platform_mobility  # lazy: start-up
     from kinestat.parallel.singularity import singularity_measure  # lazy: start-up
     from kinestat.parallel.statics import jacobian_det  # lazy: start-up (numba)
 
@@ -102,6 +106,7 @@ def info_command(
             "base_side": d.base_side, "top_side": d.top_side, "base_offset": d.base_offset,
             "top_offset": d.top_offset, "home_height": d.height,
             "home_twist_deg": float(np.degrees(d.twist)), "stiffness": d.stiffness},
+        "mobility": platform_mobility(p),
     }
     if as_json:
         print_json({**out, "units": units(p.length_unit, p.force_unit)})
@@ -118,6 +123,13 @@ def info_command(
                         _pose_rows(p.home_pose)))
     console.print(f"det j at home = {out['jacobian_det_home']:.6g}, singularity measure = "
                   f"{out['singularity_measure_home']:.4f}")
+    mob = out["mobility"]
+    console.print(f"mobility ({mob['structure']}; Grübler–Kutzbach {mob['formula']}, λ = "
+                  f"{mob['space']}, n = {mob['links']}, j = {mob['joints']}): "
+                  + "; ".join(f"{c} legs M = {v['mobility']}"
+                              + (f" ({v['idle']} idle leg spins, the top {v['top']})"
+                                 if v["idle"] else "")
+                              for c, v in mob["chains"].items()))
 
 
 @platform_app.command("fk")

@@ -227,15 +227,20 @@ def platform_design_command(
                                 "parameter's smallest and largest value instead of the grid."),
     seed: int = SEED,
     poses: int = typer.Option(256, "--poses", help="Random poses in the range per design."),
+    score: str = typer.Option("table-3-1", "--score", help="What 'best' maximises: "
+                              "'table-3-1' (fraction of the motion range within spec) or "
+                              "'lee' (|det j| at home over the top side cubed, Lee's "
+                              "criterion)."),
     range_mm: str = RANGE_MM, range_deg: str = RANGE_DEG,
     max_deflection: float = MAX_DEFL, max_load: float = MAX_LOAD,
     chunk_size: int | None = None, arrays: bool = True,
 ) -> dict:
-    """Special 6-6 designs scored on Vibhute Table 3-1 (unswept parameters: the --platform's).
+    """Special 6-6 designs scored on Vibhute Table 3-1 or by Lee's criterion (unswept
+    parameters: the --platform's).
 
-    Summary: designs, valid, meets_spec, fraction_within {min, mean, max}, min_singularity,
-    best (highest fraction of the motion range within spec), reference (the --platform's own
-    design, if in the grid).
+    Summary: score, designs, valid, meets_spec, fraction_within {min, mean, max},
+    min_singularity, lee {min, mean, max}, best (the highest score), reference (the
+    --platform's own design, if in the grid).
     """
     from kinestat.studies.platform_design import (  # lazy: start-up (the studies load Dask)
         DEFAULT_CHUNK,
@@ -248,7 +253,7 @@ def platform_design_command(
     return platform_design_spec(
         platform, values={k: v for k, v in given.items() if v is not None}, grid=grid,
         samples=samples, seed=seed, poses=poses, max_deflection=max_deflection,
-        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=arrays,
+        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=arrays, score=score,
         **_ranges(range_mm, range_deg))
 
 

@@ -1,4 +1,4 @@
-"""The simulated cell's mechanics: PUMA 762 + compliant platform + tool + rigid planar workpiece.
+"""The simulated cell's mechanics: PUMA 762 + compliant platform + tool + planar workpiece.
 
 The cell of Vibhute 2011 ch. 4-5: the special 6-6 platform's base is bolted to the robot's
 flange (frame 6), a tool tip is fixed to its top, and the tip presses on a workpiece. For each
@@ -23,6 +23,10 @@ Frames and conventions (all lengths in mm, forces in N):
   home; with the centred mount that point is on the top's axis, 175 mm above the top plane.
 * The workpiece is the half-space behind a plane through ``point`` with unit ``normal``
   pointing OUT of the material, towards the tool. The gap of the tip is ``n·(tip − point)``.
+* A compliant workpiece (``Workpiece.stiffness`` k, N/mm; None: rigid) gives way under the
+  tip along its normal: the tip sits ``f_n / k`` behind the surface, ``n·(tip − point) =
+  −f_n / k``, and a sticking tip stays on the normal through its anchor (the surface is
+  compliant along its normal only; tangentially the anchor holds or Coulomb slides it).
 * Forces: ``contact_force`` is what the workpiece exerts on the tool; ``tool_force`` (its
   negative) is what the tool exerts on the workpiece — the sense of the thesis's ``W_eq``
   and of ``F_req``.
@@ -30,18 +34,20 @@ Frames and conventions (all lengths in mm, forces in N):
 Equilibrium (all in base coordinates, unknown top pose X):
 
 * out of contact (the unloaded tip is not behind the plane): the top rests at home;
-* frictionless contact: ``w(X) = λ [n; p × n]`` and ``n·(p(X) − c) = 0`` with ``λ ≥ 0``, where
+* frictionless contact: ``w(X) = λ [n; p × n]`` and ``n·(p(X) − c) = −λ/k`` with ``λ ≥ 0``
+  (``1/k = 0`` when rigid), where
   ``w`` is the external wrench the springs balance (:func:`kinestat.parallel.statics.spring_wrench`)
   and ``p`` the tip. 7 equations in (X, λ), solved by Newton with the platform stiffness
   ``K = ∂w/∂D`` (:func:`kinestat.parallel.stiffness.stiffness`) plus the contact's geometric
   term;
-* Coulomb friction ``μ``: the tip sticks at its first contact point ``a`` (``w(X) = [f; p × f]``,
-  ``p(X) = a``, 9 equations) while ``|f_t| ≤ μ f_n``; beyond that it slides quasi-statically
-  to the anchor ``a'`` where ``|f_t| = μ f_n`` with the friction opposing the slip
-  ``a' − a`` (maximum dissipation), found by Newton over the 2-D slip.
+* Coulomb friction ``μ``: the tip sticks at its first contact point ``a`` (``w(X) =
+  [f; p × f]``, ``p(X) = a − (f·n/k) n``, 9 equations) while ``|f_t| ≤ μ f_n``; beyond that it
+  slides quasi-statically to the anchor ``a'`` where ``|f_t| = μ f_n`` with the friction
+  opposing the slip ``a' − a`` (maximum dissipation), found by Newton over the 2-D slip.
 
 Each solution is checked: wrench residual ≤ ``tol`` (1e-9 N and N·mm by default), tip on the
-plane, ``f_n ≥ 0`` (unilateral), and every leg deflection within the legs' stroke.
+plane (at ``−f_n/k`` from it when compliant), ``f_n ≥ 0`` (unilateral), and every leg
+deflection within the legs' stroke.
 """
 
 from __future__ import annotations
@@ -116,15 +122,32 @@ def _unit(v, name: str) -> np.ndarray:
     return a / n
 
 
+def check_stiffness(stiffness) -> float | None:
+    """A workpiece's normal stiffness (N/mm) as a float, None (rigid) kept; anything but a
+    finite positive number is refused."""
+    if stiffness is None:
+        return None
+    try:
+        k = float(stiffness)
+    except (TypeError, ValueError):
+        k = math.nan
+    if not (math.isfinite(k) and k > 0.0):
+        raise InputError(f"workpiece stiffness must be a finite number of N/mm > 0 (or none "
+                         f"for a rigid workpiece), got {stiffness!r}")
+    return k
+
+
 @dataclass(frozen=True, eq=False)
 class Workpiece:
-    """A rigid planar workpiece: a plane through ``point`` with unit ``normal`` pointing out of
+    """A planar workpiece: a plane through ``point`` with unit ``normal`` pointing out of
     the material (towards the tool), fixed frame; Coulomb ``friction`` coefficient μ ≥ 0
-    (0: frictionless)."""
+    (0: frictionless); normal ``stiffness`` k in N/mm (None: rigid), the tip then sinks
+    ``f_n / k`` into it."""
 
     point: np.ndarray
     normal: np.ndarray
     friction: float = 0.0
+    stiffness: float | None = None
 
     def __post_init__(self) -> None:
         p = as_array(self.point, shape_tail=(3,), name="workpiece point")
@@ -137,6 +160,12 @@ class Workpiece:
             raise InputError(f"friction coefficient must be a finite number >= 0, got "
                              f"{self.friction!r}")
         object.__setattr__(self, "friction", mu)
+        object.__setattr__(self, "stiffness", check_stiffness(self.stiffness))
+
+    @property
+    def compliance(self) -> float:
+        """``1 / stiffness`` (mm/N), 0 for a rigid workpiece."""
+        return 0.0 if self.stiffness is None else 1.0 / self.stiffness
 
     def gap(self, points) -> np.ndarray:
         """Signed distance of points (..., 3) from the plane; negative means behind it."""
@@ -220,6 +249,7 @@ def make_cell(
     plane_point,
     plane_normal,
     friction: float = 0.0,
+    stiffness: float | None = None,
     mount=None,
     tool_point_6=DEFAULT_TOOL_POINT_6,
     tool_tip=None,
@@ -248,7 +278,8 @@ def make_cell(
     else:
         tip = tool_tip
     return Cell(platform=platform, mount=M, tool_tip=tip,
-                workpiece=Workpiece(plane_point, plane_normal, friction), stroke=stroke,
+                workpiece=Workpiece(plane_point, plane_normal, friction, stiffness),
+                stroke=stroke,
                 leg_law=legs if legs is not None and nonlinear else None)
 
 
@@ -334,43 +365,60 @@ def unloaded_tip(cell: Cell, flange_pose) -> np.ndarray:
     return apply(T @ cell.mount @ cell.platform.home_pose, cell.tool_tip)
 
 
+def _frictionless_system(cell: Cell, n: np.ndarray, c: np.ndarray, X: np.ndarray, lam: float):
+    """The frictionless contact's residual ``r (7,)`` and Newton matrix ``A (7, 7)`` at (X, λ)
+    (base coordinates): ``r = [w(X) − λ [n; p×n]; n·(p − c) + λ/k]``."""
+    cmp = cell.workpiece.compliance
+    p = apply(X, cell.tool_tip)
+    wc = np.concatenate([n, np.cross(p, n)])
+    sp = _springs(cell, X)
+    r = np.concatenate([spring_wrench(sp, X) - lam * wc, [n @ (p - c) + cmp * lam]])
+    G = np.zeros((6, 6))
+    G[3:, :3] = skew(n) @ skew(p)
+    G[3:, 3:] = -skew(n)
+    A = np.zeros((7, 7))
+    A[:6, :6] = stiffness(sp, X, twist_order="axis") - lam * G
+    A[:6, 6] = -wc
+    A[6, :3] = np.cross(p, n)
+    A[6, 3:6] = n
+    A[6, 6] = cmp
+    return r, A
+
+
 def _solve_frictionless(cell: Cell, n: np.ndarray, c: np.ndarray, X0: np.ndarray,
-                        tol: float, max_iter: int):
-    """Newton on (X, λ): w(X) − λ [n; p×n] = 0, n·(p − c) = 0 (base coordinates)."""
+                        tol: float, max_iter: int, damped: bool = False):
+    """Newton on (X, λ): w(X) − λ [n; p×n] = 0, n·(p − c) + λ/k = 0 (base coordinates).
+
+    ``damped``: each step is halved until the residual (moments over the platform's scale)
+    falls — the second try when the plain Newton from the unloaded pose overshoots into a
+    cycle (seen 2.8 mm into a 560 N/mm plane tilted 2.75°)."""
     plat = cell.platform
     X, lam = X0.copy(), 0.0
     it = 0
+    weight = np.array([1.0, 1.0, 1.0, 1.0 / plat.scale, 1.0 / plat.scale, 1.0 / plat.scale, 1.0])
+    r, A = _frictionless_system(cell, n, c, X, lam)
     while it < max_iter:
         it += 1
-        p = apply(X, cell.tool_tip)
-        wc = np.concatenate([n, np.cross(p, n)])
-        sp = _springs(cell, X)
-        r = np.concatenate([spring_wrench(sp, X) - lam * wc, [n @ (p - c)]])
-        K = stiffness(sp, X, twist_order="axis")
-        G = np.zeros((6, 6))
-        G[3:, :3] = skew(n) @ skew(p)
-        G[3:, 3:] = -skew(n)
-        A = np.zeros((7, 7))
-        A[:6, :6] = K - lam * G
-        A[:6, 6] = -wc
-        A[6, :3] = np.cross(p, n)
-        A[6, 3:6] = n
-        d = np.linalg.solve(A, -r)
-        d = _limit_step(d, plat.scale)
-        X = _displace(X, d[:6])
-        lam += d[6]
-        if np.max(np.abs(d[:6])) < 1e-13 * max(1.0, plat.scale):
+        d = _limit_step(np.linalg.solve(A, -r), plat.scale)
+        t = 1.0
+        for _ in range(20 if damped else 1):
+            Xt, lt = _displace(X, t * d[:6]), lam + t * d[6]
+            rt, At = _frictionless_system(cell, n, c, Xt, lt)
+            if not damped or np.linalg.norm(weight * rt) < np.linalg.norm(weight * r):
+                break
+            t *= 0.5
+        X, lam, r, A = Xt, lt, rt, At
+        if np.max(np.abs(t * d[:6])) < 1e-13 * max(1.0, plat.scale):
             break
-    p = apply(X, cell.tool_tip)
-    wc = np.concatenate([n, np.cross(p, n)])
-    res = float(np.max(np.abs(spring_wrench(_springs(cell, X), X) - lam * wc)))
-    return X, lam, res, abs(float(n @ (p - c))), it
+    return X, lam, float(np.max(np.abs(r[:6]))), abs(float(r[6])), it
 
 
-def _stick_system(cell: Cell, X: np.ndarray, f: np.ndarray):
+def _stick_system(cell: Cell, X: np.ndarray, f: np.ndarray, n: np.ndarray):
     """The sticking contact's wrench residual and Newton matrix at (X, f) (base coordinates):
-    ``(r (6,), p (3,), A (9, 9))`` with ``r = w(X) − [f; p×f]``, rows 0-5 of ``A`` its
-    derivative in ``[δφ; δx_O; δf]`` and rows 6-8 that of the tip ``p(X)``."""
+    ``(r (6,), q (3,), A (9, 9))`` with ``r = w(X) − [f; p×f]``, rows 0-5 of ``A`` its
+    derivative in ``[δφ; δx_O; δf]`` and rows 6-8 that of the surface point under the tip,
+    ``q = p(X) + (f·n/k) n`` (the tip itself on a rigid workpiece), which the anchor holds."""
+    cmp = cell.workpiece.compliance
     p = apply(X, cell.tool_tip)
     sp = _springs(cell, X)
     r = spring_wrench(sp, X) - np.concatenate([f, np.cross(p, f)])
@@ -382,18 +430,22 @@ def _stick_system(cell: Cell, X: np.ndarray, f: np.ndarray):
     A[3:6, 6:] = -skew(p)
     A[6:, :3] = -skew(p)
     A[6:, 3:6] = np.eye(3)
+    if cmp:
+        A[6:, 6:] = cmp * np.outer(n, n)
+        return r, p + cmp * float(f @ n) * n, A
     return r, p, A
 
 
-def _solve_stick(cell: Cell, a: np.ndarray, X0: np.ndarray, tol: float, max_iter: int):
-    """Newton on (X, f): w(X) − [f; p×f] = 0, p(X) − a = 0 (base coordinates)."""
+def _solve_stick(cell: Cell, a: np.ndarray, n: np.ndarray, X0: np.ndarray, tol: float,
+                 max_iter: int):
+    """Newton on (X, f): w(X) − [f; p×f] = 0, p(X) + (f·n/k) n − a = 0 (base coordinates)."""
     plat = cell.platform
     X, f = X0.copy(), np.zeros(3)
     it = 0
     while it < max_iter:
         it += 1
-        r, p, A = _stick_system(cell, X, f)
-        d = np.linalg.solve(A, -np.concatenate([r, p - a]))
+        r, q, A = _stick_system(cell, X, f, n)
+        d = np.linalg.solve(A, -np.concatenate([r, q - a]))
         d[:6] = _limit_step(d[:6], plat.scale)
         X = _displace(X, d[:6])
         f = f + d[6:]
@@ -402,7 +454,8 @@ def _solve_stick(cell: Cell, a: np.ndarray, X0: np.ndarray, tol: float, max_iter
     p = apply(X, cell.tool_tip)
     res = float(np.max(np.abs(spring_wrench(_springs(cell, X), X)
                               - np.concatenate([f, np.cross(p, f)]))))
-    return X, f, res, float(np.max(np.abs(p - a))), it
+    q = p + cell.workpiece.compliance * float(f @ n) * n
+    return X, f, res, float(np.max(np.abs(q - a))), it
 
 
 def _solve_slide(cell: Cell, a: np.ndarray, E: np.ndarray, n: np.ndarray, X0: np.ndarray,
@@ -423,7 +476,7 @@ def _solve_slide(cell: Cell, a: np.ndarray, E: np.ndarray, n: np.ndarray, X0: np
     B = np.zeros((11, 11))
     clamped = 0
     for it in range(1, max_iter + 1):
-        r, p, A = _stick_system(cell, X, f)
+        r, p, A = _stick_system(cell, X, f, n)
         u, v = np.array([math.cos(phi), math.sin(phi)]), np.array([-math.sin(phi), math.cos(phi)])
         c = E @ u
         fn = float(f @ n)
@@ -536,6 +589,9 @@ def equilibrium(
         X, lam, res, gap, it = _solve_frictionless(cell, nB, cB, guess, tol, max_iter)
         iters += it
     if not (res <= tol and gap <= tol):
+        X, lam, res, gap, it = _solve_frictionless(cell, nB, cB, home, tol, max_iter, True)
+        iters += it
+    if not (res <= tol and gap <= tol):
         raise UnreachableError(
             f"simulated cell: no frictionless contact equilibrium found (wrench residual "
             f"{res:.3g}, gap {gap:.3g} mm after {it} Newton steps); the tool is pushed too far "
@@ -544,7 +600,8 @@ def equilibrium(
         raise UnreachableError(f"simulated cell: contact equilibrium needs a pulling contact "
                                f"force ({lam:.6g} N); not a valid unilateral contact")
     fF = lam * wp.normal
-    a_new = apply(TB, apply(X, cell.tool_tip)) if mu > 0.0 else None
+    a_new = (apply(TB, apply(X, cell.tool_tip)) + wp.compliance * lam * wp.normal
+             if mu > 0.0 else None)
     return _finish(cell, T, X, fF, a_new, False, res, iters, extra)
 
 
@@ -644,7 +701,7 @@ def _stick_or_slip(cell: Cell, TB, TBinv, nB, a_F, home, tol, max_iter, guess=No
 
     def stick(aF, X0):
         nonlocal iters
-        X, f, res, perr, it = _solve_stick(cell, apply(TBinv, aF), X0, tol, max_iter)
+        X, f, res, perr, it = _solve_stick(cell, apply(TBinv, aF), nB, X0, tol, max_iter)
         iters += it
         if not (res <= tol and perr <= tol):
             raise UnreachableError(

@@ -1,4 +1,4 @@
-"""Curved workpieces for the simulated cell: a rigid cylinder beside the plane of
+"""Curved workpieces for the simulated cell: a cylinder beside the plane of
 :mod:`kinestat.sim.contact`.
 
 The tool touches the workpiece at one point, so the contact only sees the surface's tangent
@@ -6,7 +6,9 @@ plane there. :func:`solve` therefore reuses the plane's contact equilibrium
 (:func:`kinestat.sim.contact.equilibrium`, frictionless or Coulomb stick/slip) on the tangent
 plane at the surface point nearest the tip, and repeats with the tangent plane at the new tip
 until the tip lies on the surface (a fixed point: the tip on the tangent plane at its own
-projection IS on the surface, and the contact force is along the true normal there). Each
+projection IS on the surface, and the contact force is along the true normal there). A
+compliant cylinder (``stiffness`` k, N/mm) lets the tip sink ``f_n / k`` along that normal:
+the same fixed point, the tip on the normal through its own projection. Each
 repetition moves the contact point by about (deflection / radius) of the last change, so two
 to four passes reach 1e-10 mm. A slide whose passes alternate between two tips, neither a rest
 on its own tangent plane, is solved again from the farther one (:data:`_BRANCH_PASSES`).
@@ -25,7 +27,14 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from kinestat.errors import InputError, UnreachableError
-from kinestat.sim.contact import Cell, Equilibrium, Workpiece, equilibrium, unloaded_tip
+from kinestat.sim.contact import (
+    Cell,
+    Equilibrium,
+    Workpiece,
+    check_stiffness,
+    equilibrium,
+    unloaded_tip,
+)
 from kinestat.spatial.transforms import as_array
 from kinestat.spatial.validate import frozen
 
@@ -55,8 +64,9 @@ def _vec3(v, name: str) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class Cylinder:
-    """A rigid solid cylinder: axis through ``point`` along unit ``axis``, ``radius`` mm; the
-    tool touches its outside (the normal points radially out). Coulomb ``friction`` μ ≥ 0.
+    """A solid cylinder: axis through ``point`` along unit ``axis``, ``radius`` mm; the
+    tool touches its outside (the normal points radially out). Coulomb ``friction`` μ ≥ 0;
+    normal ``stiffness`` k in N/mm (None: rigid), the tip then sinks ``f_n / k`` into it.
 
     >>> c = Cylinder(point=[0, 0, 0], axis=[0, 0, 1], radius=200.0)
     >>> float(c.gap([250.0, 0.0, 5.0])), c.normal_at([250.0, 0.0, 5.0]).tolist()
@@ -67,6 +77,7 @@ class Cylinder:
     axis: np.ndarray
     radius: float
     friction: float = 0.0
+    stiffness: float | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "point", frozen(_vec3(self.point, "cylinder point"), float))
@@ -85,6 +96,7 @@ class Cylinder:
             raise InputError(f"friction coefficient must be a finite number >= 0, got "
                              f"{self.friction!r}")
         object.__setattr__(self, "friction", mu)
+        object.__setattr__(self, "stiffness", check_stiffness(self.stiffness))
 
     def _radial(self, points) -> np.ndarray:
         d = np.asarray(points, dtype=float) - self.point
@@ -110,8 +122,9 @@ class Cylinder:
 
     def tangent_plane(self, point) -> Workpiece:
         """The tangent plane (a plane :class:`~kinestat.sim.contact.Workpiece` with the same
-        friction) at the surface point nearest ``point``."""
-        return Workpiece(self.project(point), self.normal_at(point), self.friction)
+        friction and stiffness) at the surface point nearest ``point``."""
+        return Workpiece(self.project(point), self.normal_at(point), self.friction,
+                         self.stiffness)
 
 
 def cylinder_ahead(start_point, direction, distance: float, radius: float, axis) -> Cylinder:

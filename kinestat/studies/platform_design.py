@@ -13,7 +13,13 @@ Each design is scored on the same ``poses`` random displacements over Table 3-1'
   (the score; ties go to the lower design index);
 * ``meets_spec`` — each motion of Table 3-1 alone, to ± its full range, stays within the limits
   (:func:`platform_common.axis_check`) and the range holds no singular pose;
-* ``min_singularity`` — the worst (smallest) singularity measure over the poses and home.
+* ``min_singularity`` — the worst (smallest) singularity measure over the poses and home;
+* ``lee`` — Lee's criterion (Vibhute §3.1.2): ``|det j|`` of the leg lines at home divided by
+  the top side cubed (det j is a length³; so scaled it depends on the shape alone).
+
+``score`` chooses what ``best`` maximises: ``"table-3-1"`` (``fraction_within``, the default)
+or ``"lee"``. Lee's optimum for the octahedral 3-3 (edge offsets 0) is a base side twice the
+top side, the home height equal to the top side and the top turned 60° (docs/sweeps.md).
 
 Impossible or architecturally singular designs are counted as ``invalid`` with the reason.
 """
@@ -27,18 +33,28 @@ import numpy as np
 
 from kinestat.errors import InputError, KinestatError
 from kinestat.parallel import singularity_measure, special_6_6
+from kinestat.parallel.statics import jacobian_det
 from kinestat.studies import grids
 from kinestat.studies import platform_common as pc
 from kinestat.studies import reduce as red
 from kinestat.studies.base import ChunkedStudy
 
-__all__ = ["PlatformDesignStudy", "platform_design_spec", "PARAMETERS"]
+__all__ = ["PlatformDesignStudy", "platform_design_spec", "PARAMETERS", "SCORES", "lee_score"]
 
 #: swept parameters (CLI option names), each a single number (equal sides/offsets)
 PARAMETERS = ("base_side", "top_side", "base_offset", "top_offset", "height", "twist_deg",
               "stiffness")
 DEFAULT_CHUNK = 16
 _BINS = 20
+#: ``--score`` names and the summary key each ranks designs by
+SCORES = {"table-3-1": "fraction_within", "lee": "lee"}
+
+
+def lee_score(platform) -> float:
+    """Lee's criterion: ``|det j|`` of the leg lines at the home pose over the top side cubed
+    (dimensionless; ``platform.design`` gives the top side)."""
+    a = float(np.mean(platform.design.top_side))
+    return float(abs(jacobian_det(platform, platform.home_pose))) / a ** 3
 
 
 def _defaults(platform) -> dict[str, float]:
@@ -66,12 +82,16 @@ def platform_design_spec(platform: str | None = None, *, values: dict[str, str] 
                          range_deg=pc.TABLE_3_1["range_deg"],
                          max_deflection: float = pc.TABLE_3_1["max_deflection"],
                          max_load: float = pc.TABLE_3_1["max_load"],
-                         chunk_size: int = DEFAULT_CHUNK, arrays: bool = True) -> dict:
+                         chunk_size: int = DEFAULT_CHUNK, arrays: bool = True,
+                         score: str = "table-3-1") -> dict:
     """Check the inputs and build the spec of a design study.
 
     ``values`` maps parameter names (:data:`PARAMETERS`) to text: ``v``, ``v1,v2``, ``lo:hi``
     (``grid`` values) or ``lo:hi:n``. ``samples`` draws random designs instead of the grid.
+    ``score``: what ``best`` maximises (:data:`SCORES`).
     """
+    if score not in SCORES:
+        raise InputError(f"--score must be one of {', '.join(SCORES)}, got {score!r}")
     label, text = pc.platform_text(platform)
     base = _defaults(pc.load_platform(label, text))
     values = dict(values or {})
@@ -97,7 +117,7 @@ def platform_design_spec(platform: str | None = None, *, values: dict[str, str] 
                             range_mm=range_mm, range_deg=range_deg, chunk_size=chunk_size,
                             arrays=arrays, values=lists, reference=base,
                             poses=int(poses), max_deflection=float(max_deflection),
-                            max_load=float(max_load), **inputs)
+                            max_load=float(max_load), score=score, **inputs)
     PlatformDesignStudy(spec)
     return spec
 
@@ -118,6 +138,7 @@ class PlatformDesignStudy(ChunkedStudy):
         self.names = (base.name, base.length_unit, base.force_unit)
         rng = grids.chunk_rng(spec["seed"], 0, grids.STREAM_POSES)
         self.displacements = rng.uniform(-self.box, self.box, size=(spec["poses"], 6))
+        self.key = SCORES[spec.get("score", "table-3-1")]
 
     def designs(self, i: int) -> np.ndarray:
         """Design parameters ``(rows, 7)`` (order :data:`PARAMETERS`) of chunk ``i``."""
@@ -151,7 +172,7 @@ class PlatformDesignStudy(ChunkedStudy):
                    float(singularity_measure(plat, plat.home_pose)))
         return {"valid": True, "fraction_within": float(r["ok"].mean()),
                 "meets_spec": bool(ax["meets"] and sing > pc.SINGULAR_TOL),
-                "min_singularity": sing,
+                "min_singularity": sing, "lee": lee_score(plat),
                 "max_deflection": float(r["max_deflection"].max()),
                 "max_force_z": float(r["force_z"].max()),
                 "axis_max_deflection": ax["max_deflection"], "axis_max_force_z": ax["max_force_z"]}
@@ -170,11 +191,11 @@ class PlatformDesignStudy(ChunkedStudy):
         def col(key):
             return np.array([s.get(key, nan) for s in scores], dtype=float)
 
-        frac, sing = col("fraction_within"), col("min_singularity")
+        frac, sing, lee = col("fraction_within"), col("min_singularity"), col("lee")
         meets = np.array([s.get("meets_spec", False) for s in scores])
         best = None
         for j, s in enumerate(scores):
-            if s["valid"] and (best is None or s["fraction_within"] > best["fraction_within"]):
+            if s["valid"] and (best is None or s[self.key] > best[self.key]):
                 best = {"index": start + j, "params": dict(zip(PARAMETERS, P[j].tolist(),
                                                                strict=True)), **s}
         ref = None
@@ -190,13 +211,14 @@ class PlatformDesignStudy(ChunkedStudy):
         partial = {"designs": len(scores), "valid": int(valid.sum()),
                    "meets_spec": int(meets.sum()), "invalid_reasons": reasons,
                    "fraction_within": red.stats(frac), "min_singularity": red.stats(sing),
+                   "lee": red.stats(lee),
                    "hist_fraction": red.histogram(frac, np.linspace(0, 1, _BINS + 1)),
                    "best": best, "reference": ref}
         rows = {}
         if self.spec["arrays"]:
             rows = {k: P[:, j] for j, k in enumerate(PARAMETERS)}
             rows.update(index=np.arange(start, start + len(P)), valid=valid, meets_spec=meets,
-                        fraction_within=frac, min_singularity=sing,
+                        fraction_within=frac, min_singularity=sing, lee=lee,
                         max_deflection=col("max_deflection"), max_force_z=col("max_force_z"))
         return rows, partial
 
@@ -204,7 +226,7 @@ class PlatformDesignStudy(ChunkedStudy):
         best = None
         for p in partials:  # chunk order: the first of equal scores wins
             b = p["best"]
-            if b is not None and (best is None or b["fraction_within"] > best["fraction_within"]):
+            if b is not None and (best is None or b[self.key] > best[self.key]):
                 best = b
         ref = next((p["reference"] for p in partials if p["reference"] is not None), None)
         reasons: dict[str, int] = {}
@@ -213,7 +235,9 @@ class PlatformDesignStudy(ChunkedStudy):
                 reasons[k] = reasons.get(k, 0) + v
         frac = red.finish_stats(red.merge_stats([p["fraction_within"] for p in partials]))
         sing = red.finish_stats(red.merge_stats([p["min_singularity"] for p in partials]))
+        lee = red.finish_stats(red.merge_stats([p["lee"] for p in partials]))
         return {"platform": self.names[0], "mode": self.spec["mode"],
+                "score": self.spec.get("score", "table-3-1"),
                 "designs": sum(p["designs"] for p in partials),
                 "valid": sum(p["valid"] for p in partials),
                 "meets_spec": sum(p["meets_spec"] for p in partials),
@@ -221,6 +245,7 @@ class PlatformDesignStudy(ChunkedStudy):
                 "poses_per_design": self.spec["poses"],
                 "fraction_within": {k: frac[k] for k in ("min", "mean", "max")},
                 "min_singularity": {k: sing[k] for k in ("min", "mean", "max")},
+                "lee": {k: lee[k] for k in ("min", "mean", "max")},
                 "best": best, "reference": ref,
                 "histograms": {"fraction_within": red.merge_histograms(
                     [p["hist_fraction"] for p in partials])}}
