@@ -330,9 +330,11 @@ def control_command(
     logged; faults end in a safe stop (ST). Exit status 0 when converged, 2 otherwise.
 
     JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
-    tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
-    torque_about_tool, torque_about_base (N·mm, fixed frame), equivalent_force (the
-    equivalent wrench's force, N: base − tool torque = tool_point × it), procedure,
+    tool_point (the commanded, unloaded tool point P_tool_F), tip (the measured, deflected
+    tip), final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
+    torque_about_tip, torque_about_tool, torque_about_base (N·mm, fixed frame: about the tip,
+    the tool point and the robot base), equivalent_force (the equivalent wrench's force, N:
+    base − tool torque = tool_point × it), procedure,
     calibration, cycles; with --task follow also task, completed, travel,
     normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
     simulated); with --arm also arm (name, joints, base, placement, limits_deg).
@@ -477,13 +479,16 @@ def _print_report(out: dict) -> None:
                           + ("n/a" if rms is None else f"RMS {rms:.4f} N, max {mx:.4f} N")
                           + f"; contact lost {out['contact_lost']} cycles")
     rows = []
-    # the equivalent wrench's force beside its torques: base − tool = tool_point × that force
+    # the equivalent wrench's force beside its torques: base − tool = tool_point × that force,
+    # base − tip = tip × that force
     for key, label in (("force", f"force, {out.get('estimator', 'point')} estimate (N)"),
                        ("equivalent_force", "equivalent wrench: force (N)"),
-                       ("torque_about_tool", "  torque about tool point (N·mm)"),
+                       ("torque_about_tip", "  torque about measured tip (N·mm)"),
+                       ("torque_about_tool", "  torque about tool point P_tool_F (N·mm)"),
                        ("torque_about_base", "  torque about robot base (N·mm)"),
                        ("true_force", "true force (N)"), ("tool_axis", "tool axis S6"),
-                       ("tool_point", "tool point (mm)")):
+                       ("tip", "tip, measured (mm)"),
+                       ("tool_point", "tool point (mm), commanded")):
         if out.get(key) is not None:
             rows.append([label, *out[key]])
     if rows:
