@@ -35,7 +35,14 @@ from kinestat.cli._model import (
 )
 from kinestat.cli._options import check_seed, flag
 from kinestat.cli._output import console as out_console
-from kinestat.cli._output import err_console, literal, parse_floats, print_json, table
+from kinestat.cli._output import (
+    err_console,
+    literal,
+    parse_floats,
+    parse_pose,
+    print_json,
+    table,
+)
 from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.devices.ceilings import MAX_SAMPLES
 from kinestat.errors import InputError, KinestatError
@@ -257,8 +264,23 @@ def control_command(
         "(the 2011 prototype's maps), 'nominal' (the design springs) or a TOML file "
         "(docs/control.md).", metavar="thesis|nominal|FILE"),
     platform: str = typer.Option(
-        None, "--platform", help="Platform TOML file (default the 2011 prototype).",
-        metavar="FILE"),
+        None, "--platform", help="Platform TOML file (default the 2011 prototype); its "
+        "[mount] table, if any, is the default --mount.", metavar="FILE"),
+    tool_offset: str = typer.Option(
+        None, "--tool-offset", "--tool-point-6", metavar="X,Y,Z",
+        help="The tool point fixed on the top plate, given where it sits in frame 6 (the "
+        "flange) when the platform is unloaded: the thesis's P_tool_6 (mm; default 0,0,235). "
+        "The simulated cell carries the same tool."),
+    a67: str = typer.Option(
+        None, "--a67", "--a67-f", metavar="X,Y,Z",
+        help="The start pose's a67_F (fixed frame), perpendicular to --direction (default: "
+        "the fixed z axis made perpendicular to it)."),
+    mount: str = typer.Option(
+        None, "--mount", metavar="centred|FILE|POSE",
+        help="The platform's base frame on the flange, 6_BT: 'centred' (the base triangle's "
+        "centroid on S6, base x along a67; the default), a platform TOML file's [mount] "
+        "table, or a pose (a pose file, or 16 numbers row by row, mm). The simulated cell is "
+        "built with the same mount."),
     sim_legs: str = typer.Option(
         "thesis", "--sim-legs",
         help="The simulated legs' TRUE law: 'thesis', 'nominal' or a calibration TOML file "
@@ -380,7 +402,8 @@ def control_command(
                                      else parse_floats(travel_dir, 3, "travel-dir")),
                          travel_step=1.0 if travel_step is None else travel_step,
                          tilt_deg=0.0 if tilt_deg is None else tilt_deg, auto_tilt=auto_tilt,
-                         arm=arm_spec, probe_span=probe_span, max_approach=max_approach)
+                         arm=arm_spec, probe_span=probe_span, max_approach=max_approach,
+                         **_tool_and_mount(tool_offset, a67, mount))
     cold = tuple(g for g in KERNELS if is_cold(g))
     if cold:  # compile before the run, so that its timing is the loop's own
         with compiling_notice(*cold):
@@ -428,6 +451,23 @@ def control_command(
         what = "the follow task did not complete" if task == "follow" else (
             "kinestatic control did not converge")
         raise KinestatError(f"{what}: {report.stop_reason}")
+
+
+def _tool_and_mount(tool_offset: str | None, a67: str | None, mount: str | None) -> dict:
+    """``--tool-offset``, ``--a67`` and ``--mount`` as :class:`ControlRequest` fields."""
+    out: dict = {}
+    if tool_offset is not None:
+        out["tool_point_6"] = parse_floats(tool_offset, 3, "tool-offset")
+    if a67 is not None:
+        out["a67"] = parse_floats(a67, 3, "a67")
+    if mount is not None:
+        text = mount.strip()
+        if text in ("centred", "centered") or (Path(text).suffix.lower() == ".toml"
+                                              and Path(text).is_file()):
+            out["mount"] = text
+        else:
+            out["mount"] = parse_pose(text, "mount")
+    return out
 
 
 def _arm_words(placed) -> str:
