@@ -29,13 +29,19 @@ from kinestat.hardware.leg_calibration import LegCalibration
 from kinestat.hardware.leg_law import calibrated_platform, nominal_calibration, rescale_counts
 from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, THESIS_TOOL_POINT_6
 from kinestat.io.library import list_calibrations, load_calibration
-from kinestat.io.platform_toml import read_platform
+from kinestat.io.platform_toml import (
+    PlatformMount,
+    read_mount_file,
+    read_platform,
+    read_platform_mount,
+)
 from kinestat.parallel.platform import Platform, special_6_6
 from kinestat.sim.contact import centred_mount
 from kinestat.sim.sensor import IDEAL_RESOLUTION
+from kinestat.spatial.validate import as_pose
 
-__all__ = ["NamedCalibration", "resolve_platform", "resolve_calibration", "ideal_counts",
-           "calibrated_model"]
+__all__ = ["NamedCalibration", "resolve_platform", "resolve_mount", "resolve_calibration",
+           "ideal_counts", "calibrated_model", "MOUNT_ORTHO_TOL"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -50,6 +56,52 @@ def resolve_platform(path: str | os.PathLike | None) -> Platform:
     """The platform file at ``path`` (:mod:`kinestat.io.platform_toml`), or the special 6-6
     prototype when None."""
     return special_6_6() if path is None else read_platform(path)
+
+
+MOUNT_ORTHO_TOL = 1e-3
+"""Largest ``max|R Rᵀ − I|`` of a given mount's rotation: a pose typed to four decimals
+(e.g. 0.7071) passes and is made exactly orthonormal (its nearest rotation)."""
+
+MountSpec = str | os.PathLike | np.ndarray | None
+"""``--mount``: None (the ``--platform`` file's ``[mount]``, else centred), ``"centred"``, a TOML
+file (a platform file's ``[mount]`` or a pose file) or a 4x4 ``6_BT``."""
+
+
+def resolve_mount(spec: MountSpec, platform: Platform,
+                  platform_path: str | os.PathLike | None = None) -> tuple[np.ndarray, str]:
+    """``6_BT`` (the platform's base frame in frame 6, mm) of a run and where it came from.
+
+    None takes the ``platform_path`` file's ``[mount]`` table, or the centred mount
+    (:func:`~kinestat.sim.contact.centred_mount`, the base triangle's centroid on S6) when
+    there is none; ``"centred"`` the centred mount; a path a TOML file's mount (a platform
+    file's ``[mount]``, offset and turn applied to that file's platform, or a pose file); an
+    array the 4x4 pose itself."""
+    if spec is None:
+        m = None if platform_path is None else read_platform_mount(platform_path)[1]
+        if m is None:
+            return centred_mount(platform), "centred"
+        return _mount_pose(m, platform, f"[mount] of {os.fspath(platform_path)}"), \
+            os.fspath(platform_path)
+    if isinstance(spec, str) and spec in ("centred", "centered"):
+        return centred_mount(platform), "centred"
+    if isinstance(spec, (str, os.PathLike)):
+        owner, m = read_mount_file(spec)
+        return _mount_pose(m, platform if owner is None else owner,
+                           f"--mount {os.fspath(spec)}"), os.fspath(spec)
+    return _mount_pose(PlatformMount(pose=np.asarray(spec, dtype=float)), platform,
+                       "--mount"), "pose"
+
+
+def _mount_pose(m: PlatformMount, platform: Platform, what: str) -> np.ndarray:
+    """The 4x4 of a mount: offset and turn about S6 from the centred mount, or the pose checked
+    rigid to :data:`MOUNT_ORTHO_TOL` and made exactly so."""
+    if m.pose is None:
+        return centred_mount(platform, offset=m.offset, turn=np.radians(m.turn_deg))
+    T = as_pose(m.pose, what, tol=MOUNT_ORTHO_TOL, single=True).copy()
+    U, _, Vt = np.linalg.svd(T[:3, :3])
+    T[:3, :3] = U @ Vt
+    T[3] = (0.0, 0.0, 0.0, 1.0)
+    return T
 
 
 CALIBRATION_NAMES = ("thesis", "nominal")
@@ -87,12 +139,13 @@ def ideal_counts(truth: LegCalibration, *others: LegCalibration,
 
 
 def calibrated_model(platform: Platform, cal: NamedCalibration, *,
-                     tool_point_6=THESIS_TOOL_POINT_6,
+                     tool_point_6=THESIS_TOOL_POINT_6, mount: np.ndarray | None = None,
                      coupling: float = AXIS4_TO_5_COUPLING) -> ControlModel:
-    """The controller's model: ``platform`` centred on the flange with the calibrated springs,
-    the tool at ``tool_point_6`` when the calibrated legs are unloaded, forces from the
-    calibration's maps."""
+    """The controller's model: ``platform`` on the flange at ``mount`` (``6_BT``; default
+    centred) with the calibrated springs, the tool at ``tool_point_6`` when the calibrated legs
+    are unloaded, forces from the calibration's maps."""
     return ControlModel(platform=calibrated_platform(platform, cal.calibration),
-                        mount=centred_mount(platform), tool_point_6=tool_point_6,
+                        mount=centred_mount(platform) if mount is None else mount,
+                        tool_point_6=tool_point_6,
                         calibration=cal.calibration, coupling=coupling,
                         force_source="calibration", calibration_name=cal.name)

@@ -29,10 +29,12 @@ from kinestat.app.arm_cell import (
     place_arm,
 )
 from kinestat.app.calibrations import (
+    MountSpec,
     NamedCalibration,
     calibrated_model,
     ideal_counts,
     resolve_calibration,
+    resolve_mount,
     resolve_platform,
 )
 from kinestat.app.control_defaults import (
@@ -62,6 +64,7 @@ from kinestat.devices.galil import GalilClient
 from kinestat.devices.homing import is_homed
 from kinestat.devices.motion import MOVE_RULES, MoveRule
 from kinestat.errors import InputError
+from kinestat.hardware.puma762_axes import THESIS_TOOL_POINT_6
 from kinestat.parallel.platform import Platform
 from kinestat.sim.contact import Cell, make_cell
 from kinestat.sim.sensor import Sensor
@@ -164,7 +167,14 @@ class RealDevices:
 
 @dataclass(frozen=True)
 class ControlRequest:
-    """One ``kinestat control`` run: the goal, the controller's settings and the cell."""
+    """One ``kinestat control`` run: the goal, the controller's settings and the cell.
+
+    The tool and mount, as ForceCorrection.m's inputs: ``tool_point_6`` the unloaded tool point
+    in frame 6 (``P_tool_6``, mm; None the thesis's (0, 0, 235)), ``a67`` the start pose's
+    ``a67_F`` (None :func:`~kinestat.control.controller.default_a67`), ``mount`` the platform
+    on the flange (:func:`~kinestat.app.calibrations.resolve_mount`). The simulated cell is
+    built with the same tool and mount.
+    """
 
     force: np.ndarray
     start_tool_point: np.ndarray
@@ -191,14 +201,19 @@ class ControlRequest:
     arm: ArmSpec | None = None
     probe_span: float | None = None
     max_approach: float = MAX_APPROACH
+    tool_point_6: np.ndarray | None = None
+    a67: np.ndarray | None = None
+    mount: MountSpec = None
 
 
 def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: np.ndarray,
-                   platform: Platform | None = None, truth: NamedCalibration | None = None
+                   platform: Platform | None = None, truth: NamedCalibration | None = None, *,
+                   mount: np.ndarray | None = None, tool_point_6=THESIS_TOOL_POINT_6
                    ) -> tuple[Cell, Sensor]:
     """The thesis's experiment as a simulated cell and its leg sensor (Vibhute §5.1): the
     platform (default the prototype) with legs that follow ``truth`` (default
-    ``settings.sim_legs``), the sensor reading counts through the truth's length maps."""
+    ``settings.sim_legs``), the sensor reading counts through the truth's length maps; the
+    platform on the flange at ``mount`` (default centred), the tool at ``tool_point_6``."""
     platform = resolve_platform(None) if platform is None else platform
     truth = (resolve_calibration(settings.sim_legs, platform, option="--sim-legs")
              if truth is None else truth)
@@ -213,7 +228,8 @@ def simulated_cell(settings: SimulatedCell, start_point: np.ndarray, direction: 
     if settings.plane_normal is not None:
         pn = settings.plane_normal
     cell = make_cell(platform, plane_point=pp, plane_normal=pn, friction=settings.friction,
-                     stiffness=settings.workpiece_stiffness, legs=truth.calibration)
+                     stiffness=settings.workpiece_stiffness, legs=truth.calibration,
+                     mount=mount, tool_point_6=tool_point_6)
     cyl = settings.cylinder
     if cyl is not None:
         wp = (cylinder_ahead(start_point, direction, DEFAULT_PLANE_DISTANCE, cyl.radius, cyl.axis)
@@ -238,7 +254,30 @@ def _config(req: ControlRequest, model: ControlModel) -> ControllerConfig:
         step=req.step, approach_step=_or(req.approach_step, FOLLOW_APPROACH_STEP, 1.0, req),
         estimator=req.estimator,
         max_iterations=_or(req.max_iterations, FOLLOW_MAX_ITERATIONS, 60, req),
-        max_approach=req.max_approach, envelope=Envelope(), procedure=req.procedure)
+        max_approach=req.max_approach, envelope=Envelope(), procedure=req.procedure,
+        start_a67=_a67(req.a67, req.force))
+
+
+A67_DOT_TOL = 1e-3
+"""Largest |a67 · S6| of a given ``--a67`` (unit vectors; 0.06° off perpendicular): typed to
+four decimals it passes and is made exactly perpendicular to S6."""
+
+
+def _a67(a67, force) -> np.ndarray | None:
+    """``--a67`` as a unit vector exactly perpendicular to the start S6 (along F_req)."""
+    if a67 is None:
+        return None
+    a = np.asarray(a67, dtype=float)
+    s6 = force / np.linalg.norm(force)
+    if a.shape != (3,) or not np.all(np.isfinite(a)) or np.linalg.norm(a) == 0:
+        raise InputError(f"--a67 must be 3 finite numbers, not all zero, got {a.tolist()}")
+    a = a / np.linalg.norm(a)
+    dot = float(a @ s6)
+    if abs(dot) > A67_DOT_TOL:
+        raise InputError(f"--a67 must be perpendicular to the start tool axis S6 (along "
+                         f"--direction): a67 · S6 = {dot:.4g}, more than {A67_DOT_TOL:g}")
+    a = a - dot * s6
+    return a / np.linalg.norm(a)
 
 
 def _or(value, follow_default, press_default, req: ControlRequest):
@@ -299,8 +338,11 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
                     "move_rule": req.move_rule}
     platform = resolve_platform(req.platform)
     cal = resolve_calibration(req.calibration, platform)
+    mount, mount_source = resolve_mount(req.mount, platform, req.platform)
+    tool6 = THESIS_TOOL_POINT_6 if req.tool_point_6 is None else req.tool_point_6
     header["calibration"] = cal.name
     header["platform"] = req.platform or "prototype"
+    header["mount_source"] = mount_source
     if isinstance(req.cell, SimulatedCell):
         s = req.cell
         if s.plant not in PLANTS:
@@ -310,8 +352,9 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
         if s.ideal_sensor:  # the controller reads the same fine counts
             _, fine = ideal_counts(truth.calibration, cal.calibration)
             cal = NamedCalibration(cal.name, fine)
-        cell, sensor = simulated_cell(s, req.start_tool_point, direction, platform, truth)
-        config = _config(req, calibrated_model(platform, cal))
+        cell, sensor = simulated_cell(s, req.start_tool_point, direction, platform, truth,
+                                      mount=mount, tool_point_6=tool6)
+        config = _config(req, calibrated_model(platform, cal, tool_point_6=tool6, mount=mount))
         placed_arm = None
         if req.arm is not None:
             config, placed_arm = _with_arm(req.arm, config)
@@ -335,7 +378,8 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
     d = req.cell
     header.update({"galil": f"{d.host}:{d.port}", "serial": d.serial,
                    "serial_format": d.serial_format})
-    return PreparedRun(req, _config(req, calibrated_model(platform, cal)), header)
+    return PreparedRun(req, _config(req, calibrated_model(platform, cal, tool_point_6=tool6,
+                                                          mount=mount)), header)
 
 
 def _check_ahead(workpiece, start_point, direction, max_approach: float) -> None:
@@ -449,7 +493,9 @@ def report_dict(prepared: PreparedRun, report: RunReport) -> dict:
     """The run's JSON report: :meth:`RunReport.as_dict`, and for the follow task ``completed``,
     ``travel`` (mm along the surface), ``normal_force_rms_error``/``normal_force_max_error``
     (N, over the travel cycles), ``contact_lost`` (and the true errors when simulated),
-    ``travel_dir`` (the initial travel direction, unit: given, or the default)."""
+    ``travel_dir`` (the initial travel direction, unit: given, or the default); always the
+    run's tool and mount: ``tool_point_6`` (mm, frame 6), ``a67_start`` (fixed frame),
+    ``mount`` (``6_BT``, 4x4) and ``mount_source`` ("centred", "pose" or the file)."""
     out = report.as_dict()
     if prepared.cell is not None:
         out["plant"] = prepared.header.get("plant", "kinestat")
@@ -457,6 +503,11 @@ def report_dict(prepared: PreparedRun, report: RunReport) -> dict:
         out.update(figures)
         if prepared.follow is not None and figures.get("sim_time_s"):
             out["travel_speed_mm_s"] = None  # filled below from the travel
+    model = prepared.config.model
+    out["tool_point_6"] = model.tool_point_6.tolist()
+    out["a67_start"] = prepared.config.start_a67.tolist()
+    out["mount"] = model.mount.tolist()
+    out["mount_source"] = prepared.header.get("mount_source", "centred")
     if prepared.follow is not None:
         out["task"] = "follow"
         out["completed"] = report.converged

@@ -186,8 +186,11 @@ class SimHarness:
         # the robot is placed at known, calibrated counts: homed by construction
         self.controller.variables["HOMED"] = 1.0
         self.server = GalilSimServer(controller=self.controller)
+        # the box re-zeroes each leg at its strip's index mark (where the sensor's maps put it)
+        options = {"index_counts": self.state.sensor.calibration.index_counts,
+                   **(emitter_options or {})}
         self.emitter = EncoderEmitter(self.counts_now, rate_hz=rate_hz, fmt=fmt,  # type: ignore[arg-type]
-                                      **(emitter_options or {}))
+                                      **options)
         self._opened: list[Any] = []
 
     # -- life cycle

@@ -35,7 +35,14 @@ from kinestat.cli._model import (
 )
 from kinestat.cli._options import check_seed, flag
 from kinestat.cli._output import console as out_console
-from kinestat.cli._output import err_console, literal, parse_floats, print_json, table
+from kinestat.cli._output import (
+    err_console,
+    literal,
+    parse_floats,
+    parse_pose,
+    print_json,
+    table,
+)
 from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.devices.ceilings import MAX_SAMPLES
 from kinestat.errors import InputError, KinestatError
@@ -276,8 +283,23 @@ def control_command(
         "(the 2011 prototype's maps), 'nominal' (the design springs) or a TOML file "
         "(docs/control.md).", metavar="thesis|nominal|FILE"),
     platform: str = typer.Option(
-        None, "--platform", help="Platform TOML file (default the 2011 prototype).",
-        metavar="FILE"),
+        None, "--platform", help="Platform TOML file (default the 2011 prototype); its "
+        "[mount] table, if any, is the default --mount.", metavar="FILE"),
+    tool_offset: str = typer.Option(
+        None, "--tool-offset", "--tool-point-6", metavar="X,Y,Z",
+        help="The tool point fixed on the top plate, given where it sits in frame 6 (the "
+        "flange) when the platform is unloaded: the thesis's P_tool_6 (mm; default 0,0,235). "
+        "The simulated cell carries the same tool."),
+    a67: str = typer.Option(
+        None, "--a67", "--a67-f", metavar="X,Y,Z",
+        help="The start pose's a67_F (fixed frame), perpendicular to --direction (default: "
+        "the fixed z axis made perpendicular to it)."),
+    mount: str = typer.Option(
+        None, "--mount", metavar="centred|FILE|POSE",
+        help="The platform's base frame on the flange, 6_BT: 'centred' (the base triangle's "
+        "centroid on S6, base x along a67; the default), a platform TOML file's [mount] "
+        "table, or a pose (a pose file, or 16 numbers row by row, mm). The simulated cell is "
+        "built with the same mount."),
     sim: str = typer.Option(
         "kinestat", "--sim",
         help="The simulated cell's physics: 'kinestat' (the built-in contact simulator behind "
@@ -358,12 +380,14 @@ def control_command(
     logged; faults end in a safe stop (ST). Exit status 0 when converged, 2 otherwise.
 
     JSON keys: converged, iterations, force, torque, force_magnitude, true_force, tool_axis,
-    tool_point, final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
-    torque_about_tool, torque_about_base (N·mm, fixed frame), equivalent_force (the
-    equivalent wrench's force, N: base − tool torque = tool_point × it), procedure,
-    calibration, cycles, plant (simulated: kinestat or mujoco; with mujoco also sim_time_s,
-    sim_seconds_per_cycle, sim_move_s, sim_settle_s, moves_unsettled); with --task follow also
-    task, travel_speed_mm_s (mujoco), completed, travel,
+    tool_point (the commanded, unloaded tool point P_tool_F), tip (the measured, deflected
+    tip), final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
+    torque_about_tip, torque_about_tool, torque_about_base (N·mm, fixed frame: about the tip,
+    the tool point and the robot base), equivalent_force (the equivalent wrench's force, N:
+    base − tool torque = tool_point × it), procedure, calibration, cycles, plant (simulated:
+    kinestat or mujoco; with mujoco also sim_time_s, sim_seconds_per_cycle, sim_move_s,
+    sim_settle_s, moves_unsettled); with --task follow also task, travel_speed_mm_s (mujoco),
+    completed, travel,
     normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
     simulated); with --arm also arm (name, joints, base, placement, limits_deg).
     """
@@ -408,7 +432,8 @@ def control_command(
                                      else parse_floats(travel_dir, 3, "travel-dir")),
                          travel_step=1.0 if travel_step is None else travel_step,
                          tilt_deg=0.0 if tilt_deg is None else tilt_deg, auto_tilt=auto_tilt,
-                         arm=arm_spec, probe_span=probe_span, max_approach=max_approach)
+                         arm=arm_spec, probe_span=probe_span, max_approach=max_approach,
+                         **_tool_and_mount(tool_offset, a67, mount))
     cold = tuple(g for g in KERNELS if is_cold(g))
     if cold:  # compile before the run, so that its timing is the loop's own
         with compiling_notice(*cold):
@@ -456,6 +481,23 @@ def control_command(
         what = "the follow task did not complete" if task == "follow" else (
             "kinestatic control did not converge")
         raise KinestatError(f"{what}: {report.stop_reason}")
+
+
+def _tool_and_mount(tool_offset: str | None, a67: str | None, mount: str | None) -> dict:
+    """``--tool-offset``, ``--a67`` and ``--mount`` as :class:`ControlRequest` fields."""
+    out: dict = {}
+    if tool_offset is not None:
+        out["tool_point_6"] = parse_floats(tool_offset, 3, "tool-offset")
+    if a67 is not None:
+        out["a67"] = parse_floats(a67, 3, "a67")
+    if mount is not None:
+        text = mount.strip()
+        if text in ("centred", "centered") or (Path(text).suffix.lower() == ".toml"
+                                              and Path(text).is_file()):
+            out["mount"] = text
+        else:
+            out["mount"] = parse_pose(text, "mount")
+    return out
 
 
 def _arm_words(placed) -> str:
@@ -507,13 +549,16 @@ def _print_report(out: dict) -> None:
                           + ("n/a" if rms is None else f"RMS {rms:.4f} N, max {mx:.4f} N")
                           + f"; contact lost {out['contact_lost']} cycles")
     rows = []
-    # the equivalent wrench's force beside its torques: base − tool = tool_point × that force
+    # the equivalent wrench's force beside its torques: base − tool = tool_point × that force,
+    # base − tip = tip × that force
     for key, label in (("force", f"force, {out.get('estimator', 'point')} estimate (N)"),
                        ("equivalent_force", "equivalent wrench: force (N)"),
-                       ("torque_about_tool", "  torque about tool point (N·mm)"),
+                       ("torque_about_tip", "  torque about measured tip (N·mm)"),
+                       ("torque_about_tool", "  torque about tool point P_tool_F (N·mm)"),
                        ("torque_about_base", "  torque about robot base (N·mm)"),
                        ("true_force", "true force (N)"), ("tool_axis", "tool axis S6"),
-                       ("tool_point", "tool point (mm)")):
+                       ("tip", "tip, measured (mm)"),
+                       ("tool_point", "tool point (mm), commanded")):
         if out.get(key) is not None:
             rows.append([label, *out[key]])
     if rows:

@@ -110,6 +110,8 @@ class RunReport:
     equivalent_wrench: np.ndarray | None = None
     torque_about_tool: np.ndarray | None = None
     torque_about_base: np.ndarray | None = None
+    tip: np.ndarray | None = None
+    torque_about_tip: np.ndarray | None = None
     procedure: str = "kinestat"
     calibration: str = ""
     cycles: list[dict] = field(default_factory=list)
@@ -147,6 +149,8 @@ class RunReport:
                                  else arr(self.equivalent_wrench[:3])),
             "torque_about_tool": arr(self.torque_about_tool),
             "torque_about_base": arr(self.torque_about_base),
+            "tip": arr(self.tip),
+            "torque_about_tip": arr(self.torque_about_tip),
             "procedure": self.procedure,
             "calibration": self.calibration,
             "cycles": [{k: (arr(v) if isinstance(v, np.ndarray) else v) for k, v in c.items()}
@@ -174,6 +178,7 @@ def _meas_record(config: ControllerConfig, m: Measurement) -> dict:
         "tool_axis": m.s6,
         "a67": m.a67,
         "tip": m.tip(model),
+        "torque_about_tip": m.torque_about_tip(model),
         "top_pose": m.top_pose,
         "seq": m.seq,
         "age": m.age,
@@ -467,6 +472,8 @@ def _report(config, converged, state, states, moves, reason, m, truth, log, faul
         rep.equivalent_wrench = m.wrench.copy()
         rep.torque_about_tool = m.torque
         rep.torque_about_base = m.wrench[3:].copy()
+        rep.tip = np.array(m.tip(config.model), dtype=float)
+        rep.torque_about_tip = m.torque_about_tip(config.model)
         rep.tool_axis = m.s6.copy()
         rep.tool_point = m.tool_point.copy()
         rep.final_joints_deg = np.degrees(m.q)

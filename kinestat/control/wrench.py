@@ -22,8 +22,10 @@ Two estimates of the contact force come out of each measurement:
 Sign: the measured wrench is the one the **tool applies to the workpiece** — the thesis's
 ``W_eq`` (the legs' compressive forces along the leg lines), the sense of ``F_req``. It is the
 negative of :func:`kinestat.parallel.statics.spring_wrench`, the external wrench on the top.
-Moments are about the fixed origin (ray coordinates ``[f; m_O]``); :attr:`Measurement.torque`
-is the moment about the tool point ``P_tool_F``.
+Moments are about the fixed origin, the robot's base (ray coordinates ``[f; m_O]``);
+:attr:`Measurement.torque` is the moment about the commanded tool point ``P_tool_F`` (the unloaded
+tip carried by the flange) and :meth:`Measurement.torque_about_tip` the moment about the measured
+(deflected) tip, which vanishes for a point contact.
 """
 
 from __future__ import annotations
@@ -96,7 +98,8 @@ class Measurement:
 
     @property
     def torque(self) -> np.ndarray:
-        """Moment of the measured wrench about the tool point ``P_tool_F`` (N·mm)."""
+        """Moment of the measured wrench about the commanded tool point ``P_tool_F`` (N·mm): the
+        unloaded tip carried by the flange, not the deflected tip (:meth:`torque_about_tip`)."""
         return self.wrench[3:] - np.cross(self.tool_point, self.wrench[:3])
 
     def estimate(self, estimator: Estimator = "point") -> np.ndarray:
@@ -111,6 +114,12 @@ class Measurement:
     def deflections(self, model: ControlModel) -> np.ndarray:
         """Leg deflections ``l − l0`` (mm), platform leg order."""
         return self.leg_lengths - model.platform.free_lengths
+
+    def torque_about_tip(self, model: ControlModel) -> np.ndarray:
+        """Moment of the measured wrench about the measured tip :meth:`tip` (N·mm): zero, within
+        the leg encoders' resolution, when the tool touches the workpiece at a point."""
+        p = self.tip(model)
+        return self.wrench[3:] - np.cross(p, self.wrench[:3])
 
     def tip(self, model: ControlModel) -> np.ndarray:
         """The measured (deflected) tool tip, fixed frame (read-only; computed once per model:

@@ -49,6 +49,7 @@ from kinestat.hardware.encoder_packets import (
     decode_packet,
     encode_legacy_line,
     encode_packet,
+    index_mask_to_legs,
     legs_to_channels,
     unwrap16,
 )
@@ -69,6 +70,7 @@ __all__ = [
     "decode_packet",
     "encode_legacy_line",
     "encode_packet",
+    "index_mask_to_legs",
     "legs_to_channels",
     "unwrap16",
     # the stream
@@ -130,6 +132,7 @@ class StreamStats:
     duplicates: int = 0
     out_of_order: int = 0
     restarts: int = 0
+    index_pulses: int = 0
 
 
 class StreamParser:
@@ -311,6 +314,12 @@ class Reading:
     ``age`` is the time in seconds between its arrival and the call that returned it;
     ``received_at`` is when the READER took it off the line, not when the box sampled it.
     ``index`` is the packet's ordinal in the reader (1 for the first packet it took).
+    ``index_legs``: the legs (1..6) whose index pulse re-zeroed their count since the previous
+    reading returned (over every packet taken since, so none is missed); ``referenced``: six
+    flags, the legs that have passed their index since the reader opened (their counts count
+    from the index, as the calibration's do; before that, from wherever the box powered up);
+    None when the stream does not report index pulses (legacy lines, ``ks`` without the
+    ``I`` field).
     """
 
     seq: int | None
@@ -321,6 +330,8 @@ class Reading:
     fmt: Format = "ks"
     faults: tuple[StreamFault, ...] = field(default=())
     index: int = 0
+    index_legs: tuple[int, ...] = ()
+    referenced: tuple[bool, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -405,6 +416,8 @@ class EncoderReader:
         self._latest_id = 0
         self._returned_id = 0
         self._pending_faults: list[StreamFault] = []
+        self._index_since = np.zeros(6, dtype=bool)
+        self._referenced: np.ndarray | None = None
 
     # -- life cycle
     def open(self) -> EncoderReader:
@@ -492,15 +505,24 @@ class EncoderReader:
             legs = unwrap16(self._latest_legs, legs)
         self._latest, self._latest_legs, self._latest_t = pkt, legs, now
         self._latest_id += 1
+        if pkt.index_mask is not None:  # the box re-zeroed these legs at their index pulse
+            hit = index_mask_to_legs(pkt.index_mask, self.wiring)
+            self.parser.stats.index_pulses += int(hit.sum())
+            self._index_since |= hit
+            self._referenced = hit if self._referenced is None else self._referenced | hit
 
     def _reading(self, now: float) -> Reading:
         assert self._latest is not None and self._latest_t is not None
         assert self._latest_legs is not None
         faults, self._pending_faults = tuple(self._pending_faults), []
+        hit, self._index_since = self._index_since, np.zeros(6, dtype=bool)
+        ref = None if self._referenced is None else tuple(bool(b) for b in self._referenced)
         return Reading(seq=self._latest.seq, counts=self._latest_legs.copy(),
                        channel_counts=self._latest.counts, received_at=self._latest_t,
                        age=now - self._latest_t, fmt=self._latest.fmt, faults=faults,
-                       index=self._latest_id)
+                       index=self._latest_id,
+                       index_legs=tuple(int(k) + 1 for k in np.flatnonzero(hit)),
+                       referenced=ref)
 
     def _stale(self, now: float, why: str) -> StaleDataError:
         age = math.inf if self._latest_t is None else now - self._latest_t

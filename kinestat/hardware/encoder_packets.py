@@ -9,6 +9,11 @@ Two wire formats (see ``docs/devices.md`` for the full specification):
   ``seq`` is a 16-bit sequence number that wraps 0xFFFF -> 0x0000; each count is a signed
   32-bit integer in two's complement; the CRC is CRC-16/CCITT-FALSE (polynomial 0x1021,
   initial value 0xFFFF) over every byte between ``$`` and ``*``. A frame is 75 bytes.
+  A box that reports its legs' index pulses adds ``,I<mask:2 hex>`` before the ``*`` (79
+  bytes): bit k set when channel k's index pulse passed since the previous frame, and with it
+  the box re-zeroed that channel's counter (Vibhute 2011 §3.2.2: "every time an index pulse
+  shows up, the sensor is supposed to zero its position"), so the counts already start again
+  from the index. Frames without the field say nothing about index pulses.
 
 ``legacy`` — the thesis's 23-byte line (Vibhute 2011 §3.2.3 and App. D.6
   ``serialdaq_plat.m``): bytes 4, 7, 10, 13, 16, 19 (1-based) are the tags ``A``..``F``, each
@@ -46,6 +51,8 @@ __all__ = [
     "encode_packet",
     "decode_packet",
     "encode_legacy_line",
+    "index_mask_to_legs",
+    "legs_to_index_mask",
     "decode_legacy_line",
     "unwrap16",
     "channels_to_legs",
@@ -74,7 +81,7 @@ LEGACY_TAG_OFFSETS = (3, 6, 9, 12, 15, 18)
 
 _KS_BODY = re.compile(
     rb"KS,([0-9A-F]{4}),A([0-9A-F]{8}),B([0-9A-F]{8}),C([0-9A-F]{8}),"
-    rb"D([0-9A-F]{8}),E([0-9A-F]{8}),F([0-9A-F]{8})"
+    rb"D([0-9A-F]{8}),E([0-9A-F]{8}),F([0-9A-F]{8})(?:,I([0-9A-F]{2}))?"
 )
 
 Format = Literal["ks", "legacy"]
@@ -82,11 +89,14 @@ Format = Literal["ks", "legacy"]
 
 @dataclass(frozen=True)
 class Packet:
-    """One decoded packet: ``counts`` in channel order A..F; ``seq`` is None for legacy lines."""
+    """One decoded packet: ``counts`` in channel order A..F; ``seq`` is None for legacy lines;
+    ``index_mask`` the channels whose index pulse re-zeroed them since the previous frame (bit
+    k: channel k), None when the frame does not say (legacy lines, ``ks`` without the field)."""
 
     seq: int | None
     counts: tuple[int, ...]
     fmt: Format = "ks"
+    index_mask: int | None = None
 
 
 
@@ -118,8 +128,9 @@ def _check_counts(counts: Iterable[Any], lo: int, hi: int, what: str) -> tuple[i
     return tuple(out)
 
 
-def encode_packet(seq: int, counts: Sequence[int]) -> bytes:
-    """Encode one ``ks`` frame: sequence number 0..65535 and six signed 32-bit counts (A..F)."""
+def encode_packet(seq: int, counts: Sequence[int], index_mask: int | None = None) -> bytes:
+    """Encode one ``ks`` frame: sequence number 0..65535 and six signed 32-bit counts (A..F);
+    with ``index_mask`` (0..63, bit k: channel k re-zeroed at its index) the ``I`` field."""
     if isinstance(seq, bool) or not isinstance(seq, (int, np.integer)):
         raise InputError(f"encode_packet: sequence number must be an integer, got {seq!r}")
     if not 0 <= int(seq) < SEQ_MODULUS:
@@ -128,6 +139,12 @@ def encode_packet(seq: int, counts: Sequence[int]) -> bytes:
     body = f"KS,{int(seq):04X}," + ",".join(
         f"{ch}{v & 0xFFFFFFFF:08X}" for ch, v in zip(CHANNELS, vals, strict=True)
     )
+    if index_mask is not None:
+        if isinstance(index_mask, bool) or not isinstance(index_mask, (int, np.integer)) \
+                or not 0 <= int(index_mask) < 64:
+            raise InputError(f"encode_packet: index_mask must be an integer in 0..63 (one bit "
+                             f"per channel A..F), got {index_mask!r}")
+        body += f",I{int(index_mask):02X}"
     raw = body.encode("ascii")
     return b"$" + raw + b"*" + f"{crc16_ccitt(raw):04X}".encode("ascii") + b"\r\n"
 
@@ -162,8 +179,12 @@ def decode_packet(data: bytes) -> Packet:
             "'KS,<seq4>,A<hex8>,...,F<hex8>' (upper-case hex)"
         )
     seq = int(m.group(1), 16)
-    counts = tuple(_signed32(int(g, 16)) for g in m.groups()[1:])
-    return Packet(seq=seq, counts=counts, fmt="ks")
+    counts = tuple(_signed32(int(g, 16)) for g in m.groups()[1:7])
+    mask = None if m.group(8) is None else int(m.group(8), 16)
+    if mask is not None and mask >= 64:
+        raise ProtocolError(f"encoder packet index field I{m.group(8).decode()} sets a bit "
+                            "beyond channel F")
+    return Packet(seq=seq, counts=counts, fmt="ks", index_mask=mask)
 
 
 def encode_legacy_line(
@@ -241,6 +262,23 @@ def legs_to_channels(leg_counts: Sequence[int], wiring: Sequence[int] = THESIS_W
     w = check_wiring(wiring)
     c = np.asarray(leg_counts, dtype=np.int64)
     return c[..., np.asarray(w) - 1]
+
+
+def index_mask_to_legs(mask: int, wiring: Sequence[int] = THESIS_WIRING) -> np.ndarray:
+    """A channel bit mask (bit k: channel k) as six flags in leg order 1..6.
+
+    >>> index_mask_to_legs(0b000010).tolist()  # channel B carries leg 1 (thesis wiring)
+    [True, False, False, False, False, False]
+    """
+    bits = np.array([(int(mask) >> k) & 1 for k in range(6)], dtype=bool)
+    return channels_to_legs(bits, wiring).astype(bool)
+
+
+def legs_to_index_mask(flags: Sequence[bool], wiring: Sequence[int] = THESIS_WIRING) -> int:
+    """Six flags in leg order 1..6 as a channel bit mask (inverse of
+    :func:`index_mask_to_legs`)."""
+    ch = legs_to_channels(np.asarray(flags, dtype=bool).astype(np.int64), wiring)
+    return int(sum(int(b) << k for k, b in enumerate(ch.tolist())))
 
 
 def check_wiring(wiring: Sequence[int]) -> tuple[int, ...]:

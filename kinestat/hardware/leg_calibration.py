@@ -74,6 +74,10 @@ class LegCalibration:
         length_coeffs: (6, n) count → leg length, sensor legs 1..6.
         force_coeffs: (6, m) count → leg tension.
         leg_names: the platform leg measured by each sensor leg.
+        index_counts: (6,) the count each sensor leg's encoder box sets when the leg passes
+            its strip's index mark (Vibhute §3.2.2: the sensor "is supposed to zero its
+            position" there); default zeros: the maps count from the index, as the thesis's
+            do (its index lies at ``l = b``, the maps' constant term).
     """
 
     length_coeffs: np.ndarray
@@ -81,6 +85,7 @@ class LegCalibration:
     leg_names: tuple[str, ...] = THESIS_SENSOR_LEGS
     length_unit: str = "mm"
     force_unit: str = "N"
+    index_counts: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         for attr in ("length_coeffs", "force_coeffs"):
@@ -94,6 +99,10 @@ class LegCalibration:
         if len(names) != 6 or len(set(names)) != 6:
             raise InputError(f"leg_names must be six distinct names, got {names}")
         object.__setattr__(self, "leg_names", names)
+        idx = np.zeros(6) if self.index_counts is None else np.array(self.index_counts, float)
+        if idx.shape != (6,) or not np.all(np.isfinite(idx)):
+            raise InputError(f"index_counts must be 6 finite counts, got {self.index_counts!r}")
+        object.__setattr__(self, "index_counts", frozen(idx, float))
 
     def platform_order(self, platform_legs: Sequence[str]) -> np.ndarray:
         """Index array ``p``: ``values_platform = values_sensor[..., p]``."""

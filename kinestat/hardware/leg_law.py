@@ -135,12 +135,14 @@ def nominal_calibration(platform: Platform, length_calibration: LegCalibration) 
     force = k[:, None] * a
     force[:, 0] -= k * l0
     return LegCalibration(length_coeffs=a, force_coeffs=force,
-                          leg_names=length_calibration.leg_names)
+                          leg_names=length_calibration.leg_names,
+                          index_counts=length_calibration.index_counts)
 
 
 def rescale_counts(calibration: LegCalibration, factor) -> LegCalibration:
     """The same maps on finer (or coarser) counts ``e' = e / factor``: coefficients of degree
-    ``k`` scale by ``factor**k`` (``factor``: one positive number or six, sensor order)."""
+    ``k`` scale by ``factor**k`` (``factor``: one positive number or six, sensor order); the
+    index marks stay where they are (``index_counts / factor``)."""
     s = np.broadcast_to(np.asarray(factor, dtype=float), (6,))
     if not np.all(np.isfinite(s)) or np.any(s <= 0):
         raise InputError(f"count scale factors must be positive, got {np.asarray(factor)}")
@@ -150,4 +152,5 @@ def rescale_counts(calibration: LegCalibration, factor) -> LegCalibration:
 
     return LegCalibration(length_coeffs=scaled(calibration.length_coeffs),
                           force_coeffs=scaled(calibration.force_coeffs),
-                          leg_names=calibration.leg_names)
+                          leg_names=calibration.leg_names,
+                          index_counts=calibration.index_counts / s)

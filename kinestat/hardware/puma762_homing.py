@@ -15,12 +15,11 @@ Index marks come once per motor revolution: Table 2-1's "encoder index resolutio
 angular resolution of axis 6 (13.4e-3°) gives exactly 1000, so :data:`INDEX_PERIOD_COUNTS` is
 (3200, 3200, 3200, 1000, 1000, 1000).
 
-:func:`index_layout` places the index marks and the pots' "ready" positions of a simulated
-robot so that the thesis's sequence ends at :data:`HOME_COUNTS` in physical counts: the
-second index search must find the mark at ``HOME − SECOND_OFFSET``, the first the mark one
-step before ``HOME − SECOND_OFFSET − FIRST_OFFSET``, and the ready position sits half a period
-before that first mark, so that a coarse move anywhere within ±half a period (±1600 counts,
-±2° on axis 1) homes exactly.
+The ``PA`` offsets' signs are taken as printed (all positive). The seed's OCR drops minus
+signs elsewhere in this listing; the computation in docs/seed-errata.md ("Homing's PA offsets")
+shows that the seed cannot decide them (every reading homes alike on a robot laid out for it)
+and gives the pot voltages at home that tell the readings apart on the robot. The simulated
+robot has its own layout (:mod:`kinestat.sim.puma762_robot`), not derived from these offsets.
 """
 
 from __future__ import annotations
@@ -39,7 +38,6 @@ __all__ = [
     "COARSE_SPEED",
     "FIRST_SEARCH_SPEED",
     "SECOND_SEARCH_SPEED",
-    "index_layout",
 ]
 
 
@@ -68,18 +66,3 @@ FIRST_SEARCH_SPEED = _ro([1000, 1000, 1000, 200, 200, 200])
 SECOND_SEARCH_SPEED = _ro([500, 500, 500, 100, 100, 100])
 """Jog, acceleration and speed settings of the coarse move and the two index searches."""
 
-
-def index_layout(period=INDEX_PERIOD_COUNTS) -> tuple[np.ndarray, np.ndarray]:
-    """``(index_phase, ready_counts)`` (6,) each, physical counts: index marks at
-    ``index_phase + k·period`` and the pots' ready position, such that startup_initialize.m's
-    sequence (positive index searches) ends at :data:`HOME_COUNTS`.
-
-    >>> phase, ready = index_layout()
-    >>> ((HOME_COUNTS - SECOND_OFFSET - phase) % INDEX_PERIOD_COUNTS).tolist()
-    [0, 0, 0, 0, 0, 0]
-    """
-    p = np.asarray(period, dtype=np.int64)
-    second = HOME_COUNTS - SECOND_OFFSET
-    first = second - p * (FIRST_OFFSET // p + 1)
-    ready = first - p // 2
-    return second % p, ready

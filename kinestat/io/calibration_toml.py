@@ -20,6 +20,8 @@ fitted by least squares (:func:`kinestat.hardware.leg_calibration.fit_polynomial
     leg = "O"                        # the platform leg this sensor measures
     length = [91.9216, -0.025771]    # mm:  l = 91.9216 − 0.025771 e
     force = [14.25, -0.029796]       # N:   F = 14.25 − 0.029796 e (tension)
+    index_count = 0                  # optional: the count the box sets at the leg's index
+                                     # mark (default 0: the maps count from the index)
 
     [[legs]]                         # data instead of coefficients (any degree >= 1)
     leg = "S"
@@ -53,7 +55,7 @@ __all__ = ["CalibrationFile", "loads_calibration", "read_calibration"]
 _TOP_KEYS = {"name", "description", "source", "length_unit", "force_unit", "force_sense",
              "legs"}
 _LEG_KEYS = {"sensor", "leg", "length", "force", "length_counts", "lengths", "length_degree",
-             "force_counts", "forces", "force_degree"}
+             "force_counts", "forces", "force_degree", "index_count"}
 
 
 class CalibrationFile:
@@ -90,7 +92,7 @@ def loads_calibration(text: str, source: str = "<string>") -> CalibrationFile:
     if not isinstance(legs, list) or len(legs) != 6:
         raise ParseError("a calibration needs six [[legs]] tables (sensor legs 1..6)",
                          file=source, field="legs")
-    names, lengths, forces = [], [], []
+    names, lengths, forces, index = [], [], [], []
     for i, leg in enumerate(legs):
         where = f"legs[{i}]"
         if not isinstance(leg, dict):
@@ -103,9 +105,10 @@ def loads_calibration(text: str, source: str = "<string>") -> CalibrationFile:
         lengths.append(_map(leg, "length", source, where))
         f = _map(leg, "force", source, where)
         forces.append(-f if sense == "compression" else f)
+        index.append(number(leg.get("index_count", 0), source, f"{where}.index_count"))
     try:
         cal = LegCalibration(length_coeffs=_pad(lengths), force_coeffs=_pad(forces),
-                             leg_names=tuple(names))
+                             leg_names=tuple(names), index_counts=index)
     except InputError as exc:
         raise ParseError(str(exc), file=source) from exc
     return CalibrationFile(name=string(doc.get("name", Path(source).stem), source, "name"),

@@ -39,12 +39,25 @@ Explicit form — any six-leg platform::
     free_length = 80.969       # optional; default: the leg length at home_pose
 
 A file holds exactly one of ``[design]`` and ``[[legs]]``.
+
+Either form may say how the platform is bolted on the robot's flange (frame 6), an optional
+``[mount]`` table (:func:`read_platform_mount`; ``kinestat control --platform``/``--mount``)::
+
+    [mount]
+    offset = 12.5              # the base plane along S6 from the flange face (length_unit)
+    turn_deg = 30.0            # the base x axis turned from a67 about S6
+
+with the base triangle's centroid on S6 (the centred mount), or the whole ``6_BT``::
+
+    [mount]
+    pose = [[1, 0, 0, -60], [0, 1, 0, -34.64], [0, 0, 1, 0], [0, 0, 0, 1]]
 """
 
 from __future__ import annotations
 
 import math
 import os
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -57,14 +70,15 @@ from kinestat.parallel.platform import LEG_NAMES, Platform, special_6_6
 from kinestat.parallel.singularity import check_design
 from kinestat.spatial.transforms import apply
 
-__all__ = ["LENGTH_UNITS", "FORCE_UNITS", "loads_platform", "read_platform", "dumps_platform",
-           "write_platform"]
+__all__ = ["LENGTH_UNITS", "FORCE_UNITS", "PlatformMount", "loads_platform", "read_platform",
+           "read_platform_mount", "read_mount_file", "dumps_platform", "write_platform"]
 
 LENGTH_UNITS = ("mm", "cm", "m", "in")
 FORCE_UNITS = ("N", "kN", "lbf")
 
 _TOP_KEYS = {"name", "description", "source", "length_unit", "force_unit", "leg_names",
-             "design", "legs", "home_pose"}
+             "design", "legs", "home_pose", "mount"}
+_MOUNT_KEYS = {"offset", "turn_deg", "pose"}
 _DESIGN_KEYS = {"kind", "base_side", "top_side", "base_offset", "top_offset", "home_height",
                 "home_twist_deg", "stiffness", "free_lengths"}
 _LEG_KEYS = {"name", "base", "top", "stiffness", "free_length"}
@@ -84,8 +98,56 @@ def read_platform(path: str | os.PathLike) -> Platform:
     return loads_platform(read_text_file(path, "platform file"), source=str(Path(path)))
 
 
+@dataclass(frozen=True, eq=False)
+class PlatformMount:
+    """A platform file's ``[mount]``: the whole ``6_BT`` (``pose``, 4x4) or, when ``pose`` is
+    None, the centred mount shifted by ``offset`` along S6 and turned by ``turn_deg`` about it
+    (:func:`kinestat.sim.contact.centred_mount`)."""
+
+    pose: np.ndarray | None = None
+    offset: float = 0.0
+    turn_deg: float = 0.0
+
+
+def read_platform_mount(path: str | os.PathLike) -> tuple[Platform, PlatformMount | None]:
+    """The platform of a TOML platform file and its ``[mount]`` table (None when it has none)."""
+    source = str(Path(path))
+    doc = parse_toml(read_text_file(path, "platform file"), source)
+    return _from_doc(doc, source), _mount(doc.get("mount"), source)
+
+
+def read_mount_file(path: str | os.PathLike) -> tuple[Platform | None, PlatformMount]:
+    """A mount from a TOML file: a platform file's ``[mount]`` table (with its platform), or a
+    pose file's ``pose = [[…] ×4]`` (``6_BT``; no platform)."""
+    source = str(Path(path))
+    doc = parse_toml(read_text_file(path, "mount file"), source)
+    if "pose" in doc and not {"design", "legs"} & set(doc):
+        return None, PlatformMount(pose=matrix(doc["pose"], source, "pose", (4, 4)))
+    plat, mount = _from_doc(doc, source), _mount(doc.get("mount"), source)
+    if mount is None:
+        raise ParseError("the platform file has no [mount] table (offset, turn_deg or pose) "
+                         "to take the mount from", file=source)
+    return plat, mount
+
+
+def _mount(table, source: str) -> PlatformMount | None:
+    if table is None:
+        return None
+    if not isinstance(table, dict):
+        raise ParseError("[mount] must be a table", file=source, card="mount")
+    refuse_unknown(table, _MOUNT_KEYS, source, "keys in [mount]", card="mount")
+    if "pose" in table:
+        if {"offset", "turn_deg"} & set(table):
+            raise ParseError("give either pose or offset/turn_deg, not both", file=source,
+                             card="mount")
+        return PlatformMount(pose=matrix(table["pose"], source, "mount.pose", (4, 4)))
+    return PlatformMount(offset=number(table.get("offset", 0.0), source, "mount.offset"),
+                         turn_deg=number(table.get("turn_deg", 0.0), source, "mount.turn_deg"))
+
+
 def _from_doc(doc: dict, source: str) -> Platform:
     refuse_unknown(doc, _TOP_KEYS, source, "top-level keys")
+    _mount(doc.get("mount"), source)  # checked with the file, wherever it is read
     name = string(doc.get("name", Path(source).stem), source, "name")
     lu = _unit(doc, "length_unit", LENGTH_UNITS, source)
     fu = _unit(doc, "force_unit", FORCE_UNITS, source)

@@ -32,8 +32,8 @@ from kinestat.hardware.puma762_homing import (
     INDEX_PERIOD_COUNTS,
     POT_COUNTS_PER_V,
     READY_POT_V,
-    index_layout,
 )
+from kinestat.sim.puma762_robot import layout
 
 __all__ = ["TC_MESSAGES", "SimClock", "RealClock", "trapezoid", "DmcSimulator"]
 
@@ -227,13 +227,13 @@ class DmcSimulator:
     def unknown_start(cls, seed: int | None = None, *, pot_noise: float = 0.002,
                       **kw) -> DmcSimulator:
         """A robot at an arbitrary position (within ±25° of home on axes 1-3, ±19° on 4-6),
-        its encoders reading 0 at power-up, with index marks and pots laid out by
-        :func:`kinestat.hardware.puma762_homing.index_layout` so that startup_initialize.m
-        homes it (physical counts: the home pose is :data:`HOME_COUNTS`)."""
+        its encoders reading 0 at power-up, its index marks and pots where the simulated
+        robot has them (:mod:`kinestat.sim.puma762_robot`; its home pose is
+        :data:`HOME_COUNTS` in physical counts)."""
         rng = np.random.default_rng(seed)
         span = np.array([20000, 28000, 22000, 3000, 3000, 1400])
         start = HOME_COUNTS + rng.integers(-span, span + 1)
-        phase, ready = index_layout(kw.get("index_period", INDEX_PERIOD_COUNTS))
+        phase, ready = layout(kw.get("index_period", INDEX_PERIOD_COUNTS))
         sim = cls(initial_counts=start, index_phase=tuple(phase), pot_ready=ready,
                   pot_noise=pot_noise, seed=None if seed is None else seed + 1, **kw)
         for ax in sim._axes:

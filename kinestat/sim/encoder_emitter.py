@@ -11,6 +11,12 @@ Fault injection: :meth:`~EncoderEmitter.drop` (packets lost on air: sequence num
 consumed), :meth:`~EncoderEmitter.corrupt` (one byte changed), :meth:`~EncoderEmitter.freeze`
 (the same packet repeated: a frozen sensor), :meth:`~EncoderEmitter.silence` (nothing sent),
 :meth:`~EncoderEmitter.inject` (raw bytes), and random ``drop_rate`` / ``corrupt_rate``.
+
+Index pulses (Vibhute §3.2.2): with ``index_counts`` (each leg's count at its strip's index
+mark, in the counts ``counts_now`` gives) the box keeps a counter per leg that follows the leg
+but can lose counts (:meth:`~EncoderEmitter.miss`: a drift), and re-zeroes it when the leg
+passes its index mark — the counter then reads the true count again — reporting the pulse in
+the next ``ks`` frame's ``I`` field (:mod:`kinestat.hardware.encoder_packets`).
 """
 
 from __future__ import annotations
@@ -33,6 +39,7 @@ from kinestat.hardware.encoder_packets import (
     encode_legacy_line,
     encode_packet,
     legs_to_channels,
+    legs_to_index_mask,
 )
 
 
@@ -65,6 +72,7 @@ class EncoderEmitter:
         drop_rate: float = 0.0,
         corrupt_rate: float = 0.0,
         seed: int | None = None,
+        index_counts: Sequence[float] | None = None,
     ) -> None:
         if not callable(counts_now):
             raise InputError("EncoderEmitter: counts_now must be a callable returning 6 counts")
@@ -77,6 +85,16 @@ class EncoderEmitter:
             if not (isinstance(p, (int, float)) and 0.0 <= p <= 1.0):
                 raise InputError(f"EncoderEmitter: {name} must be in [0, 1], got {p!r}")
         legs_to_channels(np.zeros(6), wiring)  # validates the wiring
+        self._index = None
+        if index_counts is not None:
+            idx = np.asarray(index_counts, dtype=float)
+            if idx.shape != (6,) or not np.all(np.isfinite(idx)):
+                raise InputError(f"EncoderEmitter: index_counts must be 6 finite leg counts, "
+                                 f"got {index_counts!r}")
+            self._index = idx
+        self._drift = np.zeros(6, dtype=np.int64)
+        self._side: np.ndarray | None = None  # each leg's side of its index at the last frame
+        self._pulsed = np.zeros(6, dtype=bool)
         self.counts_now = counts_now
         self.rate_hz = float(rate_hz)
         self.fmt: Format = fmt
@@ -124,6 +142,30 @@ class EncoderEmitter:
         with self._lock:
             self._silent = bool(enabled)
 
+    def miss(self, leg: int, counts: int) -> None:
+        """Leg ``leg`` (1..6)'s counter loses ``counts`` counts (signed: positive, it reads that
+        many low), a drift that lasts until the leg passes its index mark (for good without
+        ``index_counts``)."""
+        if not (isinstance(leg, (int, np.integer)) and 1 <= int(leg) <= 6):
+            raise InputError(f"EncoderEmitter.miss: leg must be 1..6, got {leg!r}")
+        with self._lock:
+            self._drift[int(leg) - 1] -= int(counts)
+
+    def _box_counts(self, true: np.ndarray) -> tuple[np.ndarray, int | None]:
+        """The box's counters for the true counts: the drift, re-zeroed at index crossings
+        (a change of side of a leg's index mark since the last frame); the ``I`` mask."""
+        if self._index is None:
+            return true + self._drift, None
+        side = np.sign(true - self._index)
+        if self._side is not None:
+            crossed = side != self._side
+            self._drift[crossed] = 0
+            self._pulsed |= crossed
+        self._side = side
+        mask = legs_to_index_mask(self._pulsed, self.wiring) if self.fmt == "ks" else None
+        self._pulsed[:] = False
+        return true + self._drift, mask
+
     def inject(self, raw: bytes) -> None:
         """Write ``raw`` bytes onto the line before the next packet (garbage, partial frames)."""
         with self._lock:
@@ -151,10 +193,10 @@ class EncoderEmitter:
                 frame = self._last_frame
             else:
                 try:
-                    legs = self._counts()
+                    legs, mask = self._box_counts(self._counts())
                     ch = legs_to_channels(legs, self.wiring)
                     if self.fmt == "ks":
-                        frame = encode_packet(self._seq, ch.tolist())
+                        frame = encode_packet(self._seq, ch.tolist(), index_mask=mask)
                         self._seq = (self._seq + 1) % SEQ_MODULUS
                     else:
                         frame = encode_legacy_line((ch & 0xFFFF).tolist())

@@ -44,7 +44,8 @@ def ideal_calibration(reference: LegCalibration = THESIS_CALIBRATION,
     if fc.shape[1] == 2:
         force[:, 1] = fc[:, 1] * resolution / np.abs(a[:, 1])
     return LegCalibration(length_coeffs=length, force_coeffs=force,
-                          leg_names=reference.leg_names)
+                          leg_names=reference.leg_names,
+                          index_counts=reference.index_counts * np.abs(a[:, 1]) / resolution)
 
 
 @dataclass(frozen=True, eq=False)

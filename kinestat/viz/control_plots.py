@@ -3,7 +3,8 @@
 Vibhute 2011 Figure 5-2 (A–G): the force magnitude, the force components fx, fy, fz and the
 torque components mx, my, mz of the effective wrench in the fixed frame, against the states
 a–e of the run (:data:`kinestat.control.controller.STATES`). Here each measurement cycle is a
-point, coloured by its state; the torque is the moment about the tool point ``P_tool_F``. When
+point, coloured by its state; the torque (E–G) is the moment about the robot's base, the fixed
+frame's origin, as the thesis's panels take it (the log's ``torque_about_base``). When
 the log holds the simulator's true force (``true``), panel A also shows it (dashed), and the
 target band ``|F_req| ± force_tol`` is shaded.
 """
@@ -29,22 +30,24 @@ _PANELS = [
     ("B", "fx (N)", 0),
     ("C", "fy (N)", 1),
     ("D", "fz (N)", 2),
-    ("E", "mx about the tool point (N·mm)", 3),
-    ("F", "my about the tool point (N·mm)", 4),
-    ("G", "mz about the tool point (N·mm)", 5),
+    ("E", "mx about the robot base (N·mm)", 3),
+    ("F", "my about the robot base (N·mm)", 4),
+    ("G", "mz about the robot base (N·mm)", 5),
 ]
 
 
 def cycle_series(records: list[dict]) -> dict:
-    """Arrays from a run's log records: cycle, state, force (n, 3), torque (n, 3), |F|, true |F|
-    (NaN where unknown), and the target and tolerance from the start record."""
+    """Arrays from a run's log records: cycle, state, force (n, 3), torque about the robot base
+    (n, 3), |F|, true |F| (NaN where unknown), and the target and tolerance from the start
+    record."""
     cyc = [r for r in records if r.get("type") == "cycle"]
     if not cyc:
         raise InputError("the log has no measurement cycles to plot")
     head = next((r for r in records if r.get("type") == "start"), {})
     cfg = head.get("config", {})
     force = np.array([r["measured"]["force"] for r in cyc], dtype=float)
-    torque = np.array([r["measured"]["torque"] for r in cyc], dtype=float)
+    torque = np.array([r["measured"].get("torque_about_base", r["measured"].get("moment_origin"))
+                       for r in cyc], dtype=float)
     true = np.array([
         (r.get("true") or {}).get("tool_force_magnitude", np.nan) for r in cyc], dtype=float)
     return {

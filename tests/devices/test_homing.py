@@ -10,16 +10,18 @@ import pytest
 from kinestat.app.homing_run import run_home
 from kinestat.cli.main import main
 from kinestat.control.log import read_log
+from kinestat.devices import homing as homing_mod
 from kinestat.devices.galil import GalilClient
 from kinestat.devices.homing import home, is_homed
 from kinestat.hardware.puma762_homing import (
+    FIRST_OFFSET,
     HOME_COUNTS,
     INDEX_PERIOD_COUNTS,
     SECOND_OFFSET,
-    index_layout,
 )
 from kinestat.sim.dmc import DmcSimulator, SimClock
 from kinestat.sim.galil_server import GalilSimServer
+from kinestat.sim.puma762_robot import HOME_PAST_INDEX, layout
 
 
 def _sim(seed, **kw) -> DmcSimulator:
@@ -32,8 +34,67 @@ def test_table_2_1_index_periods_and_the_layout():
     scale = np.array([0.00125, 0.00086875, 0.001115625, 0.00626, 0.00626, 0.01337])
     np.testing.assert_allclose(rev_deg / scale, INDEX_PERIOD_COUNTS, rtol=3e-3)
     assert DmcSimulator().index_period == tuple(float(p) for p in INDEX_PERIOD_COUNTS)
-    phase, ready = index_layout()
-    np.testing.assert_array_equal((HOME_COUNTS - SECOND_OFFSET - phase) % INDEX_PERIOD_COUNTS, 0)
+    phase, ready = layout()
+    np.testing.assert_array_equal((HOME_COUNTS - HOME_PAST_INDEX - phase) % INDEX_PERIOD_COUNTS,
+                                  0)
+
+
+def _homed_physically(sim: DmcSimulator) -> np.ndarray:
+    with GalilSimServer(controller=sim) as srv, GalilClient("127.0.0.1", srv.port) as g:
+        rep = home(g, poll_interval=0)
+        assert rep.homed, rep.stop_reason  # the read-back passes: DP defines the counts
+    return sim.motor_counts()
+
+
+def _next_mark_ahead(x, p):
+    """Where a positive index search starting at ``x`` (counts from a mark) stops."""
+    return p * (np.floor_divide(x, p) + 1)
+
+
+@pytest.mark.parametrize("which", ["first", "second"])
+def test_a_restored_minus_sign_ends_away_from_home(monkeypatch, which):
+    """The simulated robot's layout is its own (kinestat.sim.puma762_robot), not derived from
+    the PA offsets: a minus restored on any offset ends the homing physically away from home,
+    by the amount the index periods give (computed here from the search's rule)."""
+    sign = np.array([1, -1, 1, -1, 1, -1])  # restore a minus on axes B, D, F
+    first, second = FIRST_OFFSET.copy(), SECOND_OFFSET.copy()
+    if which == "first":
+        first = first * sign
+    else:
+        second = second * sign
+    monkeypatch.setattr(homing_mod, "FIRST_OFFSET", first)
+    monkeypatch.setattr(homing_mod, "SECOND_OFFSET", second)
+    P = INDEX_PERIOD_COUNTS
+    expected = (_next_mark_ahead(first, P) + second) - (_next_mark_ahead(FIRST_OFFSET, P)
+                                                         + SECOND_OFFSET)
+    end = _homed_physically(_sim(11))
+    np.testing.assert_array_equal(end - HOME_COUNTS, expected)
+    moved = sign < 0
+    if which == "second":
+        moved &= SECOND_OFFSET != 0  # axis B's second offset is 0: no sign to restore
+    assert np.all(expected[moved] != 0) and np.all(expected[~moved] == 0)
+
+
+def _margin(offset, p):
+    return np.minimum(offset % p, p - offset % p)
+
+
+@pytest.mark.parametrize("signs", [(1, 1), (-1, 1), (1, -1), (-1, -1)])
+def test_every_reading_of_the_signs_homes_a_robot_laid_out_for_it(monkeypatch, signs):
+    """Why the seed cannot decide the signs: the second search's margin (its start's distance
+    from a mark) is the same for either sign, and each reading homes exactly a robot whose
+    marks and pots sit where that reading puts them (its layout computed here)."""
+    P = INDEX_PERIOD_COUNTS
+    first, second = signs[0] * FIRST_OFFSET, signs[1] * SECOND_OFFSET
+    np.testing.assert_array_equal(_margin(first, P), _margin(FIRST_OFFSET, P))
+    assert _margin(FIRST_OFFSET, P)[4] == 0  # axis E: 3000 counts, three revolutions
+    monkeypatch.setattr(homing_mod, "FIRST_OFFSET", first)
+    monkeypatch.setattr(homing_mod, "SECOND_OFFSET", second)
+    end = _next_mark_ahead(first, P) + second  # home, counted from the first search's mark
+    sim = _sim(3)
+    sim.index_phase = tuple(float(v) for v in (HOME_COUNTS - end) % P)
+    sim.pot_ready = (HOME_COUNTS - end - P // 2).astype(float)
+    np.testing.assert_array_equal(_homed_physically(sim), HOME_COUNTS)
 
 
 def test_homing_from_20_random_start_positions():
