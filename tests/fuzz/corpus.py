@@ -242,7 +242,7 @@ def seeds(reader: str) -> tuple[str, ...]:
     """The valid seed inputs of ``reader`` (a key of :data:`READERS`)."""
     if reader == "model_toml":
         return tuple(_model_seeds())
-    if reader == "platform_toml":
+    if reader in ("platform_toml", "control_platform"):
         return tuple(_platform_seeds())
     if reader == "axes_toml":
         return (tomli_w.dumps(_AXES_DOC),)
@@ -364,6 +364,16 @@ def _control_calibration(text: str, workdir: Path):
     return calibrated_model(platform, cal)
 
 
+def _control_platform(text: str, workdir: Path):
+    """``kinestat control --platform FILE``: the platform read and the controller's model
+    built on it with the thesis's and the nominal calibrations."""
+    from kinestat.app.calibrations import calibrated_model, resolve_calibration, resolve_platform
+
+    platform = resolve_platform(_write(workdir, "control-platform.toml", text))
+    return [calibrated_model(platform, resolve_calibration(c, platform))
+            for c in ("thesis", "nominal")]
+
+
 def _galil_handler(text: str, workdir: Path):
     """One command line to the simulated DMC's interpreter: it must answer (``:``, data then
     ``:``, or ``?``), never raise — an exception would end the server's connection thread."""
@@ -397,6 +407,7 @@ READERS: dict[str, Reader] = {r.name: r for r in (
     Reader("text", _text),
     Reader("calibration_toml", _calibration),
     Reader("control_calibration", _control_calibration),
+    Reader("control_platform", _control_platform),
     Reader("galil_handler", _galil_handler),
 )}
 
