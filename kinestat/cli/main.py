@@ -123,9 +123,9 @@ def main(argv: list[str] | None = None) -> int:
     except UsageError as exc:
         typer.echo(_usage_error(exc), err=True)
         return 2
-    except ClickException as exc:  # e.g. a file option Click could not open
+    except ClickException as exc:  # e.g. a file option Click could not open: a bad call
         typer.echo(f"kinestat: error: {_one_line(exc.format_message())}", err=True)
-        return exc.exit_code
+        return 2
     except typer.Abort:
         typer.echo("kinestat: aborted", err=True)
         return 1

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import functools
 import inspect
+import math
 import warnings
 from collections.abc import Callable
 
@@ -28,7 +29,7 @@ from kinestat.cli._model import (
 )
 from kinestat.cli._options import XYZ_METAVAR, flag
 from kinestat.cli._output import console, parse_floats, print_json, table
-from kinestat.errors import KinestatWarning
+from kinestat.errors import InputError, KinestatWarning
 
 sweep_app = typer.Typer(
     name="sweep",
@@ -93,6 +94,7 @@ def _study_command(name: str):
 
         @functools.wraps(build)
         def command(**options) -> None:
+            _check_run_options(options)
             run = {k: options.pop(k) for k in _RUN_OPTIONS}
             arrays = not options.pop("no_arrays")
             _run(name, build(**options, arrays=arrays), **run)
@@ -102,6 +104,21 @@ def _study_command(name: str):
         return sweep_app.command(name)(command)
 
     return register_build
+
+
+def _check_run_options(options: dict) -> None:
+    """``--chunk-size`` (≥ 1 when given: 0 is not "the default") and ``--timeout`` (a finite
+    number of seconds > 0), before anything is built or started."""
+    chunk = options.get("chunk_size")
+    if chunk is not None and chunk < 1:
+        raise InputError(f"--chunk-size must be at least 1, got {chunk}")
+    t = options.get("timeout")
+    if not (isinstance(t, (int, float)) and math.isfinite(t) and t > 0):
+        raise InputError(f"--timeout must be a finite number of seconds > 0, got {t}")
+
+
+def _chunk(chunk_size: int | None, default: int) -> int:
+    return default if chunk_size is None else chunk_size
 
 
 def _ranges(range_mm: str, range_deg: str) -> dict:
@@ -178,7 +195,7 @@ def workspace_command(
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", KinestatWarning)
         return workspace_spec(model, grid=grid, samples=_samples_default(grid, samples, 100_000),
-                              seed=seed, chunk_size=chunk_size or DEFAULT_CHUNK, task=task,
+                              seed=seed, chunk_size=_chunk(chunk_size, DEFAULT_CHUNK), task=task,
                               arrays=arrays, tip=tip, base=base, scale=scale,
                               length_unit=length_unit)
 
@@ -207,7 +224,7 @@ def platform_range_command(
     return platform_range_spec(
         platform, grid=grid, samples=_samples_default(grid, samples, 20_000), seed=seed,
         max_deflection=max_deflection, max_load=max_load,
-        chunk_size=chunk_size or DEFAULT_CHUNK, arrays=arrays,
+        chunk_size=_chunk(chunk_size, DEFAULT_CHUNK), arrays=arrays,
         **_ranges(range_mm, range_deg))
 
 
@@ -253,7 +270,8 @@ def platform_design_command(
     return platform_design_spec(
         platform, values={k: v for k, v in given.items() if v is not None}, grid=grid,
         samples=samples, seed=seed, poses=poses, max_deflection=max_deflection,
-        max_load=max_load, chunk_size=chunk_size or DEFAULT_CHUNK, arrays=arrays, score=score,
+        max_load=max_load, chunk_size=_chunk(chunk_size, DEFAULT_CHUNK), arrays=arrays,
+        score=score,
         **_ranges(range_mm, range_deg))
 
 
@@ -282,5 +300,5 @@ def tolerance_command(
 
     return tolerance_spec(platform, samples=samples, seed=seed, sigma_mount=sigma_mount,
                           sigma_k=sigma_k, sigma_offset=sigma_offset,
-                          chunk_size=chunk_size or DEFAULT_CHUNK, arrays=arrays,
+                          chunk_size=_chunk(chunk_size, DEFAULT_CHUNK), arrays=arrays,
                           **_ranges(range_mm, range_deg))

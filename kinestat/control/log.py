@@ -72,18 +72,28 @@ class CycleLog:
 
 
 def read_log(path: str | os.PathLike) -> list[dict]:
-    """All records of a cycle log; raises :class:`InputError` on an unreadable line."""
+    """All records of a cycle log (JSON objects, one per line); raises :class:`InputError` on
+    an unreadable file or line (not UTF-8, not JSON, not an object, nested too deeply)."""
     out = []
     p = Path(path)
     try:
-        lines = p.read_text(encoding="utf-8").splitlines()
+        lines = p.read_bytes().splitlines()
     except OSError as exc:
         raise InputError(f"cannot read the cycle log {str(p)!r}: {exc}") from exc
-    for i, line in enumerate(lines, 1):
-        if not line.strip():
+    for i, raw in enumerate(lines, 1):
+        if not raw.strip():
             continue
         try:
-            out.append(json.loads(line))
+            rec = json.loads(raw.decode("utf-8"))
+        except UnicodeDecodeError as exc:
+            raise InputError(f"{p}: line {i} is not UTF-8 text (byte {exc.start + 1}); is this "
+                             "a cycle log?") from None
         except json.JSONDecodeError as exc:
             raise InputError(f"{p}: line {i} is not JSON: {exc}") from exc
+        except (ValueError, RecursionError) as exc:  # the digit limit, deep nesting
+            raise InputError(f"{p}: line {i} is not a cycle record: {type(exc).__name__}: "
+                             f"{str(exc)[:80]}") from None
+        if not isinstance(rec, dict):
+            raise InputError(f"{p}: line {i} is not a cycle record (a JSON object)")
+        out.append(rec)
     return out

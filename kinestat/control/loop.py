@@ -74,8 +74,9 @@ class CellIO(Protocol):
     def sensor(self) -> SensorReading:
         """Leg counts measured after the last motion completed."""
 
-    def stop(self) -> str:
-        """Stop the robot now (best effort); say what was done."""
+    def stop(self) -> object:
+        """Stop the robot now (best effort); say what was done (its ``str``; a ``confirmed``
+        attribute, when present, is logged as ``stop_confirmed``)."""
 
     def truth(self) -> dict | None:
         """The true state when simulated (for the log and report), else None."""
@@ -452,8 +453,10 @@ def _safe_stop(io: CellIO, log: CycleLog, reason: str, faults: list[str], t0: fl
     except Exception as exc:  # noqa: BLE001 - a failing stop must not hide the fault
         stopped = f"stopping failed: {exc}"
     faults.append(reason)
-    _once_more_if_interrupted(log.write, {"type": "fault", "t": time.monotonic() - t0,
-                                          "reason": reason, "action": stopped})
+    rec = {"type": "fault", "t": time.monotonic() - t0, "reason": reason, "action": str(stopped)}
+    if isinstance(getattr(stopped, "confirmed", None), bool):  # what the controller confirmed
+        rec["stop_confirmed"] = stopped.confirmed
+    _once_more_if_interrupted(log.write, rec)
     return f"{reason} ({stopped})"
 
 

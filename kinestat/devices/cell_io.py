@@ -23,7 +23,7 @@ from kinestat.devices.encoder_stream import TooManyFaultsError, sampled_after
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.devices.motion import MOVE_RULES, MoveRule, move_plan
 from kinestat.devices.motion_check import POSITION_TOLERANCE_COUNTS, check_arrival
-from kinestat.devices.safe_stop import RECONNECT_TIMEOUT, send_stop
+from kinestat.devices.safe_stop import RECONNECT_TIMEOUT, StopReport, send_stop
 from kinestat.errors import DeviceError, InputError
 from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, axis45_compensation
 
@@ -83,7 +83,7 @@ class DeviceIO:
     (:func:`kinestat.control.envelope.sent_command_guard`); after each move the read-back
     positions must agree with the command within ``position_tolerance`` counts before the
     axis-5 encoder is redefined (:mod:`kinestat.devices.motion_check`). :meth:`stop` sends
-    ``ST``, on a fresh connection if the link failed (:mod:`kinestat.devices.safe_stop`).
+    ``ST`` until the controller confirms no axis moves (:mod:`kinestat.devices.safe_stop`).
     """
 
     def __init__(self, client: GalilClient, reader: Any, *, profile: MotionProfile | None = None,
@@ -195,9 +195,10 @@ class DeviceIO:
         return SensorSample(counts=total / n, seq=last.seq, age=last.age,
                             faults=tuple(faults))
 
-    def stop(self) -> str:
-        """Send ``ST`` (best effort, bounded): on the open link, or once on a fresh connection
-        if the link failed (:func:`kinestat.devices.safe_stop.send_stop`); say what was done."""
+    def stop(self) -> StopReport:
+        """``ST`` until the controller confirms no axis moves, on the open link or on a fresh
+        connection if it failed (bounded: :func:`kinestat.devices.safe_stop.confirm_stop`);
+        the report says what the controller confirmed."""
         return send_stop(self.client, reconnect_timeout=self.reconnect_timeout)
 
     def truth(self) -> dict | None:

@@ -249,17 +249,10 @@ class GalilClient:
         return pending
 
     def _exchange(self, cmd: str, *, discard_pending: bool = False) -> str:
-        if not isinstance(cmd, str) or not cmd.strip():
-            raise InputError(f"Galil command must be a non-empty string, got {cmd!r}")
-        if any(c in cmd for c in ";\r\n"):
-            raise InputError(f"send one Galil command at a time (no ';' or newline): {cmd!r}")
+        raw = self._encode(cmd)
         if self._sock is None:
             raise DeviceError(f"Galil at {self.host}:{self.port} is not connected; call "
                               "connect() first")
-        try:
-            raw = cmd.encode("ascii") + b"\r"
-        except UnicodeEncodeError as exc:
-            raise InputError(f"Galil commands are ASCII: {cmd!r}") from exc
         unread = self._in_flight  # a previous exchange was interrupted before its reply
         if unread is not None and not discard_pending:
             raise self._fault(f"the reply to {unread!r} was never read (interrupted); "
@@ -337,6 +330,74 @@ class GalilClient:
                                   f"answering {cmd!r}")
             buf += chunk
         return parts
+
+    def send_only(self, cmd: str) -> None:
+        """Send ``cmd`` without reading its reply (for ``ST``, whose bare ``:`` proves nothing:
+        it cannot be told from a late ``:`` of an earlier command). The next
+        :meth:`tagged_query` skips that reply; any other command refuses to go on first."""
+        raw = self._encode(cmd)
+        if self._sock is None:
+            raise DeviceError(f"Galil at {self.host}:{self.port} is not connected")
+        try:
+            self._sock.sendall(raw)
+        except OSError as exc:
+            self.close()
+            raise DeviceError(f"Galil link to {self.host}:{self.port} failed while sending "
+                              f"{cmd!r}: {exc}") from exc
+        self._in_flight = cmd
+
+    def tagged_query(self, operands: list[str], tag: int) -> list[float]:
+        """``MG tag,op1,op2...``: the values of ``operands``, read from the one reply that
+        begins with ``tag``.
+
+        Replies come in the order of the commands, so the replies before the tagged one
+        belong to earlier commands (an interrupted exchange, :meth:`send_only`, a late or
+        duplicated reply) and are skipped; a reply carrying the tag but not exactly
+        ``len(operands)`` finite numbers after it is garbled (:class:`ProtocolError`, link
+        closed). No tagged reply within ``timeout``: :class:`DeviceError`, link closed.
+        """
+        if not (isinstance(tag, int) and 0 < tag < 10**6):
+            raise InputError(f"tagged_query: tag must be an integer in 1..999999, got {tag!r}")
+        cmd = "MG " + ",".join([str(tag), *operands])
+        raw = self._encode(cmd)
+        if self._sock is None:
+            raise DeviceError(f"Galil at {self.host}:{self.port} is not connected")
+        try:
+            self._sock.sendall(raw)
+        except OSError as exc:
+            self.close()
+            raise DeviceError(f"Galil link to {self.host}:{self.port} failed while sending "
+                              f"{cmd!r}: {exc}") from exc
+        self._in_flight = cmd
+        buf, self._buf = self._buf, b""
+        while True:
+            reply, buf = self._receive(cmd, buf)
+            text = reply.decode("ascii", errors="replace")
+            # the tagged reply's fields are the last ones (a garbled earlier reply may have
+            # run into it: its ':' lost); no tag: an earlier command's reply, skipped
+            fields = text[:-1].split()[-len(operands) - 1:]
+            try:
+                vals = [float(f) for f in fields]
+            except ValueError:
+                vals = []
+            if not text.endswith(":") or len(vals) != len(operands) + 1 or vals[0] != tag:
+                continue
+            vals = vals[1:]
+            if not all(math.isfinite(v) for v in vals):
+                raise self._fault(f"garbled reply {text!r} to {cmd!r}")
+            self._in_flight = None
+            self._buf = buf  # bytes after it (a duplicate?) are a fault for the next command
+            return vals
+
+    def _encode(self, cmd: str) -> bytes:
+        if not isinstance(cmd, str) or not cmd.strip():
+            raise InputError(f"Galil command must be a non-empty string, got {cmd!r}")
+        if any(c in cmd for c in ";\r\n"):
+            raise InputError(f"send one Galil command at a time (no ';' or newline): {cmd!r}")
+        try:
+            return cmd.encode("ascii") + b"\r"
+        except UnicodeEncodeError as exc:
+            raise InputError(f"Galil commands are ASCII: {cmd!r}") from exc
 
     def _tell_error(self) -> tuple[int | None, str]:
         reply = self._exchange("TC1")

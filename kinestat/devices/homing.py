@@ -17,8 +17,10 @@
 4. read-back: ``TP`` must equal the home definition; then ``HOMED=1``, the session's mark
    that ``kinestat control --galil`` checks (:func:`is_homed`).
 
-Any fault (a check failing, a ``?``, a dropped link, a motion timeout) ends with ``MO`` when
-the link is up (amplifiers off) and a report saying why; ``record`` receives a JSON-ready
+Any fault (a check failing, a ``?``, a dropped link, a motion timeout, a signal) ends with
+``ST`` confirmed by the controller (:func:`kinestat.devices.safe_stop.confirm_stop`, on a
+fresh connection if the link failed), then ``MO`` (amplifiers off), and a report saying why
+and what the controller confirmed; ``record`` receives a JSON-ready
 record per step so that the caller's log is complete.
 """
 
@@ -31,6 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kinestat.devices.galil import GalilClient, GalilCommandError
+from kinestat.devices.safe_stop import confirm_stop
 from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
 from kinestat.hardware.puma762_axes import AXES
 from kinestat.hardware.puma762_homing import (
@@ -198,24 +201,20 @@ def home(client: GalilClient, *, samples: int = 100, max_coarse: float = 60000.0
                "interrupted by the user" if isinstance(exc, KeyboardInterrupt) else
                str(exc) if isinstance(exc, SafetyStop) else
                f"{'device fault' if isinstance(exc, DeviceError) else type(exc).__name__}: {exc}")
-        done = _amplifiers_off(client)
-        rec({"type": "fault", "reason": why, "action": done})
+        done, confirmed = _amplifiers_off(client)
+        rec({"type": "fault", "reason": why, "action": done, "stop_confirmed": confirmed})
         return HomingReport(False, f"{why} ({done})", axes, time.monotonic() - t0)
 
 
-def _amplifiers_off(client: GalilClient) -> str:
-    """``ST`` then ``MO`` (best effort; after a dropped link, one reconnection is tried);
-    say what was done."""
-    again = ""
+def _amplifiers_off(client: GalilClient) -> tuple[str, bool]:
+    """``ST`` until the controller confirms no axis moves (on a fresh connection if the link
+    failed: :func:`kinestat.devices.safe_stop.confirm_stop`), then ``MO``; say what the
+    controller confirmed and what was done."""
+    stop = confirm_stop(client)
     if not client.connected:
-        try:
-            client.connect()
-        except KinestatError:
-            return "the Galil link is down and a reconnection failed: ST/MO could not be sent"
-        again = " after reconnecting"
+        return f"{stop}; MO could not be sent", stop.confirmed
     try:
-        client.stop()
-        client.motor_off()
+        client.command("MO", discard_pending=True)
     except KinestatError as exc:
-        return f"ST/MO failed{again}: {exc}"
-    return f"ST and MO sent{again}: amplifiers off"
+        return f"{stop}; MO failed: {exc}", stop.confirmed
+    return f"{stop}; MO sent: amplifiers off", stop.confirmed

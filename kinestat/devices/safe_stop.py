@@ -1,42 +1,119 @@
-"""Sending ``ST`` when something went wrong: on the link if it is up, else on a fresh one.
+"""Stopping the axes when something went wrong, and proving it: ``ST`` until the controller
+says no axis moves.
 
-After a reply timeout, a protocol fault or a dropped link the client has closed its
-connection (a late reply would otherwise be taken for the next one), but the controller may
-still be moving the robot and accepting connections. :func:`send_stop` then reconnects ONCE,
-within ``reconnect_timeout``, and sends ``ST`` there. It says exactly what happened:
-``"ST sent to the Galil"``, ``"ST sent on a fresh connection (...)"`` or
-``"ST could not be sent: <why>"``.
+An acknowledgement ``:`` proves nothing about a stop: after an interrupted exchange (a signal
+while waiting for ``BG``'s reply) the late ``:`` of ``BG`` looks exactly like ``ST``'s, and a
+lost ``ST`` has no reply at all. :func:`confirm_stop` therefore sends ``ST`` without reading
+its reply (:meth:`~kinestat.devices.galil.GalilClient.send_only`) and then asks the controller
+whether any axis is still profiling a motion with ``MG <tag>,_BGA,...,_BGF``
+(:meth:`~kinestat.devices.galil.GalilClient.tagged_query`): the reply carrying the fresh tag
+is provably the answer to that query and was produced after the controller had processed
+every earlier command, ``ST`` included. ``ST`` is repeated (harmless while the axes
+decelerate) until two successive tagged answers say no axis moves: one garbled flag cannot
+confirm a stop.
+
+A reply timeout, a garbled tagged reply or a dropped link close the connection; the stop is
+then retried on a fresh connection (at most :data:`MAX_ATTEMPTS` connections in all, each
+bounded by ``reconnect_timeout``). :class:`StopReport` says what the controller confirmed:
+``"ST confirmed by the controller ..."`` or ``"ST unconfirmed: ..."`` (the link gone, or the
+axes still moving after ``stop_timeout``).
 """
 
 from __future__ import annotations
 
-from kinestat.devices.galil import GalilClient
-from kinestat.errors import KinestatError
+import itertools
+import random
+import time
+from dataclasses import dataclass
 
-__all__ = ["RECONNECT_TIMEOUT", "send_stop"]
+from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
+from kinestat.errors import KinestatError
+from kinestat.hardware.puma762_axes import AXES
+
+__all__ = ["RECONNECT_TIMEOUT", "STOP_TIMEOUT", "MAX_ATTEMPTS", "StopReport", "confirm_stop",
+           "send_stop"]
 
 RECONNECT_TIMEOUT = 1.0
-"""Bound (s) on the fresh connection and on its ``ST`` reply."""
+"""Bound (s) on a fresh connection and on each reply during a stop."""
+
+STOP_TIMEOUT = 2.0 * max(v / a for v, a in zip(THESIS_SPEED_MAX, THESIS_ACCEL, strict=True))
+"""Time (s) the axes get to come to rest after ``ST``: twice the longest deceleration of the
+thesis's profile from its maximum speed (``SP / DC``, 1 s on axes A, B, C and F)."""
+
+MAX_ATTEMPTS = 3
+"""Connections tried for one stop: the open link, then up to two fresh ones."""
+
+_MOTION_FLAGS = [f"_BG{a}" for a in AXES]
+_tags = itertools.count(random.SystemRandom().randrange(1, 500_000))
 
 
-def send_stop(client: GalilClient, *, reconnect_timeout: float = RECONNECT_TIMEOUT) -> str:
-    """Send ``ST`` (best effort, bounded in time); return what was done, for the log."""
-    if client.connected:
-        try:
-            client.stop()
-            return "ST sent to the Galil"
-        except KinestatError as exc:
-            first = f"ST on the open link failed: {exc}"
-    else:
-        first = "the link was down"
+@dataclass(frozen=True)
+class StopReport:
+    """What a stop achieved: ``confirmed`` when the controller answered (twice, to tagged
+    queries) that no axis moves; ``text`` for the log; ``attempts`` connections used."""
+
+    confirmed: bool
+    text: str
+    attempts: int = 1
+
+    def __str__(self) -> str:
+        return self.text
+
+
+def _next_tag() -> int:
+    return next(_tags) % 999_999 + 1
+
+
+def _stop_until_still(client: GalilClient, t_end: float, poll: float) -> list[float] | None:
+    """``ST`` then the tagged motion query, repeated until two answers in a row say no axis
+    moves (None) or ``t_end`` passes (the last flags)."""
+    still = 0
+    while True:
+        client.send_only("ST")
+        flags = client.tagged_query(_MOTION_FLAGS, _next_tag())
+        still = still + 1 if not any(flags) else 0
+        if still >= 2:
+            return None
+        if still == 0 and time.monotonic() > t_end:
+            return flags
+        if still == 0 and poll > 0:
+            time.sleep(poll)
+
+
+def confirm_stop(client: GalilClient, *, reconnect_timeout: float = RECONNECT_TIMEOUT,
+                 stop_timeout: float = STOP_TIMEOUT, poll: float = 0.01) -> StopReport:
+    """Stop every axis and prove it (module docstring); bounded in time, never raises for a
+    device fault."""
     saved = client.timeout
+    notes: list[str] = []
+    t_end = time.monotonic() + float(stop_timeout)
+    flags: list[float] | None = None
     try:
         client.timeout = min(saved, float(reconnect_timeout))
-        client.connect(timeout=client.timeout)
-        client.stop()
-    except KinestatError as exc:
-        client.close()
-        return f"ST could not be sent: {first}; a fresh connection failed too: {exc}"
+        for attempt in range(1, MAX_ATTEMPTS + 1):
+            fresh = attempt > 1 or not client.connected
+            try:
+                if fresh:
+                    client.connect(timeout=client.timeout)
+                flags = _stop_until_still(client, t_end, poll)
+            except KinestatError as exc:
+                client.close()
+                notes.append(f"{'fresh connection' if fresh else 'open link'}: {exc}")
+                continue
+            if flags is None:
+                where = (f" on a fresh connection ({'; '.join(notes) or 'the link was down'})"
+                         if fresh else "")
+                return StopReport(True, "ST confirmed by the controller: no axis in motion "
+                                  f"(MG _BGA.._BGF all 0, twice){where}", attempt)
+            moving = [a for a, f in zip(AXES, flags, strict=True) if f]
+            return StopReport(False, f"ST unconfirmed: axes {', '.join(moving)} still in "
+                              f"motion {stop_timeout:g} s after ST", attempt)
     finally:
         client.timeout = saved
-    return f"ST sent on a fresh connection ({first})"
+    return StopReport(False, "ST unconfirmed: the link is gone (" + "; ".join(notes) + ")",
+                      MAX_ATTEMPTS)
+
+
+def send_stop(client: GalilClient, *, reconnect_timeout: float = RECONNECT_TIMEOUT) -> StopReport:
+    """:func:`confirm_stop` with the default stop timeout (the loop's and homing's stop)."""
+    return confirm_stop(client, reconnect_timeout=reconnect_timeout)

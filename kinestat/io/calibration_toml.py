@@ -40,7 +40,6 @@ maps (Vibhute App. D.7 ``leg_to_T10.m``) with the signs the OCR lost restored
 from __future__ import annotations
 
 import os
-import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -48,7 +47,7 @@ import numpy as np
 from kinestat.errors import InputError, ParseError
 from kinestat.hardware.leg_calibration import LegCalibration, fit_polynomial
 from kinestat.io._fields import number, refuse_unknown, string
-from kinestat.io.textfile import read_text_file
+from kinestat.io.textfile import parse_toml, read_text_file
 
 __all__ = ["CalibrationFile", "loads_calibration", "read_calibration"]
 
@@ -72,10 +71,7 @@ class CalibrationFile:
 
 def loads_calibration(text: str, source: str = "<string>") -> CalibrationFile:
     """Parse a TOML leg calibration (``source`` names it in error messages)."""
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ParseError(f"not valid TOML: {exc}", file=source) from exc
+    doc = parse_toml(text, source)
     refuse_unknown(doc, _TOP_KEYS, source, "top-level keys")
     for key, unit in (("length_unit", "mm"), ("force_unit", "N")):
         if key not in doc:

@@ -10,8 +10,9 @@ lengths to metres from its ``length_unit`` (mm, cm, m, in, ft; another unit is r
 multiplies the file's numbers instead (a file written in millimetres: ``scale=1e-3``). A file
 whose joint offsets look like millimetres (one longer than 10 m) raises a
 :class:`~kinestat.errors.KinestatWarning` when no ``scale`` is given.
-A ``<mimic>`` joint on the chain is refused (kinestat has no coupled joints); so are floating and
-planar joints (no single axis). Screw joints have no URDF form and are refused on export.
+A moving joint with a ``<mimic>`` on the chain is refused (kinestat has no coupled joints; on a
+fixed joint a ``<mimic>`` couples nothing and is ignored, as Pinocchio does); so are floating
+and planar joints (no single axis). Screw joints have no URDF form and are refused on export.
 """
 
 from __future__ import annotations
@@ -140,7 +141,7 @@ def _check_joint(j: ET.Element, where: str, source: str) -> None:
         raise ParseError(f"{where}: joint type {jtype!r} is not supported in a serial chain",
                          file=source)
     mimic = j.find("mimic")
-    if mimic is not None:
+    if mimic is not None and jtype != "fixed":  # a fixed joint has no value to couple
         raise ParseError(f"{where} mimics joint {mimic.get('joint')!r} (<mimic>): kinestat "
                          "models independent joints only, so coupled joints are refused; end "
                          "the chain before it (tip=, --tip)", file=source)
@@ -287,10 +288,14 @@ def from_urdf(
     converted from metres; or the file's numbers times ``scale`` when it is given (a file
     written in millimetres: ``scale=1e-3``; the model's unit is then ``length_unit`` or "m").
     Without ``scale``, a joint offset longer than 10 (file numbers) warns that the file looks
-    like millimetres. Angles are radians. A ``<mimic>``, floating or planar joint on the chain
-    is a ParseError naming it.
+    like millimetres. Angles are radians. A moving joint with a ``<mimic>``, a floating or a
+    planar joint on the chain is a ParseError naming it; ``scale`` must be finite and > 0.
     """
     explicit_scale = scale is not None
+    if explicit_scale and not (isinstance(scale, (int, float)) and not isinstance(scale, bool)
+                               and math.isfinite(scale) and scale > 0):
+        raise InputError(f"scale (--scale) must be a finite number > 0, got {scale!r}: zero "
+                         "collapses every length and a negative one mirrors the arm")
     if scale is None:
         scale = 1.0 / metres_per_unit(length_unit or "m")
     length_unit = length_unit or "m"

@@ -358,8 +358,8 @@ class DmcSimulator:
             self._update()
             try:
                 data = self._execute(cmd)
-            except _Reject as rej:
-                self._code = rej.code
+            except (_Reject, ValueError, ArithmeticError, RecursionError) as rej:
+                self._code = getattr(rej, "code", 4)  # else an operand out of reach
                 return stale + "?"
             return stale + (":" if data is None else f"{data}\r\n:")
 
@@ -572,7 +572,7 @@ class DmcSimulator:
             if key == "TV":
                 return float(round(ax.velocity))
             return float(getattr(ax, key.lower()))
-        m = re.fullmatch(r"@(IN|AN)\[(\d+)\]", op)
+        m = re.fullmatch(r"@(IN|AN)\[(\d{1,4})\]", op)  # more digits: an operand error
         if m:
             n = int(m.group(2))
             if m.group(1) == "IN":  # 0: "VAL power on", "arm power on" (startup_initialize.m)

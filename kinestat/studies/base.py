@@ -86,13 +86,19 @@ class ChunkedStudy(Study):
 
     total: int = 0
     chunk: int = 1
+    #: bytes one evaluation may take while its chunk is computed (rows and intermediates: the
+    #: measured peak, tracemalloc, rounded up about twice); the chunk size is checked against it
+    ROW_BYTES: int = 16 << 10
+
+    def row_bytes(self) -> int:
+        return self.ROW_BYTES
 
     def _set_items(self, total: int, what: str = "evaluations") -> None:
         if total > grids.MAX_POINTS:
             raise InputError(f"{total:.3e} {what} is too many (at most {grids.MAX_POINTS:.3e})")
         self.total = int(total)
         self.chunk = int(self.spec["chunk_size"])
-        self._chunks = grids.chunk_count(self.total, self.chunk)
+        self._chunks = grids.check_chunking(self.total, self.chunk, self.row_bytes(), what)
 
     @property
     def n_chunks(self) -> int:

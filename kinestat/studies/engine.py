@@ -13,7 +13,9 @@ two tasks per worker thread are in flight, which bounds the client's memory.
 from __future__ import annotations
 
 import logging
+import math
 import os
+import socket
 import time
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -73,6 +75,56 @@ def check_address(address: str) -> None:
         raise InputError(f"--scheduler {address!r}: expected an address tcp://HOST:PORT")
 
 
+def probe_scheduler(address: str, timeout_s: float) -> None:
+    """Refuse, within ``timeout_s``, a ``tcp://`` address where no Dask scheduler listens.
+
+    A Dask scheduler speaks first: on a new TCP connection it sends its handshake (an 8-byte
+    little-endian length, then msgpack frames naming ``compression``, ``python`` and
+    ``pickle-protocol``). Nothing within the timeout (an HTTP server, a silent listener) or
+    other bytes (a service answering garbage) is a :class:`ClusterError` naming the address;
+    ``distributed.Client`` would otherwise wait or fail with a traceback. Other protocols
+    (``tls://``...) are left to the client's own timeout.
+    """
+    proto, _, rest = address.rpartition("://")
+    if proto not in ("", "tcp"):
+        return
+    host, _, port = rest.rpartition(":")
+    host = host.strip("[]")
+    where = f"--scheduler {address}"
+    deadline = time.monotonic() + timeout_s
+    try:
+        sock = socket.create_connection((host, int(port)), timeout=timeout_s)
+    except OSError as exc:
+        raise ClusterError(f"{where}: cannot connect within {timeout_s:g} s ({exc}); check the "
+                           "address and that the scheduler runs") from None
+    data = b""
+    with sock:
+        while len(data) < 8 or len(data) < 8 + _frame_length(data) <= 8 + 4096:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                break
+            sock.settimeout(left)
+            try:
+                chunk = sock.recv(4096)
+            except OSError:  # the timeout included
+                break
+            if not chunk:
+                break
+            data += chunk
+    if not data:
+        raise ClusterError(f"{where}: no Dask handshake within {timeout_s:g} s — not a Dask "
+                           "scheduler (an HTTP server or another service?); check the address "
+                           "and port (the scheduler's, usually 8786)")
+    if b"pickle-protocol" not in data[:4096] or _frame_length(data) > 4096:
+        raise ClusterError(f"{where}: answered {data[:24]!r}..., not a Dask scheduler's "
+                           "handshake; check the address and port (the scheduler's, usually "
+                           "8786)")
+
+
+def _frame_length(data: bytes) -> int:
+    return int.from_bytes(data[:8], "little") if len(data) >= 8 else 0
+
+
 @contextmanager
 def open_client(scheduler: str | None, workers: int | None, processes: bool,
                 timeout_s: float) -> Iterator:
@@ -85,10 +137,11 @@ def open_client(scheduler: str | None, workers: int | None, processes: bool,
 
     if scheduler:
         check_address(scheduler)
+        probe_scheduler(scheduler, timeout_s)
         try:
             client = distributed.Client(scheduler, timeout=f"{timeout_s}s",
                                         set_as_default=False)
-        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+        except Exception as exc:  # noqa: BLE001 - whatever the peer did: one clear error
             raise ClusterError(
                 f"--scheduler {scheduler}: cannot connect to a Dask scheduler within "
                 f"{timeout_s:g} s ({type(exc).__name__}: {str(exc).splitlines()[0][:160]}); "
@@ -183,6 +236,8 @@ def run_study(study: Study, output: str | os.PathLike | None = None, *,
     t0 = time.perf_counter()
     if max_chunks is not None and max_chunks < 0:
         raise InputError(f"--max-chunks must be >= 0, got {max_chunks}")
+    if not (math.isfinite(timeout_s) and timeout_s > 0):
+        raise InputError(f"--timeout must be a finite number of seconds > 0, got {timeout_s}")
     root = Path(output) if output is not None else default_output(study)
     store = StudyStore(root, study.name, study.spec, spec_hash(study.spec), study.n_chunks)
     if scheduler is not None and not scheduler.strip():

@@ -8,16 +8,60 @@ chunk ``i`` draws the same numbers on any worker, in any order, after any restar
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 
 from kinestat.errors import InputError
 
-__all__ = ["MAX_POINTS", "check_grid", "check_grid_count", "check_samples", "check_seed",
+__all__ = ["MAX_POINTS", "MAX_CHUNKS", "check_chunking", "memory_budget",
+           "check_grid", "check_grid_count", "check_samples", "check_seed",
            "sampling", "chunk_count", "chunk_range", "grid_points", "chunk_rng",
            "parse_values"]
 
 #: the largest grid or sample count accepted (indices stay exact in int64)
 MAX_POINTS = 1 << 62
+
+#: the most chunks a study may have: each is a JSON and a Parquet file in its directory, and
+#: the reduction holds every chunk's partial summary at once
+MAX_CHUNKS = 1_000_000
+
+#: the share of this machine's memory one chunk may take (a worker holds up to two chunks per
+#: thread in flight, one worker per core; the client receives their rows)
+CHUNK_MEMORY_SHARE = 1 / 8
+
+
+def memory_budget() -> int:
+    """Bytes one chunk may take here: :data:`CHUNK_MEMORY_SHARE` of the physical memory."""
+    try:
+        phys = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):  # no sysconf: assume a small machine, 4 GiB
+        phys = 4 << 30
+    return int(phys * CHUNK_MEMORY_SHARE)
+
+
+def check_chunking(total: int, chunk_size: int, row_bytes: int, what: str) -> int:
+    """The chunk count of ``total`` items in chunks of ``chunk_size``, refused BEFORE anything
+    is allocated when one chunk (``row_bytes`` per item) would not fit :func:`memory_budget`
+    or the chunks would be more than :data:`MAX_CHUNKS`.
+
+    >>> check_chunking(10, 4, 100, "samples")
+    3
+    """
+    n = chunk_count(total, chunk_size)
+    budget = memory_budget()
+    largest = max(1, budget // row_bytes)
+    if min(chunk_size, total) > largest:
+        raise InputError(f"--chunk-size {chunk_size}: one chunk would take about "
+                         f"{min(chunk_size, total) * row_bytes / 2**30:.3g} GiB ({row_bytes} bytes "
+                         f"per evaluation), more than the {budget / 2**30:.3g} GiB a chunk may "
+                         f"use on this machine; give --chunk-size {largest} or less")
+    if n > MAX_CHUNKS:
+        raise InputError(f"{total:.4g} {what} in chunks of {chunk_size} make {n:.4g} chunks, "
+                         f"more than the {MAX_CHUNKS:.0e} a study holds; give a larger "
+                         f"--chunk-size (at most {largest} here) or fewer {what}")
+    return n
+
 
 #: independent random streams of a study (the stream is the first spawn key)
 STREAM_INPUTS = 0

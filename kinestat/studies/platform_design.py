@@ -127,6 +127,10 @@ class PlatformDesignStudy(ChunkedStudy):
 
     name = "platform-design"
 
+    def row_bytes(self) -> int:
+        """Per design: its ``poses`` evaluations (measured peak ~1.8 KiB each, 256 poses)."""
+        return (4 << 10) * int(self.spec["poses"])
+
     def __init__(self, spec: dict) -> None:
         super().__init__(spec)
         self.box = pc.range_box(spec["range_mm"], spec["range_deg"])

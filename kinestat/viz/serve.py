@@ -12,6 +12,7 @@ counted, the rest nearest the current configuration first.
 from __future__ import annotations
 
 import errno
+import http.client
 import json
 import socket
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
@@ -63,10 +64,77 @@ def _near(model: ChainModel, c: np.ndarray, q: np.ndarray) -> np.ndarray:
     return out
 
 
+MAX_BODY = 1 << 20
+"""Largest ``POST /ik`` body (bytes): a configuration and a target take well under 1 KiB; a
+larger body is answered 413 without being kept (at most this much of it is read and dropped,
+so that the client gets the answer before the connection closes)."""
+
+MAX_HEADERS = 32 << 10
+"""Largest request head (request line excluded, bytes); beyond it the answer is 431."""
+
+REQUEST_TIMEOUT = 10.0
+"""Seconds a connection may stay silent in the middle of a request before it is closed."""
+
+
+class _HeadBudget:
+    """``rfile`` while the headers are read: ``readline`` past :data:`MAX_HEADERS` bytes in
+    all raises ``LineTooLong`` (http.server then answers 431)."""
+
+    def __init__(self, raw, budget: int) -> None:
+        self.raw, self.left = raw, budget
+
+    def readline(self, limit: int = -1) -> bytes:
+        line = self.raw.readline(min(limit, self.left + 1) if limit >= 0 else self.left + 1)
+        self.left -= len(line)
+        if self.left < 0:
+            raise http.client.LineTooLong(f"request headers over {MAX_HEADERS} bytes")
+        return line
+
+    def __getattr__(self, name: str):
+        return getattr(self.raw, name)
+
+
+def _ik_request(body: bytes) -> tuple[object, object]:
+    """``q`` and ``target`` of a ``POST /ik`` body; InputError for anything else."""
+    try:
+        req = json.loads(body or b"{}")
+    except RecursionError:
+        raise InputError("the request body nests too deeply") from None
+    except ValueError as exc:  # JSONDecodeError, UnicodeDecodeError, the digit limit
+        raise InputError(f"the request body is not JSON: {exc}") from None
+    if not isinstance(req, dict):
+        raise InputError(f'the request body must be a JSON object {{"q": [...], "target": '
+                         f'[x, y, z]}}, got {type(req).__name__}')
+    return req.get("q"), req.get("target")
+
+
 def _handler(page: bytes, scene_bytes: bytes, model: ChainModel | None):
     class Handler(BaseHTTPRequestHandler):
+        timeout = REQUEST_TIMEOUT
+
         def log_message(self, format, *args):  # noqa: A002 - quiet server
             pass
+
+        def parse_request(self) -> bool:
+            raw, self.rfile = self.rfile, _HeadBudget(self.rfile, MAX_HEADERS)
+            try:
+                return super().parse_request()
+            finally:
+                self.rfile = raw
+
+        def _discard(self, limit: int) -> None:
+            """Read and drop up to ``limit`` bytes of an unwanted body (closing with unread
+            bytes would reset the connection before the client read the answer)."""
+            self.wfile.flush()
+            left = limit
+            try:
+                while left > 0 and (chunk := self.rfile.read1(min(left, 65536))):
+                    left -= len(chunk)
+            except OSError:
+                pass
+
+        def _json(self, code: int, ans: dict) -> None:
+            self._send(code, json.dumps(ans).encode(), "application/json")
 
         def _send(self, code: int, body: bytes, ctype: str) -> None:
             self.send_response(code)
@@ -87,13 +155,32 @@ def _handler(page: bytes, scene_bytes: bytes, model: ChainModel | None):
             if self.path != "/ik" or model is None:
                 self._send(404, b"not found", "text/plain")
                 return
+            length = self.headers.get("Content-Length", "0").strip()
+            if not (length.isascii() and length.isdigit()):
+                self.close_connection = True
+                self._json(400, {"solutions": [], "error": "Content-Length must be a number "
+                                 f"of bytes, got {length[:40]!r}"})
+                return
+            if int(length) > MAX_BODY:
+                self.close_connection = True
+                self._json(413, {"solutions": [], "error": f"request body of {length} bytes: "
+                                 f"at most {MAX_BODY}"})
+                self._discard(MAX_BODY)
+                return
             try:
-                n = int(self.headers.get("Content-Length", "0"))
-                req = json.loads(self.rfile.read(n) or b"{}")
-                ans = ik_answer(model, req.get("q"), req.get("target"))
-            except (KinestatError, ValueError, TypeError) as exc:
+                q, target = _ik_request(self.rfile.read(int(length)))
+            except (InputError, OSError) as exc:
+                self.close_connection = True
+                self._json(400, {"solutions": [], "error": str(exc)})
+                return
+            try:
+                ans = ik_answer(model, q, target)
+            except (KinestatError, ValueError, TypeError, OverflowError, RecursionError) as exc:
                 ans = {"solutions": [], "error": str(exc)}
-            self._send(200, json.dumps(ans).encode(), "application/json")
+            except Exception as exc:  # noqa: BLE001 - the server answers and keeps serving
+                self._json(500, {"solutions": [], "error": f"internal error: {exc}"})
+                return
+            self._json(200, ans)
 
     return Handler
 

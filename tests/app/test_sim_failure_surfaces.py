@@ -57,7 +57,8 @@ def test_a_simulator_failure_mid_run_is_the_stop_reason(tmp_path):
     recs = read_log(log)
     assert [r["type"] for r in recs][-2:] == ["fault", "end"]
     assert "the simulated cell failed" in recs[-2]["reason"]
-    assert recs[-2]["action"] == "ST sent to the Galil"
+    assert recs[-2]["action"].startswith("ST confirmed by the controller")
+    assert recs[-2]["stop_confirmed"]
 
 
 def test_the_checked_reader_raises_the_emitters_error_not_stale_data():
@@ -104,5 +105,5 @@ def test_control_force_10_stops_on_the_envelope_not_on_the_simulator(tmp_path, c
         report["stop_reason"]
     assert "stale" not in report["stop_reason"]
     assert report["true_force_magnitude"] > 8.0  # past where the solve used to fail (5.9 N)
-    assert read_log(log)[-2]["action"] == "ST sent to the Galil"
+    assert read_log(log)[-2]["action"].startswith("ST confirmed by the controller")
     assert Envelope().max_load > 10  # the stop is the platform's motion range, not the load

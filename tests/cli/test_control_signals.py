@@ -68,7 +68,7 @@ def _assert_fault_and_end(log: Path, sig: signal.Signals) -> dict:
     assert kinds[0] == "start" and kinds[-2:] == ["fault", "end"], kinds
     fault = recs[-2]
     assert fault["reason"] == f"stopped by {sig.name}"
-    assert fault["action"] == "ST sent to the Galil"
+    assert fault["action"].startswith("ST confirmed by the controller") and fault["stop_confirmed"]
     assert not recs[-1]["report"]["converged"]
     assert f"stopped by {sig.name}" in recs[-1]["report"]["stop_reason"]
     return fault

@@ -62,7 +62,9 @@ def test_a_signal_during_the_coarse_move_stops_the_robot(tmp_path, sig):
     kinds = [r["type"] for r in recs]
     assert kinds[0] == "start" and kinds[-2:] == ["fault", "end"], kinds
     assert recs[-2]["reason"] == f"stopped by {sig.name}"
-    assert "ST and MO sent" in recs[-2]["action"]
+    assert "ST confirmed by the controller" in recs[-2]["action"]
+    assert "MO sent" in recs[-2]["action"]
+    assert recs[-2]["stop_confirmed"] is True
     assert recs[-1]["report"]["homed"] is False
     assert err.count(f"stopped by {sig.name}") == 1 and err.startswith("kinestat: error:")
 

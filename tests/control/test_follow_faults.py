@@ -1,6 +1,6 @@
 """The follow task behind the real Galil client and encoder reader (TCP loopback and a pty),
 with faults injected during the travel: like the press task's (``test_loop.py``), every fault
-must end in a safe stop (ST sent) with a complete log, and no command may leave the axis
+must end in a safe stop (ST confirmed) with a complete log, and no command may leave the axis
 limits or the platform's load and deflection limits."""
 
 from __future__ import annotations
@@ -74,7 +74,7 @@ def test_a_fault_during_the_travel_stops_the_cell_with_a_complete_log(tmp_path, 
     prep, rep, recs, commands, injected = _follow_with(tmp_path, inject, friction)
     assert injected, f"the travel never started: {rep.stop_reason}"
     assert not rep.converged and reason in rep.stop_reason, rep.stop_reason
-    assert commands[-1] == "ST" or "ST sent" in rep.stop_reason
+    assert "ST" in commands and "ST confirmed by the controller" in rep.stop_reason
     _assert_log_complete(recs, rep)
     assert any(r["type"] == "fault" for r in recs)
     _assert_inside_envelope(recs, prep.config)  # the axis limits from the config's model
@@ -87,7 +87,7 @@ def test_a_fault_while_probing_the_surface_stops_the_cell_with_a_complete_log(tm
     prep, rep, recs, commands, injected = _follow_with(tmp_path, inject, 0.3, _during_probing)
     assert injected, f"the probe never ran: {rep.stop_reason}"
     assert not rep.converged and reason in rep.stop_reason, rep.stop_reason
-    assert commands[-1] == "ST" or "ST sent" in rep.stop_reason
+    assert "ST" in commands and "ST confirmed by the controller" in rep.stop_reason
     _assert_log_complete(recs, rep)
     assert any(r["type"] == "fault" for r in recs)
     _assert_inside_envelope(recs, prep.config)

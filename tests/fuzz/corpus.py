@@ -222,12 +222,27 @@ _CLI_SEEDS: tuple[str, ...] = (
 )
 
 
+#: Galil DMC command lines the simulator's handler answers (Vibhute App. D.4, D.5, D.9 and the
+#: client's stop proof).
+_GALIL_SEEDS: tuple[str, ...] = (
+    "MG @IN[3]", "MG @AN[2]", "MG _BGA,_TPB,_MOC", "PA 1000,2000,-3000,0,0,5", "PR ,,100",
+    "SP 8000,11511,8964,3194,1469.24,1496", "AC 8000,11511,8964,3194,3194,1496", "DC 1,2",
+    "JG 1000,-500", "FI", "FI AB", "BG", "BG A", "ST", "ST AC", "TP", "TP A", "TC1", "TC", "MO",
+    "SH", "DP 0,103597,80672,0,0,0", "AF 0,0,0,0,0,0", "OP1", "HOMED=1", "MG HOMED",
+    "MG 4711,_BGA,_BGB,_BGC,_BGD,_BGE,_BGF",
+)
+
+
+def _calibration_seeds() -> list[str]:
+    return [_data("calibrations", "thesis-2011.toml")]
+
+
 @cache
 def seeds(reader: str) -> tuple[str, ...]:
     """The valid seed inputs of ``reader`` (a key of :data:`READERS`)."""
     if reader == "model_toml":
         return tuple(_model_seeds())
-    if reader == "platform_toml":
+    if reader in ("platform_toml", "control_platform"):
         return tuple(_platform_seeds())
     if reader == "axes_toml":
         return (tomli_w.dumps(_AXES_DOC),)
@@ -250,6 +265,10 @@ def seeds(reader: str) -> tuple[str, ...]:
         return (*_model_seeds()[:1], _deck_seeds()[0], "plain text\n")
     if reader == "cli":
         return _CLI_SEEDS
+    if reader in ("calibration_toml", "control_calibration"):
+        return tuple(_calibration_seeds())
+    if reader == "galil_handler":
+        return _GALIL_SEEDS
     raise KeyError(reader)
 
 
@@ -327,6 +346,46 @@ def _cli(text: str, workdir: Path):
     return code
 
 
+def _calibration(text: str, workdir: Path):
+    from kinestat.io.calibration_toml import loads_calibration, read_calibration
+
+    if any("\udc80" <= c <= "\udcff" for c in text):
+        return read_calibration(_write(workdir, "calibration.toml", text))
+    return loads_calibration(text, source="fuzz.toml")
+
+
+def _control_calibration(text: str, workdir: Path):
+    """``kinestat control --calibration FILE``: the file read and the controller's model built
+    from it (:mod:`kinestat.app.calibrations`)."""
+    from kinestat.app.calibrations import calibrated_model, resolve_calibration, resolve_platform
+
+    platform = resolve_platform(None)
+    cal = resolve_calibration(str(_write(workdir, "control-cal.toml", text)), platform)
+    return calibrated_model(platform, cal)
+
+
+def _control_platform(text: str, workdir: Path):
+    """``kinestat control --platform FILE``: the platform read and the controller's model
+    built on it with the thesis's and the nominal calibrations."""
+    from kinestat.app.calibrations import calibrated_model, resolve_calibration, resolve_platform
+
+    platform = resolve_platform(_write(workdir, "control-platform.toml", text))
+    return [calibrated_model(platform, resolve_calibration(c, platform))
+            for c in ("thesis", "nominal")]
+
+
+def _galil_handler(text: str, workdir: Path):
+    """One command line to the simulated DMC's interpreter: it must answer (``:``, data then
+    ``:``, or ``?``), never raise — an exception would end the server's connection thread."""
+    from kinestat.sim.dmc import DmcSimulator, SimClock
+
+    line = text.encode("ascii", "replace").decode("ascii")  # what the server decodes
+    reply = DmcSimulator(clock=SimClock(step_per_command=0.01)).handle(line)
+    if not (isinstance(reply, str) and reply.endswith((":", "?"))):
+        raise AssertionError(f"no DMC reply to {line[:60]!r}: {reply!r}")
+    return reply
+
+
 @dataclass(frozen=True)
 class Reader:
     """One reader under test: ``call(text, workdir)`` feeds it one input."""
@@ -346,6 +405,10 @@ READERS: dict[str, Reader] = {r.name: r for r in (
     Reader("urdf", _urdf),
     Reader("disp_deck", _deck),
     Reader("text", _text),
+    Reader("calibration_toml", _calibration),
+    Reader("control_calibration", _control_calibration),
+    Reader("control_platform", _control_platform),
+    Reader("galil_handler", _galil_handler),
 )}
 
 #: The command line, fuzzed by the campaign only (``--readers cli``): slower than the readers.

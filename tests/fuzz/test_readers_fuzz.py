@@ -61,7 +61,9 @@ _KEYS = st.sampled_from(["name", "notation", "joints", "type", "pitch", "limits"
                          "a", "alpha", "r", "angle_unit", "length_unit", "base", "tool",
                          "q_home", "frame_points", "hand", "design", "legs", "kind", "stiffness",
                          "home_pose", "leg_names", "axes", "point", "direction", "plucker",
-                         "tol", "pose", "free_lengths", "x"]) | st.text(max_size=4)
+                         "tol", "pose", "free_lengths", "x", "force_unit", "force_sense",
+                         "sensor", "leg", "length", "force", "length_counts", "lengths",
+                         "force_degree"]) | st.text(max_size=4)
 _SCALARS = (
     st.integers()
     | st.integers(min_value=10**300, max_value=10**1000)
@@ -76,7 +78,8 @@ _VALUES = st.recursive(_SCALARS, lambda inner: st.lists(inner, max_size=6)
                        | st.dictionaries(_KEYS, inner, max_size=4), max_leaves=24)
 _STRUCTURED = {
     "model_toml": "toml", "platform_toml": "toml", "axes_toml": "toml", "axes_json": "json",
-    "pose_json": "json", "pose_toml": "toml",
+    "pose_json": "json", "pose_toml": "toml", "calibration_toml": "toml",
+    "control_calibration": "toml",
 }
 
 

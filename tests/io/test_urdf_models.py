@@ -164,3 +164,64 @@ def test_no_moving_joint_is_a_model_error():
     <joint name="f" type="fixed"><parent link="a"/><child link="b"/></joint></robot>"""
     with pytest.raises(ModelError, match="no moving joint"):
         from_urdf(text, tip="b")
+
+
+def _fixed_mimic_chains():
+    """(file, leaf) of every Talos chain (example-robot-data) passing through a FIXED joint
+    that carries a <mimic>, read off the files."""
+    import xml.etree.ElementTree as ET
+
+    from tests.urdf_arms import robots_dir
+
+    out = []
+    for f in sorted((robots_dir() / "talos_data" / "robots").glob("talos*.urdf")):
+        joints = ET.parse(f).getroot().findall("joint")
+        by_child = {j.find("child").get("link"): j for j in joints}
+        parents = {j.find("parent").get("link") for j in joints}
+        for leaf in sorted(set(by_child) - parents):
+            link, via = leaf, False
+            while link in by_child:
+                j = by_child[link]
+                via |= j.get("type") == "fixed" and j.find("mimic") is not None
+                link = j.find("parent").get("link")
+            if via:
+                out.append((f, leaf))
+    return out
+
+
+def test_a_mimic_on_a_fixed_joint_couples_nothing_talos_equals_pinocchio(rng):
+    """Issue 43: a fixed joint with a <mimic> refused the whole chain (28 Talos chains of
+    example-robot-data). A fixed joint has no value to couple: the chains import, and their FK
+    equals Pinocchio's model of the same file."""
+    chains = _fixed_mimic_chains()
+    assert len(chains) == 28  # talos_left_arm 4, talos_reduced{,_box,_corrected} 8 each
+    models: dict = {}
+    for path, leaf in chains:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", KinestatWarning)
+            m = kinestat.load(path, tip=leaf)
+        if path not in models:
+            models[path] = pin.buildModelFromUrdf(str(path))
+        pm = models[path]
+        data = pm.createData()
+        fid = pm.getFrameId(leaf)
+        worst = 0.0
+        for q in _random_q(m, rng, 5):
+            pin.framesForwardKinematics(pm, data, _pin_q(pm, m, q))
+            worst = max(worst, float(np.abs(kinestat.fk(m, q) - data.oMf[fid].homogeneous).max()))
+        assert worst < 1e-12, (path.name, leaf, worst)
+
+
+def test_a_mimic_on_a_moving_joint_is_still_refused_and_scale_must_be_positive(tmp_path):
+    text = ('<robot name="r"><link name="a"/><link name="b"/><link name="c"/>'
+            '<joint name="j1" type="revolute"><parent link="a"/><child link="b"/>'
+            '<axis xyz="0 0 1"/><limit lower="-1" upper="1"/></joint>'
+            '<joint name="j2" type="{kind}"><parent link="b"/><child link="c"/>'
+            '<axis xyz="0 0 1"/><limit lower="-1" upper="1"/><mimic joint="j1"/></joint>'
+            '</robot>')
+    assert from_urdf(text.format(kind="fixed")).n == 1
+    with pytest.raises(ParseError, match="mimics joint 'j1'"):
+        from_urdf(text.format(kind="revolute"))
+    for bad in (0.0, -1.0, float("nan"), float("inf")):
+        with pytest.raises(InputError, match="scale"):
+            from_urdf(text.format(kind="fixed"), scale=bad)

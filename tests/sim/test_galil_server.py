@@ -269,3 +269,19 @@ def test_allow_remote_true_binds_all_interfaces_deliberately():
         assert srv._listener.getsockname()[0] == "0.0.0.0"
     finally:
         srv.stop()
+
+
+def test_an_operand_beyond_reach_is_answered_and_the_connection_lives_on():
+    """Issue 43: ``MG @IN[<5000 digits>]`` killed the connection's thread (a ValueError from
+    the 4300-digit limit); it is a '?' (TC1 6) and the next command is answered."""
+    import socket
+
+    with GalilSimServer() as srv, socket.create_connection(("127.0.0.1", srv.port), 2) as s:
+        for line, want in ((b"MG @IN[" + b"9" * 5000 + b"]", b"?"), (b"TC1", b"4 Operand error"),
+                           (b"MG @IN[3]", b" 0.0000\r\n:")):
+            s.sendall(line + b"\r")
+            got = b""
+            while not got.endswith((b":", b"?")):
+                got += s.recv(4096)
+            assert got.startswith(want) or want in got, (line[:20], got)
+        assert srv.connections == 1

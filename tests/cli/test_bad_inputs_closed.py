@@ -1,0 +1,34 @@
+"""Issue 43: bad calls end in one ``kinestat: error:`` line and status 2 — a cycle log that is
+not UTF-8, a URDF scale of zero or below."""
+
+from __future__ import annotations
+
+import pytest
+
+from kinestat.cli.main import main
+from tests.urdf_arms import arm_path
+
+
+def _one_error(capsys, argv) -> str:
+    code = main(argv)
+    err = capsys.readouterr().err.strip().splitlines()
+    assert code == 2 and len(err) == 1 and err[0].startswith("kinestat: error:"), (code, err)
+    return err[0]
+
+
+@pytest.mark.parametrize(("content", "what"), [
+    (b'\xff\xfe{"type": "start"}\n', "not UTF-8 text"),
+    (b'{"type": "start"}\n[1, 2]\n', "line 2 is not a cycle record"),
+    (b"[" * 100_000 + b"]" * 100_000 + b"\n", "line 1 is not a cycle record"),
+])
+def test_view_log_on_a_file_that_is_not_a_cycle_log(capsys, tmp_path, content, what):
+    p = tmp_path / "log.jsonl"
+    p.write_bytes(content)
+    assert what in _one_error(capsys, ["view", "log", str(p), "--no-open"])
+
+
+@pytest.mark.parametrize("scale", ["0", "-1", "nan", "-inf"])
+def test_urdf_scale_zero_or_negative_is_refused(capsys, scale):
+    msg = _one_error(capsys, ["fk", str(arm_path("ur5")), "--tip", "tool0", "--scale", scale,
+                              "--q", "0,0,0,0,0,0"])
+    assert "--scale" in msg and "> 0" in msg
