@@ -77,7 +77,8 @@ def _wrist(W, Rp: np.ndarray, wrist_tol: float):
 def solve_pieper(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
                  wrist_tol: float = _WRIST_TOL) -> IKAllResult:
     """All solutions (8 slots) for a spherical-wrist arm; ``T (N, 4, 4)``. Axes 1, 2 meeting
-    here; an offset shoulder by :func:`kinestat.serial.analytic.pieper_offset.solve_pieper_offset`."""
+    here; an offset shoulder by
+    :func:`kinestat.serial.analytic.pieper_offset.solve_pieper_offset`."""
     ax, w, s = data["axes"], data["wrist"], data["shoulder"]
     if s is None:
         return pieper_offset.solve_pieper_offset(model, T, data, tol=tol, wrist_tol=wrist_tol)

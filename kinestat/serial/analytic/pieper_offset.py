@@ -73,7 +73,7 @@ def pack(model: ChainModel, ax, w: np.ndarray, x6: np.ndarray) -> np.ndarray:
 
 def _theta3(G: np.ndarray, W: np.ndarray, pw: np.ndarray) -> list[float]:
     """The real roots θ3 of the shoulder's equations for one wrist centre (skew axes 1, 2)."""
-    o1, r2, u0, u1, u2 = G[0:3], G[3:6], G[6:9], G[9:12], G[12:15]
+    o1, u0, u1, u2 = G[0:3], G[6:9], G[9:12], G[12:15]
     A, sa, ca = G[15:18]
     d = pw - o1
     N = np.array([u0 @ u0 + u1 @ u1, 2 * u0 @ u1, 2 * u0 @ u2])
