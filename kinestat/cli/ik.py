@@ -100,6 +100,15 @@ def ik_command(
         "with prismatic joints before a spherical wrist (kinestat.ik_all), and the one nearest "
         "--current-deg (or --q0-deg; default the model's home) within the limits."
     ),
+    lock: list[str] = typer.Option(
+        None, "--lock", help="With --all, a 7-joint arm: hold joint J (number from 1, or name) at "
+        "VALUE (degrees; prismatic: length) and solve the other six; repeatable. With "
+        "--self-motion: J alone.", metavar="J=VALUE"
+    ),
+    self_motion: int = typer.Option(
+        None, "--self-motion", help="With --all --lock J: sample joint J at N values over its "
+        "limits and give every solution at each (the self-motion).", metavar="N"
+    ),
     tip: str = tip_option(),
     base: str = base_option(),
     scale: float = scale_option(),
@@ -118,12 +127,16 @@ def ik_command(
     Any 6R arm, or R/P arm with a spherical wrist, every solution (--pose --all): JSON
     {"solutions": [{"q", "q_deg", "residual", "within_limits", "singular"}],
     "singular_families", "selected", "reason", "method", "units"}; an unreachable pose gives no
-    solution, the reason, and exit status 0.
+    solution, the reason, and exit status 0. A 7-joint arm with --lock J=VALUE: the same, with
+    "locked"; with --lock J --self-motion N: {"self_motion": {"joint", "samples": [{"value",
+    "value_deg", "solutions", ...}]}}.
     """
     closed = any(v is not None for v in (tool_point, s6, a67))
+    if (lock or self_motion is not None) and not all_solutions:
+        raise InputError("--lock and --self-motion go with --all")
     if all_solutions:
         _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg,
-                     (tip, base, scale, length_unit), as_json)
+                     (tip, base, scale, length_unit), as_json, lock or [], self_motion)
         return
     if closed and pose is not None:
         raise InputError("give either --pose (numerical IK) or --tool-point/--s6/--a67 "
@@ -324,10 +337,46 @@ def _numerical(model_name, pose, q0_deg, restarts, max_iter, seed, ignore_limits
         )
 
 
+def _lock_joint(m, text: str) -> int:
+    """The 0-based index of joint ``text`` (a number from 1, or a joint name) of model m."""
+    names = [j.name for j in m.joints]
+    if text in names and not text.isdigit():
+        return names.index(text)
+    if text.isdigit() and 1 <= int(text) <= m.n:
+        return int(text) - 1
+    raise InputError(f"--lock: joint {text!r} is neither a joint number (1 to {m.n}) nor a "
+                     f"joint name of model {m.name!r} ({', '.join(names)})")
+
+
+def _parse_locks(m, lock: list[str], self_motion: int | None) -> dict[int, float]:
+    """``--lock J=VALUE`` options as ``{joint index: value}`` (radians or length); with
+    ``--self-motion`` one ``--lock J`` whose value is NaN (sampled)."""
+    out: dict[int, float] = {}
+    for item in lock:
+        j_text, sep, v_text = item.partition("=")
+        j = _lock_joint(m, j_text.strip())
+        if j in out:
+            raise InputError(f"--lock: joint {j_text.strip()!r} is given twice")
+        if self_motion is not None:
+            if sep or len(lock) != 1:
+                raise InputError("--self-motion samples one joint: give it as --lock J "
+                                 "(no value)")
+            out[j] = float("nan")
+            continue
+        if not sep:
+            raise InputError(f"--lock: expected J=VALUE, got {item!r}")
+        v = float(parse_floats(v_text, 1, f"lock {j_text.strip()}")[0])
+        out[j] = v if m.prismatic[j] else float(np.radians(v))
+    if self_motion is not None and not out:
+        raise InputError("--self-motion needs the joint to sample: --lock J")
+    return out
+
+
 def _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg, urdf,
-                 as_json) -> None:
+                 as_json, lock: list[str], self_motion: int | None) -> None:
     """``kinestat ik MODEL --pose ... --all``: every analytic solution (docs/ik-all.md)."""
     from kinestat.serial.analytic import ik_all, method_for, select_nearest  # lazy: numba
+    from kinestat.serial.analytic.locked import check_locked, fold  # lazy: numba
 
     if closed or current_axis_deg is not None:
         raise InputError("--all goes with --pose (--tool-point/--s6/--a67 and "
@@ -344,20 +393,56 @@ def _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg, urd
     if ref_text is not None:
         v = parse_floats(ref_text, m.n, ref_name)
         ref = np.where(m.prismatic, v, np.radians(v))
+    locked = _parse_locks(m, lock, self_motion)
+    m6 = fold(m, check_locked(m, {j: 0.0 for j in locked})) if locked else m
     groups = {"raghavan-roth": ("ik_all_closed", "ik_all_general"),
-              "decoupled": ("serial",)}.get(method_for(m), ("ik_all_closed",))
+              "decoupled": ("serial",)}.get(method_for(m6), ("ik_all_closed",))
+    if self_motion is not None:
+        _self_motion(m, T, next(iter(locked)), self_motion, ref, groups, as_json)
+        return
     with compiling_notice(*groups):
-        res = ik_all(m, T)
+        res = ik_all(m, T, locked=locked or None)
     sel = select_nearest(m, res, ref)
     records = [_all_record(m, res, sel, i, ref) for i in np.ndindex(res.shape)]
     head = {"model": m.name, "method": res.method, "length_unit": m.length_unit,
             "joint_names": [j.name for j in m.joints]}
+    if locked:
+        head["locked"] = [{"joint": m.joints[j].name, "index": j + 1, "value": v,
+                           "value_deg": None if m.prismatic[j] else float(np.degrees(v))}
+                          for j, v in locked.items()]
     if as_json:
         body = records[0] if T.ndim == 2 else {"targets": records}
         print_json({**head, **body, "units": units(m.length_unit)})
         return
     for k, rec in enumerate(records):
         _print_all(m, rec, res.method, None if T.ndim == 2 else k)
+
+
+def _self_motion(m, T, j: int, n: int, ref, groups, as_json) -> None:
+    """``--all --lock J --self-motion N``: every solution at N values of joint J."""
+    from kinestat.serial.analytic import ik_self_motion, select_nearest  # lazy: numba
+
+    if T.ndim != 2:
+        raise InputError("--self-motion takes one target pose (--pose with one 4x4)")
+    with compiling_notice(*groups):
+        sm = ik_self_motion(m, T, j, n)
+    samples = []
+    for v, res in zip(sm.values, sm.results, strict=True):
+        rec = _all_record(m, res, select_nearest(m, res, ref), (), ref)
+        samples.append({"value": float(v), "value_deg": None if m.prismatic[j] else
+                        float(np.degrees(v)), "method": res.method, **rec})
+    out = {"model": m.name, "length_unit": m.length_unit,
+           "joint_names": [jt.name for jt in m.joints],
+           "self_motion": {"joint": m.joints[j].name, "index": j + 1, "samples": samples},
+           "n_solutions": int(sum(s["n_solutions"] for s in samples))}
+    if as_json:
+        print_json({**out, "units": units(m.length_unit)})
+        return
+    for k, (s, res) in enumerate(zip(samples, sm.results, strict=True)):
+        console.print(f"[bold]joint {literal(m.joints[j].name)} = "
+                      f"{s['value'] if s['value_deg'] is None else s['value_deg']:.4f}"
+                      f"{'' if s['value_deg'] is None else '°'}[/] (sample {k + 1} of {n})")
+        _print_all(m, s, res.method, None)
 
 
 def _all_record(m, res, sel, i: tuple, ref: np.ndarray) -> dict:

@@ -1,10 +1,12 @@
 """All inverse-kinematics solutions of 6-joint serial arms (closed forms and the general 6R).
 
-Public entry points: :func:`ik_all`, :class:`IKAllResult`, :func:`select_nearest`.
+Public entry points: :func:`ik_all` (with ``locked=`` for 7-joint arms), :func:`ik_self_motion`,
+:class:`IKAllResult`, :func:`select_nearest`.
 """
 
+from kinestat.serial.analytic.locked import SelfMotion
 from kinestat.serial.analytic.result import IKAllResult, Selection, select_nearest, wrap_to_limits
-from kinestat.serial.analytic.solve import METHODS, ik_all, method_for
+from kinestat.serial.analytic.solve import METHODS, ik_all, ik_self_motion, method_for
 
-__all__ = ["ik_all", "IKAllResult", "Selection", "select_nearest", "wrap_to_limits", "METHODS",
-           "method_for"]
+__all__ = ["ik_all", "ik_self_motion", "SelfMotion", "IKAllResult", "Selection", "select_nearest",
+           "wrap_to_limits", "METHODS", "method_for"]

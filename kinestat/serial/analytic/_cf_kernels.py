@@ -285,18 +285,60 @@ def _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
     return store(n, q, pos, rot, dedup, out_q, out_valid, out_pos, out_rot, cnt)
 
 
-# -- spherical wrist, shoulder axes meeting (Pieper) --------------------------------------------
-@nb.njit(**_OPTS)
-def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
-                 out_pos, out_rot, out_sing, out_sign, out_fam):
+@nb.njit(inline="always", **_OPTS)
+def clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam):
+    """Empty slots of pose n, with no wrist family."""
     _clear(n, out_q, out_valid, out_pos, out_rot)
     for k in range(out_q.shape[1]):
         out_sing[n, k] = False
         out_sign[n, k] = 0.0
         out_fam[n, k] = np.nan
+
+
+@nb.njit(inline="always", **_OPTS)
+def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, out_q,
+                out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, cnt):
+    """The spherical wrist (axes 4, 5, 6 meeting) for the arm angles t1, t2, t3 (triples; R3
+    the rotation of t3): ``R4 R5 ω6 = R' ω6`` (subproblem 2), θ6 (subproblem 1), each candidate
+    verified and stored; on the singular set (ω6 along ω4) the family's sign and value are
+    recorded. Returns the new count."""
+    W3, W4, W5 = _row(W, 3), _row(W, 4), _row(W, 5)
+    Rp = _mtm(_mm(_mm(_rot(_row(W, 0), t1), _rot(_row(W, 1), t2)), R3), Rg)
+    target = _mv(Rp, W5)
+    sing = _norm(_cross(W3, target)) < wrist_tol
+    if sing:  # θ4 free: θ4 = 0, align ω6 with θ5 alone
+        t4a = t4b = _NONE
+        t5a = t5b = _sp1(W4, _Z3, W5, target)
+    else:
+        ok45, t4a, t5a, t4b, t5b = _sp2(W3, W4, _Z3, W5, target, tol)
+        if not ok45:
+            return cnt
+    f3 = _link(C, 3, t3, _link(C, 2, t2, _link(C, 1, t1, f0)))  # shared by 2 wrists
+    for i45 in range(2):
+        t4 = t4a if i45 == 0 else t4b
+        t5 = t5a if i45 == 0 else t5b
+        R5 = _rot(W4, t5)
+        t6 = _sp1(W5, _Z3, xs, _mtv(_mm(_rot(W3, t4), R5), _mv(Rp, xs)))
+        f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, f3)))
+        q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
+        new = _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
+        if new > cnt and sing:
+            sig = 1.0 if _dot(W3, _mv(R5, W5)) >= 0.0 else -1.0
+            out_sing[n, cnt] = True
+            out_sign[n, cnt] = sig
+            out_fam[n, cnt] = _wrap(out_q[n, cnt, 3] + sig * out_q[n, cnt, 5])
+        cnt = new
+    return cnt
+
+
+# -- spherical wrist, shoulder axes meeting (Pieper) --------------------------------------------
+@nb.njit(**_OPTS)
+def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
+                 out_pos, out_rot, out_sing, out_sign, out_fam):
+    clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
     Tn = T[n]
     Rg, tg = _pose_times(Tn, T0inv)
-    W0, W1, W2, W3, W4, W5 = _row(W, 0), _row(W, 1), _row(W, 2), _row(W, 3), _row(W, 4), _row(W, 5)
+    W0, W1, W2 = _row(W, 0), _row(W, 1), _row(W, 2)
     P2 = _row(P, 2)
     wc = (w[0], w[1], w[2])
     sc = (s[0], s[1], s[2])
@@ -317,32 +359,9 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
         for i12 in range(2):
             t1 = t1a if i12 == 0 else t1b
             t2 = t2a if i12 == 0 else t2b
-            Rp = _mtm(_mm(_mm(_rot(W0, t1), _rot(W1, t2)), R3), Rg)
-            target = _mv(Rp, W5)
-            sing = _norm(_cross(W3, target)) < wrist_tol
-            if sing:  # θ4 free: θ4 = 0, align ω6 with θ5 alone
-                t4a = t4b = _NONE
-                t5a = t5b = _sp1(W4, _Z3, W5, target)
-            else:
-                ok45, t4a, t5a, t4b, t5b = _sp2(W3, W4, _Z3, W5, target, tol)
-                if not ok45:
-                    continue
-            f3 = _link(C, 3, t3, _link(C, 2, t2, _link(C, 1, t1, f0)))  # shared by 2 wrists
-            for i45 in range(2):
-                t4 = t4a if i45 == 0 else t4b
-                t5 = t5a if i45 == 0 else t5b
-                R5 = _rot(W4, t5)
-                t6 = _sp1(W5, _Z3, xs, _mtv(_mm(_rot(W3, t4), R5), _mv(Rp, xs)))
-                f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, f3)))
-                q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
-                new = _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot,
-                             cnt)
-                if new > cnt and sing:
-                    sig = 1.0 if _dot(W3, _mv(R5, W5)) >= 0.0 else -1.0
-                    out_sing[n, cnt] = True
-                    out_sign[n, cnt] = sig
-                    out_fam[n, cnt] = _wrap(out_q[n, cnt, 3] + sig * out_q[n, cnt, 5])
-                cnt = new
+            cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup,
+                              out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
+                              cnt)
     return cnt
 
 

@@ -23,6 +23,7 @@ import sys
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
+from kinestat.serial.analytic import pieper_offset
 from kinestat.serial.analytic._common import nan_array, pack, reasons, run_kernels
 from kinestat.serial.analytic.families import add_wrist_families
 from kinestat.serial.analytic.result import IKAllResult
@@ -75,8 +76,12 @@ def _wrist(W, Rp: np.ndarray, wrist_tol: float):
 
 def solve_pieper(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
                  wrist_tol: float = _WRIST_TOL) -> IKAllResult:
-    """All solutions (8 slots) for a spherical-wrist arm whose axes 1, 2 meet; ``T (N, 4, 4)``."""
+    """All solutions (8 slots) for a spherical-wrist arm; ``T (N, 4, 4)``. Axes 1, 2 meeting
+    here; an offset shoulder by
+    :func:`kinestat.serial.analytic.pieper_offset.solve_pieper_offset`."""
     ax, w, s = data["axes"], data["wrist"], data["shoulder"]
+    if s is None:
+        return pieper_offset.solve_pieper_offset(model, T, data, tol=tol, wrist_tol=wrist_tol)
     W, P = ax.w, ax.r
     N = T.shape[0]
     g = T @ np.linalg.inv(ax.T0)
@@ -167,13 +172,21 @@ def _cf_kernels():
     return K
 
 
+def _offset_kernels():
+    K = sys.modules.get("kinestat.serial.analytic._offset_kernels")
+    if K is None:
+        from kinestat.serial.analytic import _offset_kernels as K  # lazy: Numba start-up
+    return K
+
+
 def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
                           wrist_tol: float = _WRIST_TOL, shape: tuple[int, ...] | None = None,
                           plain: bool | None = None) -> IKAllResult:
     """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first); ``shape``:
     the batch shape of the result (default ``(N,)``); ``plain``: the caller has checked
     :func:`~kinestat.serial.analytic._common.plain_poses` (None: check here)."""
-    K = _cf_kernels()
+    offset = data["shoulder"] is None
+    K = _offset_kernels() if offset else _cf_kernels()
     N = T.shape[0]
     q, valid, pos, rot, cnt = _outputs(N, 8)
     sing = np.empty((N, 8), dtype=bool)
@@ -182,18 +195,24 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     Kp = data.get("kernel_args")
     if Kp is None:  # pose-independent, kept with the model's cached geometry
         ax = data["axes"]
-        Kp = data["kernel_args"] = K.pack(model.constants, np.linalg.inv(ax.T0), ax.w, ax.r,
-                                          data["wrist"], data["shoulder"], _perp(ax.w[5]))
+        Kp = data["kernel_args"] = pieper_offset.pack(
+            model, ax, data["wrist"], _perp(ax.w[5])) if offset else K.pack(
+            model.constants, np.linalg.inv(ax.T0), ax.w, ax.r, data["wrist"], data["shoulder"],
+            _perp(ax.w[5]))
     args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
-    run_kernels(K.pieper_batch, K.pieper_serial, args, T, _PARALLEL_MIN, plain)
+    if offset:
+        run_kernels(K.offset_batch, K.offset_serial, args, T, _PARALLEL_MIN, plain)
+    else:
+        run_kernels(K.pieper_batch, K.pieper_serial, args, T, _PARALLEL_MIN, plain)
+    reason = pieper_offset.REASON if offset else _REASON_PIEPER
     if shape == ():
         return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
-                                     _REASON_PIEPER if cnt[0] == 0 else "", "pieper", tol)
+                                     reason if cnt[0] == 0 else "", "pieper", tol)
     return IKAllResult.build((N,) if shape is None else shape, q=q, valid=valid,
                              position_error=pos, rotation_error=rot, singular=sing,
                              family_sign=sign, family_value=fam, family_joints=(3, 5),
                              n_solutions=cnt,
-                             reason=reasons(cnt, _REASON_PIEPER), method="pieper", tol=tol)
+                             reason=reasons(cnt, reason), method="pieper", tol=tol)
 
 
 def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, *,

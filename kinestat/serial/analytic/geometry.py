@@ -4,8 +4,9 @@ In product-of-exponentials form ``T(q) = e^{ξ̂1 q1} ⋯ e^{ξ̂6 q6} T(0)`` (M
 axis at q = 0 is the z axis of ``C0 C1 ⋯ C(i-1)``. Closed forms by subproblems need special
 axis geometry:
 
-- ``"pieper"``: axes 4, 5, 6 meet at one point (a spherical wrist, Pieper 1968) and axes 1, 2
-  meet (PUMA-type shoulders): subproblems 3, 2, 2, 1.
+- ``"pieper"``: axes 4, 5, 6 meet at one point (a spherical wrist, Pieper 1968). Axes 1, 2
+  meeting (PUMA-type shoulders): subproblems 3, 2, 2, 1; an offset shoulder (KUKA, ABB,
+  Fanuc): a quartic in θ3 (:mod:`kinestat.serial.analytic.pieper_offset`).
 - ``"three-parallel"``: axes 2, 3, 4 parallel and axes 5, 6 meeting (UR-type): subproblems 4,
   4, 1, 1, 3, 1.
 - ``"decoupled"``: prismatic joints among joints 1-3 and a spherical wrist (one univariate
@@ -80,10 +81,8 @@ def classify(model: ChainModel, tol: float = 1e-9) -> tuple[str, dict]:
         float(np.linalg.norm(np.cross(w - ax.r[5], ax.w[5]))) <= tol * ax.scale
     if "prismatic" in kinds:
         return ("decoupled", {"axes": ax, "wrist": w}) if spherical else ("none", {})
-    if spherical:
-        r12 = meet(ax, 0, 1, tol)
-        if r12 is not None:
-            return "pieper", {"axes": ax, "wrist": w, "shoulder": r12}
+    if spherical:  # shoulder: where axes 1, 2 meet, None for an offset shoulder
+        return "pieper", {"axes": ax, "wrist": w, "shoulder": meet(ax, 0, 1, tol)}
     if parallel(ax, 1, 2, tol) and parallel(ax, 1, 3, tol):
         p56 = meet(ax, 4, 5, tol)
         if p56 is not None and not parallel(ax, 0, 1, tol) and not parallel(ax, 4, 1, tol):

@@ -25,11 +25,14 @@ from kinestat.serial.analytic import (
     general6r,
     thesis_puma762,
 )
+from kinestat.serial.analytic import (
+    locked as _locked,
+)
 from kinestat.serial.analytic._common import call_compiled, check_poses, plain_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 
-__all__ = ["ik_all", "METHODS", "BACKENDS", "method_for"]
+__all__ = ["ik_all", "ik_self_motion", "METHODS", "BACKENDS", "method_for"]
 
 METHODS = ("auto", "pieper", "three-parallel", "decoupled", "raghavan-roth", "puma762")
 BACKENDS = ("numba", "numpy")
@@ -116,7 +119,7 @@ def _kernels():
 
 
 def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
-           backend: str = "numba") -> IKAllResult:
+           backend: str = "numba", locked: dict | None = None) -> IKAllResult:
     """Every IK solution of the 6-joint ``model`` for poses ``T_base_flange (..., 4, 4)``.
 
     Returns an :class:`~kinestat.serial.analytic.result.IKAllResult` (``q (..., K, 6)``,
@@ -128,6 +131,9 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     ``backend``: ``"numba"`` (compiled kernels, default) or ``"numpy"`` (the references).
     A rotation accepted as orthonormal within 1e-6 but not to rounding (float32 or printed
     poses) is first replaced by the nearest rotation; residuals refer to that pose.
+    ``locked``: ``{joint index (0-based): value}`` for an arm of more than 6 joints, the
+    joints held fixed (radians or length) so that six remain; ``q`` then holds every joint,
+    the locked ones at their values (:mod:`kinestat.serial.analytic.locked`).
 
     >>> import kinestat, numpy as np
     >>> m = kinestat.load("puma560")
@@ -140,6 +146,11 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     """
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
+    if locked:
+        pairs = _locked.check_locked(model, locked)
+        res = ik_all(_locked.fold(model, pairs), T_base_flange, method=method, tol=tol,
+                     backend=backend)
+        return _locked.expand(model, pairs, res)
     kind, data = _plan(model)
     if method not in METHODS:
         raise ModelError(f"ik_all: unknown method {method!r}; expected one of {METHODS}")
@@ -199,3 +210,16 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     else:
         res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend, shape=shape)
     return _reshape(res, shape)
+
+
+def ik_self_motion(model: ChainModel, T_base_flange, joint: int, n: int, *,
+                   method: str = "auto", tol: float = 1e-9) -> _locked.SelfMotion:
+    """Every solution along the self-motion of a 7-joint ``model``: ``joint`` (0-based) locked
+    at ``n`` values over its limits (:func:`~kinestat.serial.analytic.locked.self_motion_values`)
+    and the other six solved by :func:`ik_all` at each (families included)."""
+    if not isinstance(model, ChainModel):
+        raise ModelError(f"ik_self_motion: expected a ChainModel, got {type(model).__name__}")
+    values = _locked.self_motion_values(model, joint, n)
+    results = tuple(ik_all(model, T_base_flange, method=method, tol=tol,
+                           locked={joint: float(v)}) for v in values)
+    return _locked.SelfMotion(joint=int(joint), values=values, results=results)

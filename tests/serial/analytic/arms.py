@@ -110,3 +110,44 @@ def newton_solutions(model, T: np.ndarray, starts: int = 400, iters: int = 60,
                 sols.append(qi)
         out.append(np.array(sols).reshape(-1, 6))
     return out
+
+
+def random_pieper(seed: int, parallel: str = ""):
+    """A random spherical-wrist 6R (standard DH with a4 = a5 = d5 = 0: axes 4, 5, 6 meet) whose
+    shoulder is offset (axes 1, 2 skew); ``parallel="12"`` or ``"23"`` makes those two axes
+    parallel (α = 0)."""
+    rng = np.random.default_rng(seed)
+    rows = np.column_stack([rng.uniform(-PI, PI, 6), rng.uniform(-1, 1, 6),
+                            rng.uniform(-1, 1, 6), rng.uniform(-PI, PI, 6)])
+    rows[3, 2] = rows[4, 2] = rows[4, 1] = 0.0
+    if parallel:
+        rows[int(parallel[0]) - 1, 3] = 0.0
+    return from_standard_dh(rows, name=f"pieper{parallel}-{seed}", length_unit="m")
+
+
+#: industrial arms with an offset shoulder and a spherical wrist: rtb-data's URDF (path under
+#: its ``xacro/`` folder, tip link) or a Robotics Toolbox DH model (class name)
+INDUSTRIAL = {
+    "kr16": ("kuka_description/kuka_kr16/urdf/kr16_2.urdf", None),
+    "kr120": ("kuka_description/kuka_kr120/urdf/kr120r2500pro.urdf", None),
+    "kr210": ("kuka_description/kuka_kr210/urdf/kr210l150.urdf", "tool0"),
+    "kr5": ("rtb:KR5", None),
+    "irb140": ("rtb:IRB140", None),
+}
+
+
+def industrial(name: str):
+    """An arm of :data:`INDUSTRIAL` (the test skips when its package is not installed)."""
+    import pytest
+
+    src, tip = INDUSTRIAL[name]
+    if src.startswith("rtb:"):
+        rtb = pytest.importorskip("roboticstoolbox")
+        robot = getattr(rtb.models.DH, src[4:])()
+        rows = [[L.offset, L.d, L.a, L.alpha] for L in robot.links]
+        return from_standard_dh(np.array(rows), name=name, length_unit="m")
+    from pathlib import Path
+
+    rtbdata = pytest.importorskip("rtbdata", reason="rtb-data is not installed "
+                                  "(pip install -r requirements/dev.txt)")
+    return kinestat.load(Path(rtbdata.__file__).parent / "xacro" / src, tip=tip)

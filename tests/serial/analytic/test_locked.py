@@ -1,0 +1,108 @@
+"""7-joint arms (Panda, iiwa 14) with one joint locked: every solution reproduces its pose by the
+7-joint model's FK, the locked joint keeps its value, the generating configuration is found,
+the count equals EAIK's with the same axis fixed; the self-motion samples the joint's range."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kinestat
+from kinestat.errors import InputError, ModelError
+from kinestat.serial.analytic import ik_all, ik_self_motion
+from kinestat.serial.analytic.geometry import home_axes
+from tests.urdf_arms import ARMS, arm_path
+
+from .arms import wrapped_distance
+
+
+def _arm(name):
+    if name == "panda":
+        return kinestat.load(arm_path("panda"), tip=ARMS["panda"][1])
+    rtbdata = pytest.importorskip("rtbdata")
+    return kinestat.load(Path(rtbdata.__file__).parent / "xacro" / "kuka_description" /
+                         "kuka_lbr_iiwa" / "urdf" / "lbr_iiwa_14_r820.urdf", tip="tool0")
+
+
+def _configs(model, j, value, n, seed):
+    q = np.random.default_rng(seed).uniform(-2.0, 2.0, (n, model.n))
+    q[:, j] = value
+    return q
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa"])
+@pytest.mark.parametrize("j", range(7))
+def test_locked_solutions_reproduce_the_pose(name, j):
+    model = _arm(name)
+    q = _configs(model, j, 0.4, 40, seed=j)
+    T = kinestat.fk(model, q)
+    res = ik_all(model, T, locked={j: 0.4})
+    assert res.q.shape[-1] == 7
+    F = kinestat.fk(model, np.where(res.valid[..., None], res.q, 0.0))
+    pos = np.linalg.norm(F[..., :3, 3] - T[:, None, :3, 3], axis=-1)
+    rot = np.linalg.norm(F[..., :3, :3] - T[:, None, :3, :3], axis=(-2, -1))
+    assert np.where(res.valid, pos, 0).max() < 1e-9 and np.where(res.valid, rot, 0).max() < 1e-9
+    assert np.all(res.q[..., j][res.valid] == 0.4)
+    d = wrapped_distance(res.q, q[:, None, :])
+    assert np.all(np.any(np.where(res.valid, d, np.inf) < 1e-6, axis=1))
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa"])
+@pytest.mark.parametrize("j", [0, 2, 4, 6])
+def test_locked_count_equals_eaik_fixed_axes(name, j):
+    HPRobot = pytest.importorskip("eaik.IK_HP", reason="eaik is not installed "
+                                  "(pip install -r requirements/bench.txt)").HPRobot
+    model = _arm(name)
+    ax = home_axes(model)
+    pts = np.vstack([ax.r, ax.T0[:3, 3]])
+    bot = HPRobot(ax.w.copy(), np.vstack([pts[0], np.diff(pts, axis=0)]), fixed_axes=[(j, 0.4)])
+    if not bot.hasKnownDecomposition():
+        pytest.skip(f"EAIK has no decomposition for {name} with joint {j} fixed")
+    q = _configs(model, j, 0.4, 30, seed=10 + j)
+    T = kinestat.fk(model, q)
+    res = ik_all(model, T, locked={j: 0.4})
+    for i in range(len(q)):
+        Tp = T[i].copy()
+        Tp[:3, :3] = T[i][:3, :3] @ ax.T0[:3, :3].T
+        theirs: list[np.ndarray] = []
+        for s in bot.IK(Tp).Q:
+            s = np.asarray(s)
+            F = kinestat.fk(model, s)
+            if np.linalg.norm(F[:3, 3] - T[i][:3, 3]) < 1e-6 and \
+                    np.linalg.norm(F[:3, :3] - T[i][:3, :3]) < 1e-6 and \
+                    all(wrapped_distance(s, t) > 1e-6 for t in theirs):
+                theirs.append(s)
+        assert res.n_solutions[i] == len(theirs), f"pose {i}"
+
+
+def test_self_motion_samples_the_limits_and_every_sample_solves():
+    model = _arm("iiwa")
+    q = np.array([0.3, 0.5, -0.4, -1.2, 0.2, 0.8, -0.3])
+    T = kinestat.fk(model, q)
+    sm = ik_self_motion(model, T, 2, 9)
+    assert sm.values[0] == model.lower[2] and sm.values[-1] == model.upper[2]
+    sols, which = sm.solutions()
+    assert len(sols) == sum(int(r.n_solutions) for r in sm.results) > 0
+    assert np.allclose(sols[:, 2], sm.values[which])
+    F = kinestat.fk(model, sols)
+    assert np.abs(F - T).max() < 1e-9
+    # the generating configuration's joint value is on the curve: sampling it finds q
+    res = ik_all(model, T, locked={2: q[2]})
+    assert np.min(wrapped_distance(res.solutions(), q)) < 1e-9
+
+
+def test_locked_errors():
+    model = _arm("panda")
+    T = kinestat.fk(model, np.zeros(7))
+    with pytest.raises(ModelError, match="6 free joints"):
+        ik_all(model, T, locked={0: 0.1, 1: 0.2})
+    with pytest.raises(InputError, match="not a joint index"):
+        ik_all(model, T, locked={7: 0.1})
+    with pytest.raises(InputError, match="not finite"):
+        ik_all(model, T, locked={1: float("nan")})
+    with pytest.raises(ModelError, match="exactly 6"):
+        ik_all(model, T)
+    with pytest.raises(InputError, match="positive integer"):
+        ik_self_motion(model, T, 1, 0)
