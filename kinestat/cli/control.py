@@ -251,6 +251,8 @@ def control_command(
         None, "--log", help="Cycle log file, JSON lines (default: "
         "./kinestat-runs/<timestamp>/log.jsonl)."),
     view: bool = flag(False, "--view", help="Also open a 3D replay in the browser."),
+    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+                              "3D replay to FILE (self-contained) instead of opening a browser."),
     calibration: str = typer.Option(
         "thesis", "--calibration",
         help="Leg calibration the controller uses (counts -> leg length and force): 'thesis' "
@@ -418,10 +420,10 @@ def control_command(
             print_json(out)
         else:
             _print_report(out)
-    if view:
+    if view or html is not None:
         from kinestat.viz.show import show_log  # lazy: viewer only with --view
 
-        show_log(log_path)
+        show_log(log_path, html=html)
     if not report.converged:
         what = "the follow task did not complete" if task == "follow" else (
             "kinestatic control did not converge")

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import typer
+from typer.core import TyperGroup
 
 from kinestat.cli._model import (
     MODEL_HELP,
@@ -35,10 +36,23 @@ from kinestat.cli._output import console, parse_floats, parse_pose
 from kinestat.errors import InputError
 from kinestat.io.textfile import write_text_atomic
 
+
+class _ViewGroup(TyperGroup):
+    """``kinestat view MODEL …`` is ``kinestat view model MODEL …``: a first word that names no
+    view is taken as the model."""
+
+    def resolve_command(self, ctx, args):
+        if args and not args[0].startswith("-") and args[0] not in self.commands:
+            return "model", self.commands["model"], args
+        return super().resolve_command(ctx, args)
+
+
 view_app = typer.Typer(
     name="view",
-    help="3D views in the browser: model, platform, screw, disp, log (or --log FILE).",
+    help="3D views in the browser: MODEL (or model MODEL), platform, screw, disp, log (or "
+    "--log FILE).",
     invoke_without_command=True,
+    cls=_ViewGroup,
 )
 
 HTML_HELP = "Write the page to this HTML file (self-contained, opens offline)."

@@ -79,7 +79,7 @@ def _escape(text: str) -> str:
     return text.replace("&", "&amp;").replace("<", "&lt;").replace(">", "&gt;")
 
 
-def render_html(scene: dict) -> str:
+def render_html(scene: dict, *, meshes: str = "embed") -> str:
     """The self-contained page showing ``scene``."""
     parts = {
         "__THREE__": THREE_VERSION,

@@ -212,3 +212,54 @@ def test_serve_command_prints_its_loopback_address_and_serves():
             proc.kill()
             proc.wait()
     assert proc.returncode == 130  # interrupted: "kinestat: interrupted"
+
+
+def test_view_model_name_first_is_view_model(tmp_path):
+    """`kinestat view MODEL …` is `kinestat view model MODEL …`: the same page."""
+    a, b = tmp_path / "a.html", tmp_path / "b.html"
+    args = ["--q-deg", "10,-30,20,5,40,-15", "--frames"]
+    assert main(["view", "puma762", *args, "--html", str(a)]) == 0
+    assert main(["view", "model", "puma762", *args, "--html", str(b)]) == 0
+    assert _scene(a) == _scene(b)
+
+
+def test_view_unknown_model_first_is_one_error(tmp_path, capsys):
+    assert main(["view", "no-such-robot", "--html", str(tmp_path / "x.html")]) == 2
+    assert "no-such-robot" in _one_error_line(capsys)
+
+
+def test_html_flag_of_computing_commands(tmp_path, opened, capsys):
+    """`--view --html FILE` writes the page there (no browser), the same scene `kinestat view`
+    writes; the JSON output stays clean."""
+    import json
+
+    legs = "81.47,81.27,80.97,68,67.8,68.1"
+    pts = ["--points1", "0,0,0,0,0,1,1,0,0", "--points2", "2,1,0,2,1,1,2,2,0"]
+    cases = [
+        (["platform", "fk", "--legs", legs], ["platform", "--legs", legs]),
+        (["screw", *pts], ["screw", *pts]),
+        (["disp", "illustration5"], ["disp", "illustration5"]),
+    ]
+    for k, (cmd, view) in enumerate(cases):
+        a, b = tmp_path / f"a{k}.html", tmp_path / f"b{k}.html"
+        assert main([*cmd, "--json", "--view", "--html", str(a)]) == 0
+        json.loads(capsys.readouterr().out)
+        assert main(["view", *view, "--html", str(b)]) == 0
+        capsys.readouterr()
+        assert _scene(a) == _scene(b), cmd
+    g = tmp_path / "g.html"
+    assert main(["guide", "puma762", "--q0-deg", "30,-30,20,5,40,-15", "--to",
+                 "300,200,400,300,200,500,400,200,400", "--json", "--view", "--html",
+                 str(g)]) in (0, 2)
+    assert _scene(g)["kind"] == "disp" and len(_scene(g)["steps"]) > 1
+    assert opened == []
+
+
+def test_control_html_flag(tmp_path, capsys):
+    log, page = tmp_path / "log.jsonl", tmp_path / "run.html"
+    assert main(["control", "--log", str(log), "--no-plot", "--json", "--view", "--html",
+                 str(page)]) == 0
+    report = __import__("json").loads(capsys.readouterr().out)
+    s = _scene(page)
+    assert s["kind"] == "log"
+    assert "".join(st["state"] for st in s["steps"]) == report["states"]
