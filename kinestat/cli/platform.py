@@ -176,7 +176,8 @@ def fk_command(
     if view or html is not None:
         from kinestat.viz.show import show_platform_modes  # lazy: viewer only with --view
 
-        show_platform_modes(p, poses, L, html=html)
+        show_platform_modes(p, poses, L, html=html,
+                            physical=0 if physical is None else physical)
     if as_json:
         print_json({**out, "units": units(p.length_unit, p.force_unit)})
         return

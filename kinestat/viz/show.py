@@ -39,11 +39,11 @@ def show(scene: dict, *, open_browser: bool = True, html: str | os.PathLike | No
     return path
 
 
-def show_platform_modes(platform, poses, legs=None, html=None) -> Path:
+def show_platform_modes(platform, poses, legs=None, html=None, physical: int = 0) -> Path:
     """Every assembly mode side by side (``kinestat platform fk --view``)."""
     from kinestat.viz.scene import platform_scene  # lazy: keeps show's import light
 
-    return show(platform_scene(platform, poses, legs=legs), html=html)
+    return show(platform_scene(platform, poses, legs=legs, physical=physical), html=html)
 
 
 def show_screw(T1, T2, points1=None, points2=None, html=None) -> Path:
