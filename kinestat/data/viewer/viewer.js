@@ -298,6 +298,11 @@
       el.appendChild(box);
     }
   }
+  function runLength(xs) {   // "a×3 → b → p×56", as kinestat.viz.scene.run_length
+    const runs = [];
+    for (const x of xs) { if (runs.length && runs[runs.length - 1][0] === x) runs[runs.length - 1][1] += 1; else runs.push([x, 1]); }
+    return runs.map(([x, n]) => n > 1 ? x + "×" + n : x).join(" → ");
+  }
   function setInfo(lines) { $("info").textContent = (lines || []).join("\n"); }
   $("title").textContent = scene.title || "kinestat";
   $("title").title = scene.title || "";
@@ -388,7 +393,7 @@
     timeline.max = Math.max(steps.length - 1, 0);
   }
   if (steps.length || scene.live) {
-    setupPlayer();
+    setupPlayer();   // live runs add steps later
     timeline.addEventListener("input", () => showStep(Number(timeline.value)));
     play.addEventListener("click", () => {
       if (timer) { clearInterval(timer); timer = null; play.textContent = "play"; return; }
@@ -441,7 +446,9 @@
     if (n) {   // the cursor: the cycle shown in the 3D view
       const k = Math.min(status.step, n - 1), x = X(sr.cycle[k]);
       g.strokeStyle = "#7f00ff"; g.lineWidth = 1.5; g.beginPath(); g.moveTo(x, T); g.lineTo(x, H - B); g.stroke();
-      g.fillStyle = "#7f00ff"; g.textAlign = "center"; g.textBaseline = "bottom"; g.fillText("cycle " + sr.cycle[k], x, T + 12 > H - B ? T : T + 12);
+      const right = x < (L + W - R) / 2;
+      g.fillStyle = "#7f00ff"; g.textAlign = right ? "left" : "right"; g.textBaseline = "top";
+      g.fillText("cycle " + sr.cycle[k], x + (right ? 4 : -4), T + 4);
       status.cursor = { cycle: sr.cycle[k], x: x };
     }
   }
@@ -537,7 +544,8 @@
 
   // "#step=N" in the address opens the animation at step N (links, screenshots)
   const wanted = /step=(\d+)/.exec(location.hash || "");
-  const first = wanted ? Math.min(Number(wanted[1]), Math.max(steps.length - 1, 0)) : 0;
+  const last = Math.max(steps.length - 1, 0);   // a live run opens on its latest cycle
+  const first = wanted ? Math.min(Number(wanted[1]), last) : (scene.live ? last : 0);
   if (steps.length) { timeline.value = first; showStep(first); }
   else { if (robot) drawRobot(robot, q); setInfo(scene.info); legend(scene.items); }
   if (modes.length) showMode(modeShown);
@@ -546,6 +554,7 @@
     steps.push(st);
     if (scene.series && st.series) for (const key of ["cycle", "force", "magnitude"]) scene.series[key].push(st.series[key]);
     setupPlayer();
+    if (scene.info && scene.info.length) scene.info[0] = steps.length + " cycles, states " + runLength(steps.map((x) => x.state || "?"));
     const follow = Number(timeline.value) >= steps.length - 2 || steps.length === 1;
     if (follow) { timeline.value = steps.length - 1; showStep(steps.length - 1); } else drawPlot();
     st.shown_ms = Date.now();
@@ -555,7 +564,26 @@
     status.ready = true;
     status.load_ms = performance.now();   // since navigation start: parse, build, first render
     status.webgl = renderer.getContext() ? true : false;
+    status.live = scene.live ? { received: [], ended: !!scene.live.ended } : null;
     publish();
-    if (window.kinestatLive) window.kinestatLive(api);
+    if (scene.live && !scene.live.ended) listen();
   });
+  function listen() {   // live runs: each cycle as the server reads it from the log
+    const el = $("live-status"); el.hidden = false;
+    el.textContent = "live: " + steps.length + " cycle(s) so far, waiting for the next";
+    const es = new EventSource(scene.live.events + "?from=" + steps.length);
+    es.onmessage = (e) => {
+      const st = JSON.parse(e.data); api.addStep(st);
+      status.live.received.push({ cycle: st.series ? st.series.cycle : steps.length, shown_ms: st.shown_ms });
+      el.textContent = "live: " + (st.label || ("cycle " + steps.length));
+      publish();
+    };
+    es.addEventListener("end", (e) => {
+      es.close(); status.live.ended = true;
+      const rep = JSON.parse(e.data || "{}");
+      el.textContent = "run ended" + (rep.stop_reason ? ": " + rep.stop_reason : "") + " (" + steps.length + " cycles)";
+      publish();
+    });
+    es.onerror = () => { if (!status.live.ended) el.textContent = "live view: connection lost"; };
+  }
 })();
