@@ -50,7 +50,7 @@ ESBUILD_VERSION ?= 0.28.2
 vendor-three:
 	rm -rf build/three && mkdir -p build/three
 	cd build/three && npm install --no-save --silent three@$(THREE_VERSION) esbuild@$(ESBUILD_VERSION) \
-	  && printf "export * from 'three';\nexport { OrbitControls } from 'three/addons/controls/OrbitControls.js';\nexport { TransformControls } from 'three/addons/controls/TransformControls.js';\n" > entry.js \
+	  && printf "export * from 'three';\nexport { OrbitControls } from 'three/addons/controls/OrbitControls.js';\nexport { TransformControls } from 'three/addons/controls/TransformControls.js';\nexport { STLLoader } from 'three/addons/loaders/STLLoader.js';\nexport { ColladaLoader } from 'three/addons/loaders/ColladaLoader.js';\nexport { OBJLoader } from 'three/addons/loaders/OBJLoader.js';\n" > entry.js \
 	  && node_modules/.bin/esbuild entry.js --bundle --minify --format=iife --global-name=THREE \
 	       --legal-comments=none --outfile=../../kinestat/data/viewer/vendor/three.min.js
 	cp build/three/node_modules/three/LICENSE kinestat/data/viewer/vendor/LICENSE-three.txt

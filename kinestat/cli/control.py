@@ -277,6 +277,11 @@ def control_command(
         None, "--log", help="Cycle log file, JSON lines (default: "
         "./kinestat-runs/<timestamp>/log.jsonl)."),
     view: bool = flag(False, "--view", help="Also open a 3D replay in the browser."),
+    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+                              "3D replay to FILE (self-contained) instead of opening a browser."),
+    serve: bool = flag(False, "--serve", help="With --view: a live view on loopback while the "
+                       "run goes (each cycle streamed to the page as it is logged); its address "
+                       "goes to stderr, and after the run it serves until Ctrl-C."),
     calibration: str = typer.Option(
         "thesis", "--calibration",
         help="Leg calibration the controller uses (counts -> leg length and force): 'thesis' "
@@ -439,6 +444,8 @@ def control_command(
         with compiling_notice(*cold):
             warm_kernels(cold)
     prepared = prepare_control(req)
+    if serve and (not view or html is not None):
+        raise InputError("--serve goes with --view (and not with --html)")
     run_dir = None  # claimed only now: a refused request leaves nothing behind
     if log is None or (plot is None and not no_plot):
         run_dir = _run_dir(Path("kinestat-runs"))
@@ -454,6 +461,7 @@ def control_command(
                       + ("" if prepared.follow is None else
                          "; follow {:g} mm, first along ({:.4f}, {:.4f}, {:.4f})".format(
                              prepared.follow.travel, *prepared.follow.travel_dir)))
+    live = _start_live(log_path, platform) if serve else None
     # SIGTERM / SIGHUP stop the cell as Ctrl-C does: ST, a fault and an end record, status 2
     with stop_on_signals():
         try:
@@ -473,10 +481,12 @@ def control_command(
             print_json(out)
         else:
             _print_report(out)
-    if view:
+    if live is not None:
+        _serve_until_interrupted(live)
+    elif view or html is not None:
         from kinestat.viz.show import show_log  # lazy: viewer only with --view
 
-        show_log(log_path)
+        show_log(log_path, html=html)
     if not report.converged:
         what = "the follow task did not complete" if task == "follow" else (
             "kinestatic control did not converge")
@@ -498,6 +508,37 @@ def _tool_and_mount(tool_offset: str | None, a67: str | None, mount: str | None)
         else:
             out["mount"] = parse_pose(text, "mount")
     return out
+
+
+def _start_live(log_path: Path, platform: str | None):
+    """The live view of the run (``--view --serve``), opened in the browser."""
+    import webbrowser
+
+    from kinestat.viz.live import start_live  # lazy: the server only with --serve
+
+    p = None
+    if platform is not None:
+        from kinestat.io.platform_toml import read_platform  # lazy: only with --platform
+
+        p = read_platform(platform)
+    live = start_live(log_path, platform=p)
+    err_console.print(f"kinestat control: live view at {live.url}")
+    err_console.file.flush()
+    webbrowser.open(live.url)
+    return live
+
+
+def _serve_until_interrupted(live) -> None:
+    err_console.print(f"kinestat control: the run has ended; the live view stays at {live.url} "
+                      "until Ctrl-C")
+    err_console.file.flush()
+    try:
+        while True:
+            time.sleep(3600)
+    except KeyboardInterrupt:
+        pass
+    finally:
+        live.close()
 
 
 def _arm_words(placed) -> str:

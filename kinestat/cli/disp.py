@@ -95,6 +95,8 @@ def disp(
                                    "reproduces that table with the illustration5-published "
                                    "deck. Not stated in the thesis."),
     view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
+    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+                              "3D page to FILE (self-contained) instead of opening a browser."),
 ) -> None:
     """Run a DISP deck (Nadkarni 1977): MS 1 screw axes, 2 mechanism data, 3 both, 0/4/5/6
     guidance of types II/III/IV/I.
@@ -141,10 +143,10 @@ def disp(
                 console.print(f"note: {literal(n)}")
         for p in written:
             console.print(f"wrote {literal(p)}")
-    if view and run.result is not None:
+    if (view or html is not None) and run.result is not None:
         from kinestat.viz.show import show_guidance  # lazy: viewer only with --view
 
-        show_guidance(run.result, f"DISP MS = {d.ms}: {d.source}")
+        show_guidance(run.result, f"DISP MS = {d.ms}: {d.source}", html=html)
     if run.result is not None:
         run.result.raise_if_stopped()
 

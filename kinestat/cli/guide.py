@@ -204,6 +204,8 @@ def guide(
                                 "(Nadkarni suggestion 1): deg/s of rotation, or length/s for a "
                                 "pure translation."),
     view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
+    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+                              "3D page to FILE (self-contained) instead of opening a browser."),
     tip: str = tip_option(),
     base: str = base_option(),
     scale: float = scale_option(),
@@ -284,10 +286,10 @@ def guide(
                                  for i in range(m.n)]))
         for p in written:
             console.print(f"wrote {literal(p)}")
-    if view:
+    if view or html is not None:
         from kinestat.viz.show import show_guidance  # lazy: viewer only with --view
 
-        show_guidance(result, f"kinestat guide {m.name}")
+        show_guidance(result, f"kinestat guide {m.name}", html=html)
     result.raise_if_stopped()
 
 

@@ -9,6 +9,8 @@ origin O0, base frame (see docs/platform.md for the sign conventions).
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import typer
 
@@ -139,6 +141,8 @@ def fk_command(
     platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
     all_poses: bool = flag(False, "--all-poses", help="Also print every mode's 4x4 pose."),
     view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
+    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+                              "3D page to FILE (self-contained) instead of opening a browser."),
     as_json: bool = json_option(),
 ) -> None:
     """Every real assembly mode for six leg lengths, each verified by reverse kinematics; the
@@ -181,10 +185,11 @@ def fk_command(
     out = {"count": len(sols), "method": method, "leg_names": list(p.leg_names),
            "leg_lengths": L, "solutions": sols,
            "physical_mode": None if physical is None else physical + 1}
-    if view:
+    if view or html is not None:
         from kinestat.viz.show import show_platform_modes  # lazy: viewer only with --view
 
-        show_platform_modes(p, poses, L)
+        show_platform_modes(p, poses, L, html=html,
+                            physical=0 if physical is None else physical)
     if as_json:
         print_json({**out, "units": units(p.length_unit, p.force_unit)})
         return

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import typer
 
@@ -61,6 +63,8 @@ def screw(
     points2: str = typer.Option(None, "--points2", help="Second position, as --points1.",
                                 metavar=POINTS3_METAVAR),
     view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
+    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+                              "3D page to FILE (self-contained) instead of opening a browser."),
     as_json: bool = json_option(),
 ) -> None:
     """Screw axis of the displacement between two positions of a body (Nadkarni ch. III).
@@ -81,14 +85,14 @@ def screw(
         if points1 is None or points2 is None:
             raise InputError("both --points1 and --points2 are needed")
         sc = screw_from_points(_points(points1, "points1"), _points(points2, "points2"))
-    if view:
+    if view or html is not None:
         from kinestat.viz.show import show_screw  # lazy: viewer only with --view
 
         if by_pose:
-            show_screw(_pose(pose1, "pose1"), _pose(pose2, "pose2"))
+            show_screw(_pose(pose1, "pose1"), _pose(pose2, "pose2"), html=html)
         else:
             P1, P2 = _points(points1, "points1"), _points(points2, "points2")
-            show_screw(frame_from_triple(P1), frame_from_triple(P2), P1, P2)
+            show_screw(frame_from_triple(P1), frame_from_triple(P2), P1, P2, html=html)
     if as_json:
         print_json({**screw_json(sc), "units": units("the input's length unit")})
         return

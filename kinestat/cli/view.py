@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import typer
+from typer.core import TyperGroup
 
 from kinestat.cli._model import (
     MODEL_HELP,
@@ -35,10 +36,23 @@ from kinestat.cli._output import console, parse_floats, parse_pose
 from kinestat.errors import InputError
 from kinestat.io.textfile import write_text_atomic
 
+
+class _ViewGroup(TyperGroup):
+    """``kinestat view MODEL …`` is ``kinestat view model MODEL …``: a first word that names no
+    view is taken as the model."""
+
+    def resolve_command(self, ctx, args):
+        if args and not args[0].startswith("-") and args[0] not in self.commands:
+            return "model", self.commands["model"], args
+        return super().resolve_command(ctx, args)
+
+
 view_app = typer.Typer(
     name="view",
-    help="3D views in the browser: model, platform, screw, disp, log (or --log FILE).",
+    help="3D views in the browser: MODEL (or model MODEL), platform, screw, disp, log (or "
+    "--log FILE).",
     invoke_without_command=True,
+    cls=_ViewGroup,
 )
 
 HTML_HELP = "Write the page to this HTML file (self-contained, opens offline)."
@@ -69,7 +83,7 @@ def _out_options(html: Path | None, serve: bool, host: str, port: int, no_open: 
     return _Out(html, serve, host, port, no_open, allow_remote)
 
 
-def _emit(scene: dict, out: _Out, model=None) -> None:
+def _emit(scene: dict, out: _Out, model=None, meshes: str = "embed") -> None:
     # lazy: the viewer (three.js page, HTTP server) loads only when a view is asked for
     from kinestat.viz.html import render_html
 
@@ -77,6 +91,9 @@ def _emit(scene: dict, out: _Out, model=None) -> None:
         # lazy: the HTTP server and IK only with --serve
         from kinestat.viz.serve import make_server
 
+        if meshes == "none" and scene.get("meshes"):
+            scene = {**scene, "meshes": [], "mesh_messages": [
+                *scene.get("mesh_messages", []), "meshes not drawn (--meshes none)"]}
         srv = make_server(scene, host=out.host, port=out.port, model=model,
                           allow_remote=out.allow_remote)
         host, port = srv.server_address[:2]
@@ -93,9 +110,9 @@ def _emit(scene: dict, out: _Out, model=None) -> None:
     if out.html is None:
         from kinestat.viz.show import show  # lazy: as above
 
-        show(scene, open_browser=not out.no_open)
+        show(scene, open_browser=not out.no_open, meshes=meshes)
         return
-    write_text_atomic(out.html, render_html(scene))
+    write_text_atomic(out.html, render_html(scene, meshes=meshes))
     console.print(f"wrote {out.html}")
 
 
@@ -157,6 +174,9 @@ def view_model(
     q_deg: str = typer.Option(None, "--q-deg", help="Joint values, rotating joints in degrees.",
                               metavar=Q_METAVAR),
     frames: bool = flag(False, "--frames", help="Show every joint frame."),
+    meshes: str = typer.Option("embed", "--meshes", metavar="embed|link|none", help="A URDF "
+                               "model's visual meshes (STL, DAE, OBJ): in the page (one offline "
+                               "file), linked to the files, or none (the stick figure)."),
     tip: str = tip_option(),
     base: str = base_option(),
     scale: float = scale_option(),
@@ -166,7 +186,8 @@ def view_model(
     no_open: bool = _no_open_opt(),
 ) -> None:
     """A serial model with joint sliders (FK in the page); IK of a target with --serve."""
-    from kinestat.viz.scene import model_scene  # lazy: scenes load only for a view
+    # lazy: scenes load only for a view
+    from kinestat.viz.scene import check_within_limits, model_scene
 
     out = _out_options(html, serve, host, port, no_open, allow_remote)
     m = load_model(model, tip, base, scale, length_unit)
@@ -178,7 +199,17 @@ def view_model(
     elif q_deg is not None:
         vals = parse_floats(q_deg, m.n, "q-deg")
         vals = np.where(m.prismatic, vals, np.deg2rad(vals))
-    _emit(model_scene(m, vals, show_frames=frames), out, model=m)
+    if vals is not None:
+        check_within_limits(m, vals, "--q" if q is not None else "--q-deg")
+    if meshes not in ("embed", "link", "none"):
+        raise InputError(f"--meshes must be embed, link or none, got {meshes!r}")
+    visuals = None
+    if Path(model).suffix.lower() == ".urdf" and Path(model).is_file():
+        from kinestat.viz.meshes import urdf_meshes  # lazy: only for a URDF
+
+        visuals = urdf_meshes(model, m, base=base, scale=scale, length_unit=length_unit)
+    _emit(model_scene(m, vals, show_frames=frames, meshes=visuals), out, model=m,
+          meshes=meshes)
 
 
 @view_app.command("platform")

@@ -20,9 +20,28 @@ from kinestat.errors import InputError
 from kinestat.io.library import prototype
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import Joint
-from kinestat.viz.scene import _base, _pt, chain_frames, force_color, robot_record
+from kinestat.viz.scene import (
+    _base,
+    _configuration,
+    _pt,
+    chain_frames,
+    force_color,
+    robot_record,
+    run_length,
+)
 
-__all__ = ["read_cycle_log", "cell_scene"]
+__all__ = ["read_cycle_log", "cell_scene", "force_series"]
+
+
+def force_series(cycles: list[dict], target: float, unit: str) -> dict:
+    """The measured force per cycle for the page's plot (the Fig. 5-2 panels): ``cycle``,
+    ``force`` (x, y, z per cycle, the estimate the controller acted on), ``magnitude``,
+    ``target`` and ``unit``."""
+    F = [[float(x) for x in (c["measured"].get("estimate") or c["measured"]["force"])]
+         for c in cycles]
+    return {"cycle": [int(c.get("cycle", k + 1)) for k, c in enumerate(cycles)], "force": F,
+            "magnitude": [float(np.linalg.norm(f)) for f in F], "target": float(target),
+            "unit": unit}
 
 _CYCLE_KEYS = ("joints_deg", "top_pose", "tip", "force", "leg_lengths")
 
@@ -86,7 +105,8 @@ def _cycle_items(platform, mount, F6, meas: dict, true: dict | None,
     for name, b, p, f in zip(platform.leg_names, Bw, Pw, forces, strict=True):
         items.append({"type": "segment", "a": _pt(b), "b": _pt(p), "radius": platform.scale * 0.03,
                       "color": force_color(float(f), fmax),
-                      "label": f"leg {name}: {float(f):+.3g} {platform.force_unit}"})
+                      "label": f"leg {name}: {float(f):+.3g} {platform.force_unit}",
+                      "group": "platform legs"})
     tip = np.asarray(meas["tip"], dtype=float)
     items.append({"type": "segment", "a": _pt(top[:3, 3]), "b": _pt(tip),
                   "radius": platform.scale * 0.05, "color": "#444444", "label": "tool"})
@@ -129,6 +149,7 @@ def cell_scene(start: dict, cycles: list[dict], end: dict | None = None, *, plat
     force_scale = 0.08 * scale / max(target, 1e-9)
     s = _base("log", title, model.length_unit, scale)
     s["robot"] = robot_record(model, Q[0], live=False)
+    _configuration(s, model, Q[0])
     s["frames"] = chain_frames(model, Q[0])
     s["items"] = _workpiece(start, 0.1 * scale)
     s["items"].append({"type": "polyline", "points": [_pt(c["measured"]["tip"]) for c in cycles],
@@ -151,9 +172,11 @@ def cell_scene(start: dict, cycles: list[dict], end: dict | None = None, *, plat
                       "items": _cycle_items(platform, mount, Fall[k], meas, c.get("true"),
                                             force_scale)})
     s["steps"] = steps
-    # the view opens on the wrist, the platform, the tool and the workpiece (zoom out for more)
-    s["focus"] = {"point": _pt(cycles[0]["measured"]["tip"]), "radius": 0.35 * scale}
-    s["info"] = [f"{len(cycles)} cycles, states {''.join(c.get('state', '?') for c in cycles)}"]
+    # the view opens on the whole cell; "frame tool" looks at the wrist, platform and tool
+    s["tool_focus"] = {"point": _pt(cycles[0]["measured"]["tip"]), "radius": 0.35 * scale}
+    s["series"] = force_series(cycles, target, platform.force_unit)
+    s["info"] = [f"{len(cycles)} cycles, states "
+                 f"{run_length(c.get('state', '?') for c in cycles)}"]
     if end is not None and isinstance(end.get("report"), dict):
         rep = end["report"]
         s["info"].append(f"converged: {rep.get('converged')}, stop: {rep.get('stop_reason')}")

@@ -154,10 +154,8 @@ class Browser:
             url += f"#{fragment}" if fragment else ""
             self.send("Page.navigate", {"url": url}, session)
             self._wait_event("Page.loadEventFired", session)
+            text = self._status_text(session)
             dt = time.perf_counter() - t0
-            text = self.send("Runtime.evaluate", {"expression": _STATUS_JS,
-                                                  "returnByValue": True}, session)
-            text = text.get("result", {}).get("value") or ""
             value = None
             if evaluate is not None:
                 ans = self.send("Runtime.evaluate", {"expression": evaluate, "awaitPromise": True,
@@ -178,6 +176,20 @@ class Browser:
             self.send("Target.closeTarget", {"targetId": target})
         return PageResult(status=json.loads(text) if text else {}, console=console, png=png,
                           seconds=dt, value=value)
+
+    def _status_text(self, session: str) -> str:
+        """The viewer's status once it has published it (meshes load after the load event),
+        or "" when the page threw an uncaught exception or the timeout passed."""
+        deadline = time.monotonic() + self.timeout
+        while True:
+            ans = self.send("Runtime.evaluate", {"expression": _STATUS_JS,
+                                                 "returnByValue": True}, session)
+            text = ans.get("result", {}).get("value") or ""
+            thrown = any(e.get("sessionId") == session
+                         and e.get("method") == "Runtime.exceptionThrown" for e in self._events)
+            if text or thrown or time.monotonic() > deadline:
+                return text
+            time.sleep(0.05)
 
     def close(self) -> None:
         if self._proc.poll() is None:

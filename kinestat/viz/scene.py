@@ -15,6 +15,9 @@ point a 3-list. The keys:
   ``live`` (sliders shown);
 - ``items``: static drawables (below); ``steps``: ``[{"label", "q", "frames", "items",
   "info"}]`` for animations, per step the same frames plus items drawn at that step only;
+- ``q`` (the configuration shown first, radians for rotating joints, the length unit for
+  prismatic ones), ``limits`` (``[lower, upper]`` per joint, same units, ``null`` where
+  unbounded) and ``q_units`` when the scene has a robot;
 - optional: ``show_frames`` (joint frames drawn at first), ``focus`` (``{"point", "radius"}``,
   where the camera looks first), ``force_unit``, ``ik_url`` (served pages).
 
@@ -43,11 +46,14 @@ __all__ = [
     "chain_frames",
     "robot_record",
     "model_scene",
+    "opening_q",
+    "check_within_limits",
     "platform_scene",
     "screw_scene",
     "guidance_scene",
     "force_color",
     "wrench_axis",
+    "run_length",
 ]
 
 SCHEMA = "kinestat-scene/1"
@@ -101,20 +107,65 @@ def robot_record(model: ChainModel, q, *, live: bool = False) -> dict:
     }
 
 
+def _limit(x: float) -> float | None:
+    return float(x) if math.isfinite(x) else None
+
+
+def _configuration(s: dict, model: ChainModel, q) -> None:
+    """The scene's ``q``, ``limits`` and ``q_units`` keys (docs/viewer.md)."""
+    s["q"] = [float(x) for x in q]
+    s["limits"] = [[_limit(lo), _limit(hi)] for lo, hi in zip(model.lower, model.upper,
+                                                               strict=True)]
+    s["q_units"] = [model.length_unit if p else "rad" for p in model.prismatic]
+
+
+def opening_q(model: ChainModel) -> np.ndarray:
+    """The configuration a model opens at: its home when within the joint limits, else the
+    point within the limits nearest to zero (each joint clipped into its interval).
+
+    >>> import kinestat
+    >>> [round(float(x), 4) for x in np.degrees(opening_q(kinestat.load("puma762")))][:2]
+    [20.0, 0.0]
+    """
+    home = np.asarray(model.q_home, dtype=float)
+    if bool(model.within_limits(home)):
+        return home
+    return np.clip(np.zeros(model.n), model.lower, model.upper)
+
+
+def check_within_limits(model: ChainModel, q, what: str = "q") -> np.ndarray:
+    """``q`` when every joint is within its limits; else an InputError naming the joint."""
+    q = model.check_q(q)
+    for i, (x, lo, hi) in enumerate(zip(q, model.lower, model.upper, strict=True)):
+        if not lo <= x <= hi:
+            k = 1.0 if model.prismatic[i] else 180.0 / math.pi
+            u = model.length_unit if model.prismatic[i] else "deg"
+            name = model.joints[i].name
+            named = "" if name in ("", str(i + 1)) else f" ({name})"
+            raise InputError(f"{what}: joint {i + 1}{named} = {x * k:.6g} "
+                             f"{u} is outside its limits [{lo * k:.6g}, {hi * k:.6g}] {u}")
+    return q
+
+
 def _base(kind: str, title: str, unit: str, scale: float) -> dict:
     return {"schema": SCHEMA, "kind": kind, "title": title, "length_unit": unit,
             "scale": float(scale), "info": [], "frames": [], "robot": None, "items": [],
             "steps": []}
 
 
-def model_scene(model: ChainModel, q=None, *, show_frames: bool = False) -> dict:
-    """A serial model at ``q`` (default ``q_home``) with live joint sliders."""
-    q = model.q_home if q is None else model.check_q(q)
+def model_scene(model: ChainModel, q=None, *, show_frames: bool = False,
+                meshes: tuple[list[dict], list[str]] | None = None) -> dict:
+    """A serial model at ``q`` (default :func:`opening_q`; a given ``q`` must lie within the
+    joint limits, as the sliders do) with live joint sliders."""
+    q = opening_q(model) if q is None else check_within_limits(model, q)
     scale = _span(model, q)
     s = _base("model", f"{model.name} ({model.n} joints)", model.length_unit, scale)
     s["frames"] = chain_frames(model, q)
     s["robot"] = robot_record(model, q, live=True)
+    _configuration(s, model, q)
     s["show_frames"] = bool(show_frames)
+    if meshes is not None:  # a URDF's visual meshes (kinestat.viz.meshes.urdf_meshes)
+        s["meshes"], s["mesh_messages"] = list(meshes[0]), list(meshes[1])
     s["info"] = [f"notation {model.notation}, lengths in {model.length_unit}",
                  "joints: " + ", ".join(f"{j.name} {j.kind}" for j in model.joints)]
     return s
@@ -151,6 +202,21 @@ def wrench_axis(w) -> tuple[np.ndarray, np.ndarray, float] | None:
     if ff <= 1e-24:
         return None
     return f / math.sqrt(ff), np.cross(f, m) / ff, float(f @ m) / ff
+
+
+def run_length(states) -> str:
+    """A sequence of states in run-length form, runs joined by arrows.
+
+    >>> run_length("aaab" + "p" * 3 + "tt")
+    'a×3 → b → p×3 → t×2'
+    """
+    runs: list[list] = []
+    for x in states:
+        if runs and runs[-1][0] == x:
+            runs[-1][1] += 1
+        else:
+            runs.append([x, 1])
+    return " → ".join(f"{x}×{n}" if n > 1 else f"{x}" for x, n in runs)
 
 
 def _platform_items(platform, T, offset: np.ndarray, forces, tag: str) -> list[dict]:
@@ -192,7 +258,10 @@ def _wrench_items(platform, T, offset, w, tag: str, force_scale: float) -> list[
 
 def platform_scene(platform, poses, *, legs=None, physical: int = 0,
                    wrench=None) -> dict:
-    """Every assembly mode (``poses``) side by side; ``physical`` marks the assembled one.
+    """Every assembly mode (``poses``) in the platform's base frame, one at a time in the page
+    (``modes``: the physical one first, the others ghosted on demand); ``physical`` marks the
+    assembled one. Every item carries its ``mode`` (0-based index into ``poses``) and its
+    legend ``group``.
 
     Leg forces are the springs' tensions at each pose (Vibhute eq. 2-9), or those balancing
     ``wrench`` (eq. 2-8) when given; the wrench drawn is ``j f`` (eqs. 2-3 to 2-5).
@@ -200,36 +269,34 @@ def platform_scene(platform, poses, *, legs=None, physical: int = 0,
     poses = [np.asarray(T, dtype=float) for T in poses]
     if not poses:
         raise InputError("no platform pose to show")
-    gap = 3.0 * platform.scale
+    physical = physical if 0 <= physical < len(poses) else 0
     s = _base("platform", f"{platform.name}: {len(poses)} assembly mode(s)",
               platform.length_unit, platform.scale)
     s["force_unit"] = platform.force_unit
     items, frames = [], []
+    order = [physical] + [k for k in range(len(poses)) if k != physical]
+    s["modes"] = [{"index": k, "label": f"mode {k + 1}" + (" (physical)" if k == physical
+                                                            else "")} for k in order]
+    zero = np.zeros(3)
     for k, T in enumerate(poses):
-        off = np.array([k * gap, 0.0, 0.0])
         tag = f"mode {k + 1}" + (" (physical)" if k == physical else "")
         f = (spring_forces(platform, leg_lengths(platform, T)) if wrench is None
              else forces_from_wrench(platform, T, wrench))
         w = wrench_from_forces(platform, T, f)
         fmax = float(np.max(np.abs(w[:3]))) or 1.0
-        items += _platform_items(platform, T, off, f, tag)
-        items += _wrench_items(platform, T, off, w, tag, platform.scale / fmax)
-        Tw = T.copy()
-        Tw[:3, 3] += off
-        items.append({"type": "frame", "pose": _pose(Tw), "size": platform.scale * 0.3})
-        if k == physical:
-            items.append({"type": "marker", "at": _pt(off + [0, 0, -0.15 * platform.scale]),
-                          "radius": platform.scale * 0.12, "color": "#ff7f0e",
-                          "label": f"mode {k + 1} is the physical assembly"})
-        base = np.eye(4)
-        base[:3, 3] = off
-        frames += [{"name": f"base{k + 1}", "pose": _pose(base)},
-                   {"name": f"top{k + 1}", "pose": _pose(Tw)}]
+        mine = _platform_items(platform, T, zero, f, "")
+        mine += _wrench_items(platform, T, zero, w, "", platform.scale / fmax)
+        mine.append({"type": "frame", "pose": _pose(T), "size": platform.scale * 0.3})
+        for it in mine:
+            it["mode"], it["group"] = k, tag
+            if "label" in it:
+                it["label"] = it["label"].strip()
+        items += mine
+        frames.append({"name": f"top{k + 1}", "pose": _pose(T)})
         s["info"].append(f"{tag}: z = {T[2, 3]:.4g} {platform.length_unit}, leg forces "
                          + ", ".join(f"{x:+.3g}" for x in f))
-    Tp = poses[physical].copy()
-    Tp[:3, 3] += [physical * gap, 0.0, 0.0]
-    frames.append({"name": "end", "pose": _pose(Tp)})
+    frames.insert(0, {"name": "base", "pose": _pose(np.eye(4))})
+    frames.append({"name": "end", "pose": _pose(poses[physical])})
     s["frames"], s["items"] = frames, items
     if legs is not None:
         s["info"].insert(0, "leg lengths " + ", ".join(f"{x:.4g}" for x in legs))
@@ -289,6 +356,7 @@ def guidance_scene(result, *, title: str = "guidance run") -> dict:
     scale = max(_span(m, Q[0]), float(np.max(np.ptp(E[:, :3, 3], axis=0))))
     s = _base("disp", title, m.length_unit, scale)
     s["robot"] = robot_record(m, Q[0], live=False)
+    _configuration(s, m, Q[0])
     s["frames"] = chain_frames(m, Q[0])
     names = [f"joint{i + 1}" for i in range(m.n)] + ["end"]
     stage = np.asarray(result.stage)

@@ -35,8 +35,8 @@ def _views(rph_model_path, control_log):
     log = read_cycle_log(control_log)[1]
     res = run_deck(embedded_deck("illustration5")).result
     return {
-        "model": (["model", "puma762", "--q-deg", "10,-30,20,5,40,-15", "--frames"],
-                  kinestat.load("puma762"), np.radians([10, -30, 20, 5, 40, -15])),
+        "model": (["model", "puma762", "--q-deg", "30,-30,20,5,40,-15", "--frames"],
+                  kinestat.load("puma762"), np.radians([30, -30, 20, 5, 40, -15])),
         "model-rph": (["model", str(rph_model_path), "--q", "0.4,120,-1.1", "--frames"],
                       kinestat.load(str(rph_model_path)), np.array([0.4, 120.0, -1.1])),
         "platform": (["platform", "--legs", "81.47,81.27,80.97,68,67.8,68.1"], None, None),

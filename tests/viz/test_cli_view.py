@@ -22,12 +22,12 @@ def _frames(scene) -> dict:
 
 def test_view_model_html(tmp_path, capsys):
     out = tmp_path / "m.html"
-    assert main(["view", "model", "puma762", "--q-deg", "10,-30,20,5,40,-15", "--html",
+    assert main(["view", "model", "puma762", "--q-deg", "30,-30,20,5,40,-15", "--html",
                  str(out)]) == 0
     assert str(out) in capsys.readouterr().out
     s = _scene(out)
     m = kinestat.load("puma762")
-    q = np.radians([10, -30, 20, 5, 40, -15])
+    q = np.radians([30, -30, 20, 5, 40, -15])
     np.testing.assert_allclose(_frames(s)["end"], kinestat.fk(m, q), atol=1e-9, rtol=0)
 
 
@@ -155,11 +155,9 @@ def test_view_flags_of_existing_commands(opened, capsys):
     s = _opened_scene(opened[-1])
     tops = [np.array(f["pose"]) for f in s["frames"] if f["name"].startswith("top")]
     assert s["kind"] == "platform" and len(tops) == out["count"]
-    for k, (T, sol) in enumerate(zip(tops, out["solutions"], strict=True)):
-        shift = np.array(sol["pose"])
-        shift[0, 3] += T[0, 3] - np.array(sol["pose"])[0, 3]
-        np.testing.assert_allclose(T, shift, atol=1e-9)
-        assert k == 0 or T[0, 3] > tops[k - 1][0, 3]
+    for T, sol in zip(tops, out["solutions"], strict=True):  # each mode where fk puts it
+        np.testing.assert_allclose(T, np.array(sol["pose"]), atol=1e-9)
+    assert s["modes"][0]["index"] == out["physical_mode"] - 1  # the physical one first
     assert main(["screw", "--points1", "0,0,0,0,0,1,1,0,0", "--points2", "2,1,0,2,1,1,2,2,0",
                  "--view"]) == 0
     assert _opened_scene(opened[-1])["kind"] == "screw"
@@ -212,3 +210,54 @@ def test_serve_command_prints_its_loopback_address_and_serves():
             proc.kill()
             proc.wait()
     assert proc.returncode == 130  # interrupted: "kinestat: interrupted"
+
+
+def test_view_model_name_first_is_view_model(tmp_path):
+    """`kinestat view MODEL …` is `kinestat view model MODEL …`: the same page."""
+    a, b = tmp_path / "a.html", tmp_path / "b.html"
+    args = ["--q-deg", "30,-30,20,5,40,-15", "--frames"]
+    assert main(["view", "puma762", *args, "--html", str(a)]) == 0
+    assert main(["view", "model", "puma762", *args, "--html", str(b)]) == 0
+    assert _scene(a) == _scene(b)
+
+
+def test_view_unknown_model_first_is_one_error(tmp_path, capsys):
+    assert main(["view", "no-such-robot", "--html", str(tmp_path / "x.html")]) == 2
+    assert "no-such-robot" in _one_error_line(capsys)
+
+
+def test_html_flag_of_computing_commands(tmp_path, opened, capsys):
+    """`--view --html FILE` writes the page there (no browser), the same scene `kinestat view`
+    writes; the JSON output stays clean."""
+    import json
+
+    legs = "81.47,81.27,80.97,68,67.8,68.1"
+    pts = ["--points1", "0,0,0,0,0,1,1,0,0", "--points2", "2,1,0,2,1,1,2,2,0"]
+    cases = [
+        (["platform", "fk", "--legs", legs], ["platform", "--legs", legs]),
+        (["screw", *pts], ["screw", *pts]),
+        (["disp", "illustration5"], ["disp", "illustration5"]),
+    ]
+    for k, (cmd, view) in enumerate(cases):
+        a, b = tmp_path / f"a{k}.html", tmp_path / f"b{k}.html"
+        assert main([*cmd, "--json", "--view", "--html", str(a)]) == 0
+        json.loads(capsys.readouterr().out)
+        assert main(["view", *view, "--html", str(b)]) == 0
+        capsys.readouterr()
+        assert _scene(a) == _scene(b), cmd
+    g = tmp_path / "g.html"
+    assert main(["guide", "puma762", "--q0-deg", "30,-30,20,5,40,-15", "--to",
+                 "300,200,400,300,200,500,400,200,400", "--json", "--view", "--html",
+                 str(g)]) in (0, 2)
+    assert _scene(g)["kind"] == "disp" and len(_scene(g)["steps"]) > 1
+    assert opened == []
+
+
+def test_control_html_flag(tmp_path, capsys):
+    log, page = tmp_path / "log.jsonl", tmp_path / "run.html"
+    assert main(["control", "--log", str(log), "--no-plot", "--json", "--view", "--html",
+                 str(page)]) == 0
+    report = __import__("json").loads(capsys.readouterr().out)
+    s = _scene(page)
+    assert s["kind"] == "log"
+    assert "".join(st["state"] for st in s["steps"]) == report["states"]

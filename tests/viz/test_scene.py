@@ -55,7 +55,7 @@ def test_rph_chain_and_urdf_round_trip(rph_model_path, tmp_path):
     u = tmp_path / "puma.urdf"
     u.write_text(to_urdf(p), encoding="utf-8")
     mu = read_urdf(u)
-    q6 = np.radians([10, -20, 30, -40, 50, -60])
+    q6 = np.radians([30, -20, 30, -40, 50, -60])
     _chain_ok(mu, q6, _frames(model_scene(mu, q6)))
 
 
@@ -63,28 +63,27 @@ def test_platform_scene_modes_legs_and_wrench():
     p = prototype()
     L = leg_lengths(p, p.home_pose) + np.array([0.5, 0.3, 0.0, 0.0, -0.2, 0.1])
     poses = fk_list(p, L)
-    s = platform_scene(p, poses, legs=L)
+    s = platform_scene(p, poses, legs=L, physical=1)
     fr = _frames(s)
-    gap = fr["base2"][0, 3] - fr["base1"][0, 3]
-    assert gap > 0
-    for k, T in enumerate(poses):
-        shifted = T.copy()
-        shifted[0, 3] += k * gap
-        np.testing.assert_allclose(fr[f"top{k + 1}"], shifted, atol=1e-9)
+    np.testing.assert_array_equal(fr["base"], np.eye(4))
+    for k, T in enumerate(poses):  # every mode in the base frame, as platform fk gives it
+        np.testing.assert_allclose(fr[f"top{k + 1}"], T, atol=1e-12)
         # the legs drawn join the base points to the top points of this mode
-        legs = [it for it in s["items"] if it["type"] == "segment"
-                and it["label"].startswith(f"mode {k + 1}")]
-        tops = top_points_in_base(p, T) + [k * gap, 0, 0]
-        np.testing.assert_allclose([it["b"] for it in legs], tops, atol=1e-9)
+        legs = [it for it in s["items"] if it["type"] == "segment" and it["mode"] == k]
+        np.testing.assert_allclose([it["b"] for it in legs], top_points_in_base(p, T),
+                                   atol=1e-9)
         np.testing.assert_allclose(np.linalg.norm(np.subtract([it["b"] for it in legs],
                                                               [it["a"] for it in legs]), axis=1),
                                    L, atol=1e-6)
-    np.testing.assert_allclose(fr["end"], poses[0], atol=1e-12)
-    marked = [it for it in s["items"] if "physical assembly" in it.get("label", "")]
-    assert len(marked) == 1
+        assert {it["group"] for it in s["items"] if it["mode"] == k} == {
+            f"mode {k + 1}" + (" (physical)" if k == 1 else "")}
+    # the selector: the physical mode first, then the others in order
+    assert [m["index"] for m in s["modes"]] == [1, 0, *range(2, len(poses))]
+    assert s["modes"][0]["label"] == "mode 2 (physical)"
+    np.testing.assert_allclose(fr["end"], poses[1], atol=1e-12)
     # leg colours: tension reddish, compression bluish (leg P is stretched, S shortened)
-    legs1 = {it["label"].split()[4][:-1]: it["color"]
-             for it in s["items"] if it["type"] == "segment" and "mode 1" in it["label"]}
+    legs1 = {it["label"].split()[1][:-1]: it["color"]
+             for it in s["items"] if it["type"] == "segment" and it["mode"] == 0}
     red = lambda c: int(c[1:3], 16) > int(c[5:7], 16)  # noqa: E731
     assert red(legs1["P"]) and not red(legs1["S"])
 
@@ -187,5 +186,6 @@ def test_html_embeds_the_scene_verbatim():
     s["title"] = "a </script><script>alert(1)</script> title"
     html = render_html(s)
     assert extract_scene(html) == json.loads(json.dumps(s))
-    assert html.count("</script>") == 3  # scene, three.js, viewer: nothing leaks out
+    # scene, meshes, three.js, viewer: nothing leaks out
+    assert html.count("</script>") == 4
     assert "three.js 0.187.0" in html
