@@ -151,13 +151,18 @@ class _Unreached(GuidanceEvent):
 
 @dataclass(frozen=True, eq=False)
 class NotConverged(_Unreached):
-    """The closed-loop Newton correction did not reach the ideal pose of the step."""
+    """The closed-loop Newton correction did not reach the ideal pose of the step:
+    ``reason`` ``singular`` (the Jacobian where it ended is singular, condition number
+    ``cond``), ``out_of_reach`` (the error stopped decreasing with a regular Jacobian) or
+    ``diverged`` (the error grew)."""
 
     kind: ClassVar[str] = "not_converged"
 
     position_error: float = 0.0
     angle_error_deg: float = 0.0
     iterations: int = 0
+    reason: str = ""
+    cond: float = 0.0
     action: str = "stopped"
 
 

@@ -284,9 +284,13 @@ class _Run:
         self.stop(ev, msg)
         return True
 
-    def _error_small(self, T, T_ref, tol: float) -> tuple[bool, float, float]:
+    def _error_small(self, T, T_ref, tol: float, scale: float | None = None
+                     ) -> tuple[bool, float, float]:
+        """Pose error of ``T`` from ``T_ref`` within ``tol`` rad and ``tol``·scale (default
+        max(1, L))."""
         dp, da = pose_error(T, T_ref)
-        return bool(da <= tol and dp <= tol * max(1.0, self.L)), float(dp), float(da)
+        scale = max(1.0, self.L) if scale is None else scale
+        return bool(da <= tol and dp <= tol * scale), float(dp), float(da)
 
     def _solve(self, J, B, damping):
         o = self.opt
@@ -405,10 +409,14 @@ class _Run:
         if o.singular == "damped":
             self.events.append(Singularity(*where, **base, action="damped"))
             return J, "auto"
-        escape = perturb_all_joints if o.singular == "perturb_all" else escape_singularity
+        if o.singular == "perturb_all":
+            escape, inc, tries_max = (perturb_all_joints, o.perturb_all_deg,
+                                      o.max_perturb_all_tries)
+        else:
+            escape, inc, tries_max = escape_singularity, o.perturb_deg, o.max_perturb_tries
         q_new, cond_new, tries = escape(self.model, self.q, length=self.L,
-                                        cond_limit=o.cond_limit, increment_deg=o.perturb_deg,
-                                        max_tries=o.max_perturb_tries)
+                                        cond_limit=o.cond_limit, increment_deg=inc,
+                                        max_tries=tries_max)
         self.perturbations += 1
         base.update(joint_increments=joint_display(self.model, q_new - self.q), tries=tries,
                     cond_after=cond_new, method=o.singular)
@@ -435,25 +443,32 @@ class _Run:
 
     # -- corrections -------------------------------------------------------------------------
     def newton(self, st: _Stage, target, q) -> np.ndarray | None:
-        """Closed loop: Newton iterations ``J δq = twist(actual → target)`` until the pose
-        error ≤ tol; the corrected joints, or None (stopped) when they do not converge."""
+        """Closed loop: Newton iterations ``J δq = twist(actual → target)`` until the hand is
+        within ``tol``·L and ``tol`` rad of the step's path pose; the corrected joints, or None
+        (stopped, with the reason) when they do not get there."""
         o = self.opt
         damping = "auto" if o.singular == "damped" else None
-        dp = da = math.inf
+        history: list[float] = []
         for it in range(o.max_newton + 1):
             T = fk(self.model, q)
-            ok, dp, da = self._error_small(T, target, o.tol)
+            ok, dp, da = self._error_small(T, target, o.tol, self.L)
             if ok:
                 return q
-            if it == o.max_newton:
+            history.append(dp / self.L + da)
+            if it == o.max_newton or _stalled(history):
                 break
             q = q + self._solve(jacobian(self.model, q), twist_between(T, target), damping).dq
+        _, cond = conditioning(scaled_jacobian(jacobian(self.model, q), self.model.prismatic,
+                                               self.L))
+        reason, why = _newton_failure(float(cond), o.cond_limit, history)
+        unit = self.model.length_unit
         self.stop(NotConverged(self.gstep, st.index + 1, position_error=dp,
-                               angle_error_deg=math.degrees(da), iterations=o.max_newton),
-                  f"step {self.gstep}: the closed-loop correction did not reach the path "
-                  f"(error {dp:.3g} {self.model.length_unit}, {math.degrees(da):.3g} deg after "
-                  f"{o.max_newton} iterations): the path leaves the workspace or crosses a "
-                  "singularity")
+                               angle_error_deg=math.degrees(da), iterations=len(history) - 1,
+                               reason=reason, cond=float(cond)),
+                  f"step {self.gstep}: the closed-loop correction did not bring the hand onto "
+                  f"the path: after {len(history) - 1} Newton iterations it is {dp:.3g} {unit} "
+                  f"and {math.degrees(da):.3g} deg from the step's path pose (tolerance "
+                  f"{o.tol * self.L:.3g} {unit} = {o.tol:g} × L and {o.tol:g} rad); {why}")
         return None
 
     def settle(self, si: int) -> None:
@@ -461,7 +476,7 @@ class _Run:
         o = self.opt
         target = self.targets[-1]
         for it in range(o.max_settle + 1):
-            ok, dp, da = self._error_small(self.H, target, o.settle_tol)
+            ok, dp, da = self._error_small(self.H, target, o.settle_tol, o.settle_length)
             if ok:
                 return
             if it == o.max_settle:
@@ -555,6 +570,26 @@ def run_guidance(
             raise
         raise GuidanceInterrupted(run.gstep, run.total_planned) from None
     return run.result(notes)
+
+
+def _stalled(history: list[float], window: int = 6) -> bool:
+    """True when the last ``window`` Newton iterations did not halve the error."""
+    return len(history) > window and history[-1] > 0.5 * history[-1 - window]
+
+
+def _newton_failure(cond: float, cond_limit: float, history: list[float]) -> tuple[str, str]:
+    """Why a closed-loop correction failed: ``(reason, explanation)`` from the Jacobian's
+    condition number where it ended and the course of the error."""
+    if cond > cond_limit:
+        return "singular", (f"the Jacobian there is singular (condition number {cond:.3g} > "
+                            f"{cond_limit:g}): the path crosses a singularity")
+    if len(history) > 1 and history[-1] >= history[0]:
+        return "diverged", (f"the error grew from the first iteration with a regular Jacobian "
+                            f"(condition number {cond:.3g}): the step is too large for Newton "
+                            "from where it started; give more steps")
+    return "out_of_reach", (f"the error stopped decreasing with a regular Jacobian (condition "
+                            f"number {cond:.3g}): the path pose is out of the mechanism's "
+                            "reach there (the path leaves the workspace)")
 
 
 def _substeps(model: ChainModel, dq, L: float, max_joint_step_deg: float | None) -> int:
