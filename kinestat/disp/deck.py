@@ -35,6 +35,7 @@ from typing import Literal
 
 import numpy as np
 
+from kinestat.disp.steps import disp_step_count
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import DispDeck, deck_warnings
 from kinestat.mechanism.chain import ChainModel, from_nadkarni
@@ -170,7 +171,9 @@ def deck_stages(deck: DispDeck, start_points) -> list[StageSpec]:
     kind = {0: "screw", 4: "line", 6: "general"}.get(ms)
     if kind is None:
         raise InputError(f"MS = {ms} is not a guidance analysis (0, 4, 5, 6)")
-    return target_stages(kind, start_points, list(deck.positions[1:]))
+    # type II steps from the actual hand to the next screw position (App. I: DISP uses "the
+    # actual position of the manipulator hand ... for any intermediate stage")
+    return target_stages(kind, start_points, list(deck.positions[1:]), from_actual=ms == 0)
 
 
 #: DISP's tables print joint values and hand points to 2-3 decimals, and Illustration 5's
@@ -225,9 +228,12 @@ def disp_options(*, settle: bool = False, closed_loop: bool = False,
 
 def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
              options: GuidanceOptions | None = None,
-             progress: Callable[[int, int], None] | None = None) -> DeckRun:
+             progress: Callable[[int, int], None] | None = None,
+             auto_steps: Literal["disp", "kinestat"] = "disp") -> DeckRun:
     """Run a deck for its MS as DISP does. ``steps`` overrides the deck's IT (0/None: IT, or
-    automatic when IT = 0); ``options`` default to :func:`disp_options` (DISP's behaviour).
+    automatic when IT = 0: DISP's inferred rule, :func:`~kinestat.disp.steps.disp_step_count`,
+    or with ``auto_steps="kinestat"`` kinestat's own, as ``kinestat guide`` uses);
+    ``options`` default to :func:`disp_options` (DISP's behaviour).
     The inferred 1977 step rule (``step_rule="disp_1977"``) belongs to the type III analysis
     (MS = 4) it was fitted to and is refused for other MS."""
     if not isinstance(deck, DispDeck):
@@ -249,8 +255,9 @@ def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
     stages = deck_stages(deck, P0)
     if steps is None or steps == 0:
         steps = deck.it if deck.it > 0 else None
+    step_count = None if auto_steps == "kinestat" else disp_step_count
     result = run_guidance(model, model.q_home, stages, steps=steps, options=options,
-                          progress=progress)
+                          progress=progress, step_count=step_count)
     if not result.stopped and (not options.settle or options.settle_length is not None):
         dp, da = result.final_pose_error()
         if dp > 1e-9 * max(1.0, result.length) or da > 1e-9:

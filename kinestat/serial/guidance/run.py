@@ -40,6 +40,8 @@ from kinestat.serial.guidance.events import (
     SettleStep,
     Singularity,
     TargetNotReached,
+    newton_failure,
+    newton_stalled,
 )
 from kinestat.serial.guidance.planners import (
     Path,
@@ -234,8 +236,10 @@ class _Run:
 
     def __init__(self, model: ChainModel, q: np.ndarray, opt: GuidanceOptions, L: float,
                  progress: Callable[[int, int], None] | None,
-                 rule: StepRule | None = None) -> None:
+                 rule: StepRule | None = None,
+                 step_count: Callable[[Path], int] | None = None) -> None:
         self.model, self.opt, self.L, self.progress = model, opt, L, progress
+        self.step_count = step_count
         self.rule: StepRule = opt.rule() if rule is None else rule
         self.q = q
         self.H = fk(model, q)
@@ -303,6 +307,8 @@ class _Run:
         refine = None
         k = k_given
         left = MAX_RUN_STEPS - self.total_planned
+        if k is None and self.step_count is not None:
+            k = _step_count(self.step_count(path))
         if k is None:
             refine = self.opt.max_joint_step_deg
             k = auto_steps(path, self.L, max_step_deg=self.opt.max_step_deg,
@@ -455,12 +461,12 @@ class _Run:
             if ok:
                 return q
             history.append(dp / self.L + da)
-            if it == o.max_newton or _stalled(history):
+            if it == o.max_newton or newton_stalled(history):
                 break
             q = q + self._solve(jacobian(self.model, q), twist_between(T, target), damping).dq
         _, cond = conditioning(scaled_jacobian(jacobian(self.model, q), self.model.prismatic,
                                                self.L))
-        reason, why = _newton_failure(float(cond), o.cond_limit, history)
+        reason, why = newton_failure(float(cond), o.cond_limit, history)
         unit = self.model.length_unit
         self.stop(NotConverged(self.gstep, st.index + 1, position_error=dp,
                                angle_error_deg=math.degrees(da), iterations=len(history) - 1,
@@ -519,6 +525,7 @@ def run_guidance(
     progress: Callable[[int, int], None] | None = None,
     length: float | None = None,
     rule: StepRule | None = None,
+    step_count: Callable[[Path], int] | None = None,
 ) -> GuidanceResult:
     """Guide the hand of ``model`` from joint values ``q0`` through ``stages`` (Nadkarni
     ch. IV: eq. 4-11 per step, the singularity and joint-limit rules of "Singularities").
@@ -533,6 +540,10 @@ def run_guidance(
         progress: called as ``progress(steps_done, steps_planned_so_far)``.
         rule: a step rule (:class:`~kinestat.serial.guidance.rules.StepRule`) to use instead
             of the one ``options.step_rule`` names.
+        step_count: for stages without a count, ``path -> k`` called with the stage's path
+            at its start (e.g. DISP's inferred IT = 0 rule) instead of
+            :func:`~kinestat.serial.guidance.planners.auto_steps`; such counts are not refined
+            into sub-steps.
 
     >>> from kinestat.io.library import load
     >>> from kinestat.serial.guidance.planners import command_path
@@ -557,7 +568,7 @@ def run_guidance(
             f"the chain has {model.n} joints, not 6: each step solves J δq = B in the "
             "least-squares sense" + (" (minimum-norm increments)" if model.n > 6 else
                                      " (the residual is reported in the events)"))
-    run = _Run(model, q, opt, L, progress, rule)
+    run = _Run(model, q, opt, L, progress, rule, step_count)
     if run.limit_stop(q, None):
         return run.result(notes)
     try:
@@ -570,26 +581,6 @@ def run_guidance(
             raise
         raise GuidanceInterrupted(run.gstep, run.total_planned) from None
     return run.result(notes)
-
-
-def _stalled(history: list[float], window: int = 6) -> bool:
-    """True when the last ``window`` Newton iterations did not halve the error."""
-    return len(history) > window and history[-1] > 0.5 * history[-1 - window]
-
-
-def _newton_failure(cond: float, cond_limit: float, history: list[float]) -> tuple[str, str]:
-    """Why a closed-loop correction failed: ``(reason, explanation)`` from the Jacobian's
-    condition number where it ended and the course of the error."""
-    if cond > cond_limit:
-        return "singular", (f"the Jacobian there is singular (condition number {cond:.3g} > "
-                            f"{cond_limit:g}): the path crosses a singularity")
-    if len(history) > 1 and history[-1] >= history[0]:
-        return "diverged", (f"the error grew from the first iteration with a regular Jacobian "
-                            f"(condition number {cond:.3g}): the step is too large for Newton "
-                            "from where it started; give more steps")
-    return "out_of_reach", (f"the error stopped decreasing with a regular Jacobian (condition "
-                            f"number {cond:.3g}): the path pose is out of the mechanism's "
-                            "reach there (the path leaves the workspace)")
 
 
 def _substeps(model: ChainModel, dq, L: float, max_joint_step_deg: float | None) -> int:
