@@ -47,7 +47,6 @@ export PYTHONPATH=
 K=$V/kinestat
 "$V/python" -c "import kinestat, sys; assert '/venv/' in kinestat.__file__, kinestat.__file__"
 test "$("$K" --version)" = "kinestat $VERSION"
-"$K" warmup >/dev/null
 "$K" control >control.txt
 grep -q "log: " control.txt
 "$K" view model puma762 --html x.html --no-open
