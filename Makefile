@@ -61,7 +61,6 @@ vendor-three:
 test: $(DEV_STAMP) browser
 	$(BIN)/ruff check kinestat tests $(wildcard benchmarks scripts)
 	$(BIN)/lint-imports
-	$(BIN)/python scripts/api_pages.py --check
 	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
 	$(BIN)/pytest
 

@@ -16,15 +16,8 @@ import griffe
 def fence_doctests(text: str) -> str:
     """Wrap every doctest paragraph of ``text`` in a ```` ```pycon ```` fence.
 
-    >>> print(fence_doctests("Add.\\n\\n>>> 1 + 1\\n2\\n\\nDone."))
-    Add.
-    <BLANKLINE>
-    ```pycon
-    >>> 1 + 1
-    2
-    ```
-    <BLANKLINE>
-    Done.
+    >>> fence_doctests("Add.\\n\\n>>> 1 + 1\\n2\\n\\nDone.").split("\\n")
+    ['Add.', '', '```pycon', '>>> 1 + 1', '2', '```', '', 'Done.']
     """
     out: list[str] = []
     in_fence = in_doctest = False
