@@ -69,8 +69,10 @@ def to_urdf(model: ChainModel, *, scale: float | None = None, name: str | None =
 
     >>> from kinestat.mechanism.chain import from_standard_dh
     >>> arm = from_standard_dh([[0.0, 0.0, 650.0, 0.0]], length_unit="mm")
-    >>> 'xyz="0.65 0 0"' in to_urdf(arm)
-    True
+    >>> import re
+    >>> tool = re.search(r'"tool_fixed".*?xyz="([^"]+)"', to_urdf(arm)).group(1)
+    >>> [round(float(v), 12) for v in tool.split()]
+    [0.65, 0.0, 0.0]
     """
     if any(j.kind == "screw" for j in model.joints):
         raise ModelError(f"model {model.name!r} has a screw joint, which URDF cannot express")

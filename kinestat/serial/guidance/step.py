@@ -124,7 +124,8 @@ def solve_step(J, B, *, prismatic, length: float = 1.0, damping=None,
     """Solve ``J δq = B`` (eq. 4-11) for Jacobians ``(..., 6, n)`` and twists ``(..., 6)``.
 
     Args:
-        J, B: the twist Jacobian and the hand displacement twist ``[δθ u_ω; v_O]``.
+        J: the twist Jacobian ``(..., 6, n)``.
+        B: the hand displacement twist ``[δθ u_ω; v_O]`` ``(..., 6)``.
         prismatic: boolean mask ``(n,)`` of prismatic joints (for the dimensionless scaling).
         length: the characteristic length L.
         damping: ``None`` for the plain solution (exact when n = 6 and J is regular, least
