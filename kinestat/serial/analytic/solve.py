@@ -22,8 +22,6 @@ from kinestat.serial.analytic import (
     closed_form,
     decoupled,
     families,
-    general6r,
-    thesis_puma762,
 )
 from kinestat.serial.analytic import (
     locked as _locked,
@@ -182,7 +180,9 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if backend not in BACKENDS:
         raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
     fast = backend == "numba"
-    if use == thesis_puma762.METHOD:
+    if use == "puma762":
+        from kinestat.serial.analytic import thesis_puma762  # lazy: start-up (its kernels)
+
         if not thesis_puma762.is_puma762(model):
             raise ModelError(f"ik_all: method 'puma762' applies only to the PUMA 762's geometry "
                              f"(millimetres, Vibhute Table 2-2); model {model.name!r} differs")
@@ -208,6 +208,8 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
                                           closed_form.solve_three_parallel(model, Tf, data,
                                                                            tol=tol))
     else:
+        from kinestat.serial.analytic import general6r  # lazy: start-up (SciPy's LAPACK)
+
         res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend, shape=shape)
     return _reshape(res, shape)
 
