@@ -46,6 +46,8 @@ def arm(name: str):
         return jaco6()
     if name.startswith("random"):
         return random_6r(int(name[6:]))
+    if name in INDUSTRIAL:
+        return industrial(name)
     return kinestat.load(name)
 
 
