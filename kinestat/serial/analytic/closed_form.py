@@ -25,7 +25,6 @@ import numpy as np
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import pieper_offset
 from kinestat.serial.analytic._common import nan_array, pack, reasons, run_kernels
-from kinestat.serial.analytic.families import add_wrist_families
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
 
@@ -245,6 +244,8 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
                   reason=reasons(cnt, _REASON_3P), method="three-parallel", tol=tol)
     where = np.flatnonzero(near) if N > 1 else (np.zeros(1, dtype=np.intp) if near[0] else None)
     if where is not None and where.size:
+        from kinestat.serial.analytic.families import add_wrist_families  # lazy: rarely needed
+
         res = add_wrist_families(model, T, data, IKAllResult.build((N,), **fields), near=where)
         fields = {f: getattr(res, f) for f in fields} | {"family_curve": res.family_curve}
     return IKAllResult.build((N,) if shape is None else shape, **fields)

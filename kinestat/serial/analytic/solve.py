@@ -20,8 +20,6 @@ from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import (
     closed_form,
-    decoupled,
-    families,
 )
 from kinestat.serial.analytic import (
     locked as _locked,
@@ -57,6 +55,8 @@ def _check_chain(model: ChainModel) -> None:
                 f"of a screw joint are different configurations) — use kinestat.ik for a "
                 f"numerical solution")
     if model.prismatic.any():
+        from kinestat.serial.analytic import decoupled  # lazy: start-up (prismatic arms only)
+
         decoupled.plan(model)  # raises, naming why, outside the decoupled class
 
 
@@ -174,7 +174,7 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         plain = None
     shape = T.shape[:-2]
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
-    if (use in ("pieper", "three-parallel") or kind == decoupled.METHOD) and use != kind:
+    if (use in ("pieper", "three-parallel") or kind == "decoupled") and use != kind:
         raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
                          f"(its geometry is {kind!r})")
     if backend not in BACKENDS:
@@ -187,7 +187,9 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
             raise ModelError(f"ik_all: method 'puma762' applies only to the PUMA 762's geometry "
                              f"(millimetres, Vibhute Table 2-2); model {model.name!r} differs")
         res = thesis_puma762.solve_puma762(model, Tf, tol=tol, backend=backend)
-    elif use == decoupled.METHOD:
+    elif use == "decoupled":
+        from kinestat.serial.analytic import decoupled  # lazy: start-up (prismatic arms only)
+
         if kind != use:
             try:
                 decoupled.plan(model)
@@ -204,6 +206,8 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         if fast:
             return closed_form.solve_three_parallel_compiled(model, Tf, data, tol=tol,
                                                              shape=shape, plain=plain)
+        from kinestat.serial.analytic import families  # lazy: start-up (NumPy path only)
+
         res = families.add_wrist_families(model, Tf, data,
                                           closed_form.solve_three_parallel(model, Tf, data,
                                                                            tol=tol))
