@@ -20,6 +20,7 @@ from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import (
     closed_form,
+    reversed_chain,
 )
 from kinestat.serial.analytic import (
     locked as _locked,
@@ -62,7 +63,12 @@ def _check_chain(model: ChainModel) -> None:
 
 @lru_cache(maxsize=64)
 def _classified(model: ChainModel):
-    return classify(model)
+    kind, data = classify(model)
+    if kind == "general":  # axes 1, 2, 3 meeting: the reversed chain is a pieper arm
+        rev = reversed_chain.reverse(model)
+        if classify(rev)[0] == "pieper":
+            return "pieper", {"reversed": rev}
+    return kind, data
 
 
 @lru_cache(maxsize=64)
@@ -197,6 +203,9 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
                 raise ModelError(f"ik_all: method 'decoupled' does not apply to model "
                                  f"{model.name!r}: {exc}") from None
         res = decoupled.solve_decoupled(model, Tf, tol=tol)
+    elif use == "pieper" and "reversed" in data:
+        res = ik_all(data["reversed"], reversed_chain.invert_poses(Tf), tol=tol, backend=backend)
+        res = reversed_chain.unreverse(res)
     elif use == "pieper":
         if fast:
             return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape,
