@@ -20,6 +20,7 @@ from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import (
     closed_form,
+    pieper_offset,
     reversed_chain,
 )
 from kinestat.serial.analytic import (
@@ -210,7 +211,9 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         if fast:
             return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape,
                                                      plain=plain)
-        res = closed_form.solve_pieper(model, Tf, data, tol=tol)
+        solve = closed_form.solve_pieper if data["shoulder"] is not None else \
+            pieper_offset.solve_pieper_offset
+        res = solve(model, Tf, data, tol=tol)
     elif use == "three-parallel":
         if fast:
             return closed_form.solve_three_parallel_compiled(model, Tf, data, tol=tol,
