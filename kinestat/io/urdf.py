@@ -24,7 +24,6 @@ import xml.etree.ElementTree as ET
 from pathlib import Path
 
 import numpy as np
-from scipy.spatial.transform import Rotation
 
 from kinestat.errors import InputError, KinestatWarning, ModelError, ParseError
 from kinestat.io.textfile import read_text_file
@@ -55,6 +54,8 @@ def metres_per_unit(unit: str, what: str = "length unit") -> float:
 
 
 def _origin(T: np.ndarray, scale: float) -> str:
+    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
+
     xyz = " ".join(f"{v * scale:.17g}" for v in T[:3, 3])
     with warnings.catch_warnings():  # gimbal lock is harmless: any valid rpy reproduces R
         warnings.simplefilter("ignore", UserWarning)
