@@ -356,7 +356,7 @@
       name.className = "jname"; name.textContent = robot.joint_names[i]; name.title = robot.joint_names[i];
       inp.type = "range"; inp.min = lo * k; inp.max = hi * k; inp.step = "any"; inp.value = q[i] * k;
       inp.id = "joint" + (i + 1); inp.title = robot.joint_names[i];
-      out.className = "jval"; out.textContent = fmtQ(i, q[i]);
+      out.className = "jval"; out.textContent = fmtQ(i, q[i]); out.title = out.textContent;
       inp.addEventListener("input", () => {
         q[i] = Math.min(Math.max(Number(inp.value) / k, lo), hi); out.textContent = fmtQ(i, q[i]);
         drawRobot(robot, q); render();
@@ -539,7 +539,8 @@
     const f = inFrame(); status.in_frame = f.content; status.floor_visible = f.floor;
     $("kinestat-status").textContent = JSON.stringify(status);
   }
-  const api = { scene: scene, status: status, chainFrames: chainFrames, fit: fit, publish: publish };
+  const api = { scene: scene, status: status, chainFrames: chainFrames, fit: fit, publish: publish,
+    camera: camera, controls: controls };
   window.kinestatViewer = api;
 
   // "#step=N" in the address opens the animation at step N (links, screenshots)
@@ -550,14 +551,27 @@
   else { if (robot) drawRobot(robot, q); setInfo(scene.info); legend(scene.items); }
   if (modes.length) showMode(modeShown);
   api.showStep = showStep; api.gizmo = gizmo; api.ikTo = ikTo; api.showMode = showMode;
-  api.addStep = function (st) {   // live runs: a cycle as it is logged
-    steps.push(st);
+  let pending = null;
+  api.addStep = function (st) {   // live runs: a cycle as it is logged; drawn with the others
+    steps.push(st);               // that arrived meanwhile, the newest shown (one render)
     if (scene.series && st.series) for (const key of ["cycle", "force", "magnitude"]) scene.series[key].push(st.series[key]);
-    setupPlayer();
-    if (scene.info && scene.info.length) scene.info[0] = steps.length + " cycles, states " + runLength(steps.map((x) => x.state || "?"));
-    const follow = Number(timeline.value) >= steps.length - 2 || steps.length === 1;
-    if (follow) { timeline.value = steps.length - 1; showStep(steps.length - 1); } else drawPlot();
-    st.shown_ms = Date.now();
+    if (pending) { pending.push(st); return; }
+    pending = [st];
+    setTimeout(() => {
+      const batch = pending; pending = null;
+      setupPlayer();
+      if (scene.info && scene.info.length) scene.info[0] = steps.length + " cycles, states " + runLength(steps.map((x) => x.state || "?"));
+      const follow = Number(timeline.value) >= steps.length - 1 - batch.length;
+      if (follow) { timeline.value = steps.length - 1; showStep(steps.length - 1); } else drawPlot();
+      const now = Date.now();
+      for (const x of batch) {
+        x.shown_ms = now;
+        if (status.live) status.live.received.push({ cycle: x.series ? x.series.cycle : null, shown_ms: now,
+          got_ms: x.got_ms, read_ms: 1000 * x.read_at, made_ms: 1000 * x.drawn_at });
+      }
+      $("live-status").textContent = "live: " + (batch[batch.length - 1].label || ("cycle " + steps.length));
+      publish();
+    }, 0);
   };
   loadMeshes(robot).then(() => {
     buildGround(); fit(); render();
@@ -573,17 +587,18 @@
     el.textContent = "live: " + steps.length + " cycle(s) so far, waiting for the next";
     const es = new EventSource(scene.live.events + "?from=" + steps.length);
     es.onmessage = (e) => {
-      const st = JSON.parse(e.data); api.addStep(st);
-      status.live.received.push({ cycle: st.series ? st.series.cycle : steps.length, shown_ms: st.shown_ms });
-      el.textContent = "live: " + (st.label || ("cycle " + steps.length));
-      publish();
+      const st = JSON.parse(e.data); st.got_ms = Date.now(); api.addStep(st);
     };
     es.addEventListener("end", (e) => {
-      es.close(); status.live.ended = true;
-      const rep = JSON.parse(e.data || "{}");
-      el.textContent = "run ended" + (rep.stop_reason ? ": " + rep.stop_reason : "") + " (" + steps.length + " cycles)";
-      publish();
+      es.close();
+      setTimeout(() => {   // after the last cycles are drawn
+        status.live.ended = true;
+        const rep = JSON.parse(e.data || "{}");
+        el.textContent = "run ended" + (rep.stop_reason ? ": " + rep.stop_reason : "") + " (" + steps.length + " cycles)";
+        publish();
+      }, 0);
     });
+    es.onopen = () => { status.live.open_ms = Date.now(); };
     es.onerror = () => { if (!status.live.ended) el.textContent = "live view: connection lost"; };
   }
 })();
