@@ -73,19 +73,8 @@ def browser():
         yield b
 
 
-#: elements of the side panel reaching out of it, and how far the panel itself overflows
-OVERFLOW_JS = """(() => {
-  const side = document.getElementById("side"), r = side.getBoundingClientRect(), bad = [];
-  for (const e of side.querySelectorAll("*")) {
-    const b = e.getBoundingClientRect();
-    if (!b.width || e.closest("[hidden]")) continue;
-    const spills = getComputedStyle(e).overflowX === "visible" && e.clientWidth > 0
-      && e.scrollWidth > e.clientWidth + 1;
-    if (b.right > r.right + 0.5 || b.left < r.left - 0.5 || spills)
-      bad.push((e.id || e.tagName) + ": " + (e.textContent || "").slice(0, 40));
-  }
-  return {bad: bad, panel: side.scrollWidth - side.clientWidth};
-})()"""
+OVERFLOW_JS = headless.PANEL_OVERFLOW_JS
+
 
 PAGES = ["model", "model-rph", "model-ur5-meshes", "model-opens-in-limits", "platform", "screw",
          "disp", "log"]
@@ -104,6 +93,7 @@ def test_page_loads_draws_and_agrees_with_fk(pages, name, browser):
     assert headless.canvas_variance(page.png) > MIN_VARIANCE
     assert status["in_frame"] and status["floor_visible"], status.get("floor")
     assert page.value == {"bad": [], "panel": 0}, page.value
+    assert headless.page_problems(page, min_variance=MIN_VARIANCE) == []
     if name == "model-ur5-meshes":  # every visual mesh of the UR5 loaded and drawn
         assert status["meshes"] == {"loaded": 7, "failed": []}
     if m is not None:  # the page's own FK (the sliders' code) against kinestat

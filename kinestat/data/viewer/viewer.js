@@ -108,9 +108,10 @@
       case "polyline": return polyline(it.points, it.color, it.dashed);
       case "polygon": return polygon(it.points, it.color, it.opacity);
       case "arrow": return arrow(it.origin, it.vector, it.color);
-      case "line": {
+      case "line": {   // an axis: endless in principle, so it neither places the floor nor the camera
         const p = v3(it.point), u = v3(it.direction).normalize(), h = (it.length || 2 * S) / 2;
-        return polyline([p.clone().addScaledVector(u, -h).toArray(), p.clone().addScaledVector(u, h).toArray()], it.color, true);
+        const line = polyline([p.clone().addScaledVector(u, -h).toArray(), p.clone().addScaledVector(u, h).toArray()], it.color, true);
+        line.userData.unbounded = true; return line;
       }
       case "marker": {
         const m = new THREE.Mesh(new THREE.SphereGeometry(it.radius || 0.02 * S, 20, 12), material(it.color));
@@ -241,7 +242,7 @@
     const box = new THREE.Box3();
     world.updateMatrixWorld(true);
     for (const g of [staticGroup, robotGroup, meshGroup, stepGroup]) g.traverseVisible((o) => {
-      if (!o.geometry) return;   // what is drawn: hidden assembly modes do not count
+      if (!o.geometry || o.userData.unbounded) return;   // what is drawn: hidden modes do not count
       if (!o.geometry.boundingBox) o.geometry.computeBoundingBox();
       box.union(o.geometry.boundingBox.clone().applyMatrix4(o.matrixWorld));
     });
@@ -271,7 +272,8 @@
       const sp = textSprite(t, c, 0.45 * a); sp.position.set(1.12 * a * d[0], 1.12 * a * d[1], z + 1.12 * a * d[2]); groundGroup.add(sp);
     });
     const u = scene.length_unit || "";
-    $("grid-note").textContent = "floor grid: " + cell + " " + u + " squares; world axes x y z (" + a + " " + u + ")";
+    const len = (x) => u ? x + " " + u : String(x);
+    $("grid-note").textContent = "floor grid: " + len(cell) + " squares; world axes x y z (" + len(a) + ")";
     floorInfo = { z: z, centre: [cx, cy, z], half: half, cell: cell };
     status.floor = floorInfo;
   }
@@ -509,8 +511,17 @@
   function frameBox(box) {   // the camera looks at box from the front-right, all of it in view
     const c = box.getCenter(new THREE.Vector3()), r = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1e-9);
     const vfov = camera.fov * Math.PI / 180, hfov = 2 * Math.atan(Math.tan(vfov / 2) * camera.aspect);
-    const d = 1.08 * r / Math.sin(Math.min(vfov, hfov) / 2);
-    camera.position.copy(c).add(new THREE.Vector3(0.9, -1.4, 0.8).normalize().multiplyScalar(d));
+    let d = 1.08 * r / Math.sin(Math.min(vfov, hfov) / 2);
+    const dir = new THREE.Vector3(0.9, -1.4, 0.8).normalize(), corners = [];
+    for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z]) corners.push(new THREE.Vector3(x, y, z));
+    for (let it = 0; it < 4; it++) {   // closer while every corner stays in view (a sphere's fit is loose)
+      camera.position.copy(c).addScaledVector(dir, d); camera.lookAt(c);
+      camera.near = d / 100; camera.far = d * 100; camera.updateProjectionMatrix(); camera.updateMatrixWorld();
+      const m = Math.max(...corners.map((p) => { const q = p.clone().project(camera); return Math.max(Math.abs(q.x), Math.abs(q.y)); }));
+      if (!(m > 0) || m > 0.92) break;
+      d *= 0.5 + 0.5 * m / 0.9;
+    }
+    camera.position.copy(c).addScaledVector(dir, d);
     camera.near = d / 100; camera.far = d * 100; camera.updateProjectionMatrix();
     controls.target.copy(c); controls.update(); render();
   }
