@@ -440,10 +440,9 @@ def control_command(
 
 def _start_live(log_path: Path, platform: str | None):
     """The live view of the run (``--view --serve``), opened in the browser."""
-    # lazy: the browser and the server only with --serve
-    import webbrowser
+    import webbrowser  # lazy: the browser only with --serve
 
-    from kinestat.viz.live import start_live
+    from kinestat.viz.live import start_live  # lazy: the server only with --serve
 
     p = None
     if platform is not None:
