@@ -129,8 +129,8 @@ def test_live_view_shows_each_cycle_within_half_a_second(tmp_path):
               f", received +{r['got_ms'] - t:.0f}, shown +{r['shown_ms'] - t:.0f}")
     # streamed, not replayed: the page showed cycles before the run's last one was logged
     assert min(r["shown_ms"] / 1000.0 for r in streamed) < seen[cycles[-1]["cycle"]]
-    # the server's part: each cycle's page step made within 0.1 s of its record appearing
-    assert max(r["made_ms"] / 1000.0 - seen[r["cycle"]] for r in streamed) < 0.1
+    # the server's part: each cycle's page step made within the bound of its record appearing
+    assert max(r["made_ms"] / 1000.0 - seen[r["cycle"]] for r in streamed) < LATENCY_S
     load = os.getloadavg()[0] / (os.cpu_count() or 1)
     if load > 2.0:  # WebGL on SwiftShader shares the CPU: timing says nothing when oversubscribed
         pytest.skip(f"load average {load:.1f} per CPU: the 0.5 s bound is not checked "
