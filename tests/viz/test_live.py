@@ -35,8 +35,9 @@ WATCH_JS = """(async () => {
   }
   const v = window.kinestatViewer;
   return {live: v.status.live, steps: v.scene.steps.length,
-          labels: v.scene.steps.map(s => s.label), cursor: v.status.cursor};
-})()"""
+          labels: v.scene.steps.map(s => s.label), cursor: v.status.cursor,
+          panel: PANEL};
+})()""".replace("PANEL", headless.PANEL_OVERFLOW_JS)
 
 
 def _watch_log(path: Path, seen: dict, stop: threading.Event) -> None:
@@ -111,6 +112,10 @@ def test_live_view_shows_each_cycle_within_half_a_second(tmp_path):
     report = json.loads(out)
     live = page.value["live"]
     assert page.console == () and live["ended"]
+    # the page as a user sees it at the end: drawn, in frame, floor in view, panel tidy
+    shown = headless.PageResult(status=page.status, console=page.console, png=page.png,
+                                seconds=page.seconds, value=page.value["panel"])
+    assert headless.page_problems(shown) == []
     # the page ends with every cycle of the run, in order, as the replay of the log shows it
     start, cycles, end = read_cycle_log(log)
     assert page.value["steps"] == len(cycles) == len(report["cycles"]) == report["iterations"]
