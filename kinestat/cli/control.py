@@ -512,7 +512,7 @@ def _tool_and_mount(tool_offset: str | None, a67: str | None, mount: str | None)
 
 def _start_live(log_path: Path, platform: str | None):
     """The live view of the run (``--view --serve``), opened in the browser."""
-    import webbrowser
+    import webbrowser  # lazy: the browser only with --serve
 
     from kinestat.viz.live import start_live  # lazy: the server only with --serve
 
