@@ -166,7 +166,7 @@ def _arm_xml(arm: ChainModel, p: SceneParams, inner: str) -> str:
     k = length_scale(arm)
     C = np.asarray(arm.constants)
     lo, hi = arm.lower, arm.upper
-    body_T = [arm.base @ C[0]] + [C[i] for i in range(1, 6)]
+    body_T = [C[i] for i in range(6)]  # fk is C0 · Z(q1) · … · C6 (base and tool folded in)
     xml_close = ""
     out = []
     pris = np.asarray(arm.prismatic, dtype=bool)
@@ -187,7 +187,7 @@ def _arm_xml(arm: ChainModel, p: SceneParams, inner: str) -> str:
                    f'<joint name="q{i + 1}" type="{jtype}" axis="0 0 1" limited='
                    f'"{"true" if limited else "false"}"{rng}/>{geom}')
         xml_close += "</body>"
-    out.append(f'<body name="flange" {_pose_attr(C[6] @ arm.tool, k)}{grav}>'
+    out.append(f'<body name="flange" {_pose_attr(C[6], k)}{grav}>'
                f'<site name="flange"/>{inner}</body>')
     return "".join(out) + xml_close
 
