@@ -57,7 +57,7 @@ _UNITS_M = {"mm": 1e-3, "m": 1.0, "cm": 1e-2, "in": 0.0254}
 def load_mujoco():
     """The ``mujoco`` module, imported on first use (one clear error when it is missing)."""
     try:
-        import mujoco  # noqa: PLC0415 - lazy: only --sim mujoco pays for it
+        import mujoco  # lazy: only --sim mujoco pays for it
     except ImportError as exc:  # pragma: no cover - installed with the project
         raise InputError("--sim mujoco needs the 'mujoco' package (pip install mujoco; it is "
                          "in requirements/run.txt)") from exc
@@ -142,7 +142,7 @@ def _f(v) -> str:
 
 def _quat(R: np.ndarray) -> np.ndarray:
     """Unit quaternion (w, x, y, z) of a rotation matrix (scipy's, reordered)."""
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy only when a scene is built
 
     x, y, z, w = Rotation.from_matrix(R).as_quat()
     return np.array([w, x, y, z])
