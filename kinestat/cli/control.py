@@ -350,8 +350,8 @@ def control_command(
     torque_about_tool, torque_about_base (N·mm, fixed frame), equivalent_force (the
     equivalent wrench's force, N: base − tool torque = tool_point × it), procedure,
     calibration, cycles, plant (simulated: kinestat or mujoco; with mujoco also sim_time_s,
-    sim_seconds_per_cycle, sim_move_s, sim_settle_s, moves_unsettled); with --task follow also
-    task, travel_speed_mm_s (mujoco), completed, travel,
+    time_to_goal_s, sim_seconds_per_cycle, sim_move_s, sim_settle_s, moves_unsettled); with
+    --task follow also task, travel_speed_mm_s (mujoco), completed, travel,
     normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
     simulated); with --arm also arm (name, joints, base, placement, limits_deg).
     """
