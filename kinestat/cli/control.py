@@ -411,7 +411,8 @@ def control_command(
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {procedure}, method "
                       f"{method}, calibration {calibration}, "
-                      + (f"simulated cell ({sim})" if simulated
+                      + (("simulated cell" + (" (MuJoCo)" if sim == "mujoco" else ""))
+                         if simulated
                          else literal(f"Galil {galil}, sensor {serial}"))
                       + ("" if prepared.arm is None else literal(_arm_words(prepared.arm)))
                       + ("" if prepared.follow is None else
