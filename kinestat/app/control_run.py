@@ -501,6 +501,8 @@ def report_dict(prepared: PreparedRun, report: RunReport) -> dict:
         out["plant"] = prepared.header.get("plant", "kinestat")
         figures = getattr(report, "plant_figures", None) or {}
         out.update(figures)
+        if "sim_time_s" in figures:
+            out["time_to_goal_s"] = figures["sim_time_s"] if report.converged else None
         if prepared.follow is not None and figures.get("sim_time_s"):
             out["travel_speed_mm_s"] = None  # filled below from the travel
     model = prepared.config.model

@@ -391,7 +391,8 @@ def control_command(
     the tool point and the robot base), equivalent_force (the equivalent wrench's force, N:
     base − tool torque = tool_point × it), procedure, calibration, cycles, tool_point_6 (mm,
     frame 6), a67_start, mount (6_BT), mount_source, plant (simulated: kinestat or mujoco;
-    with mujoco also sim_time_s, sim_seconds_per_cycle, sim_move_s, sim_settle_s,
+    with mujoco also sim_time_s, time_to_goal_s,
+    sim_seconds_per_cycle, sim_move_s, sim_settle_s,
     moves_unsettled); with --task follow also task, travel_speed_mm_s (mujoco), completed,
     travel, normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
     simulated); with --arm also arm (name, joints, base, placement, limits_deg).
@@ -455,7 +456,8 @@ def control_command(
     err_console.print(f"[bold]kinestat control[/]: |F_req| = {force:g} N along "
                       f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {procedure}, method "
                       f"{method}, calibration {calibration}, "
-                      + (f"simulated cell ({sim})" if simulated
+                      + (("simulated cell" + (" (MuJoCo)" if sim == "mujoco" else ""))
+                         if simulated
                          else literal(f"Galil {galil}, sensor {serial}"))
                       + ("" if prepared.arm is None else literal(_arm_words(prepared.arm)))
                       + ("" if prepared.follow is None else

@@ -194,11 +194,12 @@ def encoders(
 def _galil_mujoco(host: str, port: int, allow_remote: bool, duration: float | None,
                   as_json: bool, opts: dict) -> None:
     """The simulated Galil and encoder stream on a MuJoCo cell, until Ctrl-C."""
-    from kinestat.app.control_defaults import DEFAULT_DIRECTION, DEFAULT_START
-    from kinestat.app.control_run import ControlRequest, prepare_control
+    # lazy: the cell (numba, scipy, mujoco) only for --plant mujoco
+    from kinestat.app.control_defaults import DEFAULT_DIRECTION, DEFAULT_START  # lazy: as above
+    from kinestat.app.control_run import ControlRequest, prepare_control  # lazy: as above
     from kinestat.app.mujoco_harness import MujocoHarness  # lazy: mujoco
-    from kinestat.app.sim_cell import start_counts
-    from kinestat.cli.control import _cell
+    from kinestat.app.sim_cell import start_counts  # lazy: as above
+    from kinestat.cli.control import _cell  # lazy: as above
 
     d = parse_floats(opts["direction"] or DEFAULT_DIRECTION, 3, "direction")
     if not np.linalg.norm(d) > 0:

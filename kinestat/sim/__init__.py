@@ -16,6 +16,9 @@ are imported here; the wiring of a simulated cell to the controller is
   pseudo-terminal, with fault injection.
 - :mod:`kinestat.sim.arm` — any 6-joint arm whose joints are set directly within its limits
   (the in-process cell of ``kinestat control --arm``).
+- :mod:`kinestat.sim.mujoco_scene` and :mod:`kinestat.sim.mujoco_plant` — the cell as a MuJoCo
+  scene built from kinestat's models, stepped in time (``--sim mujoco``; MuJoCo is imported
+  only there).
 """
 
 from __future__ import annotations

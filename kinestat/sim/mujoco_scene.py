@@ -57,7 +57,7 @@ _UNITS_M = {"mm": 1e-3, "m": 1.0, "cm": 1e-2, "in": 0.0254}
 def load_mujoco():
     """The ``mujoco`` module, imported on first use (one clear error when it is missing)."""
     try:
-        import mujoco  # noqa: PLC0415 - lazy: only --sim mujoco pays for it
+        import mujoco  # lazy: only --sim mujoco pays for it
     except ImportError as exc:  # pragma: no cover - installed with the project
         raise InputError("--sim mujoco needs the 'mujoco' package (pip install mujoco; it is "
                          "in requirements/run.txt)") from exc
@@ -142,7 +142,7 @@ def _f(v) -> str:
 
 def _quat(R: np.ndarray) -> np.ndarray:
     """Unit quaternion (w, x, y, z) of a rotation matrix (scipy's, reordered)."""
-    from scipy.spatial.transform import Rotation
+    from scipy.spatial.transform import Rotation  # lazy: scipy only when a scene is built
 
     x, y, z, w = Rotation.from_matrix(R).as_quat()
     return np.array([w, x, y, z])
@@ -166,7 +166,7 @@ def _arm_xml(arm: ChainModel, p: SceneParams, inner: str) -> str:
     k = length_scale(arm)
     C = np.asarray(arm.constants)
     lo, hi = arm.lower, arm.upper
-    body_T = [arm.base @ C[0]] + [C[i] for i in range(1, 6)]
+    body_T = [C[i] for i in range(6)]  # fk is C0 · Z(q1) · … · C6 (base and tool folded in)
     xml_close = ""
     out = []
     pris = np.asarray(arm.prismatic, dtype=bool)
@@ -187,7 +187,7 @@ def _arm_xml(arm: ChainModel, p: SceneParams, inner: str) -> str:
                    f'<joint name="q{i + 1}" type="{jtype}" axis="0 0 1" limited='
                    f'"{"true" if limited else "false"}"{rng}/>{geom}')
         xml_close += "</body>"
-    out.append(f'<body name="flange" {_pose_attr(C[6] @ arm.tool, k)}{grav}>'
+    out.append(f'<body name="flange" {_pose_attr(C[6], k)}{grav}>'
                f'<site name="flange"/>{inner}</body>')
     return "".join(out) + xml_close
 

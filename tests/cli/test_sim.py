@@ -102,3 +102,31 @@ def test_sim_options_checked_before_starting(capsys, argv, msg):
     out = capsys.readouterr()
     assert msg in out.err and len(out.err.splitlines()) == 1
     assert out.out == ""  # nothing was started
+
+
+@pytest.mark.skipif(not hasattr(os, "openpty"), reason="needs a pseudo-terminal")
+def test_sim_galil_plant_mujoco_serves_the_galil_and_the_legs_of_one_cell(capsys):
+    pytest.importorskip("mujoco")
+    t, result = run_in_thread(["sim", "galil", "--plant", "mujoco", "--json", "--duration",
+                               "3.0"])
+    info = wait_json(capsys, timeout=60.0)
+    assert info["plant"] == "mujoco"
+    host, port = info["galil"].rsplit(":", 1)
+    with GalilClient(host, int(port), timeout=2) as g:
+        counts = g.position_counts()
+    assert any(c != 0 for c in counts)  # the robot at the start pose of the default cell
+    with EncoderReader(info["serial"], stale_after=1.0) as rd:
+        legs = rd.read().counts
+    assert legs.shape == (6,)
+    t.join(30)
+    assert not t.is_alive() and result["rc"] == 0
+
+
+@pytest.mark.parametrize("argv, msg", [
+    (["sim", "galil", "--plant", "bullet", "--duration", "0"], "--plant must be"),
+    (["sim", "galil", "--plant", "mujoco", "--seed", "3", "--duration", "0"], "do not apply"),
+    (["sim", "galil", "--friction", "0.3", "--duration", "0"], "options of --plant mujoco"),
+])
+def test_sim_galil_plant_refuses_bad_input(capsys, argv, msg):
+    assert main(argv) == 2
+    assert msg in capsys.readouterr().err

@@ -56,9 +56,14 @@ def _pose_of(data, body: int) -> np.ndarray:
 
 
 
-@pytest.mark.parametrize("name", ["puma762", "ur5", "stanford"])
+@pytest.mark.parametrize("name", ["puma762", "ur5", "stanford", "ur5-placed"])
 def test_joint_frames_and_flange_equal_kinestat_fk(name):
-    arm = kinestat.load(name)
+    if name == "ur5-placed":  # as `kinestat control --arm ur5` places it: mm, base moved
+        from kinestat.app.arm_cell import in_millimetres, placed
+
+        arm = placed(in_millimetres(kinestat.load("ur5")), [-900.0, 350.0, -200.0])
+    else:
+        arm = kinestat.load(name)
     rng = np.random.default_rng(3)
     lo, hi = np.maximum(arm.lower, -np.pi), np.minimum(arm.upper, np.pi)
     _, scene = _scene(arm, PUMA_START if name == "puma762" else np.zeros(6))
@@ -73,7 +78,7 @@ def test_joint_frames_and_flange_equal_kinestat_fk(name):
         Z = joint_motion(arm, q)
         for i in range(6):  # MuJoCo's body i: joint i's frame turned by q_i
             b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"link{i + 1}")
-            F = arm.base @ frames[i] @ Z[i]
+            F = frames[i] @ Z[i]
             F[:3, 3] *= k
             np.testing.assert_allclose(_pose_of(d, b), F, atol=1e-9)
         s = scene.ids["flange"]
