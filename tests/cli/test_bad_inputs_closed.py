@@ -32,3 +32,12 @@ def test_urdf_scale_zero_or_negative_is_refused(capsys, scale):
     msg = _one_error(capsys, ["fk", str(arm_path("ur5")), "--tip", "tool0", "--scale", scale,
                               "--q", "0,0,0,0,0,0"])
     assert "--scale" in msg and "> 0" in msg
+
+
+@pytest.mark.parametrize(("argv", "what"), [
+    (["--rate", "nan"], "--rate must be in"), (["--rate", "0"], "--rate must be in"),
+    (["--rate", "1e999"], "--rate must be in"), (["--log", "."], "is a directory"),
+])
+def test_control_refuses_a_bad_rate_or_log_before_printing_anything(capsys, argv, what):
+    """The header of the run used to be printed first, the error as a second line."""
+    assert what in _one_error(capsys, ["control", *argv])
