@@ -400,6 +400,7 @@ def control_command(
     _check_counts(samples, max_iterations)
     check_seed(seed)
     _check_plot_dir(plot, no_plot)
+    _check_rate_and_log(rate, log)
     d = parse_floats(direction, 3, "direction")
     if np.linalg.norm(d) == 0:
         raise InputError("--direction must not be the zero vector")
@@ -569,6 +570,17 @@ def _check_counts(samples: int, max_iterations: int | None) -> None:
     if max_iterations is not None and not 1 <= max_iterations <= MAX_ITERATIONS:
         raise InputError(f"--max-iterations must be in 1..{MAX_ITERATIONS}, got "
                          f"{max_iterations}")
+
+
+def _check_rate_and_log(rate: float, log: Path | None) -> None:
+    """--rate (the simulated encoder's packet rate) and --log (a file, not a directory), before
+    anything starts or is printed."""
+    from kinestat.sim.encoder_emitter import MAX_RATE_HZ  # lazy: start-up
+
+    if not (math.isfinite(rate) and 0 < rate <= MAX_RATE_HZ):
+        raise InputError(f"--rate must be in (0, {MAX_RATE_HZ:g}] Hz, got {rate}")
+    if log is not None and log.is_dir():
+        raise InputError(f"--log {str(log)!r} is a directory; give the cycle log's file name")
 
 
 def _check_plot_dir(plot: Path | None, no_plot: bool) -> None:

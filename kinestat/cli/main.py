@@ -90,9 +90,19 @@ def _root(
     """Kinematics and statics of robot manipulators."""
 
 
+MAX_ARGS = 1000
+"""Most arguments one call takes: the longest real command line has a few dozen; 200,000
+arguments kept Click's parser busy for 10 s before its error."""
+
+MAX_MESSAGE = 1000
+"""Longest error line printed (characters): a message quoting a huge bad value is cut."""
+
+
 def _one_line(text: str) -> str:
-    """``text`` on one line (blank runs, line breaks included, become one blank)."""
-    return " ".join(text.split())
+    """``text`` on one line (blank runs, line breaks included, become one blank), at most
+    :data:`MAX_MESSAGE` characters."""
+    line = " ".join(text.split())
+    return line if len(line) <= MAX_MESSAGE else line[:MAX_MESSAGE - 1] + "…"
 
 
 def _usage_error(exc: UsageError) -> str:
@@ -110,6 +120,11 @@ def main(argv: list[str] | None = None) -> int:
     status 2. Click runs with ``standalone_mode=False`` so that its errors reach this function
     instead of being drawn as a box.
     """
+    n_args = len(sys.argv) - 1 if argv is None else len(argv)
+    if n_args > MAX_ARGS:
+        typer.echo(f"kinestat: error: {n_args} arguments, more than the {MAX_ARGS} a call takes "
+                   "(see 'kinestat --help')", err=True)
+        return 2
     try:
         code = app(args=argv, prog_name="kinestat", standalone_mode=False)
     except SystemExit as exc:

@@ -130,12 +130,23 @@ def _ranges(range_mm: str, range_deg: str) -> dict:
 def _run(study_name: str, spec: dict, *, output, scheduler, workers, threads, timeout,
          max_chunks, no_plots, quiet, as_json) -> None:
     from kinestat.studies.base import build_study  # lazy: start-up (the studies load Dask)
-    from kinestat.studies.engine import run_study  # lazy: start-up (the studies load Dask)
+    from kinestat.studies.engine import (  # lazy: start-up (the studies load Dask)
+        StudyInterrupted,
+        run_study,
+    )
 
     study = build_study(study_name, spec)
-    res = run_study(study, output, scheduler=scheduler, workers=workers,
-                    processes=not threads, max_chunks=max_chunks, progress=not quiet,
-                    timeout_s=timeout, plots=not no_plots)
+    try:
+        res = run_study(study, output, scheduler=scheduler, workers=workers,
+                        processes=not threads, max_chunks=max_chunks, progress=not quiet,
+                        timeout_s=timeout, plots=not no_plots)
+    except StudyInterrupted as exc:  # Typer would turn it into a silent exit 130
+        typer.echo(f"kinestat: interrupted: {exc.message}", err=True)
+        raise typer.Exit(130) from None
+    if res.chunks_damaged:
+        typer.echo(f"kinestat: warning: {res.chunks_damaged} chunk(s) in {res.output} did not "
+                   "match their checksums (manifest.sha256): damaged or unfinished, "
+                   "recomputed", err=True)
     out = res.to_json()
     if as_json:
         if out["summary"] is not None:

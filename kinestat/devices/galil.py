@@ -370,7 +370,12 @@ class GalilClient:
                               f"{cmd!r}: {exc}") from exc
         self._in_flight = cmd
         buf, self._buf = self._buf, b""
+        t_end = time.monotonic() + self.timeout
         while True:
+            if time.monotonic() > t_end:  # earlier replies kept coming, never ours
+                self.close()
+                raise DeviceError(f"Galil at {self.host}:{self.port} did not answer {cmd!r} "
+                                  f"within {self.timeout} s; connection closed")
             reply, buf = self._receive(cmd, buf)
             text = reply.decode("ascii", errors="replace")
             # the tagged reply's fields are the last ones (a garbled earlier reply may have

@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kinestat.devices.galil import GalilClient, GalilCommandError
-from kinestat.devices.safe_stop import confirm_stop
+from kinestat.devices.safe_stop import confirm_motor_off, confirm_stop
 from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
 from kinestat.hardware.puma762_axes import AXES
 from kinestat.hardware.puma762_homing import (
@@ -213,8 +213,4 @@ def _amplifiers_off(client: GalilClient) -> tuple[str, bool]:
     stop = confirm_stop(client)
     if not client.connected:
         return f"{stop}; MO could not be sent", stop.confirmed
-    try:
-        client.command("MO", discard_pending=True)
-    except KinestatError as exc:
-        return f"{stop}; MO failed: {exc}", stop.confirmed
-    return f"{stop}; MO sent: amplifiers off", stop.confirmed
+    return f"{stop}; {confirm_motor_off(client)[1]}", stop.confirmed

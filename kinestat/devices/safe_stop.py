@@ -31,7 +31,7 @@ from kinestat.errors import KinestatError
 from kinestat.hardware.puma762_axes import AXES
 
 __all__ = ["RECONNECT_TIMEOUT", "STOP_TIMEOUT", "MAX_ATTEMPTS", "StopReport", "confirm_stop",
-           "send_stop"]
+           "confirm_motor_off", "send_stop"]
 
 RECONNECT_TIMEOUT = 1.0
 """Bound (s) on a fresh connection and on each reply during a stop."""
@@ -112,6 +112,20 @@ def confirm_stop(client: GalilClient, *, reconnect_timeout: float = RECONNECT_TI
         client.timeout = saved
     return StopReport(False, "ST unconfirmed: the link is gone (" + "; ".join(notes) + ")",
                       MAX_ATTEMPTS)
+
+
+def confirm_motor_off(client: GalilClient) -> tuple[bool, str]:
+    """``MO`` (amplifiers off) on the open link, proved the same way: the tagged answer of
+    ``MG <tag>,_MOA,...,_MOF`` must say every axis is off. (confirmed, what happened)."""
+    try:
+        client.send_only("MO")
+        flags = client.tagged_query([f"_MO{a}" for a in AXES], _next_tag())
+    except KinestatError as exc:
+        return False, f"MO failed: {exc}"
+    on = [a for a, f in zip(AXES, flags, strict=True) if f != 1]
+    if on:
+        return False, f"MO sent but axes {', '.join(on)} still servo (MG _MO flags)"
+    return True, "MO sent and confirmed: amplifiers off (MG _MOA.._MOF all 1)"
 
 
 def send_stop(client: GalilClient, *, reconnect_timeout: float = RECONNECT_TIMEOUT) -> StopReport:

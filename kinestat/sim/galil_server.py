@@ -177,7 +177,10 @@ class GalilSimServer:
                     text = raw.decode("ascii", errors="replace").strip()
                     if not text:
                         continue
-                    reply = self.controller.handle(text)
+                    try:
+                        reply = self.controller.handle(text)
+                    except Exception:  # noqa: BLE001 - a command must not end the connection
+                        reply = "?"  # (the fuzz tests hold handle() itself to never raising)
                     if reply is not None:
                         conn.sendall(reply.encode("ascii"))
         except OSError:

@@ -26,7 +26,17 @@ from kinestat.errors import ClusterError, InputError, KinestatError
 from kinestat.studies.base import Study, build_study, spec_hash, spec_json
 from kinestat.studies.store import StudyStore
 
-__all__ = ["ClusterError", "RunResult", "run_study", "default_output", "compute_chunk_task"]
+__all__ = ["ClusterError", "RunResult", "StudyInterrupted", "run_study", "default_output",
+           "compute_chunk_task"]
+
+
+class StudyInterrupted(KeyboardInterrupt):
+    """Ctrl-C (or a signal raising KeyboardInterrupt) during a study: ``message`` says how far
+    it got and how to resume (the chunks written so far are kept)."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(message)
+        self.message = message
 
 #: where studies go when no --output is given
 RUNS_DIR = "kinestat-runs"
@@ -45,12 +55,13 @@ class RunResult:
     chunks_reused: int
     elapsed_s: float
     plots: list[str]
+    chunks_damaged: int = 0
 
     def to_json(self) -> dict:
         return {"study": self.study, "complete": self.complete, "summary": self.summary,
                 "output": str(self.output),
                 "chunks": {"total": self.chunks_total, "computed": self.chunks_computed,
-                           "reused": self.chunks_reused},
+                           "reused": self.chunks_reused, "damaged": self.chunks_damaged},
                 "elapsed_s": self.elapsed_s, "plots": self.plots}
 
 
@@ -243,17 +254,23 @@ def run_study(study: Study, output: str | os.PathLike | None = None, *,
     if scheduler is not None and not scheduler.strip():
         raise InputError("--scheduler: empty address; give tcp://HOST:PORT")
     done = store.check()
+    damaged = list(store.damaged)  # recomputed below like any chunk not done
     todo = [i for i in range(study.n_chunks) if i not in done]
     if max_chunks is not None:
         todo = todo[:max_chunks]
     computed = 0
-    if todo:
-        # connect first: a bad scheduler leaves no output directory behind
-        with open_client(scheduler, workers, processes, timeout_s) as client:
+    try:
+        if todo:
+            # connect first: a bad scheduler leaves no output directory behind
+            with open_client(scheduler, workers, processes, timeout_s) as client:
+                store.open()
+                computed = _compute(client, study, store, todo, progress, len(done))
+        else:
             store.open()
-            computed = _compute(client, study, store, todo, progress, len(done))
-    else:
-        store.open()
+    except KeyboardInterrupt:
+        n = len(store.done_chunks())
+        raise StudyInterrupted(f"{study.name}: {n} of {study.n_chunks} chunks done in {root}; "
+                               "run the same command again to resume") from None
     complete = len(done) + computed == study.n_chunks
     summary, plot_files = None, []
     if complete:
@@ -266,7 +283,7 @@ def run_study(study: Study, output: str | os.PathLike | None = None, *,
     return RunResult(study=study.name, output=root, complete=complete, summary=summary,
                      chunks_total=study.n_chunks, chunks_computed=computed,
                      chunks_reused=len(done), elapsed_s=time.perf_counter() - t0,
-                     plots=plot_files)
+                     plots=plot_files, chunks_damaged=len(damaged))
 
 
 def run_reference(study: Study) -> dict:

@@ -57,6 +57,11 @@ def platform_spec(study: str, source: tuple[str, str], *, range_mm, range_deg,
     ``platform_text`` (``source``: :func:`platform_text`), the motion range, ``chunk_size``,
     ``arrays`` — plus ``entries``."""
     label, text = source
+    range_box(range_mm, range_deg)  # finite, non-negative: refused before anything runs
+    for key in ("max_deflection", "max_load"):
+        v = entries.get(key)
+        if v is not None and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise InputError(f"--{key.replace('_', '-')} must be a finite number > 0, got {v}")
     return {"study": study, "platform": label, "platform_text": text,
             "range_mm": [float(x) for x in range_mm], "range_deg": [float(x) for x in range_deg],
             "chunk_size": int(chunk_size), "arrays": bool(arrays), **entries}

@@ -32,3 +32,27 @@ def test_urdf_scale_zero_or_negative_is_refused(capsys, scale):
     msg = _one_error(capsys, ["fk", str(arm_path("ur5")), "--tip", "tool0", "--scale", scale,
                               "--q", "0,0,0,0,0,0"])
     assert "--scale" in msg and "> 0" in msg
+
+
+@pytest.mark.parametrize(("argv", "what"), [
+    (["--rate", "nan"], "--rate must be in"), (["--rate", "0"], "--rate must be in"),
+    (["--rate", "1e999"], "--rate must be in"), (["--log", "."], "is a directory"),
+])
+def test_control_refuses_a_bad_rate_or_log_before_printing_anything(capsys, argv, what):
+    """The header of the run used to be printed first, the error as a second line."""
+    assert what in _one_error(capsys, ["control", *argv])
+
+
+def test_a_huge_command_line_is_refused_at_once(capsys):
+    """200,003 arguments (a mutated command line of the campaign) kept Click's parser busy for
+    10 s and printed a 600 KB error line."""
+    import time
+
+    t0 = time.monotonic()
+    msg = _one_error(capsys, ["disp", *(["x", "="] * 100_000), "--json"])
+    assert "200002 arguments, more than the 1000" in msg and time.monotonic() - t0 < 1.0
+
+
+def test_an_error_line_quoting_a_huge_value_is_cut(capsys):
+    msg = _one_error(capsys, ["fk", "puma762", "--q-deg", "1" * 5000])
+    assert len(msg) <= 1000 + len("kinestat: error: ")

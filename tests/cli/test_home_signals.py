@@ -54,7 +54,7 @@ def test_a_signal_during_the_coarse_move_stops_the_robot(tmp_path, sig):
         time.sleep(0.3)
         still = sim.motor_counts()
     assert proc.returncode == 2, err
-    assert "ST" in commands and commands[-1] == "MO"
+    assert "ST" in commands and commands[-2] == "MO" and commands[-1].endswith(",_MOF")
     assert commands.index("ST") > max(i for i, c in enumerate(commands) if c == "BG")
     np.testing.assert_array_equal(still, stopped_at)  # no unsupervised motion afterwards
     assert not sim.homed

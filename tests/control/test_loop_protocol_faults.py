@@ -185,3 +185,46 @@ def test_tcp_drop_mid_move_sends_st_on_a_fresh_connection_and_stops_the_controll
         assert not any(ctrl.moving())  # confirmed: at rest already
         assert server.true_axis_counts()[0] < 16000 - 2000
         client.close()
+
+
+@pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
+def test_a_signal_while_bg_is_pending_and_st_lost_ends_in_a_confirmed_stop(tmp_path, sig):
+    """Issue 43, the control path: the signal arrives while the loop waits for BG's reply (late
+    on the wire, through a proxy) and the first ST is lost. The late ':' of BG is not taken for
+    ST's; the fault record says what the controller confirmed."""
+    import signal as signals
+
+    from kinestat.app.signals import stop_on_signals
+    from kinestat.app.sim_cell import SimCheckedReader
+    from tests._galil_proxy import GalilProxy
+
+    scn = scenario(coupling=COUPLED)
+    cfg = scn.config()
+    path = tmp_path / "log.jsonl"
+    with SimHarness(scn.cell, scn.sensor, start_counts=start_counts(cfg), record=True) as h, \
+            GalilProxy(h.server.port) as proxy:
+        client = GalilClient("127.0.0.1", proxy.port, timeout=1.0).connect()
+        reader = SimCheckedReader(h.reader(), h.emitter)
+        io = DeviceIO(client, reader, truth=h.truth, settle=2.5 / h.emitter.rate_hz,
+                      guard=sent_command_guard(cfg.envelope, cfg.model))
+
+        def progress(rec):
+            if rec["cycle"] == 2:
+                proxy.rule("BG", "late", delay=0.3)
+                proxy.rule("BG", "signal", sig=getattr(signals, sig))
+                proxy.rule("ST", "lose")
+
+        with stop_on_signals(), CycleLog(path) as log:
+            rep = run(cfg, io, log, progress=progress)
+        moving = any(h.controller.moving())
+        commands = list(h.controller.commands)
+        client.close()
+    recs = read_log(path)
+    _assert_stopped_with_complete_log(rep, recs)
+    fault = recs[-2]
+    assert fault["reason"] in ("interrupted by the user", f"stopped by {sig}")
+    assert fault["stop_confirmed"] is True, fault
+    assert fault["action"].startswith("ST confirmed by the controller")
+    assert proxy.lost == ["ST"] and not moving
+    last_bg = max(i for i, c in enumerate(commands) if c == "BG")
+    assert "ST" in commands[last_bg:]

@@ -137,7 +137,8 @@ def test_a_link_drop_while_homing_stops_safely_with_a_complete_log(tmp_path):
     assert [r["type"] for r in recs][0] == "start" and recs[-1]["type"] == "end"
     assert any(r["type"] == "fault" for r in recs)
     assert recs[-1]["report"]["homed"] is False
-    assert "ST" in sim.commands and sim.commands[-1] == "MO"  # stopped after reconnecting
+    assert "ST" in sim.commands and sim.commands[-2] == "MO"  # stopped after reconnecting
+    assert sim.commands[-1].endswith(",_MOF")  # the proof that the amplifiers are off
     assert not sim.homed
 
 

@@ -152,7 +152,9 @@ def test_sigterm_during_the_coarse_move_with_st_lost_is_confirmed_stopped(tmp_pa
     assert "ST confirmed by the controller" in rep.stop_reason and "MO sent" in rep.stop_reason
     assert len(fault) == 1 and fault[0]["stop_confirmed"] is True
     assert [r["type"] for r in recs][-1] == "end" and not moving
-    assert proxy.lost == ["ST"] and sim.commands[-1] == "MO"
+    assert proxy.lost == ["ST"] and sim.commands[-2] == "MO"  # then its proof, MG <tag>,_MOA..
+    assert sim.commands[-1].endswith(",_MOA,_MOB,_MOC,_MOD,_MOE,_MOF")
+    assert "MO sent and confirmed" in rep.stop_reason
     bg = sim.commands.index("BG")
     assert "ST" in sim.commands[bg:]
 

@@ -45,7 +45,7 @@ def test_staged_run_resumes_from_default_output(capsys, tmp_path, monkeypatch):
     code, stdout, _ = run(capsys, *args)
     second = json.loads(stdout)
     assert second["complete"] is True and second["chunks"] == {"total": 8, "computed": 5,
-                                                               "reused": 3}
+                                                               "reused": 3, "damaged": 0}
     assert second["summary"]["poses"] == 729
     code, stdout, _ = run(capsys, *args[:-1])  # complete: nothing to compute, human output
     assert code == 0 and "within_both" in stdout

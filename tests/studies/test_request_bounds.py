@@ -114,3 +114,16 @@ def test_an_http_server_is_refused_within_the_timeout(capsys, tmp_path):
         assert not (tmp_path / "w").exists()
     finally:
         srv.shutdown()
+
+
+@pytest.mark.parametrize(("argv", "what"), [
+    (["platform-range", "--max-deflection", "inf"], "--max-deflection must be a finite"),
+    (["platform-range", "--max-load", "nan"], "--max-load must be a finite"),
+    (["platform-range", "--max-load", "0"], "--max-load"),
+    (["platform-design", "--max-deflection", "-1", "--height", "50,60"], "--max-deflection"),
+    (["platform-range", "--range-mm", "1,1,inf"], "--range-mm"),
+])
+def test_platform_limits_must_be_finite_and_positive(capsys, tmp_path, argv, what):
+    """``--max-deflection inf`` ended in a traceback (exit 1) writing the spec as JSON."""
+    msg = _error(capsys, ["sweep", *argv, "--samples", "10", "--output", str(tmp_path / "w")])
+    assert what in msg and not (tmp_path / "w").exists()
