@@ -12,7 +12,6 @@ default: Vibhute 2011 §5.1) and drives it through the real client and reader. W
 from __future__ import annotations
 
 import math
-import time
 from pathlib import Path
 
 import numpy as np
@@ -26,22 +25,20 @@ from kinestat.app.control_defaults import (
     TASKS,
 )
 from kinestat.app.signals import stop_on_signals
+from kinestat.cli import _control_options as opts
+from kinestat.cli import _control_output as show
 from kinestat.cli._model import (
     base_option,
     length_unit_option,
-    load_model,
     scale_option,
     tip_option,
 )
 from kinestat.cli._options import check_seed, flag
-from kinestat.cli._output import console as out_console
 from kinestat.cli._output import (
     err_console,
     literal,
     parse_floats,
-    parse_pose,
     print_json,
-    table,
 )
 from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.devices.ceilings import MAX_SAMPLES
@@ -50,168 +47,6 @@ from kinestat.errors import InputError, KinestatError
 
 def register(app: typer.Typer) -> None:
     app.command("control")(control_command)
-
-
-def _host_port(text: str) -> tuple[str, int]:
-    host, sep, port = text.rpartition(":")
-    if not sep or not host:
-        raise InputError(f"--galil: expected HOST:PORT, got {text!r}")
-    try:
-        p = int(port)
-    except ValueError as exc:
-        raise InputError(f"--galil: port {port!r} is not a number") from exc
-    if not 0 < p < 65536:
-        raise InputError(f"--galil: port {p} outside 1..65535")
-    return host, p
-
-
-def _run_dir(base: Path) -> Path:
-    """A new run directory ``base/<timestamp>[-k]``, created here: two runs started in the
-    same second each get their own (mkdir is atomic; checking for it first was not, and two
-    runs wrote one interleaved log)."""
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    base.mkdir(parents=True, exist_ok=True)
-    k = 1
-    while True:
-        d = base / (stamp if k == 1 else f"{stamp}-{k}")
-        try:
-            d.mkdir()
-            return d
-        except FileExistsError:
-            k += 1
-
-
-def _workpiece(text: str | None):
-    """``--workpiece``: "plane" (None) or "cylinder:radius=R,axis=x,y,z[,point=x,y,z]" (a
-    :class:`~kinestat.app.control_run.CylinderSpec`)."""
-    from kinestat.app.control_run import CylinderSpec  # lazy: start-up (numba)
-
-    if text is None or text.strip() == "plane":
-        return None
-    kind, sep, rest = text.partition(":")
-    if kind.strip() != "cylinder" or not sep:
-        raise InputError(f"--workpiece: expected 'plane' or 'cylinder:radius=R,axis=x,y,z"
-                         f"[,point=x,y,z]', got {text!r}")
-    fields: dict[str, list[str]] = {}
-    key = None
-    for tok in rest.split(","):
-        name, eq, val = tok.partition("=")
-        if eq:
-            key = name.strip()
-            if key not in ("radius", "axis", "point") or key in fields:
-                raise InputError(f"--workpiece: unknown or repeated field {key!r} in {text!r}")
-            fields[key] = [val]
-        elif key is None:
-            raise InputError(f"--workpiece: expected name=value after 'cylinder:', got {text!r}")
-        else:
-            fields[key].append(tok)
-    if "radius" not in fields or "axis" not in fields:
-        raise InputError(f"--workpiece: a cylinder needs radius= and axis=, got {text!r}")
-    radius = parse_floats(",".join(fields["radius"]), 1, "workpiece radius")[0]
-    axis = parse_floats(",".join(fields["axis"]), 3, "workpiece axis")
-    point = (parse_floats(",".join(fields["point"]), 3, "workpiece point")
-             if "point" in fields else None)
-    return CylinderSpec(radius=float(radius), axis=axis, point=point)
-
-
-def _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise, friction,
-          rate, seed, sim_legs="thesis", workpiece=None, sim="kinestat",
-          workpiece_stiffness=None):
-    """The cell the options describe: simulated (no device options) or the real devices."""
-    from kinestat.app.control_run import (  # lazy: start-up (numba)
-        PLANTS,
-        RealDevices,
-        SimulatedCell,
-    )
-
-    if sim not in PLANTS:
-        raise InputError(f"--sim must be one of {', '.join(PLANTS)}, got {sim!r}")
-    if galil is not None and sim != "kinestat":
-        raise InputError("--sim chooses the simulated cell's physics; with real devices "
-                         "(--galil/--serial) run `kinestat sim galil --plant mujoco` and give "
-                         "its addresses instead")
-
-    if (galil is None) != (serial is None):
-        raise InputError("give both --galil HOST:PORT and --serial DEVICE for real devices, or "
-                         "neither to run the simulated cell")
-    if galil is not None and (plane_point or plane_normal or ideal_sensor or noise or friction
-                              or sim_legs != "thesis" or workpiece is not None
-                              or workpiece_stiffness is not None):
-        raise InputError("--plane-point/--plane-normal/--ideal-sensor/--noise/--friction/"
-                         "--sim-legs/--workpiece/--workpiece-stiffness describe the simulated "
-                         "cell; they cannot be used "
-                         "with real devices")
-    cylinder = _workpiece(workpiece)
-    if cylinder is not None and (plane_point or plane_normal):
-        raise InputError("--plane-point/--plane-normal describe a plane workpiece; with "
-                         "--workpiece cylinder:... give the cylinder's point= instead")
-    if serial_format not in ("ks", "legacy"):
-        raise InputError(f"--serial-format must be 'ks' or 'legacy', got {serial_format!r}")
-    if ideal_sensor and noise:
-        raise InputError("--ideal-sensor and --noise exclude each other")
-    if not (math.isfinite(noise) and noise >= 0):
-        raise InputError(f"--noise must be >= 0 mm, got {noise}")
-    if workpiece_stiffness is not None and not (math.isfinite(workpiece_stiffness)
-                                                and workpiece_stiffness > 0):
-        raise InputError(f"--workpiece-stiffness must be a finite number of N/mm > 0, got "
-                         f"{workpiece_stiffness}")
-
-    if galil is None:
-        return SimulatedCell(
-            plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
-            plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
-            friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed,
-            sim_legs=sim_legs, cylinder=cylinder, plant=sim,
-            workpiece_stiffness=workpiece_stiffness)
-    host, port = _host_port(galil)
-    return RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
-
-
-THESIS_ARM_NAME = "puma762"
-"""``--arm`` naming the thesis's PUMA 762 (the default): today's cell, Galil and encoders."""
-
-
-def _arm(arm, tip, base, scale, length_unit, arm_base, galil, serial):
-    """The ``--arm`` of the run (an :class:`~kinestat.app.arm_cell.ArmSpec`), or None for the
-    thesis's PUMA 762; every refusal before anything is loaded or moves."""
-    urdf = [o for o, v in (("--tip", tip), ("--base", base), ("--scale", scale),
-                           ("--length-unit", length_unit)) if v is not None]
-    if arm is None:
-        if urdf or arm_base is not None:
-            raise InputError(f"{'/'.join(urdf + (['--arm-base'] if arm_base else []))}: "
-                             "options of --arm MODEL; give --arm")
-        return None
-    if arm == THESIS_ARM_NAME and not urdf:
-        if arm_base is not None:
-            raise InputError("--arm-base: the thesis's PUMA 762 is the cell's fixed frame; "
-                             "--arm-base places another arm")
-        return None
-    if galil is not None or serial is not None:
-        raise InputError(f"--arm {arm}: another arm runs on the in-process simulated cell "
-                         "only; the Galil and encoder protocols are the PUMA 762's hardware "
-                         "(drop --galil/--serial)")
-    from kinestat.app.arm_cell import ArmSpec  # lazy: start-up (numba)
-
-    b = None if arm_base is None else parse_floats(arm_base, 3, "arm-base")
-    return ArmSpec(model=load_model(arm, tip, base, scale, length_unit), base=b, name=arm)
-
-
-def _print_progress(rec: dict) -> None:
-    """One line per cycle on stderr."""
-    m = rec["measured"]
-    c = rec["commanded"]
-    what = rec["decision"] if c is None else c["action"]
-    extra = ""
-    if c is not None and c["step"]:
-        extra += f" step {c['step']:+.4f} mm"
-    if c is not None and c["rotation_deg"]:
-        extra += f" turn {c['rotation_deg']:.3f}°"
-    fmag = float(np.linalg.norm(m["estimate"]))
-    task = rec.get("task")
-    if task:
-        extra += f"  F_n {task['normal_force']:7.4f} N  travel {task['travel']:7.3f} mm"
-    err_console.print(f"cycle {rec['cycle']:3d}  state {rec['state']}  |F| {fmag:7.4f} N"
-                      f"  -> {what}{extra}")
 
 
 def control_command(
@@ -397,10 +232,10 @@ def control_command(
     travel, normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
     simulated); with --arm also arm (name, joints, base, placement, limits_deg).
     """
-    _check_counts(samples, max_iterations)
+    opts.check_counts(samples, max_iterations)
     check_seed(seed)
-    _check_plot_dir(plot, no_plot)
-    _check_rate_and_log(rate, log)
+    opts.check_plot_dir(plot, no_plot)
+    opts.check_rate_and_log(rate, log)
     d = parse_floats(direction, 3, "direction")
     if np.linalg.norm(d) == 0:
         raise InputError("--direction must not be the zero vector")
@@ -420,12 +255,12 @@ def control_command(
     )
     from kinestat.cli._compile import KERNELS, compiling_notice, is_cold, warm_kernels
 
-    _check_task_options(task, travel=travel, travel_dir=travel_dir, travel_step=travel_step,
+    opts.check_task_options(task, travel=travel, travel_dir=travel_dir, travel_step=travel_step,
                         tilt_deg=tilt_deg, auto_tilt=auto_tilt, probe_span=probe_span)
     if not (math.isfinite(max_approach) and max_approach > 0):
         raise InputError(f"--max-approach must be a positive number of mm, got {max_approach}")
-    arm_spec = _arm(arm, tip, base, scale, length_unit, arm_base, galil, serial)
-    cell = _cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
+    arm_spec = opts.arm(arm, tip, base, scale, length_unit, arm_base, galil, serial)
+    cell = opts.cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise,
                  friction, rate, seed, sim_legs, workpiece, sim, workpiece_stiffness)
     simulated = isinstance(cell, SimulatedCell)
     req = ControlRequest(force=force * d, start_tool_point=p0, cell=cell, force_tol=force_tol,
@@ -440,7 +275,7 @@ def control_command(
                          travel_step=1.0 if travel_step is None else travel_step,
                          tilt_deg=0.0 if tilt_deg is None else tilt_deg, auto_tilt=auto_tilt,
                          arm=arm_spec, probe_span=probe_span, max_approach=max_approach,
-                         **_tool_and_mount(tool_offset, a67, mount))
+                         **opts.tool_and_mount(tool_offset, a67, mount))
     cold = tuple(g for g in KERNELS if is_cold(g))
     if cold:  # compile before the run, so that its timing is the loop's own
         with compiling_notice(*cold):
@@ -450,7 +285,7 @@ def control_command(
         raise InputError("--serve goes with --view (and not with --html)")
     run_dir = None  # claimed only now: a refused request leaves nothing behind
     if log is None or (plot is None and not no_plot):
-        run_dir = _run_dir(Path("kinestat-runs"))
+        run_dir = opts.run_dir(Path("kinestat-runs"))
     log_path = log if log is not None else run_dir / "log.jsonl"
     plot_dir = None if no_plot else (plot if plot is not None else run_dir)
 
@@ -460,15 +295,15 @@ def control_command(
                       + (("simulated cell" + (" (MuJoCo)" if sim == "mujoco" else ""))
                          if simulated
                          else literal(f"Galil {galil}, sensor {serial}"))
-                      + ("" if prepared.arm is None else literal(_arm_words(prepared.arm)))
+                      + ("" if prepared.arm is None else literal(show.arm_words(prepared.arm)))
                       + ("" if prepared.follow is None else
                          "; follow {:g} mm, first along ({:.4f}, {:.4f}, {:.4f})".format(
                              prepared.follow.travel, *prepared.follow.travel_dir)))
-    live = _start_live(log_path, platform) if serve else None
+    live = show.start_live(log_path, platform) if serve else None
     # SIGTERM / SIGHUP stop the cell as Ctrl-C does: ST, a fault and an end record, status 2
     with stop_on_signals():
         try:
-            report = run_control(prepared, log_path, progress=_print_progress)
+            report = run_control(prepared, log_path, progress=show.print_progress)
         except KeyboardInterrupt as exc:  # before or after the loop: nothing was moving
             raise KinestatError(f"kinestat control: {exc or 'interrupted'} before the run "
                                 "started or after it ended") from exc
@@ -483,9 +318,9 @@ def control_command(
         if as_json:
             print_json(out)
         else:
-            _print_report(out)
+            show.print_report(out)
     if live is not None:
-        _serve_until_interrupted(live)
+        show.serve_until_interrupted(live)
     elif view or html is not None:
         from kinestat.viz.show import show_log  # lazy: viewer only with --view
 
@@ -496,147 +331,3 @@ def control_command(
         raise KinestatError(f"{what}: {report.stop_reason}")
 
 
-def _tool_and_mount(tool_offset: str | None, a67: str | None, mount: str | None) -> dict:
-    """``--tool-offset``, ``--a67`` and ``--mount`` as :class:`ControlRequest` fields."""
-    out: dict = {}
-    if tool_offset is not None:
-        out["tool_point_6"] = parse_floats(tool_offset, 3, "tool-offset")
-    if a67 is not None:
-        out["a67"] = parse_floats(a67, 3, "a67")
-    if mount is not None:
-        text = mount.strip()
-        if text in ("centred", "centered") or (Path(text).suffix.lower() == ".toml"
-                                              and Path(text).is_file()):
-            out["mount"] = text
-        else:
-            out["mount"] = parse_pose(text, "mount")
-    return out
-
-
-def _start_live(log_path: Path, platform: str | None):
-    """The live view of the run (``--view --serve``), opened in the browser."""
-    import webbrowser  # lazy: the browser only with --serve
-
-    from kinestat.viz.live import start_live  # lazy: the server only with --serve
-
-    p = None
-    if platform is not None:
-        from kinestat.io.platform_toml import read_platform  # lazy: only with --platform
-
-        p = read_platform(platform)
-    live = start_live(log_path, platform=p)
-    err_console.print(f"kinestat control: live view at {live.url}")
-    err_console.file.flush()
-    webbrowser.open(live.url)
-    return live
-
-
-def _serve_until_interrupted(live) -> None:
-    err_console.print(f"kinestat control: the run has ended; the live view stays at {live.url} "
-                      "until Ctrl-C")
-    err_console.file.flush()
-    try:
-        while True:
-            time.sleep(3600)
-    except KeyboardInterrupt:
-        pass
-    finally:
-        live.close()
-
-
-def _arm_words(placed) -> str:
-    """The banner's words on another arm: its name and where its base was put."""
-    b = ", ".join(f"{v:g}" for v in placed.base)
-    how = "placed automatically" if placed.placement == "auto" else "--arm-base"
-    return f", arm {placed.source_name} (base at {b} mm, {how})"
-
-
-def _check_task_options(task: str, **given) -> None:
-    """The follow task's options given to another task: one clear error naming them (they
-    would be ignored)."""
-    if task != "press":  # follow, or an unknown task (refused with its own error)
-        return
-    named = [f"--{k.replace('_', '-')}" for k, v in given.items() if v is not None]
-    if named:
-        raise InputError(f"{', '.join(named)} only apply to --task follow (this run is "
-                         f"--task {task})")
-
-
-def _check_counts(samples: int, max_iterations: int | None) -> None:
-    """The documented ceilings of --samples and --max-iterations, before anything starts."""
-    if not 1 <= samples <= MAX_SAMPLES:
-        raise InputError(f"--samples must be in 1..{MAX_SAMPLES} (packets averaged per "
-                         f"measurement), got {samples}")
-    if max_iterations is not None and not 1 <= max_iterations <= MAX_ITERATIONS:
-        raise InputError(f"--max-iterations must be in 1..{MAX_ITERATIONS}, got "
-                         f"{max_iterations}")
-
-
-def _check_rate_and_log(rate: float, log: Path | None) -> None:
-    """--rate (the simulated encoder's packet rate) and --log (a file, not a directory), before
-    anything starts or is printed."""
-    from kinestat.sim.encoder_emitter import MAX_RATE_HZ  # lazy: start-up
-
-    if not (math.isfinite(rate) and 0 < rate <= MAX_RATE_HZ):
-        raise InputError(f"--rate must be in (0, {MAX_RATE_HZ:g}] Hz, got {rate}")
-    if log is not None and log.is_dir():
-        raise InputError(f"--log {str(log)!r} is a directory; give the cycle log's file name")
-
-
-def _check_plot_dir(plot: Path | None, no_plot: bool) -> None:
-    """--plot names a directory: refuse an existing file before running (as ``disp --plot``)."""
-    if plot is not None and not no_plot and plot.exists() and not plot.is_dir():
-        raise InputError(f"--plot {str(plot)!r} exists and is not a directory; give a "
-                         "directory for the wrench-vs-state plot")
-
-
-def _print_report(out: dict) -> None:
-    ok = "[green]converged[/]" if out["converged"] else "[red]not converged[/]"
-    out_console.print(f"Kinestatic control {ok} after {out['iterations']} cycles "
-                      f"({out['moves']} moves, {out['elapsed_s']:.1f} s); states "
-                      + (" → ".join(out["states"]) if out["states"]
-                         else "none (stopped before the first cycle)"))
-    if out["converged"]:  # a failed run's reason is the one error line on stderr
-        out_console.print(f"  {literal(out['stop_reason'])}")
-    if out.get("task") == "follow":
-        rms, mx = out.get("normal_force_rms_error"), out.get("normal_force_max_error")
-        out_console.print(f"  travel {out['travel']:.3f} mm along the surface; normal force error "
-                          + ("n/a" if rms is None else f"RMS {rms:.4f} N, max {mx:.4f} N")
-                          + f"; contact lost {out['contact_lost']} cycles")
-    rows = []
-    # the equivalent wrench's force beside its torques: base − tool = tool_point × that force,
-    # base − tip = tip × that force
-    for key, label in (("force", f"force, {out.get('estimator', 'point')} estimate (N)"),
-                       ("equivalent_force", "equivalent wrench: force (N)"),
-                       ("torque_about_tip", "  torque about measured tip (N·mm)"),
-                       ("torque_about_tool", "  torque about tool point P_tool_F (N·mm)"),
-                       ("torque_about_base", "  torque about robot base (N·mm)"),
-                       ("true_force", "true force (N)"), ("tool_axis", "tool axis S6"),
-                       ("tip", "tip, measured (mm)"),
-                       ("tool_point", "tool point (mm), commanded")):
-        if out.get(key) is not None:
-            rows.append([label, *out[key]])
-    if rows:
-        out_console.print(table("Final state (fixed frame)", ["", "x", "y", "z"], rows))
-    if out.get("force_magnitude") is not None:
-        line = f"|F| = {out['force_magnitude']:.4f} N (target {out['target_force']:g} N)"
-        if out.get("true_force_magnitude") is not None:
-            line += f", true |F| = {out['true_force_magnitude']:.4f} N"
-        if out.get("axis_error_deg") is not None:
-            line += f", true force vs tool axis {out['axis_error_deg']:.3f}°"
-        out_console.print(line)
-    if out.get("final_axis_deg") is not None:
-        out_console.print("robot axes (deg): " + ", ".join(f"{v:.4f}"
-                                                           for v in out["final_axis_deg"]))
-    if out.get("tool_point_6") is not None:
-        out_console.print("tool P_tool_6 (" + ", ".join(f"{v:g}" for v in out["tool_point_6"])
-                          + ") mm, mount " + literal(str(out.get("mount_source", "centred"))))
-    if out.get("arm") is not None:
-        arm = out["arm"]
-        out_console.print(literal(f"arm {arm['name']}: base at ("
-                                  + ", ".join(f"{v:g}" for v in arm["base"]) + ") mm, "
-                                  + ("placed automatically" if arm["placement"] == "auto"
-                                     else "--arm-base")))
-    out_console.print(f"log: {literal(out['log'])}")
-    for p in out.get("plots", []):
-        out_console.print(f"plot: {literal(p)}")

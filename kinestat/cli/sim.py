@@ -199,7 +199,7 @@ def _galil_mujoco(host: str, port: int, allow_remote: bool, duration: float | No
     from kinestat.app.control_run import ControlRequest, prepare_control  # lazy: as above
     from kinestat.app.mujoco_harness import MujocoHarness  # lazy: mujoco
     from kinestat.app.sim_cell import start_counts  # lazy: as above
-    from kinestat.cli.control import _cell  # lazy: as above
+    from kinestat.cli._control_options import cell as sim_cell  # lazy: as above
 
     d = parse_floats(opts["direction"] or DEFAULT_DIRECTION, 3, "direction")
     if not np.linalg.norm(d) > 0:
@@ -207,9 +207,9 @@ def _galil_mujoco(host: str, port: int, allow_remote: bool, duration: float | No
     p0 = parse_floats(opts["start"] or DEFAULT_START, 3, "start")
     if not (0 < opts["rate"] <= 5000):
         raise InputError(f"--rate must be in (0, 5000] packets per second, got {opts['rate']}")
-    cell = _cell(None, None, "ks", opts["plane_point"], opts["plane_normal"], False, 0.0,
-                 opts["friction"], opts["rate"], 0, opts["sim_legs"], opts["workpiece"],
-                 "mujoco")
+    cell = sim_cell(None, None, "ks", opts["plane_point"], opts["plane_normal"], False, 0.0,
+                    opts["friction"], opts["rate"], 0, opts["sim_legs"], opts["workpiece"],
+                    "mujoco")
     prep = prepare_control(ControlRequest(force=4.0 * d / np.linalg.norm(d),
                                           start_tool_point=p0, cell=cell))
     harness = MujocoHarness(prep.plant, prep.config.model, prep.sensor,

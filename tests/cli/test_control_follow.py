@@ -6,7 +6,7 @@ import json
 
 import pytest
 
-from kinestat.cli.control import _workpiece
+from kinestat.cli._control_options import parse_workpiece as _workpiece
 from kinestat.cli.main import main
 from kinestat.errors import InputError
 from tests.cli._cell_helpers import use_fast_moves
