@@ -62,10 +62,10 @@ from kinestat.control.controller import (  # noqa: E402
     _solve_counts,
     decide,
 )
-from kinestat.control.envelope import predict  # noqa: E402
 from kinestat.control.follow import decide_follow  # noqa: E402
 from kinestat.control.log import CycleLog  # noqa: E402
 from kinestat.control.loop import run  # noqa: E402
+from kinestat.control.predict import predict  # noqa: E402
 from kinestat.control.wrench import Measurement, measure  # noqa: E402
 
 START = np.array([-400.0, 800.0, -100.0])

@@ -157,7 +157,7 @@ def _warm_kinestatic() -> None:
 def _warm_control() -> None:
     """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
     vernier_pick), the PUMA 762's move in one call (vernier.puma_move_one), the envelope's
-    pre-checks and predictions (envelope.predict, envelope.sliding_push) and
+    pre-checks and predictions (predict.predict, predict.sliding_push) and
     the follow task's path curvature (contact_estimate.path_curvature_one) and base twist
     (follow._base_twist)."""
     from kinestat.control._cycle_kernels import (  # lazy: start-up (numba)

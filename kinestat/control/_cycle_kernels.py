@@ -345,7 +345,7 @@ def _base_pose(Tn, mount):
 @nb.njit(**_OPTS)
 def predict_kernel(Tn, mount, tip_F, p, base_R, f_point, B, P_top, T, K, flange, lengths,
                    free_lengths, force, defl, tip_motion, top):
-    """:func:`kinestat.control.envelope.predict`'s compiled path for one measurement and one
+    """:func:`kinestat.control.predict.predict`'s compiled path for one measurement and one
     new flange pose ``Tn`` (4, 4), in one call: the base's new pose ``Tn · mount``, the pinned
     tip's offset ``u`` in the new base frame and the external force ``F = −R_Bᵀ f_point`` on
     the tip (base frame), the platform's response
@@ -387,7 +387,7 @@ def predict_kernel(Tn, mount, tip_F, p, base_R, f_point, B, P_top, T, K, flange,
 
 @nb.njit(**_OPTS)
 def slide_kernel(Tn, mount, tip_F, p, base_R, est, K, C, push, has_push, out):
-    """:func:`kinestat.control.envelope.sliding_push`'s first-order frictionless slide for one
+    """:func:`kinestat.control.predict.sliding_push`'s first-order frictionless slide for one
     measurement and one new flange pose ``Tn`` (4, 4), in one call: ``out[0]`` the force
     magnitude ``f + δf`` (N) after the move and, when ``has_push``, ``out[1]`` its rate
     ``d(f + δf)/ds`` (N/mm) for a further translation ``s`` of the flange along ``push`` (3,,

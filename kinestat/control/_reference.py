@@ -18,7 +18,7 @@ from collections.abc import Iterator
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from kinestat.control import controller, cycle, envelope, follow
+from kinestat.control import controller, cycle, envelope, follow, predict
 from kinestat.control.contact_estimate import cone_normal, friction_sample, path_curvature
 from kinestat.control.controller import Target
 from kinestat.control.model import ControlModel
@@ -85,7 +85,7 @@ def reference_cycle() -> Iterator[None]:
     saved = [(controller, "_puma_move", lambda *a: None),
              (controller, "_solve_counts", solve_counts_reference),
              (controller, "_flange_pose", lambda model, q: puma762.forward(q).pose),
-             (envelope, "cycle_data", UncachedCycleData),
+             (predict, "cycle_data", UncachedCycleData),
              (follow, "cycle_data", UncachedCycleData),
              (follow, "_base_twist_fast", lambda *a: None),
              (follow, "compose_twist_line", compose_twist),
@@ -97,11 +97,11 @@ def reference_cycle() -> Iterator[None]:
              (follow, "solve_one", np.linalg.solve),
              (follow, "replace", dataclasses.replace),
              (follow, "mount_inverse", lambda model: inv(model.mount)),
-             (envelope, "rotvec_matrix_one",
+             (predict, "rotvec_matrix_one",
               lambda r: Rotation.from_rotvec(r).as_matrix()),
              (envelope, "_rotation_clear", lambda *a: False),
-             (envelope, "_predict_fast", lambda *a: None),
-             (envelope, "_slide_fast", lambda *a: None),
+             (predict, "_predict_fast", lambda *a: None),
+             (predict, "_slide_fast", lambda *a: None),
              (envelope, "_measurement_clear", lambda *a: False),
              (envelope, "_command_clear", lambda *a: False)]
     old = [(mod, name, getattr(mod, name)) for mod, name, _ in saved]

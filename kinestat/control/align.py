@@ -16,7 +16,7 @@ import numpy as np
 
 from kinestat.control.arm import frame_from_tool
 from kinestat.control.cycle import cross3, norm3
-from kinestat.control.envelope import sliding_push, tip_stiffness
+from kinestat.control.predict import sliding_push, tip_stiffness
 from kinestat.spatial.se3 import rotvec_matrix_one
 
 __all__ = [
@@ -269,7 +269,7 @@ def turned_force(config, state, meas, s6, a67) -> tuple[float, float] | None:
     """``(f, k)``: |F| (N) predicted after turning the tool onto ``s6``, ``a67`` about the
     tool point, no step along the axis, with the tip sliding freely, and its rate ``k``
     (N/mm) for a push along the new ``s6``
-    (:func:`~kinestat.control.envelope.sliding_push`); None out of contact. A turn onto the
+    (:func:`~kinestat.control.predict.sliding_push`); None out of contact. A turn onto the
     force undoes the top's soft deflection across the tool and loads the stiff axis instead:
     on a frictionless cylinder met 41° off the tool axis at 5.8 N two 20° turns raised the
     force from 0.3 to 4.7 N (predicted 5.8 N), and the Newton step computed without the turn

@@ -27,7 +27,7 @@ Each cycle is labelled with the states of Vibhute's Figure 5-2:
 Step along S6 (``method``): ``"fixed"`` is the thesis's 1 mm step with the sign of the force
 error (``step``); ``"stiffness"`` is a Newton step ``δ = (|F_req| − |F|) / k_axial`` with
 ``k_axial = s6ᵀ K_tip s6`` the platform's point stiffness at the tip along S6
-(:func:`kinestat.control.envelope.tip_stiffness`), clipped to ``step``.
+(:func:`kinestat.control.predict.tip_stiffness`), clipped to ``step``.
 
 The commanded axis angles are rounded to whole encoder counts of the robot. With ``vernier``
 the controller picks, among the count vectors next to the ideal one (±4 counts on axes 1..3,
@@ -71,13 +71,12 @@ from kinestat.control.cycle import norm3, replace
 from kinestat.control.envelope import (
     AXIS_STEP_VIOLATION,
     Envelope,
-    Prediction,
     check_command,
     check_measurement,
     check_target,
-    predict,
 )
 from kinestat.control.model import ControlModel
+from kinestat.control.predict import Prediction, predict
 from kinestat.control.vernier import (
     AXIS_OFFSETS,
     OFFSETS,

@@ -1,6 +1,6 @@
 """The envelope's compiled prediction (issue 13, compute time) against its NumPy formulation:
 the kernels on random stiffness matrices, tips and moves (incl. singular ones), and
-:func:`~kinestat.control.envelope.predict` on recorded measurements with random flange moves,
+:func:`~kinestat.control.predict.predict` on recorded measurements with random flange moves,
 with :func:`~kinestat.control.envelope.check_command`'s verdicts compared for envelopes whose
 limits sit just around the predicted values."""
 
@@ -15,11 +15,12 @@ import pytest
 
 from kinestat.app.control_run import ControlRequest, SimulatedCell, prepare_control
 from kinestat.app.sim_cell import InProcessIO, start_counts
-from kinestat.control import envelope as env_mod
+from kinestat.control import predict as env_mod
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, decide
-from kinestat.control.envelope import Envelope, check_command, predict, top_motion
+from kinestat.control.envelope import Envelope, check_command, top_motion
 from kinestat.control.log import CycleLog
 from kinestat.control.loop import run
+from kinestat.control.predict import predict
 from kinestat.io.library import prototype
 from kinestat.parallel.stiffness import (
     pinned_tip_step,
@@ -36,7 +37,7 @@ START = np.array([-400.0, 800.0, -100.0])
 
 def _numpy_step(K, p, u, F, platform, T):
     """The prediction's linear algebra as NumPy solves (the formulation of
-    :func:`kinestat.control.envelope.predict`'s NumPy path), written out independently."""
+    :func:`kinestat.control.predict.predict`'s NumPy path), written out independently."""
     A = np.vstack([np.eye(3), skew(p)])
     B = np.hstack([-skew(p), np.eye(3)])
     b = np.concatenate([np.zeros(3), np.cross(u, F)])

@@ -187,7 +187,7 @@ def test_compiled_prediction_wrapping_equals_the_numpy_wrapping():
     from pathlib import Path
 
     from kinestat.app.sim_cell import InProcessIO, start_counts
-    from kinestat.control import envelope as env_mod
+    from kinestat.control import predict as env_mod
     from kinestat.control.controller import decide
     from kinestat.control.log import CycleLog
     from kinestat.control.loop import run

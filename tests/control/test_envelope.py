@@ -13,13 +13,15 @@ from kinestat.control._reference import reference_cycle
 from kinestat.control.controller import axis_counts_to_q
 from kinestat.control.envelope import (
     Envelope,
-    Prediction,
     check_command,
     check_measurement,
     check_target,
+    require,
+)
+from kinestat.control.predict import (
+    Prediction,
     predict,
     predict_sliding,
-    require,
     sliding_force,
     sliding_push,
     tip_compliance,
