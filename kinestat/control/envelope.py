@@ -35,7 +35,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from kinestat.control._cycle_kernels import command_clear_kernel, measurement_clear_kernel
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, SafetyStop
@@ -102,19 +101,6 @@ class Envelope:
 
 
 
-def _c(a) -> np.ndarray:
-    """``a`` as a writeable C-ordered float array (itself when it is one: the kernels compile
-    for one array type)."""
-    if type(a) is np.ndarray and a.dtype is _F64:
-        f = a.flags
-        if f.c_contiguous and f.writeable:
-            return a
-    return np.array(a, dtype=float)
-
-
-_F64 = np.dtype(np.float64)
-
-
 def top_motion(model: ControlModel, top_pose) -> np.ndarray:
     """The top's motion from its unloaded pose (Table 3-1's quantities), base frame: (6,)
     ``[dx, dy, dz]`` (mm) of the top triangle's centroid and ``[rx, ry, rz]`` (degrees), the
@@ -126,27 +112,16 @@ def top_motion(model: ControlModel, top_pose) -> np.ndarray:
 
 
 class _Consts:
-    """A model's constants of the checks as Python floats, made once per model (the checks run
-    several times a cycle; their scalar arithmetic beats NumPy's per-call set-up on 3-vectors)."""
+    """A model's constants of the checks as Python floats, made once per model."""
 
     def __init__(self, model: ControlModel) -> None:
         H = model.platform.home_pose
         c = model.platform.top_points.mean(axis=0)
-        self.H_rot = H[:3, :3].tolist()
         self.centroid = c.tolist()
         self.home_centroid = (H[:3, :3] @ c + H[:3, 3]).tolist()
         self.lo = model.limits_deg[:, 0].tolist()
         self.hi = model.limits_deg[:, 1].tolist()
         self.free_lengths = model.platform.free_lengths.tolist()
-        # writeable C copies for the compiled prediction (it compiles for one array type)
-        self.mount = np.array(model.mount, dtype=float)
-        self.free_lengths_array = np.array(model.platform.free_lengths, dtype=float)
-        # and for the compiled pre-checks (_measurement_clear, _command_clear)
-        self.H_rot_array = np.array(H[:3, :3], dtype=float)
-        self.centroid_array = np.array(c, dtype=float)
-        self.home_centroid_array = np.array(self.home_centroid, dtype=float)
-        self.lo_array = np.array(model.limits_deg[:, 0], dtype=float)
-        self.hi_array = np.array(model.limits_deg[:, 1], dtype=float)
 
 
 _CONSTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
@@ -176,22 +151,6 @@ def _top_translation(model: ControlModel, T: np.ndarray) -> np.ndarray:
     return np.array(_translation_list(model, np.asarray(T, dtype=float)))
 
 
-def _rotation_clear(envelope: Envelope, model: ControlModel, T: np.ndarray) -> bool:
-    """True when the top's rotation from home is so small that no component of
-    :func:`top_motion`'s rotation vector can exceed its range: its angle (from the trace,
-    ``cos θ = (tr R − 1) / 2``, ``tr(R R_homeᵀ) = Σ R_ij R_home,ij``), which bounds every
-    component, is below the smallest rotation range by 1e-6° (more than the two computations'
-    rounding apart). :func:`check_motion` then needs no rotation vector — the same verdicts,
-    without SciPy's conversion."""
-    H = _consts(model).H_rot
-    tr = 0.0
-    for row, hrow in zip(T[:3, :3].tolist(), H, strict=True):
-        tr += row[0] * hrow[0] + row[1] * hrow[1] + row[2] * hrow[2]
-    c = (tr - 1.0) / 2.0
-    angle = math.degrees(math.acos(min(1.0, max(-1.0, c))))
-    return angle + 1e-6 < min(envelope.motion_range[3:])
-
-
 _MOTION_NAMES = ("x", "y", "z", "about x", "about y", "about z")
 
 
@@ -199,10 +158,7 @@ def check_motion(envelope: Envelope, model: ControlModel, top_pose, what: str) -
     """Violations of Table 3-1's motion ranges by the top at ``top_pose`` (``what``: "measured"
     or "predicted")."""
     T = np.asarray(top_pose, dtype=float)
-    if _rotation_clear(envelope, model, T):  # no rotation component can be out of range
-        m = _translation_list(model, T) + [0.0, 0.0, 0.0]
-    else:
-        m = top_motion(model, T).tolist()
+    m = top_motion(model, T).tolist()
     out = []
     for k, (v, lim) in enumerate(zip(m, envelope.motion_range, strict=True)):
         if abs(v) > lim:
@@ -232,83 +188,9 @@ def check_target(envelope: Envelope, force_target) -> list[str]:
     return []
 
 
-def _shaped(a, shape: tuple) -> np.ndarray | None:
-    """``a`` as a writeable C float array of ``shape`` (:func:`_c`), or None."""
-    if not isinstance(a, np.ndarray) or a.shape != shape:
-        return None
-    return _c(a)
-
-
-def _measurement_clear_compiled(envelope: Envelope, model: ControlModel,
-                                meas: Measurement) -> bool:
-    """True when :func:`check_measurement` would find nothing, decided compiled with a margin
-    (:func:`kinestat.control._cycle_kernels.measurement_clear_kernel`); False when it may
-    find something (the checks in Python then run and say what)."""
-    w, lengths, T = (_shaped(meas.wrench, (6,)), _shaped(meas.leg_lengths, (6,)),
-                     _shaped(meas.top_pose, (4, 4)))
-    if w is None or lengths is None or T is None:
-        return False
-    k = _consts(model)
-    mr, rot_min = _ranges(envelope.motion_range)
-    return bool(measurement_clear_kernel(
-        w, lengths, k.free_lengths_array, T, k.H_rot_array, k.centroid_array,
-        k.home_centroid_array, mr, rot_min, float(envelope.max_load),
-        float(envelope.max_deflection)))
-
-
-def _command_clear_compiled(envelope: Envelope, model: ControlModel, axis_deg_new,
-                            axis_deg_now, prediction: Prediction | None) -> bool:
-    """True when :func:`check_command` would find nothing, decided compiled with a margin
-    (:func:`kinestat.control._cycle_kernels.command_clear_kernel`); False when it may find
-    something (the checks in Python then run and say what)."""
-    a = _shaped(axis_deg_new, (6,))
-    now = None if axis_deg_now is None else _shaped(axis_deg_now, (6,))
-    if a is None or (axis_deg_now is not None and now is None):
-        return False
-    f = d = T = None
-    if prediction is not None:
-        f, d = _shaped(prediction.force, (3,)), _shaped(prediction.deflections, (6,))
-        if f is None or d is None:
-            return False
-        if prediction.top_pose is not None:
-            T = _shaped(prediction.top_pose, (4, 4))
-            if T is None:
-                return False
-    k = _consts(model)
-    mr, rot_min = _ranges(envelope.motion_range)
-    return bool(command_clear_kernel(
-        a, _UNUSED6 if now is None else now, now is not None, k.lo_array, k.hi_array,
-        float(envelope.max_joint_step_deg), _UNUSED3 if f is None else f,
-        _UNUSED6 if d is None else d, _UNUSED44 if T is None else T, prediction is not None,
-        T is not None, k.H_rot_array, k.centroid_array, k.home_centroid_array, mr, rot_min,
-        float(envelope.max_load), float(envelope.max_deflection)))
-
-
-# placeholders for the arguments a pre-check does not read (writeable: one array type)
-_UNUSED3, _UNUSED6, _UNUSED44 = np.zeros(3), np.zeros(6), np.zeros((4, 4))
-_RANGES: dict[tuple, tuple[np.ndarray, float]] = {}
-
-
-def _ranges(motion_range: tuple) -> tuple[np.ndarray, float]:
-    """The motion ranges (6,) as an array and the least rotation range, made once per tuple."""
-    got = _RANGES.get(motion_range)
-    if got is None:
-        got = _RANGES[motion_range] = (np.array(motion_range, dtype=float),
-                                       min(motion_range[3:]))
-    return got
-
-
-#: the checks' compiled pre-checks (on the reference path: never clear, the Python checks run)
-_measurement_clear = _measurement_clear_compiled
-_command_clear = _command_clear_compiled
-
-
 def check_measurement(envelope: Envelope, model: ControlModel, meas: Measurement) -> list[str]:
-    """Violations in a measurement: load and leg deflections beyond the envelope. A
-    measurement clearly inside (the compiled pre-check, with a margin of 1e-9 relative) has
-    none; any other is checked here, value by value."""
-    if _measurement_clear(envelope, model, meas):
-        return []
+    """Violations in a measurement: load, leg deflections and the top's motion beyond the
+    envelope."""
     out = []
     w = np.asarray(meas.wrench, dtype=float).tolist()
     lengths = np.asarray(meas.leg_lengths, dtype=float).tolist()
@@ -331,12 +213,8 @@ def check_command(envelope: Envelope, model: ControlModel, axis_deg_new, axis_de
     """Violations of a command: axis limits, axis step, predicted load and deflections.
 
     ``axis_deg_new`` are the absolute axis angles that will be commanded (degrees, after
-    rounding to counts); ``axis_deg_now`` the current ones. (Scalar arithmetic on Python
-    floats: the checks run on every command.) A command clearly inside (the compiled
-    pre-check, with a margin of 1e-9 relative) has no violations.
+    rounding to counts); ``axis_deg_now`` the current ones.
     """
-    if _command_clear(envelope, model, axis_deg_new, axis_deg_now, prediction):
-        return []
     out = []
     arr = np.asarray(axis_deg_new, dtype=float)
     a = arr.tolist()

@@ -23,15 +23,12 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
-from kinestat.control._cycle_kernels import predict_kernel, slide_kernel
-from kinestat.control.cycle import cross3, cross_rows, cycle_data
-from kinestat.control.envelope import _c, _consts
+from kinestat.control.cycle import cross3, cycle_data
 from kinestat.control.model import ControlModel
 from kinestat.control.wrench import Measurement
-from kinestat.parallel.stiffness import pinned_tip_step, platform_arrays
 from kinestat.parallel.stiffness import tip_compliance as platform_tip_compliance
-from kinestat.spatial.se3 import rotvec_matrix_one
 from kinestat.spatial.transforms import apply, apply_one, inv, skew
 
 __all__ = [
@@ -43,12 +40,6 @@ __all__ = [
     "sliding_force",
     "sliding_push",
 ]
-
-
-def _norm3(v) -> float:
-    """``|v|`` of a 3-vector in scalars."""
-    a, b, c = v.tolist()
-    return math.sqrt(a * a + b * b + c * c)
 
 
 @dataclass(frozen=True, eq=False)
@@ -69,7 +60,7 @@ class Prediction:
 
     @property
     def force_magnitude(self) -> float:
-        return _norm3(self.force)
+        return float(np.linalg.norm(self.force))
 
 
 def _tip_base(model: ControlModel, meas: Measurement) -> np.ndarray:
@@ -106,9 +97,6 @@ def predict(model: ControlModel, meas: Measurement, flange_pose_new) -> Predicti
     force on the workpiece, fixed frame, is ``−R' (F + δF)``.
     """
     Tn = np.asarray(flange_pose_new, dtype=float)
-    fast = _predict_fast(model, meas, Tn)
-    if fast is not None:
-        return fast
     TB_new = Tn @ model.mount
     data = cycle_data(model, meas)  # K, the tip and C_tip at the measured pose, made once
     tip_F = data.tip_fixed
@@ -133,9 +121,9 @@ def _prediction(model: ControlModel, meas: Measurement, data, Tn: np.ndarray,
     by the small twist ``D = [δφ; δx_O]`` relative to the base (:func:`predict`,
     :func:`predict_sliding`)."""
     S, _ = data.leg_directions
-    dl = cross_rows(model.platform.base_points, S) @ D[:3] + S @ D[3:]
+    dl = np.cross(model.platform.base_points, S) @ D[:3] + S @ D[3:]
     top = np.eye(4)
-    Rd = rotvec_matrix_one(D[:3])  # Rotation.from_rotvec(·).as_matrix(), to rounding
+    Rd = Rotation.from_rotvec(D[:3]).as_matrix()
     top[:3, :3] = Rd @ meas.top_pose[:3, :3]
     top[:3, 3] = Rd @ meas.top_pose[:3, 3] + D[3:]
     tip_F = data.tip_fixed
@@ -188,9 +176,6 @@ def sliding_force(model: ControlModel, meas: Measurement, flange_pose_new) -> fl
     :func:`predict_sliding`'s force magnitude without the rest of the prediction (the press's
     step, :func:`kinestat.control.align.turned_force`). Out of contact, :func:`predict`'s."""
     Tn = np.asarray(flange_pose_new, dtype=float)
-    fast = _slide_fast(model, meas, Tn, None)
-    if fast is not None:
-        return abs(fast[0]) if fast else predict(model, meas, Tn).force_magnitude
     out = _slide(model, meas, Tn)
     if out is None:
         return predict(model, meas, Tn).force_magnitude
@@ -206,37 +191,10 @@ def sliding_push(model: ControlModel, meas: Measurement, flange_pose_new,
     The press's step after a turn (:func:`kinestat.control.align.contact_move`)."""
     Tn = np.asarray(flange_pose_new, dtype=float)
     push = np.asarray(axis, dtype=float)
-    fast = _slide_fast(model, meas, Tn, push)
-    if fast is not None:
-        return fast or None
     out = _slide(model, meas, Tn, push=push)
     if out is None:
         return None
     return out[0], out[6]
-
-
-def _slide_compiled(model: ControlModel, meas: Measurement, Tn: np.ndarray,
-                    push: np.ndarray | None) -> tuple[float, float | None] | tuple | None:
-    """:func:`_slide`'s force and rate compiled for the one pose, in one call
-    (:func:`kinestat.control._cycle_kernels.slide_kernel`; equal to the NumPy formulation to
-    rounding): ``(f + δf, rate)`` (``rate`` None without ``push``), ``()`` out of contact, or
-    None where the kernel meets a singular matrix (the NumPy formulation then runs and
-    raises)."""
-    data = cycle_data(model, meas)
-    out = np.empty(2)
-    got = slide_kernel(_c(Tn), _consts(model).mount, _c(data.tip_fixed), _c(data.tip_base),
-                       _c(meas.base_pose[:3, :3]), _c(meas.estimate("point")), _c(data.K),
-                       _c(data.C_tip), np.zeros(3) if push is None else _c(push), push is not None,
-                       out)
-    if got < 0:
-        return None
-    if got == 0:
-        return ()
-    return float(out[0]), (float(out[1]) if push is not None else None)
-
-
-#: the sliding prediction's compiled path (None on the reference path: NumPy only)
-_slide_fast = _slide_compiled
 
 
 def predict_sliding(model: ControlModel, meas: Measurement, flange_pose_new) -> Prediction:
@@ -252,7 +210,7 @@ def predict_sliding(model: ControlModel, meas: Measurement, flange_pose_new) -> 
     ``M u = C_tip δF``): the tip's displacement is ``u + T τ`` (``u`` as for the pinned tip,
     ``T`` (3, 2) the tangent plane of the normal ``n'`` in the new base frame) and the force
     ``(f + δf) n'``, so ``[M T, −C_tip n'] [τ; δf] = C_tip (f n' − F) − M u``. Out of contact
-    (|F| below 1e-9 N) it returns :func:`predict`'s (pinned) prediction. NumPy, not compiled.
+    (|F| below 1e-9 N) it returns :func:`predict`'s (pinned) prediction.
     """
     Tn = np.asarray(flange_pose_new, dtype=float)
     out = _slide(model, meas, Tn)
@@ -264,53 +222,3 @@ def predict_sliding(model: ControlModel, meas: Measurement, flange_pose_new) -> 
     A = np.vstack([np.eye(3), skew(p)])
     D = np.linalg.solve(data.K, A @ dF + np.concatenate([np.zeros(3), cross3(v, F)]))
     return _prediction(model, meas, data, Tn, TB_new, F + dF, D)
-
-
-
-
-
-def _predict_compiled(model: ControlModel, meas: Measurement, Tn: np.ndarray) -> Prediction | None:
-    """:func:`predict`'s formulation compiled for the one pose, in one call
-    (:func:`kinestat.control._cycle_kernels.predict_kernel` around
-    :func:`kinestat.parallel._stiffness_kernels.pinned_tip_step_one`: one elimination of K
-    instead of three solves, the legs and the Rodrigues rotation in scalars, the frame changes
-    around them in scalars); equal to the NumPy formulation to rounding. None when the kernel
-    meets a singular matrix (the NumPy formulation then runs and raises)."""
-    data = cycle_data(model, meas)
-    k = _consts(model)
-    B, P_top, _, _ = platform_arrays(model.platform)
-    force, defl, tip_motion, top = np.empty(3), np.empty(6), np.empty(3), np.empty((4, 4))
-    if not predict_kernel(_c(Tn), k.mount, _c(data.tip_fixed), _c(data.tip_base),
-                          _c(meas.base_pose), _c(meas.estimate("point")), B, P_top,
-                          _c(data.top_pose), _c(data.K), _c(meas.flange_pose),
-                          _c(meas.leg_lengths), k.free_lengths_array, force, defl, tip_motion,
-                          top):
-        return None
-    return Prediction(force=force, deflections=defl, tip_motion=tip_motion, top_pose=top)
-
-
-def _predict_numpy_wrapped(model: ControlModel, meas: Measurement,
-                           Tn: np.ndarray) -> Prediction | None:
-    """:func:`_predict_compiled` as first written: the platform's kernel
-    (:func:`kinestat.parallel.stiffness.pinned_tip_step`) wrapped in NumPy (kept for the
-    tests of the compiled wrapping)."""
-    TB_new = Tn @ model.mount
-    data = cycle_data(model, meas)
-    tip_F = data.tip_fixed
-    p = data.tip_base
-    R_new, t_new = TB_new[:3, :3], TB_new[:3, 3]
-    u = (tip_F - t_new) @ R_new - p  # inv(TB_new) tip_F − p
-    F = -(meas.estimate("point") @ meas.base_pose[:3, :3])  # −Rᵀ F: external force, base frame
-    out = pinned_tip_step(model.platform, data.top_pose, data.K, p, u, F)
-    if out is None:
-        return None
-    dF, _, dl, top = out
-    Tf = meas.flange_pose
-    local = (tip_F - Tf[:3, 3]) @ Tf[:3, :3]  # the tip in the measured flange frame
-    tip_motion = Tn[:3, :3] @ local + Tn[:3, 3] - tip_F
-    return Prediction(force=-(R_new @ (F + dF)), deflections=meas.deflections(model) + dl,
-                      tip_motion=tip_motion, top_pose=top)
-
-
-#: the prediction's compiled path (None on the reference path: the NumPy formulation only)
-_predict_fast = _predict_compiled
