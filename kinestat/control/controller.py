@@ -3,7 +3,8 @@
 Over 600 lines on purpose: the procedure's types (configuration, state, command), its one
 decision per cycle and the move path every task and procedure shares (:func:`move_command`)
 are one unit; the rules of the turn and the step live in :mod:`kinestat.control.align`, the
-counts in :mod:`kinestat.control.vernier` and the checks in :mod:`kinestat.control.envelope`.
+counts in :mod:`kinestat.control.vernier`, the predictions in :mod:`kinestat.control.predict`
+and the checks in :mod:`kinestat.control.envelope`.
 
 One call per cycle, :func:`decide`, takes the controller's state and the cycle's
 :class:`~kinestat.control.wrench.Measurement` and returns the next :class:`Command` and the new
