@@ -7,7 +7,7 @@ RUN_STAMP := $(VENV)/.run-installed
 DEV_STAMP := $(VENV)/.dev-installed
 BENCH_STAMP := $(VENV)/.bench-installed
 
-.PHONY: run test lint bench startup clean browser vendor-three
+.PHONY: run test lint bench startup clean browser vendor-three docs release
 
 $(BIN)/python:
 	$(PY) -m venv $(VENV)
@@ -19,7 +19,7 @@ $(RUN_STAMP): $(BIN)/python requirements/run.txt pyproject.toml
 	$(BIN)/kinestat warmup
 	touch $@
 
-$(DEV_STAMP): $(RUN_STAMP) requirements/dev.txt
+$(DEV_STAMP): $(RUN_STAMP) requirements/dev.txt requirements/docs.txt
 	$(BIN)/pip install -q -r requirements/dev.txt
 	touch $@
 
@@ -55,12 +55,25 @@ vendor-three:
 	       --legal-comments=none --outfile=../../kinestat/data/viewer/vendor/three.min.js
 	cp build/three/node_modules/three/LICENSE kinestat/data/viewer/vendor/LICENSE-three.txt
 
-# The whole test suite: lint, the layer contract (.importlinter, docs/architecture.md), then
-# pytest (which fails when no test runs).
+# The whole test suite: lint, the layer contract (.importlinter, docs/architecture.md), the
+# docs site built with --strict (any warning, broken page link or anchor fails), then pytest
+# (which fails when no test runs; it runs every module's doctests and the tutorials too).
 test: $(DEV_STAMP) browser
 	$(BIN)/ruff check kinestat tests $(wildcard benchmarks scripts)
 	$(BIN)/lint-imports
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict --quiet
 	$(BIN)/pytest
+
+# The documentation site (MkDocs + Material + mkdocstrings) into build/site; open
+# build/site/index.html, or `.venv/bin/mkdocs serve` to preview while editing.
+docs: $(DEV_STAMP)
+	$(BIN)/python scripts/api_pages.py
+	NO_MKDOCS_2_WARNING=1 $(BIN)/mkdocs build --strict
+
+# The release: sdist and wheel in build/release/dist, installed into a fresh venv and
+# smoke-tested (CI runs this after make test).
+release: $(DEV_STAMP)
+	bash scripts/wheel_smoke.sh
 
 $(BENCH_STAMP): $(DEV_STAMP) requirements/bench.txt
 	$(BIN)/pip install -q -r requirements/bench.txt

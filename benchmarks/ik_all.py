@@ -4,7 +4,9 @@ Run ``.venv/bin/python benchmarks/ik_all.py [--n 10000] [--single 200] [--json]`
 
 Arms (the same random configurations, uniform in [-π, π]^6, fixed seed): UR5 (three parallel
 axes), PUMA 560 (spherical wrist, embedded), PUMA 762 (embedded, Crane–Duffy frames), a Kinova
-Jaco2-type 6R with a 60° wrist (non-Pieper) and a random general 6R. For every solver and arm:
+Jaco2-type 6R with a 60° wrist (non-Pieper), a random general 6R, and three spherical-wrist arms
+with an offset shoulder (KUKA KR16-2 from rtb-data's URDF, KUKA KR5 and ABB IRB140 from the
+Robotics Toolbox's DH models). For every solver and arm:
 single-call time per pose (one pose per call, median over ``--single`` poses), batched poses/s
 (kinestat: one call on ``--n`` poses, the fastest of ``--repeat`` calls; peers have no batch
 call, so their figure is 1/single),
@@ -47,10 +49,10 @@ from arms import arm  # noqa: E402  (test arms, public constructors)
 
 import kinestat  # noqa: E402
 from kinestat.serial.analytic import ik_all  # noqa: E402
-from kinestat.serial.analytic.geometry import home_axes  # noqa: E402
+from kinestat.serial.analytic.geometry import home_axes, meet, parallel  # noqa: E402
 
 PI = math.pi
-ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1")
+ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1", "kr16", "kr5", "irb140")
 
 
 def _wrapdist(a, b):
@@ -130,11 +132,26 @@ def peer_ssik(model):
 
 
 def peer_eaik(model):
+    """EAIK from DH parameters, or (a URDF model) from the home axes (H, P); the solutions it
+    does not flag least-squares."""
     from eaik.IK_DH import DhRobot
+    from eaik.IK_HP import HPRobot
 
     dh = _dh(model)
     if dh is None:
-        return None
+        ax = home_axes(model)
+        pts = np.vstack([ax.r, ax.T0[:3, 3]])
+        bot = HPRobot(ax.w.copy(), np.vstack([pts[0], np.diff(pts, axis=0)]))
+        R0 = ax.T0[:3, :3]
+        if not bot.hasKnownDecomposition():
+            return None
+
+        def call_hp(T):
+            Tp = T.copy()
+            Tp[:3, :3] = T[:3, :3] @ R0.T
+            s = bot.IK(Tp)
+            return [np.asarray(q) for q, ls in zip(s.Q, s.is_LS, strict=True) if not ls]
+        return call_hp
     th, d, a, al = dh
     bot = DhRobot(al, a, d)
     if not bot.hasKnownDecomposition():
@@ -153,8 +170,12 @@ def peer_ikgeo(model, kind):
     h = ax.w.tolist()
     pts = np.vstack([ax.r, ax.T0[:3, 3]])
     p = np.vstack([pts[0], np.diff(pts, axis=0)]).tolist()
+    if kind == "pieper" and meet(ax, 0, 1) is None:  # offset shoulder
+        kind = "pieper-parallel" if parallel(ax, 1, 2) else "pieper-offset"
     ctor = {"three-parallel": Robot.three_parallel_two_intersecting,
-            "pieper": Robot.spherical_two_intersecting}.get(kind, Robot.gen_six_dof)
+            "pieper": Robot.spherical_two_intersecting,
+            "pieper-parallel": Robot.spherical_two_parallel,
+            "pieper-offset": Robot.spherical}.get(kind, Robot.gen_six_dof)
     bot = ctor(h, p)
     R0 = ax.T0[:3, :3]
 

@@ -11,6 +11,11 @@ as often, each time with an empty ``NUMBA_CACHE_DIR``, so every kernel it uses c
     python benchmarks/startup.py --json     # the same as JSON
 
 Goal (issue 16): ``import kinestat`` and ``kinestat --help`` at most ~2x ``import numpy``.
+Goal (issue 44): one FK from the CLI on a URDF (``kinestat fk ur5_robot.urdf ... --json``) at
+most 2x a Pinocchio script that loads the same URDF and prints the same pose (both rows in the
+same run, the ``x pinocchio`` column); the first ``ik_all`` call of a fresh process (after
+``import kinestat``, loading the model and one ``fk``) at most 20 ms: measured inside fresh
+processes (the ``first ik_all`` rows, median of ``--repeat``).
 """
 
 from __future__ import annotations
@@ -30,6 +35,35 @@ CLI = "import sys; from kinestat.cli.main import main; sys.exit(main(sys.argv[1:
 FK = ["fk", "puma762", "--q-deg", "0,0,0,0,0,0"]
 IK = ["ik", "puma762", "--tool-point", "725,190,650", "--s6", "1,0,0", "--a67", "0,0,1"]
 
+
+
+def _robots() -> Path | None:
+    from importlib.metadata import PackageNotFoundError, distribution
+
+    try:
+        return Path(str(distribution("example-robot-data").locate_file(
+            "cmeel.prefix/share/example-robot-data/robots")))
+    except PackageNotFoundError:
+        return None
+
+
+_ERD = _robots()
+UR5 = str(_ERD / "ur_description/urdf/ur5_robot.urdf") if _ERD else ""
+Q_UR5 = "0.1,0.2,0.3,0.4,0.5,0.6"
+FK_URDF = ["fk", UR5, "--tip", "tool0", "--q", Q_UR5, "--json"]
+PINOCCHIO = (f"import sys, numpy as np, pinocchio as pin; m = pin.buildModelFromUrdf({UR5!r}); "
+             f"d = m.createData(); pin.framesForwardKinematics(m, d, np.array([{Q_UR5}])); "
+             "print(d.oMf[m.getFrameId('tool0')].homogeneous.tolist())")
+#: the first ik_all call of a fresh process, timed inside it: wall and CPU ms on stdout (the
+#: process's CPU time is the figure a loaded machine leaves meaningful)
+FIRST_CALL = ("import time, numpy as np, kinestat; m = kinestat.load({model!r}{tip}); "
+              "T = kinestat.fk(m, np.full(m.n, 0.3)); t = time.perf_counter(); "
+              "c = time.process_time(); kinestat.ik_all(m, T); "
+              "print(1e3 * (time.perf_counter() - t), 1e3 * (time.process_time() - c))")
+KR16 = "kuka_description/kuka_kr16/urdf/kr16_2.urdf"
+FIRST_MODELS = {"puma560 (pieper)": ("puma560", None), "UR5 URDF (three-parallel)": (UR5, "tool0"),
+                "KR16 URDF (pieper, offset shoulder)": (KR16, None)}
+
 #: (label, python arguments, cold kernel cache?)
 ROWS: list[tuple[str, list[str], bool]] = [
     ('python -c "import numpy"', ["-c", "import numpy"], False),
@@ -42,10 +76,16 @@ ROWS: list[tuple[str, list[str], bool]] = [
     ("kinestat ik puma762 --tool-point ... (closed form; warm)", ["-c", CLI, *IK], False),
     ("kinestat ik puma762 --tool-point ... (closed form; cold)", ["-c", CLI, *IK], True),
 ]
+if UR5:
+    ROWS += [("pinocchio script: ur5_robot.urdf, FK at q, print the pose", ["-c", PINOCCHIO],
+              False),
+             ("kinestat fk ur5_robot.urdf --tip tool0 --q ... --json", ["-c", CLI, *FK_URDF],
+              False)]
 
 
-def _once(args: list[str], cold: bool) -> float:
+def _once(args: list[str], cold: bool, output: bool = False):
     env = dict(os.environ, PYTHONPATH=str(ROOT), COLUMNS="100")
+    env.pop("PYTHONDONTWRITEBYTECODE", None)  # as a user's shell: bytecode cached
     with tempfile.TemporaryDirectory(prefix="kinestat-numba-") as cache:
         if cold:
             env["NUMBA_CACHE_DIR"] = cache
@@ -55,7 +95,29 @@ def _once(args: list[str], cold: bool) -> float:
         took = time.perf_counter() - t0
     if run.returncode != 0:
         raise SystemExit(f"{args} failed ({run.returncode}): {run.stderr[-500:]}")
-    return took
+    return [float(v) for v in run.stdout.split()[-2:]] if output else took
+
+
+def first_calls(repeat: int) -> list[dict]:
+    """The first ik_all call's time (ms) inside fresh processes, per model: median and range."""
+    out = []
+    for label, (model, tip) in FIRST_MODELS.items():
+        if model == KR16:
+            try:
+                import rtbdata
+            except ImportError:
+                continue
+            model = str(Path(rtbdata.__file__).parent / "xacro" / KR16)
+        if not model:
+            continue
+        code = FIRST_CALL.format(model=model, tip="" if tip is None else f", tip={tip!r}")
+        _once(["-c", code], False, True)  # compile once, untimed
+        runs = [_once(["-c", code], False, True) for _ in range(repeat)]
+        wall, cpu = [r[0] for r in runs], [r[1] for r in runs]
+        out.append({"model": label, "median_ms": statistics.median(wall), "min_ms": min(wall),
+                    "max_ms": max(wall), "cpu_median_ms": statistics.median(cpu),
+                    "cpu_min_ms": min(cpu), "cpu_max_ms": max(cpu), "runs": repeat})
+    return out
 
 
 def measure(repeat: int = 5) -> list[dict]:
@@ -72,8 +134,10 @@ def measure(repeat: int = 5) -> list[dict]:
     rows = [{"command": label, "median_s": statistics.median(t), "min_s": min(t), "runs": len(t)}
             for (label, _, _), t in zip(ROWS, times, strict=True)]
     base = rows[0]["median_s"]
+    pin = next((r["median_s"] for r in rows if r["command"].startswith("pinocchio")), None)
     for r in rows:
         r["ratio_to_numpy"] = r["median_s"] / base
+        r["ratio_to_pinocchio"] = None if pin is None else r["median_s"] / pin
     return rows
 
 
@@ -83,17 +147,26 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--json", action="store_true", help="print JSON")
     a = ap.parse_args(argv)
     rows = measure(a.repeat)
+    first = first_calls(a.repeat)
     stamp = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
+    load = os.getloadavg()
     if a.json:
-        print(json.dumps({"date": stamp, "python": sys.version.split()[0], "rows": rows},
-                         indent=2))
+        print(json.dumps({"date": stamp, "python": sys.version.split()[0], "load_avg": load,
+                          "rows": rows, "first_ik_all": first}, indent=2))
         return 0
     width = max(len(r["command"]) for r in rows)
-    print(f"start-up, {stamp}, Python {sys.version.split()[0]}, median of fresh processes")
-    print(f"{'command':<{width}}  {'median s':>9}  {'min s':>7}  {'x numpy':>8}")
+    print(f"start-up, {stamp}, Python {sys.version.split()[0]}, median of fresh processes, "
+          f"load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f}")
+    print(f"{'command':<{width}}  {'median s':>9}  {'min s':>7}  {'x numpy':>8}  "
+          f"{'x pinocchio':>11}")
     for r in rows:
+        xp = "" if r["ratio_to_pinocchio"] is None else f"{r['ratio_to_pinocchio']:.2f}"
         print(f"{r['command']:<{width}}  {r['median_s']:>9.3f}  {r['min_s']:>7.3f}  "
-              f"{r['ratio_to_numpy']:>8.2f}")
+              f"{r['ratio_to_numpy']:>8.2f}  {xp:>11}")
+    for f in first:
+        print(f"first ik_all call, {f['model']}: median {f['median_ms']:.1f} ms "
+              f"(range {f['min_ms']:.1f}-{f['max_ms']:.1f}), CPU {f['cpu_median_ms']:.1f} ms "
+              f"({f['cpu_min_ms']:.1f}-{f['cpu_max_ms']:.1f}), {f['runs']} processes")
     return 0
 
 

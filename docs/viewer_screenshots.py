@@ -1,8 +1,12 @@
 """Make the screenshots of docs/viewer.md: each kind of `kinestat view` page, written with
-``--html`` and photographed in headless Chromium (kinestat.viz.headless).
+``--html`` and photographed in headless Chromium (kinestat.viz.headless) at 1280x800, with the
+browser tests' checks (kinestat.viz.headless.page_problems): the viewer finished, nothing on
+the console, the canvas not blank, the scene inside the frame, the floor in view, nothing
+spilling out of the side panel. A page failing them is not photographed (exit status 1).
 
 Run: ``.venv/bin/python docs/viewer_screenshots.py [OUTDIR]`` (default docs/img). Needs a
-Chromium (``make browser``). The control run is simulated (``kinestat control``).
+Chromium (``make browser``) and example-robot-data (requirements/dev.txt) for the UR5. The
+control run is simulated (``kinestat control --task follow``).
 """
 
 from __future__ import annotations
@@ -18,7 +22,8 @@ from kinestat.viz import headless
 from kinestat.viz.html import extract_scene
 
 VIEWS = {
-    "model": (["model", "puma762", "--q-deg", "20,-40,30,10,50,0", "--frames"], None),
+    "model": (["puma762", "--q-deg", "30,-40,30,10,50,0", "--frames"], None),
+    "model-ur5": (["{ur5}", "--tip", "tool0", "--q-deg", "20,-70,100,-120,-90,30"], None),
     "model-rph": (["model", "{rph}", "--q", "0.6,150,-1.2", "--frames"], None),
     "platform": (["platform", "--legs", "81.47,81.27,80.97,68,67.8,68.1"], None),
     "screw": (["screw", "--points1", "0,0,0,0,0,1,1,0,0",
@@ -57,22 +62,28 @@ alpha = 45.0
 def main(argv: list[str]) -> int:
     out = Path(argv[1] if len(argv) > 1 else Path(__file__).parent / "img")
     out.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory() as tmp, headless.Browser(size=(1200, 720)) as b:
+    from importlib.metadata import distribution
+
+    ur5 = Path(str(distribution("example-robot-data").locate_file(
+        "cmeel.prefix/share/example-robot-data/robots/ur_description/urdf/ur5_robot.urdf")))
+    with tempfile.TemporaryDirectory() as tmp, headless.Browser(size=(1280, 800)) as b:
         d = Path(tmp)
         (d / "rph.toml").write_text(RPH, encoding="utf-8")
         log = d / "run" / "log.jsonl"
         with contextlib.redirect_stdout(io.StringIO()):
-            assert kinestat(["control", "--log", str(log), "--no-plot", "--json"]) == 0
+            assert kinestat(["control", "--task", "follow", "--travel", "15", "--log", str(log),
+                             "--no-plot", "--json"]) == 0
         for name, (args, at) in VIEWS.items():
             page = d / f"{name}.html"
-            args = [a.format(rph=d / "rph.toml", log=log) for a in args]
+            args = [a.format(rph=d / "rph.toml", log=log, ur5=ur5) for a in args]
             with contextlib.redirect_stdout(io.StringIO()):
                 assert kinestat(["view", *args, "--html", str(page)]) == 0
             n = len(extract_scene(page.read_text(encoding="utf-8"))["steps"])
             frag = {"middle": f"step={n // 2}", "last": f"step={n - 1}"}.get(at, "")
-            r = b.load(page, fragment=frag)
-            if not r.status.get("ready") or r.console:
-                print(f"{name}: page failed: {r.console}", file=sys.stderr)
+            r = b.load(page, fragment=frag, evaluate=headless.PANEL_OVERFLOW_JS)
+            problems = headless.page_problems(r)
+            if problems:
+                print(f"{name}: {'; '.join(problems)}", file=sys.stderr)
                 return 1
             png = out / f"viewer-{name}.png"
             png.write_bytes(r.png)

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import lazy_loader
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"  # the one place the version is written (pyproject reads it)
 
 # the public names load with their module on first use (PEP 562, lazy_loader)
 __getattr__, __dir__, __all__ = lazy_loader.attach(

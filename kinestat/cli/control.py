@@ -289,7 +289,7 @@ def control_command(
         "(docs/control.md).", metavar="thesis|nominal|FILE"),
     platform: str = typer.Option(
         None, "--platform", help="Platform TOML file (default the 2011 prototype); its "
-        "[mount] table, if any, is the default --mount.", metavar="FILE"),
+        "\\[mount] table, if any, is the default --mount.", metavar="FILE"),
     tool_offset: str = typer.Option(
         None, "--tool-offset", "--tool-point-6", metavar="X,Y,Z",
         help="The tool point fixed on the top plate, given where it sits in frame 6 (the "
@@ -302,7 +302,7 @@ def control_command(
     mount: str = typer.Option(
         None, "--mount", metavar="centred|FILE|POSE",
         help="The platform's base frame on the flange, 6_BT: 'centred' (the base triangle's "
-        "centroid on S6, base x along a67; the default), a platform TOML file's [mount] "
+        "centroid on S6, base x along a67; the default), a platform TOML file's \\[mount] "
         "table, or a pose (a pose file, or 16 numbers row by row, mm). The simulated cell is "
         "built with the same mount."),
     sim: str = typer.Option(
@@ -389,11 +389,11 @@ def control_command(
     tip), final_joints_deg, final_leg_lengths, log, states, stop_reason, method, plots,
     torque_about_tip, torque_about_tool, torque_about_base (N·mm, fixed frame: about the tip,
     the tool point and the robot base), equivalent_force (the equivalent wrench's force, N:
-    base − tool torque = tool_point × it), procedure, calibration, cycles, plant (simulated:
-    kinestat or mujoco; with mujoco also sim_time_s, sim_seconds_per_cycle, sim_move_s,
-    sim_settle_s, moves_unsettled); with --task follow also task, travel_speed_mm_s (mujoco),
-    completed, travel,
-    normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
+    base − tool torque = tool_point × it), procedure, calibration, cycles, tool_point_6 (mm,
+    frame 6), a67_start, mount (6_BT), mount_source, plant (simulated: kinestat or mujoco;
+    with mujoco also sim_time_s, sim_seconds_per_cycle, sim_move_s, sim_settle_s,
+    moves_unsettled); with --task follow also task, travel_speed_mm_s (mujoco), completed,
+    travel, normal_force_rms_error, normal_force_max_error, contact_lost (and the true errors,
     simulated); with --arm also arm (name, joints, base, placement, limits_deg).
     """
     _check_counts(samples, max_iterations)
@@ -512,7 +512,7 @@ def _tool_and_mount(tool_offset: str | None, a67: str | None, mount: str | None)
 
 def _start_live(log_path: Path, platform: str | None):
     """The live view of the run (``--view --serve``), opened in the browser."""
-    import webbrowser
+    import webbrowser  # lazy: the browser only with --serve
 
     from kinestat.viz.live import start_live  # lazy: the server only with --serve
 
@@ -614,6 +614,9 @@ def _print_report(out: dict) -> None:
     if out.get("final_axis_deg") is not None:
         out_console.print("robot axes (deg): " + ", ".join(f"{v:.4f}"
                                                            for v in out["final_axis_deg"]))
+    if out.get("tool_point_6") is not None:
+        out_console.print("tool P_tool_6 (" + ", ".join(f"{v:g}" for v in out["tool_point_6"])
+                          + ") mm, mount " + literal(str(out.get("mount_source", "centred"))))
     if out.get("arm") is not None:
         arm = out["arm"]
         out_console.print(literal(f"arm {arm['name']}: base at ("

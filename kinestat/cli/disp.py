@@ -1,7 +1,8 @@
 """``kinestat disp``: run a DISP card deck (Nadkarni 1977, App. I) for any MS = 0..6.
 
 By default it behaves as DISP did: first-order steps (eq. 4-11), the deck's own step counts
-(IT), no correction ("settle") rows. kinestat's refinements (settling, closed loop, damping,
+(IT), every joint nudged at a singular start, a final correction onto the target to the
+printed precision for MS 0 and MS 4. kinestat's refinements (settling, closed loop, damping,
 second order) are options. ``kinestat guide`` is not an emulator and keeps them on.
 """
 
@@ -73,15 +74,16 @@ def disp(
                               "IT. 0 = automatic.", metavar=STEPS_METAVAR),
     settle: bool = flag(False, "--settle", help="Not DISP: after each stage add "
                                 "correction steps straight at its target until it is reached "
-                                "(rows marked *)."),
-    no_settle: bool = flag(False, "--no-settle", help="No correction steps (the "
-                                   "default, as DISP; kept for compatibility)."),
+                                "to 1e-9 (rows marked *)."),
+    no_settle: bool = flag(False, "--no-settle", help="No correction steps at all (DISP "
+                                   "ended MS 0 and MS 4 runs with correction rows to its "
+                                   "printed precision, 0.0005; that is the default there)."),
     closed_loop: bool = flag(False, "--closed-loop", help="Not DISP: correct every "
                                      "step onto the ideal path by Newton iterations "
-                                     "(error ≤ 1e-12)."),
+                                     "(to 1e-9 × the mechanism's size L)."),
     second_order: bool = flag(False, "--second-order", help="Not DISP: include the "
                                       "second-order terms of Nadkarni eq. 5-5 in every step."),
-    singular: str = typer.Option("perturb", "--singular", help=SINGULAR_HELP),
+    singular: str = typer.Option("perturb-all", "--singular", help=SINGULAR_HELP),
     damped: bool = flag(False, "--damped", help="Short for --singular damped (not "
                                 "DISP)."),
     plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png into "
@@ -101,9 +103,10 @@ def disp(
     """Run a DISP deck (Nadkarni 1977): MS 1 screw axes, 2 mechanism data, 3 both, 0/4/5/6
     guidance of types II/III/IV/I.
 
-    By default this is DISP: first-order steps, the deck's step counts, no correction rows
-    (the table holds the initial configuration, one row per step, the last step last). Use
-    `kinestat guide` for kinestat's defaults (correction steps at each target).
+    By default this is DISP: first-order steps, the deck's step counts, every joint nudged
+    at a singular configuration, and for MS 0 and MS 4 a final correction row (marked *) onto
+    each target to the printed precision. Use `kinestat guide` for kinestat's defaults
+    (correction steps to 1e-9 at each target).
 
     Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
     table up to that point is printed first.
@@ -113,9 +116,10 @@ def disp(
     d = load_deck(deck)
     if settle and no_settle:
         raise InputError("give --settle or --no-settle, not both")
-    opts = disp_options(settle=settle, closed_loop=closed_loop, second_order=second_order,
+    correction = "settle" if settle else ("none" if no_settle else None)
+    opts = disp_options(closed_loop=closed_loop, second_order=second_order,
                         singular=singular_mode(singular, damped), cond_limit=cond_limit,
-                        disp_1977=disp_1977)
+                        disp_1977=disp_1977, correction=correction, ms=d.ms)
     with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         run = run_deck(d, steps=parse_steps(steps), options=opts, progress=prog)
     written = []

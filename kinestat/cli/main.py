@@ -52,8 +52,8 @@ COMMANDS: tuple[CommandEntry, ...] = (
                  "encoder stream."),
     CommandEntry("platform", "platform", "The compliant special 6-6 platform: info, fk, ik, "
                  "statics, stiffness."),
-    CommandEntry("view", "view", "3D views in the browser: model, platform, screw, disp, log (or "
-                 "--log FILE)."),
+    CommandEntry("view", "view", "3D views in the browser: MODEL (or model MODEL), platform, "
+                 "screw, disp, log (or --log FILE)."),
     CommandEntry("sweep", "sweep", "Studies at scale on Dask: workspace, platform-range, "
                  "platform-design, tolerance."),
 )

@@ -57,7 +57,7 @@ of misalignment (a turn cut at ``MAX_ALIGN_TURN_DEG``), is made without the forc
 along the new axis (stepping back is still made): the Newton step was computed at the old
 axis and the light first contact, and on a frictionless surface met far off the tool axis the
 push and the large turn together drove the force from about 1 N to 5–7 N in one cycle and the
-top past its 4° range (docs/control-studies.md "The press on curved and steep workpieces")."""
+top past its 4° range (docs/control.md, "The press on curved and steep workpieces")."""
 OVERSHOOT_RATIO = 0.5
 """An align turn overshot when the next misalignment points back against it by more than this
 fraction of the turn (:func:`align_gain`)."""
@@ -87,7 +87,7 @@ def align_gain(gain: float, last_turn, misalignment) -> float:
     not move. On a frictionless curved surface of curvature κ the turn δ also slides the free
     tip across the surface by about B δ (the platform's soft mode), where the normal differs by
     κ B δ; the whole turn then lands κ B e past the normal, and for κ B ≥ 1 the turns alternate
-    for good (a frictionless R = 200 mm cylinder at 4 N: ±2.35° a cycle, docs/control-studies.md
+    for good (a frictionless R = 200 mm cylinder at 4 N: ±2.35° a cycle; docs/control.md,
     "The press on curved and steep workpieces"). The turn that lands on the normal is e / (1 + κ B).
     Without measuring κ B: a turn overshot when the new misalignment points back along it by
     more than ``OVERSHOOT_RATIO`` of the turn (κ B > ½ at the whole turn); the gain then halves

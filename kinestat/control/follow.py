@@ -241,7 +241,7 @@ first estimates can read twice the curvature: fed forward from the second cycle,
 ahead of the surface for 25 cycles and the tip crept at 0.4 mm a step). Without it, S6 waited
 for the dead band: it fell 0.3° behind, turned by up to 0.7° in one cycle, and the tip, held
 only by the top's soft tangential stiffness less N/R, ran ahead 3 mm and back
-(docs/control-studies.md, "Frictionless slides: the surface's turn fed forward")."""
+(docs/control.md, "Control law" and "Limits and choices")."""
 FRICTIONLESS_TURN_GAIN = 0.5
 """A frictionless slide turns S6 by this fraction of its misalignment a cycle. The turn itself
 moves the tip: turned by δ, the tip swings back across the surface by about B δ (B =
@@ -324,9 +324,8 @@ by the platform's soft mode: the tip runs ahead and the normal force drops (S6 1
 1.1 mm and −1.15 N; 0.7° ahead: 0.4 mm and −0.47 N on seed 101's R = 246 mm cylinder, ideal
 sensor), and a lead well past the margin runs it ahead too (3.5°: −0.6 N on the CLI's
 default plane, with the simulated devices' axis-5 drift). The edge is seen once the lead has
-grown ``EDGE_LEAD`` past its recent mean (docs/control-studies.md, "The breakaway at the sliding
-lead" and "The stuck lead at the margin"; 0.5° until 2026-12-03, then 0.9° with the lead's
-drift held, until the drift was found to be the devices' axis-5 rounding)."""
+grown ``EDGE_LEAD`` past its recent mean (docs/control.md, "The breakaway with S6 ahead"; a
+smaller lead read the stuck lead's jitter as the edge)."""
 EDGE_STEP = 0.1
 """The travel steps just after the first slip measured against the probe's normal
 (fraction of ``travel_step``): ``EDGE_STEP`` of it in the slip's cycle, growing by as
@@ -867,7 +866,7 @@ def _lead_hold(st: FollowState) -> float:
     force then turns a little less than S6 (the force control presses it back along the
     normal, ``LEAD_CAP``), and the lead drifts up (+0.6° over 80 cycles on the CLI's default
     plane in process); the hold does not hold it back: over 160 random workpieces
-    (docs/control-studies.md, "The stuck lead at the margin") the runs were better without the hold
+    (docs/control.md, "Results: current figures") the runs were better without the hold
     of that drift than with it. ``LEAD_CAP`` bounds it instead."""
     return 1.0 if st.lead_ref is None else 0.0
 

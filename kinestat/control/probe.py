@@ -101,7 +101,7 @@ def probe_offsets(travel_dir, approach, span: float) -> tuple:
     ``span`` across the travel, back along it, across the other way, ahead, then the centre
     again: symmetric about the centre, so that the fitted slope is the central difference.
 
-    >>> [np.round(o, 6).tolist() for o in probe_offsets([0, 1, 0], [0, 0, -1], 3.0)][:2]
+    >>> [(np.round(o, 6) + 0.0).tolist() for o in probe_offsets([0, 1, 0], [0, 0, -1], 3.0)][:2]
     [[3.0, 0.0, 0.0], [0.0, -3.0, 0.0]]
     """
     d = np.asarray(approach, dtype=float)

@@ -3,6 +3,7 @@
 - :mod:`.deck` — the chain and hand of a deck, its stages, :func:`run_deck` for every MS,
   :func:`disp_options` (DISP's behaviour by default)
 - :mod:`.record` — the JSON records (:func:`deck_json`, :func:`result_record`)
+- :mod:`.steps` — DISP's inferred step count when IT = 0 (:func:`disp_step_count`)
 
 Layer 3: imports io, serial, mechanism, spatial. See docs/guidance.md and docs/disp-decks.md.
 """
@@ -21,5 +22,6 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
             'deck_stages', 'disp_options', 'run_deck',
         ],
         'record': ['deck_json', 'result_record'],
+        'steps': ['disp_step_count', 'stage_motion'],
     },
 )

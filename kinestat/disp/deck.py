@@ -31,9 +31,11 @@ import dataclasses
 import math
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 
+from kinestat.disp.steps import disp_step_count
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import DispDeck, deck_warnings
 from kinestat.mechanism.chain import ChainModel, from_nadkarni
@@ -169,39 +171,74 @@ def deck_stages(deck: DispDeck, start_points) -> list[StageSpec]:
     kind = {0: "screw", 4: "line", 6: "general"}.get(ms)
     if kind is None:
         raise InputError(f"MS = {ms} is not a guidance analysis (0, 4, 5, 6)")
-    return target_stages(kind, start_points, list(deck.positions[1:]))
+    # type II steps from the actual hand to the next screw position (App. I: DISP uses "the
+    # actual position of the manipulator hand ... for any intermediate stage")
+    return target_stages(kind, start_points, list(deck.positions[1:]), from_actual=ms == 0)
+
+
+#: DISP's tables print joint values and hand points to 2-3 decimals, and Illustration 5's
+#: summary says the computed final hand "coincide[s] with the desired final position ... with
+#: three decimal accuracy": the final correction goes on until every hand point (origin, unit
+#: +z and +x points) is within half the third decimal of the target's, in the deck's length
+#: unit (and so the hand's orientation within 0.0005 rad).
+PRINTED_PRECISION = 5e-4
+
+#: The analyses whose run DISP ended on the target by a correction (Illustration 4, MS 0;
+#: Illustration 5, MS 4, Table A2-9's last row).
+CORRECTED_MS = (0, 4)
+
+Correction = Literal["printed", "settle", "none"]
 
 
 def disp_options(*, settle: bool = False, closed_loop: bool = False,
-                 second_order: bool = False, singular: SingularMode = "perturb",
-                 cond_limit: float = 1e3, disp_1977: bool = False) -> GuidanceOptions:
+                 second_order: bool = False, singular: SingularMode = "perturb_all",
+                 cond_limit: float = 1e3, disp_1977: bool = False,
+                 correction: Correction | None = None, ms: int | None = None
+                 ) -> GuidanceOptions:
     """Guidance options of DISP (Nadkarni 1977, ch. IV, App. I) by default: first-order
-    steps (eq. 4-11), no correction ("settle") steps, the thesis's perturbation at a
-    singularity; kinestat's refinements are opt-in. ``disp_1977`` selects the inferred type III
-    step rule of Table A2-9, which includes its final correction step.
+    steps (eq. 4-11), DISP's perturbation of every joint at a singularity (``perturb_all``),
+    and, for the type II and III analyses (``ms`` 0 and 4), DISP's final correction: rows
+    straight at each target until the hand is on it to the printed precision
+    (``correction="printed"``, :data:`PRINTED_PRECISION`); ``"settle"`` (or ``settle=True``)
+    corrects to 1e-9 (kinestat's), ``"none"`` not at all. kinestat's refinements are opt-in.
+    ``disp_1977`` selects the inferred type III step rule of Table A2-9, which includes its
+    final correction step.
 
     >>> o = disp_options()
-    >>> o.step_rule, o.settle, o.closed_loop
-    ('first_order', False, False)
+    >>> o.step_rule, o.settle, o.closed_loop, o.singular
+    ('first_order', False, False, 'perturb_all')
+    >>> o = disp_options(ms=0)
+    >>> o.settle, o.settle_tol, o.settle_length
+    (True, 0.0005, 1.0)
     """
+    if correction is None:
+        correction = "settle" if settle else ("printed" if ms in CORRECTED_MS else "none")
+    if correction not in ("printed", "settle", "none"):
+        raise InputError(f"correction must be printed, settle or none, got {correction!r}")
     if disp_1977:
         return GuidanceOptions.disp_1977(closed_loop=closed_loop, second_order=second_order,
                                          singular=singular, cond_limit=cond_limit)
+    extra: dict = {}
+    if correction == "printed":
+        extra = {"settle_tol": PRINTED_PRECISION, "settle_length": 1.0}
     return GuidanceOptions(step_rule="second_order" if second_order else "first_order",
-                           closed_loop=closed_loop, singular=singular, settle=settle,
-                           cond_limit=cond_limit)
+                           closed_loop=closed_loop, singular=singular,
+                           settle=correction != "none", cond_limit=cond_limit, **extra)
 
 
 def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
              options: GuidanceOptions | None = None,
-             progress: Callable[[int, int], None] | None = None) -> DeckRun:
+             progress: Callable[[int, int], None] | None = None,
+             auto_steps: Literal["disp", "kinestat"] = "disp") -> DeckRun:
     """Run a deck for its MS as DISP does. ``steps`` overrides the deck's IT (0/None: IT, or
-    automatic when IT = 0); ``options`` default to :func:`disp_options` (DISP's behaviour).
+    automatic when IT = 0: DISP's inferred rule, :func:`~kinestat.disp.steps.disp_step_count`,
+    or with ``auto_steps="kinestat"`` kinestat's own, as ``kinestat guide`` uses);
+    ``options`` default to :func:`disp_options` (DISP's behaviour).
     The inferred 1977 step rule (``step_rule="disp_1977"``) belongs to the type III analysis
     (MS = 4) it was fitted to and is refused for other MS."""
     if not isinstance(deck, DispDeck):
         raise InputError(f"run_deck takes a DispDeck, got {type(deck).__name__}")
-    options = disp_options() if options is None else options
+    options = disp_options(ms=deck.ms) if options is None else options
     notes = list(deck_warnings(deck))
     ms = deck.ms
     if options.step_rule == "disp_1977" and ms != 4:
@@ -218,12 +255,15 @@ def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
     stages = deck_stages(deck, P0)
     if steps is None or steps == 0:
         steps = deck.it if deck.it > 0 else None
+    step_count = None if auto_steps == "kinestat" else disp_step_count
     result = run_guidance(model, model.q_home, stages, steps=steps, options=options,
-                          progress=progress)
-    if not result.stopped and not options.settle:
+                          progress=progress, step_count=step_count)
+    if not result.stopped and (not options.settle or options.settle_length is not None):
         dp, da = result.final_pose_error()
         if dp > 1e-9 * max(1.0, result.length) or da > 1e-9:
-            notes.append(f"the last step left the hand {dp:.4g} {model.length_unit} and "
-                         f"{math.degrees(da):.3g} deg from the target (the first-order "
-                         "residual; --settle adds correction steps)")
+            what = ("after DISP's correction to the printed precision" if options.settle else
+                    "after the last step (the first-order residual; --settle adds correction "
+                    "steps)")
+            notes.append(f"the hand ended {dp:.4g} {model.length_unit} and "
+                         f"{math.degrees(da):.3g} deg from the target {what}")
     return DeckRun(deck, model=model, result=result, notes=tuple(notes) + result.notes)

@@ -73,7 +73,8 @@ def loads_axes(doc: dict, source: str = "<string>") -> dict:
     :func:`kinestat.mechanism.dh_from_axes.dh_from_axes` plus the joint ``kinds`` and ``axes``
     (``(n, 2, 3)`` point and direction, or ``(n, 6)`` Plücker coordinates).
 
-    >>> spec = loads_axes({"axes": [{"point": [0, 0, 0], "direction": [0, 0, 1]},
+    >>> spec = loads_axes({"length_unit": "mm",
+    ...                    "axes": [{"point": [0, 0, 0], "direction": [0, 0, 1]},
     ...                             {"point": [0, 0, 0], "direction": [1, 0, 0]}]})
     >>> spec["axes"].shape, spec["kinds"], spec["names"]
     ((2, 2, 3), ['revolute', 'revolute'], ['1', '2'])

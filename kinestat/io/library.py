@@ -19,13 +19,16 @@ import os
 from functools import lru_cache
 from importlib import resources
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from kinestat.errors import InputError
-from kinestat.io.calibration_toml import CalibrationFile, loads_calibration, read_calibration
 from kinestat.io.model_toml import loads_model, read_model
 from kinestat.io.platform_toml import loads_platform
 from kinestat.mechanism.chain import ChainModel
 from kinestat.parallel.platform import Platform
+
+if TYPE_CHECKING:
+    from kinestat.io.calibration_toml import CalibrationFile
 
 __all__ = ["load", "list_models", "prototype", "list_calibrations", "load_calibration",
            "embedded_text"]
@@ -153,6 +156,11 @@ def load_calibration(name_or_path: str | os.PathLike) -> CalibrationFile:
     >>> c.name, c.calibration.leg_names[:2], float(c.calibration.force_coeffs[0, 1])
     ('thesis-2011', ('O', 'S'), -0.029796)
     """
+    from kinestat.io.calibration_toml import (  # lazy: start-up (a model load needs none)
+        loads_calibration,
+        read_calibration,
+    )
+
     s = os.fspath(name_or_path)
     s = CALIBRATION_ALIASES.get(s, s)
     cal = _embedded_or_file(s, "calibration", "calibrations", loads_calibration, read_calibration)

@@ -10,6 +10,7 @@ implementation they are tested against is :func:`kinestat.serial._reference.fk_r
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterator
 
 import numpy as np
@@ -17,7 +18,6 @@ import numpy as np
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import JointKind
-from kinestat.serial import _kernels
 from kinestat.serial._kernel_cache import _BY_ID, kernel_data
 from kinestat.serial.chunks import CHUNK_ROWS, chunk_slices
 
@@ -69,10 +69,19 @@ _FK_ONE = None
 _JAC_ONE = None
 
 
+def kernels():
+    """The compiled kernel module, imported on the first compiled call (Numba's import is most
+    of a fresh process's start-up; :func:`fk_frames` and :func:`joint_motion` need none)."""
+    k = sys.modules.get("kinestat.serial._kernels")
+    if k is None:
+        from kinestat.serial import _kernels as k  # lazy: start-up (Numba)
+    return k
+
+
 def _entry(name: str):
     """Fetch (and remember) a compiled single-configuration entry point."""
     global _FK_ONE, _JAC_ONE
-    ep = _kernels.single_entry(name)
+    ep = kernels().single_entry(name)
     if name == "fk_one":
         _FK_ONE = ep
     else:
@@ -129,7 +138,8 @@ def fk(model: ChainModel, q) -> np.ndarray:
             if out is None:
                 raise _nonfinite()
             return out
-    return evaluate(model, q, _kernels.fk_one, _kernels.fk_batch, (4, 4))
+    k = kernels()
+    return evaluate(model, q, k.fk_one, k.fk_batch, (4, 4))
 
 
 #: the theses' name for :func:`fk`

@@ -12,7 +12,6 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial import _kernels
 from kinestat.serial import fk as _fkmod
 from kinestat.serial._kernel_cache import _BY_ID, kernel_data
 from kinestat.serial.fk import _F64, _ND, _S8, _as_q
@@ -57,7 +56,8 @@ def jacobian(model: ChainModel, q) -> np.ndarray:
             if J is None:
                 raise InputError("q contains NaN or infinity")
             return J
-    return _fkmod.evaluate(model, q, _kernels.jacobian_one, _kernels.jacobian_batch,
+    k = _fkmod.kernels()
+    return _fkmod.evaluate(model, q, k.jacobian_one, k.jacobian_batch,
                            (6, model.n))
 
 
@@ -76,6 +76,6 @@ def fk_and_jacobian(model: ChainModel, q) -> tuple[np.ndarray, np.ndarray]:
     Q = np.ascontiguousarray(q.reshape(-1, model.n))
     T = np.empty((Q.shape[0], 4, 4))
     J = np.empty((Q.shape[0], 6, model.n))
-    if _kernels.fk_jacobian_batch(d.constants, d.kinds, d.pitches, Q, T, J):
+    if _fkmod.kernels().fk_jacobian_batch(d.constants, d.kinds, d.pitches, Q, T, J):
         raise InputError("q contains NaN or infinity")
     return T.reshape(lead + (4, 4)), J.reshape(lead + (6, model.n))

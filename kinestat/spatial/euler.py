@@ -1,6 +1,7 @@
 """Euler angles of a rotation: all 12 axis sequences, intrinsic and extrinsic (24 conventions).
 
-Built on :class:`scipy.spatial.transform.Rotation` and its sequence strings: upper case is
+SciPy's conventions (:class:`scipy.spatial.transform.Rotation`, written out here in NumPy so
+that a command printing one pose does not import SciPy) and its sequence strings: upper case is
 intrinsic (rotations about the moving axes, ``"ZYX"``: yaw-pitch-roll), lower case extrinsic
 (about the fixed axes, ``"zyx"``). ``matrix_from_euler(a, "ZYX")`` is ``Rz(a0) Ry(a1) Rx(a2)``;
 ``matrix_from_euler(a, "zyx")`` is ``Rx(a2) Ry(a1) Rz(a0)``.
@@ -83,12 +84,53 @@ def matrix_from_euler(angles, seq: str, *, degrees: bool = False) -> np.ndarray:
            [ 1.,  0.,  0.],
            [ 0.,  0.,  1.]])
     """
-    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
     check_sequence(seq)
     a = as_array(angles, shape_tail=(3,), name="Euler angles")
-    flat = a.reshape(-1, 3)
-    R = Rotation.from_euler(seq, flat, degrees=degrees).as_matrix()
-    return R.reshape(a.shape[:-1] + (3, 3))
+    flat = np.radians(a.reshape(-1, 3)) if degrees else a.reshape(-1, 3)
+    return _compose(flat, seq).reshape(a.shape[:-1] + (3, 3))
+
+
+def _elementary(axis: int, t: np.ndarray) -> np.ndarray:
+    """Rotations ``(N, 3, 3)`` by angles ``t (N,)`` about base axis 0, 1 or 2."""
+    c, s = np.cos(t), np.sin(t)
+    R = np.zeros(t.shape + (3, 3))
+    i, j = (axis + 1) % 3, (axis + 2) % 3
+    R[:, axis, axis] = 1.0
+    R[:, i, i] = c
+    R[:, j, j] = c
+    R[:, j, i] = s
+    R[:, i, j] = -s
+    return R
+
+
+def _compose(a: np.ndarray, seq: str) -> np.ndarray:
+    """``R (N, 3, 3)`` of angles ``a (N, 3)``: intrinsic ``R1 R2 R3``, extrinsic ``R3 R2 R1``."""
+    Rs = [_elementary(_AXIS[c.lower()], a[:, n]) for n, c in enumerate(seq)]
+    return Rs[0] @ Rs[1] @ Rs[2] if seq.isupper() else Rs[2] @ Rs[1] @ Rs[0]
+
+
+def _quat_from_matrix(R: np.ndarray) -> np.ndarray:
+    """Unit quaternions ``(N, 4)`` (scalar last) of rotations ``(N, 3, 3)``: Shepperd's method
+    (the largest of the trace and the diagonal picks the component computed by a square root,
+    as SciPy's ``from_matrix``), then normalised."""
+    d = np.stack([R[:, 0, 0], R[:, 1, 1], R[:, 2, 2], R[:, 0, 0] + R[:, 1, 1] + R[:, 2, 2]], -1)
+    pick = np.argmax(d, axis=-1)
+    q = np.empty((len(R), 4))
+    for i in range(3):  # a diagonal entry is largest: component i by the square root
+        n = pick == i
+        j, k = (i + 1) % 3, (i + 2) % 3
+        Rn = R[n]
+        q[n, i] = 1.0 - d[n, 3] + 2.0 * d[n, i]
+        q[n, j] = Rn[:, j, i] + Rn[:, i, j]
+        q[n, k] = Rn[:, k, i] + Rn[:, i, k]
+        q[n, 3] = Rn[:, k, j] - Rn[:, j, k]
+    n = pick == 3
+    Rn = R[n]
+    q[n, 0] = Rn[:, 2, 1] - Rn[:, 1, 2]
+    q[n, 1] = Rn[:, 0, 2] - Rn[:, 2, 0]
+    q[n, 2] = Rn[:, 1, 0] - Rn[:, 0, 1]
+    q[n, 3] = 1.0 + d[n, 3]
+    return q / np.linalg.norm(q, axis=-1, keepdims=True)
 
 
 def _check_rotations(R: np.ndarray, tol: float) -> None:
@@ -144,11 +186,10 @@ def _angles_from_quat(quat: np.ndarray, seq: str) -> tuple[np.ndarray, np.ndarra
 def _zero_third(R: np.ndarray, ang: np.ndarray, seq: str) -> np.ndarray:
     """At gimbal lock, move the third angle into the first (``first +- third``, whichever sign
     reproduces ``R``) where the result still reproduces ``R`` to 1e-12; else keep ``ang``."""
-    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
     best, err_best = ang, np.full(len(ang), np.inf)
     for sgn in (1.0, -1.0):
         cand = np.stack([_wrap(ang[:, 0] + sgn * ang[:, 2]), ang[:, 1], np.zeros(len(ang))], -1)
-        err = np.max(np.abs(Rotation.from_euler(seq, cand).as_matrix() - R), axis=(-1, -2))
+        err = np.max(np.abs(_compose(cand, seq) - R), axis=(-1, -2))
         take = err < err_best
         best = np.where(take[:, None], cand, best)
         err_best = np.where(take, err, err_best)
@@ -179,12 +220,11 @@ def euler_from_matrix(
     >>> np.round(euler_from_matrix(R, 'ZYX', degrees=True), 9)
     array([30., 20., 10.])
     """
-    from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
     check_sequence(seq)
     R = as_array(R, shape_tail=(3, 3), name="R")
     _check_rotations(R, tol)
     flat = R.reshape(-1, 3, 3)
-    ang, distance = _angles_from_quat(Rotation.from_matrix(flat).as_quat(), seq)
+    ang, distance = _angles_from_quat(_quat_from_matrix(flat), seq)
     degenerate = distance <= GIMBAL_TOL
     if np.any(degenerate):
         ang[degenerate] = _zero_third(flat[degenerate], ang[degenerate], seq)

@@ -30,7 +30,7 @@ from kinestat.viz.scene import (
     run_length,
 )
 
-__all__ = ["read_cycle_log", "cell_scene", "force_series"]
+__all__ = ["read_cycle_log", "cell_scene", "force_series", "run_arm"]
 
 
 def force_series(cycles: list[dict], target: float, unit: str) -> dict:
@@ -135,11 +135,17 @@ def _logged_arm(arm: dict) -> ChainModel:
                          ) from exc
 
 
+def run_arm(start: dict) -> ChainModel:
+    """The arm of a run: the PUMA 762, or the ``--arm`` its log header records."""
+    return kinestat.load("puma762") if "arm" not in start else _logged_arm(start["arm"])
+
+
 def cell_scene(start: dict, cycles: list[dict], end: dict | None = None, *, platform=None,
-               title: str = "kinestatic control run") -> dict:
-    """The scene of a control run: one step per cycle record (see the module docstring)."""
+               title: str = "kinestatic control run", model: ChainModel | None = None) -> dict:
+    """The scene of a control run: one step per cycle record (see the module docstring);
+    ``model`` is the run's arm when already loaded (:func:`run_arm`)."""
     platform = prototype() if platform is None else platform
-    model = kinestat.load("puma762") if "arm" not in start else _logged_arm(start["arm"])
+    model = run_arm(start) if model is None else model
     cfg = start["config"]
     mount = np.asarray(cfg.get("mount", np.eye(4)), dtype=float)
     Q = np.radians(np.array([c["measured"]["joints_deg"] for c in cycles], dtype=float))

@@ -26,7 +26,23 @@ import numpy as np
 
 from kinestat.errors import InputError
 
-__all__ = ["find_browser", "Browser", "PageResult", "canvas_variance"]
+__all__ = ["find_browser", "Browser", "PageResult", "canvas_variance", "PANEL_OVERFLOW_JS",
+           "page_problems"]
+
+#: elements of a viewer page's side panel reaching out of it, and how far the panel itself
+#: overflows sideways: ``{"bad": [...], "panel": px}`` (``{"bad": [], "panel": 0}`` when fine)
+PANEL_OVERFLOW_JS = """(() => {
+  const side = document.getElementById("side"), r = side.getBoundingClientRect(), bad = [];
+  for (const e of side.querySelectorAll("*")) {
+    const b = e.getBoundingClientRect();
+    if (!b.width || e.closest("[hidden]")) continue;
+    const spills = getComputedStyle(e).overflowX === "visible" && e.clientWidth > 0
+      && e.scrollWidth > e.clientWidth + 1;
+    if (b.right > r.right + 0.5 || b.left < r.left - 0.5 || spills)
+      bad.push((e.id || e.tagName) + ": " + (e.textContent || "").slice(0, 40));
+  }
+  return {bad: bad, panel: side.scrollWidth - side.clientWidth};
+})()"""
 
 _NAMES = ("chromium", "chromium-browser", "google-chrome", "google-chrome-stable")
 _STATUS_JS = "(() => { const e = document.getElementById('kinestat-status'); " \
@@ -226,6 +242,27 @@ def _console_text(e: dict) -> str:
         return "exception: " + str(d.get("exception", {}).get("description") or d.get("text"))
     entry = p.get("entry", {})
     return f"log.{entry.get('level')}: {entry.get('text')}"
+
+
+def page_problems(page: PageResult, *, min_variance: float = 20.0) -> list[str]:
+    """What is wrong with a viewer page as a user would see it (empty when nothing): it did not
+    finish, wrote to the console, left the canvas blank, the drawn scene outside the frame, the
+    floor out of view, or something spilling out of the side panel (``page`` loaded with
+    ``evaluate=PANEL_OVERFLOW_JS``)."""
+    st, out = page.status, []
+    if not st.get("ready"):
+        out.append("the viewer did not finish")
+    if st.get("errors") or page.console:
+        out.append(f"console: {list(st.get('errors') or [])} {list(page.console)}")
+    if page.png is not None and canvas_variance(page.png) <= min_variance:
+        out.append("the canvas is blank")
+    if not st.get("in_frame"):
+        out.append("the scene is not inside the frame")
+    if not st.get("floor_visible"):
+        out.append("the floor is not in view")
+    if page.value is not None and page.value != {"bad": [], "panel": 0}:
+        out.append(f"side panel overflows: {page.value}")
+    return out
 
 
 def canvas_variance(png: bytes | str | os.PathLike, *, panel_width: int = 330) -> float:

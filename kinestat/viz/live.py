@@ -22,9 +22,10 @@ from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from urllib.parse import parse_qs, urlparse
 
-from kinestat.errors import InputError
+from kinestat.errors import InputError, KinestatError
+from kinestat.io.library import prototype
 from kinestat.io.netbind import resolve_bind_address
-from kinestat.viz.cell_scene import cell_scene
+from kinestat.viz.cell_scene import cell_scene, run_arm
 from kinestat.viz.html import render_html
 
 __all__ = ["LogTail", "LiveServer", "start_live"]
@@ -35,11 +36,15 @@ POLL_S = 0.02
 
 class LogTail:
     """The records of a cycle log as they are written: ``start``, ``cycles`` (each with
-    ``_read_at``, the wall time it was read), ``end``. A file that exists when the tail starts
-    is ignored until it is rewritten (the run truncates it)."""
+    ``_read_at``, the wall time it was read), ``events`` (the page's step of each cycle, made as
+    it is read), ``end``. A file that exists when the tail starts is ignored until it is
+    rewritten (the run truncates it)."""
 
-    def __init__(self, path: str | os.PathLike) -> None:
+    def __init__(self, path: str | os.PathLike, platform=None) -> None:
         self.path = Path(path)
+        self.platform = prototype() if platform is None else platform
+        self.events: list[bytes] = []
+        self._arm = None
         self.start: dict | None = None
         self.cycles: list[dict] = []
         self.end: dict | None = None
@@ -71,6 +76,7 @@ class LogTail:
         if st[1] < self._pos:  # rewritten: start over
             with self.changed:
                 self._pos, self._buf, self.start, self.cycles, self.end = 0, b"", None, [], None
+                self.events, self._arm = [], None
         try:
             with open(self.path, "rb") as f:
                 f.seek(self._pos)
@@ -91,10 +97,20 @@ class LogTail:
                     continue
                 kind = rec.get("type") if isinstance(rec, dict) else None
                 if kind == "start":
-                    self.start = rec
-                elif kind == "cycle" and isinstance(rec.get("measured"), dict):
+                    try:
+                        self.start, self._arm = rec, run_arm(rec)
+                    except KinestatError:
+                        self.start = None  # a header this view cannot draw: no live view
+                elif kind == "cycle" and isinstance(rec.get("measured"), dict) and self.start:
                     rec["_read_at"] = now
                     self.cycles.append(rec)
+                    try:
+                        ev = b"data: " + json.dumps({**_step_event(
+                            self.start, rec, self.platform, self._arm), "read_at": now,
+                            "drawn_at": time.time()}).encode() + b"\n\n"
+                    except (KinestatError, KeyError, TypeError, ValueError) as exc:
+                        ev = f": cycle {rec.get('cycle')} cannot be drawn: {exc}\n\n".encode()
+                    self.events.append(ev)
                 elif kind == "end":
                     self.end = rec
             self.changed.notify_all()
@@ -104,15 +120,15 @@ class LogTail:
         self._thread.join(timeout=2)
 
 
-def _step_event(start: dict, cycle: dict, platform) -> dict:
+def _step_event(start: dict, cycle: dict, platform, arm) -> dict:
     """The page's step for one cycle, as the replay draws it, and its point of the plot."""
-    s = cell_scene(start, [cycle], platform=platform)
+    s = cell_scene(start, [cycle], platform=platform, model=arm)
     sr = s["series"]
     return {**s["steps"][0], "series": {"cycle": sr["cycle"][0], "force": sr["force"][0],
                                         "magnitude": sr["magnitude"][0]}}
 
 
-def _handler(tail: LogTail, platform, title: str, wait_s: float):
+def _handler(tail: LogTail, title: str, wait_s: float):
     class Handler(BaseHTTPRequestHandler):
         def log_message(self, format, *args):  # noqa: A002 - quiet server
             pass
@@ -145,7 +161,8 @@ def _handler(tail: LogTail, platform, title: str, wait_s: float):
             if start is None or not cycles:
                 self._send(503, b"the run has logged no cycle yet; reload", "text/plain")
                 return
-            scene = cell_scene(start, cycles, end, platform=platform, title=title)
+            scene = cell_scene(start, cycles, end, platform=tail.platform, title=title,
+                               model=tail._arm)
             scene["live"] = {"events": "/events", "ended": end is not None}
             self._send(200, render_html(scene).encode("utf-8"), "text/html; charset=utf-8")
 
@@ -157,12 +174,11 @@ def _handler(tail: LogTail, platform, title: str, wait_s: float):
             try:
                 while True:
                     with tail.changed:
-                        tail.changed.wait_for(lambda k=n: len(tail.cycles) > k
+                        tail.changed.wait_for(lambda k=n: len(tail.events) > k
                                               or tail.end is not None, timeout=1.0)
-                        new, start, end = tail.cycles[n:], tail.start, tail.end
-                    for c in new:
-                        ev = _step_event(start, c, platform)
-                        self.wfile.write(b"data: " + json.dumps(ev).encode() + b"\n\n")
+                        new, end = tail.events[n:], tail.end
+                    if new:
+                        self.wfile.write(b"".join(new))
                     n += len(new)
                     if end is not None and not new:
                         rep = end.get("report") if isinstance(end.get("report"), dict) else {}
@@ -199,11 +215,11 @@ def start_live(log_path: str | os.PathLike, *, platform=None, port: int = 0,
     one), in background threads."""
     family, sockaddr = resolve_bind_address(
         "127.0.0.1", port, False, what="the live view", exposure="it shows the cell")
-    tail = LogTail(log_path)
+    tail = LogTail(log_path, platform)
     server_class = type("_LiveServer", (ThreadingHTTPServer,),
                         {"address_family": family, "daemon_threads": True})
     try:
-        srv = server_class(sockaddr, _handler(tail, platform, title or f"control run {log_path}"
+        srv = server_class(sockaddr, _handler(tail, title or f"control run {log_path}"
                                               " (live)", wait_s))
     except OSError as exc:
         tail.close()

@@ -18,8 +18,6 @@ from kinestat.viz.scene import model_scene
 from tests.urdf_arms import ARMS, arm_path
 
 
-
-
 @pytest.mark.parametrize("name", ["ur5", "panda", "kinova-j2s6s200", "z1"])
 def test_meshes_ride_where_the_urdf_puts_them(name, rng):
     """At random joint values each mesh's pose (the chain frame that carries it times its

@@ -108,9 +108,10 @@
       case "polyline": return polyline(it.points, it.color, it.dashed);
       case "polygon": return polygon(it.points, it.color, it.opacity);
       case "arrow": return arrow(it.origin, it.vector, it.color);
-      case "line": {
+      case "line": {   // an axis: endless in principle, so it neither places the floor nor the camera
         const p = v3(it.point), u = v3(it.direction).normalize(), h = (it.length || 2 * S) / 2;
-        return polyline([p.clone().addScaledVector(u, -h).toArray(), p.clone().addScaledVector(u, h).toArray()], it.color, true);
+        const line = polyline([p.clone().addScaledVector(u, -h).toArray(), p.clone().addScaledVector(u, h).toArray()], it.color, true);
+        line.userData.unbounded = true; return line;
       }
       case "marker": {
         const m = new THREE.Mesh(new THREE.SphereGeometry(it.radius || 0.02 * S, 20, 12), material(it.color));
@@ -241,7 +242,7 @@
     const box = new THREE.Box3();
     world.updateMatrixWorld(true);
     for (const g of [staticGroup, robotGroup, meshGroup, stepGroup]) g.traverseVisible((o) => {
-      if (!o.geometry) return;   // what is drawn: hidden assembly modes do not count
+      if (!o.geometry || o.userData.unbounded) return;   // what is drawn: hidden modes do not count
       if (!o.geometry.boundingBox) o.geometry.computeBoundingBox();
       box.union(o.geometry.boundingBox.clone().applyMatrix4(o.matrixWorld));
     });
@@ -271,7 +272,8 @@
       const sp = textSprite(t, c, 0.45 * a); sp.position.set(1.12 * a * d[0], 1.12 * a * d[1], z + 1.12 * a * d[2]); groundGroup.add(sp);
     });
     const u = scene.length_unit || "";
-    $("grid-note").textContent = "floor grid: " + cell + " " + u + " squares; world axes x y z (" + a + " " + u + ")";
+    const len = (x) => u ? x + " " + u : String(x);
+    $("grid-note").textContent = "floor grid: " + len(cell) + " squares; world axes x y z (" + len(a) + ")";
     floorInfo = { z: z, centre: [cx, cy, z], half: half, cell: cell };
     status.floor = floorInfo;
   }
@@ -356,7 +358,7 @@
       name.className = "jname"; name.textContent = robot.joint_names[i]; name.title = robot.joint_names[i];
       inp.type = "range"; inp.min = lo * k; inp.max = hi * k; inp.step = "any"; inp.value = q[i] * k;
       inp.id = "joint" + (i + 1); inp.title = robot.joint_names[i];
-      out.className = "jval"; out.textContent = fmtQ(i, q[i]);
+      out.className = "jval"; out.textContent = fmtQ(i, q[i]); out.title = out.textContent;
       inp.addEventListener("input", () => {
         q[i] = Math.min(Math.max(Number(inp.value) / k, lo), hi); out.textContent = fmtQ(i, q[i]);
         drawRobot(robot, q); render();
@@ -509,8 +511,17 @@
   function frameBox(box) {   // the camera looks at box from the front-right, all of it in view
     const c = box.getCenter(new THREE.Vector3()), r = Math.max(box.getSize(new THREE.Vector3()).length() / 2, 1e-9);
     const vfov = camera.fov * Math.PI / 180, hfov = 2 * Math.atan(Math.tan(vfov / 2) * camera.aspect);
-    const d = 1.08 * r / Math.sin(Math.min(vfov, hfov) / 2);
-    camera.position.copy(c).add(new THREE.Vector3(0.9, -1.4, 0.8).normalize().multiplyScalar(d));
+    let d = 1.08 * r / Math.sin(Math.min(vfov, hfov) / 2);
+    const dir = new THREE.Vector3(0.9, -1.4, 0.8).normalize(), corners = [];
+    for (const x of [box.min.x, box.max.x]) for (const y of [box.min.y, box.max.y]) for (const z of [box.min.z, box.max.z]) corners.push(new THREE.Vector3(x, y, z));
+    for (let it = 0; it < 4; it++) {   // closer while every corner stays in view (a sphere's fit is loose)
+      camera.position.copy(c).addScaledVector(dir, d); camera.lookAt(c);
+      camera.near = d / 100; camera.far = d * 100; camera.updateProjectionMatrix(); camera.updateMatrixWorld();
+      const m = Math.max(...corners.map((p) => { const q = p.clone().project(camera); return Math.max(Math.abs(q.x), Math.abs(q.y)); }));
+      if (!(m > 0) || m > 0.92) break;
+      d *= 0.5 + 0.5 * m / 0.9;
+    }
+    camera.position.copy(c).addScaledVector(dir, d);
     camera.near = d / 100; camera.far = d * 100; camera.updateProjectionMatrix();
     controls.target.copy(c); controls.update(); render();
   }
@@ -539,7 +550,8 @@
     const f = inFrame(); status.in_frame = f.content; status.floor_visible = f.floor;
     $("kinestat-status").textContent = JSON.stringify(status);
   }
-  const api = { scene: scene, status: status, chainFrames: chainFrames, fit: fit, publish: publish };
+  const api = { scene: scene, status: status, chainFrames: chainFrames, fit: fit, publish: publish,
+    camera: camera, controls: controls };
   window.kinestatViewer = api;
 
   // "#step=N" in the address opens the animation at step N (links, screenshots)
@@ -550,14 +562,27 @@
   else { if (robot) drawRobot(robot, q); setInfo(scene.info); legend(scene.items); }
   if (modes.length) showMode(modeShown);
   api.showStep = showStep; api.gizmo = gizmo; api.ikTo = ikTo; api.showMode = showMode;
-  api.addStep = function (st) {   // live runs: a cycle as it is logged
-    steps.push(st);
+  let pending = null;
+  api.addStep = function (st) {   // live runs: a cycle as it is logged; drawn with the others
+    steps.push(st);               // that arrived meanwhile, the newest shown (one render)
     if (scene.series && st.series) for (const key of ["cycle", "force", "magnitude"]) scene.series[key].push(st.series[key]);
-    setupPlayer();
-    if (scene.info && scene.info.length) scene.info[0] = steps.length + " cycles, states " + runLength(steps.map((x) => x.state || "?"));
-    const follow = Number(timeline.value) >= steps.length - 2 || steps.length === 1;
-    if (follow) { timeline.value = steps.length - 1; showStep(steps.length - 1); } else drawPlot();
-    st.shown_ms = Date.now();
+    if (pending) { pending.push(st); return; }
+    pending = [st];
+    setTimeout(() => {
+      const batch = pending; pending = null;
+      setupPlayer();
+      if (scene.info && scene.info.length) scene.info[0] = steps.length + " cycles, states " + runLength(steps.map((x) => x.state || "?"));
+      const follow = Number(timeline.value) >= steps.length - 1 - batch.length;
+      if (follow) { timeline.value = steps.length - 1; showStep(steps.length - 1); } else drawPlot();
+      const now = Date.now();
+      for (const x of batch) {
+        x.shown_ms = now;
+        if (status.live) status.live.received.push({ cycle: x.series ? x.series.cycle : null, shown_ms: now,
+          got_ms: x.got_ms, read_ms: 1000 * x.read_at, made_ms: 1000 * x.drawn_at });
+      }
+      $("live-status").textContent = "live: " + (batch[batch.length - 1].label || ("cycle " + steps.length));
+      publish();
+    }, 0);
   };
   loadMeshes(robot).then(() => {
     buildGround(); fit(); render();
@@ -573,17 +598,18 @@
     el.textContent = "live: " + steps.length + " cycle(s) so far, waiting for the next";
     const es = new EventSource(scene.live.events + "?from=" + steps.length);
     es.onmessage = (e) => {
-      const st = JSON.parse(e.data); api.addStep(st);
-      status.live.received.push({ cycle: st.series ? st.series.cycle : steps.length, shown_ms: st.shown_ms });
-      el.textContent = "live: " + (st.label || ("cycle " + steps.length));
-      publish();
+      const st = JSON.parse(e.data); st.got_ms = Date.now(); api.addStep(st);
     };
     es.addEventListener("end", (e) => {
-      es.close(); status.live.ended = true;
-      const rep = JSON.parse(e.data || "{}");
-      el.textContent = "run ended" + (rep.stop_reason ? ": " + rep.stop_reason : "") + " (" + steps.length + " cycles)";
-      publish();
+      es.close();
+      setTimeout(() => {   // after the last cycles are drawn
+        status.live.ended = true;
+        const rep = JSON.parse(e.data || "{}");
+        el.textContent = "run ended" + (rep.stop_reason ? ": " + rep.stop_reason : "") + " (" + steps.length + " cycles)";
+        publish();
+      }, 0);
     });
+    es.onopen = () => { status.live.open_ms = Date.now(); };
     es.onerror = () => { if (!status.live.ended) el.textContent = "live view: connection lost"; };
   }
 })();

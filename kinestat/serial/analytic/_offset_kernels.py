@@ -246,7 +246,7 @@ def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q, o
 
 @nb.njit(inline="always", **_OPTS)
 def _unpack(Kp):
-    """The data packed by :func:`kinestat.serial.analytic.pieper_offset.pack`: ``C (7, 4, 4)``,
+    """The data packed by :func:`kinestat.serial.analytic._offset_pack.pack`: ``C (7, 4, 4)``,
     ``T0inv``, ``W (6, 3)``, ``P (6, 3)``, the wrist centre, a unit vector normal to axis 6 and
     the shoulder's 20 numbers ``G``."""
     return (Kp[:112].reshape((7, 4, 4)), Kp[112:128].reshape((4, 4)), Kp[128:146].reshape((6, 3)),

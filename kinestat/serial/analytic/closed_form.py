@@ -23,9 +23,8 @@ import sys
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic import pieper_offset
+from kinestat.serial.analytic import _offset_pack
 from kinestat.serial.analytic._common import nan_array, pack, reasons, run_kernels
-from kinestat.serial.analytic.families import add_wrist_families
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
 
@@ -76,12 +75,9 @@ def _wrist(W, Rp: np.ndarray, wrist_tol: float):
 
 def solve_pieper(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
                  wrist_tol: float = _WRIST_TOL) -> IKAllResult:
-    """All solutions (8 slots) for a spherical-wrist arm; ``T (N, 4, 4)``. Axes 1, 2 meeting
-    here; an offset shoulder by
-    :func:`kinestat.serial.analytic.pieper_offset.solve_pieper_offset`."""
+    """All solutions (8 slots) for a spherical-wrist arm whose axes 1, 2 meet; ``T (N, 4, 4)``
+    (an offset shoulder: :func:`kinestat.serial.analytic.pieper_offset.solve_pieper_offset`)."""
     ax, w, s = data["axes"], data["wrist"], data["shoulder"]
-    if s is None:
-        return pieper_offset.solve_pieper_offset(model, T, data, tol=tol, wrist_tol=wrist_tol)
     W, P = ax.w, ax.r
     N = T.shape[0]
     g = T @ np.linalg.inv(ax.T0)
@@ -195,7 +191,7 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     Kp = data.get("kernel_args")
     if Kp is None:  # pose-independent, kept with the model's cached geometry
         ax = data["axes"]
-        Kp = data["kernel_args"] = pieper_offset.pack(
+        Kp = data["kernel_args"] = _offset_pack.pack(
             model, ax, data["wrist"], _perp(ax.w[5])) if offset else K.pack(
             model.constants, np.linalg.inv(ax.T0), ax.w, ax.r, data["wrist"], data["shoulder"],
             _perp(ax.w[5]))
@@ -204,7 +200,7 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
         run_kernels(K.offset_batch, K.offset_serial, args, T, _PARALLEL_MIN, plain)
     else:
         run_kernels(K.pieper_batch, K.pieper_serial, args, T, _PARALLEL_MIN, plain)
-    reason = pieper_offset.REASON if offset else _REASON_PIEPER
+    reason = _offset_pack.REASON if offset else _REASON_PIEPER
     if shape == ():
         return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
                                      reason if cnt[0] == 0 else "", "pieper", tol)
@@ -245,6 +241,8 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
                   reason=reasons(cnt, _REASON_3P), method="three-parallel", tol=tol)
     where = np.flatnonzero(near) if N > 1 else (np.zeros(1, dtype=np.intp) if near[0] else None)
     if where is not None and where.size:
+        from kinestat.serial.analytic.families import add_wrist_families  # lazy: rarely needed
+
         res = add_wrist_families(model, T, data, IKAllResult.build((N,), **fields), near=where)
         fields = {f: getattr(res, f) for f in fields} | {"family_curve": res.family_curve}
     return IKAllResult.build((N,) if shape is None else shape, **fields)

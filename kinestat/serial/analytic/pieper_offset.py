@@ -19,8 +19,9 @@ axis 1), and the wrist as for the meeting shoulder: up to 8 solutions.
 Axes 1 and 2 parallel (ω): the height ``ω·p = ω·e^{ξ̂3θ3} w`` fixes θ3 (subproblem 4), the
 distance of p from axis 1 fixes θ2 (subproblem 3), then θ1 (subproblem 1).
 
-:func:`pack` builds the compiled kernel's data (:mod:`kinestat.serial.analytic._offset_kernels`);
-:func:`solve_pieper_offset` is the NumPy reference (the quartic's roots by ``numpy.roots``).
+:mod:`kinestat.serial.analytic._offset_pack` packs the compiled kernel's data
+(:mod:`kinestat.serial.analytic._offset_kernels`); :func:`solve_pieper_offset` is the NumPy
+reference (the quartic's roots by ``numpy.roots``).
 """
 
 from __future__ import annotations
@@ -31,45 +32,12 @@ import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic._common import pack as pack_result
+from kinestat.serial.analytic._offset_pack import REASON, shoulder
+from kinestat.serial.analytic.closed_form import _wrist
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp3, sp4
 
-__all__ = ["shoulder", "pack", "solve_pieper_offset", "REASON"]
-
-REASON = ("no real solution: the wrist centre is out of reach of the arm (the shoulder's "
-          "equations have no real root)")
-
-
-def shoulder(W: np.ndarray, P: np.ndarray, w: np.ndarray) -> np.ndarray:
-    """The shoulder's 20 numbers: o1, r2, the coefficient vectors ``u = u0 + u1 cos θ3 + u2 sin
-    θ3``, A, sin α, cos α, 0, and 1.0 when axes 1 and 2 are parallel (then only that flag)."""
-    G = np.zeros(20)
-    w1, w2, w3 = W[0], W[1], W[2]
-    ca = float(w1 @ w2)
-    if np.linalg.norm(np.cross(w1, w2)) <= 1e-9:
-        G[19] = 1.0
-        return G
-    d = P[1] - P[0]
-    t = (ca * float(d @ w1) - float(d @ w2)) / (1.0 - ca * ca)
-    s = float(d @ w1) + t * ca
-    o1 = P[0] + s * w1
-    r2 = P[1] + t * w2
-    a = r2 - o1
-    A = float(np.linalg.norm(a))
-    e2 = np.cross(w2, a / A)
-    m = w - P[2]
-    mpar = w3 * float(w3 @ m)
-    u1 = m - mpar
-    G[:15] = np.concatenate([o1, r2, P[2] + mpar - r2, u1, np.cross(w3, u1)])
-    G[15:18] = A, float(w1 @ e2), ca
-    return G
-
-
-def pack(model: ChainModel, ax, w: np.ndarray, x6: np.ndarray) -> np.ndarray:
-    """The compiled kernel's pose-independent data in one float array."""
-    parts = (model.constants, np.linalg.inv(ax.T0), ax.w, ax.r, w, x6, shoulder(ax.w, ax.r, w))
-    return np.ascontiguousarray(np.concatenate([np.ravel(x) for x in parts]), dtype=np.float64)
-
+__all__ = ["solve_pieper_offset"]
 
 def _theta3(G: np.ndarray, W: np.ndarray, pw: np.ndarray) -> list[float]:
     """The real roots θ3 of the shoulder's equations for one wrist centre (skew axes 1, 2)."""
@@ -132,8 +100,6 @@ def solve_pieper_offset(model: ChainModel, T: np.ndarray, data: dict, *, tol: fl
                         wrist_tol: float = 1e-10) -> IKAllResult:
     """All solutions (8 slots) for a spherical-wrist arm whose axes 1, 2 do not meet;
     ``T (N, 4, 4)``. The NumPy reference of the compiled kernel (a loop over poses)."""
-    from kinestat.serial.analytic.closed_form import _wrist  # lazy: import cycle
-
     ax, w = data["axes"], data["wrist"]
     W, P = ax.w, ax.r
     G = shoulder(W, P, w)

@@ -20,10 +20,8 @@ from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import (
     closed_form,
-    decoupled,
-    families,
-    general6r,
-    thesis_puma762,
+    pieper_offset,
+    reversed_chain,
 )
 from kinestat.serial.analytic import (
     locked as _locked,
@@ -59,12 +57,19 @@ def _check_chain(model: ChainModel) -> None:
                 f"of a screw joint are different configurations) — use kinestat.ik for a "
                 f"numerical solution")
     if model.prismatic.any():
+        from kinestat.serial.analytic import decoupled  # lazy: start-up (prismatic arms only)
+
         decoupled.plan(model)  # raises, naming why, outside the decoupled class
 
 
 @lru_cache(maxsize=64)
 def _classified(model: ChainModel):
-    return classify(model)
+    kind, data = classify(model)
+    if kind == "general":  # axes 1, 2, 3 meeting: the reversed chain is a pieper arm
+        rev = reversed_chain.reverse(model)
+        if classify(rev)[0] == "pieper":
+            return "pieper", {"reversed": rev}
+    return kind, data
 
 
 @lru_cache(maxsize=64)
@@ -176,18 +181,22 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         plain = None
     shape = T.shape[:-2]
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
-    if (use in ("pieper", "three-parallel") or kind == decoupled.METHOD) and use != kind:
+    if (use in ("pieper", "three-parallel") or kind == "decoupled") and use != kind:
         raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
                          f"(its geometry is {kind!r})")
     if backend not in BACKENDS:
         raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
     fast = backend == "numba"
-    if use == thesis_puma762.METHOD:
+    if use == "puma762":
+        from kinestat.serial.analytic import thesis_puma762  # lazy: start-up (its kernels)
+
         if not thesis_puma762.is_puma762(model):
             raise ModelError(f"ik_all: method 'puma762' applies only to the PUMA 762's geometry "
                              f"(millimetres, Vibhute Table 2-2); model {model.name!r} differs")
         res = thesis_puma762.solve_puma762(model, Tf, tol=tol, backend=backend)
-    elif use == decoupled.METHOD:
+    elif use == "decoupled":
+        from kinestat.serial.analytic import decoupled  # lazy: start-up (prismatic arms only)
+
         if kind != use:
             try:
                 decoupled.plan(model)
@@ -195,19 +204,28 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
                 raise ModelError(f"ik_all: method 'decoupled' does not apply to model "
                                  f"{model.name!r}: {exc}") from None
         res = decoupled.solve_decoupled(model, Tf, tol=tol)
+    elif use == "pieper" and "reversed" in data:
+        res = ik_all(data["reversed"], reversed_chain.invert_poses(Tf), tol=tol, backend=backend)
+        res = reversed_chain.unreverse(res)
     elif use == "pieper":
         if fast:
             return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape,
                                                      plain=plain)
-        res = closed_form.solve_pieper(model, Tf, data, tol=tol)
+        solve = closed_form.solve_pieper if data["shoulder"] is not None else \
+            pieper_offset.solve_pieper_offset
+        res = solve(model, Tf, data, tol=tol)
     elif use == "three-parallel":
         if fast:
             return closed_form.solve_three_parallel_compiled(model, Tf, data, tol=tol,
                                                              shape=shape, plain=plain)
+        from kinestat.serial.analytic import families  # lazy: start-up (NumPy path only)
+
         res = families.add_wrist_families(model, Tf, data,
                                           closed_form.solve_three_parallel(model, Tf, data,
                                                                            tol=tol))
     else:
+        from kinestat.serial.analytic import general6r  # lazy: start-up (SciPy's LAPACK)
+
         res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend, shape=shape)
     return _reshape(res, shape)
 

@@ -45,6 +45,8 @@ __all__ = [
     "SettleStep",
     "TargetNotReached",
     "NumericalFailure",
+    "newton_failure",
+    "newton_stalled",
 ]
 
 
@@ -151,13 +153,18 @@ class _Unreached(GuidanceEvent):
 
 @dataclass(frozen=True, eq=False)
 class NotConverged(_Unreached):
-    """The closed-loop Newton correction did not reach the ideal pose of the step."""
+    """The closed-loop Newton correction did not reach the ideal pose of the step:
+    ``reason`` ``singular`` (the Jacobian where it ended is singular, condition number
+    ``cond``), ``out_of_reach`` (the error stopped decreasing with a regular Jacobian) or
+    ``diverged`` (the error grew)."""
 
     kind: ClassVar[str] = "not_converged"
 
     position_error: float = 0.0
     angle_error_deg: float = 0.0
     iterations: int = 0
+    reason: str = ""
+    cond: float = 0.0
     action: str = "stopped"
 
 
@@ -192,3 +199,23 @@ class NumericalFailure(GuidanceEvent):
     stops: ClassVar[bool] = True
 
     reason: str = ""
+
+
+def newton_stalled(history: list[float], window: int = 6) -> bool:
+    """True when the last ``window`` Newton iterations did not halve the error."""
+    return len(history) > window and history[-1] > 0.5 * history[-1 - window]
+
+
+def newton_failure(cond: float, cond_limit: float, history: list[float]) -> tuple[str, str]:
+    """Why a closed-loop correction failed: ``(reason, explanation)`` from the Jacobian's
+    condition number where it ended and the course of the error."""
+    if cond > cond_limit:
+        return "singular", (f"the Jacobian there is singular (condition number {cond:.3g} > "
+                            f"{cond_limit:g}): the path crosses a singularity")
+    if len(history) > 1 and history[-1] >= history[0]:
+        return "diverged", (f"the error grew from the first iteration with a regular Jacobian "
+                            f"(condition number {cond:.3g}): the step is too large for Newton "
+                            "from where it started; give more steps")
+    return "out_of_reach", (f"the error stopped decreasing with a regular Jacobian (condition "
+                            f"number {cond:.3g}): the path pose is out of the mechanism's "
+                            "reach there (the path leaves the workspace)")

@@ -145,27 +145,34 @@ class ScrewPath(_PathEnd):
 
     ``twist`` ξ ``(6,)`` is the whole screw displacement ``[θU; hθU − θU×ρn]``; the step twist
     is the constant ``(s1 − s0) ξ`` whatever the hand's actual pose (eq. 4-19: ρn "constant
-    throughout the analysis").
+    throughout the analysis"). With ``from_actual`` a step is instead the screw from the hand's
+    actual pose to the path's pose at ``s1`` (DISP, App. I: "the actual position of the
+    manipulator hand ... for any intermediate stage"), so first-order errors do not add up.
     """
 
     start: np.ndarray
     twist: np.ndarray
     kind: str = "screw"
+    from_actual: bool = False
 
     def pose_at(self, s) -> np.ndarray:
         s = _s(s)
         return twist_exp(s[..., None] * self.twist) @ self.start
 
     def step_twist(self, s0: float, s1: float, hand) -> np.ndarray:
+        if self.from_actual:
+            return twist_between(np.asarray(hand, dtype=float), self.pose_at(s1))
         return (s1 - s0) * self.twist
 
     def step_target(self, s0: float, s1: float, hand) -> np.ndarray:
+        if self.from_actual:
+            return self.pose_at(s1)
         return twist_exp((s1 - s0) * self.twist) @ np.asarray(hand, dtype=float)
 
     def replan(self, hand, s_now: float) -> ScrewPath:
         """A screw path from ``hand`` to this path's end (after a perturbation)."""
         hand = _pose(hand, "hand pose")
-        return ScrewPath(hand, twist_between(hand, self.end), self.kind)
+        return ScrewPath(hand, twist_between(hand, self.end), self.kind, self.from_actual)
 
 
 @dataclass(frozen=True, eq=False)
@@ -263,8 +270,9 @@ class GeneralPath(_PathEnd):
         return general_path(hand, self.end)
 
 
-def screw_path(start, target) -> ScrewPath:
-    """Type II (eqs. 4-18, 4-19): the screw displacement from ``start`` to ``target``.
+def screw_path(start, target, *, from_actual: bool = False) -> ScrewPath:
+    """Type II (eqs. 4-18, 4-19): the screw displacement from ``start`` to ``target``
+    (``from_actual``: each step aims from the actual hand at the next path pose, as DISP).
 
     >>> from kinestat.spatial.transforms import trans
     >>> p = screw_path(np.eye(4), trans([0.0, 0.0, 4.0]))
@@ -273,7 +281,7 @@ def screw_path(start, target) -> ScrewPath:
     """
     start = _pose(start, "start pose")
     target = _pose(target, "target pose")
-    return ScrewPath(start, twist_between(start, target))
+    return ScrewPath(start, twist_between(start, target), from_actual=from_actual)
 
 
 def line_path(points0, points1) -> LinePath:

@@ -169,10 +169,13 @@ class GuidanceOptions:
       ``step_rule="second_order"``; ``origin_step``/``split_substep_deg2`` are the
       parameters of the ``disp_1977`` rule (setting either selects it).
     - ``closed_loop``: after each step, Newton iterations ``J δq = ε`` with ε the error twist
-      from the actual to the ideal hand pose of the step, until ``|ε_ω| ≤ tol`` and
-      ``|ε_p| ≤ tol·max(1, L)`` (beyond the thesis). Not with ``disp_1977``.
+      from the actual to the ideal hand pose of the step, until the hand is within ``tol``·L of
+      the path pose and ``tol`` rad of its orientation (L the characteristic length of the
+      mechanism: a relative tolerance, 1e-9 by default, ~1 nm on a 1 m arm; beyond the thesis).
+      Not with ``disp_1977``.
     - ``singular``: ``"perturb"`` (greedy: one joint by ``perturb_deg`` per try),
-      ``"perturb_all"`` (DISP's way, ch. IV: small increments on all joints at once),
+      ``"perturb_all"`` (DISP's way, ch. IV: every joint by ``perturb_all_deg`` per try, each
+      with the sign that raises σ_min, up to ``max_perturb_all_tries`` tries),
       ``"damped"`` or ``"stop"``; a configuration is singular when the dimensionless
       condition number exceeds ``cond_limit``.
     - ``max_step_deg``, ``max_step_fraction``: the automatic step count (IT = 0): no step
@@ -183,24 +186,30 @@ class GuidanceOptions:
     - ``settle``: after the last step of a stage, take first-order steps straight at the stage's
       target (eq. 4-19 with k = 1: Newton's method) until it is reached to ``settle_tol``; each
       is a table row and a ``settle`` event. A target still missed after ``max_settle`` of them
-      stops the run (``target_not_reached``). Not in DISP (``kinestat disp`` leaves it off).
+      stops the run (``target_not_reached``). The position criterion is ``settle_tol`` ×
+      ``settle_length`` (default max(1, L)), the angle ``settle_tol`` rad. ``kinestat disp``
+      uses it as DISP's final correction, to the printed precision of its tables (0.0005 in
+      and 0.0005 rad: every hand point within 0.0005 of the target's).
     """
 
     step_rule: StepRuleName = "first_order"
     closed_loop: bool = False
     singular: SingularMode = "perturb"
     cond_limit: float = DEFAULT_COND_LIMIT
-    tol: float = 1e-12
+    tol: float = 1e-9
     max_newton: int = 30
     perturb_deg: float = 1.0
     max_perturb_tries: int = 30
     max_perturbations: int = 25
+    perturb_all_deg: float = 0.1
+    max_perturb_all_tries: int = 300
     max_damping: float = 0.1
     max_step_deg: float = 1.0
     max_step_fraction: float = 0.01
     max_joint_step_deg: float | None = 2.0
     settle: bool = True
     settle_tol: float = 1e-9
+    settle_length: float | None = None
     max_settle: int = 10
     check_limits: bool = True
     second_order: bool = False
@@ -242,7 +251,10 @@ class GuidanceOptions:
         if self.singular not in SINGULAR_MODES:
             raise InputError(
                 f"singular must be one of {', '.join(SINGULAR_MODES)}, got {self.singular!r}")
-        for name in ("cond_limit", "tol", "perturb_deg", "max_step_deg", "max_step_fraction"):
+        if self.settle_length is not None:
+            _positive("settle_length", self.settle_length)
+        for name in ("cond_limit", "tol", "perturb_deg", "perturb_all_deg", "max_step_deg",
+                     "max_step_fraction"):
             _positive(name, getattr(self, name))
 
     def rule(self) -> StepRule:

@@ -40,6 +40,8 @@ from kinestat.serial.guidance.events import (
     SettleStep,
     Singularity,
     TargetNotReached,
+    newton_failure,
+    newton_stalled,
 )
 from kinestat.serial.guidance.planners import (
     Path,
@@ -234,8 +236,10 @@ class _Run:
 
     def __init__(self, model: ChainModel, q: np.ndarray, opt: GuidanceOptions, L: float,
                  progress: Callable[[int, int], None] | None,
-                 rule: StepRule | None = None) -> None:
+                 rule: StepRule | None = None,
+                 step_count: Callable[[Path], int] | None = None) -> None:
         self.model, self.opt, self.L, self.progress = model, opt, L, progress
+        self.step_count = step_count
         self.rule: StepRule = opt.rule() if rule is None else rule
         self.q = q
         self.H = fk(model, q)
@@ -284,9 +288,13 @@ class _Run:
         self.stop(ev, msg)
         return True
 
-    def _error_small(self, T, T_ref, tol: float) -> tuple[bool, float, float]:
+    def _error_small(self, T, T_ref, tol: float, scale: float | None = None
+                     ) -> tuple[bool, float, float]:
+        """Pose error of ``T`` from ``T_ref`` within ``tol`` rad and ``tol``·scale (default
+        max(1, L))."""
         dp, da = pose_error(T, T_ref)
-        return bool(da <= tol and dp <= tol * max(1.0, self.L)), float(dp), float(da)
+        scale = max(1.0, self.L) if scale is None else scale
+        return bool(da <= tol and dp <= tol * scale), float(dp), float(da)
 
     def _solve(self, J, B, damping):
         o = self.opt
@@ -299,6 +307,8 @@ class _Run:
         refine = None
         k = k_given
         left = MAX_RUN_STEPS - self.total_planned
+        if k is None and self.step_count is not None:
+            k = _step_count(self.step_count(path))
         if k is None:
             refine = self.opt.max_joint_step_deg
             k = auto_steps(path, self.L, max_step_deg=self.opt.max_step_deg,
@@ -405,10 +415,14 @@ class _Run:
         if o.singular == "damped":
             self.events.append(Singularity(*where, **base, action="damped"))
             return J, "auto"
-        escape = perturb_all_joints if o.singular == "perturb_all" else escape_singularity
+        if o.singular == "perturb_all":
+            escape, inc, tries_max = (perturb_all_joints, o.perturb_all_deg,
+                                      o.max_perturb_all_tries)
+        else:
+            escape, inc, tries_max = escape_singularity, o.perturb_deg, o.max_perturb_tries
         q_new, cond_new, tries = escape(self.model, self.q, length=self.L,
-                                        cond_limit=o.cond_limit, increment_deg=o.perturb_deg,
-                                        max_tries=o.max_perturb_tries)
+                                        cond_limit=o.cond_limit, increment_deg=inc,
+                                        max_tries=tries_max)
         self.perturbations += 1
         base.update(joint_increments=joint_display(self.model, q_new - self.q), tries=tries,
                     cond_after=cond_new, method=o.singular)
@@ -435,25 +449,32 @@ class _Run:
 
     # -- corrections -------------------------------------------------------------------------
     def newton(self, st: _Stage, target, q) -> np.ndarray | None:
-        """Closed loop: Newton iterations ``J δq = twist(actual → target)`` until the pose
-        error ≤ tol; the corrected joints, or None (stopped) when they do not converge."""
+        """Closed loop: Newton iterations ``J δq = twist(actual → target)`` until the hand is
+        within ``tol``·L and ``tol`` rad of the step's path pose; the corrected joints, or None
+        (stopped, with the reason) when they do not get there."""
         o = self.opt
         damping = "auto" if o.singular == "damped" else None
-        dp = da = math.inf
+        history: list[float] = []
         for it in range(o.max_newton + 1):
             T = fk(self.model, q)
-            ok, dp, da = self._error_small(T, target, o.tol)
+            ok, dp, da = self._error_small(T, target, o.tol, self.L)
             if ok:
                 return q
-            if it == o.max_newton:
+            history.append(dp / self.L + da)
+            if it == o.max_newton or newton_stalled(history):
                 break
             q = q + self._solve(jacobian(self.model, q), twist_between(T, target), damping).dq
+        _, cond = conditioning(scaled_jacobian(jacobian(self.model, q), self.model.prismatic,
+                                               self.L))
+        reason, why = newton_failure(float(cond), o.cond_limit, history)
+        unit = self.model.length_unit
         self.stop(NotConverged(self.gstep, st.index + 1, position_error=dp,
-                               angle_error_deg=math.degrees(da), iterations=o.max_newton),
-                  f"step {self.gstep}: the closed-loop correction did not reach the path "
-                  f"(error {dp:.3g} {self.model.length_unit}, {math.degrees(da):.3g} deg after "
-                  f"{o.max_newton} iterations): the path leaves the workspace or crosses a "
-                  "singularity")
+                               angle_error_deg=math.degrees(da), iterations=len(history) - 1,
+                               reason=reason, cond=float(cond)),
+                  f"step {self.gstep}: the closed-loop correction did not bring the hand onto "
+                  f"the path: after {len(history) - 1} Newton iterations it is {dp:.3g} {unit} "
+                  f"and {math.degrees(da):.3g} deg from the step's path pose (tolerance "
+                  f"{o.tol * self.L:.3g} {unit} = {o.tol:g} × L and {o.tol:g} rad); {why}")
         return None
 
     def settle(self, si: int) -> None:
@@ -461,7 +482,7 @@ class _Run:
         o = self.opt
         target = self.targets[-1]
         for it in range(o.max_settle + 1):
-            ok, dp, da = self._error_small(self.H, target, o.settle_tol)
+            ok, dp, da = self._error_small(self.H, target, o.settle_tol, o.settle_length)
             if ok:
                 return
             if it == o.max_settle:
@@ -504,6 +525,7 @@ def run_guidance(
     progress: Callable[[int, int], None] | None = None,
     length: float | None = None,
     rule: StepRule | None = None,
+    step_count: Callable[[Path], int] | None = None,
 ) -> GuidanceResult:
     """Guide the hand of ``model`` from joint values ``q0`` through ``stages`` (Nadkarni
     ch. IV: eq. 4-11 per step, the singularity and joint-limit rules of "Singularities").
@@ -518,6 +540,10 @@ def run_guidance(
         progress: called as ``progress(steps_done, steps_planned_so_far)``.
         rule: a step rule (:class:`~kinestat.serial.guidance.rules.StepRule`) to use instead
             of the one ``options.step_rule`` names.
+        step_count: for stages without a count, ``path -> k`` called with the stage's path
+            at its start (e.g. DISP's inferred IT = 0 rule) instead of
+            :func:`~kinestat.serial.guidance.planners.auto_steps`; such counts are not refined
+            into sub-steps.
 
     >>> from kinestat.io.library import load
     >>> from kinestat.serial.guidance.planners import command_path
@@ -542,7 +568,7 @@ def run_guidance(
             f"the chain has {model.n} joints, not 6: each step solves J δq = B in the "
             "least-squares sense" + (" (minimum-norm increments)" if model.n > 6 else
                                      " (the residual is reported in the events)"))
-    run = _Run(model, q, opt, L, progress, rule)
+    run = _Run(model, q, opt, L, progress, rule, step_count)
     if run.limit_stop(q, None):
         return run.result(notes)
     try:

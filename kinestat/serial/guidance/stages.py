@@ -47,8 +47,10 @@ class Command(Protocol):
     def frame(self) -> str: ...
 
 
-def target_stages(kind: PathType, start_points, targets) -> list[StageSpec]:
-    """One stage per target (three points ``(3, 3)`` each): ``"screw"`` type II (eq. 4-19),
+def target_stages(kind: PathType, start_points, targets, *,
+                  from_actual: bool = False) -> list[StageSpec]:
+    """One stage per target (three points ``(3, 3)`` each): ``"screw"`` type II (eq. 4-19;
+    ``from_actual``: each step aims from the actual hand at the next path pose, as DISP),
     ``"line"`` type III from ``start_points`` (eq. 4-20), ``"general"`` type I Example 4
     (eqs. 4-16, 4-17, re-planned every step).
 
@@ -64,7 +66,7 @@ def target_stages(kind: PathType, start_points, targets) -> list[StageSpec]:
         return [(lambda H, a=P[i - 1], b=P[i]: line_path(a, b)) for i in range(1, len(P))]
     frames = [frame_from_triple(t) for t in pts]
     if kind == "screw":
-        return [(lambda H, T=T: screw_path(H, T)) for T in frames]
+        return [(lambda H, T=T: screw_path(H, T, from_actual=from_actual)) for T in frames]
     return [(lambda H, T=T: general_path(H, T)) for T in frames]
 
 

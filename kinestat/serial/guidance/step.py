@@ -47,6 +47,7 @@ __all__ = [
     "solve_second_order",
     "escape_singularity",
     "perturb_all_joints",
+    "sigma_min_gradient",
     "limit_violation",
     "origin_displacement_twist",
     "split_substep_count",
@@ -123,7 +124,8 @@ def solve_step(J, B, *, prismatic, length: float = 1.0, damping=None,
     """Solve ``J δq = B`` (eq. 4-11) for Jacobians ``(..., 6, n)`` and twists ``(..., 6)``.
 
     Args:
-        J, B: the twist Jacobian and the hand displacement twist ``[δθ u_ω; v_O]``.
+        J: the twist Jacobian ``(..., 6, n)``.
+        B: the hand displacement twist ``[δθ u_ω; v_O]`` ``(..., 6)``.
         prismatic: boolean mask ``(n,)`` of prismatic joints (for the dimensionless scaling).
         length: the characteristic length L.
         damping: ``None`` for the plain solution (exact when n = 6 and J is regular, least
@@ -286,39 +288,65 @@ def escape_singularity(model: ChainModel, q, *, length: float,
     return q, cond, max_tries
 
 
+def sigma_min_gradient(model: ChainModel, q, *, length: float, h: float = 1e-6) -> np.ndarray:
+    """``∂σ_min/∂q`` ``(n,)`` of the dimensionless Jacobian, per unit of the scaled joint
+    variables (radians; prismatic joints in units of L), by central differences."""
+    q = np.asarray(q, dtype=float)
+    pris = model.prismatic
+    scale = np.where(pris, length, 1.0)
+    dq = np.diag(h * scale)
+    cand = np.concatenate([q + dq, q - dq])
+    smin, _ = conditioning(scaled_jacobian(jacobian(model, cand), pris, length))
+    n = q.shape[0]
+    return (smin[:n] - smin[n:]) / (2.0 * h)
+
+
 def perturb_all_joints(model: ChainModel, q, *, length: float,
                        cond_limit: float = DEFAULT_COND_LIMIT, increment_deg: float = 1.0,
                        max_tries: int = 30) -> tuple[np.ndarray, float, int]:
-    """Nadkarni ch. IV, "Singularities" 1): "small increments to the joint variables" — all
-    of them at once — until the singularity disappears.
+    """Nadkarni ch. IV, "Singularities" 1): "a new configuration of the manipulator by giving
+    small increments to the joint variables till the singularity becomes non-existent" — to
+    all of them at once.
 
-    Deterministic rule: try ``t = 1, 2, …`` moves every joint by ``t·δ`` (δ = ``increment_deg``
-    for revolute and screw joints, L/100 for prismatic ones) towards its farther limit (+ when
-    both are equally far, e.g. unlimited), until the dimensionless condition number is below
-    ``cond_limit``. Returns ``(q_new, cond_new, tries)``; ``cond_new >= cond_limit`` means no
-    try within the joint limits succeeded (``q_new`` is then ``q``).
+    Deterministic rule: each try moves every joint by ``increment_deg`` (prismatic joints:
+    that angle in radians × L) in the direction, + or −, in which it raises the Jacobian's
+    smallest dimensionless singular value σ_min (the sign of ``∂σ_min/∂q``, + where it is 0):
+    the steepest ascent of σ_min when every increment is bounded by the same small amount, so
+    every joint moves, with mixed signs. Tries repeat until the dimensionless condition number
+    is below ``cond_limit``. A try that would pass a joint limit, or that does not raise
+    σ_min, ends the search. Returns ``(q_new, cond_new, tries)``; ``cond_new >= cond_limit``
+    means it gave up (``q_new`` is the best configuration found).
 
     >>> from kinestat.io.library import load
     >>> m = load("puma762")
     >>> q_wrist_singular = np.radians([90.0, -30.0, 30.0, 0.0, 0.0, 0.0])  # θ5 = 0
     >>> q, c, t = perturb_all_joints(m, q_wrist_singular, length=400.0)
-    >>> np.degrees(q - q_wrist_singular).round(6).tolist(), bool(c < DEFAULT_COND_LIMIT)
-    ([1.0, 1.0, -1.0, 1.0, 1.0, 1.0], True)
+    >>> d = np.degrees(q - q_wrist_singular)
+    >>> bool(c < DEFAULT_COND_LIMIT), bool(np.allclose(np.abs(d), t)), bool(np.ptp(np.sign(d)))
+    (True, True, True)
     """
     q = model.check_q(q).astype(float)
     pris = model.prismatic
     lo, hi = model.lower, model.upper
-    inc = np.where(pris, length / 100.0, math.radians(increment_deg))
-    sign = np.where(hi - q >= q - lo, 1.0, -1.0)
-    _, cond = conditioning(scaled_jacobian(jacobian(model, q), pris, length))
+    scale = np.where(pris, length, 1.0)
+    step = math.radians(increment_deg)
+    smin, cond = (float(v) for v in conditioning(
+        scaled_jacobian(jacobian(model, q), pris, length)))
     for tries in range(1, max_tries + 1):
-        cand = q + tries * sign * inc
+        g = sigma_min_gradient(model, q, length=length)
+        if not np.all(np.isfinite(g)):
+            return q, cond, tries
+        cand = q + step * scale * np.where(g >= 0.0, 1.0, -1.0)
         if not np.all((cand >= lo) & (cand <= hi)):
-            return q, float(cond), tries
-        _, cc = conditioning(scaled_jacobian(jacobian(model, cand), pris, length))
-        if float(cc) < cond_limit:
-            return cand, float(cc), tries
-    return q, float(cond), max_tries
+            return q, cond, tries
+        s_new, c_new = (float(v) for v in conditioning(
+            scaled_jacobian(jacobian(model, cand), pris, length)))
+        if not s_new > smin:
+            return q, cond, tries
+        q, smin, cond = cand, s_new, c_new
+        if cond < cond_limit:
+            return q, cond, tries
+    return q, cond, max_tries
 
 
 def limit_violation(model: ChainModel, q, tol: float = 1e-12):

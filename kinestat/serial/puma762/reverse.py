@@ -221,7 +221,8 @@ def reverse_batch(
 
     Args:
         tool_point: ``P_tool_F (*B, 3)`` in mm.
-        s6, a67: ``S6_F``, ``a67_F (*B, 3)``, unit and perpendicular to ``unit_tol``.
+        s6: ``S6_F (*B, 3)``, a unit vector (to ``unit_tol``) perpendicular to ``a67``.
+        a67: ``a67_F (*B, 3)``, a unit vector (to ``unit_tol``) perpendicular to ``s6``.
         tool_point_6: ``P_tool_6 (*B, 3)`` or ``(3,)``.
         verify: run the forward analysis on every branch and keep only those that reproduce the
             pose within ``tol`` (mm for the position, radians for the rotation).

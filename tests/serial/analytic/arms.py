@@ -46,6 +46,8 @@ def arm(name: str):
         return jaco6()
     if name.startswith("random"):
         return random_6r(int(name[6:]))
+    if name in INDUSTRIAL:
+        return industrial(name)
     return kinestat.load(name)
 
 
@@ -151,3 +153,13 @@ def industrial(name: str):
     rtbdata = pytest.importorskip("rtbdata", reason="rtb-data is not installed "
                                   "(pip install -r requirements/dev.txt)")
     return kinestat.load(Path(rtbdata.__file__).parent / "xacro" / src, tip=tip)
+
+
+def random_shoulder(seed: int):
+    """A random 6R whose first three axes meet (standard DH with a1 = a2 = d2 = 0) and whose
+    wrist is not spherical."""
+    rng = np.random.default_rng(seed)
+    rows = np.column_stack([rng.uniform(-PI, PI, 6), rng.uniform(-1, 1, 6),
+                            rng.uniform(-1, 1, 6), rng.uniform(-PI, PI, 6)])
+    rows[0, 2] = rows[1, 2] = rows[1, 1] = 0.0
+    return from_standard_dh(rows, name=f"shoulder-{seed}", length_unit="m")

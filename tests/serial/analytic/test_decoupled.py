@@ -93,8 +93,9 @@ def _found(model, res, q):
 @pytest.mark.parametrize("name", ARMS)
 def test_generating_configuration_found_and_residuals(name):
     model = arm(name)
-    # auto picks the decoupled solver when a prismatic joint is present; RRR is forced
-    assert method_for(model) == ("decoupled" if model.prismatic.any() else "raghavan-roth")
+    # auto picks the decoupled solver when a prismatic joint is present; an RRR arm with a
+    # spherical wrist is a pieper arm (offset shoulder or not), decoupled is forced
+    assert method_for(model) == ("decoupled" if model.prismatic.any() else "pieper")
     q = configs(model, 1000, seed=len(name))
     q = q[_regular(model, q)]
     T = kinestat.fk(model, q)
@@ -109,6 +110,8 @@ def test_generating_configuration_found_and_residuals(name):
     # prismatic values are lengths, not wrapped; revolute ones are in [-π, π)
     qr = res.q[..., ~model.prismatic][res.valid]
     assert np.all((qr >= -PI) & (qr < PI))
+    if not model.prismatic.any():  # two derivations, one count
+        assert np.array_equal(ik_all(model, T).n_solutions, res.n_solutions)
 
 
 @pytest.mark.parametrize("name", ARMS)

@@ -1,6 +1,6 @@
-"""Spherical-wrist arms with an offset shoulder (KUKA, ABB, random Pieper arms): every solution
-reproduces its pose, the generating configuration is found, and the count equals EAIK's and a
-many-start Newton oracle's."""
+"""Spherical-wrist arms with an offset shoulder (KUKA, ABB, random Pieper arms) and arms whose
+first three axes meet (solved reversed): every solution reproduces its pose, the generating
+configuration is found, and the count equals EAIK's and a many-start Newton oracle's."""
 
 from __future__ import annotations
 
@@ -18,15 +18,18 @@ from .arms import (
     industrial,
     newton_solutions,
     random_pieper,
+    random_shoulder,
     slot_residuals,
     wrapped_distance,
 )
 
-RANDOM = [("", 0), ("", 1), ("", 2), ("12", 3), ("23", 4), ("23", 5)]
+RANDOM = [("", 0), ("", 1), ("", 2), ("12", 3), ("23", 4), ("23", 5), ("123", 6), ("123", 7)]
 
 
 def _arm(key):
-    return industrial(key) if isinstance(key, str) else random_pieper(key[1], key[0])
+    if isinstance(key, str):
+        return industrial(key)
+    return random_shoulder(key[1]) if key[0] == "123" else random_pieper(key[1], key[0])
 
 
 KEYS = sorted(INDUSTRIAL) + RANDOM
@@ -112,7 +115,8 @@ def test_count_equals_eaik(key):
             assert np.min(wrapped_distance(mine, s)) < 1e-6
 
 
-@pytest.mark.parametrize("key", [RANDOM[0], RANDOM[1], RANDOM[3], RANDOM[4]], ids=_ids)
+@pytest.mark.parametrize("key", [RANDOM[0], RANDOM[1], RANDOM[3], RANDOM[4], RANDOM[6]],
+                         ids=_ids)
 def test_count_matches_many_start_newton(key):
     model = _arm(key)
     q = np.random.default_rng(5).uniform(-PI, PI, (3, 6))

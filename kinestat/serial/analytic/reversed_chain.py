@@ -1,0 +1,63 @@
+"""Arms whose first three axes meet (a spherical shoulder) solved as their reversed chain, whose
+last three axes meet: a ``pieper`` arm (:mod:`kinestat.serial.analytic.closed_form`).
+
+``T = C0 Z(q1) C1 ⋯ Z(q6) C6`` gives ``T⁻¹ = C6⁻¹ Z(−q6) C5⁻¹ ⋯ Z(−q1) C0⁻¹``, and
+``Z(−q) = F Z(q) F`` with ``F = Rx(π)`` (it flips the y and z axes; for a turn about z and a
+slide along z alike). So ``T⁻¹`` is the chain ``C'0 = C6⁻¹ F``, ``C'k = F C(6−k)⁻¹ F``,
+``C'6 = F C0⁻¹`` in the joints ``q' = (q6, …, q1)``.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+
+import numpy as np
+
+from kinestat.mechanism.chain import ChainModel
+from kinestat.serial.analytic.result import IKAllResult
+
+__all__ = ["reverse", "invert_poses", "unreverse"]
+
+_F = np.diag([1.0, -1.0, -1.0, 1.0])
+
+
+def _inv(C: np.ndarray) -> np.ndarray:
+    out = np.eye(4)
+    out[:3, :3] = C[:3, :3].T
+    out[:3, 3] = -C[:3, :3].T @ C[:3, 3]
+    return out
+
+
+@lru_cache(maxsize=64)
+def reverse(model: ChainModel) -> ChainModel:
+    """The chain from the flange to the base (joints in reverse order, see the module)."""
+    C = model.constants
+    n = model.n
+    Cr = [_inv(C[n]) @ _F] + [_F @ _inv(C[n - k]) @ _F for k in range(1, n)] + [_F @ _inv(C[0])]
+    return ChainModel(name=f"{model.name} (reversed)", joints=tuple(reversed(model.joints)),
+                      constants=np.array(Cr), length_unit=model.length_unit,
+                      q_home=np.asarray(model.q_home)[::-1])
+
+
+def invert_poses(T: np.ndarray) -> np.ndarray:
+    """``T⁻¹`` of rigid poses ``(..., 4, 4)``."""
+    T = np.asarray(T, dtype=float)
+    Rt = np.swapaxes(T[..., :3, :3], -1, -2)
+    out = np.zeros(T.shape)
+    out[..., :3, :3] = Rt
+    out[..., :3, 3] = -np.einsum("...ij,...j->...i", Rt, T[..., :3, 3])
+    out[..., 3, 3] = 1.0
+    return out
+
+
+def unreverse(res: IKAllResult) -> IKAllResult:
+    """The reversed chain's result in the model's joint order."""
+    fields = {f: getattr(res, f) for f in ("valid", "position_error", "rotation_error",
+                                           "singular", "family_sign", "family_value",
+                                           "n_solutions", "reason", "method", "tol")}
+    n = res.q.shape[-1]
+    fields["q"] = res.q[..., ::-1]
+    fields["family_joints"] = None if res.family_joints is None else \
+        tuple(n - 1 - j for j in res.family_joints)
+    fields["family_curve"] = None
+    return IKAllResult(**fields)
