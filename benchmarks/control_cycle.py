@@ -5,20 +5,13 @@ thesis cell: 5° tilted plane, thesis calibration and sensor), then times the de
 on each recorded pair (``decide`` for the press task, ``decide_follow`` for a 50 mm follow run,
 and for one with friction 0.3 on an R = 200 mm cylinder with the automatic tilt;
 both include the closed-form reverse analysis, the vernier's rounding to counts and the
-envelope's prediction), on the fast path and — side by side, alternating, in the same run — on
-the unoptimised reference path (:func:`kinestat.control._reference.reference_cycle`: the NumPy
-vernier and selection, the stiffness recomputed on every use, SciPy's rotation vector in every
-motion check; in the follow task the batched NumPy cone normal, friction sample and path
-curvature (``lstsq``), NumPy's norms and solves and ``dataclasses.replace``). Also times the
-parts: the move onto the target (for the PUMA one compiled call: reverse analysis, selection,
-vernier, joint angles and flange pose; the reference: reverse analysis, selection and
-vernier), the envelope's prediction (``predict``), the decision without the vernier, the
-decision alone (the fast path's calls back to back on the same inputs, the caches warm: a
-lower bound; the alternating runs let the reference path's large arrays evict the caches
-before every fast call), the measurement chain (``measure``, not part of the decision) and
-the decision as the control loop makes it ("in loop": each call right after the ``measure``
-that makes its Measurement, whose NumPy (~0.25 ms since its tracking FK was compiled on
-2026-12-04; ~0.85 ms before) leaves the caches cold: the closest figure to a real cycle).
+prediction). Also times the parts: the move onto the target (reverse analysis, selection and
+vernier), the prediction (``predict``), the decision without the vernier, the measurement
+chain (``measure``, not part of the decision) and the decision as the control loop makes it
+("in loop": each call right after the ``measure`` that makes its Measurement, which leaves the
+caches cold: the closest figure to a real cycle). The cycle waits hundreds of milliseconds on
+the arm's motion and settling; these figures say how small the decision's share is, they are
+not a goal.
 Figures are medians over the moving cycles (the follow task's settle and follow cycles: not
 its approach or surface-probe moves) of the median of repeats; every call gets a fresh copy
 of its Measurement (no per-cycle data is reused between calls). The kernels are compiled (or
@@ -54,22 +47,18 @@ from kinestat.app.control_run import (  # noqa: E402
 )
 from kinestat.app.sim_cell import InProcessIO, start_counts  # noqa: E402
 from kinestat.cli._compile import warm_kernels  # noqa: E402
-from kinestat.control._reference import reference_cycle, solve_counts_reference  # noqa: E402
 from kinestat.control.controller import (  # noqa: E402
     THESIS_FORCE_DIRECTION,
-    _flange_pose,
-    _puma_move,
     _solve_counts,
     decide,
 )
-from kinestat.control.envelope import predict  # noqa: E402
 from kinestat.control.follow import decide_follow  # noqa: E402
 from kinestat.control.log import CycleLog  # noqa: E402
 from kinestat.control.loop import run  # noqa: E402
+from kinestat.control.predict import predict  # noqa: E402
 from kinestat.control.wrench import Measurement, measure  # noqa: E402
 
 START = np.array([-400.0, 800.0, -100.0])
-GOAL_US = 200.0
 
 
 TASKS = ("press", "press-cylinder", "follow", "follow-friction")
@@ -131,27 +120,16 @@ def _once(fn, args) -> float:
     return _clock() - t0
 
 
-def _paired(fast, ref, pairs, repeat: int) -> tuple[float, float, float, float]:
-    """Median over ``pairs`` of the median of ``repeat`` calls, for ``fast`` and, alternating
-    with it (the same machine load), ``ref`` on the reference path; then the same with the
-    best (least) of the repeats instead of their median (less sensitive to other processes on
-    a shared machine); seconds."""
-    per_fast, per_ref, best_fast, best_ref = [], [], [], []
+def _timed(fn, pairs, repeat: int) -> tuple[float, float]:
+    """Median over ``pairs`` of the median of ``repeat`` calls, and the same with the best
+    (least) of the repeats (less sensitive to other processes on a shared machine); seconds."""
+    med, best = [], []
     for p in pairs:
-        _once(fast, p)
-        with reference_cycle():
-            _once(ref, p)
-        tf, tr = [], []
-        for _ in range(repeat):
-            tf.append(_once(fast, p))
-            with reference_cycle():
-                tr.append(_once(ref, p))
-        per_fast.append(statistics.median(tf))
-        per_ref.append(statistics.median(tr))
-        best_fast.append(min(tf))
-        best_ref.append(min(tr))
-    return (statistics.median(per_fast), statistics.median(per_ref),
-            statistics.median(best_fast), statistics.median(best_ref))
+        _once(fn, p)
+        ts = [_once(fn, p) for _ in range(repeat)]
+        med.append(statistics.median(ts))
+        best.append(min(ts))
+    return statistics.median(med), statistics.median(best)
 
 
 def _per_cycle(fn, pairs, repeat: int) -> list[float]:
@@ -207,16 +185,10 @@ def _task_row(task: str, repeat: int) -> dict:
             moving.append((s, m, cmd))
     decisions = [(s, m) for s, m, _ in moving]
     targets = [(c.target, m.q, s.axis_counts) for s, m, c in moving]
-    poses = [(m, _flange_pose(model, c.q)) for s, m, c in moving]
-    t_full, t_full_ref, b_full, b_full_ref = _paired(full, full, decisions, repeat)
-    # the fast path's move onto the target: for the PUMA one compiled call (counts with the
-    # vernier, joint angles, flange pose: _puma_move), else the counts alone
-    t_ik, t_ik_ref, *_ = _paired(lambda t, q, c: (_puma_move(model, t, q, c, True)
-                                              or _solve_counts(model, t, q, c, True)),
-                             lambda t, q, c: solve_counts_reference(model, t, q, c, True),
-                             targets, repeat)
-    t_pred, t_pred_ref, *_ = _paired(lambda m, T: predict(model, m, T),
-                                 lambda m, T: predict(model, m, T), poses, repeat)
+    poses = [(m, model.arm.flange_pose(c.q)) for s, m, c in moving]
+    t_full, b_full = _timed(full, decisions, repeat)
+    t_ik, _ = _timed(lambda t, q, c: _solve_counts(model, t, q, c, True), targets, repeat)
+    t_pred, _ = _timed(lambda m, T: predict(model, m, T), poses, repeat)
     t_plain = _single(plain, decisions, repeat)
     alone = _per_cycle(full, decisions, repeat)
     t_alone = statistics.median(alone)
@@ -230,11 +202,8 @@ def _task_row(task: str, repeat: int) -> dict:
     loop_contact = [t for t, (_, _, c) in zip(loop, moving, strict=True)
                     if c.action not in ("approach", "probe")]
     return {"task": task, "cycles": len(pairs), "moves_timed": len(moving),
-            "decide_us": 1e6 * t_full, "reference_decide_us": 1e6 * t_full_ref,
-            "speedup": t_full_ref / t_full,
-            "decide_best_us": 1e6 * b_full, "reference_decide_best_us": 1e6 * b_full_ref,
-            "ik_vernier_us": 1e6 * t_ik, "reference_ik_vernier_us": 1e6 * t_ik_ref,
-            "predict_us": 1e6 * t_pred, "reference_predict_us": 1e6 * t_pred_ref,
+            "decide_us": 1e6 * t_full, "decide_best_us": 1e6 * b_full,
+            "ik_vernier_us": 1e6 * t_ik, "predict_us": 1e6 * t_pred,
             "rest_us": 1e6 * max(t_full - t_ik - t_pred, 0.0),
             "decide_no_vernier_us": 1e6 * t_plain, "decide_alone_us": 1e6 * t_alone,
             "contact_alone_us": 1e6 * statistics.median(contact) if contact else None,
@@ -243,7 +212,7 @@ def _task_row(task: str, repeat: int) -> dict:
             "in_loop_us": 1e6 * statistics.median(loop),
             "in_loop_contact_us": (1e6 * statistics.median(loop_contact) if loop_contact
                                    else None),
-            "goal_us": GOAL_US, "converged": rep.converged}
+            "converged": rep.converged}
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -269,42 +238,23 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     print(f"{meta['date']}, {meta['machine']}, load average {meta['load_average']:.1f}, "
           f"{args.clock} clock; kernels compiled/loaded first in {first_load_s:.1f} s (not timed)")
-    print("µs per cycle (median over the moving cycles), fast path vs reference path "
-          "(same run, alternating)")
-    print(f"{'task':15s} {'cycles':>6s} {'decide+IK':>10s} {'reference':>10s} {'×':>5s} "
-          f"{'best-of':>8s} {'(ref)':>7s} "
-          f"{'IK+vernier':>11s} {'(ref)':>7s} {'prediction':>11s} {'(ref)':>7s} {'rest':>6s} "
-          f"{'no vernier':>11s} {'measure':>8s} {'alone':>6s} {'contact':>8s} {'slowest':>8s} "
-          f"{'in loop':>8s} {'(contact)':>9s}")
+    print("µs per cycle (median over the moving cycles)")
+    print(f"{'task':15s} {'cycles':>6s} {'decide+IK':>10s} {'best-of':>8s} {'IK+vernier':>11s} "
+          f"{'prediction':>11s} {'rest':>6s} {'no vernier':>11s} {'measure':>8s} {'alone':>6s} "
+          f"{'contact':>8s} {'slowest':>8s} {'in loop':>8s} {'(contact)':>9s}")
     for r in rows:
         print(f"{r['task']:15s} {r['cycles']:6d} {r['decide_us']:10.0f} "
-              f"{r['reference_decide_us']:10.0f} {r['speedup']:5.1f} {r['decide_best_us']:8.0f} "
-              f"{r['reference_decide_best_us']:7.0f} {r['ik_vernier_us']:11.0f} "
-              f"{r['reference_ik_vernier_us']:7.0f} {r['predict_us']:11.0f} "
-              f"{r['reference_predict_us']:7.0f} {r['rest_us']:6.0f} "
-              f"{r['decide_no_vernier_us']:11.0f} {r['measure_us']:8.0f} "
+              f"{r['decide_best_us']:8.0f} {r['ik_vernier_us']:11.0f} {r['predict_us']:11.0f} "
+              f"{r['rest_us']:6.0f} {r['decide_no_vernier_us']:11.0f} {r['measure_us']:8.0f} "
               f"{r['decide_alone_us']:6.0f} "
               + (f"{r['contact_alone_us']:8.0f}" if r["contact_cycles"] else f"{'-':>8s}")
               + f" {r['slowest_alone_us']:8.0f} {r['in_loop_us']:8.0f} "
               + (f"{r['in_loop_contact_us']:9.0f}" if r["contact_cycles"] else f"{'-':>9s}"))
-    print(f"goal: {GOAL_US:.0f} µs per cycle (decide + IK); best-of: the least of the repeats "
-          "per cycle (median over cycles); alone: the fast path's calls back to back on the "
-          "same inputs, not alternated with the reference path (whose large NumPy arrays evict "
-          "the caches): the caches warm, a lower bound; contact: the same over the cycles in "
-          "contact only (the press's align, force and shed moves, not its approach steps); "
-          "slowest: the slowest timed "
-          "cycle, alone; in loop: each call right after the measurement chain that makes its "
-          "measurement (as the control loop runs them: the caches cold), the closest to a real "
-          "cycle")
-    print(f"\nsummary, cycles in contact (goal {GOAL_US:.0f} µs for decide + IK):")
-    for r in rows:
-        # the cycles in contact (the press's approach steps are cheaper; the follow task's
-        # timed cycles are all in contact)
-        loop = r["in_loop_contact_us"] if r["contact_cycles"] else r["in_loop_us"]
-        alone = r["contact_alone_us"] if r["contact_cycles"] else r["decide_alone_us"]
-        print(f"  {r['task']:15s} in the loop {loop:4.0f} µs, alone {alone:4.0f} "
-              f"µs ({'within' if loop <= GOAL_US else 'OVER'} the goal in the loop); "
-              f"the measurement before it {r['measure_us']:4.0f} µs")
+    print("best-of: the least of the repeats per cycle (median over cycles); alone: the calls "
+          "back to back on the same inputs (the caches warm, a lower bound); contact: the same "
+          "over the cycles in contact only; slowest: the slowest timed cycle, alone; in loop: "
+          "each call right after the measurement chain that makes its measurement (the caches "
+          "cold), the closest to a real cycle")
     return 0
 
 

@@ -29,7 +29,6 @@ KERNELS: dict[str, str] = {
     "stiffness": "kinestat.parallel._stiffness_kernels",
     "platform": "kinestat.parallel._fk_kernels",
     "kinestatic": "kinestat.parallel._kinestatic_kernels",
-    "control": "kinestat.control._cycle_kernels",
 }
 #: kernel groups compiled on demand by the command that uses them (not by ``kinestat warmup``)
 ON_DEMAND: dict[str, str] = {
@@ -154,79 +153,9 @@ def _warm_kinestatic() -> None:
     compose_twist_line(K, w, np.array([0.0, 0.0, 0.0, 1.0, 0.0, 0.0]), 2.0 * w)
 
 
-def _warm_control() -> None:
-    """The control cycle's own kernels: the vernier's tables (kinestat.control.vernier.
-    vernier_pick), the PUMA 762's move in one call (vernier.puma_move_one), the envelope's
-    pre-checks and predictions (envelope.predict, envelope.sliding_push) and
-    the follow task's path curvature (contact_estimate.path_curvature_one) and base twist
-    (follow._base_twist)."""
-    from kinestat.control._cycle_kernels import (  # lazy: start-up (numba)
-        base_twist_kernel,
-        command_clear_kernel,
-        measurement_clear_kernel,
-        predict_kernel,
-        puma_counts_kernel,
-        slide_kernel,
-        vernier_tables_kernel,
-    )
-    from kinestat.control.contact_estimate import path_curvature_one  # lazy: numba
-    from kinestat.io.library import prototype  # lazy: start-up
-    from kinestat.parallel.stiffness import (  # lazy: start-up (numba)
-        platform_arrays,
-        stiffness_axis_trusted,
-    )
-
-    vernier_tables_kernel(np.zeros(6, dtype=np.int64), np.zeros((1, 6), dtype=np.int64),
-                          1, 1, 1, 1, 1, 0.0, 0.0, np.ones(6), np.zeros(6))
-    from kinestat.control.vernier import (  # lazy: start-up
-        AXIS_OFFSETS,
-        VERNIER_SCALES,
-        grid_rows,
-    )
-    from kinestat.serial import puma762  # lazy: start-up (numba)
-
-    q = np.full(6, 0.3)
-    f = puma762.forward(q, np.array([0.0, 0.0, 235.0]))
-    off, centre = grid_rows(AXIS_OFFSETS)
-    lims = np.radians(puma762.AXIS_LIMITS_DEG)
-    puma_counts_kernel(f.tool_point.copy(), f.s6.copy(), f.a67.copy(),
-                       np.array([0.0, 0.0, 235.0]), q, np.array(puma762.AXIS_OFFSET),
-                       np.ascontiguousarray(lims[:, 0]), np.ascontiguousarray(lims[:, 1]),
-                       np.full(6, 0.01), 0.1, 0.0, off, 9, 9, 9, 3, 3, centre,
-                       *VERNIER_SCALES, np.empty(6, dtype=np.int64), np.empty(6),
-                       np.empty((4, 4)))
-    pf = prototype()
-    B, P_top, _, l0 = platform_arrays(pf)
-    T = pf.home_pose.copy()
-    e4, v3, v6 = np.eye(4), np.array([0.0, 0.0, 100.0]), l0.copy()
-    K = stiffness_axis_trusted(pf, T)
-    predict_kernel(e4, e4.copy(), v3, v3.copy(), e4.copy(), np.ones(3), B, P_top, T,
-                   K, e4.copy(), v6, v6.copy(), np.empty(3),
-                   np.empty(6), np.empty(3), np.empty((4, 4)))
-
-    v6, r6 = np.zeros(6), np.full(6, 4.0)
-    measurement_clear_kernel(v6, v6.copy(), v6.copy(), e4.copy(), np.eye(3), np.zeros(3),
-                             np.zeros(3), r6, 4.0, 50.0, 5.0)
-    command_clear_kernel(v6.copy(), v6.copy(), True, v6 - 1.0, v6 + 1.0, 30.0, np.zeros(3),
-                         v6.copy(), e4.copy(), True, True, np.eye(3), np.zeros(3), np.zeros(3),
-                         r6, 4.0, 50.0, 5.0)
-    C3 = np.eye(3)
-    slide_kernel(e4, e4.copy(), v3, v3.copy(), np.eye(3), np.ones(3), K, C3, np.zeros(3), True,
-                 np.empty(2))
-
-    z3 = np.zeros(3)
-    base_twist_kernel(e4, K, v3, np.array([0.0, 0.0, 1.0]), z3, z3, 0.1, 0.5, 4.0, 0.0, z3,
-                      False, z3, z3, False, 1e-12, 1e-9, np.empty(6))
-
-    a = np.linspace(0.0, 0.05, 6)
-    pts = np.column_stack([100.0 * np.sin(a), 100.0 * np.cos(a) - 100.0, 0.0 * a])
-    path_curvature_one(pts[:-1], pts[-1], np.array([0.0, 1.0, 0.0]),
-                       np.array([1.0, 0.0, 0.0]), 1.0)
-
-
 _WARM = {"serial": _warm_serial, "ik": _warm_ik, "puma762": _warm_puma762,
          "cycle": _warm_cycle, "stiffness": _warm_stiffness, "platform": _warm_platform,
-         "kinestatic": _warm_kinestatic, "control": _warm_control}
+         "kinestatic": _warm_kinestatic}
 
 
 def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:

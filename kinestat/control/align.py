@@ -13,11 +13,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.spatial.transform import Rotation
 
 from kinestat.control.arm import frame_from_tool
-from kinestat.control.cycle import cross3, norm3
-from kinestat.control.envelope import sliding_push, tip_stiffness
-from kinestat.spatial.se3 import rotvec_matrix_one
+from kinestat.control.predict import sliding_push, tip_stiffness
+from kinestat.spatial.transforms import cross3
 
 __all__ = [
     "MAX_ALIGN_TURN_DEG", "PUSH_TURN_DEG", "PUSH_LEFT_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN",
@@ -32,7 +32,7 @@ def turn_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """The rotation vector (3,) (radians) of the smallest rotation taking unit ``a`` onto
     unit ``b`` (zero when they are parallel)."""
     axis = cross3(a, b)
-    s = norm3(axis)
+    s = np.linalg.norm(axis)
     if s < 1e-15:
         return np.zeros(3)
     return axis * (math.atan2(s, float(a @ b)) / s)
@@ -200,7 +200,7 @@ def turn_was_carried(before, turn, after) -> bool:
 def rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Rotate ``v`` by the smallest rotation taking unit ``a`` onto unit ``b``."""
     axis = cross3(a, b)
-    s = norm3(axis)
+    s = np.linalg.norm(axis)
     c = float(a @ b)
     if s < 1e-15:
         return v.copy()
@@ -219,7 +219,7 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float,
     the turns are carried by a stuck tip, shed the force across S6 (:func:`shed`). Then the
     step along the axis when the force is out of tolerance."""
     model, tgt = config.model, state.target
-    Fmag = norm3(F)
+    Fmag = np.linalg.norm(F)
     step, rotation, far, k_push = 0.0, 0.0, False, None
     memo: dict = {}
     if mis > config.align_tol_deg:
@@ -229,19 +229,19 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float,
         action = "align"
         gain = align_gain(state.align_gain,
                           state.align_turn if state.last_action == "align" else None, full)
-        frac = min(gain, math.radians(max_turn_deg) / max(norm3(full),
+        frac = min(gain, math.radians(max_turn_deg) / max(np.linalg.norm(full),
                                                                  1e-300))
         if frac < 1.0:
             turn = frac * full
-            R = rotvec_matrix_one(turn)
+            R = Rotation.from_rotvec(turn).as_matrix()
             axis = R @ tgt.s6
-            axis /= norm3(axis)
+            axis /= np.linalg.norm(axis)
             a67 = R @ tgt.a67
         else:
             turn, axis = full, F / Fmag
             a67 = rotate_onto(tgt.a67, tgt.s6, axis)
         a67 = a67 - (a67 @ axis) * axis
-        a67 /= norm3(a67)
+        a67 /= np.linalg.norm(a67)
         rotation = frac * mis  # frac <= 1: exactly mis for the whole turn
         far = rotation > PUSH_TURN_DEG or mis * (1.0 - frac) > PUSH_LEFT_DEG
         memo = {"align_gain": gain, "align_turn": turn, "align_from": full}
@@ -269,7 +269,7 @@ def turned_force(config, state, meas, s6, a67) -> tuple[float, float] | None:
     """``(f, k)``: |F| (N) predicted after turning the tool onto ``s6``, ``a67`` about the
     tool point, no step along the axis, with the tip sliding freely, and its rate ``k``
     (N/mm) for a push along the new ``s6``
-    (:func:`~kinestat.control.envelope.sliding_push`); None out of contact. A turn onto the
+    (:func:`~kinestat.control.predict.sliding_push`); None out of contact. A turn onto the
     force undoes the top's soft deflection across the tool and loads the stiff axis instead:
     on a frictionless cylinder met 41° off the tool axis at 5.8 N two 20° turns raised the
     force from 0.3 to 4.7 N (predicted 5.8 N), and the Newton step computed without the turn

@@ -122,15 +122,13 @@ class Puma762Arm:
         return ik_all(self.model, T_base_end, method="puma762")
 
     def flange_pose(self, q) -> np.ndarray:
-        """``F_6T`` (4, 4) of one joint vector, compiled (bit-identical to ``forward``'s)."""
-        return puma762.pose_one(q)
+        """``F_6T`` (4, 4) of one joint vector (:func:`kinestat.serial.puma762.forward`)."""
+        return puma762.forward(q).pose
 
     def solve_axis(self, tool_point, s6, a67, tool_point_6, q_now, limits_deg) -> np.ndarray:
-        # reverse analysis + least-motion selection in one compiled pass (equal to
-        # puma762.select(puma762.reverse(...), q_now, limits_deg).axis; tests/control/
-        # test_cycle_fast.py replays recorded runs through both)
-        return puma762.select_axis_one(tool_point, s6, a67, tool_point_6,
-                                       np.asarray(q_now, dtype=float), limits_deg)
+        # the reverse analysis (Vibhute App. C) and the least-motion selection within limits
+        res = puma762.reverse(tool_point, s6, a67, tool_point_6)
+        return puma762.select(res, np.asarray(q_now, dtype=float), limits_deg).axis
 
 
 THESIS_ARM = Puma762Arm()

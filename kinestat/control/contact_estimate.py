@@ -32,13 +32,6 @@ the surface around the first contact are surface points, and the plane fitted to
 (:func:`fit_plane`) gives the normal; for touches placed symmetrically about the centre
 (``±r`` across and along) the fitted plane's slope is the central difference of the surface,
 exact for a quadric, so a curved surface costs no bias at the centre.
-
-**One cycle's values** (the follow task's hot path): :func:`cone_normal_one` and
-:func:`friction_sample_one` are :func:`cone_normal` and :func:`friction_sample` for one force
-and one chord in scalar arithmetic (the same operations in the same order: equal to them to
-rounding, bit for bit on the reference machine); :func:`path_curvature_one` is
-:func:`path_curvature` compiled (:mod:`kinestat.control._cycle_kernels`: the least squares
-by QR instead of NumPy's SVD, equal to rounding).
 """
 
 from __future__ import annotations
@@ -47,20 +40,15 @@ import math
 
 import numpy as np
 
-from kinestat.control._cycle_kernels import path_curvature_kernel
-
 __all__ = [
     "cone_normal",
-    "cone_normal_one",
     "friction_sample",
-    "friction_sample_one",
     "update_friction",
     "normal_and_friction",
     "MIN_FRICTION_WEIGHT",
     "fit_circle",
     "circle_centre_radius",
     "path_curvature",
-    "path_curvature_one",
     "turn_by_curvature",
     "fit_plane",
 ]
@@ -90,43 +78,6 @@ def cone_normal(force_on_tool, slip, mu) -> np.ndarray:
     g = _unit(s - np.sum(s * u, axis=-1, keepdims=True) * u)
     a = np.arctan(np.asarray(mu, dtype=float))[..., None]
     return np.cos(a) * u + np.sin(a) * g
-
-
-def _unit_list(v) -> tuple[float, float, float]:
-    """``v/|v|`` of one 3-vector as floats (:func:`_unit`'s operations: the squares summed in
-    order, one square root, three divisions)."""
-    a, b, c = np.asarray(v, dtype=float).tolist()
-    n = math.sqrt(a * a + b * b + c * c)
-    return a / n, b / n, c / n
-
-
-def cone_normal_one(force_on_tool, slip, mu: float) -> np.ndarray:
-    """:func:`cone_normal` of one force (3,), one slip direction (3,) and one ``mu``, in
-    scalars (3,).
-
-    >>> n = cone_normal_one([-0.3, 0.0, 1.0], [1.0, 0.0, 0.1], 0.3)
-    >>> np.round(n, 12).tolist()
-    [0.0, 0.0, 1.0]
-    """
-    u0, u1, u2 = _unit_list(force_on_tool)
-    s0, s1, s2 = np.asarray(slip, dtype=float).tolist()
-    su = s0 * u0 + s1 * u1 + s2 * u2
-    g0, g1, g2 = _unit_list((s0 - su * u0, s1 - su * u1, s2 - su * u2))
-    a = float(np.arctan(float(mu)))  # NumPy's arctan: libm's may differ in the last bit
-    ca, sa = float(np.cos(a)), float(np.sin(a))
-    return np.array([ca * u0 + sa * g0, ca * u1 + sa * g1, ca * u2 + sa * g2])
-
-
-def friction_sample_one(force_on_tool, chord) -> float:
-    """:func:`friction_sample` in scalars (one force (3,), one chord (3,)).
-
-    >>> round(friction_sample_one([-0.3, 0.0, 1.0], [2.0, 0.0, 0.0]), 12)
-    0.3
-    """
-    u0, u1, u2 = _unit_list(force_on_tool)
-    c0, c1, c2 = _unit_list(chord)
-    s = min(max(-(u0 * c0 + u1 * c1 + u2 * c2), -0.99), 0.99)
-    return s / math.sqrt(1.0 - s * s)
 
 
 def friction_sample(force_on_tool, chord) -> float:
@@ -224,28 +175,6 @@ def path_curvature(points, tip, normal, tangent, min_span: float) -> float:
     if abs(kappa) * span * span / 8.0 < 2.0 * float(np.sqrt(np.mean(resid * resid))):
         return 0.0
     return kappa
-
-
-def path_curvature_one(points, tip, normal, tangent, min_span: float) -> float:
-    """:func:`path_curvature` compiled (:func:`~kinestat.control._cycle_kernels.
-    path_curvature_kernel`, the least squares by QR): equal to it to rounding; a fit near rank
-    deficiency runs :func:`path_curvature` itself.
-
-    Shapes: points (N, 3), tip/normal/tangent (3,) (unit, perpendicular).
-
-    >>> a = np.linspace(0.0, 0.05, 6)
-    >>> pts = np.column_stack([100 * np.sin(a), 100 * np.cos(a) - 100, 0 * a])
-    >>> round(path_curvature_one(pts[:-1], pts[-1], pts[-1] / 100 + [0, 1, 0],
-    ...                          [math.cos(0.05), -math.sin(0.05), 0.0], 1.0), 12)
-    0.01
-    """
-    P = np.array(points, dtype=float)  # a writeable C array (the kernel's one signature)
-    if P.ndim != 2 or P.shape[1:] != (3,) or len(P) < 3:
-        return path_curvature(points, tip, normal, tangent, min_span)
-    kappa, ok = path_curvature_kernel(P, np.array(tip, dtype=float),
-                                      np.array(normal, dtype=float),
-                                      np.array(tangent, dtype=float), float(min_span))
-    return float(kappa) if ok else path_curvature(points, tip, normal, tangent, min_span)
 
 
 def turn_by_curvature(normal, tangent, angle: float) -> tuple[np.ndarray, np.ndarray]:

@@ -3,7 +3,8 @@
 Over 600 lines on purpose: the procedure's types (configuration, state, command), its one
 decision per cycle and the move path every task and procedure shares (:func:`move_command`)
 are one unit; the rules of the turn and the step live in :mod:`kinestat.control.align`, the
-counts in :mod:`kinestat.control.vernier` and the checks in :mod:`kinestat.control.envelope`.
+counts in :mod:`kinestat.control.vernier`, the predictions in :mod:`kinestat.control.predict`
+and the checks in :mod:`kinestat.control.envelope`.
 
 One call per cycle, :func:`decide`, takes the controller's state and the cycle's
 :class:`~kinestat.control.wrench.Measurement` and returns the next :class:`Command` and the new
@@ -27,7 +28,7 @@ Each cycle is labelled with the states of Vibhute's Figure 5-2:
 Step along S6 (``method``): ``"fixed"`` is the thesis's 1 mm step with the sign of the force
 error (``step``); ``"stiffness"`` is a Newton step ``δ = (|F_req| − |F|) / k_axial`` with
 ``k_axial = s6ᵀ K_tip s6`` the platform's point stiffness at the tip along S6
-(:func:`kinestat.control.envelope.tip_stiffness`), clipped to ``step``.
+(:func:`kinestat.control.predict.tip_stiffness`), clipped to ``step``.
 
 The commanded axis angles are rounded to whole encoder counts of the robot. With ``vernier``
 the controller picks, among the count vectors next to the ideal one (±4 counts on axes 1..3,
@@ -51,7 +52,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Literal, get_args
 
 import numpy as np
@@ -65,35 +66,23 @@ from kinestat.control.align import (
     contact_move,
 )
 from kinestat.control.approach import approach_waypoints, check_approach
-from kinestat.control.arm import Puma762Arm
 from kinestat.control.ceilings import MAX_ITERATIONS
-from kinestat.control.cycle import norm3, replace
 from kinestat.control.envelope import (
     AXIS_STEP_VIOLATION,
     Envelope,
-    Prediction,
     check_command,
     check_measurement,
     check_target,
-    predict,
 )
 from kinestat.control.model import ControlModel
+from kinestat.control.predict import Prediction, predict
 from kinestat.control.vernier import (
-    AXIS_OFFSETS,
-    OFFSETS,
-    ZERO_OFFSETS,
-    axis5_residual,
     axis_counts_to_q,
-    puma_move_one,
     q_to_axis_counts,
-    vernier_generic,
-    vernier_pick,
+    vernier_search,
 )
 from kinestat.control.wrench import Estimator, Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
-
-# names this module had before the vernier moved out (used by tests and the reference path)
-_OFFSETS, _axis5_residual, _q_to_axis_counts = OFFSETS, axis5_residual, q_to_axis_counts
 
 __all__ = [
     "THESIS_FORCE_DIRECTION",
@@ -379,30 +368,11 @@ def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
     """Reverse analysis, selection within limits, rounding to counts (with the vernier).
 
     Returns (counts, residual along S6 in mm of the chosen counts). Raises UnreachableError or
-    JointLimitError. For the thesis's PUMA 762 the vernier's search runs compiled
-    (:func:`vernier_pick`; the NumPy formulation it reproduces is
-    :func:`kinestat.control._reference.solve_counts_reference`); any other arm takes the same
-    search in NumPy (:func:`vernier_generic`)."""
+    JointLimitError. The vernier searches the count vectors next to the rounded ones
+    (:func:`kinestat.control.vernier.vernier_search`)."""
     axis = model.arm.solve_axis(target.tool_point, target.s6, target.a67, model.tool_point_6,
                                 np.asarray(q_now, dtype=float), model.limits_deg)
-    c0 = q_to_axis_counts(model, axis)
-    if not isinstance(model.arm, Puma762Arm):
-        return vernier_generic(model, target, c0, counts_now, vernier)
-    if not vernier:
-        k, along = vernier_pick(model, target, c0, counts_now, ZERO_OFFSETS)
-        return c0, along
-    k, along = vernier_pick(model, target, c0, counts_now, AXIS_OFFSETS)
-    return c0 + OFFSETS[k], along
-
-
-#: the thesis's PUMA 762 moved onto a target in one compiled call (None for any other arm, on
-#: failure, and on the reference path): :func:`~kinestat.control.vernier.puma_move_one`
-_puma_move = puma_move_one
-
-
-def _flange_pose(model: ControlModel, q) -> np.ndarray:
-    """``F_6T`` of the joint angles ``q``: the arm's flange pose (compiled for the PUMA 762)."""
-    return model.arm.flange_pose(q)
+    return vernier_search(model, target, q_to_axis_counts(model, axis), counts_now, vernier)
 
 
 def approach_refusal(config: ControllerConfig, tool_point) -> str:
@@ -436,7 +406,7 @@ def start(config: ControllerConfig, q_now, *, counts_now=None) -> tuple[Command,
     model = config.model
     q_now = np.asarray(q_now, dtype=float)
     if counts_now is None:
-        counts_now = _q_to_axis_counts(model, model.arm.axis_from_q(q_now))
+        counts_now = q_to_axis_counts(model, model.arm.axis_from_q(q_now))
     counts_now = np.asarray(counts_now, dtype=np.int64)
     target = Target(config.start_tool_point, config.start_s6, config.start_a67)
     state = ControllerState(cycle=0, label="", last_action="start", target=target,
@@ -482,16 +452,12 @@ def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target
     the vernier when asked), checked against the envelope's joint limits, per-command step and
     predicted platform state (:func:`~kinestat.control.envelope.check_command`); or the
     :class:`Refusal` that stops the run. One path for every task and procedure."""
-    fast = _puma_move(model, new, meas.q, counts_now, vernier)
-    if fast is not None:  # the thesis's arm: the three steps below in one compiled call
-        counts, q_new, T_new = fast
-    else:
-        try:
-            counts, _ = _solve_counts(model, new, meas.q, counts_now, vernier)
-        except (UnreachableError, JointLimitError) as exc:
-            return Refusal(f"{action} target not reachable: {exc}", {})
-        q_new = axis_counts_to_q(model, counts)
-        T_new = _flange_pose(model, q_new)
+    try:
+        counts, _ = _solve_counts(model, new, meas.q, counts_now, vernier)
+    except (UnreachableError, JointLimitError) as exc:
+        return Refusal(f"{action} target not reachable: {exc}", {})
+    q_new = axis_counts_to_q(model, counts)
+    T_new = model.arm.flange_pose(q_new)
     axis_deg = counts * model.axis_deg_per_count
     pred = predict(model, meas, T_new)
     bad = check_command(envelope, model, axis_deg, counts_now * model.axis_deg_per_count, pred)
@@ -573,7 +539,7 @@ def decide(config: ControllerConfig, state: ControllerState,
         return replace(state, cycle=cycle, top_pose=meas.top_pose, **kw)
 
     F = meas.estimate(config.estimator)
-    Fmag = norm3(F)
+    Fmag = np.linalg.norm(F)
     contact = Fmag >= config.contact_force
     err = config.force_target - Fmag
     s6 = state.target.s6

@@ -83,15 +83,14 @@ following (travel), ``e`` done.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
-from kinestat.control._cycle_kernels import base_twist_kernel
 from kinestat.control.contact_estimate import (
-    cone_normal_one,
-    friction_sample_one,
-    path_curvature_one,
+    cone_normal,
+    friction_sample,
+    path_curvature,
     update_friction,
 )
 from kinestat.control.controller import (
@@ -104,7 +103,7 @@ from kinestat.control.controller import (
     contact_at_start,
     move_command,
 )
-from kinestat.control.cycle import cross3, cycle_data, mount_inverse, norm3, replace
+from kinestat.control.cycle import cross3, cycle_data
 from kinestat.control.envelope import (
     Envelope,
     check_measurement,
@@ -114,14 +113,12 @@ from kinestat.control.model import ControlModel
 from kinestat.control.probe import PROBE_SPAN, Probe, probe_normal, probe_step, start_probe
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
-from kinestat.parallel.kinestatic import _IN_TOL as IN_TOL
-from kinestat.parallel.kinestatic import _K_TOL as K_TOL
-from kinestat.parallel.kinestatic import compose_twist_line, solve_one
+from kinestat.parallel.kinestatic import compose_twist
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
-from kinestat.spatial.se3 import twist_exp, twist_exp_one
-from kinestat.spatial.transforms import apply, apply_one, skew
+from kinestat.spatial.se3 import twist_exp
+from kinestat.spatial.transforms import apply, apply_one, inv, skew
 
 __all__ = [
     "FollowConfig",
@@ -616,34 +613,11 @@ def estimate_normal(force, path_dir=None) -> np.ndarray:
 def _turn(s6: np.ndarray, axis: np.ndarray, limit_rad: float) -> np.ndarray:
     """Rotation vector turning ``s6`` towards ``axis`` by at most ``limit_rad``."""
     c = cross3(s6, axis)
-    s = norm3(c)
+    s = np.linalg.norm(c)
     if s < 1e-15:
         return np.zeros(3)
     ang = min(math.atan2(s, float(s6 @ axis)), limit_rad)
     return c / s * ang
-
-
-_ZERO3 = np.zeros(3)
-_ZERO3.setflags(write=False)
-
-
-def _base_twist_fast(model: ControlModel, meas: Measurement, tip: np.ndarray,
-                     normal: np.ndarray, omega: np.ndarray, travel: np.ndarray, dlam: float,
-                     max_correction: float, friction: float, slip: np.ndarray | None,
-                     hold: tuple[np.ndarray, np.ndarray] | None) -> np.ndarray | None:
-    """:func:`_base_twist` compiled (:func:`~kinestat.control._cycle_kernels.
-    base_twist_kernel`, equal to :func:`_base_twist_numpy` to rounding); None where a check
-    or a solve failed (the NumPy formulation then says why)."""
-    f64 = np.float64
-    out = np.empty(6)
-    hf, hw = (_ZERO3, _ZERO3) if hold is None else hold
-    ok = base_twist_kernel(
-        np.asarray(meas.base_pose, f64), cycle_data(model, meas).K, np.asarray(tip, f64),
-        np.asarray(normal, f64), np.asarray(omega, f64), np.asarray(travel, f64), float(dlam),
-        float(max_correction), TANGENTIAL_FACTOR, float(friction),
-        _ZERO3 if slip is None else np.asarray(slip, f64), slip is not None,
-        np.asarray(hf, f64), np.asarray(hw, f64), hold is not None, K_TOL, IN_TOL, out)
-    return out if ok else None
 
 
 def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal: np.ndarray,
@@ -656,22 +630,8 @@ def _base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, normal:
     normal's line W, or, for a tip sliding along ``slip`` with the friction ratio
     ``friction``, the friction cone's edge ``[n − μ ŝ; p × (n − μ ŝ)]``: a sliding contact's
     force changes along the edge, so the normal force changes by Δλ and the tip keeps
-    sliding. Compiled (:func:`_base_twist_fast`); where its checks fail, the NumPy formulation
-    (:func:`_base_twist_numpy`) raises the error."""
-    T = _base_twist_fast(model, meas, tip, normal, omega, travel, dlam, max_correction,
-                         friction, slip, hold)
-    if T is not None:
-        return T
-    return _base_twist_numpy(model, meas, tip, normal, omega, travel, dlam, max_correction,
-                             friction, slip, hold)
-
-
-def _base_twist_numpy(model: ControlModel, meas: Measurement, tip: np.ndarray,
-                      normal: np.ndarray, omega: np.ndarray, travel: np.ndarray, dlam: float,
-                      max_correction: float, friction: float = 0.0,
-                      slip: np.ndarray | None = None,
-                      hold: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
-    """:func:`_base_twist` in NumPy (the reference formulation; it raises the errors)."""
+    sliding.
+    """
     TB = meas.base_pose
     R = TB[:3, :3]
     p = R.T @ (tip - TB[:3, 3])
@@ -685,23 +645,23 @@ def _base_twist_numpy(model: ControlModel, meas: Measurement, tip: np.ndarray,
     if friction > 0.0 and slip is not None:
         s = R.T @ slip
         Wt = np.concatenate([s, cross3(p, s)])
-    Tc = -dlam * solve_one(K, W - friction * Wt)  # K⁻¹ δw, δw = −Δλ W_c
+    Tc = -dlam * np.linalg.solve(K, W - friction * Wt)  # K⁻¹ δw, δw = −Δλ W_c
     dp = Tc[3:] + cross3(Tc[:3], p)  # the tip's motion under the compliance twist
     scale = max(abs(float(dp @ n)) / max_correction,
-                norm3(dp) / (TANGENTIAL_FACTOR * max_correction), 1.0)
-    T = compose_twist_line(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
+                np.linalg.norm(dp) / (TANGENTIAL_FACTOR * max_correction), 1.0)
+    T = compose_twist(K, W, Tf, -(dlam / scale) * W)  # = T_f + T_c, checked reciprocal
     if friction > 0.0 and slip is not None:
-        T = T + (dlam / scale) * friction * solve_one(K, Wt)
+        T = T + (dlam / scale) * friction * np.linalg.solve(K, Wt)
     if hold is not None:  # the sliding contact's force turns with the surface, not the base
         f_world, w_surf = hold
         df = cross3(R.T @ w_surf - w, R.T @ f_world)
-        T = T - solve_one(K, np.concatenate([df, cross3(p, df)]))
+        T = T - np.linalg.solve(K, np.concatenate([df, cross3(p, df)]))
     return T
 
 
 def _target(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
-    TB_new = meas.base_pose @ twist_exp_one(T_base)
-    T6 = TB_new @ mount_inverse(model)
+    TB_new = meas.base_pose @ twist_exp(T_base)
+    T6 = TB_new @ inv(model.mount)
     return Target(apply_one(T6, model.tool_point_6), T6[:3, 2].copy(), T6[:3, 0].copy())
 
 
@@ -714,7 +674,7 @@ def _chord(path: tuple, tip: np.ndarray, min_len: float) -> np.ndarray | None:
     """The chord from the latest earlier tip at least ``min_len`` mm away to ``tip``."""
     for old in reversed(path):
         c = tip - old
-        if norm3(c) >= min_len:
+        if np.linalg.norm(c) >= min_len:
             return c
     return None
 
@@ -762,9 +722,9 @@ def _creeping(st: FollowState, path: tuple, tip: np.ndarray, advance: float) -> 
         c = _chord(path, tip, LEARN_CHORD_LENGTH)
     else:  # a fresh chord: it crept on since the last sample
         c = tip - st.sample_tip
-        if norm3(c) < LEARN_CHORD_LENGTH:
+        if np.linalg.norm(c) < LEARN_CHORD_LENGTH:
             return False
-    return c is not None and float(c @ st.tangent) > 0.5 * norm3(c)
+    return c is not None and float(c @ st.tangent) > 0.5 * np.linalg.norm(c)
 
 
 def _tilt_past_force(s6: np.ndarray, force: np.ndarray, t: np.ndarray) -> float:
@@ -813,10 +773,10 @@ def _curvature(st: FollowState, path: tuple, tip: np.ndarray, n: np.ndarray,
     fails the significance test is replaced by the fit with the probe's touches."""
     with_probe = st.probe is not None and st.travel < CURVATURE_PROBE_TRAVEL
     if not (with_probe and st.travel < CURVATURE_SPAN):  # (cheaper than the path's span)
-        kappa = path_curvature_one(np.asarray(path), tip, n, t, CURVATURE_SPAN)
+        kappa = path_curvature(np.asarray(path), tip, n, t, CURVATURE_SPAN)
         if kappa != 0.0 or not with_probe:
             return kappa
-    return path_curvature_one(np.asarray(st.probe.line + tuple(path)), tip, n, t,
+    return path_curvature(np.asarray(st.probe.line + tuple(path)), tip, n, t,
                               CURVATURE_SPAN)
 
 
@@ -848,7 +808,7 @@ def _slipped_on_probe_normal(config: FollowConfig, st: FollowState, meas: Measur
     stuck = ratio < mu - EDGE_TOL
     advance = float((tip - st.last_tip) @ st.tangent)
     t = st.tangent - float(st.tangent @ n) * n
-    kappa = _curvature(st, path, tip, n, t / norm3(t))
+    kappa = _curvature(st, path, tip, n, t / np.linalg.norm(t))
     return replace(st, travel=travel, last_tip=tip, path=path, friction_ratio=mu,
                    curvature=kappa, curvature_cycles=1 if kappa != 0.0 else 0,
                    friction_mean=mu, friction_samples=LEARN_CHORDS, sample_tip=tip,
@@ -869,7 +829,7 @@ def _propelled(F: np.ndarray, n: np.ndarray, slip: np.ndarray) -> bool:
     the cone's normal 1.2° off the force for the rest of the run (seed 6's 5.9 N run,
     2026-12-04). A shorter "slide" is not tested: a first slip at μ = 0.3 measured 0.1 mm
     back against its force (the tip's recoil), and its ratio (0.294) was μ."""
-    return norm3(slip) >= CHORD_LENGTH and float((F - float(F @ n) * n) @ slip) < 0.0
+    return np.linalg.norm(slip) >= CHORD_LENGTH and float((F - float(F @ n) * n) @ slip) < 0.0
 
 
 def _lead_tracked(st: FollowState) -> bool:
@@ -980,7 +940,7 @@ def _force_line(F: np.ndarray, n: np.ndarray) -> tuple[float, np.ndarray]:
     whole force down: the ratio is kept."""
     fn = float(-(F @ n))
     g = F + fn * n  # the tangential part of F: that of the force on the tool, reversed
-    a = norm3(g)
+    a = np.linalg.norm(g)
     if fn <= 0.0 or a == 0.0:
         return 0.0, n
     return a / fn, g / a
@@ -1048,7 +1008,7 @@ def _frictionless_hold(config: FollowConfig, st: FollowState, meas: Measurement,
     the path's curvature is known and the tips used for it run along the travel
     (:func:`_path_along`; tips drifting across it fit a spurious κ̂), else it is not held
     (as before 2026-12-03). None when it does not apply."""
-    if not (_frictionless_slide(st) and norm3(omega) > 0.0):
+    if not (_frictionless_slide(st) and np.linalg.norm(omega) > 0.0):
         return None
     model = config.base.model
     b = cross3(n, t)
@@ -1125,7 +1085,7 @@ def _normal_in_cone(n0: np.ndarray, u: np.ndarray, mu: float) -> np.ndarray:
     lim = math.atan(mu) + math.radians(CONE_SLACK_DEG)
     if float(n0 @ u) >= math.cos(lim):
         return n0
-    return cone_normal_one(u, n0, math.tan(lim))
+    return cone_normal(u, n0, math.tan(lim))
 
 
 def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.ndarray,
@@ -1195,13 +1155,13 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         # nor in the cycle a travel step stuck: the step pressed the tip along the tilted
         # tool's axis (the force rose); the force control relieves it first
         grow = grow and not (st.tilting and st.step > 0.0) and st.withdraw == 0.0
-        n = (_normal_in_cone(n0, -F / norm3(F), st.friction_ratio)
+        n = (_normal_in_cone(n0, -F / np.linalg.norm(F), st.friction_ratio)
              if st.friction_samples >= LEARN_CHORDS else n0)
         return replace(st, travel=travel, normal=n, last_tip=tip, path=path, sticking=stuck,
                        slid=False, stuck_travel=pushed if stuck else 0.0,
                        step_cap=0.0 if stuck else st.step_cap,
                        breakaway=st.breakaway + (_breakaway_step(st) if grow else 0.0))
-    u = -F / norm3(F)  # the force on the tool's direction
+    u = -F / np.linalg.norm(F)  # the force on the tool's direction
     mu, raw, samples = st.friction_ratio, st.friction_mean, st.friction_samples
     c = _chord(path, tip, CHORD_LENGTH if st.friction_samples >= LEARN_CHORDS
                else LEARN_CHORD_LENGTH)
@@ -1209,26 +1169,26 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     sample_tip = st.sample_tip
     if st.probe_trusted and not samples:  # it slid: μ against the probe's normal
         return _slipped_on_probe_normal(config, st, meas, F, tip, travel, path)
-    if c is not None and float(c @ s) > 0.5 * norm3(c):
-        raw, samples = update_friction(raw, samples, friction_sample_one(u, c))
+    if c is not None and float(c @ s) > 0.5 * np.linalg.norm(c):
+        raw, samples = update_friction(raw, samples, friction_sample(u, c))
         sample_tip = tip
         mu = min(max(raw, 0.0), MAX_FRICTION)
-        n = cone_normal_one(u, c, mu)
+        n = cone_normal(u, c, mu)
     elif samples:  # no chord for μ yet: the slip's direction, measured if precise enough
         g = _chord(path, tip, _slip_chord_length(st))
-        n = cone_normal_one(u, g if g is not None and float(g @ s) > 0.5 * norm3(g) else s, mu)
-    n = n / norm3(n)
+        n = cone_normal(u, g if g is not None and float(g @ s) > 0.5 * np.linalg.norm(g) else s, mu)
+    n = n / np.linalg.norm(n)
     brk = max(st.breakaway - BREAKAWAY_DECAY, 0.0)
     if samples and not st.friction_samples:  # first slip measured: keep the tool's tilt
         brk = _kept_breakaway(config, meas.s6, n, mu)
     t = s - (s @ n) * n
-    kappa = _curvature(st, path, tip, n, t / norm3(t))
+    kappa = _curvature(st, path, tip, n, t / np.linalg.norm(t))
     if c is not None:
         st = replace(st, direct_slip=0.0)  # a chord: the tip slides
     return replace(st, travel=travel, normal=n, last_tip=tip, path=path, curvature=kappa,
                    curvature_cycles=st.curvature_cycles + 1 if kappa != 0.0 else 0,
                    friction_ratio=mu, friction_mean=raw, friction_samples=samples,
-                   path_dir=None if c is None else c / norm3(c), sample_tip=sample_tip,
+                   path_dir=None if c is None else c / np.linalg.norm(c), sample_tip=sample_tip,
                    sticking=False, breakaway=brk, slid=True, stuck_travel=0.0)
 
 
@@ -1247,13 +1207,13 @@ def decide_follow(config: FollowConfig, state: ControllerState,
           else FollowState(**vars(state), tilting=config.auto_tilt is True))
     st = replace(st, cycle=st.cycle + 1, top_pose=meas.top_pose)
     F = meas.estimate(base.estimator)
-    contact = norm3(F) >= base.contact_force
+    contact = np.linalg.norm(F) >= base.contact_force
     st = _observe(config, st, meas, F, contact)
     label = {"approach": "a", "probe": "p", "settle": "d", "travel": "f"}[st.phase]
     if contact and (st.phase == "approach" or (st.phase == "probe" and st.probe.cycles == 0)):
         label = "b"
     fn = float(-(F @ st.normal)) if (contact and st.normal is not None) else 0.0
-    ft = 0.0 if not contact else norm3(F + fn * st.normal)
+    ft = 0.0 if not contact else np.linalg.norm(F + fn * st.normal)
     err = base.force_target - fn
     info = {"phase": st.phase, "tip": meas.tip(model), "normal_estimate": st.normal,
             "normal_force": fn, "tangential_force": ft, "travel": st.travel,
@@ -1266,7 +1226,7 @@ def decide_follow(config: FollowConfig, state: ControllerState,
         return _stop(st, label, "measurement outside the envelope: " + "; ".join(bad),
                      violations=tuple(bad), **kw)
     if contact and state.last_action == "start":
-        return _stop(st, label, contact_at_start(norm3(F)), **kw)
+        return _stop(st, label, contact_at_start(np.linalg.norm(F)), **kw)
     if st.cycle >= base.max_iterations:
         return _stop(st, label, f"travel not completed after {st.cycle} cycles "
                      f"({st.travel:.3f} of {config.travel:g} mm)", **kw)
@@ -1318,11 +1278,11 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     n = st.normal
     t0 = st.tangent if st.tangent is not None else config.travel_dir
     t = t0 - (t0 @ n) * n
-    if norm3(t) < math.sin(math.radians(config.min_angle_deg)):
+    if np.linalg.norm(t) < math.sin(math.radians(config.min_angle_deg)):
         return _stop(st, label, f"the travel direction {np.round(t0, 4).tolist()} is within "
                      f"{config.min_angle_deg:g}° of the measured normal "
                      f"{np.round(n, 4).tolist()}: it points into the surface", **kw)
-    t /= norm3(t)
+    t /= np.linalg.norm(t)
     tilt = math.radians(config.tilt_deg)
     if st.tilting:  # S6 along the force's cone edge; tilt more while the tip sticks
         tilt = ((math.atan(st.friction_ratio) + math.radians(AUTO_TILT_MARGIN_DEG)
@@ -1387,7 +1347,7 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str, c
     new = _target(model, meas, T)
     action = "follow" if phase == "travel" else "settle"
     return _command(config, st, meas, new, label, action, step,
-                    math.degrees(norm3(omega)), kw)
+                    math.degrees(np.linalg.norm(omega)), kw)
 
 
 def _contact_terms(config: FollowConfig, st: FollowState, meas: Measurement, phase: str,
@@ -1432,7 +1392,7 @@ def _surface_turn(config: FollowConfig, st: FollowState, s6: np.ndarray, n: np.n
         return omega, 1.0
     ramp = min(1.0, st.curvature_cycles / CURVATURE_RAMP) if CURVATURE_RAMP else 1.0
     angle = ramp * st.curvature * step
-    feed = _feed_fraction(config, st, s6, n, angle, norm3(omega))
+    feed = _feed_fraction(config, st, s6, n, angle, np.linalg.norm(omega))
     return (_curvature_feedforward(n, t, feed * angle, omega, math.radians(config.max_turn_deg)),
             feed)
 
@@ -1489,7 +1449,7 @@ def _curvature_feedforward(n: np.ndarray, t: np.ndarray, angle: float, omega: np
     travel stays along the tangent (a twist of freedom; the chord's sag ``κ Δs²/2`` is left
     to the force control)."""
     w = omega + angle * cross3(n, t)
-    a = norm3(w)
+    a = np.linalg.norm(w)
     if a > limit_rad:
         w *= limit_rad / a
     return w

@@ -25,7 +25,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from kinestat.control.contact_estimate import fit_plane
-from kinestat.control.cycle import cross3, norm3
+from kinestat.spatial.transforms import cross3
 
 __all__ = [
     "PROBE_SPAN",
@@ -105,10 +105,10 @@ def probe_offsets(travel_dir, approach, span: float) -> tuple:
     [[3.0, 0.0, 0.0], [0.0, -3.0, 0.0]]
     """
     d = np.asarray(approach, dtype=float)
-    d = d / norm3(d)
+    d = d / np.linalg.norm(d)
     t = np.asarray(travel_dir, dtype=float)
     t = t - float(t @ d) * d
-    t = t / norm3(t)
+    t = t / np.linalg.norm(t)
     b = cross3(d, t)
     r = float(span)
     return (r * b, -r * t, -r * b, r * t, np.zeros(3))
@@ -143,7 +143,7 @@ def start_probe(tip, tool_point, approach, travel_dir, span: float) -> Probe:
     """The probe after the first contact at the measured ``tip`` with the commanded
     ``tool_point`` and S6 ``approach``."""
     d = np.asarray(approach, dtype=float)
-    d = d / norm3(d)
+    d = d / np.linalg.norm(d)
     tip = np.asarray(tip, dtype=float).copy()
     return Probe(origin=np.asarray(tool_point, dtype=float).copy(), approach=d,
                  offsets=probe_offsets(travel_dir, d, span), points=(tip,), line=(tip,))
@@ -177,7 +177,7 @@ def probe_step(probe: Probe, tool_point, contact: bool, tip, approach_step: floa
     depth = float((tp - pr.origin) @ d)
     if mode == "shift":
         rem = pr.origin + pr.offsets[pr.index] + depth * d - tp
-        dist = norm3(rem)
+        dist = np.linalg.norm(rem)
         if dist > 1e-9:
             if dist <= wide:
                 pr = replace(pr, mode="descend")

@@ -135,8 +135,7 @@ class Measurement:
 
 def tool_frame(q, model: ControlModel):
     """Forward analysis of the robot with the model's tool: ``(P_tool_F, S6_F, a67_F, F_6T)``
-    of one joint vector ``q`` (6,), from the arm's single-pose ``flange_pose`` (compiled for the
-    PUMA 762; the pose its ``forward`` gives)."""
+    of one joint vector ``q`` (6,), from the arm's ``flange_pose``."""
     T = model.arm.flange_pose(q)
     return apply_one(T, model.tool_point_6), T[:3, 2].copy(), T[:3, 0].copy(), T
 

@@ -137,7 +137,7 @@ def tip_compliance_one(K, p, C):
 @nb.njit(**_OPTS)
 def pinned_tip_step_one(B, P_top, T, K, p, u, F, dF, D, dl, top):
     """The platform's first-order response when its base moves so that the tip, pinned in
-    space, sits at ``p + u`` in the base frame (:func:`kinestat.control.envelope.predict`):
+    space, sits at ``p + u`` in the base frame (:func:`kinestat.control.predict.predict`):
     with ``A = [I; [p]×]``, ``Bt = [−[p]×, I]``, ``b = [0; u × F]``,
     ``δF = C_tip⁻¹ (u − Bt K⁻¹ b)`` into ``dF`` (3,), the top's twist ``D = K⁻¹ (A δF + b)``
     into ``D`` (6, axis order ``[δφ; δx_O]``), the legs' changes ``jᵀ D`` into ``dl`` (6,) and

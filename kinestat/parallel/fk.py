@@ -18,6 +18,7 @@ determinant ``Π(1 − t) − Π t`` — zero for an architecturally singular la
 from __future__ import annotations
 
 import math
+import warnings
 import weakref
 from dataclasses import dataclass
 from functools import lru_cache
@@ -357,7 +358,7 @@ def fk_numeric(platform: Platform, lengths, guess=None, *, tol: float = 1e-9,
 
 def fk_tracking(platform: Platform, lengths, previous_pose, *, tol: float = 1e-9,
                 max_iter: int = 20, verify: bool | None = None,
-                backend: Backend = "numba") -> np.ndarray:
+                backend: Backend | None = None) -> np.ndarray:
     """The assembly mode continuous with ``previous_pose`` (Newton from it), checked.
 
     Checks that the iteration converged and that the determinant of the line Jacobian kept its
@@ -365,20 +366,29 @@ def fk_tracking(platform: Platform, lengths, previous_pose, *, tol: float = 1e-9
     True for a special 6-6) it also solves all modes and checks that the result is the mode
     nearest the previous pose.
 
-    ``backend``: ``"numba"`` (default) runs the Newton iteration compiled
-    (:func:`kinestat.parallel._fk_kernels.track_kernel`, the same steps solved by L D Lᵀ: the
-    poses agree with the NumPy iteration's to rounding). It decides only the clear cases: where
-    any pose fails to converge or the determinant's sign changes or comes within 1e-9
-    (relative) of zero, the whole batch is re-run by ``"numpy"`` (``_newton``), which decides
-    and names the failure.
+    The Newton iteration runs compiled over the batch
+    (:func:`kinestat.parallel._fk_kernels.track_kernel`, the steps solved by L D Lᵀ). It decides
+    only the clear cases: where any pose fails to converge or the determinant's sign changes
+    or comes within 1e-9 (relative) of zero, the whole batch is re-run by the NumPy iteration
+    (``_newton``), which decides and names the failure.
+
+    ``backend`` is deprecated (a :class:`DeprecationWarning`; it served the control cycle's
+    compute-time work, which is retired): leave it out. ``"numpy"`` still runs the NumPy
+    iteration alone until the argument is removed.
 
     Raises:
         UnreachableError: no convergence.
         SingularityError: the path crossed a singularity or landed in another mode; the
             assembly mode is ambiguous — re-initialise from :func:`fk_list`.
     """
-    if backend not in ("numba", "numpy"):
-        raise InputError(f"backend must be 'numba' or 'numpy', got {backend!r}")
+    if backend is not None:
+        warnings.warn("fk_tracking(backend=...) is deprecated and will be removed: leave the "
+                      "argument out (the compiled iteration runs, with the NumPy iteration "
+                      "deciding the unclear cases)", DeprecationWarning, stacklevel=2)
+        if backend not in ("numba", "numpy"):
+            raise InputError(f"backend must be 'numba' or 'numpy', got {backend!r}")
+    else:
+        backend = "numba"
     L = check_lengths(lengths)
     prev = as_pose(previous_pose, "previous_pose")
     prev = np.broadcast_to(prev, L.shape[:-1] + (4, 4)).copy()

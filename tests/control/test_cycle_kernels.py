@@ -1,8 +1,9 @@
-"""The envelope's compiled prediction (issue 13, compute time) against its NumPy formulation:
-the kernels on random stiffness matrices, tips and moves (incl. singular ones), and
-:func:`~kinestat.control.envelope.predict` on recorded measurements with random flange moves,
-with :func:`~kinestat.control.envelope.check_command`'s verdicts compared for envelopes whose
-limits sit just around the predicted values."""
+"""The prediction against independent formulations: the platform's compiled pinned-tip kernel
+(Gaussian elimination) against NumPy solves written out here, on random stiffness matrices,
+tips and moves (incl. singular ones); and :func:`~kinestat.control.predict.predict` (NumPy
+solves) on recorded measurements with random flange moves against the prediction rebuilt from
+that kernel, with :func:`~kinestat.control.envelope.check_command`'s verdicts compared for
+envelopes whose limits sit just around the predicted values."""
 
 from __future__ import annotations
 
@@ -15,11 +16,11 @@ import pytest
 
 from kinestat.app.control_run import ControlRequest, SimulatedCell, prepare_control
 from kinestat.app.sim_cell import InProcessIO, start_counts
-from kinestat.control import envelope as env_mod
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, decide
-from kinestat.control.envelope import Envelope, check_command, predict, top_motion
+from kinestat.control.envelope import Envelope, check_command, top_motion
 from kinestat.control.log import CycleLog
 from kinestat.control.loop import run
+from kinestat.control.predict import Prediction, predict
 from kinestat.io.library import prototype
 from kinestat.parallel.stiffness import (
     pinned_tip_step,
@@ -36,7 +37,7 @@ START = np.array([-400.0, 800.0, -100.0])
 
 def _numpy_step(K, p, u, F, platform, T):
     """The prediction's linear algebra as NumPy solves (the formulation of
-    :func:`kinestat.control.envelope.predict`'s NumPy path), written out independently."""
+    :func:`kinestat.control.predict.predict`'s NumPy path), written out independently."""
     A = np.vstack([np.eye(3), skew(p)])
     B = np.hstack([-skew(p), np.eye(3)])
     b = np.concatenate([np.zeros(3), np.cross(u, F)])
@@ -96,20 +97,30 @@ def test_singular_stiffness_falls_back_to_numpy_and_raises():
         tip_compliance_one(np.zeros((6, 6)), np.zeros(3))
 
 
-def _numpy_predict(model, meas, Tn):
-    saved = env_mod._predict_fast
-    env_mod._predict_fast = lambda *a: None
-    try:
-        return predict(model, copy.copy(meas), Tn)
-    finally:
-        env_mod._predict_fast = saved
+def _kernel_predict(model, meas, Tn) -> Prediction:
+    """The pinned-tip prediction rebuilt from the platform's compiled kernel
+    (:func:`kinestat.parallel.stiffness.pinned_tip_step`), independently of
+    :func:`~kinestat.control.predict.predict`'s NumPy solves."""
+    top = np.asarray(meas.top_pose, dtype=float)
+    K = stiffness(model.platform, top, twist_order="axis")
+    TB_new = Tn @ model.mount
+    tip_F = meas.tip(model)
+    p = top[:3, :3] @ model.tool_tip_top + top[:3, 3]
+    R_new, t_new = TB_new[:3, :3], TB_new[:3, 3]
+    u = (tip_F - t_new) @ R_new - p
+    F = -(meas.estimate("point") @ meas.base_pose[:3, :3])
+    dF, _, dl, top_new = pinned_tip_step(model.platform, top, K, p, u, F)
+    Tf = meas.flange_pose
+    local = (tip_F - Tf[:3, 3]) @ Tf[:3, :3]
+    return Prediction(force=-(R_new @ (F + dF)), deflections=meas.deflections(model) + dl,
+                      tip_motion=Tn[:3, :3] @ local + Tn[:3, 3] - tip_F, top_pose=top_new)
 
 
 def _verdicts(env, model, axis, pred):
     return check_command(env, model, axis, axis, pred)
 
 
-def test_compiled_prediction_equals_numpy_with_the_same_verdicts_near_the_limits(recorded):
+def test_prediction_equals_the_kernels_with_the_same_verdicts_near_the_limits(recorded):
     model, meas = recorded
     rng = np.random.default_rng(8)
     axis = np.zeros(6)
@@ -120,12 +131,12 @@ def test_compiled_prediction_equals_numpy_with_the_same_verdicts_near_the_limits
                            * 10.0 ** rng.uniform(-3, 0.5))
             Tn = m.flange_pose @ dT
             fast = predict(model, copy.copy(m), Tn)
-            ref = _numpy_predict(model, m, Tn)
+            ref = _kernel_predict(model, m, Tn)
             for x, y in ((fast.force, ref.force), (fast.deflections, ref.deflections),
                          (fast.tip_motion, ref.tip_motion), (fast.top_pose, ref.top_pose)):
                 np.testing.assert_allclose(x, y, rtol=1e-9, atol=1e-9)
-            # envelopes whose limits sit 1e-6 relative around the predicted values: both paths
-            # on the same side of every limit
+            # envelopes whose limits sit 1e-6 relative around the predicted values: both
+            # formulations on the same side of every limit
             motion = np.abs(top_motion(model, ref.top_pose))
             for f in (1.0 - 1e-6, 1.0 + 1e-6):
                 env = Envelope(max_load=ref.force_magnitude * f,
@@ -139,6 +150,6 @@ def test_compiled_prediction_equals_numpy_with_the_same_verdicts_near_the_limits
     m = meas[-1]
     Tn = m.flange_pose.copy()
     Tn[:3, 3] += 5.0 * m.s6
-    fast, ref = predict(model, copy.copy(m), Tn), _numpy_predict(model, m, Tn)
+    fast, ref = predict(model, copy.copy(m), Tn), _kernel_predict(model, m, Tn)
     bad = _verdicts(env, model, axis, fast)
     assert bad and bad == _verdicts(env, model, axis, ref)

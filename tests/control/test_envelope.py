@@ -2,24 +2,22 @@
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 from kinestat.app.sim_cell import start_counts
-from kinestat.control._reference import reference_cycle
 from kinestat.control.controller import axis_counts_to_q
 from kinestat.control.envelope import (
     Envelope,
-    Prediction,
     check_command,
     check_measurement,
     check_target,
+    require,
+)
+from kinestat.control.predict import (
     predict,
     predict_sliding,
-    require,
     sliding_force,
     sliding_push,
     tip_compliance,
@@ -157,32 +155,6 @@ def test_sliding_push_rate_is_the_force_change_of_a_push(tilt):
     assert 0.0 < k <= float(axis @ tip_stiffness(scn.model, m) @ axis) * (1 + 1e-9)
 
 
-@pytest.mark.parametrize("tilt", [4.0, 30.0])
-def test_compiled_sliding_push_equals_the_numpy_formulation(tilt):
-    """The compiled slide (``slide_kernel``) gives the NumPy formulation's force and rate (the
-    reference path) to rounding, for random turns about the tool point and pushes; out of
-    contact both give None."""
-    scn = scenario(tilt_deg=tilt, friction=0.0)
-    T, _, m = _loaded(scn, push=0.3)
-    rng = np.random.default_rng(7)
-    for _ in range(20):
-        R = np.eye(4)
-        R[:3, :3] = Rotation.from_rotvec(np.radians(rng.uniform(0, 20)) * _unit(rng)).as_matrix()
-        Tn = trans(rng.uniform(-0.5, 0.5, 3)) @ trans(m.tool_point) @ R @ trans(-m.tool_point) @ T
-        axis = _unit(rng)
-        fast = sliding_push(scn.model, m, Tn, axis)
-        fast_f = sliding_force(scn.model, m, Tn)
-        with reference_cycle():
-            ref = sliding_push(scn.model, m, Tn, axis)
-            ref_f = sliding_force(scn.model, m, Tn)
-        assert fast == pytest.approx(ref, rel=1e-9, abs=1e-12)
-        assert fast_f == pytest.approx(ref_f, rel=1e-9)
-    m0 = dataclasses.replace(m, point_force=np.zeros(3))  # no force: out of contact
-    assert sliding_push(scn.model, m0, T, [0, 0, 1.0]) is None
-    with reference_cycle():
-        assert sliding_push(scn.model, m0, T, [0, 0, 1.0]) is None
-
-
 def _unit(rng) -> np.ndarray:
     v = rng.normal(size=3)
     return v / np.linalg.norm(v)
@@ -194,92 +166,6 @@ def _rotated(T, rotvec_deg, shift) -> np.ndarray:
     out[:3, :3] = R @ out[:3, :3]
     out[:3, 3] = out[:3, 3] + shift
     return out
-
-
-def test_the_compiled_pre_checks_never_clear_a_violation():
-    """The compiled pre-checks (``_measurement_clear``, ``_command_clear``) may only call clear
-    what the checks in Python find nothing in: measurements and commands drawn at and across
-    every limit (load, deflection, the top's motion ranges, axis limits, axis step, NaN),
-    against the Python checks alone (the reference path). And they do clear most inputs
-    that are inside, so the fast path is the one that runs."""
-    from kinestat.control import envelope as env_mod
-
-    scn = scenario()
-    model = scn.model
-    _, _, m = _loaded(scn)
-    rng = np.random.default_rng(3)
-    lim = np.asarray(ENV.motion_range)
-    H = PLATFORM.home_pose
-    near = lambda x: x * (1.0 + rng.choice([-1e-6, -1e-10, 0.0, 1e-10, 1e-6, -0.3, 0.5]))  # noqa: E731
-    cleared = inside = 0
-    for i in range(3000):
-        w = np.array(m.wrench, dtype=float)
-        lengths = np.array(m.leg_lengths, dtype=float)
-        top = np.array(m.top_pose, dtype=float)
-        kind = i % 5
-        if kind == 0:  # the load
-            w[:3] *= near(ENV.max_load) / np.linalg.norm(w[:3])
-        elif kind == 1:  # a leg's deflection
-            j = rng.integers(6)
-            lengths[j] = PLATFORM.free_lengths[j] + rng.choice([-1, 1]) * near(ENV.max_deflection)
-        elif kind == 2:  # a rotation about x, y or z at its range
-            r = np.zeros(3)
-            r[rng.integers(3)] = rng.choice([-1, 1]) * near(lim[3 + rng.integers(3)])
-            top = _rotated(H, r, np.zeros(3))
-        elif kind == 3:  # a translation at its range
-            d = np.zeros(3)
-            j = rng.integers(3)
-            d[j] = rng.choice([-1, 1]) * near(lim[j])
-            top = _rotated(H, rng.normal(0, 0.5, 3), d)
-        elif rng.random() < 0.5:  # a NaN somewhere
-            (w if rng.random() < 0.5 else lengths)[rng.integers(6)] = np.nan
-        mm = dataclasses.replace(m, wrench=w, leg_lengths=lengths, top_pose=top)
-        fast = env_mod._measurement_clear_compiled(ENV, model, mm)
-        with reference_cycle():
-            ref = check_measurement(ENV, model, mm)
-        assert not (fast and ref), (i, ref)
-        inside += not ref
-        cleared += bool(fast)
-    # many "inside" draws sit on a limit or within the margin, or rotate past the least
-    # rotation range about z (6° against 4°): those go to the Python checks on purpose
-    assert inside > 500 and cleared >= 0.3 * inside
-    assert env_mod._measurement_clear_compiled(ENV, model, m)  # a loaded measurement
-    lo, hi = model.limits_deg[:, 0], model.limits_deg[:, 1]
-    cleared = inside = 0
-    for i in range(3000):
-        a = rng.uniform(lo + 1.0, hi - 1.0)
-        now = a + rng.uniform(-10.0, 10.0, 6)
-        j = rng.integers(6)
-        kind = i % 6
-        if kind == 0:
-            a[j] = rng.choice([lo[j], hi[j]]) * (1.0 + rng.choice([-1e-12, 0.0, 1e-12]))
-        elif kind == 1:
-            now[j] = a[j] + rng.choice([-1, 1]) * near(ENV.max_joint_step_deg)
-        elif kind == 2:
-            a[j] = np.nan
-        pred = None
-        if kind >= 3:
-            force = rng.normal(size=3)
-            force *= (near(ENV.max_load) if kind == 3 else 4.0) / np.linalg.norm(force)
-            defl = rng.uniform(-1.0, 1.0, 6)
-            if kind == 4:
-                defl[j] = rng.choice([-1, 1]) * near(ENV.max_deflection)
-            r = np.zeros(3)
-            r[rng.integers(3)] = rng.choice([-1, 1]) * near(lim[3 + rng.integers(3)])
-            top = _rotated(H, r, np.zeros(3)) if kind == 5 else None
-            pred = Prediction(force=force, deflections=defl, tip_motion=np.zeros(3),
-                              top_pose=top)
-        fast = env_mod._command_clear_compiled(ENV, model, a, now, pred)
-        with reference_cycle():
-            ref = check_command(ENV, model, a, now, pred)
-        assert not (fast and ref), (i, ref)
-        inside += not ref
-        cleared += bool(fast)
-    assert inside > 500 and cleared >= 0.3 * inside
-    typical = Prediction(force=np.array([3.9, 0.1, -1.0]), deflections=np.full(6, -0.3),
-                         tip_motion=np.zeros(3), top_pose=m.top_pose)
-    mid = 0.5 * (lo + hi)
-    assert env_mod._command_clear_compiled(ENV, model, mid, mid + 1.0, typical)
 
 
 def test_command_checks():

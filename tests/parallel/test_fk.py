@@ -182,16 +182,27 @@ def test_tracking_refuses_a_jump_to_another_mode():
 
 
 def _tracked(p, L, prev, backend):
-    """fk_tracking's pose, or the class of the error it raised."""
+    """fk_tracking's pose (``backend`` "numba") or the NumPy iteration's, checked and verified
+    as fk_tracking checks it (``backend`` "numpy": ``_newton_checked`` and the nearest-mode
+    test), or the class of the error it raised."""
+    import kinestat.parallel.fk as fk_mod
+
     try:
-        return fk_tracking(p, L, prev, backend=backend)
+        if backend == "numba":
+            return fk_tracking(p, L, prev)
+        Lc = np.asarray(L, dtype=float)
+        prev_b = np.broadcast_to(prev, Lc.shape[:-1] + (4, 4)).copy()
+        pose = fk_mod._newton_checked(p, Lc, prev_b, 1e-9, 20)
+        if p.layout is not None:
+            fk_mod._verify_nearest(p, Lc, prev_b, pose, 1e-9, "numpy")
+        return pose
     except (SingularityError, UnreachableError) as exc:
         return type(exc)
 
 
 @pytest.mark.parametrize("platform", ["prototype", "general"])
-def test_compiled_tracking_agrees_with_numpy(platform):
-    """The compiled Newton (backend "numba", the default) against the NumPy iteration: the same
+def test_compiled_tracking_agrees_with_the_numpy_iteration(platform):
+    """The compiled Newton (fk_tracking) against the NumPy iteration (``_newton``): the same
     pose to rounding or the same error, from small moves to jumps between modes, near and across
     singular configurations (lengths from poses far from home), for a special and a general
     6-6; and the compiled path decides most small moves itself (it is not always falling back)."""
@@ -239,11 +250,20 @@ def test_compiled_tracking_agrees_with_numpy(platform):
     # a batch with one pose the compiled path cannot decide: the whole batch by NumPy, the
     # same error
     L = np.stack([leg_lengths(p, p.home_pose), np.full(6, 1.0)])
+    assert _tracked(p, L, np.stack([p.home_pose] * 2), "numpy") is UnreachableError
+    with pytest.raises(UnreachableError, match="did not converge"):
+        fk_tracking(p, L, np.stack([p.home_pose] * 2))
+
+
+def test_tracking_backend_is_deprecated_but_accepted():
+    p = prototype()
+    L = leg_lengths(p, p.home_pose)
     for backend in ("numba", "numpy"):
-        with pytest.raises(UnreachableError, match="did not converge"):
-            fk_tracking(p, L, np.stack([p.home_pose] * 2), backend=backend)
-    with pytest.raises(InputError, match="backend"):
-        fk_tracking(p, L[0], p.home_pose, backend="fortran")
+        with pytest.warns(DeprecationWarning, match="leave the argument out"):
+            got = fk_tracking(p, L, p.home_pose, backend=backend)
+        np.testing.assert_allclose(got, p.home_pose, atol=1e-9)
+    with pytest.warns(DeprecationWarning), pytest.raises(InputError, match="backend"):
+        fk_tracking(p, L, p.home_pose, backend="fortran")
 
 
 def _non_special():
