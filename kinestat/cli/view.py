@@ -328,7 +328,7 @@ def disp_result(deck: str, steps: str | None = None, disp_1977: bool = False):
     else:
         raise InputError(f"DECK {deck!r} is neither a file nor an embedded deck; embedded "
                          f"decks: {', '.join(list_embedded_decks())}")
-    opts = disp_options(disp_1977=disp_1977)
+    opts = disp_options(disp_1977=disp_1977, ms=d.ms)  # DISP's defaults, as `kinestat disp`
     run = run_deck(d, steps=parse_steps(steps), options=opts)
     if run.result is None:
         raise InputError(f"deck {deck!r} (MS = {d.ms}) has no guidance run to animate; "

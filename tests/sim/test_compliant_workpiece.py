@@ -71,7 +71,10 @@ def _check_contact(cell, eq):
     f = eq.contact_force
     fn = float(f @ n)
     assert fn >= 0.0
-    assert float(wp.gap(eq.tip)) == pytest.approx(-fn / wp.stiffness, abs=2e-9)
+    # a sliding solve is accepted with a force residual up to SLIDE_TOL (kinestat.sim.contact),
+    # which the workpiece's spring turns into a depth error of at most SLIDE_TOL / k
+    depth_tol = 2e-9 if wp.friction == 0.0 or eq.sticking else SLIDE_TOL / wp.stiffness
+    assert float(wp.gap(eq.tip)) == pytest.approx(-fn / wp.stiffness, abs=depth_tol)
     assert _balanced(cell, eq) <= 1e-6
     ft = float(np.linalg.norm(f - fn * n))
     assert ft <= wp.friction * fn * (1.0 + 1e-6) + SLIDE_TOL

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 import kinestat
-from kinestat.viz.scene import model_scene
+from kinestat.viz.scene import model_scene, opening_q
 from kinestat.viz.serve import MAX_BODY, MAX_HEADERS, make_server
 
 ARM = kinestat.load("puma762")
@@ -19,7 +19,7 @@ ARM = kinestat.load("puma762")
 
 @pytest.fixture(scope="module")
 def server():
-    srv = make_server(model_scene(ARM, ARM.q_home), model=ARM)
+    srv = make_server(model_scene(ARM), model=ARM)
     t = threading.Thread(target=srv.serve_forever, daemon=True)
     t.start()
     yield srv.server_address[1]
@@ -98,9 +98,9 @@ def test_oversized_headers_are_431(server, head):
 
 
 def test_the_server_keeps_serving_and_answers_ik(server):
-    q = np.asarray(ARM.q_home, dtype=float) + 0.1
-    target = kinestat.fk(ARM, q)[:3, 3]
-    body = json.dumps({"q": ARM.q_home.tolist(), "target": target.tolist()}).encode()
+    q0 = opening_q(ARM)  # the page's opening configuration, within the limits
+    target = kinestat.fk(ARM, q0 + 0.1)[:3, 3]
+    body = json.dumps({"q": q0.tolist(), "target": target.tolist()}).encode()
     code, ans = _post(server, body, timeout=300)  # the first IK compiles its kernels
     sols = json.loads(ans)["solutions"]
     assert code == 200 and sols
