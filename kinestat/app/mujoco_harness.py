@@ -19,7 +19,7 @@ from typing import Any
 import numpy as np
 
 from kinestat.app.mujoco_cell import counts_to_q
-from kinestat.app.sim_cell import SIM_STALE_AFTER, SimCheckedReader
+from kinestat.app.sim_cell import SIM_STALE_AFTER, SimCheckedReader, stop_devices
 from kinestat.control.model import ControlModel
 from kinestat.devices.cell_io import DeviceIO
 from kinestat.devices.encoder_stream import EncoderReader
@@ -115,14 +115,7 @@ class MujocoHarness:
 
     def stop(self) -> None:
         """Close what it opened, stop the emitter, the server and the plant's thread."""
-        for obj in reversed(self._opened):
-            try:
-                obj.close()
-            except Exception:  # noqa: BLE001 - closing must not fail
-                pass
-        self._opened.clear()
-        self.emitter.stop()
-        self.server.stop()
+        stop_devices(self._opened, self.emitter, self.server)
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)

@@ -48,8 +48,8 @@ from kinestat.sim.sensor import Sensor
 from kinestat.sim.surface import solve as solve_contact
 from kinestat.sim.surface import surface_normal
 
-__all__ = ["CellState", "SimHarness", "SimCheckedReader", "InProcessIO", "control_model",
-           "simulator_fault", "start_counts"]
+__all__ = ["CellState", "SimHarness", "stop_devices", "SimCheckedReader", "InProcessIO",
+           "control_model", "simulator_fault", "start_counts"]
 
 
 def control_model(cell: Cell, sensor: Sensor, *, coupling: float = AXIS4_TO_5_COUPLING,
@@ -84,6 +84,19 @@ def start_counts(config: ControllerConfig, current_counts=(0, 0, 0, 0, 0, 0)) ->
 
 SIM_STALE_AFTER = 1.0
 """Staleness limit (s) of the reader on the simulated encoder stream (:meth:`SimHarness.reader`)."""
+
+def stop_devices(opened: list, emitter, server) -> None:
+    """Close the clients and readers a harness opened (newest first, never failing), then
+    stop its encoder emitter and its Galil server."""
+    for obj in reversed(opened):
+        try:
+            obj.close()
+        except Exception:  # noqa: BLE001 - closing must not fail
+            pass
+    opened.clear()
+    emitter.stop()
+    server.stop()
+
 
 class CellState:
     """The evolving state of a simulated cell (thread-safe): friction anchor, last solution.
@@ -206,14 +219,7 @@ class SimHarness:
 
     def stop(self) -> None:
         """Close the clients and readers it opened, stop the emitter and the server."""
-        for obj in reversed(self._opened):
-            try:
-                obj.close()
-            except Exception:  # noqa: BLE001 - closing must not fail
-                pass
-        self._opened.clear()
-        self.emitter.stop()
-        self.server.stop()
+        stop_devices(self._opened, self.emitter, self.server)
 
     def __enter__(self) -> SimHarness:
         return self.start()

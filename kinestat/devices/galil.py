@@ -331,10 +331,9 @@ class GalilClient:
             buf += chunk
         return parts
 
-    def send_only(self, cmd: str) -> None:
-        """Send ``cmd`` without reading its reply (for ``ST``, whose bare ``:`` proves nothing:
-        it cannot be told from a late ``:`` of an earlier command). The next
-        :meth:`tagged_query` skips that reply; any other command refuses to go on first."""
+    def _send_unread(self, cmd: str) -> None:
+        """Send ``cmd`` and mark it in flight, its reply not read yet (the link closed and a
+        :class:`DeviceError` if the send fails)."""
         raw = self._encode(cmd)
         if self._sock is None:
             raise DeviceError(f"Galil at {self.host}:{self.port} is not connected")
@@ -345,6 +344,12 @@ class GalilClient:
             raise DeviceError(f"Galil link to {self.host}:{self.port} failed while sending "
                               f"{cmd!r}: {exc}") from exc
         self._in_flight = cmd
+
+    def send_only(self, cmd: str) -> None:
+        """Send ``cmd`` without reading its reply (for ``ST``, whose bare ``:`` proves nothing:
+        it cannot be told from a late ``:`` of an earlier command). The next
+        :meth:`tagged_query` skips that reply; any other command refuses to go on first."""
+        self._send_unread(cmd)
 
     def tagged_query(self, operands: list[str], tag: int) -> list[float]:
         """``MG tag,op1,op2...``: the values of ``operands``, read from the one reply that
@@ -359,16 +364,7 @@ class GalilClient:
         if not (isinstance(tag, int) and 0 < tag < 10**6):
             raise InputError(f"tagged_query: tag must be an integer in 1..999999, got {tag!r}")
         cmd = "MG " + ",".join([str(tag), *operands])
-        raw = self._encode(cmd)
-        if self._sock is None:
-            raise DeviceError(f"Galil at {self.host}:{self.port} is not connected")
-        try:
-            self._sock.sendall(raw)
-        except OSError as exc:
-            self.close()
-            raise DeviceError(f"Galil link to {self.host}:{self.port} failed while sending "
-                              f"{cmd!r}: {exc}") from exc
-        self._in_flight = cmd
+        self._send_unread(cmd)
         buf, self._buf = self._buf, b""
         t_end = time.monotonic() + self.timeout
         while True:
