@@ -3,8 +3,8 @@
 One definition for everything that holds the platform to it: the safety envelope of the control
 loop (:mod:`kinestat.control.envelope`) and the design and range studies
 (:mod:`kinestat.studies`). The motion ranges are read as ± from the unloaded pose of the top
-relative to the base, one component at a time (docs/seed-errata.md, "The kinestatic control
-procedure", entry 11; the OCR lost the degree signs).
+relative to the base, one component at a time (docs/seed-errata-vibhute.md, "The kinestatic
+control procedure", K11; the OCR lost the degree signs).
 """
 
 __all__ = ["MAX_DEFLECTION", "MAX_LOAD", "MOTION_RANGE_MM", "MOTION_RANGE_DEG", "MOTION_RANGE"]

@@ -10,8 +10,8 @@ from the offsets it is there to check: a change of any offset's sign makes the h
 (``tests/devices/test_homing.py``).
 
 The numbers are the robot that App. D.4 read as printed (every ``PA`` offset positive) homes:
-the only published evidence of the thesis robot's layout (docs/seed-errata.md, "Homing's PA
-offsets"). In physical counts, the home pose is :data:`HOME_COUNTS`.
+the only published evidence of the thesis robot's layout (docs/seed-errata-vibhute.md,
+"Homing's PA offsets"). In physical counts, the home pose is :data:`HOME_COUNTS`.
 """
 
 from __future__ import annotations
