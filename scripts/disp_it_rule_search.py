@@ -119,7 +119,7 @@ def search(feats, counts, n: int = 1500) -> list[tuple[str, str, str, str]]:
                     ok &= R(F((a / c1)[:, None], (t / c2)[None, :])) == k
                 out.append((tname, rname, fname, _ranges(ok, c1, c2)))
             one = np.ones(n, dtype=bool)
-            for a, t, k in zip(th, T, target, strict=True):
+            for t, k in zip(T, target, strict=True):
                 one &= R(t / c2) == k
             out.append((tname, rname, "T/c2 alone", _ranges(one[None, :], c1[:1], c2)))
     c0 = np.linspace(-10.0, 10.0, n)  # an offset (steps) as the second constant
