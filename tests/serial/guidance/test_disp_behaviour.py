@@ -267,3 +267,37 @@ def test_the_library_criterion_needs_larger_increments():
                       ).result.events[0]
     assert strict.cond_after < DEFAULT_COND_LIMIT
     assert np.max(np.abs(strict.joint_increments)) > np.max(np.abs(small))
+
+
+def test_disp_singularity_criterion_follows_the_cards_and_the_size():
+    """κ > L / p: the same arm in millimetres (cards still to 0.005) tolerates 25.4 times the
+    condition number; a command deck (SET THREE, F10.3) ten times more than F10.2 points."""
+    import dataclasses
+
+    from kinestat.disp.deck import disp_cond_limit
+
+    deck = embedded_deck("illustration4")
+    mm = dataclasses.replace(
+        deck, joints=[(25.4 * j.r, j.alpha_deg, 25.4 * j.a, j.theta_deg, j.pitch)
+                      for j in deck.joints],
+        positions=25.4 * np.asarray(deck.positions),
+        frame_points=25.4 * np.asarray(deck.frame_points))
+    assert disp_cond_limit(mm) == pytest.approx(25.4 * disp_cond_limit(deck), rel=1e-9)
+    m = kinestat.disp.deck_model(deck)
+    assert disp_cond_limit(deck) == pytest.approx(characteristic_length(m, m.q_home) / 0.005)
+    six = embedded_deck("illustration6-corrected")
+    seven = embedded_deck("illustration7-corrected")  # the same arm, hand on F10.2 cards
+    assert disp_cond_limit(six) == pytest.approx(10 * disp_cond_limit(seven))
+    assert disp_cond_limit(embedded_deck("illustration2")) == DEFAULT_COND_LIMIT
+
+
+def test_sub_steps_only_for_counted_stages():
+    """IT = 0 counts split a step whose joint increments exceed the count's bound; an explicit
+    count is taken as given (and its first step from the perturbed start swings far)."""
+    deck = embedded_deck("illustration4")
+    counted = run_deck(deck).result
+    given = run_deck(deck, steps=counted.steps[0]).result
+    assert counted.substeps > 0 and given.substeps == 0
+    first = np.abs(np.diff(joint_display(given.model, given.q[:2]), axis=0)).max()
+    assert first > 90.0 > np.abs(np.diff(joint_display(counted.model, counted.q[:2]),
+                                         axis=0)).max()
