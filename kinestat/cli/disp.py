@@ -88,8 +88,11 @@ def disp(
                                 "DISP)."),
     plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png into "
                               "this directory.", metavar="DIR"),
-    cond_limit: float = typer.Option(1e3, "--cond-limit", help="Dimensionless condition "
-                                     "number above which a configuration counts as singular."),
+    cond_limit: float = typer.Option(None, "--cond-limit", help="Dimensionless condition "
+                                     "number above which a configuration counts as singular "
+                                     "(default: DISP's, L / 0.005 for a deck whose hand is "
+                                     "given on F10.2 cards: the cards no longer fix the "
+                                     "joint increments).", show_default=False),
     disp_1977: bool = flag(False, "--disp-1977", help="MS = 4 only: an inferred step "
                                    "rule for the type III analysis, fitted to Table A2-9 "
                                    "(B from the hand origin's second-order displacement, "
@@ -119,7 +122,7 @@ def disp(
     correction = "settle" if settle else ("none" if no_settle else None)
     opts = disp_options(closed_loop=closed_loop, second_order=second_order,
                         singular=singular_mode(singular, damped), cond_limit=cond_limit,
-                        disp_1977=disp_1977, correction=correction, ms=d.ms)
+                        disp_1977=disp_1977, correction=correction, deck=d)
     with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         run = run_deck(d, steps=parse_steps(steps), options=opts, progress=prog)
     written = []

@@ -35,7 +35,7 @@ from typing import Literal
 
 import numpy as np
 
-from kinestat.disp.steps import disp_step_count
+from kinestat.disp.steps import DISP_STEP_DEG, disp_step_count
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import DispDeck, deck_warnings
 from kinestat.mechanism.chain import ChainModel, from_nadkarni
@@ -45,12 +45,15 @@ from kinestat.serial.guidance.planners import StageSpec, pose_error
 from kinestat.serial.guidance.rules import GuidanceOptions, SingularMode
 from kinestat.serial.guidance.run import GuidanceResult, run_guidance
 from kinestat.serial.guidance.stages import command_stages, target_stages
+from kinestat.serial.guidance.step import DEFAULT_COND_LIMIT
+from kinestat.serial.lengths import characteristic_length
 from kinestat.spatial.displacement import frame_from_triple, screws_between
 from kinestat.spatial.transforms import inv
 
 __all__ = [
     "DeckRun",
     "disp_options",
+    "disp_cond_limit",
     "deck_model",
     "deck_initial_hand",
     "deck_screws",
@@ -189,28 +192,59 @@ CORRECTED_MS = (0, 4)
 
 Correction = Literal["printed", "settle", "none"]
 
+#: Half a unit of the last decimal DISP's cards give the hand in: SET TWO's points are F10.2
+#: (0.005 in the deck's length unit), SET THREE's distances F10.3 (0.0005).
+HAND_CARD_PRECISION = {"TWO": 0.005, "THREE": 0.0005}
+
+
+def disp_cond_limit(deck: DispDeck) -> float:
+    """DISP's singularity criterion for a guidance deck (an inferred, stated criterion: the
+    thesis says only that [A] "does not have an inverse"): a configuration is singular when
+    its dimensionless condition number κ exceeds L / p, with L the mechanism's characteristic
+    length at the deck's initial configuration and p half a unit of the last decimal of the
+    cards that give the hand (:data:`HAND_CARD_PRECISION`). Beyond it κ · p / L ≥ 1: the
+    relative uncertainty the cards leave, amplified by κ, is as large as the step itself, so
+    the cards no longer fix the joint increments. Other decks: the library's 1000.
+
+    >>> from kinestat.io.disp_deck import embedded_deck
+    >>> round(disp_cond_limit(embedded_deck("illustration4")))   # L = 19.59 in, p = 0.005 in
+    3919
+    """
+    if deck.ms not in (0, 4, 5, 6):
+        return DEFAULT_COND_LIMIT
+    model, _, _ = deck_initial_hand(deck, deck_model(deck))
+    p = HAND_CARD_PRECISION["THREE" if deck.ms == 5 else "TWO"]
+    return characteristic_length(model, model.q_home) / p
+
 
 def disp_options(*, settle: bool = False, closed_loop: bool = False,
                  second_order: bool = False, singular: SingularMode = "perturb_all",
-                 cond_limit: float = 1e3, disp_1977: bool = False,
-                 correction: Correction | None = None, ms: int | None = None
-                 ) -> GuidanceOptions:
+                 cond_limit: float | None = None, disp_1977: bool = False,
+                 correction: Correction | None = None, ms: int | None = None,
+                 deck: DispDeck | None = None) -> GuidanceOptions:
     """Guidance options of DISP (Nadkarni 1977, ch. IV, App. I) by default: first-order
-    steps (eq. 4-11), DISP's perturbation of every joint at a singularity (``perturb_all``),
-    and, for the type II and III analyses (``ms`` 0 and 4), DISP's final correction: rows
-    straight at each target until the hand is on it to the printed precision
-    (``correction="printed"``, :data:`PRINTED_PRECISION`); ``"settle"`` (or ``settle=True``)
-    corrects to 1e-9 (kinestat's), ``"none"`` not at all. kinestat's refinements are opt-in.
-    ``disp_1977`` selects the inferred type III step rule of Table A2-9, which includes its
-    final correction step.
+    steps (eq. 4-11), DISP's perturbation of every joint at a singularity (``perturb_all``)
+    with the singularity criterion of ``deck`` (:func:`disp_cond_limit`; without a deck or
+    with ``cond_limit`` given, that limit or 1000), a step of an automatically counted stage
+    whose joint increments exceed the count's rotation bound done as sub-steps
+    (``counted_substep_deg``), and, for the type II and III analyses (``ms`` 0 and 4),
+    DISP's final correction: rows straight at each target until the hand is on it to the
+    printed precision (``correction="printed"``, :data:`PRINTED_PRECISION`); ``"settle"`` (or
+    ``settle=True``) corrects to 1e-9 (kinestat's), ``"none"`` not at all. kinestat's
+    refinements are opt-in. ``disp_1977`` selects the inferred type III step rule of Table
+    A2-9, which includes its final correction step.
 
     >>> o = disp_options()
-    >>> o.step_rule, o.settle, o.closed_loop, o.singular
-    ('first_order', False, False, 'perturb_all')
+    >>> o.step_rule, o.settle, o.closed_loop, o.singular, o.cond_limit
+    ('first_order', False, False, 'perturb_all', 1000.0)
     >>> o = disp_options(ms=0)
     >>> o.settle, o.settle_tol, o.settle_length
     (True, 0.0005, 1.0)
     """
+    if deck is not None and ms is None:
+        ms = deck.ms
+    if cond_limit is None:
+        cond_limit = DEFAULT_COND_LIMIT if deck is None else disp_cond_limit(deck)
     if correction is None:
         correction = "settle" if settle else ("printed" if ms in CORRECTED_MS else "none")
     if correction not in ("printed", "settle", "none"):
@@ -223,7 +257,8 @@ def disp_options(*, settle: bool = False, closed_loop: bool = False,
         extra = {"settle_tol": PRINTED_PRECISION, "settle_length": 1.0}
     return GuidanceOptions(step_rule="second_order" if second_order else "first_order",
                            closed_loop=closed_loop, singular=singular,
-                           settle=correction != "none", cond_limit=cond_limit, **extra)
+                           settle=correction != "none", cond_limit=cond_limit,
+                           counted_substep_deg=DISP_STEP_DEG, **extra)
 
 
 def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
@@ -238,7 +273,7 @@ def run_deck(deck: DispDeck, *, steps: Sequence[int] | int | None = None,
     (MS = 4) it was fitted to and is refused for other MS."""
     if not isinstance(deck, DispDeck):
         raise InputError(f"run_deck takes a DispDeck, got {type(deck).__name__}")
-    options = disp_options(ms=deck.ms) if options is None else options
+    options = disp_options(deck=deck) if options is None else options
     notes = list(deck_warnings(deck))
     ms = deck.ms
     if options.step_rule == "disp_1977" and ms != 4:

@@ -183,6 +183,12 @@ class GuidanceOptions:
       ``max_step_fraction`` × L; and, for automatically counted stages only, a step whose joint
       increments exceed ``max_joint_step_deg`` (prismatic: that angle in radians × L) is done
       as equal sub-steps (``None`` disables it). Explicit step counts are never refined.
+    - ``counted_substep_deg``: for stages counted by a step-count rule (``run_guidance``'s
+      ``step_count``, DISP's IT = 0), a step is done as round(largest joint increment /
+      ``counted_substep_deg``) equal sub-steps, the Jacobian recomputed at each (prismatic:
+      that angle in radians × L); ``None`` (default) takes such counts as they are. Near a
+      singularity the first-order increments of a whole step grow as 1/σ_min; sub-steps follow
+      the path instead of extrapolating them.
     - ``settle``: after the last step of a stage, take first-order steps straight at the stage's
       target (eq. 4-19 with k = 1: Newton's method) until it is reached to ``settle_tol``; each
       is a table row and a ``settle`` event. A target still missed after ``max_settle`` of them
@@ -207,6 +213,7 @@ class GuidanceOptions:
     max_step_deg: float = 1.0
     max_step_fraction: float = 0.01
     max_joint_step_deg: float | None = 2.0
+    counted_substep_deg: float | None = None
     settle: bool = True
     settle_tol: float = 1e-9
     settle_length: float | None = None
@@ -253,6 +260,8 @@ class GuidanceOptions:
                 f"singular must be one of {', '.join(SINGULAR_MODES)}, got {self.singular!r}")
         if self.settle_length is not None:
             _positive("settle_length", self.settle_length)
+        if self.counted_substep_deg is not None:
+            _positive("counted_substep_deg", self.counted_substep_deg)
         for name in ("cond_limit", "tol", "perturb_deg", "perturb_all_deg", "max_step_deg",
                      "max_step_fraction"):
             _positive(name, getattr(self, name))

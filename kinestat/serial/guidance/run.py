@@ -219,13 +219,15 @@ def _per_stage_steps(steps, n_stages: int) -> list[int | None]:
 @dataclass
 class _Stage:
     """The stage being run: its path (replaced after a perturbation), step count k, the step
-    j0 at which the current path object starts, and the sub-step limit (auto counts only)."""
+    j0 at which the current path object starts, and the sub-step limit (automatic counts
+    only; ``nearest``: sub-step counts rounded to the nearest)."""
 
     index: int
     path: Path
     k: int
     refine: float | None
     j0: int = 0
+    nearest: bool = False
 
     def fractions(self, j: int) -> tuple[float, float]:
         return (j - 1 - self.j0) / (self.k - self.j0), (j - self.j0) / (self.k - self.j0)
@@ -307,8 +309,10 @@ class _Run:
         refine = None
         k = k_given
         left = MAX_RUN_STEPS - self.total_planned
-        if k is None and self.step_count is not None:
+        counted = k is None and self.step_count is not None
+        if counted:
             k = _step_count(self.step_count(path))
+            refine = self.opt.counted_substep_deg
         if k is None:
             refine = self.opt.max_joint_step_deg
             k = auto_steps(path, self.L, max_step_deg=self.opt.max_step_deg,
@@ -319,7 +323,7 @@ class _Run:
         self.planned.append(k)
         self.total_planned += k
         self.targets.append(np.asarray(path.end, dtype=float))
-        stage = _Stage(si, path, k, refine)
+        stage = _Stage(si, path, k, refine, nearest=counted)
         try:
             for j in range(1, k + 1):
                 self.gstep += 1
@@ -385,7 +389,8 @@ class _Run:
         if self.model.n != 6 and res.solution.residual > 1e-9:
             self.events.append(LeastSquaresStep(self.gstep, st.index + 1,
                                                 residual=float(res.solution.residual)))
-        m_sub = _substeps(self.model, res.dq, self.L, st.refine if self.rule.refinable else None)
+        m_sub = _substeps(self.model, res.dq, self.L, st.refine if self.rule.refinable else None,
+                          nearest=st.nearest)
         if m_sub <= 1:
             return res.dq
         q_i, H_i = self.q, self.H  # the same hand motion in m_sub smaller steps
@@ -542,8 +547,8 @@ def run_guidance(
             of the one ``options.step_rule`` names.
         step_count: for stages without a count, ``path -> k`` called with the stage's path
             at its start (e.g. DISP's inferred IT = 0 rule) instead of
-            :func:`~kinestat.serial.guidance.planners.auto_steps`; such counts are not refined
-            into sub-steps.
+            :func:`~kinestat.serial.guidance.planners.auto_steps`; such counts are refined
+            into sub-steps only with ``options.counted_substep_deg``.
 
     >>> from kinestat.io.library import load
     >>> from kinestat.serial.guidance.planners import command_path
@@ -583,10 +588,13 @@ def run_guidance(
     return run.result(notes)
 
 
-def _substeps(model: ChainModel, dq, L: float, max_joint_step_deg: float | None) -> int:
-    """Sub-steps needed so that no joint moves more than the limit (prismatic: the limit in
-    radians times L)."""
+def _substeps(model: ChainModel, dq, L: float, max_joint_step_deg: float | None, *,
+              nearest: bool = False) -> int:
+    """Sub-steps so that no joint moves more than the limit (prismatic: in radians times L);
+    ``nearest``: the ratio rounded to the nearest (up to 1.5 × the limit each), else up."""
     if max_joint_step_deg is None:
         return 1
     size = float(np.max(np.abs(np.where(model.prismatic, dq / L, dq))))
-    return int(min(1000, max(1, math.ceil(size / math.radians(max_joint_step_deg) - 1e-9))))
+    x = size / math.radians(max_joint_step_deg)
+    m = math.floor(x + 0.5) if nearest else math.ceil(x - 1e-9)
+    return int(min(1000, max(1, m)))

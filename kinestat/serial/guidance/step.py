@@ -301,52 +301,82 @@ def sigma_min_gradient(model: ChainModel, q, *, length: float, h: float = 1e-6) 
     return (smin[:n] - smin[n:]) / (2.0 * h)
 
 
-def perturb_all_joints(model: ChainModel, q, *, length: float,
-                       cond_limit: float = DEFAULT_COND_LIMIT, increment_deg: float = 1.0,
-                       max_tries: int = 30) -> tuple[np.ndarray, float, int]:
-    """Nadkarni ch. IV, "Singularities" 1): "a new configuration of the manipulator by giving
-    small increments to the joint variables till the singularity becomes non-existent" — to
-    all of them at once.
+def _best_signs(model: ChainModel, q, eps: np.ndarray, signs: np.ndarray, length: float
+                ) -> tuple[np.ndarray, float]:
+    """The sign pattern (every joint ±1) that gives ``q + eps·signs`` the smallest condition
+    number: start from ``signs``, flip the one joint that lowers it most while one does.
+    Candidates outside the joint limits count as infinitely ill-conditioned."""
+    pris = model.prismatic
+    lo, hi = model.lower, model.upper
 
-    Deterministic rule: each try moves every joint by ``increment_deg`` (prismatic joints:
-    that angle in radians × L) in the direction, + or −, in which it raises the Jacobian's
-    smallest dimensionless singular value σ_min (the sign of ``∂σ_min/∂q``, + where it is 0):
-    the steepest ascent of σ_min when every increment is bounded by the same small amount, so
-    every joint moves, with mixed signs. Tries repeat until the dimensionless condition number
-    is below ``cond_limit``. A try that would pass a joint limit, or that does not raise
-    σ_min, ends the search. Returns ``(q_new, cond_new, tries)``; ``cond_new >= cond_limit``
-    means it gave up (``q_new`` is the best configuration found).
+    def conds(S):
+        cand = q + eps * S
+        _, c = conditioning(scaled_jacobian(jacobian(model, cand), pris, length))
+        ok = np.all((cand >= lo) & (cand <= hi), axis=-1)
+        return np.where(ok, c, np.inf)
+
+    s = signs.copy()
+    best = float(conds(s[None, :])[0])
+    for _ in range(model.n):
+        flips = np.where(np.eye(model.n, dtype=bool), -s, s)
+        c = conds(flips)
+        i = int(np.argmin(c))
+        if not c[i] < best:
+            break
+        s, best = flips[i], float(c[i])
+    return s, best
+
+
+def perturb_all_joints(model: ChainModel, q, *, length: float,
+                       cond_limit: float = DEFAULT_COND_LIMIT, increment_deg: float = 0.1,
+                       max_tries: int = 300) -> tuple[np.ndarray, float, int]:
+    """Nadkarni ch. IV, "Singularities" 1): "a new configuration of the manipulator by giving
+    small increments to the joint variables till the singularity becomes non-existent" — the
+    smallest such increments, to every joint at once.
+
+    Every joint moves by the same amount t × ``increment_deg`` (prismatic joints: that angle
+    in radians × L), each in its own direction: the sign pattern starts from the sign of
+    ``∂σ_min/∂q`` (σ_min the smallest singular value of the dimensionless Jacobian; + where it
+    is 0) and single joints are flipped while that lowers the condition number at that size.
+    The criterion: the dimensionless condition number below ``cond_limit``. t is the smallest
+    whole number ≤ ``max_tries`` that meets it (doubling, then bisection, which assumes the
+    best condition number falls as t grows). A candidate past a joint limit does not count.
+    Returns ``(q_new, cond_new, t)``; ``cond_new >= cond_limit`` means none within
+    ``max_tries`` increments did (``q_new`` is then the start).
 
     >>> from kinestat.io.library import load
     >>> m = load("puma762")
     >>> q_wrist_singular = np.radians([90.0, -30.0, 30.0, 0.0, 0.0, 0.0])  # θ5 = 0
     >>> q, c, t = perturb_all_joints(m, q_wrist_singular, length=400.0)
     >>> d = np.degrees(q - q_wrist_singular)
-    >>> bool(c < DEFAULT_COND_LIMIT), bool(np.allclose(np.abs(d), t)), bool(np.ptp(np.sign(d)))
-    (True, True, True)
+    >>> bool(c < DEFAULT_COND_LIMIT), bool(np.allclose(np.abs(d), 0.1 * t))
+    (True, True)
+    >>> bool(np.ptp(np.sign(d)))                                     # mixed signs
+    True
     """
     q = model.check_q(q).astype(float)
-    pris = model.prismatic
-    lo, hi = model.lower, model.upper
-    scale = np.where(pris, length, 1.0)
-    step = math.radians(increment_deg)
-    smin, cond = (float(v) for v in conditioning(
-        scaled_jacobian(jacobian(model, q), pris, length)))
-    for tries in range(1, max_tries + 1):
-        g = sigma_min_gradient(model, q, length=length)
-        if not np.all(np.isfinite(g)):
-            return q, cond, tries
-        cand = q + step * scale * np.where(g >= 0.0, 1.0, -1.0)
-        if not np.all((cand >= lo) & (cand <= hi)):
-            return q, cond, tries
-        s_new, c_new = (float(v) for v in conditioning(
-            scaled_jacobian(jacobian(model, cand), pris, length)))
-        if not s_new > smin:
-            return q, cond, tries
-        q, smin, cond = cand, s_new, c_new
-        if cond < cond_limit:
-            return q, cond, tries
-    return q, cond, max_tries
+    scale = np.where(model.prismatic, length, 1.0)
+    step = math.radians(increment_deg) * scale
+    _, cond0 = conditioning(scaled_jacobian(jacobian(model, q), model.prismatic, length))
+    g = sigma_min_gradient(model, q, length=length)
+    signs0 = np.where(np.isfinite(g) & (g < 0.0), -1.0, 1.0)
+    found: dict[int, tuple[np.ndarray, float]] = {}
+
+    def meets(t: int) -> bool:
+        if t not in found:
+            found[t] = _best_signs(model, q, t * step, signs0, length)
+        return found[t][1] < cond_limit
+
+    lo, hi = 0, 1
+    while hi < max_tries and not meets(hi):
+        lo, hi = hi, min(2 * hi, max_tries)
+    if not meets(hi):
+        return q, float(cond0), max_tries
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if meets(mid) else (mid, hi)
+    s, c = found[hi]
+    return q + hi * step * s, c, hi
 
 
 def limit_violation(model: ChainModel, q, tol: float = 1e-12):

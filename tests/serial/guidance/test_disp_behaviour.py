@@ -4,6 +4,7 @@ only for type III, DISP's all-joint perturbation at singularities."""
 
 from __future__ import annotations
 
+import itertools
 import json
 import math
 
@@ -125,34 +126,45 @@ def _wrist_singular():
     return m, q, characteristic_length(m, q)
 
 
-def test_perturb_all_moves_every_joint_by_the_same_small_amount():
-    """DISP's remedy (ch. IV, Singularities 1)): every joint by the same small increment, each
-    with the sign that raises σ_min, checked against a one-sided difference of numpy's SVD."""
-    m, q, L = _wrist_singular()
+def _exhaustive_best_cond(m, q, eps_rad, L):
+    """The smallest condition number over all 2^n sign patterns of ±eps on every joint."""
+    signs = np.array(list(itertools.product([-1.0, 1.0], repeat=m.n)))
+    _, c = conditioning(scaled_jacobian(kinestat.jacobian(m, q + eps_rad * signs),
+                                        m.prismatic, L))
+    return float(np.min(c))
+
+
+@pytest.mark.parametrize("case", ["puma-wrist", "illustration4"])
+def test_perturb_all_gives_every_joint_the_smallest_equal_increment(case):
+    """DISP's remedy (ch. IV, Singularities 1)): every joint by the same small increment, mixed
+    signs, and no fewer increments would do — checked against every sign pattern of one
+    increment less (an exhaustive search, not the function's own greedy one)."""
+    if case == "puma-wrist":
+        m, q, L = _wrist_singular()
+        limit = DEFAULT_COND_LIMIT
+    else:
+        from kinestat.disp import deck_model
+        from kinestat.disp.deck import disp_cond_limit
+        deck = embedded_deck("illustration4")
+        m = deck_model(deck)
+        q, L, limit = m.q_home, characteristic_length(m, m.q_home), disp_cond_limit(deck)
     _, c0 = conditioning(scaled_jacobian(kinestat.jacobian(m, q), m.prismatic, L))
-    assert c0 > DEFAULT_COND_LIMIT
-    q1, c1, tries = perturb_all_joints(m, q, length=L, increment_deg=0.1, max_tries=300)
+    assert c0 > limit
+    q1, c1, t = perturb_all_joints(m, q, length=L, cond_limit=limit, increment_deg=0.1)
     d = np.degrees(q1 - q)
-    assert np.all(np.abs(d) <= tries * 0.1 + 1e-9)  # t tries of 0.1° each
+    np.testing.assert_allclose(np.abs(d), 0.1 * t, atol=1e-9)  # every joint, t × 0.1°
+    assert np.any(d > 0) and np.any(d < 0)  # mixed signs
     _, c_check = conditioning(scaled_jacobian(kinestat.jacobian(m, q1), m.prismatic, L))
-    assert c1 == pytest.approx(float(c_check)) and c1 < DEFAULT_COND_LIMIT
-
-    def smin(x):
-        return np.linalg.svd(scaled_jacobian(kinestat.jacobian(m, x), m.prismatic, L),
-                             compute_uv=False)[-1]
-
-    # the first try's signs: a joint moved the other way would raise σ_min less
-    q_first, _, _ = perturb_all_joints(m, q, length=L, increment_deg=0.1, max_tries=1)
-    np.testing.assert_allclose(np.abs(np.degrees(q_first - q)), 0.1, atol=1e-12)  # every joint
-    sign = np.sign(q_first - q)
-    h = np.radians(1e-4)
-    for i in range(m.n):
-        e = np.zeros(m.n)
-        e[i] = h
-        assert sign[i] * (smin(q + e) - smin(q - e)) >= -1e-12
-    assert smin(q1) > smin(q)
-    q2, _, _ = perturb_all_joints(m, q, length=L, increment_deg=0.1, max_tries=300)
+    assert c1 == pytest.approx(float(c_check)) and c1 < limit
+    assert _exhaustive_best_cond(m, q, math.radians(0.1 * (t - 1)), L) >= limit
+    q2, _, _ = perturb_all_joints(m, q, length=L, cond_limit=limit, increment_deg=0.1)
     np.testing.assert_array_equal(q1, q2)  # deterministic
+
+
+def test_perturb_all_gives_up_and_says_so():
+    m, q, L = _wrist_singular()
+    q1, c1, t = perturb_all_joints(m, q, length=L, increment_deg=0.1, max_tries=2)
+    assert t == 2 and c1 >= DEFAULT_COND_LIMIT and np.array_equal(q1, q)
 
 
 @pytest.mark.parametrize("mode", ["perturb", "perturb_all"])
@@ -204,3 +216,88 @@ def test_a_custom_step_rule_plugs_in():
     assert len(calls) == 10 and calls[0] == (0.0, 0.1)
     np.testing.assert_allclose(r.q, ref.q, atol=1e-12)
     assert math.isclose(calls[-1][1], 1.0)
+
+
+def _exact_path_joints(model, q_start, target, n_rows, per_row=40):
+    """Joints along the screw from ``q_start``'s hand to ``target``, tracked by Newton on the
+    forward kinematics in small steps (independent of the guidance step rules)."""
+    from kinestat.serial.fk import fk
+    from kinestat.serial.guidance.planners import screw_path, twist_between
+
+    path = screw_path(fk(model, q_start), target)
+    q = np.array(q_start, dtype=float)
+    out = [q.copy()]
+    for j in range(1, n_rows * per_row + 1):
+        T = path.pose_at(j / (n_rows * per_row))
+        for _ in range(30):
+            e = twist_between(fk(model, q), T)
+            if np.linalg.norm(e) < 1e-12:
+                break
+            q = q + np.linalg.solve(kinestat.jacobian(model, q), e)
+        out.append(q.copy())
+    return joint_display(model, np.array(out[::per_row]))
+
+
+def test_illustration4_starts_as_disp_did_and_follows_the_screw():
+    """MS 0 from Table A2-2's singular pose: DISP's small mixed-sign increments on every joint
+    (by its criterion, well under the library's 1000), then rows that stay on the branch the
+    screw path itself takes (no first-order swing of 100°+), and the target to the printed
+    precision."""
+    from kinestat.disp.deck import disp_cond_limit
+
+    deck = embedded_deck("illustration4")
+    r = run_deck(deck).result
+    ev = r.events[0]
+    inc = ev.joint_increments
+    assert ev.method == "perturb_all" and ev.cond > disp_cond_limit(deck) > ev.cond_after
+    np.testing.assert_allclose(np.abs(inc), np.abs(inc[0]), atol=1e-9)
+    assert np.any(inc > 0) and np.any(inc < 0) and 0 < abs(inc[0]) < 7.0
+    k = r.steps[0]
+    exact = _exact_path_joints(r.model, np.radians(ev.q), r.stage_targets[0], k)
+    rows = joint_display(r.model, r.q[1:k + 1])
+    assert np.max(np.abs(rows - exact[1:])) < 1.0  # degrees: first-order error only
+    assert not r.stopped and r.final_pose_error()[0] < 5e-4
+    np.testing.assert_allclose(joint_display(r.model, r.final_q), exact[-1], atol=0.01)
+
+
+def test_the_library_criterion_needs_larger_increments():
+    deck = embedded_deck("illustration4")
+    small = run_deck(deck).result.events[0].joint_increments
+    strict = run_deck(deck, options=disp_options(deck=deck, cond_limit=DEFAULT_COND_LIMIT)
+                      ).result.events[0]
+    assert strict.cond_after < DEFAULT_COND_LIMIT
+    assert np.max(np.abs(strict.joint_increments)) > np.max(np.abs(small))
+
+
+def test_disp_singularity_criterion_follows_the_cards_and_the_size():
+    """κ > L / p: the same arm in millimetres (cards still to 0.005) tolerates 25.4 times the
+    condition number; a command deck (SET THREE, F10.3) ten times more than F10.2 points."""
+    import dataclasses
+
+    from kinestat.disp.deck import disp_cond_limit
+
+    deck = embedded_deck("illustration4")
+    mm = dataclasses.replace(
+        deck, joints=[(25.4 * j.r, j.alpha_deg, 25.4 * j.a, j.theta_deg, j.pitch)
+                      for j in deck.joints],
+        positions=25.4 * np.asarray(deck.positions),
+        frame_points=25.4 * np.asarray(deck.frame_points))
+    assert disp_cond_limit(mm) == pytest.approx(25.4 * disp_cond_limit(deck), rel=1e-9)
+    m = kinestat.disp.deck_model(deck)
+    assert disp_cond_limit(deck) == pytest.approx(characteristic_length(m, m.q_home) / 0.005)
+    six = embedded_deck("illustration6-corrected")
+    seven = embedded_deck("illustration7-corrected")  # the same arm, hand on F10.2 cards
+    assert disp_cond_limit(six) == pytest.approx(10 * disp_cond_limit(seven))
+    assert disp_cond_limit(embedded_deck("illustration2")) == DEFAULT_COND_LIMIT
+
+
+def test_sub_steps_only_for_counted_stages():
+    """IT = 0 counts split a step whose joint increments exceed the count's bound; an explicit
+    count is taken as given (and its first step from the perturbed start swings far)."""
+    deck = embedded_deck("illustration4")
+    counted = run_deck(deck).result
+    given = run_deck(deck, steps=counted.steps[0]).result
+    assert counted.substeps > 0 and given.substeps == 0
+    first = np.abs(np.diff(joint_display(given.model, given.q[:2]), axis=0)).max()
+    assert first > 90.0 > np.abs(np.diff(joint_display(counted.model, counted.q[:2]),
+                                         axis=0)).max()

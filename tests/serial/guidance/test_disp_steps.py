@@ -141,3 +141,27 @@ def test_type_ii_steps_aim_from_the_actual_hand():
         r = run_guidance(m, m.q_home, [screw_path(H, target, from_actual=fa)], steps=12)
         errs.append(r.max_path_deviation()[0])
     assert errs[1] < 0.5 * errs[0]
+
+
+def test_the_published_counts_fix_the_constants_and_rule_out_illustration_4s_22():
+    """Round-max (the rule's form): 27, 9 and 4 bound c1, 35 bounds c2 (both non-empty), and
+    no (c1, c2) in those bounds gives Illustration 4's "Total 22" (docs/disp-decks.md)."""
+    motions = {}
+    for name in ("illustration4", "illustration5", "illustration6", "illustration7"):
+        deck = embedded_deck(name)
+        model, P0, _ = deck_initial_hand(deck, deck_model(deck))
+        H = fk(model, model.q_home)
+        for i, spec in enumerate(deck_stages(deck, P0)):
+            path = resolve_stage(spec, H)
+            motions[(name, i)] = stage_motion(path)
+            H = path.end
+    lo1, hi1 = 0.0, math.inf
+    for key, k in ((("illustration5", 0), 27), (("illustration6", 0), 9),
+                   (("illustration6", 1), 4)):
+        th = motions[key][0]  # rotation-limited: θ/c1 rounds to k
+        lo1, hi1 = max(lo1, th / (k + 0.5)), min(hi1, th / (k - 0.5))
+    d7 = motions[("illustration7", 0)][1]
+    lo2, hi2 = d7 / 35.5, d7 / 34.5
+    assert lo1 < DISP_STEP_DEG <= hi1 and lo2 < DISP_STEP_HAND <= hi2
+    th4, t4 = motions[("illustration4", 0)]
+    assert max(th4 / lo1, t4 / lo2) < 21.5  # the largest count the bounds allow: 16
