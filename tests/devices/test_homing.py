@@ -19,9 +19,9 @@ from kinestat.robots.puma762.homing import (
     INDEX_PERIOD_COUNTS,
     SECOND_OFFSET,
 )
+from kinestat.robots.puma762.layout import HOME_PAST_INDEX, layout
 from kinestat.sim.dmc import DmcSimulator, SimClock
 from kinestat.sim.galil_server import GalilSimServer
-from kinestat.robots.puma762.layout import HOME_PAST_INDEX, layout
 
 
 def _sim(seed, **kw) -> DmcSimulator:

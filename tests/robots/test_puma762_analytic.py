@@ -10,13 +10,12 @@ import kinestat
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import from_modified_dh
 from kinestat.robots.puma762 import closed_form as P
-from kinestat.serial.analytic import ik_all
 from kinestat.robots.puma762.analytic import (
     ik_all_thesis,
     is_puma762,
     puma762_chain,
 )
-
+from kinestat.serial.analytic import ik_all
 from tests.serial.analytic.arms import PI, slot_residuals, wrapped_distance
 
 
