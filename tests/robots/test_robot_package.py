@@ -43,6 +43,15 @@ def test_old_import_paths_give_the_same_objects(old):
         assert set(b.__all__) <= set(a.__all__)
 
 
+def test_the_old_package_keeps_its_functions_when_a_submodule_is_imported():
+    code = ("import kinestat.serial.puma762.forward, kinestat.serial.puma762.reverse; "
+            "from kinestat.serial import puma762 as P; "
+            "print(callable(P.forward), callable(P.reverse), P.forward.__module__)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True).stdout.split()
+    assert out == ["True", "True", "kinestat.robots.puma762.forward"]
+
+
 def test_the_puma762_method_is_registered_not_named_by_the_dispatch():
     # the generic methods do not name the robot; it is a registered method
     from kinestat.serial.analytic import METHODS
