@@ -34,7 +34,7 @@ warnings.filterwarnings("ignore")
 
 import kinestat  # noqa: E402
 from kinestat.io.urdf import to_urdf  # noqa: E402
-from kinestat.serial import puma762 as P  # noqa: E402
+from kinestat.robots.puma762 import closed_form as P  # noqa: E402
 from kinestat.serial.ik import ik  # noqa: E402
 from kinestat.spatial.se3 import pose_error  # noqa: E402
 

@@ -13,7 +13,7 @@ import time
 import numpy as np
 
 import kinestat
-from kinestat.serial import puma762
+from kinestat.robots.puma762 import closed_form as puma762
 from kinestat.serial.fk import iter_fk
 
 

@@ -32,9 +32,9 @@ from kinestat.app.sim_cell import InProcessIO
 from kinestat.control.arm import ChainArm, frame_from_tool
 from kinestat.control.model import ControlModel
 from kinestat.errors import InputError, KinestatError, ModelError
-from kinestat.hardware.puma762_axes import round_half_away
 from kinestat.io.urdf import metres_per_unit
 from kinestat.mechanism.chain import ChainModel
+from kinestat.robots.puma762.axes import round_half_away
 from kinestat.serial.fk import fk
 from kinestat.serial.jacobian import jacobian
 from kinestat.sim.arm import SimulatedArm

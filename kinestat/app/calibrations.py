@@ -27,7 +27,6 @@ from kinestat.control.model import ControlModel
 from kinestat.errors import InputError
 from kinestat.hardware.leg_calibration import LegCalibration
 from kinestat.hardware.leg_law import calibrated_platform, nominal_calibration, rescale_counts
-from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, THESIS_TOOL_POINT_6
 from kinestat.io.library import list_calibrations, load_calibration
 from kinestat.io.platform_toml import (
     PlatformMount,
@@ -36,6 +35,7 @@ from kinestat.io.platform_toml import (
     read_platform_mount,
 )
 from kinestat.parallel.platform import Platform, special_6_6
+from kinestat.robots.puma762.axes import AXIS4_TO_5_COUPLING, THESIS_TOOL_POINT_6
 from kinestat.sim.contact import centred_mount
 from kinestat.sim.sensor import IDEAL_RESOLUTION
 from kinestat.spatial.validate import as_pose

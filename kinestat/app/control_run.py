@@ -494,7 +494,8 @@ def report_dict(prepared: PreparedRun, report: RunReport) -> dict:
     ``travel`` (mm along the surface), ``normal_force_rms_error``/``normal_force_max_error``
     (N, over the travel cycles), ``contact_lost`` (and the true errors when simulated),
     ``travel_dir`` (the initial travel direction, unit: given, or the default); always the
-    run's tool and mount: ``tool_point_6`` (mm, frame 6), ``a67_start`` (fixed frame),
+    run's tool and mount: ``tool_point_6`` (mm, frame 6; generic name ``tool_offset``),
+    ``a67_start`` (fixed frame; generic name ``x_base_end_start``),
     ``mount`` (``6_BT``, 4x4) and ``mount_source`` ("centred", "pose" or the file)."""
     out = report.as_dict()
     if prepared.cell is not None:
@@ -508,6 +509,8 @@ def report_dict(prepared: PreparedRun, report: RunReport) -> dict:
     model = prepared.config.model
     out["tool_point_6"] = model.tool_point_6.tolist()
     out["a67_start"] = prepared.config.start_a67.tolist()
+    # the same in generic names (any arm): the tool in the end frame, the end frame's x axis
+    out["tool_offset"], out["x_base_end_start"] = out["tool_point_6"], out["a67_start"]
     out["mount"] = model.mount.tolist()
     out["mount_source"] = prepared.header.get("mount_source", "centred")
     if prepared.follow is not None:

@@ -33,7 +33,7 @@ from kinestat.devices.cell_io import SensorSample
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
 from kinestat.devices.motion import MoveRule, move_plan
 from kinestat.errors import DeviceError, KinestatError
-from kinestat.hardware.puma762_axes import AXIS_DEG_PER_COUNT
+from kinestat.robots.puma762.axes import AXIS_DEG_PER_COUNT
 from kinestat.serial.fk import fk
 from kinestat.sim.contact import Cell
 from kinestat.sim.dmc import trapezoid

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from kinestat.control.arm import Arm
 from kinestat.control.controller import ControllerConfig, axis_counts_to_q
 from kinestat.control.model import ControlModel
 from kinestat.devices.cell_io import DeviceIO, SensorSample
@@ -32,13 +33,13 @@ from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.devices.motion import coordinated_move_plan
 from kinestat.errors import DeviceError, JointLimitError, KinestatError, UnreachableError
-from kinestat.hardware.puma762_axes import (
+from kinestat.robots.puma762.arm import THESIS_ARM
+from kinestat.robots.puma762.axes import (
     AXIS4_TO_5_COUPLING,
     AXIS_DEG_PER_COUNT,
     axis_deg_to_counts,
     counts_to_joint_rad,
 )
-from kinestat.serial import puma762
 from kinestat.sim.arm import SimulatedArm
 from kinestat.sim.contact import Cell, Equilibrium, unloaded_tip
 from kinestat.sim.dmc import DmcSimulator, SimClock
@@ -103,13 +104,16 @@ class CellState:
 
     :meth:`solve` is quasi-static: call it along the robot's motion (the emitter does, at its
     rate) so that a sticking contact's anchor and the first-contact point follow the path.
-    ``arm``: the robot carrying the platform (default the PUMA 762's closed form).
+    ``arm``: the simulated arm carrying the platform (:class:`~kinestat.sim.arm.SimulatedArm`);
+    None: the robot ``robot`` moved by the simulated Galil, seen through the controller's
+    :class:`~kinestat.control.arm.Arm` protocol (default the thesis's PUMA 762).
     """
 
     def __init__(self, cell: Cell, sensor: Sensor | None = None, *, seed: int | None = 0,
-                 arm: SimulatedArm | None = None) -> None:
+                 arm: SimulatedArm | None = None, robot: Arm = THESIS_ARM) -> None:
         self.cell = cell
         self.arm = arm
+        self.robot = robot
         self.sensor = sensor if sensor is not None else Sensor()
         self._rng = np.random.default_rng(seed)
         self._lock = threading.Lock()
@@ -126,7 +130,7 @@ class CellState:
         with self._lock:
             if key == self._key and self._eq is not None:
                 return self._eq
-            T = puma762.forward(q).pose if self.arm is None else self.arm.flange_pose(q)
+            T = (self.robot if self.arm is None else self.arm).flange_pose(q)
             try:
                 guess = (self._eq.top_pose if self._eq is not None and self._eq.in_contact
                          else None)  # continuation along the robot's motion
@@ -153,7 +157,7 @@ class CellState:
         """The true state at ``q`` for logs and reports (fixed frame)."""
         eq = self.solve(q)
         if self.arm is None:
-            fwd = puma762.forward(np.asarray(q, dtype=float), tool_point_6)
+            fwd = self.robot.forward(np.asarray(q, dtype=float), tool_point_6)
             tool_axis, tool_point = fwd.s6, fwd.tool_point
         else:
             T = self.arm.flange_pose(q)
@@ -372,7 +376,7 @@ class InProcessIO:
         axis = np.radians(np.asarray(counts, dtype=float) * self._res)
         if self.arm is not None:
             return axis - self._offset
-        return puma762.from_axis_angles(axis)
+        return self.state.robot.q_from_axis(axis)
 
     def robot_counts(self) -> np.ndarray:
         """The exact robot's axis counts A..F."""

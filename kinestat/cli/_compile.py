@@ -24,8 +24,8 @@ from kinestat.cli._output import err_console
 KERNELS: dict[str, str] = {
     "serial": "kinestat.serial._kernels",
     "ik": "kinestat.serial._ik_kernels",
-    "puma762": "kinestat.serial.puma762._kernels",
-    "cycle": "kinestat.serial.puma762._cycle_kernels",
+    "puma762": "kinestat.robots.puma762._kernels",
+    "cycle": "kinestat.robots.puma762._cycle_kernels",
     "stiffness": "kinestat.parallel._stiffness_kernels",
     "platform": "kinestat.parallel._fk_kernels",
     "kinestatic": "kinestat.parallel._kinestatic_kernels",
@@ -93,7 +93,7 @@ def _warm_ik() -> None:
 
 
 def _warm_puma762() -> None:
-    from kinestat.serial import puma762  # lazy: start-up (numba)
+    from kinestat.robots.puma762 import closed_form as puma762  # lazy: start-up (numba)
 
     puma762.reverse([725.0, 190.0, 650.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
 
@@ -101,8 +101,8 @@ def _warm_puma762() -> None:
 def _warm_cycle() -> None:
     """The control cycle's single-pose kernels, with the argument types the controller passes
     (kinestat.control.controller._solve_counts and move_command)."""
-    from kinestat.serial import puma762  # lazy: start-up (numba)
-    from kinestat.serial.puma762._cycle_kernels import grid_nearest  # lazy: start-up (numba)
+    from kinestat.robots.puma762 import closed_form as puma762  # lazy: start-up (numba)
+    from kinestat.robots.puma762._cycle_kernels import grid_nearest  # lazy: start-up (numba)
 
     q = np.full(6, 0.3)
     p6 = np.array([0.0, 0.0, 235.0])

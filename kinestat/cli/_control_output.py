@@ -107,8 +107,9 @@ def print_report(out: dict) -> None:
         out_console.print("robot axes (deg): " + ", ".join(f"{v:.4f}"
                                                            for v in out["final_axis_deg"]))
     if out.get("tool_point_6") is not None:
-        out_console.print("tool P_tool_6 (" + ", ".join(f"{v:g}" for v in out["tool_point_6"])
-                          + ") mm, mount " + literal(str(out.get("mount_source", "centred"))))
+        out_console.print("tool offset (" + ", ".join(f"{v:g}" for v in out["tool_point_6"])
+                          + ") mm in the end frame, mount "
+                          + literal(str(out.get("mount_source", "centred"))))
     if out.get("arm") is not None:
         arm = out["arm"]
         out_console.print(literal(f"arm {arm['name']}: base at ("

@@ -70,7 +70,9 @@ def _transm() -> dict:
 
 def _puma() -> dict:
     """Vibhute Appendix C: reverse analysis of the PUMA 762 example pose."""
-    from kinestat.serial import puma762  # lazy: PUMA closed-form kernels, ~13 ms at start-up
+    from kinestat.robots.puma762 import (
+        closed_form as puma762,  # lazy: PUMA closed-form kernels, ~13 ms at start-up
+    )
 
     res = puma762.reverse([725.0, 190.0, 650.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0])
     sols = np.rad2deg(res.solutions)

@@ -35,9 +35,10 @@ def fk_command(
         None, "--q-deg", help="Joint values with rotating joints in degrees (prismatic: length).",
         metavar=Q_METAVAR
     ),
-    tool_point_6: str = typer.Option(
-        "0,0,0", "--tool-point-6", help="Tool point in the end frame (frame n: the PUMA's "
-        "frame 6), x,y,z.", metavar=XYZ_METAVAR
+    tool_offset: str = typer.Option(
+        "0,0,0", "--tool-offset", "--tool-point-6", help="Tool point in the end frame (frame "
+        "n), x,y,z; --tool-point-6 is the thesis's name (P_tool_6, the PUMA's frame 6).",
+        metavar=XYZ_METAVAR
     ),
     euler: str = typer.Option(
         "ZYX", "--euler", help="Euler sequence for the orientation (SciPy style: ZYX intrinsic, "
@@ -54,9 +55,9 @@ def fk_command(
     S6_F and a67_F in the thesis's words (Vibhute eq. 2-34).
 
     JSON: {"model", "q", "joint_names", "pose" (T_base_end), "tool_point" (p_base_tool),
-    "euler_deg", "euler_seq", "gimbal_lock", "length_unit"} plus the end frame's z and x axes:
-    "s6" and "a67" for the puma762 model, "z_base_end" and "x_base_end" for any other model
-    (+ "frames" with --frames, "warning" outside the joint limits).
+    "z_base_end", "x_base_end" (the end frame's z and x axes), "euler_deg", "euler_seq",
+    "gimbal_lock", "length_unit"}; for the puma762 model also "s6" and "a67" (the same axes in
+    the thesis's words) (+ "frames" with --frames, "warning" outside the joint limits).
     """
     from kinestat.serial.fk import fk_frames  # lazy: as above
     from kinestat.spatial.euler import euler_from_matrix  # lazy: scipy
@@ -67,27 +68,28 @@ def fk_command(
     vals = parse_floats(q if q is not None else q_deg, m.n, "q" if q is not None else "q-deg")
     if q_deg is not None:
         vals = np.where(m.prismatic, vals, np.deg2rad(vals))
-    p_end_tool = parse_floats(tool_point_6, 3, "tool-point-6")
+    p_end_tool = parse_floats(tool_offset, 3, "tool-offset")
     F = fk_frames(m, vals)
     T_base_end = F[-1]
     ang, lock = euler_from_matrix(T_base_end[:3, :3], euler, degrees=True,
                                   return_degenerate=True)
     puma = m.name == _PUMA762
-    z_key, x_key = ("s6", "a67") if puma else ("z_base_end", "x_base_end")
     out = {
         "model": m.name,
         "q": vals,
         "joint_names": [j.name for j in m.joints],
         "pose": T_base_end,
         "tool_point": T_base_end[:3, :3] @ p_end_tool + T_base_end[:3, 3],
-        z_key: T_base_end[:3, 2],
-        x_key: T_base_end[:3, 0],
+        "z_base_end": T_base_end[:3, 2],
+        "x_base_end": T_base_end[:3, 0],
         "euler_seq": euler,
         "euler_deg": ang,
         "gimbal_lock": bool(lock),
         "length_unit": m.length_unit,
         "units": units(m.length_unit),
     }
+    if puma:  # the thesis's names of the same axes (Vibhute eq. 2-34)
+        out["s6"], out["a67"] = out["z_base_end"], out["x_base_end"]
     if not m.within_limits(vals):
         out["warning"] = "the configuration is outside the model's joint limits"
     if frames:

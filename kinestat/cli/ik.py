@@ -154,7 +154,9 @@ def ik_command(
 
 def _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_axis_deg,
                  limits, normalize, as_json) -> None:
-    from kinestat.serial import puma762 as P  # lazy: numba kernels; keeps `kinestat --help` fast
+    from kinestat.robots.puma762 import (
+        closed_form as P,  # lazy: numba kernels; keeps `kinestat --help` fast
+    )
     from kinestat.spatial.validate import as_unit_vector  # lazy: kinestat.spatial loads scipy
 
     if model != "puma762":

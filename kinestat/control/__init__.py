@@ -2,7 +2,7 @@
 safety envelope, log every cycle.
 
 - :mod:`kinestat.control.arm` — the robot arm (any 6R arm with an analytic solver; the
-  thesis's PUMA 762 is the default instance).
+  thesis's PUMA 762, :mod:`kinestat.robots.puma762`, is the default instance).
 - :mod:`kinestat.control.model` — what the controller knows about the cell.
 - :mod:`kinestat.control.wrench` — the measurement chain (counts → wrench, fixed frame).
 - :mod:`kinestat.control.controller` — pure decision logic, ``decide(config, state, meas)``.
@@ -11,7 +11,8 @@ safety envelope, log every cycle.
 - :mod:`kinestat.control.loop` — the loop over the :class:`~kinestat.control.loop.CellIO`
   protocol (cell in, decisions, cell out); it imports no driver and no simulator.
 
-The robot's axis conventions and the leg calibration come from :mod:`kinestat.hardware`.
+The robot's axis conventions come from its package (:mod:`kinestat.robots`), the leg
+calibration from :mod:`kinestat.hardware`.
 """
 
 from __future__ import annotations

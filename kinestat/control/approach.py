@@ -23,7 +23,7 @@ import numpy as np
 
 from kinestat.control.envelope import Envelope, check_command
 from kinestat.control.model import ControlModel
-from kinestat.hardware.puma762_axes import round_half_away
+from kinestat.robots.puma762.axes import round_half_away
 
 __all__ = ["APPROACH_STEP_FRACTION", "approach_waypoints", "check_approach"]
 

@@ -7,17 +7,17 @@ reverse analysis of a target described as the thesis does — tool point ``P_too
 ``a67_F`` and ``P_tool_6`` — reduced to one solution within the axis limits nearest the current
 configuration (:meth:`Arm.solve_axis`). :class:`Arm` is that protocol; two instances:
 
-- :class:`Puma762Arm`: the thesis's PUMA 762 closed form (:mod:`kinestat.serial.puma762`) with
-  its kinematic correction (axis 1 = φ1 + 180°) and least-motion selection — exactly the calls
-  the controller made before the protocol existed (the default of
-  :class:`kinestat.control.model.ControlModel`);
+- :class:`~kinestat.robots.puma762.arm.Puma762Arm`: the thesis's PUMA 762, one robot in
+  :mod:`kinestat.robots.puma762` (closed form, axis 1 = φ1 + 180°, least-motion selection; the
+  default of :class:`kinestat.control.model.ControlModel`); re-exported here with
+  ``THESIS_ARM`` (deprecated import path: use ``kinestat.robots.puma762``);
 - :class:`ChainArm`: any :class:`~kinestat.mechanism.chain.ChainModel` that
   :func:`kinestat.ik_all` solves (spherical wrist, three parallel axes, general 6R), with the
   shared selection step :func:`kinestat.serial.analytic.select_nearest`.
 
 Encoder counts stay in :class:`~kinestat.control.model.ControlModel` (``axis_deg_per_count``
-and the axis 4 → 5 ``coupling``, a PUMA 762 convention from :mod:`kinestat.hardware`: give 0 for
-an arm without it).
+and the axis 4 → 5 ``coupling``, a PUMA 762 convention from :mod:`kinestat.robots.puma762.axes`:
+give 0 for an arm without it).
 """
 
 from __future__ import annotations
@@ -30,7 +30,7 @@ import numpy as np
 
 from kinestat.errors import JointLimitError, ModelError, UnreachableError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial import puma762
+from kinestat.robots.puma762.arm import THESIS_ARM, Puma762Arm
 from kinestat.serial.fk import fk
 from kinestat.spatial.validate import frozen
 
@@ -86,53 +86,6 @@ class Arm(Protocol):
         """Axis angles ``(6,)`` of the solution nearest ``q_now`` within ``limits_deg``; raises
         :class:`UnreachableError` (no solution) or :class:`JointLimitError` (none in limits)."""
         ...
-
-
-@dataclass(frozen=True, eq=False)
-class Puma762Arm:
-    """The thesis's PUMA 762 (Vibhute §2.2.3, App. D.2): closed form, axis 1 = φ1 + 180°.
-
-    >>> arm = Puma762Arm()
-    >>> np.degrees(arm.axis_from_q(np.zeros(6)))[0]
-    np.float64(180.0)
-    """
-
-    limits_deg: np.ndarray = field(default_factory=lambda: puma762.AXIS_LIMITS_DEG)
-
-    @property
-    def model(self) -> ChainModel:
-        """The PUMA 762 as a chain (equal to ``kinestat.load("puma762")``)."""
-        # the thesis path (reverse, select, forward) does not need the all-solutions package
-        from kinestat.serial.analytic.thesis_puma762 import puma762_chain  # lazy: scipy.linalg
-
-        return puma762_chain()
-
-    def q_from_axis(self, axis) -> np.ndarray:
-        return puma762.from_axis_angles(axis)
-
-    def axis_from_q(self, q) -> np.ndarray:
-        return puma762.to_axis_angles(q)
-
-    def forward(self, q, tool_point_6=(0.0, 0.0, 0.0)):
-        return puma762.forward(q, tool_point_6)
-
-    def ik_all(self, T_base_end) -> IKAllResult:
-        from kinestat.serial.analytic import ik_all  # lazy: scipy.linalg, ~0.3 s at import
-
-        return ik_all(self.model, T_base_end, method="puma762")
-
-    def flange_pose(self, q) -> np.ndarray:
-        """``F_6T`` (4, 4) of one joint vector (:func:`kinestat.serial.puma762.forward`)."""
-        return puma762.forward(q).pose
-
-    def solve_axis(self, tool_point, s6, a67, tool_point_6, q_now, limits_deg) -> np.ndarray:
-        # the reverse analysis (Vibhute App. C) and the least-motion selection within limits
-        res = puma762.reverse(tool_point, s6, a67, tool_point_6)
-        return puma762.select(res, np.asarray(q_now, dtype=float), limits_deg).axis
-
-
-THESIS_ARM = Puma762Arm()
-"""The PUMA 762 of the thesis's cell (the controller's default arm)."""
 
 
 def frame_from_tool(tool_point, s6, a67, tool_point_6) -> np.ndarray:

@@ -17,11 +17,12 @@ from typing import Literal, get_args
 
 import numpy as np
 
-from kinestat.control.arm import THESIS_ARM, Arm
+from kinestat.control.arm import Arm
 from kinestat.errors import ModelError
 from kinestat.hardware.leg_calibration import THESIS_CALIBRATION, LegCalibration
-from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, AXIS_DEG_PER_COUNT
 from kinestat.parallel.platform import Platform
+from kinestat.robots.puma762.arm import THESIS_ARM
+from kinestat.robots.puma762.axes import AXIS4_TO_5_COUPLING, AXIS_DEG_PER_COUNT
 from kinestat.spatial.transforms import apply, as_array, inv
 from kinestat.spatial.validate import frozen
 
@@ -47,7 +48,7 @@ class ControlModel:
             the MATLAB code's).
         axis_deg_per_count: (6,) robot encoder resolution, degrees per count.
         coupling: axis-5 counts turned per axis-4 count, compensated by the motion controller
-            (:func:`kinestat.hardware.puma762_axes.axis45_compensation`); 0 when there is none.
+            (:func:`kinestat.robots.puma762.axes.axis45_compensation`); 0 when there is none.
         force_source: "springs" (the platform's ``k (l − l0)``) or "calibration" (the
             calibration's force maps; give the platform its calibrated springs,
             :func:`kinestat.hardware.leg_law.calibrated_platform`, for the predictions).

@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from kinestat.control.model import ControlModel
-from kinestat.hardware.puma762_axes import round_half_away
+from kinestat.robots.puma762.axes import round_half_away
 
 if TYPE_CHECKING:
     from kinestat.control.controller import Target

@@ -25,7 +25,7 @@ from kinestat.devices.motion import MOVE_RULES, MoveRule, move_plan
 from kinestat.devices.motion_check import POSITION_TOLERANCE_COUNTS, check_arrival
 from kinestat.devices.safe_stop import RECONNECT_TIMEOUT, StopReport, send_stop
 from kinestat.errors import DeviceError, InputError
-from kinestat.hardware.puma762_axes import AXIS4_TO_5_COUPLING, axis45_compensation
+from kinestat.robots.puma762.axes import AXIS4_TO_5_COUPLING, axis45_compensation
 
 __all__ = ["MAX_SAMPLES", "STALE_PACKETS_SKIPPED", "SensorSample", "MotionProfile", "DeviceIO"]
 

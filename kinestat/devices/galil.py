@@ -2,7 +2,7 @@
 
 The PUMA 762 of Vibhute 2011 is driven by a Galil DMC 2160 over Ethernet (App. D.4, D.5, D.9).
 The robot's axis conventions (encoder scales, joint-1 offset, axis 4 -> 5 coupling and its
-compensation, rounding to counts) live in :mod:`kinestat.hardware.puma762_axes`. This module
+compensation, rounding to counts) live in :mod:`kinestat.robots.puma762.axes`. This module
 holds:
 
 * the thesis's move recipe (speeds, accelerations, the +5-count nudge: ``galil_control.m``);
@@ -25,7 +25,7 @@ import numpy as np
 from kinestat.devices.galil_replies import match_reply, split_reply
 from kinestat.devices.motion_check import check_arrival
 from kinestat.errors import DeviceError, InputError, ProtocolError
-from kinestat.hardware.puma762_axes import (
+from kinestat.robots.puma762.axes import (
     AXES,
     AXIS4_TO_5_COUPLING,
     COUNT_LIMIT,
@@ -478,7 +478,7 @@ class GalilClient:
         positions agreed with the command (:func:`~kinestat.devices.motion_check.check_arrival`,
         else :class:`DeviceError` and no ``DP``). Returns the final ``TP``. ``carry`` is the
         fraction of a count the true axis 5 stood past its encoder before the move (the last
-        move's :attr:`axis5_residual`; :func:`~kinestat.hardware.puma762_axes.axis45_compensation`);
+        move's :attr:`axis5_residual`; :func:`~kinestat.robots.puma762.axes.axis45_compensation`);
         after the move :attr:`axis5_residual` holds the new one.
         """
         c = _per_axis(counts, "move_compensated counts", positive=False)

@@ -35,8 +35,8 @@ import numpy as np
 from kinestat.devices.galil import GalilClient, GalilCommandError
 from kinestat.devices.safe_stop import confirm_motor_off, confirm_stop
 from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
-from kinestat.hardware.puma762_axes import AXES
-from kinestat.hardware.puma762_homing import (
+from kinestat.robots.puma762.axes import AXES
+from kinestat.robots.puma762.homing import (
     COARSE_ACCEL,
     COARSE_JOG,
     COARSE_SPEED,

@@ -34,7 +34,7 @@ import numpy as np
 
 from kinestat.devices.galil import MovePlan, thesis_move_plan
 from kinestat.errors import InputError
-from kinestat.hardware.puma762_axes import as_axes6
+from kinestat.robots.puma762.axes import as_axes6
 
 __all__ = ["MoveRule", "MOVE_RULES", "coordinated_move_plan", "move_plan"]
 

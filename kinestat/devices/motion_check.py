@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from kinestat.errors import DeviceError
-from kinestat.hardware.puma762_axes import AXES
+from kinestat.robots.puma762.axes import AXES
 
 __all__ = ["POSITION_TOLERANCE_COUNTS", "check_arrival"]
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.errors import KinestatError
-from kinestat.hardware.puma762_axes import AXES
+from kinestat.robots.puma762.axes import AXES
 
 __all__ = ["RECONNECT_TIMEOUT", "STOP_TIMEOUT", "MAX_ATTEMPTS", "StopReport", "confirm_stop",
            "confirm_motor_off", "send_stop"]

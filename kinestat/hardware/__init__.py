@@ -1,9 +1,9 @@
-"""The cell's hardware conventions (Vibhute 2011): facts about the robot and the platform's
-sensors that decisions, drivers and simulators share. No I/O, no decisions.
+"""The cell's hardware conventions (Vibhute 2011): facts about the platform's sensors that
+decisions, drivers and simulators share. No I/O, no decisions. The robot's own conventions
+(encoder scales, joint-1 offset, axis 4 -> 5 coupling, homing) are in its package,
+:mod:`kinestat.robots.puma762`; ``puma762_axes`` and ``puma762_homing`` here are deprecated
+import paths re-exporting them.
 
-- :mod:`kinestat.hardware.puma762_axes` — the PUMA 762's encoder scales, joint-1 offset,
-  axis 4 -> 5 coupling and its compensation, rounding to counts, the thesis tool point
-  ``P_tool_6``.
 - :mod:`kinestat.hardware.encoder_packets` — the encoder box's wire formats (``ks`` and the
   thesis's legacy line) and its channel -> leg wiring: the codec shared by the reader
   (:mod:`kinestat.devices`) and the emitter (:mod:`kinestat.sim`).

@@ -2,7 +2,8 @@
 
 The embedded data stays in :mod:`kinestat.data` (``models/*.toml``, ``platforms/*.toml``); this
 module is the one place that reads it, so the model layers (:mod:`kinestat.mechanism`,
-:mod:`kinestat.parallel`) never read files.
+:mod:`kinestat.parallel`) never read files. Importing it registers the built-in robots' analytic
+IK methods (:mod:`kinestat.robots`), so that a loaded model can use them by name.
 
 >>> from kinestat.io.library import list_models, load, prototype
 >>> "puma762" in list_models()
@@ -26,6 +27,7 @@ from kinestat.io.model_toml import loads_model, read_model
 from kinestat.io.platform_toml import loads_platform
 from kinestat.mechanism.chain import ChainModel
 from kinestat.parallel.platform import Platform
+from kinestat.robots import puma762 as _puma762  # noqa: F401 (registers the robots' IK methods)
 
 if TYPE_CHECKING:
     from kinestat.io.calibration_toml import CalibrationFile

@@ -1,6 +1,6 @@
 """What the compiled serial kernels share: the Numba options and the constants Numba freezes at
 compile time (:mod:`kinestat.serial._kernels`, :mod:`kinestat.serial._ik_kernels`,
-:mod:`kinestat.serial.puma762._kernels`)."""
+:mod:`kinestat.robots.puma762._kernels`)."""
 
 from __future__ import annotations
 

@@ -1,7 +1,7 @@
 """Plain NumPy references of the compiled serial kernels — private, used by the tests only.
 
 The public functions (:func:`kinestat.fk`, :func:`kinestat.jacobian`, :func:`kinestat.ik`,
-:mod:`kinestat.serial.puma762`) always run the compiled kernels. The tests check the kernels
+:mod:`kinestat.robots.puma762`) always run the compiled kernels. The tests check the kernels
 against these straightforward array implementations.
 """
 

@@ -1,6 +1,6 @@
 """Chunked iteration over large batches — the one helper behind every ``iter_*`` streamer
 (:func:`kinestat.serial.fk.iter_fk`, :func:`kinestat.serial.ik.iter_ik`,
-:func:`kinestat.serial.puma762.iter_reverse_batch_pose`) and the NumPy references' bounded
+:func:`kinestat.robots.puma762.reverse.iter_reverse_batch_pose`) and the NumPy references' bounded
 temporaries."""
 
 from __future__ import annotations

@@ -12,7 +12,8 @@ Newton here; the damped Newton and the snap in :mod:`kinestat.sim._slide`).
 
 Frames and conventions (all lengths in mm, forces in N):
 
-* ``flange_pose`` is ``F_6T``, frame 6 in the fixed frame (:func:`kinestat.serial.puma762.forward`).
+* ``flange_pose`` is ``F_6T``, frame 6 in the fixed frame
+  (:func:`kinestat.robots.puma762.forward.forward`).
 * ``Cell.mount`` is ``6_BT``, the platform's base frame (O0 at the origin, P0 on +x) in frame 6.
   The default, :func:`centred_mount`, puts the base triangle's centroid on frame 6's z axis
   (S6), the base plane in frame 6's x-y plane and the base x axis along a67 — so the top's
@@ -61,11 +62,11 @@ from scipy.spatial.transform import Rotation
 from kinestat.errors import InputError, ModelError, UnreachableError
 from kinestat.hardware.leg_calibration import LegCalibration
 from kinestat.hardware.leg_law import calibrated_platform, tension_slopes, tensions_at_lengths
-from kinestat.hardware.puma762_axes import THESIS_TOOL_POINT_6
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.platform import Platform
 from kinestat.parallel.statics import spring_wrench
 from kinestat.parallel.stiffness import stiffness
+from kinestat.robots.puma762.axes import THESIS_TOOL_POINT_6
 from kinestat.sim._slide import damped_slide, fd_jacobian, snap_slide
 from kinestat.spatial.transforms import apply, apply_vector, as_array, inv, make_pose, skew
 from kinestat.spatial.validate import frozen
@@ -84,7 +85,7 @@ __all__ = [
 
 DEFAULT_TOOL_POINT_6 = THESIS_TOOL_POINT_6
 """The unloaded tool tip in frame 6, mm: the thesis's ``P_tool_6`` (Vibhute App. D.1,
-:data:`kinestat.hardware.puma762_axes.THESIS_TOOL_POINT_6`)."""
+:data:`kinestat.robots.puma762.axes.THESIS_TOOL_POINT_6`)."""
 
 DEFAULT_STROKE = 8.0
 """Largest leg deflection |l − l0| the simulated legs can take (mm) before bottoming out.

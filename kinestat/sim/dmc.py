@@ -26,14 +26,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kinestat.errors import InputError
-from kinestat.hardware.puma762_axes import AXES, AXIS4_TO_5_COUPLING, COUNT_LIMIT
-from kinestat.hardware.puma762_homing import (
+from kinestat.robots.puma762.axes import AXES, AXIS4_TO_5_COUPLING, COUNT_LIMIT
+from kinestat.robots.puma762.homing import (
     HOME_COUNTS,
     INDEX_PERIOD_COUNTS,
     POT_COUNTS_PER_V,
     READY_POT_V,
 )
-from kinestat.sim.puma762_robot import layout
+from kinestat.robots.puma762.layout import layout
 
 __all__ = ["TC_MESSAGES", "SimClock", "RealClock", "trapezoid", "DmcSimulator"]
 
@@ -228,7 +228,7 @@ class DmcSimulator:
                       **kw) -> DmcSimulator:
         """A robot at an arbitrary position (within ±25° of home on axes 1-3, ±19° on 4-6),
         its encoders reading 0 at power-up, its index marks and pots where the simulated
-        robot has them (:mod:`kinestat.sim.puma762_robot`; its home pose is
+        robot has them (:mod:`kinestat.robots.puma762.layout`; its home pose is
         :data:`HOME_COUNTS` in physical counts)."""
         rng = np.random.default_rng(seed)
         span = np.array([20000, 28000, 22000, 3000, 3000, 1400])

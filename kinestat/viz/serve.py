@@ -3,10 +3,11 @@
 ``GET /`` is the page (:func:`kinestat.viz.html.render_html`), ``GET /scene.json`` the scene,
 ``POST /ik`` with ``{"q": [...], "target": [x, y, z]}`` moves the end frame's origin to the
 target keeping its orientation and answers ``{"solutions": [[...], ...], "outside_limits": k}``:
-every closed-form solution for the PUMA 762 (:func:`kinestat.serial.puma762.reverse_pose`), else
-the numerical :func:`kinestat.ik` from the current configuration; each checked by FK, rotating
-joints turned by whole turns into their limits, those still outside the joint limits only
-counted, the rest nearest the current configuration first.
+every closed-form solution for the PUMA 762
+(:func:`kinestat.robots.puma762.reverse.reverse_pose`), else the numerical :func:`kinestat.ik`
+from the current configuration; each checked by FK, rotating joints turned by whole turns into
+their limits, those still outside the joint limits only counted, the rest nearest the current
+configuration first.
 """
 
 from __future__ import annotations
@@ -23,7 +24,7 @@ import kinestat
 from kinestat.errors import InputError, KinestatError
 from kinestat.io.netbind import resolve_bind_address
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial import puma762
+from kinestat.robots.puma762 import closed_form as puma762
 from kinestat.viz.html import render_html, scene_json
 
 __all__ = ["ik_answer", "make_server"]

@@ -25,9 +25,9 @@ from kinestat.control.envelope import Envelope, sent_command_guard
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import run
 from kinestat.errors import DeviceError, UnreachableError
-from kinestat.hardware.puma762_axes import counts_to_joint_rad
 from kinestat.parallel.platform import special_6_6
-from kinestat.serial import puma762
+from kinestat.robots.puma762 import closed_form as puma762
+from kinestat.robots.puma762.axes import counts_to_joint_rad
 from kinestat.sim.contact import equilibrium, make_cell
 from kinestat.sim.sensor import Sensor
 

@@ -19,7 +19,7 @@ from kinestat.control.loop import run
 from kinestat.errors import KinestatError
 from kinestat.io.library import prototype
 from kinestat.io.platform_toml import read_mount_file
-from kinestat.serial import puma762
+from kinestat.robots.puma762 import closed_form as puma762
 from kinestat.spatial.transforms import apply
 
 START = np.array([-400.0, 800.0, -100.0])

@@ -34,6 +34,9 @@ def test_another_tool_and_mount_converge_through_the_devices(tmp_path, capsys, n
     assert out["converged"]
     assert abs(out["true_force_magnitude"] - 4.0) <= 0.5
     assert out["tool_point_6"] == [12.0, -8.0, 200.0] and out["a67_start"] == [0.0, 1.0, 0.0]
+    # the generic names of the same (any arm's end frame) beside the thesis's
+    assert out["tool_offset"] == out["tool_point_6"]
+    assert out["x_base_end_start"] == out["a67_start"]
     assert out["mount_source"] == str(platform)
     assert np.linalg.norm(out["torque_about_tip"]) <= 0.05
     # the simulator's TRUE tool point (its own forward analysis with its own tool) is the

@@ -9,7 +9,7 @@ import kinestat
 from kinestat.cli.main import main
 from kinestat.io.library import prototype
 from kinestat.parallel import leg_lengths
-from kinestat.serial import puma762
+from kinestat.robots.puma762 import closed_form as puma762
 
 
 def test_demo_json(capsys):

@@ -68,3 +68,19 @@ def test_fk_puma762_human_output_keeps_thesis_words(capsys):
     assert main(["fk", "puma762", "--q-deg", "200,10,20,30,40,50"]) == 0
     text = capsys.readouterr().out
     assert "S6_F" in text and "a67_F" in text
+
+
+def test_fk_puma762_gives_the_generic_names_and_the_thesis_names(capsys):
+    q_deg = [200.0, 20.0, 30.0, 40.0, 50.0, 60.0]
+    a = run_json(capsys, "fk", "puma762", "--q-deg", ",".join(map(str, q_deg)),
+                 "--tool-offset", "0,0,235", "--json")
+    b = run_json(capsys, "fk", "puma762", "--q-deg", ",".join(map(str, q_deg)),
+                 "--tool-point-6", "0,0,235", "--json")
+    assert a == b  # --tool-point-6 is the thesis's alias of --tool-offset
+    T = kinestat.fk(kinestat.load("puma762"), np.radians(q_deg))
+    for generic, thesis, col in (("z_base_end", "s6", 2), ("x_base_end", "a67", 0)):
+        np.testing.assert_allclose(a[generic], T[:3, col], atol=1e-12)
+        assert a[thesis] == a[generic]
+    np.testing.assert_allclose(a["tool_point"], T[:3, :3] @ [0, 0, 235.0] + T[:3, 3],
+                               atol=1e-9)
+

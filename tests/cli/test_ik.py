@@ -10,7 +10,7 @@ import pytest
 
 import kinestat
 from kinestat.cli.main import main
-from kinestat.serial import puma762 as P
+from kinestat.robots.puma762 import closed_form as P
 
 APPENDIX_C = ["--tool-point", "725,190,650", "--s6", "1,0,0", "--a67", "0,0,1"]
 

@@ -15,7 +15,7 @@ from kinestat.control.controller import ControllerConfig, axis_counts_to_q, deci
 from kinestat.control.wrench import measure
 from kinestat.errors import JointLimitError, ModelError, UnreachableError
 from kinestat.mechanism.chain import from_standard_dh
-from kinestat.serial import puma762
+from kinestat.robots.puma762 import closed_form as puma762
 
 from .conftest import PLATFORM, scenario
 

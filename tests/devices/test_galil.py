@@ -22,7 +22,7 @@ from kinestat.devices.galil import (
     thesis_move_plan,
 )
 from kinestat.errors import DeviceError, InputError, ProtocolError
-from kinestat.hardware.puma762_axes import (
+from kinestat.robots.puma762.axes import (
     AXIS4_TO_5_COUPLING,
     AXIS_DEG_PER_COUNT,
     JOINT1_OFFSET_DEG,

@@ -13,15 +13,15 @@ from kinestat.control.log import read_log
 from kinestat.devices import homing as homing_mod
 from kinestat.devices.galil import GalilClient
 from kinestat.devices.homing import home, is_homed
-from kinestat.hardware.puma762_homing import (
+from kinestat.robots.puma762.homing import (
     FIRST_OFFSET,
     HOME_COUNTS,
     INDEX_PERIOD_COUNTS,
     SECOND_OFFSET,
 )
+from kinestat.robots.puma762.layout import HOME_PAST_INDEX, layout
 from kinestat.sim.dmc import DmcSimulator, SimClock
 from kinestat.sim.galil_server import GalilSimServer
-from kinestat.sim.puma762_robot import HOME_PAST_INDEX, layout
 
 
 def _sim(seed, **kw) -> DmcSimulator:
@@ -53,7 +53,7 @@ def _next_mark_ahead(x, p):
 
 @pytest.mark.parametrize("which", ["first", "second"])
 def test_a_restored_minus_sign_ends_away_from_home(monkeypatch, which):
-    """The simulated robot's layout is its own (kinestat.sim.puma762_robot), not derived from
+    """The simulated robot's layout is its own (kinestat.robots.puma762.layout), not derived from
     the PA offsets: a minus restored on any offset ends the homing physically away from home,
     by the amount the index periods give (computed here from the search's rule)."""
     sign = np.array([1, -1, 1, -1, 1, -1])  # restore a minus on axes B, D, F

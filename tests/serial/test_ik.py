@@ -14,7 +14,7 @@ from scipy.spatial.transform import Rotation
 import kinestat
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import from_standard_dh
-from kinestat.serial import puma762 as P
+from kinestat.robots.puma762 import closed_form as P
 from kinestat.serial.ik import ik, model_scale, pose_error, rotation_log, wrap_joints
 from kinestat.spatial.transforms import make_pose, rot_z, trans
 from tests.serial._ik_checks import check_limits_respected_or_ignored

@@ -13,8 +13,8 @@ from scipy.spatial.transform import Rotation
 import kinestat
 from kinestat.errors import InputError, UnreachableError
 from kinestat.mechanism.chain import from_modified_dh, from_standard_dh
+from kinestat.robots.puma762 import closed_form as P
 from kinestat.serial import _ik_kernels as K
-from kinestat.serial import puma762 as P
 from kinestat.serial._reference import fk_reference
 from kinestat.serial.ik import ik, iter_ik, model_scale, pose_error, wrap_joints
 from tests.serial._ik_checks import check_limits_respected_or_ignored

@@ -12,9 +12,9 @@ from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
 from kinestat.devices.encoder_stream import StaleDataError
 from kinestat.errors import DeviceError
 from kinestat.hardware.leg_calibration import counts_to_lengths
-from kinestat.hardware.puma762_axes import counts_to_joint_rad
 from kinestat.parallel.platform import special_6_6
-from kinestat.serial import puma762
+from kinestat.robots.puma762 import closed_form as puma762
+from kinestat.robots.puma762.axes import counts_to_joint_rad
 from kinestat.sim.contact import equilibrium, make_cell
 from kinestat.sim.sensor import Sensor
 

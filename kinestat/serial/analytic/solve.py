@@ -5,8 +5,9 @@ the geometry admits one (spherical wrist with meeting shoulder axes; three paral
 meeting wrist pair), otherwise the general 6R eigenvalue method of Raghavan & Roth. A model with
 prismatic joints goes to the decoupled solver (:mod:`kinestat.serial.analytic.decoupled`: any
 three R/P positioning joints and a spherical wrist).
-``method="puma762"`` runs the thesis's PUMA 762 closed form
-(:mod:`kinestat.serial.analytic.thesis_puma762`) on a model with the PUMA 762's geometry.
+A robot's own closed form runs by its registered name (:mod:`kinestat.serial.ik_methods`), e.g.
+``method="puma762"``: the thesis's PUMA 762 closed form (:mod:`kinestat.robots.puma762`) on a
+model with the PUMA 762's geometry.
 """
 
 from __future__ import annotations
@@ -29,10 +30,14 @@ from kinestat.serial.analytic import (
 from kinestat.serial.analytic._common import call_compiled, check_poses, plain_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
+from kinestat.serial.ik_methods import get as _robot_method
+from kinestat.serial.ik_methods import registered as _robot_methods
 
 __all__ = ["ik_all", "ik_self_motion", "METHODS", "BACKENDS", "method_for"]
 
-METHODS = ("auto", "pieper", "three-parallel", "decoupled", "raghavan-roth", "puma762")
+METHODS = ("auto", "pieper", "three-parallel", "decoupled", "raghavan-roth")
+"""The generic methods; a robot's own closed form adds its name
+(:func:`kinestat.serial.ik_methods.registered`, e.g. ``"puma762"``)."""
 BACKENDS = ("numba", "numpy")
 
 
@@ -157,8 +162,10 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
                      backend=backend)
         return _locked.expand(model, pairs, res)
     kind, data = _plan(model)
-    if method not in METHODS:
-        raise ModelError(f"ik_all: unknown method {method!r}; expected one of {METHODS}")
+    robot = None if method in METHODS else _robot_method(method)
+    if method not in METHODS and robot is None:
+        raise ModelError(f"ik_all: unknown method {method!r}; expected one of "
+                         f"{METHODS + _robot_methods()}")
     T = T_base_flange
     if type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
             T.shape[-2:] == (4, 4) and backend == "numba":
@@ -187,13 +194,11 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if backend not in BACKENDS:
         raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
     fast = backend == "numba"
-    if use == "puma762":
-        from kinestat.serial.analytic import thesis_puma762  # lazy: start-up (its kernels)
-
-        if not thesis_puma762.is_puma762(model):
-            raise ModelError(f"ik_all: method 'puma762' applies only to the PUMA 762's geometry "
-                             f"(millimetres, Vibhute Table 2-2); model {model.name!r} differs")
-        res = thesis_puma762.solve_puma762(model, Tf, tol=tol, backend=backend)
+    if robot is not None:
+        if not robot.applies(model):
+            raise ModelError(f"ik_all: method {robot.name!r} applies only to {robot.geometry}; "
+                             f"model {model.name!r} differs")
+        res = robot.solve(model, Tf, tol=tol, backend=backend)
     elif use == "decoupled":
         from kinestat.serial.analytic import decoupled  # lazy: start-up (prismatic arms only)
 

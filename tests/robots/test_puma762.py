@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 
 import kinestat
 from kinestat.errors import InputError, JointLimitError, UnreachableError
-from kinestat.serial import puma762 as P
+from kinestat.robots.puma762 import closed_form as P
 from kinestat.spatial.transforms import rot_x, rot_z, trans_x, trans_z
 
 TWO_PI = 2 * math.pi

@@ -1,13 +1,13 @@
 """NumPy reference of the PUMA 762 reverse analysis — private, for the tests (the public
-functions always run :mod:`kinestat.serial.puma762._kernels`; their deprecated
+functions always run :mod:`kinestat.robots.puma762._kernels`; their deprecated
 ``backend="numpy"`` switch lands here)."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from kinestat.serial.puma762.forward import pose_residuals
-from kinestat.serial.puma762.params import (
+from kinestat.robots.puma762.forward import pose_residuals
+from kinestat.robots.puma762.params import (
     A23,
     N_BRANCHES,
     S2,

@@ -4,7 +4,7 @@ target (the controller's "vernier", :func:`kinestat.control.controller._solve_co
 The grid is the product of a few values per joint: ``n1 × n2 × n3`` arm configurations times
 ``n4 × n5`` wrist configurations (joint 5's values may depend on joint 4's: the axis 4 → 5
 coupling of the cell), joint 6 fixed. Each candidate's tool point and S6 come from the forward
-analysis (Vibhute eq. 2-33, the link product of :func:`~kinestat.serial.puma762.forward.forward`
+analysis (Vibhute eq. 2-33, the link product of :func:`~kinestat.robots.puma762.forward.forward`
 split at frame 3): frame 3 per arm configuration, frame 6 relative to frame 3 per wrist
 configuration, so the whole grid costs one product per candidate instead of five. The cost of a
 candidate whose tool point is off the target by ``d`` is
@@ -26,10 +26,10 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.robots.puma762._kernels import _link, _wrap, reverse_vectors_one
+from kinestat.robots.puma762.params import _A, _CA, _S, _SA
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial._numba_options import TWO_PI as _TWO_PI
-from kinestat.serial.puma762._kernels import _link, _wrap, reverse_vectors_one
-from kinestat.serial.puma762.params import _A, _CA, _S, _SA
 
 __all__ = ["grid_nearest", "select_one", "reverse_select_one", "pose_one"]
 
@@ -236,7 +236,7 @@ def pose_one(cs, T):
 
 @nb.njit(**_OPTS)
 def reverse_select_one(p, z, x, p6, q_now, offset, lo, hi, axis):
-    """:func:`~kinestat.serial.puma762._kernels.reverse_vectors_one` (tolerances 1e-6, 1e-9,
+    """:func:`~kinestat.robots.puma762._kernels.reverse_vectors_one` (tolerances 1e-6, 1e-9,
     1e-10) and :func:`select_one` in one call (one dispatch): the axis angles of the
     least-motion solution within ``[lo, hi]`` into ``axis``; False when the reverse analysis
     fails (an error code or status), finds no valid branch or none lies within the limits

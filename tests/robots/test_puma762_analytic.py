@@ -9,15 +9,14 @@ import pytest
 import kinestat
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import from_modified_dh
-from kinestat.serial import puma762 as P
-from kinestat.serial.analytic import ik_all
-from kinestat.serial.analytic.thesis_puma762 import (
+from kinestat.robots.puma762 import closed_form as P
+from kinestat.robots.puma762.analytic import (
     ik_all_thesis,
     is_puma762,
     puma762_chain,
 )
-
-from .arms import PI, slot_residuals, wrapped_distance
+from kinestat.serial.analytic import ik_all
+from tests.serial.analytic.arms import PI, slot_residuals, wrapped_distance
 
 
 def _same_sets(a, b, i):

@@ -1,7 +1,7 @@
-"""Compiled (Numba) kernels of the PUMA 762 closed form (:mod:`kinestat.serial.puma762`).
+"""Compiled (Numba) kernels of the PUMA 762 closed form (:mod:`kinestat.robots.puma762`).
 
-They compute what the NumPy reference (:mod:`kinestat.serial.puma762._reference`:
-``reverse_arrays`` + :func:`~kinestat.serial.puma762.forward.pose_residuals`) computes,
+They compute what the NumPy reference (:mod:`kinestat.robots.puma762._reference`:
+``reverse_arrays`` + :func:`~kinestat.robots.puma762.forward.pose_residuals`) computes,
 one pose at a time in scalars: the wrist centre, φ1 (two roots), θ3 (two roots), θ2, then for
 each arm the wrist angles θ5 (two roots), θ4 and θ6 (Vibhute eqs. 2-47..2-53 as written out in
 the reference), and — when asked — the forward analysis of every branch (eq. 2-33) as the
@@ -19,13 +19,8 @@ import math
 import numba as nb
 import numpy as np
 
-from kinestat.serial._numba_options import OPTS as _OPTS
-from kinestat.serial._numba_options import PI as _PI
-from kinestat.serial._numba_options import SQRT8 as _SQRT8
-from kinestat.serial._numba_options import TWO_PI as _TWO_PI
-
 # mechanism parameters and status codes: defined once, in params (Numba freezes them)
-from kinestat.serial.puma762.params import (
+from kinestat.robots.puma762.params import (
     _A,
     _CA,
     _S,
@@ -39,6 +34,10 @@ from kinestat.serial.puma762.params import (
     STATUS_TOO_FAR,
     STATUS_TOO_NEAR,
 )
+from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial._numba_options import PI as _PI
+from kinestat.serial._numba_options import SQRT8 as _SQRT8
+from kinestat.serial._numba_options import TWO_PI as _TWO_PI
 from kinestat.spatial.tolerances import ORTHO_TOL
 
 _NO_ARM = (0.0,) * 12
