@@ -17,8 +17,8 @@ angular resolution of axis 6 (13.4e-3°) gives exactly 1000, so :data:`INDEX_PER
 
 The ``PA`` offsets' signs are taken as printed (all positive). The seed's OCR drops minus
 signs elsewhere in this listing; the computation in docs/seed-errata-vibhute.md ("Homing's PA
-offsets") shows that the seed cannot decide them (every reading homes alike on a robot laid out for it)
-and gives the pot voltages at home that tell the readings apart on the robot. The simulated
+offsets") shows that the seed cannot decide them (every reading homes alike on a robot laid
+out for it) and gives the pot voltages at home that tell the readings apart on the robot. The simulated
 robot has its own layout (:mod:`kinestat.robots.puma762.layout`), not derived from these offsets.
 """
 
