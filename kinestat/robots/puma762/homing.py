@@ -15,11 +15,12 @@ Index marks come once per motor revolution: Table 2-1's "encoder index resolutio
 angular resolution of axis 6 (13.4e-3°) gives exactly 1000, so :data:`INDEX_PERIOD_COUNTS` is
 (3200, 3200, 3200, 1000, 1000, 1000).
 
-The ``PA`` offsets' signs are taken as printed (all positive). The seed's OCR drops minus
-signs elsewhere in this listing; the computation in docs/seed-errata-vibhute.md ("Homing's PA
-offsets") shows that the seed cannot decide them (every reading homes alike on a robot laid
-out for it) and gives the pot voltages at home that tell the readings apart on the robot. The simulated
-robot has its own layout (:mod:`kinestat.robots.puma762.layout`), not derived from these offsets.
+The ``PA`` offsets' signs are taken as printed (all positive). The seed's OCR drops minus signs
+elsewhere in this listing; the computation in docs/seed-errata-vibhute.md ("Homing's PA
+offsets") shows that the seed cannot decide them (every reading homes alike on a robot laid out
+for it) and gives the pot voltages at home that tell the readings apart on the robot. The
+simulated robot has its own layout (:mod:`kinestat.robots.puma762.layout`), not derived from
+these offsets.
 """
 
 from __future__ import annotations
