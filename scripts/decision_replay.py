@@ -70,8 +70,9 @@ def record_one(kw: dict) -> dict:
     """One run's cycle count, stop reason and commands."""
     kw = dict(kw)
     kw.setdefault("cell", SimulatedCell())
-    req = ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START,
-                         travel_dir=np.array([0.0, 1.0, 0.0]), **kw)
+    if kw["task"] == "follow":
+        kw.setdefault("travel_dir", np.array([0.0, 1.0, 0.0]))
+    req = ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START, **kw)
     prep = prepare_control(req)
     fn = (functools.partial(decide_follow, prep.follow) if kw["task"] == "follow"
           else functools.partial(decide, prep.config))

@@ -24,9 +24,11 @@ from typing import Protocol, runtime_checkable
 import numpy as np
 
 from kinestat.control.controller import Command, ControllerConfig, ControllerState
+from kinestat.control.press_task import PressTask
+from kinestat.control.thesis_task import ThesisTask
 from kinestat.control.wrench import Measurement
 
-__all__ = ["Task"]
+__all__ = ["Task", "as_task"]
 
 
 @runtime_checkable
@@ -62,9 +64,6 @@ def as_task(config: ControllerConfig, decide_fn=None) -> Task:
     or the thesis's procedure when ``config.procedure == "thesis"``), or of a bound decision
     function ``decide_fn(state, meas)`` after the press's start (the older way of passing a
     task to :func:`kinestat.control.loop.run`, kept for callers that record decisions)."""
-    from kinestat.control.press_task import PressTask
-    from kinestat.control.thesis_task import ThesisTask
-
     base = ThesisTask(config) if config.procedure == "thesis" else PressTask(config)
     return base if decide_fn is None else _BoundTask(base, decide_fn)
 
