@@ -8,6 +8,8 @@ safety envelope, log every cycle.
 - :mod:`kinestat.control.controller` — pure decision logic, ``decide(config, state, meas)``.
 - :mod:`kinestat.control.envelope` — limits, worst-case predictions, verdicts.
 - :mod:`kinestat.control.log` — the JSON-lines cycle log.
+- :mod:`kinestat.control.runspec` — one run as one frozen :class:`RunSpec` (the Python API:
+  ``kinestat.app.run(RunSpec(...))``; defaults in :mod:`kinestat.control.defaults`).
 - :mod:`kinestat.control.task` — the task protocol (start, decide, report): the press
   (:mod:`~kinestat.control.press_task`), the thesis's procedure
   (:mod:`~kinestat.control.thesis_task`) and follow (:mod:`~kinestat.control.follow_task`).
@@ -36,6 +38,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         'log': ['CycleLog', 'read_log'],
         'loop': ['CellIO', 'RunReport', 'SensorReading', 'run'],
         'model': ['ControlModel'],
+        'runspec': ['RunSpec', 'SimulatedCell', 'RealDevices', 'CylinderSpec'],
         'task': ['Task'],
         'press_task': ['PressTask'],
         'thesis_task': ['ThesisTask'],
