@@ -1,10 +1,12 @@
 """The kinestatic controller: pure decision logic, no I/O (Vibhute 2011 ch. 4, App. D.1).
 
-Over 600 lines on purpose: the procedure's types (configuration, state, command), its one
-decision per cycle and the move path every task and procedure shares (:func:`move_command`)
-are one unit; the rules of the turn and the step live in :mod:`kinestat.control.align`, the
-counts in :mod:`kinestat.control.vernier`, the predictions in :mod:`kinestat.control.predict`
-and the checks in :mod:`kinestat.control.envelope`.
+The press's start and its one decision per cycle; its settings and memory are in
+:mod:`kinestat.control.config`, the command and the move path every task shares
+(:func:`~kinestat.control.command.move_command`) in :mod:`kinestat.control.command`, the rules
+of the turn and the step in :mod:`kinestat.control.align`, the counts in
+:mod:`kinestat.control.vernier`, the predictions in :mod:`kinestat.control.predict`, the checks
+in :mod:`kinestat.control.envelope` and the tuning in :mod:`kinestat.control.tuning`. The task
+protocol runs it as :class:`~kinestat.control.press_task.PressTask`.
 
 One call per cycle, :func:`decide`, takes the controller's state and the cycle's
 :class:`~kinestat.control.wrench.Measurement` and returns the next :class:`Command` and the new
