@@ -1,13 +1,13 @@
-"""Composition root of ``kinestat control``: assemble the cell, the controller and its devices.
+"""Composition root of ``kinestat control``: a :class:`~kinestat.control.runspec.RunSpec` in,
+the prepared run out — the cell, the controller's settings and the task.
 
-The CLI (:mod:`kinestat.cli.control`) parses options into a :class:`ControlRequest` and prints
-the report; this module builds what the run needs — the thesis's experiment as a simulated
-cell (Vibhute 2011 §5.1: the special 6-6 platform centred on the flange, the tool at
-``P_tool_6``, a tilted plane ahead of the start tool point) behind the simulated Galil and
-encoder box (:mod:`kinestat.app.sim_cell`), or the real Galil and encoder stream — and runs
-the kinestatic loop (:func:`kinestat.control.loop.run`) on it. With another arm
-(``ControlRequest.arm``, ``kinestat control --arm``) the same simulated cell carries that arm
-in-process (:mod:`kinestat.app.arm_cell`).
+The CLI (:mod:`kinestat.cli.control`) and :func:`kinestat.app.run` describe a run as one
+:class:`RunSpec` (``ControlRequest`` is its older name); :func:`prepare_control` builds what it
+needs — the thesis's experiment as a simulated cell (Vibhute 2011 §5.1: the special 6-6
+platform centred on the flange, the tool at ``P_tool_6``, a tilted plane ahead of the start
+tool point) or the real cell's model, with another arm when ``RunSpec.arm`` names one
+(:mod:`kinestat.app.arm_cell`) — and :func:`run_control` opens the cell
+(:mod:`kinestat.app.cell_factory`) and runs the task on it (:func:`kinestat.control.loop.run`).
 """
 
 from __future__ import annotations
