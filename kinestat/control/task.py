@@ -25,8 +25,10 @@ import numpy as np
 
 from kinestat.control.controller import Command, ControllerConfig, ControllerState
 from kinestat.control.press_task import PressTask
+from kinestat.control.runspec import RunSpec
 from kinestat.control.thesis_task import ThesisTask
 from kinestat.control.wrench import Measurement
+from kinestat.errors import InputError
 
 __all__ = ["Task", "as_task"]
 
@@ -64,6 +66,11 @@ def as_task(config: ControllerConfig, decide_fn=None) -> Task:
     or the thesis's procedure when ``config.procedure == "thesis"``), or of a bound decision
     function ``decide_fn(state, meas)`` after the press's start (the older way of passing a
     task to :func:`kinestat.control.loop.run`, kept for callers that record decisions)."""
+    if not isinstance(config, ControllerConfig):
+        hint = (": a RunSpec runs with kinestat.app.run(spec), which builds its cell (the cell "
+                "factory sits above the control layer)" if isinstance(config, RunSpec) else "")
+        raise InputError(f"the loop runs a Task or a ControllerConfig, not a "
+                         f"{type(config).__name__}{hint}")
     base = ThesisTask(config) if config.procedure == "thesis" else PressTask(config)
     return base if decide_fn is None else _BoundTask(base, decide_fn)
 

@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
+import pytest
 
 from kinestat.app.control_run import prepare_control
 from kinestat.app.sim_cell import InProcessIO, start_counts
@@ -17,6 +18,7 @@ from kinestat.control.press_task import PressTask
 from kinestat.control.runspec import RunSpec
 from kinestat.control.task import Task, as_task
 from kinestat.control.thesis_task import ThesisTask
+from kinestat.errors import InputError
 
 
 @dataclass(frozen=True, eq=False)
@@ -84,3 +86,8 @@ def test_the_press_task_decides_as_the_bare_config(tmp_path):
     a, b = reports
     assert a.converged and (a.iterations, a.states) == (b.iterations, b.states)
     assert np.array_equal(a.tool_point, b.tool_point)
+
+
+def test_a_run_spec_given_to_the_loop_is_one_clear_error(tmp_path):
+    with CycleLog(tmp_path / "log.jsonl") as log, pytest.raises(InputError, match="app.run"):
+        run(RunSpec(), None, log)
