@@ -7,7 +7,8 @@ friction, cylinders with the automatic tilt, a tilted start that the envelope st
 noise) and writes, per run, its cycle count, stop reason and every command (kind, label,
 action, axis counts, predicted force and leg deflections) to a JSON file. ``--compare A B``
 reports, per run, whether the cycle counts, stop reasons and commands are the same and the
-largest difference of the predicted figures.
+largest difference of the predicted figures. Each run's task (press, thesis or follow) is
+recorded through the task protocol (:mod:`kinestat.control.task`).
 
     .venv/bin/python scripts/decision_replay.py record OUT.json
     .venv/bin/python scripts/decision_replay.py compare BEFORE.json AFTER.json
@@ -16,7 +17,6 @@ largest difference of the predicted figures.
 from __future__ import annotations
 
 import argparse
-import functools
 import json
 import sys
 import tempfile
@@ -26,17 +26,12 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from kinestat.app.control_run import (  # noqa: E402
-    ControlRequest,
-    CylinderSpec,
-    SimulatedCell,
-    prepare_control,
-)
+from kinestat.app.control_run import prepare_control  # noqa: E402
 from kinestat.app.sim_cell import InProcessIO, start_counts  # noqa: E402
-from kinestat.control.controller import THESIS_FORCE_DIRECTION, decide  # noqa: E402
-from kinestat.control.follow import decide_follow  # noqa: E402
+from kinestat.control.controller import THESIS_FORCE_DIRECTION  # noqa: E402
 from kinestat.control.log import CycleLog  # noqa: E402
 from kinestat.control.loop import run  # noqa: E402
+from kinestat.control.runspec import CylinderSpec, RunSpec, SimulatedCell  # noqa: E402
 
 START = np.array([-400.0, 800.0, -100.0])
 
@@ -66,28 +61,40 @@ def _listed(a) -> list | None:
     return None if a is None else np.asarray(a).tolist()
 
 
+class _Recording:
+    """The run's task (:mod:`kinestat.control.task`), recording every command it decides."""
+
+    def __init__(self, task) -> None:
+        self.name, self.config, self._task, self.cmds = task.name, task.config, task, []
+
+    def start(self, q_now, counts_now):
+        return self._task.start(q_now, counts_now)
+
+    def decide(self, state, meas):
+        cmd, new = self._task.decide(state, meas)
+        pred = getattr(cmd, "prediction", None)
+        self.cmds.append([cmd.kind, cmd.label, cmd.action, _listed(cmd.axis_counts),
+                          None if pred is None else _listed(pred.force),
+                          None if pred is None else _listed(pred.deflections)])
+        return cmd, new
+
+    def report(self, cycles):
+        return self._task.report(cycles)
+
+
 def record_one(kw: dict) -> dict:
     """One run's cycle count, stop reason and commands."""
     kw = dict(kw)
     kw.setdefault("cell", SimulatedCell())
-    req = ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START,
-                         travel_dir=np.array([0.0, 1.0, 0.0]), **kw)
+    if kw["task"] == "follow":
+        kw.setdefault("travel_dir", np.array([0.0, 1.0, 0.0]))
+    req = RunSpec(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START, **kw)
     prep = prepare_control(req)
-    fn = (functools.partial(decide_follow, prep.follow) if kw["task"] == "follow"
-          else functools.partial(decide, prep.config))
-    cmds: list = []
-
-    def recording(state, meas):
-        cmd, new = fn(state, meas)
-        pred = getattr(cmd, "prediction", None)
-        cmds.append([cmd.kind, cmd.label, cmd.action, _listed(cmd.axis_counts),
-                     None if pred is None else _listed(pred.force),
-                     None if pred is None else _listed(pred.deflections)])
-        return cmd, new
-
+    task = _Recording(prep.task)
     io = InProcessIO(prep.cell, prep.sensor, start_counts=start_counts(prep.config))
     with tempfile.TemporaryDirectory() as tmp, CycleLog(Path(tmp) / "log.jsonl") as log:
-        rep = run(prep.config, io, log, decide_fn=recording)
+        rep = run(task, io, log)
+    cmds = task.cmds
     return {"converged": rep.converged, "iterations": rep.iterations, "moves": rep.moves,
             "stop": rep.stop_reason, "cmds": cmds}
 

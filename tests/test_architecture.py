@@ -95,3 +95,25 @@ def test_long_modules_say_why_at_the_top():
     assert not unexplained, (
         f"modules over {MAX_MODULE_LINES} lines without a reason in their docstring "
         "(write 'Over 600 lines on purpose: <why>'): " + ", ".join(unexplained))
+
+
+CONTROL = PACKAGE / "control"
+CONTROL_MAX_MODULE_LINES, CONTROL_MAX_FUNCTION_LINES = 400, 60
+#: the follow task's modules, whose rewrite into estimator, law and phases is its own change
+CONTROL_SIZE_EXEMPT = ("follow",)
+
+
+def test_control_modules_and_functions_are_small():
+    """Issue 41: kinestat/control/ modules within 400 lines and whole functions within 60."""
+    big = []
+    for path in sorted(CONTROL.rglob("*.py")):
+        if path.relative_to(CONTROL).parts[0].removesuffix(".py") in CONTROL_SIZE_EXEMPT:
+            continue
+        tree, lines = _tree(path)
+        where = path.relative_to(PACKAGE.parent)
+        if len(lines) > CONTROL_MAX_MODULE_LINES:
+            big.append(f"{where} ({len(lines)} lines)")
+        big += [f"{where}:{fn.lineno} {fn.name} ({fn.end_lineno - fn.lineno + 1})"
+                for fn in _functions(tree)
+                if fn.end_lineno - fn.lineno + 1 > CONTROL_MAX_FUNCTION_LINES]
+    assert not big, "over the control package's size limits: " + ", ".join(big)

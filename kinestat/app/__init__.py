@@ -3,8 +3,11 @@ io, viz; imported only by the CLI).
 
 - :mod:`kinestat.app.sim_cell` — the simulated cell behind the simulated Galil and encoder box
   (:class:`SimHarness`), and in-process without devices (:class:`InProcessIO`).
-- :mod:`kinestat.app.control_run` — assembling the cell and the controller for
-  ``kinestat control`` (simulated or real devices) and running it.
+- :mod:`kinestat.app.control_run` — assembling the cell, the controller and the task of a
+  :class:`~kinestat.control.runspec.RunSpec` (``kinestat control``) and running it.
+- :mod:`kinestat.app.cell_factory` — the cell of a run: the built-in simulator, MuJoCo or the
+  real devices.
+- :mod:`kinestat.app.control_api` — :func:`run`: ``kinestat control`` as a Python call.
 - :mod:`kinestat.app.arm_cell` — another arm (``kinestat control --arm``) in the in-process
   simulated cell: millimetres, automatic placement, start joints.
 """
@@ -19,6 +22,7 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
     submodules=None,
     submod_attrs={
         'arm_cell': ['ArmSpec', 'PlacedArm', 'place_arm'],
+        'control_api': ['run'],
         'control_run': [
             'ControlRequest', 'PreparedRun', 'RealDevices', 'SimulatedCell', 'prepare_control',
             'run_control',

@@ -166,3 +166,12 @@ def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:
         _WARM[g]()
         took[g] = time.perf_counter() - t0
     return took
+
+
+def warm_cold_kernels() -> None:
+    """Compile the cold kernel groups of :data:`KERNELS` now, saying so on stderr (a run's
+    first cycle then does not pay for it)."""
+    cold = tuple(g for g in KERNELS if is_cold(g))
+    if cold:
+        with compiling_notice(*cold):
+            warm_kernels(cold)

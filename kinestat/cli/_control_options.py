@@ -4,13 +4,14 @@ turned into the request's fields, and every refusal made before anything starts 
 from __future__ import annotations
 
 import math
-import time
 from pathlib import Path
 
+import numpy as np
+
 from kinestat.cli._model import load_model
+from kinestat.cli._options import check_seed
 from kinestat.cli._output import parse_floats, parse_pose
-from kinestat.control.ceilings import MAX_ITERATIONS
-from kinestat.devices.ceilings import MAX_SAMPLES
+from kinestat.control.defaults import PLANTS
 from kinestat.errors import InputError
 
 
@@ -28,25 +29,16 @@ def host_port(text: str) -> tuple[str, int]:
 
 
 def run_dir(base: Path) -> Path:
-    """A new run directory ``base/<timestamp>[-k]``, created here: two runs started in the
-    same second each get their own (mkdir is atomic; checking for it first was not, and two
-    runs wrote one interleaved log)."""
-    stamp = time.strftime("%Y%m%d-%H%M%S")
-    base.mkdir(parents=True, exist_ok=True)
-    k = 1
-    while True:
-        d = base / (stamp if k == 1 else f"{stamp}-{k}")
-        try:
-            d.mkdir()
-            return d
-        except FileExistsError:
-            k += 1
+    """A new run directory (:func:`kinestat.app.control_api.run_dir`)."""
+    from kinestat.app.control_api import run_dir as claim  # lazy: start-up (numba)
+
+    return claim(base)
 
 
 def parse_workpiece(text: str | None):
     """``--workpiece``: "plane" (None) or "cylinder:radius=R,axis=x,y,z[,point=x,y,z]" (a
     :class:`~kinestat.app.control_run.CylinderSpec`)."""
-    from kinestat.app.control_run import CylinderSpec  # lazy: start-up (numba)
+    from kinestat.control.runspec import CylinderSpec  # lazy: start-up (numba)
 
     if text is None or text.strip() == "plane":
         return None
@@ -80,13 +72,9 @@ def cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, 
           rate, seed, sim_legs="thesis", workpiece=None, sim="kinestat",
           workpiece_stiffness=None):
     """The cell the options describe: simulated (no device options) or the real devices."""
-    from kinestat.app.control_run import (  # lazy: start-up (numba)
-        PLANTS,
-        RealDevices,
-        SimulatedCell,
-    )
+    from kinestat.control.runspec import RealDevices, SimulatedCell  # lazy: start-up (numba)
 
-    if sim not in PLANTS:
+    if sim not in PLANTS:  # before the next check names --sim's other values
         raise InputError(f"--sim must be one of {', '.join(PLANTS)}, got {sim!r}")
     if galil is not None and sim != "kinestat":
         raise InputError("--sim chooses the simulated cell's physics; with real devices "
@@ -104,20 +92,6 @@ def cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, 
                          "cell; they cannot be used "
                          "with real devices")
     cylinder = parse_workpiece(workpiece)
-    if cylinder is not None and (plane_point or plane_normal):
-        raise InputError("--plane-point/--plane-normal describe a plane workpiece; with "
-                         "--workpiece cylinder:... give the cylinder's point= instead")
-    if serial_format not in ("ks", "legacy"):
-        raise InputError(f"--serial-format must be 'ks' or 'legacy', got {serial_format!r}")
-    if ideal_sensor and noise:
-        raise InputError("--ideal-sensor and --noise exclude each other")
-    if not (math.isfinite(noise) and noise >= 0):
-        raise InputError(f"--noise must be >= 0 mm, got {noise}")
-    if workpiece_stiffness is not None and not (math.isfinite(workpiece_stiffness)
-                                                and workpiece_stiffness > 0):
-        raise InputError(f"--workpiece-stiffness must be a finite number of N/mm > 0, got "
-                         f"{workpiece_stiffness}")
-
     if galil is None:
         return SimulatedCell(
             plane_point=parse_floats(plane_point, 3, "plane-point") if plane_point else None,
@@ -159,7 +133,7 @@ def arm(arm, tip, base, scale, length_unit, arm_base, galil, serial):
 
 
 def tool_and_mount(tool_offset: str | None, a67: str | None, mount: str | None) -> dict:
-    """``--tool-offset``, ``--a67`` and ``--mount`` as :class:`ControlRequest` fields."""
+    """``--tool-offset``, ``--a67`` and ``--mount`` as :class:`RunSpec` fields."""
     out: dict = {}
     if tool_offset is not None:
         out["tool_point_6"] = parse_floats(tool_offset, 3, "tool-offset")
@@ -173,27 +147,6 @@ def tool_and_mount(tool_offset: str | None, a67: str | None, mount: str | None) 
         else:
             out["mount"] = parse_pose(text, "mount")
     return out
-
-
-def check_task_options(task: str, **given) -> None:
-    """The follow task's options given to another task: one clear error naming them (they
-    would be ignored)."""
-    if task != "press":  # follow, or an unknown task (refused with its own error)
-        return
-    named = [f"--{k.replace('_', '-')}" for k, v in given.items() if v is not None]
-    if named:
-        raise InputError(f"{', '.join(named)} only apply to --task follow (this run is "
-                         f"--task {task})")
-
-
-def check_counts(samples: int, max_iterations: int | None) -> None:
-    """The documented ceilings of --samples and --max-iterations, before anything starts."""
-    if not 1 <= samples <= MAX_SAMPLES:
-        raise InputError(f"--samples must be in 1..{MAX_SAMPLES} (packets averaged per "
-                         f"measurement), got {samples}")
-    if max_iterations is not None and not 1 <= max_iterations <= MAX_ITERATIONS:
-        raise InputError(f"--max-iterations must be in 1..{MAX_ITERATIONS}, got "
-                         f"{max_iterations}")
 
 
 def check_rate_and_log(rate: float, log: Path | None) -> None:
@@ -212,3 +165,56 @@ def check_plot_dir(plot: Path | None, no_plot: bool) -> None:
     if plot is not None and not no_plot and plot.exists() and not plot.is_dir():
         raise InputError(f"--plot {str(plot)!r} exists and is not a directory; give a "
                          "directory for the wrench-vs-state plot")
+
+
+def check_invocation(o: dict) -> None:
+    """The options about the command itself (outputs, viewer, seed), before anything starts."""
+    check_seed(o["seed"])
+    check_plot_dir(o["plot"], o["no_plot"])
+    check_rate_and_log(o["rate"], o["log"])
+    if o["serve"] and (not o["view"] or o["html"] is not None):
+        raise InputError("--serve goes with --view (and not with --html)")
+
+
+def direction(o: dict) -> np.ndarray:
+    """``--direction`` as a unit vector."""
+    d = parse_floats(o["direction"], 3, "direction")
+    if np.linalg.norm(d) == 0:
+        raise InputError("--direction must not be the zero vector")
+    return d / np.linalg.norm(d)
+
+
+def run_spec(o: dict):
+    """The :class:`~kinestat.control.runspec.RunSpec` of the options ``o`` (every setting
+    checked there once)."""
+    force = o["force"]
+    if not (math.isfinite(force) and force > 0):
+        raise InputError(f"--force must be a positive number of newtons, got {force}")
+    d, p0 = direction(o), parse_floats(o["start"], 3, "start")
+    from kinestat.control.runspec import RunSpec  # lazy: start-up (numba)
+
+    same = ("force_tol", "align_tol_deg", "method", "step", "approach_step", "estimator",
+            "samples", "max_iterations", "calibration", "platform", "procedure", "move_rule",
+            "assume_homed", "task", "travel", "travel_step", "tilt_deg", "auto_tilt",
+            "probe_span", "max_approach")
+    travel_dir = o["travel_dir"]
+    return RunSpec(
+        force=force * d, start_tool_point=p0, **{k: o[k] for k in same},
+        travel_dir=None if travel_dir is None else parse_floats(travel_dir, 3, "travel-dir"),
+        arm=arm(o["arm"], o["tip"], o["base"], o["scale"], o["length_unit"], o["arm_base"],
+                o["galil"], o["serial"]),
+        cell=cell(o["galil"], o["serial"], o["serial_format"], o["plane_point"],
+                  o["plane_normal"], o["ideal_sensor"], o["noise"], o["friction"], o["rate"],
+                  o["seed"], o["sim_legs"], o["workpiece"], o["sim"],
+                  o["workpiece_stiffness"]),
+        **tool_and_mount(o["tool_offset"], o["a67"], o["mount"]))
+
+
+def paths(log: Path | None, plot: Path | None, no_plot: bool) -> tuple[Path, Path | None]:
+    """The cycle log's path and the plots' directory (None: no plots); the run directory
+    ``kinestat-runs/<timestamp>`` is claimed only when one of them needs it."""
+    run_directory = None
+    if log is None or (plot is None and not no_plot):
+        run_directory = run_dir(Path("kinestat-runs"))
+    log_path = log if log is not None else run_directory / "log.jsonl"
+    return log_path, None if no_plot else (plot if plot is not None else run_directory)

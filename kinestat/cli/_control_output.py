@@ -119,3 +119,24 @@ def print_report(out: dict) -> None:
     out_console.print(f"log: {literal(out['log'])}")
     for p in out.get("plots", []):
         out_console.print(f"plot: {literal(p)}")
+
+
+def announce(prepared, o: dict) -> None:
+    """The run's first line on stderr: the goal, the procedure and the cell."""
+    spec = prepared.request
+    d = spec.direction
+    cell = (("simulated cell" + (" (MuJoCo)" if o["sim"] == "mujoco" else ""))
+            if prepared.cell is not None
+            else literal(f"Galil {o['galil']}, sensor {o['serial']}"))
+    err_console.print(f"[bold]kinestat control[/]: |F_req| = {o['force']:g} N along "
+                      f"({d[0]:.4f}, {d[1]:.4f}, {d[2]:.4f}), procedure {spec.procedure}, "
+                      f"method {spec.method}, calibration {spec.calibration}, " + cell
+                      + ("" if prepared.arm is None else literal(arm_words(prepared.arm)))
+                      + ("" if prepared.follow is None else
+                         "; follow {:g} mm, first along ({:.4f}, {:.4f}, {:.4f})".format(
+                             prepared.follow.travel, *prepared.follow.travel_dir)))
+
+
+def no_plot(exc: Exception) -> None:
+    """A plot the run's log cannot give: said on stderr, the run's result stands."""
+    err_console.print(f"[yellow]no plot:[/] {literal(exc)}")

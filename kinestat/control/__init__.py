@@ -8,8 +8,14 @@ safety envelope, log every cycle.
 - :mod:`kinestat.control.controller` — pure decision logic, ``decide(config, state, meas)``.
 - :mod:`kinestat.control.envelope` — limits, worst-case predictions, verdicts.
 - :mod:`kinestat.control.log` — the JSON-lines cycle log.
-- :mod:`kinestat.control.loop` — the loop over the :class:`~kinestat.control.loop.CellIO`
-  protocol (cell in, decisions, cell out); it imports no driver and no simulator.
+- :mod:`kinestat.control.runspec` — one run as one frozen :class:`RunSpec` (the Python API:
+  ``kinestat.app.run(RunSpec(...))``; defaults in :mod:`kinestat.control.defaults`).
+- :mod:`kinestat.control.task` — the task protocol (start, decide, report): the press
+  (:mod:`~kinestat.control.press_task`), the thesis's procedure
+  (:mod:`~kinestat.control.thesis_task`) and follow (:mod:`~kinestat.control.follow_task`).
+- :mod:`kinestat.control.loop` — the loop over a task and the
+  :class:`~kinestat.control.loop.CellIO` protocol (cell in, decisions, cell out); it imports
+  no driver and no simulator.
 
 The robot's axis conventions come from its package (:mod:`kinestat.robots`), the leg
 calibration from :mod:`kinestat.hardware`.
@@ -33,6 +39,11 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         'log': ['CycleLog', 'read_log'],
         'loop': ['CellIO', 'RunReport', 'SensorReading', 'run'],
         'model': ['ControlModel'],
+        'runspec': ['RunSpec', 'SimulatedCell', 'RealDevices', 'CylinderSpec'],
+        'task': ['Task'],
+        'press_task': ['PressTask'],
+        'thesis_task': ['ThesisTask'],
+        'follow_task': ['FollowTask'],
         'wrench': ['Measurement', 'measure'],
     },
 )

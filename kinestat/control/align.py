@@ -17,14 +17,12 @@ from scipy.spatial.transform import Rotation
 
 from kinestat.control.arm import frame_from_tool
 from kinestat.control.predict import sliding_push, tip_stiffness
+from kinestat.control.tuning import TUNING, Tuning
 from kinestat.spatial.transforms import cross3
 
 __all__ = [
-    "MAX_ALIGN_TURN_DEG", "PUSH_TURN_DEG", "PUSH_LEFT_DEG", "OVERSHOOT_RATIO", "MIN_ALIGN_GAIN",
-    "MIN_PUSH_RATE", "TURN_RETRIES", "ALIGN_PROGRESS", "ALIGN_STALL_CYCLES", "align_progress",
-    "align_stalled", "align_stall_reason",
-    "STUCK_RATIO", "turn_vector", "rotate_onto", "align_gain", "turn_was_carried",
-    "contact_move", "turned_force", "stuck", "shed",
+    "align_progress", "align_stalled", "align_stall_reason", "turn_vector", "rotate_onto",
+    "align_gain", "turn_was_carried", "contact_move", "turned_force", "stuck", "shed",
 ]
 
 
@@ -38,47 +36,7 @@ def turn_vector(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return axis * (math.atan2(s, float(a @ b)) / s)
 
 
-_ORIGIN = np.zeros(3)
-
-MAX_ALIGN_TURN_DEG = 20.0
-"""The largest align turn of S6 in one cycle (degrees): a workpiece met far off the tool axis is
-turned onto in steps (a 40° turn at once moves the wrist beyond the envelope's 30° per
-command). The default plane's first turn (4.8°) and the R = 200 mm cylinder's (13.5°, at a
-light first contact) are made at once."""
-TURN_RETRIES = 3
-"""An align turn the envelope refuses because an axis would move more than its per-command
-step (a wrist near its singular pose swings axis 4 by 30–42° for a 20° turn of S6) is tried
-again within the cycle at half the turn, up to this many times (the press's
-:func:`~kinestat.control.controller.decide`)."""
-PUSH_TURN_DEG = 10.0
-PUSH_LEFT_DEG = 5.0
-"""An align turn larger than ``PUSH_TURN_DEG``, or one that leaves more than ``PUSH_LEFT_DEG``
-of misalignment (a turn cut at ``MAX_ALIGN_TURN_DEG``), is made without the force step's push
-along the new axis (stepping back is still made): the Newton step was computed at the old
-axis and the light first contact, and on a frictionless surface met far off the tool axis the
-push and the large turn together drove the force from about 1 N to 5–7 N in one cycle and the
-top past its 4° range (docs/control.md, "The press on curved and steep workpieces")."""
-OVERSHOOT_RATIO = 0.5
-"""An align turn overshot when the next misalignment points back against it by more than this
-fraction of the turn (:func:`align_gain`)."""
-MIN_PUSH_RATE = 0.2
-"""The turned tool's push rate (:func:`turned_force`) is used for the step when it lies
-between this fraction of the axial point stiffness ``s6ᵀ K_tip s6`` and that stiffness (a
-sliding tip loads less than a pinned one); outside, the axial stiffness is kept."""
-MIN_ALIGN_GAIN = 1.0 / 32.0
-"""The smallest fraction of the misalignment an align turn makes (five halvings). A
-frictionless R = 172 mm cylinder at 5.5 N lands a turn about 16 times its size past the
-normal (κ B ≈ 16): only a turn of about 1/17 of the misalignment lands on it (the floor was
-1/8 until 2026-12-04, and that run turned to and fro for 60 cycles)."""
-ALIGN_PROGRESS = 0.8
-"""A misalignment below this fraction of the one at the last progress is progress
-(:func:`align_stalled`)."""
-ALIGN_STALL_CYCLES = 12
-"""Contact cycles without progress after which turns cut to their floor stop the run
-(:func:`align_stalled`)."""
-
-
-def align_gain(gain: float, last_turn, misalignment) -> float:
+def align_gain(gain: float, last_turn, misalignment, tuning: Tuning = TUNING) -> float:
     """The fraction of the misalignment ``misalignment`` (rotation vector from S6 onto the
     measured force, radians) that the next align turn makes, after the turn ``last_turn``
     (rotation vector, or None when the last move was not an align turn) made with ``gain``.
@@ -90,8 +48,9 @@ def align_gain(gain: float, last_turn, misalignment) -> float:
     for good (a frictionless R = 200 mm cylinder at 4 N: ±2.35° a cycle; docs/control.md,
     "The press on curved and steep workpieces"). The turn that lands on the normal is e / (1 + κ B).
     Without measuring κ B: a turn overshot when the new misalignment points back along it by
-    more than ``OVERSHOOT_RATIO`` of the turn (κ B > ½ at the whole turn); the gain then halves
-    (down to ``MIN_ALIGN_GAIN``), otherwise it grows back by a quarter (up to 1).
+    more than ``tuning.overshoot_ratio`` of the turn (κ B > ½ at the whole turn); the gain
+    then halves (down to ``tuning.min_align_gain``), otherwise it grows back by a quarter (up
+    to 1).
 
     >>> align_gain(1.0, [0.0, 0.0, 0.04], [0.0, 0.0, -0.04])   # overshot by the whole turn
     0.5
@@ -107,16 +66,16 @@ def align_gain(gain: float, last_turn, misalignment) -> float:
     if not size > 0.0:
         return float(gain)
     back = -float(np.asarray(misalignment, dtype=float) @ t) / size
-    if back > OVERSHOOT_RATIO * size:
-        return max(0.5 * float(gain), MIN_ALIGN_GAIN)
+    if back > tuning.overshoot_ratio * size:
+        return max(0.5 * float(gain), tuning.min_align_gain)
     return min(1.25 * float(gain), 1.0)
 
 
 def align_progress(ref_deg: float | None, stall: int, mis_deg: float,
-                   tol_deg: float) -> tuple[float, int]:
+                   tol_deg: float, tuning: Tuning = TUNING) -> tuple[float, int]:
     """The align turns' progress after a contact cycle measured ``mis_deg``: ``(ref, stall)``,
     the misalignment at the last progress and the cycles since. Progress is the first contact,
-    a misalignment within ``tol_deg`` or one below ``ALIGN_PROGRESS`` of ``ref_deg``
+    a misalignment within ``tol_deg`` or one below ``tuning.align_progress`` of ``ref_deg``
     (:func:`align_stalled`).
 
     >>> align_progress(None, 0, 2.0, 0.5), align_progress(2.0, 0, 1.7, 0.5)
@@ -124,30 +83,31 @@ def align_progress(ref_deg: float | None, stall: int, mis_deg: float,
     >>> align_progress(2.0, 5, 1.5, 0.5)
     (1.5, 0)
     """
-    if ref_deg is None or mis_deg <= tol_deg or mis_deg < ALIGN_PROGRESS * ref_deg:
+    if ref_deg is None or mis_deg <= tol_deg or mis_deg < tuning.align_progress * ref_deg:
         return mis_deg, 0
     return ref_deg, stall + 1
 
 
-def align_stalled(stall: int, gain: float) -> bool:
+def align_stalled(stall: int, gain: float, tuning: Tuning = TUNING) -> bool:
     """Whether the align turns cannot settle the force on S6: ``stall`` contact cycles (at
-    least ``ALIGN_STALL_CYCLES``) went by without the misalignment falling below
-    ``ALIGN_PROGRESS`` of its value at the last progress, while the turns overshot so often
-    that their gain is within a halving of its floor ``MIN_ALIGN_GAIN``. On a frictionless
-    convex surface at a high force the tip's equilibrium where the force would lie along S6
-    can be unstable: the smallest turn snaps the tip from one side of it to the other (a
-    frictionless R = 200 mm cylinder at 5.8 N: 1.18° off on one side at a 0.078° turn, 2.75°
-    off on the other at 0.104°), and no turn aligns it. The controller applies it to the
+    least ``tuning.align_stall_cycles``) went by without the misalignment falling below
+    ``tuning.align_progress`` of its value at the last progress, while the turns overshot so
+    often that their gain is within a halving of its floor ``tuning.min_align_gain``. On a
+    frictionless convex surface at a high force the tip's equilibrium where the force would
+    lie along S6 can be unstable: the smallest turn snaps the tip from one side of it to the
+    other (a frictionless R = 200 mm cylinder at 5.8 N: 1.18° off on one side at a 0.078°
+    turn, 2.75° off on the other at 0.104°), and no turn aligns it. The controller applies it to the
     stiffness method only: the fixed step's jumps of several newtons (``--method fixed``)
     also keep the turns from settling, and that run stops on its own reasons.
 
-    >>> align_stalled(12, MIN_ALIGN_GAIN), align_stalled(12, 0.5), align_stalled(3, MIN_ALIGN_GAIN)
+    >>> align_stalled(12, 1 / 32), align_stalled(12, 0.5), align_stalled(3, 1 / 32)
     (True, False, False)
     """
-    return stall >= ALIGN_STALL_CYCLES and gain <= 2.0 * MIN_ALIGN_GAIN
+    return stall >= tuning.align_stall_cycles and gain <= 2.0 * tuning.min_align_gain
 
 
-def align_stall_reason(stall: int, ref_deg: float, mis_deg: float) -> str:
+def align_stall_reason(stall: int, ref_deg: float, mis_deg: float,
+                       tuning: Tuning = TUNING) -> str:
     """The stop reason of :func:`align_stalled`: ``ref_deg`` the misalignment at the last
     progress, ``mis_deg`` the present one.
 
@@ -155,7 +115,7 @@ def align_stall_reason(stall: int, ref_deg: float, mis_deg: float) -> str:
     'the force does not settle on the tool axis: in 12 cycles in cont'
     """
     return (f"the force does not settle on the tool axis: in {stall} cycles in contact the "
-            f"misalignment did not fall {100 * (1 - ALIGN_PROGRESS):.0f} % below "
+            f"misalignment did not fall {100 * (1 - tuning.align_progress):.0f} % below "
             f"{ref_deg:.3g}° (now {mis_deg:.3g}°), and the align turns, cut to a few "
             "hundredths of it, still overshoot across S6. The contact is unstable where its "
             "force would lie along S6, and the tip snaps from one side to the other (seen on "
@@ -163,15 +123,10 @@ def align_stall_reason(stall: int, ref_deg: float, mis_deg: float) -> str:
             f"or an --align-tol-deg above {max(ref_deg, mis_deg):.2g}°")
 
 
-STUCK_RATIO = 0.5
-"""An align turn found the tip stuck when it removed less than this fraction of itself from
-the misalignment (:func:`turn_was_carried`)."""
-
-
-def turn_was_carried(before, turn, after) -> bool:
+def turn_was_carried(before, turn, after, tuning: Tuning = TUNING) -> bool:
     """Whether the align turn ``turn`` (rotation vector, radians), made from the misalignment
     ``before``, was carried by the force instead of closing the gap: the misalignment
-    ``after`` it is less than ``STUCK_RATIO`` of the turn smaller along it.
+    ``after`` it is less than ``tuning.stuck_ratio`` of the turn smaller along it.
 
     A tip that sticks on the workpiece holds the top: turning S6 about the tool point then
     turns the platform rigidly about the tip, its legs do not change, and the force turns with
@@ -194,7 +149,7 @@ def turn_was_carried(before, turn, after) -> bool:
     if not size > 0.0:
         return False
     closed = float((np.asarray(before, dtype=float) - np.asarray(after, dtype=float)) @ t) / size
-    return closed < STUCK_RATIO * size
+    return closed < tuning.stuck_ratio * size
 
 
 def rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -211,14 +166,17 @@ def rotate_onto(v: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 
 def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float,
-                 max_turn_deg: float = MAX_ALIGN_TURN_DEG):
+                 max_turn_deg: float | None = None):
     """The move of a cycle in contact: (action, target, step along the axis, turn in degrees,
     the state's align memory). Misaligned: turn S6 onto the force about the tool point (the
     torque about it vanishes) — a fraction of the turn where the last one overshot
     (:func:`~kinestat.control.align.align_gain`), at most ``max_turn_deg`` — or, where
     the turns are carried by a stuck tip, shed the force across S6 (:func:`shed`). Then the
-    step along the axis when the force is out of tolerance."""
-    model, tgt = config.model, state.target
+    step along the axis when the force is out of tolerance. ``max_turn_deg`` None: the
+    tuning's ``max_align_turn_deg``."""
+    model, tgt, tuning = config.model, state.target, config.tuning
+    if max_turn_deg is None:
+        max_turn_deg = tuning.max_align_turn_deg
     Fmag = np.linalg.norm(F)
     step, rotation, far, k_push = 0.0, 0.0, False, None
     memo: dict = {}
@@ -228,7 +186,8 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float,
             return shed(config, state, meas, F, mis, err)
         action = "align"
         gain = align_gain(state.align_gain,
-                          state.align_turn if state.last_action == "align" else None, full)
+                          state.align_turn if state.last_action == "align" else None, full,
+                          tuning)
         frac = min(gain, math.radians(max_turn_deg) / max(np.linalg.norm(full),
                                                                  1e-300))
         if frac < 1.0:
@@ -243,7 +202,7 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float,
         a67 = a67 - (a67 @ axis) * axis
         a67 /= np.linalg.norm(a67)
         rotation = frac * mis  # frac <= 1: exactly mis for the whole turn
-        far = rotation > PUSH_TURN_DEG or mis * (1.0 - frac) > PUSH_LEFT_DEG
+        far = rotation > tuning.push_turn_deg or mis * (1.0 - frac) > tuning.push_left_deg
         memo = {"align_gain": gain, "align_turn": turn, "align_from": full}
         if config.method != "fixed":
             turned = turned_force(config, state, meas, axis, a67)
@@ -257,7 +216,7 @@ def contact_move(config, state, meas, F: np.ndarray, mis: float, err: float,
             step = math.copysign(config.step, err)
         else:
             k = float(axis @ tip_stiffness(model, meas) @ axis)
-            if k_push is not None and MIN_PUSH_RATE * k <= k_push <= k:
+            if k_push is not None and tuning.min_push_rate * k <= k_push <= k:
                 k = k_push  # the turned tool's push, with the tip sliding (turned_force)
             step = float(min(max(err / k, -config.step), config.step))  # numpy.clip, in floats
         if far and step > 0.0:  # a large turn, or far off the force: turn before pushing
@@ -281,8 +240,9 @@ def turned_force(config, state, meas, s6, a67) -> tuple[float, float] | None:
     tgt = state.target
     # the rigid motion from the commanded tool frame to the turned one, applied to the flange
     # where it was measured: the turn R_new R_nowᵀ about the tool point
-    R = (frame_from_tool(_ORIGIN, s6, a67, _ORIGIN)[:3, :3]
-         @ frame_from_tool(_ORIGIN, tgt.s6, tgt.a67, _ORIGIN)[:3, :3].T)
+    o = np.zeros(3)
+    R = (frame_from_tool(o, s6, a67, o)[:3, :3]
+         @ frame_from_tool(o, tgt.s6, tgt.a67, o)[:3, :3].T)
     move = np.eye(4)
     move[:3, :3] = R
     move[:3, 3] = tgt.tool_point - R @ tgt.tool_point
@@ -297,7 +257,7 @@ def stuck(config, state, full: np.ndarray, mis: float) -> bool:
     if config.method != "stiffness":
         return False
     if state.last_action == "align":
-        return turn_was_carried(state.align_from, state.align_turn, full)
+        return turn_was_carried(state.align_from, state.align_turn, full, config.tuning)
     return state.last_action == "shed" and mis <= state.shed_expect_deg
 
 

@@ -6,9 +6,10 @@ pose is up to ~120° away on an axis, four times the envelope's 30° per command
 interpolates the axis counts linearly (a straight line in joint space, which stays inside the
 axis limits' box) and cuts it into ``n`` equal commands, ``n`` chosen so that every axis, and
 axis 5's MOTOR step with the axis 4 → 5 compensation the motion controller adds
-(Vibhute App. D.9), stays within :data:`APPROACH_STEP_FRACTION` of the limit. Every command is
-then checked by :func:`kinestat.control.envelope.check_command` (limits, step) against the one
-before it; the device side checks the sent counts again and verifies each move by read-back.
+(Vibhute App. D.9), stays within the tuning's ``approach_step_fraction``
+(:class:`~kinestat.control.tuning.Tuning`) of the limit. Every command is then checked by
+:func:`kinestat.control.envelope.check_command` (limits, step) against the one before it;
+the device side checks the sent counts again and verifies each move by read-back.
 
 The joint-space path is NOT checked for collisions (the controller does not know the
 workpiece): approach from a pose where the straight joint-space path to the start pose is
@@ -23,21 +24,17 @@ import numpy as np
 
 from kinestat.control.envelope import Envelope, check_command
 from kinestat.control.model import ControlModel
+from kinestat.control.tuning import TUNING, Tuning
 from kinestat.robots.puma762.axes import round_half_away
 
-__all__ = ["APPROACH_STEP_FRACTION", "approach_waypoints", "check_approach"]
-
-APPROACH_STEP_FRACTION = 0.6
-"""Each approach command moves an axis at most this fraction of ``max_joint_step_deg`` (18° of
-30°): axis 5's motor step adds up to |coupling| (0.47) times axis 4's, so 1.47 × 18° < 30°."""
-
+__all__ = ["approach_waypoints", "check_approach"]
 
 def approach_waypoints(envelope: Envelope, model: ControlModel, counts_now,
-                       counts_goal) -> np.ndarray:
+                       counts_goal, tuning: Tuning = TUNING) -> np.ndarray:
     """The approach's commands, shape (n, 6) whole axis counts, the last one ``counts_goal``.
 
-    ``n`` = ceil(largest step / (APPROACH_STEP_FRACTION · max_joint_step_deg)), with axis 5's
-    step counted as |Δ5| + |coupling|·|Δ4| (degrees); ``n`` = 1 for a short move.
+    ``n`` = ceil(largest step / (``tuning.approach_step_fraction`` · max_joint_step_deg)),
+    with axis 5's step counted as |Δ5| + |coupling|·|Δ4| (degrees); ``n`` = 1 for a short move.
 
     >>> from kinestat.control.model import ControlModel
     >>> from kinestat.parallel.platform import special_6_6
@@ -53,7 +50,7 @@ def approach_waypoints(envelope: Envelope, model: ControlModel, counts_now,
     res = np.asarray(model.axis_deg_per_count, dtype=float)
     step_deg = np.abs(goal - now) * res
     step_deg[4] += abs(float(model.coupling)) * step_deg[3] * res[4] / res[3]
-    per = APPROACH_STEP_FRACTION * envelope.max_joint_step_deg
+    per = tuning.approach_step_fraction * envelope.max_joint_step_deg
     n = max(1, math.ceil(float(np.max(step_deg)) / per - 1e-12))
     s = np.arange(1, n + 1, dtype=float)[:, None] / n
     wps = round_half_away(now + s * (goal - now)).astype(np.int64)

@@ -1,10 +1,12 @@
 """The kinestatic controller: pure decision logic, no I/O (Vibhute 2011 ch. 4, App. D.1).
 
-Over 600 lines on purpose: the procedure's types (configuration, state, command), its one
-decision per cycle and the move path every task and procedure shares (:func:`move_command`)
-are one unit; the rules of the turn and the step live in :mod:`kinestat.control.align`, the
-counts in :mod:`kinestat.control.vernier`, the predictions in :mod:`kinestat.control.predict`
-and the checks in :mod:`kinestat.control.envelope`.
+The press's start and its one decision per cycle; its settings and memory are in
+:mod:`kinestat.control.config`, the command and the move path every task shares
+(:func:`~kinestat.control.command.move_command`) in :mod:`kinestat.control.command`, the rules
+of the turn and the step in :mod:`kinestat.control.align`, the counts in
+:mod:`kinestat.control.vernier`, the predictions in :mod:`kinestat.control.predict`, the checks
+in :mod:`kinestat.control.envelope` and the tuning in :mod:`kinestat.control.tuning`. The task
+protocol runs it as :class:`~kinestat.control.press_task.PressTask`.
 
 One call per cycle, :func:`decide`, takes the controller's state and the cycle's
 :class:`~kinestat.control.wrench.Measurement` and returns the next :class:`Command` and the new
@@ -42,8 +44,8 @@ the new axis are commanded together (at light contact the measured direction is 
 towards the target force makes it precise).
 
 The move in contact is :func:`kinestat.control.align.contact_move`: the turn is at most
-``MAX_ALIGN_TURN_DEG`` a cycle and a large one is made before pushing along the new axis; a
-turn that overshot the force makes the next ones a fraction of the misalignment (on a
+the tuning's ``max_align_turn_deg`` a cycle and a large one is made before pushing along the
+new axis; a turn that overshot the force makes the next ones a fraction of the misalignment (on a
 frictionless curved surface the free tip slides as S6 turns, and the whole turn lands past the
 new normal); and where a stuck tip carries the turns, the force is shed across S6 instead.
 """
@@ -52,14 +54,11 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, field, replace
-from typing import Literal, get_args
+from dataclasses import dataclass, replace
 
 import numpy as np
 
 from kinestat.control.align import (
-    MAX_ALIGN_TURN_DEG,
-    TURN_RETRIES,
     align_progress,
     align_stall_reason,
     align_stalled,
@@ -67,21 +66,30 @@ from kinestat.control.align import (
 )
 from kinestat.control.approach import approach_waypoints, check_approach
 from kinestat.control.ceilings import MAX_ITERATIONS
-from kinestat.control.envelope import (
-    AXIS_STEP_VIOLATION,
-    Envelope,
-    check_command,
-    check_measurement,
-    check_target,
+from kinestat.control.command import (
+    Action,
+    Command,
+    CommandKind,
+    Refusal,
+    Target,
+    move_command,
+    solve_counts,
 )
-from kinestat.control.model import ControlModel
-from kinestat.control.predict import Prediction, predict
-from kinestat.control.vernier import (
-    axis_counts_to_q,
-    q_to_axis_counts,
-    vernier_search,
+from kinestat.control.config import (
+    ESTIMATORS,
+    METHODS,
+    PROCEDURES,
+    STATES,
+    THESIS_FORCE_DIRECTION,
+    ControllerConfig,
+    ControllerState,
+    Procedure,
+    StepMethod,
+    default_a67,
 )
-from kinestat.control.wrench import Estimator, Measurement
+from kinestat.control.envelope import AXIS_STEP_VIOLATION, check_measurement, check_target
+from kinestat.control.vernier import axis_counts_to_q, q_to_axis_counts
+from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError, JointLimitError, UnreachableError
 
 __all__ = [
@@ -102,278 +110,12 @@ __all__ = [
     "decide",
     "default_a67",
     "axis_counts_to_q",
+    "move_command",
+    "Refusal",
+    "ESTIMATORS",
 ]
 
-THESIS_FORCE_DIRECTION = np.array([0.9713, 0.0, -0.2375]) / math.hypot(0.9713, 0.2375)
-"""Direction of the thesis's ``F_req = 0.9713 i + 0 j − 0.2375 k`` (Vibhute §5.1; the OCR
-dropped the minus sign — see docs/seed-errata.md), normalised (|F_req| printed = 0.99991)."""
-THESIS_FORCE_DIRECTION.setflags(write=False)
-
-STATES = {
-    "a": "platform at rest, unloaded",
-    "b": "tool has hit the workpiece, wrench generated",
-    "c": "robot reoriented the tool along the equivalent wrench",
-    "d": "force in the tool being controlled",
-    "e": "goal force attained, kinestatic control complete",
-}
-"""The states of Vibhute's Figure 5-2."""
-
-StepMethod = Literal["fixed", "stiffness"]
-"""How the step along S6 is chosen: the thesis's fixed step or a Newton step from the
-platform stiffness (see the module docstring)."""
-METHODS: tuple[str, ...] = get_args(StepMethod)
-CommandKind = Literal["move", "measure", "done", "stop"]
-"""What a :class:`Command` asks for: send axis counts, measure again without moving (the
-thesis's procedure, :mod:`kinestat.control.procedure`), report the goal, or stop safely."""
-Action = Literal["start", "approach", "align", "shed", "force", "measure", "reorient", "translate",
-                 ""]
-"""Why a move is made (Vibhute Fig. 5-2 steps; "measure", "reorient", "translate" are the steps
-of ForceCorrection.m as written); "" for done/stop."""
-Procedure = Literal["kinestat", "thesis"]
-"""``kinestat``: :func:`decide` (the improved loop); ``thesis``: ForceCorrection.m as written
-(:func:`kinestat.control.procedure.decide_thesis`)."""
-PROCEDURES: tuple[str, ...] = get_args(Procedure)
-ESTIMATORS: tuple[str, ...] = get_args(Estimator)
-
-
-def _unit(v, name: str) -> np.ndarray:
-    a = np.asarray(v, dtype=float)
-    if a.shape != (3,) or not np.all(np.isfinite(a)):
-        raise InputError(f"{name} must be 3 finite numbers, got {np.asarray(v).tolist()}")
-    n = float(np.linalg.norm(a))
-    if n < 1e-12:
-        raise InputError(f"{name} must be a nonzero vector")
-    return a / n
-
-
-def default_a67(s6) -> np.ndarray:
-    """A link direction a67 ⟂ S6 for a start pose: the fixed z axis projected off S6 (or the
-    x axis if S6 is vertical)."""
-    s = _unit(s6, "s6")
-    for ref in (np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])):
-        a = ref - (ref @ s) * s
-        if np.linalg.norm(a) > 0.1:
-            return a / np.linalg.norm(a)
-    raise InputError("cannot choose a67")  # pragma: no cover - one of the two always works
-
-
-@dataclass(frozen=True, eq=False)
-class Target:
-    """The end effector as the thesis commands it: tool point, S6 and a67 (fixed frame)."""
-
-    tool_point: np.ndarray
-    s6: np.ndarray
-    a67: np.ndarray
-
-    def key(self) -> tuple:
-        """Hashable rounding (1 nm, 1e-9) used to spot a repeated target (a limit cycle):
-        the nearest integers, ties to even (as ``numpy.round``)."""
-        v = ([x * 1e6 for x in self.tool_point.tolist()] + [x * 1e9 for x in self.s6.tolist()]
-             + [x * 1e9 for x in self.a67.tolist()])
-        if all(map(math.isfinite, v)):
-            return tuple(int(round(x)) for x in v)
-        return tuple(np.round(np.asarray(v)).astype(np.int64).tolist())  # NaN: as NumPy casts it
-
-
-
-
-@dataclass(frozen=True, eq=False)
-class ControllerConfig:
-    """Settings of one kinestatic control run (immutable).
-
-    Attributes:
-        model: the cell as the controller knows it.
-        force: (3,) ``F_req``: its magnitude is the target force (N), its direction the
-            approach direction and the start pose's S6.
-        start_tool_point: (3,) the start pose's tool point ``P_tool_F`` (mm, fixed frame).
-        start_s6, start_a67: the start pose's S6 (default along ``force``) and a67 (default
-            :func:`default_a67`).
-        force_tol: tolerance on the force magnitude (N).
-        align_tol_deg: tolerance on the angle between S6 and the measured force (degrees).
-        method: ``"fixed"`` (thesis) or ``"stiffness"``.
-        step: the fixed step, and the largest step of the stiffness method (mm).
-        approach_step: step along S6 while no contact is measured (mm; the thesis's 1 mm).
-        contact_force: force magnitude above which the tool is in contact (N).
-        max_iterations: measurement cycles before giving up.
-        vernier: choose the count vector that best realises the target along S6.
-        estimator: the force acted on: ``"point"`` (point-contact fit, default) or
-            ``"wrench"`` (the equivalent wrench's force, as the thesis), see
-            :meth:`kinestat.control.wrench.Measurement.estimate`.
-        repeat_limit: a target commanded this many times means a limit cycle → stop.
-        max_approach: the farthest an approach without contact may carry the tool point from
-            the start tool point (mm); beyond it the run stops (:func:`approach_refusal`).
-        envelope: the safety envelope.
-        procedure: "kinestat" (default) or "thesis" (ForceCorrection.m's steps as written).
-    """
-
-    model: ControlModel
-    force: np.ndarray
-    start_tool_point: np.ndarray
-    start_s6: np.ndarray | None = None
-    start_a67: np.ndarray | None = None
-    force_tol: float = 0.5
-    align_tol_deg: float = 0.5
-    method: StepMethod = "stiffness"
-    step: float = 1.0
-    approach_step: float = 1.0
-    contact_force: float = 0.25
-    max_iterations: int = 60
-    vernier: bool = True
-    estimator: Estimator = "point"
-    repeat_limit: int = 3
-    max_approach: float = 50.0
-    envelope: Envelope = field(default_factory=Envelope)
-    procedure: Procedure = "kinestat"
-
-    def __post_init__(self) -> None:
-        F = np.asarray(self.force, dtype=float)
-        if F.shape != (3,) or not np.all(np.isfinite(F)) or np.linalg.norm(F) <= 0:
-            raise InputError(f"force (F_req) must be 3 finite numbers, not all zero, got "
-                             f"{np.asarray(self.force).tolist()}")
-        object.__setattr__(self, "force", F.copy())
-        p = np.asarray(self.start_tool_point, dtype=float)
-        if p.shape != (3,) or not np.all(np.isfinite(p)):
-            raise InputError("start_tool_point must be 3 finite numbers (mm)")
-        object.__setattr__(self, "start_tool_point", p.copy())
-        s6 = F / np.linalg.norm(F) if self.start_s6 is None else _unit(self.start_s6, "start_s6")
-        a67 = default_a67(s6) if self.start_a67 is None else _unit(self.start_a67, "start_a67")
-        if abs(float(s6 @ a67)) > 1e-6:
-            raise InputError(f"start_a67 must be perpendicular to start_s6 (dot "
-                             f"{float(s6 @ a67):.3g})")
-        object.__setattr__(self, "start_s6", s6)
-        object.__setattr__(self, "start_a67", a67)
-        if self.estimator not in ESTIMATORS:
-            raise InputError(f"estimator must be one of {ESTIMATORS}, got {self.estimator!r}")
-        if self.method not in METHODS:
-            raise InputError(f"method must be one of {METHODS}, got {self.method!r}")
-        if self.procedure not in PROCEDURES:
-            raise InputError(f"procedure must be one of {PROCEDURES}, got {self.procedure!r}")
-        for name in ("force_tol", "align_tol_deg", "step", "contact_force"):
-            v = float(getattr(self, name))
-            if not (math.isfinite(v) and v > 0):
-                raise InputError(f"{name} must be a positive number, got {getattr(self, name)!r}")
-        if not (math.isfinite(self.approach_step) and self.approach_step > 0):
-            raise InputError(f"approach_step must be positive, got {self.approach_step!r}")
-        if not (math.isfinite(self.max_approach) and self.max_approach > 0):
-            raise InputError(f"max_approach must be a positive number of mm, got "
-                             f"{self.max_approach!r}")
-        if not 1 <= int(self.max_iterations) <= MAX_ITERATIONS:
-            raise InputError(f"max_iterations must be in 1..{MAX_ITERATIONS}, got "
-                             f"{self.max_iterations!r}")
-        if self.contact_force >= np.linalg.norm(F):
-            raise InputError(f"the contact threshold {self.contact_force} N must be below the "
-                             f"requested force {np.linalg.norm(F):.3g} N")
-
-    @functools.cached_property
-    def force_target(self) -> float:
-        """|F_req| (N); computed once per config (the cycle reads it several times)."""
-        return float(np.linalg.norm(self.force))
-
-    @property
-    def approach(self) -> float:
-        return float(self.approach_step)
-
-
-@dataclass(frozen=True, eq=False)
-class ControllerState:
-    """What the controller remembers between cycles (immutable; :func:`decide` returns a new one).
-
-    Attributes:
-        cycle: measurements processed so far.
-        label: the state (a–e) of the last cycle, "" before the first.
-        last_action: the last command's action ("start", "approach", "align", "force").
-        target: the last commanded end effector.
-        axis_counts: (6,) the last commanded axis counts.
-        top_pose: (4, 4) the last measured top pose (the tracking FK's seed).
-        history: keys of the targets commanded so far (limit-cycle detection).
-        done: the run is over (goal reached or stopped).
-        reoriented: the thesis's procedure made (or no longer needs) its one reorientation.
-        align_gain: the fraction of the misalignment the next align turn makes (1: the whole
-            turn; halved each time a turn overshot, see
-            :func:`kinestat.control.align.align_gain`).
-        align_turn: (3,) the last align turn's rotation vector (radians), None before one.
-        align_from: (3,) the misalignment (rotation vector from S6 onto the force) it was
-            made from.
-        shed_expect_deg: the misalignment the last shed (a move across S6 that turns a held
-            tip's force onto S6) should leave at most (degrees).
-        align_best_deg: the misalignment measured at the align turns' last progress (degrees;
-            None before contact): the first contact, a misalignment within tolerance or one
-            below ``ALIGN_PROGRESS`` of the previous value.
-        align_stall: contact cycles since that progress
-            (:func:`~kinestat.control.align.align_stalled`).
-    """
-
-    cycle: int
-    label: str
-    last_action: Action
-    target: Target
-    axis_counts: np.ndarray
-    top_pose: np.ndarray
-    history: tuple = ()
-    done: bool = False
-    reoriented: bool = False
-    align_gain: float = 1.0
-    align_turn: np.ndarray | None = None
-    align_from: np.ndarray | None = None
-    shed_expect_deg: float = 0.0
-    align_best_deg: float | None = None
-    align_stall: int = 0
-
-
-@dataclass(frozen=True, eq=False)
-class Command:
-    """The controller's decision for one cycle.
-
-    Attributes:
-        kind: "move" (send ``axis_counts``), "done" (goal reached) or "stop" (safe stop).
-        label: the cycle's state a–e ("" for the start move).
-        action: "start", "approach", "align", "force" or "" (done/stop).
-        reason: why (always set for "stop").
-        target: the commanded end effector (moves only).
-        axis_counts: (6,) absolute axis positions in robot encoder counts (moves only).
-        axis_deg: (6,) the same in degrees; q: (6,) joint angles (radians).
-        step: signed step along S6 (mm) for approach/force moves.
-        rotation_deg: reorientation angle for align moves.
-        force_error: |F_req| − |F| (N); misalignment_deg: angle(S6, F).
-        prediction: predicted force and deflections after the move.
-        violations: envelope violations that caused a stop.
-        info: task-specific figures of the cycle for the report's ``cycles`` (the follow
-            task's phase, measured tip, normal estimate, normal force, travel); empty for the
-            press task.
-        waypoints: for the start move, the intermediate axis counts commanded before
-            ``axis_counts`` (:func:`kinestat.control.approach.approach_waypoints`).
-    """
-
-    kind: CommandKind
-    label: str
-    action: Action = ""
-    reason: str = ""
-    target: Target | None = None
-    axis_counts: np.ndarray | None = None
-    axis_deg: np.ndarray | None = None
-    q: np.ndarray | None = None
-    step: float = 0.0
-    rotation_deg: float = 0.0
-    force_error: float | None = None
-    misalignment_deg: float | None = None
-    prediction: Prediction | None = None
-    violations: tuple[str, ...] = ()
-    info: dict = field(default_factory=dict)
-    waypoints: tuple[np.ndarray, ...] = ()
-
-
-# -- joint-space helpers: kinestat.control.vernier --------------------------------------------
-def _solve_counts(model: ControlModel, target: Target, q_now, counts_now,
-                  vernier: bool) -> tuple[np.ndarray, float]:
-    """Reverse analysis, selection within limits, rounding to counts (with the vernier).
-
-    Returns (counts, residual along S6 in mm of the chosen counts). Raises UnreachableError or
-    JointLimitError. The vernier searches the count vectors next to the rounded ones
-    (:func:`kinestat.control.vernier.vernier_search`)."""
-    axis = model.arm.solve_axis(target.tool_point, target.s6, target.a67, model.tool_point_6,
-                                np.asarray(q_now, dtype=float), model.limits_deg)
-    return vernier_search(model, target, q_to_axis_counts(model, axis), counts_now, vernier)
-
+_solve_counts = solve_counts  # the older name
 
 def approach_refusal(config: ControllerConfig, tool_point) -> str:
     """Why an approach without contact to ``tool_point`` is refused ("" when it is not): it
@@ -416,13 +158,14 @@ def start(config: ControllerConfig, q_now, *, counts_now=None) -> tuple[Command,
         return (Command(kind="stop", label="", reason="; ".join(bad), violations=tuple(bad)),
                 replace(state, done=True))
     try:
-        counts, _ = _solve_counts(model, target, q_now, counts_now, config.vernier)
+        counts, _ = solve_counts(model, target, q_now, counts_now, config.vernier,
+                                 config.tuning)
     except (UnreachableError, JointLimitError) as exc:
         msg = f"the start pose cannot be commanded: {exc}"
         return Command(kind="stop", label="", reason=msg), replace(state, done=True)
     axis_deg = counts * model.axis_deg_per_count
     # a long move goes as a sequence of commands, each within the per-command step
-    wps = approach_waypoints(config.envelope, model, counts_now, counts)
+    wps = approach_waypoints(config.envelope, model, counts_now, counts, config.tuning)
     bad = check_approach(config.envelope, model, counts_now, wps)
     if bad:
         return (Command(kind="stop", label="", reason="start move: " + "; ".join(bad),
@@ -435,51 +178,6 @@ def start(config: ControllerConfig, q_now, *, counts_now=None) -> tuple[Command,
 
 def _stop(state: ControllerState, label: str, reason: str, **kw) -> tuple[Command, ControllerState]:
     return Command(kind="stop", label=label, reason=reason, **kw), replace(state, done=True)
-
-
-@dataclass(frozen=True)
-class Refusal:
-    """Why a move was not commanded: ``reason`` and the extra fields of the stop command."""
-
-    reason: str
-    extra: dict
-
-
-def move_command(model: ControlModel, envelope, vernier: bool, meas, new: Target,
-                 counts_now, *, label: str, action: str, step: float, rotation_deg: float,
-                 info: dict) -> Command | Refusal:
-    """The move onto target ``new``: its axis counts by the closed form (Vibhute App. C, with
-    the vernier when asked), checked against the envelope's joint limits, per-command step and
-    predicted platform state (:func:`~kinestat.control.envelope.check_command`); or the
-    :class:`Refusal` that stops the run. One path for every task and procedure."""
-    try:
-        counts, _ = _solve_counts(model, new, meas.q, counts_now, vernier)
-    except (UnreachableError, JointLimitError) as exc:
-        return Refusal(f"{action} target not reachable: {exc}", {})
-    q_new = axis_counts_to_q(model, counts)
-    T_new = model.arm.flange_pose(q_new)
-    axis_deg = counts * model.axis_deg_per_count
-    pred = predict(model, meas, T_new)
-    bad = check_command(envelope, model, axis_deg, counts_now * model.axis_deg_per_count, pred)
-    if bad:
-        jump = float(np.max(np.abs(axis_deg - counts_now * model.axis_deg_per_count)))
-        hint = (BRANCH_CHANGE_HINT if jump > BRANCH_CHANGE_DEG
-                and any(AXIS_STEP_VIOLATION in b for b in bad) else "")
-        return Refusal(f"{action} command refused by the envelope: " + "; ".join(bad) + hint,
-                       {"violations": tuple(bad), "prediction": pred})
-    return Command(kind="move", label=label, action=action, target=new, axis_counts=counts,
-                   axis_deg=axis_deg, q=q_new, step=step, rotation_deg=rotation_deg,
-                   prediction=pred, **info)
-
-
-BRANCH_CHANGE_DEG = 90.0
-"""An axis that would move more than this in one command for a small move of the tool has
-changed inverse-kinematics branch (:data:`BRANCH_CHANGE_HINT`)."""
-BRANCH_CHANGE_HINT = (" (the nearest solution within the axis limits is far from the present "
-                      "pose: a change of the arm's inverse-kinematics branch, such as a wrist "
-                      "flip where the continuous one leaves the limits, or a pass near a "
-                      "singular wrist; the arm is at the edge of its workspace here: choose "
-                      "another --start or --direction)")
 
 
 def contact_at_start(force_magnitude: float) -> str:
@@ -503,20 +201,20 @@ def _contact_command(config: ControllerConfig, state: ControllerState, meas, F, 
     """The move of a cycle in contact (:func:`~kinestat.control.align.contact_move`) and its
     command: ``(command or Refusal, target, action, step, rotation, memo)``. An align turn
     refused because an axis would move more than its per-command step is made smaller, half
-    the turn at a time, up to ``TURN_RETRIES`` times (a wrist near its singular pose: a 20°
-    turn of S6 swung axis 4 by 30–42°)."""
-    cap = MAX_ALIGN_TURN_DEG
-    for attempt in range(TURN_RETRIES + 1):
+    the turn at a time, up to the tuning's ``turn_retries`` times (a wrist near its singular
+    pose: a 20° turn of S6 swung axis 4 by 30–42°)."""
+    cap, retries = config.tuning.max_align_turn_deg, config.tuning.turn_retries
+    for attempt in range(retries + 1):
         action, (point, axis, a67), step, rotation, memo = contact_move(
             config, state, meas, F, mis, err, max_turn_deg=cap)
         new = Target(point, axis, a67)
         cmd = move_command(config.model, config.envelope, config.vernier, meas, new,
                            state.axis_counts, label=label, action=action, step=step,
-                           rotation_deg=rotation, info=info)
+                           rotation_deg=rotation, info=info, tuning=config.tuning)
         refused_step = (isinstance(cmd, Refusal) and action == "align"
                         and any(AXIS_STEP_VIOLATION in v
                                 for v in cmd.extra.get("violations", ())))
-        if not refused_step or attempt == TURN_RETRIES:
+        if not refused_step or attempt == retries:
             return cmd, new, action, step, rotation, memo
         cap = 0.5 * rotation
     raise AssertionError("unreachable")
@@ -531,13 +229,39 @@ def decide(config: ControllerConfig, state: ControllerState,
     """
     if state.done:
         raise InputError("decide: the run is over (state.done); start a new one")
-    model = config.model
-    env = config.envelope
+    c = _reading(config, state, meas)
+    ended = _ended(config, state, meas, c)
+    if ended is not None:
+        return ended
+    best, stall = state.align_best_deg, state.align_stall
+    if c.contact:  # the align turns' progress
+        best, stall = align_progress(best, stall, c.mis, config.align_tol_deg, config.tuning)
+        if config.method == "stiffness" and align_stalled(stall, state.align_gain,
+                                                          config.tuning):
+            return _stop(c.st(label=c.label, align_best_deg=best, align_stall=stall), c.label,
+                         align_stall_reason(stall, best, c.mis, config.tuning)
+                         + f" (|F| = {c.fmag:.4g} N, error {c.err:+.4g} N)", **c.info)
+    return _move(config, state, meas, c, {"align_best_deg": best, "align_stall": stall})
+
+
+@dataclass(frozen=True)
+class _Reading:
+    """What :func:`decide` reads off one measurement."""
+
+    st: functools.partial  # st(**changes): the new state (one replace per cycle)
+    cycle: int
+    force: np.ndarray
+    fmag: float
+    contact: bool
+    err: float
+    mis: float | None
+    label: str
+    info: dict
+
+
+def _reading(config: ControllerConfig, state: ControllerState, meas: Measurement) -> _Reading:
+    """The cycle's force, its error and misalignment, and its state a-d (Vibhute Fig. 5-2)."""
     cycle = state.cycle + 1
-
-    def st(**kw) -> ControllerState:  # the new state: one replace per cycle
-        return replace(state, cycle=cycle, top_pose=meas.top_pose, **kw)
-
     F = meas.estimate(config.estimator)
     Fmag = np.linalg.norm(F)
     contact = Fmag >= config.contact_force
@@ -552,56 +276,60 @@ def decide(config: ControllerConfig, state: ControllerState,
         label = "c"
     else:
         label = "d"
-    info = {"force_error": err, "misalignment_deg": mis}
-    bad = check_measurement(env, model, meas)
+    st = functools.partial(replace, state, cycle=cycle, top_pose=meas.top_pose)
+    return _Reading(st, cycle, F, Fmag, contact, err, mis, label,
+                    {"force_error": err, "misalignment_deg": mis})
+
+
+def _ended(config: ControllerConfig, state: ControllerState, meas: Measurement,
+           c: _Reading) -> tuple[Command, ControllerState] | None:
+    """The cycle's stop or goal, before any move is planned (None: go on)."""
+    label, info = c.label, c.info
+    bad = check_measurement(config.envelope, config.model, meas)
     if bad:
-        return _stop(st(label=label), label, "measurement outside the envelope: "
+        return _stop(c.st(label=label), label, "measurement outside the envelope: "
                      + "; ".join(bad), violations=tuple(bad), **info)
-    if contact and state.last_action == "start":
-        return _stop(st(label=label), label, contact_at_start(Fmag), **info)
-    if contact and abs(err) <= config.force_tol and mis <= config.align_tol_deg:
+    if c.contact and state.last_action == "start":
+        return _stop(c.st(label=label), label, contact_at_start(c.fmag), **info)
+    if c.contact and abs(c.err) <= config.force_tol and c.mis <= config.align_tol_deg:
         return (Command(kind="done", label="e", reason="goal attained", **info),
-                st(label="e", done=True))
-    if cycle >= config.max_iterations:
-        return _stop(st(label=label), label,
-                     f"not converged after {cycle} cycles (|F| = {Fmag:.4g} N, error "
-                     f"{err:+.4g} N" + (f", misalignment {mis:.3g}°)" if mis is not None else ")"),
-                     **info)
-    best, stall = state.align_best_deg, state.align_stall
-    if contact:  # the align turns' progress
-        best, stall = align_progress(best, stall, mis, config.align_tol_deg)
-        if config.method == "stiffness" and align_stalled(stall, state.align_gain):
-            return _stop(st(label=label, align_best_deg=best, align_stall=stall), label,
-                         align_stall_reason(stall, best, mis)
-                         + f" (|F| = {Fmag:.4g} N, error {err:+.4g} N)", **info)
-    tgt = state.target
-    rotation = 0.0
-    step = 0.0
-    memo: dict = {"align_best_deg": best, "align_stall": stall}
-    if not contact:
-        action = "approach"
-        step = config.approach
+                c.st(label="e", done=True))
+    if c.cycle >= config.max_iterations:
+        return _stop(c.st(label=label), label,
+                     f"not converged after {c.cycle} cycles (|F| = {c.fmag:.4g} N, error "
+                     f"{c.err:+.4g} N" + (f", misalignment {c.mis:.3g}°)" if c.mis is not None
+                                          else ")"), **info)
+    return None
+
+
+def _move(config: ControllerConfig, state: ControllerState, meas: Measurement, c: _Reading,
+          memo: dict) -> tuple[Command, ControllerState]:
+    """The cycle's move: the approach step out of contact, the contact move in it; stopped on
+    a limit cycle or a refusal."""
+    label, info, tgt = c.label, c.info, state.target
+    if not c.contact:
+        action, step, rotation = "approach", config.approach, 0.0
         new = Target(tgt.tool_point + step * tgt.s6, tgt.s6, tgt.a67)
         refused = approach_refusal(config, new.tool_point)
         if refused:
-            return _stop(st(label=label), label, refused, **info)
-        cmd = move_command(model, env, config.vernier, meas, new, state.axis_counts,
-                           label=label, action=action, step=step, rotation_deg=rotation,
-                           info=info)
+            return _stop(c.st(label=label), label, refused, **info)
+        cmd = move_command(config.model, config.envelope, config.vernier, meas, new,
+                           state.axis_counts, label=label, action=action, step=step,
+                           rotation_deg=rotation, info=info, tuning=config.tuning)
     else:
-        cmd, new, action, step, rotation, move_memo = _contact_command(config, state, meas, F,
-                                                                       mis, err, label, info)
+        cmd, new, action, step, rotation, move_memo = _contact_command(
+            config, state, meas, c.force, c.mis, c.err, label, info)
         memo.update(move_memo)
     key = new.key()
     if state.history.count(key) + 1 >= config.repeat_limit:
-        return _stop(st(label=label), label,
+        return _stop(c.st(label=label), label,
                      f"limit cycle: the same target has now been commanded {config.repeat_limit} "
-                     f"times without reaching the goal (|F| = {Fmag:.4g} N, error {err:+.4g} N)"
+                     f"times without reaching the goal (|F| = {c.fmag:.4g} N, error "
+                     f"{c.err:+.4g} N)"
                      + (f"; the fixed {config.step:g} mm step is too coarse for this stiffness "
                         "— use method 'stiffness' or a smaller step"
                         if config.method == "fixed" else ""), **info)
     if isinstance(cmd, Refusal):
-        return _stop(st(label=label), label, cmd.reason, **cmd.extra, **info)
-    new_state = st(label=label, last_action=action, target=new,
-                   axis_counts=cmd.axis_counts, history=state.history + (key,), **memo)
-    return cmd, new_state
+        return _stop(c.st(label=label), label, cmd.reason, **cmd.extra, **info)
+    return cmd, c.st(label=label, last_action=action, target=new,
+                     axis_counts=cmd.axis_counts, history=state.history + (key,), **memo)

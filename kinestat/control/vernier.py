@@ -9,19 +9,20 @@ Every arm takes the same search: all candidates through the arm's forward analys
 
 from __future__ import annotations
 
+import functools
 import itertools
-import math
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from kinestat.control.model import ControlModel
+from kinestat.control.tuning import TUNING, Tuning
 from kinestat.robots.puma762.axes import round_half_away
 
 if TYPE_CHECKING:
     from kinestat.control.controller import Target
 
-__all__ = ["OFFSETS", "VERNIER_SCALES", "axis5_residual", "axis_counts_to_q",
+__all__ = ["vernier_offsets", "axis5_residual", "axis_counts_to_q",
            "q_to_axis_counts", "vernier_costs", "vernier_search"]
 
 
@@ -41,21 +42,29 @@ def axis5_residual(model: ControlModel, counts: np.ndarray, counts_now: np.ndarr
     return round_half_away(-kappa) + kappa
 
 
-# Vernier candidates: ±4 counts on axes 1-3 (they move the tool point along S6 by ~1-15 µm per
-# count, so their combinations resolve ~0.1 µm), ±1 on the wrist axes 4-5, axis 6 as is (it
-# turns the tool about its own axis).
-OFFSETS = np.array([(a, b, c, d, e, 0) for a, b, c in itertools.product(range(-4, 5), repeat=3)
-                     for d, e in itertools.product((-1, 0, 1), repeat=2)], dtype=np.int64)
-#: the vernier's cost scales: 1 µm along S6, 0.05 mm across it, 0.01° of tilt
-VERNIER_SCALES = (1e-3, 0.05, math.radians(0.01))
+@functools.lru_cache(maxsize=8)
+def vernier_offsets(reach: tuple[int, int]) -> np.ndarray:
+    """The vernier's candidate offsets (n, 6) of axis counts: ± ``reach[0]`` on axes 1-3, ±
+    ``reach[1]`` on the wrist axes 4-5, axis 6 as is (:class:`~kinestat.control.tuning.Tuning`,
+    ``vernier_counts``); read-only.
+
+    >>> vernier_offsets((4, 1)).shape
+    (6561, 6)
+    """
+    a, w = range(-reach[0], reach[0] + 1), range(-reach[1], reach[1] + 1)
+    out = np.array([(i, j, k, d, e, 0) for i, j, k in itertools.product(a, repeat=3)
+                    for d, e in itertools.product(w, repeat=2)], dtype=np.int64)
+    out.setflags(write=False)
+    return out
 
 
 def vernier_costs(model: ControlModel, target: Target, c0, counts_now,
-                  vernier: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The candidates ``c0 + OFFSETS`` (or ``c0`` alone), their cost and offset along S6 (mm),
-    every candidate through the arm's forward analysis (NumPy)."""
+                  vernier: bool = True, tuning: Tuning = TUNING
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The candidates ``c0 +`` :func:`vernier_offsets` (or ``c0`` alone), their cost and
+    offset along S6 (mm), every candidate through the arm's forward analysis (NumPy)."""
     c0 = np.asarray(c0)
-    cand = c0 + OFFSETS if vernier else c0[None, :]
+    cand = c0 + vernier_offsets(tuning.vernier_counts) if vernier else c0[None, :]
     phys = cand.astype(float)
     phys[:, 4] += axis5_residual(model, cand, np.asarray(counts_now))
     fwd = model.arm.forward(axis_counts_to_q(model, phys), model.tool_point_6)
@@ -63,15 +72,15 @@ def vernier_costs(model: ControlModel, target: Target, c0, counts_now,
     along = d @ target.s6
     lateral = np.linalg.norm(d - along[:, None] * target.s6, axis=1)
     tilt = np.arccos(np.clip(fwd.s6 @ target.s6, -1.0, 1.0))
-    s_along, s_lat, s_tilt = VERNIER_SCALES
+    s_along, s_lat, s_tilt = tuning.vernier_scales
     cost = (along / s_along) ** 2 + (lateral / s_lat) ** 2 + (tilt / s_tilt) ** 2
     return cand, cost, along
 
 
 def vernier_search(model: ControlModel, target: Target, c0: np.ndarray, counts_now,
-                   vernier: bool) -> tuple[np.ndarray, float]:
+                   vernier: bool, tuning: Tuning = TUNING) -> tuple[np.ndarray, float]:
     """The vernier: (counts, offset along S6 in mm) of the cheapest candidate of
     :func:`vernier_costs` (``c0`` itself without the vernier)."""
-    cand, cost, along = vernier_costs(model, target, c0, counts_now, vernier)
+    cand, cost, along = vernier_costs(model, target, c0, counts_now, vernier, tuning)
     k = int(np.argmin(cost))
     return cand[k], float(along[k])

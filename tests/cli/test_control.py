@@ -120,10 +120,10 @@ def test_real_device_options_drive_external_devices(tmp_path, capsys):
 def test_runs_started_in_the_same_second_get_their_own_directories(tmp_path, monkeypatch):
     """``run_dir`` claims the directory (an atomic mkdir): two CLI runs started in the same
     second wrote one interleaved log when it only checked that the name was free."""
-    from kinestat.cli import _control_options as cli_options
+    from kinestat.app import control_api
 
-    monkeypatch.setattr(cli_options.time, "strftime", lambda fmt: "20261203-130150")
-    dirs = [cli_options.run_dir(tmp_path / "kinestat-runs") for _ in range(3)]
+    monkeypatch.setattr(control_api.time, "strftime", lambda fmt: "20261203-130150")
+    dirs = [control_api.run_dir(tmp_path / "kinestat-runs") for _ in range(3)]
     assert len(set(dirs)) == 3 and all(d.is_dir() for d in dirs)
     assert [d.name for d in dirs] == ["20261203-130150", "20261203-130150-2",
                                       "20261203-130150-3"]

@@ -11,10 +11,11 @@ import numpy as np
 from kinestat.app.control_run import DEFAULT_START, default_plane
 from kinestat.app.sim_cell import SimHarness, control_model, start_counts
 from kinestat.cli.main import main
-from kinestat.control.approach import APPROACH_STEP_FRACTION, approach_waypoints
+from kinestat.control.approach import approach_waypoints
 from kinestat.control.controller import THESIS_FORCE_DIRECTION, ControllerConfig
 from kinestat.control.envelope import Envelope
 from kinestat.control.log import read_log
+from kinestat.control.tuning import TUNING
 from kinestat.hardware.puma762_axes import AXIS_DEG_PER_COUNT
 from kinestat.hardware.puma762_homing import HOME_COUNTS
 from kinestat.parallel.platform import special_6_6
@@ -40,7 +41,7 @@ def test_waypoints_split_a_long_move_within_the_step_and_end_at_the_goal():
     np.testing.assert_array_equal(wps[-1], goal)
     res = np.asarray(model.axis_deg_per_count)
     prev = HOME_COUNTS.astype(float)
-    per = APPROACH_STEP_FRACTION * env.max_joint_step_deg
+    per = TUNING.approach_step_fraction * env.max_joint_step_deg
     for wp in wps:
         step = np.abs(wp - prev) * res
         assert np.all(step <= per + 1e-9)

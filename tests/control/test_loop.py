@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-import kinestat.control.loop as loop_mod
+import kinestat.control.press_task as press_mod
 from kinestat.app.sim_cell import SimHarness, start_counts
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import run
@@ -143,7 +143,7 @@ def test_an_internal_error_still_stops_the_robot_and_keeps_the_log(tmp_path, mon
     class Broken(Exception):
         pass
 
-    real = loop_mod.decide
+    real = press_mod.decide
     calls = []
 
     def flaky(*a, **k):
@@ -152,7 +152,7 @@ def test_an_internal_error_still_stops_the_robot_and_keeps_the_log(tmp_path, mon
             raise Broken("boom")
         return real(*a, **k)
 
-    monkeypatch.setattr(loop_mod, "decide", flaky)
+    monkeypatch.setattr(press_mod, "decide", flaky)
     with pytest.raises(Broken):
         run_in_process(scenario(), scenario().config(), tmp_path / "log.jsonl")
     recs = read_log(tmp_path / "log.jsonl")

@@ -14,17 +14,11 @@ from hypothesis import strategies as st
 
 from kinestat.app.control_run import ControlRequest, CylinderSpec, SimulatedCell, prepare_control
 from kinestat.app.sim_cell import InProcessIO, start_counts
-from kinestat.control.align import (
-    ALIGN_STALL_CYCLES,
-    MAX_ALIGN_TURN_DEG,
-    MIN_ALIGN_GAIN,
-    PUSH_TURN_DEG,
-    align_gain,
-    align_stalled,
-)
+from kinestat.control.align import align_gain, align_stalled
 from kinestat.control.controller import ControllerConfig
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import run
+from kinestat.control.tuning import TUNING
 from kinestat.errors import InputError
 from kinestat.sim.surface import approach_distance
 
@@ -70,7 +64,7 @@ def test_a_large_turn_is_made_before_pushing(tmp_path, radius, axis, force):
     assert abs(rep.true_force_magnitude - force) <= 0.5 and rep.axis_error_deg <= 1.0
     for r in recs:
         if r.get("type") == "cycle" and r["action"] == "align":
-            if r["commanded"]["rotation_deg"] > PUSH_TURN_DEG:
+            if r["commanded"]["rotation_deg"] > TUNING.push_turn_deg:
                 assert r["commanded"]["step"] <= 0.0
 
 
@@ -114,7 +108,7 @@ def test_a_turn_the_wrist_cannot_make_at_once_is_halved(tmp_path, radius, axis, 
     assert abs(rep.true_force_magnitude - force) <= 0.5 + 0.1 and rep.axis_error_deg <= 1.0
     turns = [r["commanded"]["rotation_deg"] for r in recs
              if r.get("type") == "cycle" and r["action"] == "align" and r["commanded"]]
-    assert any(t == pytest.approx(MAX_ALIGN_TURN_DEG / 2) for t in turns)
+    assert any(t == pytest.approx(TUNING.max_align_turn_deg / 2) for t in turns)
 
 
 @pytest.mark.parametrize("cylinder", [None, CylinderSpec(radius=200.0,
@@ -142,7 +136,7 @@ def test_a_plane_met_far_off_the_tool_axis_is_turned_onto_in_steps(tmp_path, til
     assert abs(rep.true_force_magnitude - 4.0) <= 0.5 and rep.axis_error_deg <= 1.0
     turns = [r["commanded"]["rotation_deg"] for r in recs
              if r.get("type") == "cycle" and r["action"] == "align"]
-    assert turns and max(turns) <= MAX_ALIGN_TURN_DEG + 1e-9
+    assert turns and max(turns) <= TUNING.max_align_turn_deg + 1e-9
     assert sum(turns) >= tilt - 5.0  # it did turn onto the plane, in several turns
 
 
@@ -156,7 +150,7 @@ def test_the_damped_turn_converges_where_the_whole_turn_alternates(kb, e0, sign)
     gain, last, e = 1.0, None, sign * e0
     for _ in range(40):
         gain = align_gain(gain, last, np.array([0.0, 0.0, e]))
-        assert MIN_ALIGN_GAIN <= gain <= 1.0
+        assert TUNING.min_align_gain <= gain <= 1.0
         if abs(e) < 1e-2:
             break
         last = np.array([0.0, 0.0, gain * e])
@@ -170,8 +164,9 @@ def test_the_whole_turn_is_kept_on_a_plane():
     assert align_gain(1.0, [0.0, 0.0, 0.2], [0.0, 0.0, 0.01]) == 1.0
     assert align_gain(1.0, [0.0, 0.0, 0.2], [0.0, 0.0, -0.09]) == 1.0
     assert align_gain(1.0, [0.0, 0.0, 0.2], [0.0, 0.0, -0.11]) == 0.5
-    assert align_gain(2 * MIN_ALIGN_GAIN, [0.0, 0.0, 0.2], [0.0, 0.0, -0.3]) == MIN_ALIGN_GAIN
-    assert align_gain(MIN_ALIGN_GAIN, [0.0, 0.0, 0.2], [0.0, 0.0, -0.3]) == MIN_ALIGN_GAIN
+    floor = TUNING.min_align_gain
+    assert align_gain(2 * floor, [0.0, 0.0, 0.2], [0.0, 0.0, -0.3]) == floor
+    assert align_gain(floor, [0.0, 0.0, 0.2], [0.0, 0.0, -0.3]) == floor
 
 
 def test_a_turn_of_a_sixteenth_lands_on_a_steep_frictionless_cylinder(tmp_path):
@@ -213,10 +208,11 @@ def test_the_fixed_step_is_not_taken_for_a_snapping_contact(tmp_path):
 
 
 def test_align_stalled_needs_both_no_progress_and_turns_at_their_floor():
-    assert align_stalled(ALIGN_STALL_CYCLES, MIN_ALIGN_GAIN)
-    assert align_stalled(ALIGN_STALL_CYCLES, 2 * MIN_ALIGN_GAIN)
-    assert not align_stalled(ALIGN_STALL_CYCLES - 1, MIN_ALIGN_GAIN)
-    assert not align_stalled(10 * ALIGN_STALL_CYCLES, 4 * MIN_ALIGN_GAIN)  # turns not cut
+    n, floor = TUNING.align_stall_cycles, TUNING.min_align_gain
+    assert align_stalled(n, floor)
+    assert align_stalled(n, 2 * floor)
+    assert not align_stalled(n - 1, floor)
+    assert not align_stalled(10 * n, 4 * floor)  # turns not cut
 
 
 def test_an_approach_that_meets_nothing_stops_at_max_approach(tmp_path):
