@@ -60,8 +60,8 @@ from kinestat.control.task import Task, as_task
 from kinestat.devices.cell_io import MAX_SAMPLES
 from kinestat.devices.motion import MOVE_RULES
 from kinestat.errors import InputError
-from kinestat.robots.puma762.axes import THESIS_TOOL_POINT_6
 from kinestat.parallel.platform import Platform
+from kinestat.robots.puma762.axes import THESIS_TOOL_POINT_6
 from kinestat.sim.contact import Cell, make_cell
 from kinestat.sim.sensor import Sensor
 from kinestat.sim.surface import Cylinder, approach_distance, cylinder_ahead
