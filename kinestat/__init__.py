@@ -29,3 +29,21 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         'serial.jacobian': ['jacobian'],
     },
 )
+
+
+def _run_spec(spec, **kw):
+    """The composition root's runner of a ``RunSpec``: the application layer builds the cell.
+    Named, as the table above names its modules: the root wires the layers, and a module that
+    imports the root for its version or ``load`` does not thereby depend on the application."""
+    import importlib  # lazy: on the first run only
+
+    return importlib.import_module("kinestat.app.control_api").run(spec, **kw)
+
+
+def _wire() -> None:
+    from kinestat.control.entry import use_spec_runner  # lazy: light, imports nothing
+
+    use_spec_runner(_run_spec)
+
+
+_wire()

@@ -67,8 +67,8 @@ def as_task(config: ControllerConfig, decide_fn=None) -> Task:
     function ``decide_fn(state, meas)`` after the press's start (the older way of passing a
     task to :func:`kinestat.control.loop.run`, kept for callers that record decisions)."""
     if not isinstance(config, ControllerConfig):
-        hint = (": a RunSpec runs with kinestat.app.run(spec), which builds its cell (the cell "
-                "factory sits above the control layer)" if isinstance(config, RunSpec) else "")
+        hint = (": a RunSpec runs with kinestat.control.run(spec), which builds its cell"
+                if isinstance(config, RunSpec) else "")
         raise InputError(f"the loop runs a Task or a ControllerConfig, not a "
                          f"{type(config).__name__}{hint}")
     base = ThesisTask(config) if config.procedure == "thesis" else PressTask(config)

@@ -89,5 +89,17 @@ def test_the_press_task_decides_as_the_bare_config(tmp_path):
 
 
 def test_a_run_spec_given_to_the_loop_is_one_clear_error(tmp_path):
-    with CycleLog(tmp_path / "log.jsonl") as log, pytest.raises(InputError, match="app.run"):
+    with CycleLog(tmp_path / "log.jsonl") as log, pytest.raises(InputError, match="control.run"):
         run(RunSpec(), None, log)
+
+
+def test_control_run_runs_a_spec_as_the_command_does(tmp_path):
+    """``kinestat.control.run(RunSpec(...))``: the package root hands it the application's
+    runner; the report is the command's (the same decisions as the loop on the same cell)."""
+    import kinestat.control as control
+
+    out = control.run(RunSpec(), log=tmp_path / "log.jsonl")
+    assert out["converged"] and out["states"] == "aaabe"
+    assert (tmp_path / "log.jsonl").exists()
+    with pytest.raises(InputError, match="builds its own cell"):
+        control.run(RunSpec(), object())
