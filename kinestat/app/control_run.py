@@ -56,6 +56,7 @@ from kinestat.control.follow import (
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, refuse, run
 from kinestat.control.model import ControlModel
+from kinestat.control.payload import Payload
 from kinestat.control.probe import PROBE_SPAN
 from kinestat.control.wrench import Estimator
 from kinestat.devices.cell_io import MAX_SAMPLES, DeviceIO
@@ -369,7 +370,7 @@ def _prepare_cell(req: ControlRequest) -> PreparedRun:
                        "rate_hz": s.rate_hz, "sim_legs": truth.name})
         prepared = PreparedRun(req, config, header, cell, sensor, arm=placed_arm)
         if s.plant == "mujoco":  # the scene is built now: a model MuJoCo refuses stops here
-            prepared = replace(prepared, plant=_mujoco_plant(prepared))
+            prepared = _with_plant(prepared, _mujoco_plant(prepared))
         return prepared
     if req.arm is not None:
         raise InputError("--arm: another arm runs on the in-process simulated cell only; the "
@@ -469,6 +470,18 @@ def _mujoco_plant(prepared: PreparedRun):
     counts = (arm_start_counts(prepared.arm) if prepared.arm is not None
               else start_counts(config))
     return mujoco_plant(prepared.cell, config.model, counts)
+
+
+def _with_plant(prepared: PreparedRun, plant) -> PreparedRun:
+    """The prepared run on ``plant``, its controller told the top's and the tool's weight (the
+    scene's, as a user declares a tool's mass and centre of mass)."""
+    mass, com, gravity = plant.scene.top_load()
+    config = prepared.config
+    if mass > 0.0:
+        model = replace(config.model, payload=Payload(mass, com, gravity))
+        config = replace(config, model=model)
+    header = dict(prepared.header, payload={"mass_kg": mass, "com_top_mm": com.tolist()})
+    return replace(prepared, plant=plant, config=config, header=header)
 
 
 def _run_mujoco(prepared: PreparedRun, log_path: Path, safety: dict, progress, decide_fn
