@@ -49,6 +49,7 @@ from kinestat.control.follow_task import FollowTask
 from kinestat.control.log import CycleLog, read_log
 from kinestat.control.loop import RunReport, refuse, run
 from kinestat.control.model import ControlModel
+from kinestat.control.payload import Payload
 from kinestat.control.runspec import (
     TASKS,
     CylinderSpec,
@@ -246,7 +247,7 @@ def _prepare_cell(req: RunSpec) -> PreparedRun:
     header["sim_legs"] = truth.name
     prepared = PreparedRun(req, config, header, cell, sensor, arm=placed_arm)
     if s.plant == "mujoco":  # the scene is built now: a model MuJoCo refuses stops here
-        prepared = replace(prepared, plant=_mujoco_plant(prepared))
+        prepared = _with_plant(prepared, _mujoco_plant(prepared))
     return prepared
 
 
@@ -317,6 +318,17 @@ def _plant_figures(figures: dict, report: RunReport) -> dict:
     if report.iterations:
         figures["sim_seconds_per_cycle"] = figures["sim_time_s"] / report.iterations
     return figures
+
+
+def _with_plant(prepared: PreparedRun, plant) -> PreparedRun:
+    """The prepared run on ``plant``, its controller told the top's and the tool's weight (the
+    scene's, as a user declares a tool's mass and centre of mass)."""
+    mass, com, gravity = plant.scene.top_load()
+    config = prepared.config
+    if mass > 0.0:
+        config = replace(config, model=replace(config.model, payload=Payload(mass, com, gravity)))
+    header = dict(prepared.header, payload={"mass_kg": mass, "com_top_mm": com.tolist()})
+    return replace(prepared, plant=plant, config=config, header=header)
 
 
 def _mujoco_plant(prepared: PreparedRun):

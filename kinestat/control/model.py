@@ -18,6 +18,7 @@ from typing import Literal, get_args
 import numpy as np
 
 from kinestat.control.arm import Arm
+from kinestat.control.payload import Payload
 from kinestat.errors import ModelError
 from kinestat.hardware.leg_calibration import THESIS_CALIBRATION, LegCalibration
 from kinestat.parallel.platform import Platform
@@ -55,6 +56,9 @@ class ControlModel:
         calibration_name: a label for reports ("thesis-2011", "nominal", a file name).
         arm: the robot (:class:`kinestat.control.arm.Arm`: axis angles, forward analysis with
             the tool, analytic reverse analysis with selection); default the thesis's PUMA 762.
+        payload: the top plate's and the tool's weight the legs carry besides the contact
+            (:class:`kinestat.control.payload.Payload`), compensated in every measurement;
+            None (default, as the thesis's massless top): no compensation.
     """
 
     platform: Platform
@@ -67,6 +71,7 @@ class ControlModel:
     force_source: ForceSource = "springs"
     calibration_name: str = ""
     arm: Arm = THESIS_ARM
+    payload: Payload | None = None
 
     def __post_init__(self) -> None:
         if not all(callable(getattr(type(self.arm), n, None)) for n in _ARM_METHODS):
@@ -97,6 +102,9 @@ class ControlModel:
         if not math.isfinite(float(self.coupling)):
             raise ModelError("axis 4 -> 5 coupling must be finite")
         object.__setattr__(self, "coupling", float(self.coupling))
+        if self.payload is not None and not isinstance(self.payload, Payload):
+            raise ModelError(f"payload must be a kinestat.control.payload.Payload or None, got "
+                             f"{type(self.payload).__name__}")
         # the platform's legs must match the calibration's
         self.calibration.platform_order(self.platform.leg_names)
 

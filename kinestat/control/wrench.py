@@ -20,7 +20,9 @@ Two estimates of the contact force come out of each measurement:
   residual tells whether the contact really is a point.
 
 Sign: the measured wrench is the one the **tool applies to the workpiece** — the thesis's
-``W_eq`` (the legs' compressive forces along the leg lines), the sense of ``F_req``. It is the
+``W_eq`` (the legs' compressive forces along the leg lines), the sense of ``F_req``. A top
+with weight (``ControlModel.payload``) has it subtracted first
+(:func:`kinestat.control.payload.gravity_wrench`). It is the
 negative of :func:`kinestat.parallel.statics.spring_wrench`, the external wrench on the top.
 Moments are about the fixed origin, the robot's base (ray coordinates ``[f; m_O]``);
 :attr:`Measurement.torque` is the moment about the commanded tool point ``P_tool_F`` (the unloaded
@@ -37,6 +39,7 @@ from typing import Literal
 import numpy as np
 
 from kinestat.control.model import ControlModel
+from kinestat.control.payload import gravity_wrench
 from kinestat.errors import InputError
 from kinestat.hardware.leg_calibration import counts_to_forces, counts_to_lengths
 from kinestat.parallel.fk import fk_tracking
@@ -169,15 +172,19 @@ def measure(model: ControlModel, q, counts, previous_top_pose, *, seq: int | Non
                if model.force_source == "calibration" else spring_forces(plat, lengths))
     top = fk_tracking(plat, lengths, previous_top_pose)
     j = line_jacobian_trusted(plat, top)  # a pose fk_tracking returned: rigid, finite
-    w_ext = j @ tension
     tool, s6, a67, T6 = tool_frame(q, model)
     TB = T6 @ model.mount
     R, t = TB[:3, :3], TB[:3, 3]
+    w_ext = j @ tension
+    if model.payload is not None:  # the legs also carry the top's and the tool's weight
+        w_ext = w_ext - gravity_wrench(model.payload, top, R)
     f_fixed = R @ -w_ext[:3]  # the wrench in the fixed frame, moment about its origin
     w_fixed = np.concatenate([f_fixed, R @ -w_ext[3:] + cross3(t, f_fixed)])
     # point contact at the tip: tensions = j^-1 [I; [p]x] F_ext, least squares in F_ext
     p = apply(top, model.tool_tip_top)
     M = np.linalg.solve(j, np.vstack([np.eye(3), skew(p)]))
+    if model.payload is not None:  # fit the contact's share of the tensions
+        tension = np.linalg.solve(j, w_ext)
     # by the normal equations: M is well conditioned (cond ~8 on the 2011 prototype; its
     # square loses nothing at the leg encoders' resolution), and they cost a third of lstsq
     F_ext = np.linalg.solve(M.T @ M, M.T @ tension)

@@ -78,8 +78,9 @@ class SceneParams:
     leg_damping_ratio: float = 0.5
     """Damping of the legs' dashpots as a ratio of the top's critical damping on one leg."""
     top_weight: bool = False
-    """Gravity on the top + tool. Off by default: the controller has no payload model, so the
-    leg encoders read the top's weight as a contact force (docs/mujoco.md, *Limits*)."""
+    """Gravity on the top + tool; the controller is then given their weight and centre of
+    mass (:meth:`Scene.top_load`), as a user declares a tool's. Off by default: weightless, as
+    the thesis's model and the built-in simulator (docs/mujoco.md, *Limits*)."""
     link_radius: float = 0.06
     """Radius of the arm's link capsules (m), for their mass and inertia."""
     link_density: float = 2700.0
@@ -125,6 +126,15 @@ class Scene:
     top_pose_start: np.ndarray
     workpiece_stiffness: float | None
     ids: dict = field(default_factory=dict)
+
+    def top_load(self) -> tuple[float, np.ndarray, np.ndarray]:
+        """What the legs carry besides the contact: ``(mass_kg, com_top_mm, gravity_m_s2)``,
+        the top + tool's mass (0 when ``params.top_weight`` is off), their centre of mass in
+        the top frame (mm) and the scene's gravity (fixed frame, m/s²)."""
+        b = self.ids["top"]
+        mass = float(self.model.body_mass[b]) if self.params.top_weight else 0.0
+        com = np.asarray(self.model.body_ipos[b], float) / M_PER_MM
+        return mass, com, np.asarray(self.model.opt.gravity, float).copy()
 
 
 def length_scale(model: ChainModel) -> float:
