@@ -334,11 +334,13 @@ def _with_plant(prepared: PreparedRun, plant) -> PreparedRun:
 def _mujoco_plant(prepared: PreparedRun):
     """The MuJoCo plant of a prepared simulated cell at its start pose (at rest)."""
     from kinestat.app.mujoco_cell import mujoco_plant  # lazy: mujoco only for --sim mujoco
+    from kinestat.sim.mujoco_scene import SceneParams  # lazy: as above
 
     config = prepared.config
     counts = (arm_start_counts(prepared.arm) if prepared.arm is not None
               else start_counts(config))
-    return mujoco_plant(prepared.cell, config.model, counts)
+    return mujoco_plant(prepared.cell, config.model, counts,
+                        params=SceneParams(top_weight=prepared.request.cell.top_weight))
 
 
 def report_dict(prepared: PreparedRun, report: RunReport) -> dict:

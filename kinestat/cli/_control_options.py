@@ -70,7 +70,7 @@ def parse_workpiece(text: str | None):
 
 def cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, noise, friction,
           rate, seed, sim_legs="thesis", workpiece=None, sim="kinestat",
-          workpiece_stiffness=None):
+          workpiece_stiffness=None, top_weight=False):
     """The cell the options describe: simulated (no device options) or the real devices."""
     from kinestat.control.runspec import RealDevices, SimulatedCell  # lazy: start-up (numba)
 
@@ -98,7 +98,7 @@ def cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, 
             plane_normal=parse_floats(plane_normal, 3, "plane-normal") if plane_normal else None,
             friction=friction, ideal_sensor=ideal_sensor, noise=noise, rate_hz=rate, seed=seed,
             sim_legs=sim_legs, cylinder=cylinder, plant=sim,
-            workpiece_stiffness=workpiece_stiffness)
+            workpiece_stiffness=workpiece_stiffness, top_weight=top_weight)
     host, port = host_port(galil)
     return RealDevices(host=host, port=port, serial=serial, serial_format=serial_format)
 
@@ -206,7 +206,7 @@ def run_spec(o: dict):
         cell=cell(o["galil"], o["serial"], o["serial_format"], o["plane_point"],
                   o["plane_normal"], o["ideal_sensor"], o["noise"], o["friction"], o["rate"],
                   o["seed"], o["sim_legs"], o["workpiece"], o["sim"],
-                  o["workpiece_stiffness"]),
+                  o["workpiece_stiffness"], o["top_weight"]),
         **tool_and_mount(o["tool_offset"], o["a67"], o["mount"]))
 
 

@@ -88,7 +88,9 @@ class SimulatedCell:
     (:mod:`kinestat.app.mujoco_cell`, in process). ``workpiece_stiffness``: the workpiece's
     normal stiffness (N/mm, :attr:`kinestat.sim.contact.Workpiece.stiffness`; None: rigid).
     ``noise``: leg-length noise (mm, standard deviation); ``ideal_sensor``: 1 nm leg
-    encoders; ``rate_hz``: packet rate; ``sim_legs``: the legs' true law.
+    encoders; ``rate_hz``: packet rate; ``sim_legs``: the legs' true law. ``top_weight``
+    (MuJoCo only): gravity on the top plate + tool, whose weight and centre of mass the
+    controller is then given (:mod:`kinestat.control.payload`).
     """
 
     plane_point: np.ndarray | None = None
@@ -102,10 +104,14 @@ class SimulatedCell:
     cylinder: CylinderSpec | None = None
     plant: str = "kinestat"
     workpiece_stiffness: float | None = None
+    top_weight: bool = False
 
     def __post_init__(self) -> None:
         if self.plant not in PLANTS:
             raise InputError(f"--sim must be one of {', '.join(PLANTS)}, got {self.plant!r}")
+        if self.top_weight and self.plant != "mujoco":
+            raise InputError("--top-weight needs --sim mujoco: the built-in simulator's top "
+                             "plate and tool are weightless, as the thesis's model")
         if self.cylinder is not None and (self.plane_point is not None
                                           or self.plane_normal is not None):
             raise InputError("--plane-point/--plane-normal describe a plane workpiece; with "

@@ -109,3 +109,12 @@ def test_a_given_a67_is_made_exactly_perpendicular():
     a = a / np.linalg.norm(a) + 2e-4 * s6  # typed to four decimals
     spec = RunSpec(a67=a)
     assert abs(float(spec.a67 @ s6)) < 1e-12 and np.isclose(np.linalg.norm(spec.a67), 1.0)
+
+
+def test_top_weight_needs_the_mujoco_plant():
+    from kinestat.control.runspec import SimulatedCell
+    from kinestat.errors import InputError
+
+    assert SimulatedCell(plant="mujoco", top_weight=True).top_weight
+    with pytest.raises(InputError, match="--top-weight needs --sim mujoco"):
+        SimulatedCell(top_weight=True)
