@@ -21,14 +21,17 @@ import numba as nb
 import numpy as np
 
 from kinestat.serial._kernels import _start
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._cf_kernels import (
+    RIGID_TOL,
     _add,
     _cross,
     _dot,
     _mv,
     _norm,
     _pair,
+    _pose_status,
     _pose_times,
     _rot,
     _row,
@@ -46,7 +49,7 @@ from kinestat.serial.analytic._cf_kernels import (
 _IMAG_REL = 1e-5
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _cubic_max_root(A, B, C):
     """The largest real root of ``m³ + A m² + B m + C`` (Cardano, then two Newton steps)."""
     P = B - A * A / 3.0
@@ -69,7 +72,7 @@ def _cubic_max_root(A, B, C):
     return m
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _polish(c4, c3, c2, c1, c0, t):
     """Two Newton steps of the quartic from t."""
     for _ in range(2):
@@ -118,7 +121,7 @@ def quartic_real_roots(c4, c3, c2, c1, c0):
     return k, (out[0], out[1], out[2], out[3])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _sq(l0, l1, l2, f):
     """Add the square of the linear form ``l0 + l1 cos θ + l2 sin θ`` to the Fourier
     coefficients ``f = (A0, A1, B1, A2, B2)`` of ``A0 + A1 cos θ + B1 sin θ + A2 cos 2θ +
@@ -127,7 +130,7 @@ def _sq(l0, l1, l2, f):
             f[2] + 2.0 * l0 * l2, f[3] + 0.5 * (l1 * l1 - l2 * l2), f[4] + l1 * l2)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _fourier_at(f, c, s):
     """The Fourier series f at the angle of cosine c, sine s."""
     return f[0] + f[1] * c + f[2] * s + f[3] * (c * c - s * s) + f[4] * 2.0 * s * c
@@ -175,6 +178,9 @@ def theta3_roots(f):
 def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q, out_valid,
                  out_pos, out_rot, out_sing, out_sign, out_fam):
     clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+    status = _pose_status(T, n, RIGID_TOL)
+    if status:
+        return -status
     Tn = T[n]
     Rg, tg = _pose_times(Tn, T0inv)
     W0, W1, W2 = _row(W, 0), _row(W, 1), _row(W, 2)
@@ -244,7 +250,7 @@ def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q, o
     return cnt
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _unpack(Kp):
     """The data packed by :func:`kinestat.serial.analytic._offset_pack.pack`: ``C (7, 4, 4)``,
     ``T0inv``, ``W (6, 3)``, ``P (6, 3)``, the wrist centre, a unit vector normal to axis 6 and
@@ -257,7 +263,8 @@ def _unpack(Kp):
 def offset_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
                  out_sign, out_fam, out_cnt):
     """Spherical wrist, offset shoulder: N poses into the (uninitialised) outputs; ``out_cnt
-    (N,)`` the number of solutions."""
+    (N,)`` the number of solutions (or minus the pose's status, as
+    :func:`kinestat.serial.analytic._cf_kernels.pieper_batch`)."""
     C, T0inv, W, P, w, x6, G = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
         out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q,

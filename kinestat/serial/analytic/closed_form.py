@@ -161,6 +161,11 @@ def _outputs(N: int, K: int):
             np.empty((N, K)), np.empty(N, dtype=np.int64))
 
 
+def _unchecked(cnt: np.ndarray) -> bool:
+    """Some pose's count is negative: the kernel found it not orthonormal to rounding."""
+    return cnt[0] < 0 if cnt.shape[0] == 1 else cnt.shape[0] > 1 and cnt.min() < 0
+
+
 def _cf_kernels():
     K = sys.modules.get("kinestat.serial.analytic._cf_kernels")
     if K is None:
@@ -180,7 +185,9 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
                           plain: bool | None = None) -> IKAllResult:
     """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first); ``shape``:
     the batch shape of the result (default ``(N,)``); ``plain``: the caller has checked
-    :func:`~kinestat.serial.analytic._common.plain_poses` (None: check here)."""
+    :func:`~kinestat.serial.analytic._common.plain_poses` (None: check here). None when some
+    pose is not a rigid transform orthonormal to rounding (the kernel checks each pose and
+    solves none of those): the caller checks the poses, projects them and calls again."""
     offset = data["shoulder"] is None
     K = _offset_kernels() if offset else _cf_kernels()
     N = T.shape[0]
@@ -200,6 +207,8 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
         run_kernels(K.offset_batch, K.offset_serial, args, T, _PARALLEL_MIN, plain)
     else:
         run_kernels(K.pieper_batch, K.pieper_serial, args, T, _PARALLEL_MIN, plain)
+    if _unchecked(cnt):
+        return None
     reason = _offset_pack.REASON if offset else _REASON_PIEPER
     if shape == ():
         return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
@@ -217,7 +226,7 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
                                   plain: bool | None = None) -> IKAllResult:
     """:func:`solve_three_parallel` by the compiled kernel, with the wrist-singular families
     (:func:`kinestat.serial.analytic.families.add_wrist_families`) added; ``shape``, ``plain``
-    as for :func:`solve_pieper_compiled`."""
+    as for :func:`solve_pieper_compiled`, as is the None return."""
     K = _cf_kernels()
     N = T.shape[0]
     Kp = data.get("kernel_args")
@@ -231,6 +240,8 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
     near = np.empty(N, dtype=bool)
     args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, cnt, near)
     run_kernels(K.three_parallel_batch, K.three_parallel_serial, args, T, _PARALLEL_MIN, plain)
+    if _unchecked(cnt):
+        return None
     if shape == () and not near[0]:  # one pose away from the wrist-singular set
         return IKAllResult.build_one(q, valid, pos, rot, np.zeros((1, 8), dtype=bool),
                                      np.zeros((1, 8)), nan_array((1, 8)), None, cnt,
