@@ -25,6 +25,9 @@ from kinestat.serial.analytic._solution_kernels import wrap as _wrap
 _Z3 = (0.0, 0.0, 0.0)
 #: a pose's rotation must be orthonormal with det +1 within this (the NumPy check's default)
 RIGID_TOL = 1e-6
+#: the count of a pose handed back unsolved: a candidate needs Newton steps the kernel was
+#: compiled without (``newton`` None); −1 and −2 are :func:`_pose_status`'s
+HANDED_BACK = -3
 
 
 # -- 3-vectors and rotations as tuples ----------------------------------------------------------
@@ -271,17 +274,23 @@ def _clear(n, out_q, out_valid, out_pos, out_rot):
 
 
 @nb.njit(**_OPTS)
-def _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
+def _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot, cnt):
     """Verify q (6-tuple) whose forward kinematics f (12 scalars, the chain product at the
     cosines and sines of q) against Tn and store it unless it repeats a stored one; returns the
-    new count."""
+    new count. A candidate that misses tol (rounding near a singular set) takes ``newton``
+    Newton steps; with ``newton`` None (the kernel is then compiled without them: a smaller
+    cache to load) the pose is handed back instead: :data:`HANDED_BACK` from then on."""
+    if cnt < 0:
+        return cnt
     pos, rot = pose_errors(f, Tn)
-    if not (pos <= tol and rot <= tol):  # rounding near a singular set: two Newton steps
+    if not (pos <= tol and rot <= tol):
+        if newton is None:
+            return HANDED_BACK
         qa = np.empty(6)
         for i in range(6):
             qa[i] = q[i]
         Ms, Vs = scratch()
-        pos, rot = polish(C, Tn, qa, 2, Ms, Vs)
+        pos, rot = polish(C, Tn, qa, newton, Ms, Vs)
         if not (pos <= tol and rot <= tol):
             return cnt
         q = (qa[0], qa[1], qa[2], qa[3], qa[4], qa[5])
@@ -298,8 +307,8 @@ def clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_f
         out_fam[n, k] = np.nan
 
 
-@nb.njit(**_INLINE)
-def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, out_q,
+@nb.njit(**_OPTS)  # not inlined: the offset shoulder calls it twice (one copy to load)
+def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, newton, out_q,
                 out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, cnt):
     """The spherical wrist (axes 4, 5, 6 meeting) for the arm angles t1, t2, t3 (triples; R3
     the rotation of t3): ``R4 R5 ω6 = R' ω6`` (subproblem 2), θ6 (subproblem 1), each candidate
@@ -324,7 +333,7 @@ def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, 
         t6 = _sp1(W5, _Z3, xs, _mtv(_mm(_rot(W3, t4), R5), _mv(Rp, xs)))
         f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, f3)))
         q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
-        new = _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
+        new = _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot, cnt)
         if new > cnt and sing:
             sig = 1.0 if _dot(W3, _mv(R5, W5)) >= 0.0 else -1.0
             out_sing[n, cnt] = True
@@ -336,7 +345,7 @@ def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, 
 
 # -- spherical wrist, shoulder axes meeting (Pieper) --------------------------------------------
 @nb.njit(**_OPTS)
-def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
+def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton, out_q, out_valid,
                  out_pos, out_rot, out_sing, out_sign, out_fam):
     clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
     status = _pose_status(T, n, RIGID_TOL)
@@ -366,8 +375,8 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
             t1 = t1a if i12 == 0 else t1b
             t2 = t2a if i12 == 0 else t2b
             cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup,
-                              out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
-                              cnt)
+                              newton, out_q, out_valid, out_pos, out_rot, out_sing, out_sign,
+                              out_fam, cnt)
     return cnt
 
 
@@ -386,25 +395,26 @@ def pack(C, T0inv, W, P, a, b, c) -> np.ndarray:
 
 
 @nb.njit(parallel=True, **_OPTS)
-def pieper_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
+def pieper_batch(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot, out_sing,
                  out_sign, out_fam, out_cnt):
     """Spherical-wrist closed form for N poses into the (uninitialised) outputs; ``out_cnt
     (N,)`` the number of solutions, or minus the pose's :func:`_pose_status` (a pose not
-    orthonormal to rounding is not solved: the caller checks and projects it)."""
+    orthonormal to rounding is not solved: the caller checks and projects it), or
+    :data:`HANDED_BACK`. ``newton``: Newton steps for a candidate that misses tol, or None."""
     C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
-        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q,
-                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton,
+                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 @nb.njit(**_OPTS)
-def pieper_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
-                  out_sign, out_fam, out_cnt):
+def pieper_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
+                  out_sing, out_sign, out_fam, out_cnt):
     """:func:`pieper_batch` on one thread (small batches: no thread start-up)."""
     C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     for n in range(T.shape[0]):
-        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q,
-                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton,
+                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 # -- three parallel axes, wrist pair meeting (UR type) ------------------------------------------
@@ -417,7 +427,7 @@ def _theta4(phi, t2, t3, sg):
 
 
 @nb.njit(**_OPTS)
-def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
+def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, newton, out_q,
                          out_valid, out_pos, out_rot, out_near):
     _clear(n, out_q, out_valid, out_pos, out_rot)
     out_near[n] = False
@@ -469,13 +479,13 @@ def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedu
                 f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, _link(
                     C, 3, t3, _link(C, 2, t2, f1)))))
                 q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
-                cnt = _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot,
+                cnt = _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
                              cnt)
     return cnt
 
 
 @nb.njit(parallel=True, **_OPTS)
-def three_parallel_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot,
+def three_parallel_batch(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
                          out_cnt, out_near):
     """Three-parallel-axes (UR-type) closed form for N poses; ``out_cnt (N,)`` the number of
     solutions (or minus the pose's :func:`_pose_status`, as :func:`pieper_batch`), ``out_near
@@ -484,17 +494,19 @@ def three_parallel_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos
     C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
         out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
-                                          dedup, out_q, out_valid, out_pos, out_rot, out_near)
+                                          dedup, newton, out_q, out_valid, out_pos, out_rot,
+                                          out_near)
 
 
 @nb.njit(**_OPTS)
-def three_parallel_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot,
+def three_parallel_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
                           out_cnt, out_near):
     """:func:`three_parallel_batch` on one thread."""
     C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     for n in range(T.shape[0]):
         out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
-                                          dedup, out_q, out_valid, out_pos, out_rot, out_near)
+                                          dedup, newton, out_q, out_valid, out_pos, out_rot,
+                                          out_near)
 
 
 # -- pose checks ------------------------------------------------------------------------------

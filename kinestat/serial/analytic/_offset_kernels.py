@@ -175,7 +175,7 @@ def theta3_roots(f):
 
 
 @nb.njit(**_OPTS)
-def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q, out_valid,
+def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton, out_q, out_valid,
                  out_pos, out_rot, out_sing, out_sign, out_fam):
     clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
     status = _pose_status(T, n, RIGID_TOL)
@@ -208,8 +208,8 @@ def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q, o
                 q2 = _add(P1, _mv(_rot(W1, t2), _sub(g3, P1)))
                 t1 = _sp1(W0, P0, q2, pw)
                 cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol,
-                                  dedup, out_q, out_valid, out_pos, out_rot, out_sing, out_sign,
-                                  out_fam, cnt)
+                                  dedup, newton, out_q, out_valid, out_pos, out_rot, out_sing,
+                                  out_sign, out_fam, cnt)
         return cnt
     o1 = (G[0], G[1], G[2])
     r2 = (G[3], G[4], G[5])
@@ -245,7 +245,7 @@ def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q, o
         t2 = _pair(_dot(W1, _cross(up, v)), _dot(up, v))
         q2 = _add(r2, _mv(_rot(W1, t2), u))
         t1 = _sp1(W0, o1, q2, pw)
-        cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup,
+        cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, newton,
                           out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, cnt)
     return cnt
 
@@ -260,22 +260,22 @@ def _unpack(Kp):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def offset_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
+def offset_batch(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot, out_sing,
                  out_sign, out_fam, out_cnt):
     """Spherical wrist, offset shoulder: N poses into the (uninitialised) outputs; ``out_cnt
     (N,)`` the number of solutions (or minus the pose's status, as
     :func:`kinestat.serial.analytic._cf_kernels.pieper_batch`)."""
     C, T0inv, W, P, w, x6, G = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
-        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q,
-                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton,
+                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 @nb.njit(**_OPTS)
-def offset_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
-                  out_sign, out_fam, out_cnt):
+def offset_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
+                  out_sing, out_sign, out_fam, out_cnt):
     """:func:`offset_batch` on one thread (small batches: no thread start-up)."""
     C, T0inv, W, P, w, x6, G = _unpack(Kp)
     for n in range(T.shape[0]):
-        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q,
-                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton,
+                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)

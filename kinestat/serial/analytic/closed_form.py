@@ -33,6 +33,7 @@ __all__ = ["solve_pieper", "solve_three_parallel", "solve_pieper_compiled",
 
 _WRIST_TOL = 1e-10
 _PARALLEL_MIN = 256  # smaller batches run on one thread (a pose costs a few µs)
+_NEWTON_STEPS = 2  # for a candidate that misses tol (rounding next to a singular set)
 
 
 def _apply(T: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -161,8 +162,15 @@ def _outputs(N: int, K: int):
             np.empty((N, K)), np.empty(N, dtype=np.int64))
 
 
+def _newton(N: int, checked: bool) -> int | None:
+    """The kernels' Newton steps for a candidate that misses tol: none (the pose is handed
+    back) on a few unchecked poses, else two."""
+    return None if not checked and N < _PARALLEL_MIN else _NEWTON_STEPS
+
+
 def _unchecked(cnt: np.ndarray) -> bool:
-    """Some pose's count is negative: the kernel found it not orthonormal to rounding."""
+    """Some pose's count is negative: the kernel found it not orthonormal to rounding, or
+    handed it back for Newton steps."""
     return cnt[0] < 0 if cnt.shape[0] == 1 else cnt.shape[0] > 1 and cnt.min() < 0
 
 
@@ -182,12 +190,15 @@ def _offset_kernels():
 
 def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
                           wrist_tol: float = _WRIST_TOL, shape: tuple[int, ...] | None = None,
-                          plain: bool | None = None) -> IKAllResult:
+                          plain: bool | None = None, checked: bool = True) -> IKAllResult | None:
     """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first); ``shape``:
     the batch shape of the result (default ``(N,)``); ``plain``: the caller has checked
-    :func:`~kinestat.serial.analytic._common.plain_poses` (None: check here). None when some
-    pose is not a rigid transform orthonormal to rounding (the kernel checks each pose and
-    solves none of those): the caller checks the poses, projects them and calls again."""
+    :func:`~kinestat.serial.analytic._common.plain_poses` (None: check here).
+    ``checked=False``: the caller has not checked the poses, the kernel does, and with fewer
+    than ``_PARALLEL_MIN`` poses it runs without Newton steps (a kernel with less code to load);
+    the result is then None when some pose is not a rigid transform orthonormal to rounding or
+    one of its candidates needs Newton steps: the caller checks the poses, projects them and
+    calls again, checked."""
     offset = data["shoulder"] is None
     K = _offset_kernels() if offset else _cf_kernels()
     N = T.shape[0]
@@ -202,11 +213,13 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
             model, ax, data["wrist"], _perp(ax.w[5])) if offset else K.pack(
             model.constants, np.linalg.inv(ax.T0), ax.w, ax.r, data["wrist"], data["shoulder"],
             _perp(ax.w[5]))
-    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
+    newton = _newton(N, checked)
+    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos, rot, sing, sign,
+            fam, cnt)
     if offset:
-        run_kernels(K.offset_batch, K.offset_serial, args, T, _PARALLEL_MIN, plain)
+        run_kernels(K.offset_batch, K.offset_serial, args, T, _PARALLEL_MIN, plain, newton)
     else:
-        run_kernels(K.pieper_batch, K.pieper_serial, args, T, _PARALLEL_MIN, plain)
+        run_kernels(K.pieper_batch, K.pieper_serial, args, T, _PARALLEL_MIN, plain, newton)
     if _unchecked(cnt):
         return None
     reason = _offset_pack.REASON if offset else _REASON_PIEPER
@@ -223,7 +236,8 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
 def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, *,
                                   tol: float = 1e-9, wrist_tol: float = _WRIST_TOL,
                                   shape: tuple[int, ...] | None = None,
-                                  plain: bool | None = None) -> IKAllResult:
+                                  plain: bool | None = None,
+                                  checked: bool = True) -> IKAllResult | None:
     """:func:`solve_three_parallel` by the compiled kernel, with the wrist-singular families
     (:func:`kinestat.serial.analytic.families.add_wrist_families`) added; ``shape``, ``plain``
     as for :func:`solve_pieper_compiled`, as is the None return."""
@@ -238,8 +252,10 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
                                           data["p56"], _perp(h), sg)
     q, valid, pos, rot, cnt = _outputs(N, 8)
     near = np.empty(N, dtype=bool)
-    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, cnt, near)
-    run_kernels(K.three_parallel_batch, K.three_parallel_serial, args, T, _PARALLEL_MIN, plain)
+    newton = _newton(N, checked)
+    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos, rot, cnt, near)
+    run_kernels(K.three_parallel_batch, K.three_parallel_serial, args, T, _PARALLEL_MIN, plain,
+                newton)
     if _unchecked(cnt):
         return None
     if shape == () and not near[0]:  # one pose away from the wrist-singular set

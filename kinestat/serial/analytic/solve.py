@@ -201,11 +201,12 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if closed and type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
             T.shape[-2:] == (4, 4):
         # the closed-form kernels check each pose themselves (None: some pose is not
-        # orthonormal to rounding; the checks below then raise or project it)
+        # orthonormal to rounding, or needs Newton steps; the checks below then raise or
+        # project it, and the kernel runs again with Newton steps)
         Tf = T[None] if T.ndim == 2 and T.flags.c_contiguous else \
             np.ascontiguousarray(T.reshape(-1, 4, 4))
         res = _CLOSED_FORMS[use](model, Tf, data, tol=tol, shape=T.shape[:-2],
-                                 plain=plain_poses(Tf))
+                                 plain=plain_poses(Tf), checked=False)
         if res is not None:
             return res
     Tf, shape, plain = _checked_poses(T, fast)
