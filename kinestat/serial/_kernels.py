@@ -106,18 +106,19 @@ def _unpack(P, q):
 
 
 @nb.njit(**_OPTS)
-def fk_one(P, q):
-    """End pose of one configuration of the packed chain ``P``; None if q is not finite."""
+def fk_one(P, q, out):
+    """End pose of one configuration of the packed chain ``P`` into ``out (4, 4)`` (the
+    caller's: an array made in the kernel costs more to hand to Python than to fill); False if
+    q is not finite."""
     C, o = _unpack(P, q)
     if C is None:
-        return None
+        return False
     n = q.shape[0]
     t = _start(C[0])
     for i in range(n):
         t = _step(C[i + 1], int(P[o + i]), P[o + n + i], q[i], t)
-    out = np.empty((4, 4))
     _store(t, out)
-    return out
+    return True
 
 
 @nb.njit(**_INLINE)
@@ -142,20 +143,20 @@ def _jac_column(t, kind, h, J, j):
 
 
 @nb.njit(**_OPTS)
-def jacobian_one(P, q):
-    """Space Jacobian ``(6, n)`` of one configuration of the packed chain ``P``."""
+def jacobian_one(P, q, J):
+    """Space Jacobian of one configuration of the packed chain ``P`` into ``J (6, n)``; False
+    if q is not finite."""
     C, o = _unpack(P, q)
     if C is None:
-        return None
+        return False
     n = q.shape[0]
-    J = np.empty((6, n))
     t = _start(C[0])
     for i in range(n):
         kind = int(P[o + i])
         h = P[o + n + i]
         _jac_column(t, kind, h, J, i)
         t = _step(C[i + 1], kind, h, q[i], t)
-    return J
+    return True
 
 
 @nb.njit(parallel=True, **_OPTS)
@@ -201,15 +202,17 @@ _ENTRY: dict[str, object] = {}
 
 def single_entry(name: str):
     """The compiled entry point of ``fk_one`` or ``jacobian_one`` for (packed chain: read-only
-    C-contiguous float64, q: C-contiguous float64), bypassing Numba's per-call type dispatch.
+    C-contiguous float64, q: C-contiguous float64, out: C-contiguous 2-D float64), bypassing
+    Numba's per-call type dispatch.
 
-    Callers must pass exactly those types (a 1-D float64 ndarray with strides (8,)); anything
-    else goes through the dispatcher.
+    Callers must pass exactly those types (a 1-D float64 ndarray with strides (8,), an output
+    from ``np.empty``); anything else goes through the dispatcher.
     """
     ep = _ENTRY.get(name)
     if ep is None:
         ro = nb.types.Array(nb.float64, 1, "C", readonly=True)
         rw = nb.types.Array(nb.float64, 1, "C")
-        ep = _ENTRY[name] = globals()[name].compile((ro, rw))
+        out = nb.types.Array(nb.float64, 2, "C")
+        ep = _ENTRY[name] = globals()[name].compile((ro, rw, out))
     return ep
 
