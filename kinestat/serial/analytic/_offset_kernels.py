@@ -97,28 +97,34 @@ def quartic_real_roots(c4, c3, c2, c1, c0):
     q = d - 0.5 * b * c + 0.125 * b * b * b
     r = e - 0.25 * b * d + b * b * c / 16.0 - 3.0 * b * b * b * b / 256.0
     m = _cubic_max_root(p, 0.25 * p * p - r, -0.125 * q * q)
-    z = [0j, 0j, 0j, 0j]
+    # tuples, not lists: no heap allocation per pose, and less code to load from the cache
     if m <= 1e-14 * (1.0 + abs(p) + abs(r)):  # biquadratic (q = 0)
         sq = cmath.sqrt(p * p - 4.0 * r + 0j)
         y1 = cmath.sqrt(0.5 * (-p + sq))
         y2 = cmath.sqrt(0.5 * (-p - sq))
-        z[0], z[1], z[2], z[3] = y1, -y1, y2, -y2
+        z = (y1, -y1, y2, -y2)
     else:
         s = math.sqrt(2.0 * m)
         k1 = 0.5 * p + m + 0.5 * q / s
         k2 = 0.5 * p + m - 0.5 * q / s
         d1 = cmath.sqrt(s * s - 4.0 * k1 + 0j)
         d2 = cmath.sqrt(s * s - 4.0 * k2 + 0j)
-        z[0], z[1] = 0.5 * (s + d1), 0.5 * (s - d1)
-        z[2], z[3] = 0.5 * (-s + d2), 0.5 * (-s - d2)
-    out = [0.0, 0.0, 0.0, 0.0]
+        z = (0.5 * (s + d1), 0.5 * (s - d1), 0.5 * (-s + d2), 0.5 * (-s - d2))
+    out = (0.0, 0.0, 0.0, 0.0)
     k = 0
     for i in range(4):
         t = z[i].real - 0.25 * b
         if abs(z[i].imag) <= _IMAG_REL * (1.0 + abs(t)):
-            out[k] = _polish(c4, c3, c2, c1, c0, t)
+            out = _put(out, k, _polish(c4, c3, c2, c1, c0, t))
             k += 1
-    return k, (out[0], out[1], out[2], out[3])
+    return k, out
+
+
+@nb.njit(**_INLINE)
+def _put(v, k, x):
+    """The 4-tuple v with entry k set to x."""
+    return (x if k == 0 else v[0], x if k == 1 else v[1], x if k == 2 else v[2],
+            x if k == 3 else v[3])
 
 
 @nb.njit(**_INLINE)
@@ -157,8 +163,8 @@ def theta3_roots(f):
     s2b = 2.0 * sb * cb
     A2 = f[3] * c2b + f[4] * s2b
     B2 = f[4] * c2b - f[3] * s2b
-    cs = [1.0, 1.0, 1.0, 1.0]
-    sn = [0.0, 0.0, 0.0, 0.0]
+    cs = (1.0, 1.0, 1.0, 1.0)
+    sn = (0.0, 0.0, 0.0, 0.0)
     c4 = A0 - A1 + A2
     if c4 == 0.0:
         return 0, (1.0, 1.0, 1.0, 1.0), (0.0, 0.0, 0.0, 0.0)
@@ -169,9 +175,9 @@ def theta3_roots(f):
         den = 1.0 + ti * ti
         cp = (1.0 - ti * ti) / den
         sp = 2.0 * ti / den
-        cs[i] = cp * cb - sp * sb
-        sn[i] = sp * cb + cp * sb
-    return k, (cs[0], cs[1], cs[2], cs[3]), (sn[0], sn[1], sn[2], sn[3])
+        cs = _put(cs, i, cp * cb - sp * sb)
+        sn = _put(sn, i, sp * cb + cp * sb)
+    return k, cs, sn
 
 
 @nb.njit(**_OPTS)
