@@ -24,7 +24,7 @@ import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _offset_pack
-from kinestat.serial.analytic._common import nan_array, pack, reasons, run_kernels
+from kinestat.serial.analytic._common import _ENTRY, nan_array, pack, reasons, run_kernels
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
 
@@ -162,6 +162,52 @@ def _outputs(N: int, K: int):
             np.empty((N, K)), np.empty(N, dtype=np.int64))
 
 
+def _one_pieper(entry, Kp: np.ndarray, wrist_tol: float, reason: str):
+    """The single-pose call of the spherical-wrist kernel (``entry``: its compiled entry point
+    for plain poses and no Newton steps, see :func:`~kinestat.serial.analytic._common.
+    call_compiled`): ``one(T (1, 4, 4) plain, tol: float)``, the result of
+    :func:`solve_pieper_compiled` with ``shape=()``, ``checked=False``, or None as it. The
+    per-model arguments are bound once: a single call is a few µs, so its Python steps
+    matter."""
+    if entry is None:
+        return None
+
+    def one(T, tol):
+        q, valid, pos, rot, cnt = _outputs(1, 8)
+        sing = np.empty(_S18, dtype=bool)
+        sign = np.empty(_S18)
+        fam = np.empty(_S18)
+        entry(Kp, T, tol, wrist_tol, 1e-6, None, q, valid, pos, rot, sing, sign, fam, cnt)
+        c = cnt[0]
+        if c < 0:
+            return None
+        return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
+                                     "" if c else reason, "pieper", tol)
+    return one
+
+
+def _one_three_parallel(entry, Kp: np.ndarray, wrist_tol: float):
+    """:func:`_one_pieper` for :func:`solve_three_parallel_compiled` (None also for a pose
+    near the wrist-singular set, whose families the full call adds)."""
+    if entry is None:
+        return None
+
+    def one(T, tol):
+        q, valid, pos, rot, cnt = _outputs(1, 8)
+        near = np.empty(1, dtype=bool)
+        entry(Kp, T, tol, wrist_tol, 1e-6, None, q, valid, pos, rot, cnt, near)
+        c = cnt[0]
+        if c < 0 or near[0]:
+            return None
+        return IKAllResult.build_one(q, valid, pos, rot, np.zeros(_S18, dtype=bool),
+                                     np.zeros(_S18), nan_array(_S18), None, cnt,
+                                     "" if c else _REASON_3P, "three-parallel", tol)
+    return one
+
+
+_S18 = (1, 8)
+
+
 def _newton(N: int, checked: bool) -> int | None:
     """The kernels' Newton steps for a candidate that misses tol: none (the pose is handed
     back) on a few unchecked poses, else two."""
@@ -216,13 +262,14 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     newton = _newton(N, checked)
     args = (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos, rot, sing, sign,
             fam, cnt)
-    if offset:
-        run_kernels(K.offset_batch, K.offset_serial, args, T, _PARALLEL_MIN, plain, newton)
-    else:
-        run_kernels(K.pieper_batch, K.pieper_serial, args, T, _PARALLEL_MIN, plain, newton)
+    serial = K.offset_serial if offset else K.pieper_serial
+    run_kernels(K.offset_batch if offset else K.pieper_batch, serial, args, T, _PARALLEL_MIN,
+                plain, newton)
+    reason = _offset_pack.REASON if offset else _REASON_PIEPER
+    if shape == () and newton is None and plain and "one" not in data:
+        data["one"] = _one_pieper(_ENTRY.get((serial, None)), Kp, float(wrist_tol), reason)
     if _unchecked(cnt):
         return None
-    reason = _offset_pack.REASON if offset else _REASON_PIEPER
     if shape == ():
         return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
                                      reason if cnt[0] == 0 else "", "pieper", tol)
@@ -256,6 +303,9 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
     args = (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos, rot, cnt, near)
     run_kernels(K.three_parallel_batch, K.three_parallel_serial, args, T, _PARALLEL_MIN, plain,
                 newton)
+    if shape == () and newton is None and plain and "one" not in data:
+        data["one"] = _one_three_parallel(_ENTRY.get((K.three_parallel_serial, None)), Kp,
+                                          float(wrist_tol))
     if _unchecked(cnt):
         return None
     if shape == () and not near[0]:  # one pose away from the wrist-singular set

@@ -205,8 +205,10 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         # project it, and the kernel runs again with Newton steps)
         Tf = T[None] if T.ndim == 2 and T.flags.c_contiguous else \
             np.ascontiguousarray(T.reshape(-1, 4, 4))
-        res = _CLOSED_FORMS[use](model, Tf, data, tol=tol, shape=T.shape[:-2],
-                                 plain=plain_poses(Tf), checked=False)
+        plain = plain_poses(Tf)
+        one = data.get("one") if plain and T.ndim == 2 else None  # one pose: the bound call
+        res = one(Tf, float(tol)) if one is not None else _CLOSED_FORMS[use](
+            model, Tf, data, tol=tol, shape=T.shape[:-2], plain=plain, checked=False)
         if res is not None:
             return res
     Tf, shape, plain = _checked_poses(T, fast)
