@@ -114,6 +114,9 @@ def _nearest_rigid(Tf: np.ndarray) -> np.ndarray:
     return Tf
 
 
+_S44 = (4, 4)
+_F64 = np.dtype(np.float64)
+
 #: the compiled closed forms (each kernel checks its poses: :func:`ik_all`'s fast path)
 _CLOSED_FORMS = {"pieper": closed_form.solve_pieper_compiled,
                  "three-parallel": closed_form.solve_three_parallel_compiled}
@@ -177,6 +180,17 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     >>> bool(np.any(np.all(np.abs(res.solutions() - q) < 1e-9, axis=1)))
     True
     """
+    T = T_base_flange
+    if type(T) is np.ndarray and T.shape == _S44 and method == "auto" and backend == "numba" \
+            and not locked and isinstance(model, ChainModel):
+        # one plain pose, defaults: the closed form's bound single call (after the first)
+        one = _plan(model)[1].get("one")
+        if one is not None and T.dtype is _F64:
+            f = T.flags
+            if f.c_contiguous and f.aligned and f.writeable:
+                res = one(T[None], float(tol))
+                if res is not None:
+                    return res
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
     if locked:
@@ -195,7 +209,6 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if (use in ("pieper", "three-parallel") or kind == "decoupled") and use != kind:
         raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
                          f"(its geometry is {kind!r})")
-    T = T_base_flange
     fast = backend == "numba"
     closed = fast and use in _CLOSED_FORMS and "reversed" not in data
     if closed and type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
