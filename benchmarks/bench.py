@@ -120,8 +120,13 @@ class Bench:
                 pin.updateFramePlacement(pm, data, fid)
                 return data.oMf[fid]
 
+            def pin_fk_array():  # like for like: the pose as a 4x4 array, as kinestat returns
+                return pin_fk().homogeneous
+
             assert np.allclose(pin_fk().homogeneous, ref, atol=1e-9)
-            self.add("fk single", "pinocchio", median_time(pin_fk, number=n))
+            self.add("fk single", "pinocchio", median_time(pin_fk, number=n), note="SE3 out")
+            self.add("fk single", "pinocchio (array)", median_time(pin_fk_array, number=n),
+                     note=".homogeneous: 4x4 array out")
         if "rtb_ets" in self.peers:
             ets = self.peers["rtb_ets"]
             # ``eval`` returns the 4x4 array as kinestat does (``fkine`` wraps it in an SE3

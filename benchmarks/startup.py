@@ -15,7 +15,9 @@ Goal (issue 44): one FK from the CLI on a URDF (``kinestat fk ur5_robot.urdf ...
 most 2x a Pinocchio script that loads the same URDF and prints the same pose (both rows in the
 same run, the ``x pinocchio`` column); the first ``ik_all`` call of a fresh process (after
 ``import kinestat``, loading the model and one ``fk``) at most 20 ms: measured inside fresh
-processes (the ``first ik_all`` rows, median of ``--repeat``).
+processes (the ``first call`` rows, median of ``--repeat``), beside the first call of EAIK's
+``IK`` and ik-geo's ``get_ik`` on the URDF arms (after importing them and building the robot),
+the processes taking turns; ``--first-only`` runs just these rows.
 """
 
 from __future__ import annotations
@@ -98,25 +100,87 @@ def _once(args: list[str], cold: bool, output: bool = False):
     return [float(v) for v in run.stdout.split()[-2:]] if output else took
 
 
+#: a peer's first IK call of a fresh process, after importing it and building the robot from
+#: the model's home axes (as benchmarks/ik_all.py calls it); wall and CPU ms on stdout
+PEER_FIRST = {
+    "EAIK IK": ("import time, numpy as np; from eaik.IK_HP import HPRobot; "
+                "bot = HPRobot(np.array({H}), np.array({P})); T = np.array({T}); "
+                "t = time.perf_counter(); c = time.process_time(); bot.IK(T); "
+                "print(1e3 * (time.perf_counter() - t), 1e3 * (time.process_time() - c))"),
+    "ik-geo get_ik": ("import time; from ik_geo import Robot; bot = Robot.{ctor}({H}, {P}); "
+                      "R, p = {R}, {p}; t = time.perf_counter(); c = time.process_time(); "
+                      "bot.get_ik(R, p); print(1e3 * (time.perf_counter() - t), "
+                      "1e3 * (time.process_time() - c))"),
+}
+
+
+def _peer_codes(model: str, tip: str | None) -> dict[str, str]:
+    """The peers' first-call scripts for the model at the pose FIRST_CALL solves (ik-geo's
+    constructor for the model's class, as benchmarks/ik_all.py picks it)."""
+    import numpy as np
+
+    import kinestat
+    from kinestat.serial.analytic import method_for
+    from kinestat.serial.analytic.geometry import home_axes, meet, parallel
+
+    m = kinestat.load(model, tip=tip) if tip else kinestat.load(model)
+    T = kinestat.fk(m, np.full(m.n, 0.3))
+    ax = home_axes(m)
+    pts = np.vstack([ax.r, ax.T0[:3, 3]])
+    H, P = ax.w.tolist(), np.vstack([pts[0], np.diff(pts, axis=0)]).tolist()
+    Rr = T[:3, :3] @ ax.T0[:3, :3].T
+    Tp = T.copy()
+    Tp[:3, :3] = Rr
+    kind = method_for(m)
+    if kind == "pieper" and meet(ax, 0, 1) is None:
+        kind = "pieper-parallel" if parallel(ax, 1, 2) else "pieper-offset"
+    ctor = {"three-parallel": "three_parallel_two_intersecting",
+            "pieper": "spherical_two_intersecting", "pieper-parallel": "spherical_two_parallel",
+            "pieper-offset": "spherical"}.get(kind, "gen_six_dof")
+    fill = {"H": H, "P": P, "T": Tp.tolist(), "ctor": ctor, "R": Rr.T.tolist(),
+            "p": T[:3, 3].tolist()}
+    return {k: v.format(**fill) for k, v in PEER_FIRST.items()}
+
+
+def _model_path(model: str) -> str | None:
+    if model == KR16:
+        try:
+            import rtbdata
+        except ImportError:
+            return None
+        return str(Path(rtbdata.__file__).parent / "xacro" / KR16)
+    return model or None
+
+
 def first_calls(repeat: int) -> list[dict]:
-    """The first ik_all call's time (ms) inside fresh processes, per model: median and range."""
+    """The first IK call's time (ms) inside fresh processes, per model, kinestat's ``ik_all``
+    and each peer's, the processes taking turns: median and range."""
     out = []
     for label, (model, tip) in FIRST_MODELS.items():
-        if model == KR16:
-            try:
-                import rtbdata
-            except ImportError:
-                continue
-            model = str(Path(rtbdata.__file__).parent / "xacro" / KR16)
-        if not model:
+        model = _model_path(model)
+        if model is None:
             continue
-        code = FIRST_CALL.format(model=model, tip="" if tip is None else f", tip={tip!r}")
-        _once(["-c", code], False, True)  # compile once, untimed
-        runs = [_once(["-c", code], False, True) for _ in range(repeat)]
-        wall, cpu = [r[0] for r in runs], [r[1] for r in runs]
-        out.append({"model": label, "median_ms": statistics.median(wall), "min_ms": min(wall),
-                    "max_ms": max(wall), "cpu_median_ms": statistics.median(cpu),
-                    "cpu_min_ms": min(cpu), "cpu_max_ms": max(cpu), "runs": repeat})
+        codes = {"kinestat ik_all": FIRST_CALL.format(
+            model=model, tip="" if tip is None else f", tip={tip!r}")}
+        if model.endswith(".urdf"):  # peers from the URDF's home axes
+            codes |= _peer_codes(model, tip)
+        for code in codes.values():
+            _once(["-c", code], False, True)  # compile once, untimed
+        runs: dict[str, list] = {k: [] for k in codes}
+        for _ in range(repeat):
+            for k, code in codes.items():
+                try:
+                    runs[k].append(_once(["-c", code], False, True))
+                except SystemExit:  # a peer not installed
+                    pass
+        for k, rr in runs.items():
+            if not rr:
+                continue
+            wall, cpu = [r[0] for r in rr], [r[1] for r in rr]
+            out.append({"model": label, "solver": k, "median_ms": statistics.median(wall),
+                        "min_ms": min(wall), "max_ms": max(wall),
+                        "cpu_median_ms": statistics.median(cpu), "cpu_min_ms": min(cpu),
+                        "cpu_max_ms": max(cpu), "runs": len(rr)})
     return out
 
 
@@ -145,8 +209,10 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=5, help="processes per row (default 5)")
     ap.add_argument("--json", action="store_true", help="print JSON")
+    ap.add_argument("--first-only", action="store_true",
+                    help="only the first-IK-call rows (kinestat and peers)")
     a = ap.parse_args(argv)
-    rows = measure(a.repeat)
+    rows = [] if a.first_only else measure(a.repeat)
     first = first_calls(a.repeat)
     stamp = time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime())
     load = os.getloadavg()
@@ -154,7 +220,7 @@ def main(argv: list[str] | None = None) -> int:
         print(json.dumps({"date": stamp, "python": sys.version.split()[0], "load_avg": load,
                           "rows": rows, "first_ik_all": first}, indent=2))
         return 0
-    width = max(len(r["command"]) for r in rows)
+    width = max([len(r["command"]) for r in rows] + [7])
     print(f"start-up, {stamp}, Python {sys.version.split()[0]}, median of fresh processes, "
           f"load average {load[0]:.1f} {load[1]:.1f} {load[2]:.1f}")
     print(f"{'command':<{width}}  {'median s':>9}  {'min s':>7}  {'x numpy':>8}  "
@@ -164,7 +230,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"{r['command']:<{width}}  {r['median_s']:>9.3f}  {r['min_s']:>7.3f}  "
               f"{r['ratio_to_numpy']:>8.2f}  {xp:>11}")
     for f in first:
-        print(f"first ik_all call, {f['model']}: median {f['median_ms']:.1f} ms "
+        print(f"first call, {f['solver']}, {f['model']}: median {f['median_ms']:.1f} ms "
               f"(range {f['min_ms']:.1f}-{f['max_ms']:.1f}), CPU {f['cpu_median_ms']:.1f} ms "
               f"({f['cpu_min_ms']:.1f}-{f['cpu_max_ms']:.1f}), {f['runs']} processes")
     return 0

@@ -17,6 +17,7 @@ import numba as nb
 import numpy as np
 
 from kinestat.mechanism.joints import JointKind
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 
 #: joint kind codes as plain ints (Numba freezes them at compile time)
@@ -25,7 +26,7 @@ SCREW = int(JointKind.SCREW)
 
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _turn(c, s, t):
     """``t · Rz`` for the rotation about z with cosine c and sine s (12 values, row-major 3x4:
     only the first two columns change)."""
@@ -35,7 +36,7 @@ def _turn(c, s, t):
             c * r20 + s * r21, c * r21 - s * r20, r22, p2)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _affine(C, t):
     """``t · C`` for the running transform ``t`` (12 values) and a rigid ``C (4, 4)``."""
     r00, r01, r02, p0, r10, r11, r12, p1, r20, r21, r22, p2 = t
@@ -54,7 +55,7 @@ def _affine(C, t):
     return (n00, n01, n02, n03, n10, n11, n12, n13, n20, n21, n22, n23)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _step(C, kind, h, qi, t):
     """Apply ``Z(qi) · C`` to the running transform ``t`` (12 values, row-major 3x4)."""
     if kind != PRISMATIC:
@@ -69,13 +70,13 @@ def _step(C, kind, h, qi, t):
     return _affine(C, t)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _start(C0):
     return (C0[0, 0], C0[0, 1], C0[0, 2], C0[0, 3], C0[1, 0], C0[1, 1], C0[1, 2], C0[1, 3],
             C0[2, 0], C0[2, 1], C0[2, 2], C0[2, 3])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _store(t, out):
     out[0, 0], out[0, 1], out[0, 2], out[0, 3] = t[0], t[1], t[2], t[3]
     out[1, 0], out[1, 1], out[1, 2], out[1, 3] = t[4], t[5], t[6], t[7]
@@ -83,7 +84,7 @@ def _store(t, out):
     out[3, 0], out[3, 1], out[3, 2], out[3, 3] = 0.0, 0.0, 0.0, 1.0
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _row_finite(Q, k, n):
     """True when row ``k`` of ``Q`` holds only finite values."""
     for i in range(n):
@@ -92,7 +93,7 @@ def _row_finite(Q, k, n):
     return True
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _unpack(P, q):
     """The joint constants ``C (n+1, 4, 4)`` and the offset of the kinds in the packed chain
     ``P``; ``C`` is None when ``q (n,)`` is not finite."""
@@ -105,21 +106,22 @@ def _unpack(P, q):
 
 
 @nb.njit(**_OPTS)
-def fk_one(P, q):
-    """End pose of one configuration of the packed chain ``P``; None if q is not finite."""
+def fk_one(P, q, out):
+    """End pose of one configuration of the packed chain ``P`` into ``out (4, 4)`` (the
+    caller's: an array made in the kernel costs more to hand to Python than to fill); False if
+    q is not finite."""
     C, o = _unpack(P, q)
     if C is None:
-        return None
+        return False
     n = q.shape[0]
     t = _start(C[0])
     for i in range(n):
         t = _step(C[i + 1], int(P[o + i]), P[o + n + i], q[i], t)
-    out = np.empty((4, 4))
     _store(t, out)
-    return out
+    return True
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _jac_column(t, kind, h, J, j):
     ux, uy, uz = t[2], t[6], t[10]
     px, py, pz = t[3], t[7], t[11]
@@ -141,20 +143,20 @@ def _jac_column(t, kind, h, J, j):
 
 
 @nb.njit(**_OPTS)
-def jacobian_one(P, q):
-    """Space Jacobian ``(6, n)`` of one configuration of the packed chain ``P``."""
+def jacobian_one(P, q, J):
+    """Space Jacobian of one configuration of the packed chain ``P`` into ``J (6, n)``; False
+    if q is not finite."""
     C, o = _unpack(P, q)
     if C is None:
-        return None
+        return False
     n = q.shape[0]
-    J = np.empty((6, n))
     t = _start(C[0])
     for i in range(n):
         kind = int(P[o + i])
         h = P[o + n + i]
         _jac_column(t, kind, h, J, i)
         t = _step(C[i + 1], kind, h, q[i], t)
-    return J
+    return True
 
 
 @nb.njit(parallel=True, **_OPTS)
@@ -200,15 +202,17 @@ _ENTRY: dict[str, object] = {}
 
 def single_entry(name: str):
     """The compiled entry point of ``fk_one`` or ``jacobian_one`` for (packed chain: read-only
-    C-contiguous float64, q: C-contiguous float64), bypassing Numba's per-call type dispatch.
+    C-contiguous float64, q: C-contiguous float64, out: C-contiguous 2-D float64), bypassing
+    Numba's per-call type dispatch.
 
-    Callers must pass exactly those types (a 1-D float64 ndarray with strides (8,)); anything
-    else goes through the dispatcher.
+    Callers must pass exactly those types (a 1-D float64 ndarray with strides (8,), an output
+    from ``np.empty``); anything else goes through the dispatcher.
     """
     ep = _ENTRY.get(name)
     if ep is None:
         ro = nb.types.Array(nb.float64, 1, "C", readonly=True)
         rw = nb.types.Array(nb.float64, 1, "C")
-        ep = _ENTRY[name] = globals()[name].compile((ro, rw))
+        out = nb.types.Array(nb.float64, 2, "C")
+        ep = _ENTRY[name] = globals()[name].compile((ro, rw, out))
     return ep
 

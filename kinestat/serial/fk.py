@@ -94,13 +94,15 @@ def _nonfinite() -> InputError:
 
 
 def evaluate(model: ChainModel, q, one, batch, tail: tuple[int, ...]) -> np.ndarray:
-    """Run a compiled chain kernel on checked joint values ``q (..., n)``: ``one(packed, q)`` for
-    one configuration, ``batch(constants, kinds, pitches, Q, out)`` into ``out (N, *tail)``
+    """Run a compiled chain kernel on checked joint values ``q (..., n)``: ``one(packed, q, out)``
+    for one configuration, ``batch(constants, kinds, pitches, Q, out)`` into ``out (N, *tail)``
     otherwise; shaped ``(..., *tail)``."""
     q = _as_q(model, q)
     d = kernel_data(model)
     if q.ndim == 1:
-        out = one(d.packed, q)
+        out = np.empty(tail)
+        if not one(d.packed, q, out):
+            out = None
     else:
         Q = np.ascontiguousarray(q.reshape(-1, model.n))
         out = np.empty((Q.shape[0],) + tail)
@@ -114,6 +116,7 @@ def evaluate(model: ChainModel, q, one, batch, tail: tuple[int, ...]) -> np.ndar
 _F64 = np.dtype(np.float64)
 _ND = np.ndarray
 _S8 = (8,)
+_S44 = (4, 4)
 
 
 def fk(model: ChainModel, q) -> np.ndarray:
@@ -134,8 +137,8 @@ def fk(model: ChainModel, q) -> np.ndarray:
     if type(q) is _ND and q.strides == _S8 and q.dtype is _F64:
         d = _BY_ID.get(id(model))
         if d is not None and len(q) == d.n:
-            out = (_FK_ONE or _entry("fk_one"))(d.packed, q)
-            if out is None:
+            out = np.empty(_S44)
+            if not (_FK_ONE or _entry("fk_one"))(d.packed, q, out):
                 raise _nonfinite()
             return out
     k = kernels()

@@ -52,8 +52,8 @@ def jacobian(model: ChainModel, q) -> np.ndarray:
     if type(q) is _ND and q.strides == _S8 and q.dtype is _F64:
         d = _BY_ID.get(id(model))
         if d is not None and len(q) == d.n:
-            J = (_fkmod._JAC_ONE or _fkmod._entry("jacobian_one"))(d.packed, q)
-            if J is None:
+            J = np.empty((6, d.n))
+            if not (_fkmod._JAC_ONE or _fkmod._entry("jacobian_one"))(d.packed, q, J):
                 raise InputError("q contains NaN or infinity")
             return J
     k = _fkmod.kernels()

@@ -19,6 +19,12 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.serial._numba_options import INLINE as _INLINE
+from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial._numba_options import PI as _PI
+from kinestat.serial._numba_options import SQRT8 as _SQRT8
+from kinestat.serial._numba_options import TWO_PI as _TWO_PI
+
 # mechanism parameters and status codes: defined once, in params (Numba freezes them)
 from kinestat.robots.puma762.params import (
     _A,
@@ -224,7 +230,7 @@ def solve_pose(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, pe, re):
     return status
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _solve_row(T, k, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe, re):
     """:func:`solve_pose` of pose ``k``; returns 1 when it is not finite (its row is left
     unwritten), else 0."""
@@ -256,13 +262,13 @@ def reverse_batch(T, tol, s5_tol, verify, q, valid, sing, fsum, fval, status, pe
     return bad
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _finite3(v):
     """True when the three components of ``v`` are finite."""
     return math.isfinite(v[0]) and math.isfinite(v[1]) and math.isfinite(v[2])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _axes_deviation(z0, z1, z2, x0, x1, x2):
     """|‖S6‖ − 1|, |‖a67‖ − 1| and |S6·a67| of the end effector's two unit vectors."""
     return (abs(math.sqrt(z0 * z0 + z1 * z1 + z2 * z2) - 1.0),
@@ -270,7 +276,7 @@ def _axes_deviation(z0, z1, z2, x0, x1, x2):
             abs(z0 * x0 + z1 * x1 + z2 * x2))
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _axes_problem(z0, z1, z2, x0, x1, x2, tol):
     """(error code, deviation) of S6 and a67 against ``tol``: ``(ERR_NONE, 0)`` when both are
     unit vectors and perpendicular."""

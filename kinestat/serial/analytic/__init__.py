@@ -4,9 +4,18 @@ Public entry points: :func:`ik_all` (with ``locked=`` for 7-joint arms), :func:`
 :class:`IKAllResult`, :func:`select_nearest`.
 """
 
-from kinestat.serial.analytic.locked import SelfMotion
 from kinestat.serial.analytic.result import IKAllResult, Selection, select_nearest, wrap_to_limits
 from kinestat.serial.analytic.solve import METHODS, ik_all, ik_self_motion, method_for
 
 __all__ = ["ik_all", "ik_self_motion", "SelfMotion", "IKAllResult", "Selection", "select_nearest",
            "wrap_to_limits", "METHODS", "method_for"]
+
+
+def __getattr__(name: str):
+    """``SelfMotion`` loads with :mod:`~kinestat.serial.analytic.locked` on first use (PEP 562:
+    a first ``ik_all`` call does not pay for the 7-joint helpers)."""
+    if name == "SelfMotion":
+        from kinestat.serial.analytic.locked import SelfMotion  # lazy: first-call time
+
+        return SelfMotion
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -17,50 +17,56 @@ import numba as nb
 import numpy as np
 
 from kinestat.serial._kernels import _affine, _start, _turn
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._solution_kernels import polish, pose_errors, scratch, store
 from kinestat.serial.analytic._solution_kernels import wrap as _wrap
 
 _Z3 = (0.0, 0.0, 0.0)
+#: a pose's rotation must be orthonormal with det +1 within this (the NumPy check's default)
+RIGID_TOL = 1e-6
+#: the count of a pose handed back unsolved: a candidate needs Newton steps the kernel was
+#: compiled without (``newton`` None); −1 and −2 are :func:`_pose_status`'s
+HANDED_BACK = -3
 
 
 # -- 3-vectors and rotations as tuples ----------------------------------------------------------
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _row(A, i):
     return (A[i, 0], A[i, 1], A[i, 2])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _add(a, b):
     return (a[0] + b[0], a[1] + b[1], a[2] + b[2])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _sub(a, b):
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _scale(a, s):
     return (a[0] * s, a[1] * s, a[2] * s)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _dot(a, b):
     return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _cross(a, b):
     return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _norm(a):
     return math.sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _pair(y, x):
     """``(θ, cos θ, sin θ)`` of ``θ = atan2(y, x)``: the cosine and sine are the normalised
     arguments (no cos/sin call; equal to ``cos θ``, ``sin θ`` to rounding)."""
@@ -70,7 +76,7 @@ def _pair(y, x):
     return math.atan2(y, x), x / h, y / h
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _unit(y, x):
     """``(cos θ, sin θ)`` of ``θ = atan2(y, x)`` (θ itself not needed)."""
     h = math.sqrt(x * x + y * y)
@@ -79,7 +85,7 @@ def _unit(y, x):
     return x / h, y / h
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _shift(a, c, s, sign):
     """``(θa + sign·α, cos, sin)`` for θa given by its cosine ``a[-2]`` and sine ``a[-1]`` (an
     angle triple or a pair) and α by c, s: the angle-addition formulas, the angle from the
@@ -89,7 +95,7 @@ def _shift(a, c, s, sign):
     return math.atan2(sn, cs), cs, sn
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _rot(w, a):
     """Rodrigues' rotation matrix (MLS eq. 2.14) as a row-major 9-tuple, for the angle triple
     ``a = (θ, cos θ, sin θ)``."""
@@ -102,20 +108,20 @@ def _rot(w, a):
             z * x * v - y * s, z * y * v + x * s, c + z * z * v)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _neg(a):
     """The angle triple of −θ."""
     return -a[0], a[1], -a[2]
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _mv(R, x):
     return (R[0] * x[0] + R[1] * x[1] + R[2] * x[2],
             R[3] * x[0] + R[4] * x[1] + R[5] * x[2],
             R[6] * x[0] + R[7] * x[1] + R[8] * x[2])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _mtv(R, x):
     """``Rᵀ x``."""
     return (R[0] * x[0] + R[3] * x[1] + R[6] * x[2],
@@ -123,7 +129,7 @@ def _mtv(R, x):
             R[2] * x[0] + R[5] * x[1] + R[8] * x[2])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _mm(A, B):
     return (A[0] * B[0] + A[1] * B[3] + A[2] * B[6], A[0] * B[1] + A[1] * B[4] + A[2] * B[7],
             A[0] * B[2] + A[1] * B[5] + A[2] * B[8],
@@ -133,7 +139,7 @@ def _mm(A, B):
             A[6] * B[2] + A[7] * B[5] + A[8] * B[8])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _mtm(A, B):
     """``Aᵀ B``."""
     return (A[0] * B[0] + A[3] * B[3] + A[6] * B[6], A[0] * B[1] + A[3] * B[4] + A[6] * B[7],
@@ -144,7 +150,7 @@ def _mtm(A, B):
             A[2] * B[2] + A[5] * B[5] + A[8] * B[8])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _mmt(A, B):
     """``A Bᵀ``."""
     return (A[0] * B[0] + A[1] * B[1] + A[2] * B[2], A[0] * B[3] + A[1] * B[4] + A[2] * B[5],
@@ -155,13 +161,13 @@ def _mmt(A, B):
             A[6] * B[6] + A[7] * B[7] + A[8] * B[8])
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _rotate(w, r, a, x):
     """The point x turned by the angle triple a about the axis (ω, r)."""
     return _add(r, _mv(_rot(w, a), _sub(x, r)))
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _pose_times(T, A):
     """Rotation (9-tuple) and translation (3-tuple) of ``T · A`` for 4x4 rigid arrays."""
     R = (T[0, 0], T[0, 1], T[0, 2], T[1, 0], T[1, 1], T[1, 2], T[2, 0], T[2, 1], T[2, 2])
@@ -173,7 +179,7 @@ def _pose_times(T, A):
 # -- Paden–Kahan subproblems (the NumPy references are in subproblems.py) -----------------------
 # Every angle is the triple (θ, cos θ, sin θ): the rotations and the FK check use the pair, so
 # no cos/sin is evaluated (θ comes from atan2 of the same pair).
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _sp1(w, r, p, q):
     """Subproblem 1: the angle of p → q about (ω, r)."""
     u = _sub(p, r)
@@ -186,7 +192,7 @@ def _sp1(w, r, p, q):
 _NONE = (0.0, 1.0, 0.0)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _sp2(w1, w2, r, p, q, tol):
     """Subproblem 2 (axes meeting at r): ``(exists, θ1, θ2, θ1', θ2')``."""
     u = _sub(p, r)
@@ -207,7 +213,7 @@ def _sp2(w1, w2, r, p, q, tol):
     return True, _sp1(w1, r, c, q), _sp1(w2, r, p, c), _sp1(w1, r, d, q), _sp1(w2, r, p, d)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _sp3(w, r, p, q, delta, tol):
     """Subproblem 3: ``(exists, θ, θ')`` with ``|e^{ξ̂θ} p − q| = δ`` (θ0 ∓ acos c)."""
     u = _sub(p, r)
@@ -229,7 +235,7 @@ def _sp3(w, r, p, q, delta, tol):
     return True, _shift(t0, c, s, -1.0), _shift(t0, c, s, 1.0)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _sp4(h, w, p, d, tol):
     """Subproblem 4 (one axis): ``(exists, θ, θ')`` with ``hᵀ R(ω, θ) p = d`` (φ ∓ acos c)."""
     par = _scale(w, _dot(w, p))
@@ -249,14 +255,14 @@ def _sp4(h, w, p, d, tol):
 
 
 # -- verification, de-duplication, storage ------------------------------------------------------
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _link(C, i, a, t):
     """The running FK transform t (12 scalars) times ``Z(θ_i) C_i`` for the angle triple a of
     joint i (1-based): the serial FK kernel's step with the angle's cosine and sine."""
     return _affine(C[i], _turn(a[1], a[2], t))
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _clear(n, out_q, out_valid, out_pos, out_rot):
     """Empty slots of pose n (NaN, not valid): the caller's outputs are uninitialised."""
     for k in range(out_q.shape[1]):
@@ -268,24 +274,30 @@ def _clear(n, out_q, out_valid, out_pos, out_rot):
 
 
 @nb.njit(**_OPTS)
-def _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt):
+def _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot, cnt):
     """Verify q (6-tuple) whose forward kinematics f (12 scalars, the chain product at the
     cosines and sines of q) against Tn and store it unless it repeats a stored one; returns the
-    new count."""
+    new count. A candidate that misses tol (rounding near a singular set) takes ``newton``
+    Newton steps; with ``newton`` None (the kernel is then compiled without them: a smaller
+    cache to load) the pose is handed back instead: :data:`HANDED_BACK` from then on."""
+    if cnt < 0:
+        return cnt
     pos, rot = pose_errors(f, Tn)
-    if not (pos <= tol and rot <= tol):  # rounding near a singular set: two Newton steps
+    if not (pos <= tol and rot <= tol):
+        if newton is None:
+            return HANDED_BACK
         qa = np.empty(6)
         for i in range(6):
             qa[i] = q[i]
         Ms, Vs = scratch()
-        pos, rot = polish(C, Tn, qa, 2, Ms, Vs)
+        pos, rot = polish(C, Tn, qa, newton, Ms, Vs)
         if not (pos <= tol and rot <= tol):
             return cnt
         q = (qa[0], qa[1], qa[2], qa[3], qa[4], qa[5])
     return store(n, q, pos, rot, dedup, out_q, out_valid, out_pos, out_rot, cnt)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam):
     """Empty slots of pose n, with no wrist family."""
     _clear(n, out_q, out_valid, out_pos, out_rot)
@@ -295,8 +307,8 @@ def clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_f
         out_fam[n, k] = np.nan
 
 
-@nb.njit(inline="always", **_OPTS)
-def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, out_q,
+@nb.njit(**_OPTS)  # not inlined: the offset shoulder calls it twice (one copy to load)
+def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, newton, out_q,
                 out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, cnt):
     """The spherical wrist (axes 4, 5, 6 meeting) for the arm angles t1, t2, t3 (triples; R3
     the rotation of t3): ``R4 R5 ω6 = R' ω6`` (subproblem 2), θ6 (subproblem 1), each candidate
@@ -321,7 +333,7 @@ def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, 
         t6 = _sp1(W5, _Z3, xs, _mtv(_mm(_rot(W3, t4), R5), _mv(Rp, xs)))
         f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, f3)))
         q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
-        new = _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot, cnt)
+        new = _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot, cnt)
         if new > cnt and sing:
             sig = 1.0 if _dot(W3, _mv(R5, W5)) >= 0.0 else -1.0
             out_sing[n, cnt] = True
@@ -333,9 +345,12 @@ def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, 
 
 # -- spherical wrist, shoulder axes meeting (Pieper) --------------------------------------------
 @nb.njit(**_OPTS)
-def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, out_valid,
+def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton, out_q, out_valid,
                  out_pos, out_rot, out_sing, out_sign, out_fam):
     clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+    status = _pose_status(T, n, RIGID_TOL)
+    if status:
+        return -status
     Tn = T[n]
     Rg, tg = _pose_times(Tn, T0inv)
     W0, W1, W2 = _row(W, 0), _row(W, 1), _row(W, 2)
@@ -360,12 +375,12 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q, o
             t1 = t1a if i12 == 0 else t1b
             t2 = t2a if i12 == 0 else t2b
             cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup,
-                              out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
-                              cnt)
+                              newton, out_q, out_valid, out_pos, out_rot, out_sing, out_sign,
+                              out_fam, cnt)
     return cnt
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _unpack(Kp):
     """The pose-independent data packed by :func:`pack` (one array: one argument to unbox per
     call): ``C (7, 4, 4)``, ``T0inv (4, 4)``, ``W (6, 3)``, ``P (6, 3)`` and three 3-vectors."""
@@ -380,28 +395,30 @@ def pack(C, T0inv, W, P, a, b, c) -> np.ndarray:
 
 
 @nb.njit(parallel=True, **_OPTS)
-def pieper_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
+def pieper_batch(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot, out_sing,
                  out_sign, out_fam, out_cnt):
     """Spherical-wrist closed form for N poses into the (uninitialised) outputs; ``out_cnt
-    (N,)`` the number of solutions."""
+    (N,)`` the number of solutions, or minus the pose's :func:`_pose_status` (a pose not
+    orthonormal to rounding is not solved: the caller checks and projects it), or
+    :data:`HANDED_BACK`. ``newton``: Newton steps for a candidate that misses tol, or None."""
     C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
-        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q,
-                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton,
+                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 @nb.njit(**_OPTS)
-def pieper_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
-                  out_sign, out_fam, out_cnt):
+def pieper_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
+                  out_sing, out_sign, out_fam, out_cnt):
     """:func:`pieper_batch` on one thread (small batches: no thread start-up)."""
     C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     for n in range(T.shape[0]):
-        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, out_q,
-                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton,
+                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 # -- three parallel axes, wrist pair meeting (UR type) ------------------------------------------
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _theta4(phi, t2, t3, sg):
     """θ4 = σ3 (φ − σ1 θ2 − σ2 θ3) (axes 2-4 parallel with signs σ) as an angle triple."""
     u = _shift(phi, t2[1], t2[2], -sg[0])
@@ -410,10 +427,13 @@ def _theta4(phi, t2, t3, sg):
 
 
 @nb.njit(**_OPTS)
-def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, out_q,
+def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, newton, out_q,
                          out_valid, out_pos, out_rot, out_near):
     _clear(n, out_q, out_valid, out_pos, out_rot)
     out_near[n] = False
+    status = _pose_status(T, n, RIGID_TOL)
+    if status:
+        return -status
     Tn = T[n]
     Rg, tg = _pose_times(Tn, T0inv)
     W0, W1, W2, W4, W5 = _row(W, 0), _row(W, 1), _row(W, 2), _row(W, 4), _row(W, 5)
@@ -459,35 +479,38 @@ def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedu
                 f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, _link(
                     C, 3, t3, _link(C, 2, t2, f1)))))
                 q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
-                cnt = _store(n, C, Tn, q, f, tol, dedup, out_q, out_valid, out_pos, out_rot,
+                cnt = _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
                              cnt)
     return cnt
 
 
 @nb.njit(parallel=True, **_OPTS)
-def three_parallel_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot,
+def three_parallel_batch(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
                          out_cnt, out_near):
     """Three-parallel-axes (UR-type) closed form for N poses; ``out_cnt (N,)`` the number of
-    solutions, ``out_near (N,)`` a θ1 branch is near the wrist-singular set (axis 6 within
-    1e-6 of parallel to axes 2-4: where :mod:`~kinestat.serial.analytic.families` looks)."""
+    solutions (or minus the pose's :func:`_pose_status`, as :func:`pieper_batch`), ``out_near
+    (N,)`` a θ1 branch is near the wrist-singular set (axis 6 within 1e-6 of parallel to axes
+    2-4: where :mod:`~kinestat.serial.analytic.families` looks)."""
     C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
         out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
-                                          dedup, out_q, out_valid, out_pos, out_rot, out_near)
+                                          dedup, newton, out_q, out_valid, out_pos, out_rot,
+                                          out_near)
 
 
 @nb.njit(**_OPTS)
-def three_parallel_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot,
+def three_parallel_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
                           out_cnt, out_near):
     """:func:`three_parallel_batch` on one thread."""
     C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     for n in range(T.shape[0]):
         out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
-                                          dedup, out_q, out_valid, out_pos, out_rot, out_near)
+                                          dedup, newton, out_q, out_valid, out_pos, out_rot,
+                                          out_near)
 
 
 # -- pose checks ------------------------------------------------------------------------------
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _pose_status(T, n, tol):
     """0: a rotation orthonormal to rounding (1e-13); 1: within tol only (to be projected);
     2: not a finite rigid transform."""

@@ -28,7 +28,7 @@ def nan_array(shape: tuple[int, ...]) -> np.ndarray:
 _ENTRY: dict = {}
 
 
-def call_compiled(kernel, *args):
+def call_compiled(kernel, *args, variant=None):
     """``kernel(*args)`` through the compiled overload's entry point: Numba's per-call
     resolution of the argument types (≈ 70 ns per array; 1-2 µs of a 13- or 18-argument
     single-pose call) is done once, on the first call, which goes through the dispatcher
@@ -36,27 +36,29 @@ def call_compiled(kernel, *args):
 
     The caller guarantees that the arguments' Numba types never change between calls: arrays
     it allocates itself, poses that are C-contiguous, aligned and writeable float64, and
-    Python floats for the scalars. Anything else must call the dispatcher itself.
+    Python floats for the scalars. Anything else must call the dispatcher itself, or name the
+    ``variant`` of argument types (e.g. None or an int in one place) it calls.
     """
-    entry = _ENTRY.get(kernel)
+    entry = _ENTRY.get((kernel, variant))
     if entry is not None:
         return entry(*args)
     out = kernel(*args)
     cres = kernel.overloads.get(tuple(kernel.typeof_pyval(a) for a in args))
     if cres is not None:
-        _ENTRY[kernel] = cres.entry_point
+        _ENTRY[kernel, variant] = cres.entry_point
     return out
 
 
 def run_kernels(batch, serial, args: tuple, T: np.ndarray, parallel_min: int,
-                plain: bool | None = None) -> None:
+                plain: bool | None = None, variant=None) -> None:
     """Run a kernel pair on ``args`` (poses ``T (N, 4, 4)`` among them): the parallel
     ``batch`` kernel from ``parallel_min`` poses on, else the ``serial`` one, through
-    :func:`call_compiled` when the poses are plain (``plain``, or :func:`plain_poses`)."""
+    :func:`call_compiled` (with ``variant``) when the poses are plain (``plain``, or
+    :func:`plain_poses`)."""
     if T.shape[0] >= parallel_min:
         batch(*args)
     elif plain_poses(T) if plain is None else plain:
-        call_compiled(serial, *args)
+        call_compiled(serial, *args, variant=variant)
     else:
         serial(*args)
 

@@ -21,14 +21,17 @@ import numba as nb
 import numpy as np
 
 from kinestat.serial._kernels import _start
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._cf_kernels import (
+    RIGID_TOL,
     _add,
     _cross,
     _dot,
     _mv,
     _norm,
     _pair,
+    _pose_status,
     _pose_times,
     _rot,
     _row,
@@ -46,7 +49,7 @@ from kinestat.serial.analytic._cf_kernels import (
 _IMAG_REL = 1e-5
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _cubic_max_root(A, B, C):
     """The largest real root of ``m³ + A m² + B m + C`` (Cardano, then two Newton steps)."""
     P = B - A * A / 3.0
@@ -69,7 +72,7 @@ def _cubic_max_root(A, B, C):
     return m
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _polish(c4, c3, c2, c1, c0, t):
     """Two Newton steps of the quartic from t."""
     for _ in range(2):
@@ -94,31 +97,37 @@ def quartic_real_roots(c4, c3, c2, c1, c0):
     q = d - 0.5 * b * c + 0.125 * b * b * b
     r = e - 0.25 * b * d + b * b * c / 16.0 - 3.0 * b * b * b * b / 256.0
     m = _cubic_max_root(p, 0.25 * p * p - r, -0.125 * q * q)
-    z = [0j, 0j, 0j, 0j]
+    # tuples, not lists: no heap allocation per pose, and less code to load from the cache
     if m <= 1e-14 * (1.0 + abs(p) + abs(r)):  # biquadratic (q = 0)
         sq = cmath.sqrt(p * p - 4.0 * r + 0j)
         y1 = cmath.sqrt(0.5 * (-p + sq))
         y2 = cmath.sqrt(0.5 * (-p - sq))
-        z[0], z[1], z[2], z[3] = y1, -y1, y2, -y2
+        z = (y1, -y1, y2, -y2)
     else:
         s = math.sqrt(2.0 * m)
         k1 = 0.5 * p + m + 0.5 * q / s
         k2 = 0.5 * p + m - 0.5 * q / s
         d1 = cmath.sqrt(s * s - 4.0 * k1 + 0j)
         d2 = cmath.sqrt(s * s - 4.0 * k2 + 0j)
-        z[0], z[1] = 0.5 * (s + d1), 0.5 * (s - d1)
-        z[2], z[3] = 0.5 * (-s + d2), 0.5 * (-s - d2)
-    out = [0.0, 0.0, 0.0, 0.0]
+        z = (0.5 * (s + d1), 0.5 * (s - d1), 0.5 * (-s + d2), 0.5 * (-s - d2))
+    out = (0.0, 0.0, 0.0, 0.0)
     k = 0
     for i in range(4):
         t = z[i].real - 0.25 * b
         if abs(z[i].imag) <= _IMAG_REL * (1.0 + abs(t)):
-            out[k] = _polish(c4, c3, c2, c1, c0, t)
+            out = _put(out, k, _polish(c4, c3, c2, c1, c0, t))
             k += 1
-    return k, (out[0], out[1], out[2], out[3])
+    return k, out
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
+def _put(v, k, x):
+    """The 4-tuple v with entry k set to x."""
+    return (x if k == 0 else v[0], x if k == 1 else v[1], x if k == 2 else v[2],
+            x if k == 3 else v[3])
+
+
+@nb.njit(**_INLINE)
 def _sq(l0, l1, l2, f):
     """Add the square of the linear form ``l0 + l1 cos θ + l2 sin θ`` to the Fourier
     coefficients ``f = (A0, A1, B1, A2, B2)`` of ``A0 + A1 cos θ + B1 sin θ + A2 cos 2θ +
@@ -127,7 +136,7 @@ def _sq(l0, l1, l2, f):
             f[2] + 2.0 * l0 * l2, f[3] + 0.5 * (l1 * l1 - l2 * l2), f[4] + l1 * l2)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _fourier_at(f, c, s):
     """The Fourier series f at the angle of cosine c, sine s."""
     return f[0] + f[1] * c + f[2] * s + f[3] * (c * c - s * s) + f[4] * 2.0 * s * c
@@ -154,8 +163,8 @@ def theta3_roots(f):
     s2b = 2.0 * sb * cb
     A2 = f[3] * c2b + f[4] * s2b
     B2 = f[4] * c2b - f[3] * s2b
-    cs = [1.0, 1.0, 1.0, 1.0]
-    sn = [0.0, 0.0, 0.0, 0.0]
+    cs = (1.0, 1.0, 1.0, 1.0)
+    sn = (0.0, 0.0, 0.0, 0.0)
     c4 = A0 - A1 + A2
     if c4 == 0.0:
         return 0, (1.0, 1.0, 1.0, 1.0), (0.0, 0.0, 0.0, 0.0)
@@ -166,15 +175,18 @@ def theta3_roots(f):
         den = 1.0 + ti * ti
         cp = (1.0 - ti * ti) / den
         sp = 2.0 * ti / den
-        cs[i] = cp * cb - sp * sb
-        sn[i] = sp * cb + cp * sb
-    return k, (cs[0], cs[1], cs[2], cs[3]), (sn[0], sn[1], sn[2], sn[3])
+        cs = _put(cs, i, cp * cb - sp * sb)
+        sn = _put(sn, i, sp * cb + cp * sb)
+    return k, cs, sn
 
 
 @nb.njit(**_OPTS)
-def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q, out_valid,
+def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton, out_q, out_valid,
                  out_pos, out_rot, out_sing, out_sign, out_fam):
     clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+    status = _pose_status(T, n, RIGID_TOL)
+    if status:
+        return -status
     Tn = T[n]
     Rg, tg = _pose_times(Tn, T0inv)
     W0, W1, W2 = _row(W, 0), _row(W, 1), _row(W, 2)
@@ -202,8 +214,8 @@ def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q, o
                 q2 = _add(P1, _mv(_rot(W1, t2), _sub(g3, P1)))
                 t1 = _sp1(W0, P0, q2, pw)
                 cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol,
-                                  dedup, out_q, out_valid, out_pos, out_rot, out_sing, out_sign,
-                                  out_fam, cnt)
+                                  dedup, newton, out_q, out_valid, out_pos, out_rot, out_sing,
+                                  out_sign, out_fam, cnt)
         return cnt
     o1 = (G[0], G[1], G[2])
     r2 = (G[3], G[4], G[5])
@@ -239,12 +251,12 @@ def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q, o
         t2 = _pair(_dot(W1, _cross(up, v)), _dot(up, v))
         q2 = _add(r2, _mv(_rot(W1, t2), u))
         t1 = _sp1(W0, o1, q2, pw)
-        cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup,
+        cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, newton,
                           out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, cnt)
     return cnt
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _unpack(Kp):
     """The data packed by :func:`kinestat.serial.analytic._offset_pack.pack`: ``C (7, 4, 4)``,
     ``T0inv``, ``W (6, 3)``, ``P (6, 3)``, the wrist centre, a unit vector normal to axis 6 and
@@ -254,21 +266,22 @@ def _unpack(Kp):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def offset_batch(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
+def offset_batch(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot, out_sing,
                  out_sign, out_fam, out_cnt):
     """Spherical wrist, offset shoulder: N poses into the (uninitialised) outputs; ``out_cnt
-    (N,)`` the number of solutions."""
+    (N,)`` the number of solutions (or minus the pose's status, as
+    :func:`kinestat.serial.analytic._cf_kernels.pieper_batch`)."""
     C, T0inv, W, P, w, x6, G = _unpack(Kp)
     for n in nb.prange(T.shape[0]):
-        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q,
-                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton,
+                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
 
 
 @nb.njit(**_OPTS)
-def offset_serial(Kp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing,
-                  out_sign, out_fam, out_cnt):
+def offset_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
+                  out_sing, out_sign, out_fam, out_cnt):
     """:func:`offset_batch` on one thread (small batches: no thread start-up)."""
     C, T0inv, W, P, w, x6, G = _unpack(Kp)
     for n in range(T.shape[0]):
-        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, out_q,
-                                  out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton,
+                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)

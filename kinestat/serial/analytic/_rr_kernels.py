@@ -30,6 +30,7 @@ from numba.np.linalg import _LAPACK
 
 from kinestat.mechanism.joints import JointKind
 from kinestat.serial._kernels import _step
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._rr_qz import nearly_real, pencil_eigvals_qz, qz_scratch, suspect
 from kinestat.serial.analytic._solution_kernels import polish, store
@@ -54,7 +55,7 @@ _TINY_PIVOT = 1e-17
 _B0 = (0.31, -0.72, 0.55, 0.13, -0.94, 0.67, -0.28, 0.81, -0.46, 0.19, 0.73, -0.35)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _rigid_product(A, B, C, out):
     """``out = A B C`` for rigid 4x4 arrays (bottom row [0, 0, 0, 1])."""
     for i in range(3):
@@ -71,7 +72,7 @@ def _rigid_product(A, B, C, out):
     out[3, 3] = 1.0
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _rigid_inverse(T, out):
     """``out = T⁻¹`` for a rigid 4x4 array."""
     for i in range(3):
@@ -363,7 +364,7 @@ def _null_vector(A, x, S, v, perm, y):
             v[i, 0] /= nv
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _ratio(v, axis):
     """Least-squares ratio along ``axis`` (0: x4, 1: x5) of the power products ``v[3i + j]``
     (i: power of x4, j: power of x5)."""

@@ -26,6 +26,7 @@ import numpy as np
 from numba import types
 from numba.extending import get_cython_function_address
 
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 
 __all__ = ["LWORK", "NEAR_REAL", "PIVOT_SUSPECT", "qz_scratch", "pencil_eigvals_qz", "nearly_real",
@@ -106,7 +107,7 @@ def nearly_real(wr, wi):
     return near
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def suspect(tried, lost, near, err, pivot):
     """Whether the companion pass may have missed real roots (then the QZ pass runs):
 

@@ -16,6 +16,7 @@ import numpy as np
 
 from kinestat.mechanism.joints import JointKind
 from kinestat.serial._kernels import _jac_column, _start, _step
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial._numba_options import PI, SQRT8, TWO_PI
 from kinestat.spatial._elimination import eliminate
@@ -23,7 +24,7 @@ from kinestat.spatial._elimination import eliminate
 REVOLUTE = int(JointKind.REVOLUTE)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def wrap(x):
     """``x`` wrapped to [-π, π) (no division for values already there)."""
     if -PI <= x < PI:
@@ -31,14 +32,14 @@ def wrap(x):
     return x - TWO_PI * math.floor((x + PI) / TWO_PI)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def angle_distance(a, b):
     """``|wrap(a − b)|`` for a, b already in [-π, π)."""
     d = abs(a - b)
     return TWO_PI - d if d > PI else d
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def pose_errors(t, Tn):
     """Position and rotation-angle error of the 12-scalar transform t against ``Tn (4, 4)``."""
     pos = math.sqrt((t[3] - Tn[0, 3]) ** 2 + (t[7] - Tn[1, 3]) ** 2 + (t[11] - Tn[2, 3]) ** 2)
@@ -49,7 +50,7 @@ def pose_errors(t, Tn):
     return pos, _two_asin(math.sqrt(d2) / SQRT8)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _two_asin(x):
     """``2 asin(min(x, 1))`` for x ≥ 0; below 1e-4 by its series ``x + x³/6 + 3x⁵/40 +
     5x⁷/112`` (the next term is 35x⁹/1152: relative 3e-34, below rounding)."""
@@ -59,7 +60,7 @@ def _two_asin(x):
     return 2.0 * math.asin(min(x, 1.0))
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _fk_jac(C, q, J):
     """End pose (12 scalars) and the space Jacobian into ``J (6, 6)`` at ``q (6,)``."""
     t = _start(C[0])
@@ -69,7 +70,7 @@ def _fk_jac(C, q, J):
     return t
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def _twist_error(t, Tn, e):
     """First-order spatial twist ``[ω; v_O]`` taking t to Tn (``Tn ≈ (I + [ξ]) F``) into e;
     returns its norm."""
@@ -97,7 +98,7 @@ def _twist_error(t, Tn, e):
     return math.sqrt(s)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def scratch():
     """The scratch :func:`polish` needs (allocate once per pose, not per root)."""
     return np.empty((3, 6, 7)), np.empty((4, 6))
@@ -110,14 +111,17 @@ def polish(C, Tn, q, iters, Ms, Vs):
     q. ``Ms (3, 6, 7)``, ``Vs (4, 6)``: scratch (:func:`scratch`)."""
     J, Jn, Jc = Ms[0, :, :6], Ms[1, :, :6], Ms[2]
     e, en_v, qn = Vs[0], Vs[1], Vs[3]
-    dq = Jc[:, 6]
     t = _fk_jac(C, q, J)
     en = _twist_error(t, Tn, e)
+    # element loops, not slice assignments: those carry Numba's shape-mismatch error path,
+    # whose message formatting doubles the compiled code every caller's cache loads
     for _ in range(iters):
         if en < 1e-15:
             break
-        Jc[:, :6] = J
-        Jc[:, 6] = e
+        for i in range(6):
+            for j in range(6):
+                Jc[i, j] = J[i, j]
+            Jc[i, 6] = e[i]
         if eliminate(Jc, 6, 0.0, None) < 1e-14:  # [J | e] → [· | δq]
             break
         step = 1.0
@@ -126,7 +130,7 @@ def polish(C, Tn, q, iters, Ms, Vs):
         tn = t
         for _half in range(6):  # backtracking: full Newton step, then halves
             for i in range(6):
-                qn[i] = q[i] + step * dq[i]
+                qn[i] = q[i] + step * Jc[i, 6]
             tn = _fk_jac(C, qn, Jn)
             nn = _twist_error(tn, Tn, en_v)
             if nn < en:
@@ -135,15 +139,17 @@ def polish(C, Tn, q, iters, Ms, Vs):
             step *= 0.5
         if not moved:
             break
-        q[:] = qn
-        J[:, :] = Jn
-        e[:] = en_v
+        for i in range(6):
+            q[i] = qn[i]
+            e[i] = en_v[i]
+            for j in range(6):
+                J[i, j] = Jn[i, j]
         en = nn
         t = tn
     return pose_errors(t, Tn)
 
 
-@nb.njit(inline="always", **_OPTS)
+@nb.njit(**_INLINE)
 def store(n, q, pos, rot, dedup, out_q, out_valid, out_pos, out_rot, cnt):
     """Store the verified q (6-tuple) into slot ``cnt`` of pose n, wrapped, unless it repeats a
     stored solution (every joint within ``dedup``) or the slots are full; returns the new

@@ -24,7 +24,7 @@ import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _offset_pack
-from kinestat.serial.analytic._common import nan_array, pack, reasons, run_kernels
+from kinestat.serial.analytic._common import _ENTRY, nan_array, pack, reasons, run_kernels
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
 
@@ -33,6 +33,7 @@ __all__ = ["solve_pieper", "solve_three_parallel", "solve_pieper_compiled",
 
 _WRIST_TOL = 1e-10
 _PARALLEL_MIN = 256  # smaller batches run on one thread (a pose costs a few µs)
+_NEWTON_STEPS = 2  # for a candidate that misses tol (rounding next to a singular set)
 
 
 def _apply(T: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -161,6 +162,64 @@ def _outputs(N: int, K: int):
             np.empty((N, K)), np.empty(N, dtype=np.int64))
 
 
+def _one_pieper(entry, Kp: np.ndarray, wrist_tol: float, reason: str):
+    """The single-pose call of the spherical-wrist kernel (``entry``: its compiled entry point
+    for plain poses and no Newton steps, see :func:`~kinestat.serial.analytic._common.
+    call_compiled`): ``one(T (1, 4, 4) plain, tol: float)``, the result of
+    :func:`solve_pieper_compiled` with ``shape=()``, ``checked=False``, or None as it. The
+    per-model arguments are bound once: a single call is a few µs, so its Python steps
+    matter."""
+    if entry is None:
+        return None
+
+    def one(T, tol):
+        q, valid, pos, rot, cnt = _outputs(1, 8)
+        sing = np.empty(_S18, dtype=bool)
+        sign = np.empty(_S18)
+        fam = np.empty(_S18)
+        entry(Kp, T, tol, wrist_tol, 1e-6, None, q, valid, pos, rot, sing, sign, fam, cnt)
+        c = cnt[0]
+        if c < 0:
+            return None
+        return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
+                                     "" if c else reason, "pieper", tol)
+    return one
+
+
+def _one_three_parallel(entry, Kp: np.ndarray, wrist_tol: float):
+    """:func:`_one_pieper` for :func:`solve_three_parallel_compiled` (None also for a pose
+    near the wrist-singular set, whose families the full call adds)."""
+    if entry is None:
+        return None
+
+    def one(T, tol):
+        q, valid, pos, rot, cnt = _outputs(1, 8)
+        near = np.empty(1, dtype=bool)
+        entry(Kp, T, tol, wrist_tol, 1e-6, None, q, valid, pos, rot, cnt, near)
+        c = cnt[0]
+        if c < 0 or near[0]:
+            return None
+        return IKAllResult.build_one(q, valid, pos, rot, np.zeros(_S18, dtype=bool),
+                                     np.zeros(_S18), nan_array(_S18), None, cnt,
+                                     "" if c else _REASON_3P, "three-parallel", tol)
+    return one
+
+
+_S18 = (1, 8)
+
+
+def _newton(N: int, checked: bool) -> int | None:
+    """The kernels' Newton steps for a candidate that misses tol: none (the pose is handed
+    back) on a few unchecked poses, else two."""
+    return None if not checked and N < _PARALLEL_MIN else _NEWTON_STEPS
+
+
+def _unchecked(cnt: np.ndarray) -> bool:
+    """Some pose's count is negative: the kernel found it not orthonormal to rounding, or
+    handed it back for Newton steps."""
+    return cnt[0] < 0 if cnt.shape[0] == 1 else cnt.shape[0] > 1 and cnt.min() < 0
+
+
 def _cf_kernels():
     K = sys.modules.get("kinestat.serial.analytic._cf_kernels")
     if K is None:
@@ -177,10 +236,15 @@ def _offset_kernels():
 
 def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
                           wrist_tol: float = _WRIST_TOL, shape: tuple[int, ...] | None = None,
-                          plain: bool | None = None) -> IKAllResult:
+                          plain: bool | None = None, checked: bool = True) -> IKAllResult | None:
     """:func:`solve_pieper` by the compiled kernel (same slots, valid ones first); ``shape``:
     the batch shape of the result (default ``(N,)``); ``plain``: the caller has checked
-    :func:`~kinestat.serial.analytic._common.plain_poses` (None: check here)."""
+    :func:`~kinestat.serial.analytic._common.plain_poses` (None: check here).
+    ``checked=False``: the caller has not checked the poses, the kernel does, and with fewer
+    than ``_PARALLEL_MIN`` poses it runs without Newton steps (a kernel with less code to load);
+    the result is then None when some pose is not a rigid transform orthonormal to rounding or
+    one of its candidates needs Newton steps: the caller checks the poses, projects them and
+    calls again, checked."""
     offset = data["shoulder"] is None
     K = _offset_kernels() if offset else _cf_kernels()
     N = T.shape[0]
@@ -195,12 +259,17 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
             model, ax, data["wrist"], _perp(ax.w[5])) if offset else K.pack(
             model.constants, np.linalg.inv(ax.T0), ax.w, ax.r, data["wrist"], data["shoulder"],
             _perp(ax.w[5]))
-    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, sing, sign, fam, cnt)
-    if offset:
-        run_kernels(K.offset_batch, K.offset_serial, args, T, _PARALLEL_MIN, plain)
-    else:
-        run_kernels(K.pieper_batch, K.pieper_serial, args, T, _PARALLEL_MIN, plain)
+    newton = _newton(N, checked)
+    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos, rot, sing, sign,
+            fam, cnt)
+    serial = K.offset_serial if offset else K.pieper_serial
+    run_kernels(K.offset_batch if offset else K.pieper_batch, serial, args, T, _PARALLEL_MIN,
+                plain, newton)
     reason = _offset_pack.REASON if offset else _REASON_PIEPER
+    if shape == () and newton is None and plain and "one" not in data:
+        data["one"] = _one_pieper(_ENTRY.get((serial, None)), Kp, float(wrist_tol), reason)
+    if _unchecked(cnt):
+        return None
     if shape == ():
         return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
                                      reason if cnt[0] == 0 else "", "pieper", tol)
@@ -214,10 +283,11 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
 def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, *,
                                   tol: float = 1e-9, wrist_tol: float = _WRIST_TOL,
                                   shape: tuple[int, ...] | None = None,
-                                  plain: bool | None = None) -> IKAllResult:
+                                  plain: bool | None = None,
+                                  checked: bool = True) -> IKAllResult | None:
     """:func:`solve_three_parallel` by the compiled kernel, with the wrist-singular families
     (:func:`kinestat.serial.analytic.families.add_wrist_families`) added; ``shape``, ``plain``
-    as for :func:`solve_pieper_compiled`."""
+    as for :func:`solve_pieper_compiled`, as is the None return."""
     K = _cf_kernels()
     N = T.shape[0]
     Kp = data.get("kernel_args")
@@ -229,8 +299,15 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
                                           data["p56"], _perp(h), sg)
     q, valid, pos, rot, cnt = _outputs(N, 8)
     near = np.empty(N, dtype=bool)
-    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, q, valid, pos, rot, cnt, near)
-    run_kernels(K.three_parallel_batch, K.three_parallel_serial, args, T, _PARALLEL_MIN, plain)
+    newton = _newton(N, checked)
+    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos, rot, cnt, near)
+    run_kernels(K.three_parallel_batch, K.three_parallel_serial, args, T, _PARALLEL_MIN, plain,
+                newton)
+    if shape == () and newton is None and plain and "one" not in data:
+        data["one"] = _one_three_parallel(_ENTRY.get((K.three_parallel_serial, None)), Kp,
+                                          float(wrist_tol))
+    if _unchecked(cnt):
+        return None
     if shape == () and not near[0]:  # one pose away from the wrist-singular set
         return IKAllResult.build_one(q, valid, pos, rot, np.zeros((1, 8), dtype=bool),
                                      np.zeros((1, 8)), nan_array((1, 8)), None, cnt,

@@ -14,24 +14,21 @@ from __future__ import annotations
 
 import sys
 from functools import lru_cache
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
-from kinestat.serial.analytic import (
-    closed_form,
-    pieper_offset,
-    reversed_chain,
-)
-from kinestat.serial.analytic import (
-    locked as _locked,
-)
+from kinestat.serial.analytic import closed_form
 from kinestat.serial.analytic._common import call_compiled, check_poses, plain_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.ik_methods import get as _robot_method
 from kinestat.serial.ik_methods import registered as _robot_methods
+
+if TYPE_CHECKING:
+    from kinestat.serial.analytic.locked import SelfMotion
 
 __all__ = ["ik_all", "ik_self_motion", "METHODS", "BACKENDS", "method_for"]
 
@@ -71,6 +68,8 @@ def _check_chain(model: ChainModel) -> None:
 def _classified(model: ChainModel):
     kind, data = classify(model)
     if kind == "general":  # axes 1, 2, 3 meeting: the reversed chain is a pieper arm
+        from kinestat.serial.analytic import reversed_chain  # lazy: first-call time
+
         rev = reversed_chain.reverse(model)
         if classify(rev)[0] == "pieper":
             return "pieper", {"reversed": rev}
@@ -120,6 +119,38 @@ def _nearest_rigid(Tf: np.ndarray) -> np.ndarray:
     return Tf
 
 
+_S44 = (4, 4)
+_F64 = np.dtype(np.float64)
+
+#: the compiled closed forms (each kernel checks its poses: :func:`ik_all`'s fast path)
+_CLOSED_FORMS = {"pieper": closed_form.solve_pieper_compiled,
+                 "three-parallel": closed_form.solve_three_parallel_compiled}
+
+
+def _checked_poses(T, fast: bool):
+    """``(Tf (N, 4, 4), batch shape, plain)``: the poses checked as rigid transforms (raises
+    :class:`~kinestat.errors.InputError` naming the first that is not), those orthonormal only
+    to within 1e-6 projected onto the nearest rotation; ``plain``: see
+    :func:`~kinestat.serial.analytic._common.plain_poses` (None: not known)."""
+    if type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
+            T.shape[-2:] == (4, 4) and fast:
+        Tf = T[None] if T.ndim == 2 and T.flags.c_contiguous else \
+            np.ascontiguousarray(T.reshape(-1, 4, 4))
+        plain = plain_poses(Tf)
+        if plain:
+            bad, n_project = call_compiled(_kernels().check_rigid, Tf, 1e-6)
+        else:
+            bad, n_project = _kernels().check_rigid(Tf, 1e-6)
+        if bad >= 0:
+            check_poses(T)  # raises with the full message
+        if n_project:
+            Tf = _nearest_rigid(Tf)
+            plain = None
+        return Tf, T.shape[:-2], plain
+    T = check_poses(T)
+    return _nearest_rigid(np.ascontiguousarray(T.reshape(-1, 4, 4))), T.shape[:-2], None
+
+
 def _kernels():
     """The closed-form kernel module (imported on first use: Numba start-up)."""
     mod = sys.modules.get("kinestat.serial.analytic._cf_kernels")
@@ -154,9 +185,22 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     >>> bool(np.any(np.all(np.abs(res.solutions() - q) < 1e-9, axis=1)))
     True
     """
+    T = T_base_flange
+    if type(T) is np.ndarray and T.shape == _S44 and method == "auto" and backend == "numba" \
+            and not locked and isinstance(model, ChainModel):
+        # one plain pose, defaults: the closed form's bound single call (after the first)
+        one = _plan(model)[1].get("one")
+        if one is not None and T.dtype is _F64:
+            f = T.flags
+            if f.c_contiguous and f.aligned and f.writeable:
+                res = one(T[None], float(tol))
+                if res is not None:
+                    return res
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
     if locked:
+        from kinestat.serial.analytic import locked as _locked  # lazy: first-call time
+
         pairs = _locked.check_locked(model, locked)
         res = ik_all(_locked.fold(model, pairs), T_base_flange, method=method, tol=tol,
                      backend=backend)
@@ -166,34 +210,33 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if method not in METHODS and robot is None:
         raise ModelError(f"ik_all: unknown method {method!r}; expected one of "
                          f"{METHODS + _robot_methods()}")
-    T = T_base_flange
-    if type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
-            T.shape[-2:] == (4, 4) and backend == "numba":
-        # one pose (the single call): a view with the batch axis; otherwise flattened
-        Tf = T[None] if T.ndim == 2 and T.flags.c_contiguous else \
-            np.ascontiguousarray(T.reshape(-1, 4, 4))
-        plain = plain_poses(Tf)
-        if plain:
-            bad, n_project = call_compiled(_kernels().check_rigid, Tf, 1e-6)
-        else:
-            bad, n_project = _kernels().check_rigid(Tf, 1e-6)
-        if bad >= 0:
-            check_poses(T)  # raises with the full message
-        if n_project:
-            Tf = _nearest_rigid(Tf)
-            plain = None
-    else:
-        T = check_poses(T)
-        Tf = _nearest_rigid(np.ascontiguousarray(T.reshape(-1, 4, 4)))
-        plain = None
-    shape = T.shape[:-2]
+    if backend not in BACKENDS:
+        raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
     if (use in ("pieper", "three-parallel") or kind == "decoupled") and use != kind:
         raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
                          f"(its geometry is {kind!r})")
-    if backend not in BACKENDS:
-        raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
     fast = backend == "numba"
+    closed = fast and use in _CLOSED_FORMS and "reversed" not in data
+    if closed and type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and \
+            T.shape[-2:] == (4, 4):
+        # the closed-form kernels check each pose themselves (None: some pose is not
+        # orthonormal to rounding, or needs Newton steps; the checks below then raise or
+        # project it, and the kernel runs again with Newton steps)
+        Tf = T[None] if T.ndim == 2 and T.flags.c_contiguous else \
+            np.ascontiguousarray(T.reshape(-1, 4, 4))
+        plain = plain_poses(Tf)
+        one = data.get("one") if plain and T.ndim == 2 else None  # one pose: the bound call
+        res = one(Tf, float(tol)) if one is not None else _CLOSED_FORMS[use](
+            model, Tf, data, tol=tol, shape=T.shape[:-2], plain=plain, checked=False)
+        if res is not None:
+            return res
+    Tf, shape, plain = _checked_poses(T, fast)
+    if closed:
+        res = _CLOSED_FORMS[use](model, Tf, data, tol=tol, shape=shape, plain=plain)
+        if res is None:
+            raise AssertionError("ik_all: a checked pose failed the kernel's check (a bug)")
+        return res
     if robot is not None:
         if not robot.applies(model):
             raise ModelError(f"ik_all: method {robot.name!r} applies only to {robot.geometry}; "
@@ -210,19 +253,17 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
                                  f"{model.name!r}: {exc}") from None
         res = decoupled.solve_decoupled(model, Tf, tol=tol)
     elif use == "pieper" and "reversed" in data:
+        from kinestat.serial.analytic import reversed_chain  # lazy: first-call time
+
         res = ik_all(data["reversed"], reversed_chain.invert_poses(Tf), tol=tol, backend=backend)
         res = reversed_chain.unreverse(res)
     elif use == "pieper":
-        if fast:
-            return closed_form.solve_pieper_compiled(model, Tf, data, tol=tol, shape=shape,
-                                                     plain=plain)
+        from kinestat.serial.analytic import pieper_offset  # lazy: NumPy reference only
+
         solve = closed_form.solve_pieper if data["shoulder"] is not None else \
             pieper_offset.solve_pieper_offset
         res = solve(model, Tf, data, tol=tol)
     elif use == "three-parallel":
-        if fast:
-            return closed_form.solve_three_parallel_compiled(model, Tf, data, tol=tol,
-                                                             shape=shape, plain=plain)
         from kinestat.serial.analytic import families  # lazy: start-up (NumPy path only)
 
         res = families.add_wrist_families(model, Tf, data,
@@ -236,10 +277,12 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
 
 
 def ik_self_motion(model: ChainModel, T_base_flange, joint: int, n: int, *,
-                   method: str = "auto", tol: float = 1e-9) -> _locked.SelfMotion:
+                   method: str = "auto", tol: float = 1e-9) -> SelfMotion:
     """Every solution along the self-motion of a 7-joint ``model``: ``joint`` (0-based) locked
     at ``n`` values over its limits (:func:`~kinestat.serial.analytic.locked.self_motion_values`)
     and the other six solved by :func:`ik_all` at each (families included)."""
+    from kinestat.serial.analytic import locked as _locked  # lazy: first-call time
+
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_self_motion: expected a ChainModel, got {type(model).__name__}")
     values = _locked.self_motion_values(model, joint, n)

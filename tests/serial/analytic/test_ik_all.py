@@ -188,6 +188,30 @@ def test_rounded_pose_is_projected_onto_a_rotation(name):
     assert np.min(wrapped_distance(res.solutions(), q)) < 1e-5
 
 
+@pytest.mark.parametrize("name", ["ur5", "puma560", "kr16"])
+def test_closed_form_kernels_hand_unchecked_poses_to_the_checks(name):
+    """The closed-form kernels check each float64 pose themselves: a pose orthonormal only to
+    within 1e-6 (printed to 7 decimals) is still projected, in a batch and alone, and a pose
+    that is not rigid still raises, naming its index in the batch."""
+    model = arm(name)
+    q = np.random.default_rng(4).uniform(-PI, PI, (5, 6))
+    T = kinestat.fk(model, q)
+    Tr = T.copy()
+    Tr[2] = np.round(T[2], 7)
+    exact, rounded = ik_all(model, T), ik_all(model, Tr)
+    np.testing.assert_array_equal(rounded.n_solutions, exact.n_solutions)
+    for i in range(5):
+        assert np.min(wrapped_distance(rounded.solutions((i,)), q[i])) < 1e-4
+    one = ik_all(model, np.ascontiguousarray(Tr[2]))
+    np.testing.assert_array_equal(one.q, rounded.q[2])
+    bad = T.copy()
+    bad[3, 0, 0] += 1e-3
+    with pytest.raises(InputError, match=r"pose \(3,\) is not a rigid transform"):
+        ik_all(model, bad)
+    with pytest.raises(InputError, match="not a rigid transform"):
+        ik_all(model, np.ascontiguousarray(bad[3]))
+
+
 #: Jaco2-type poses (seeds 1, 9, 10, 100, 122 of ``default_rng(seed).uniform(-π, π, (10000, 6))``,
 #: indices 958, 402, 1231, 2595, 4251, 2486) away from singular sets (Jacobian σmin/σmax 4e-4
 #: to 2e-2) whose real roots in x3 cluster (two to four solutions within 1e-2 of each other):

@@ -8,7 +8,7 @@ import pytest
 
 import kinestat
 from kinestat.errors import InputError
-from kinestat.serial.analytic import ik_all
+from kinestat.serial.analytic import closed_form, ik_all, solve
 from kinestat.serial.analytic._common import plain_poses
 
 from .arms import PI, arm
@@ -91,3 +91,29 @@ def test_integer_tolerance_is_the_float_one():
     a, b = ik_all(model, T[1], tol=1), ik_all(model, T[1], tol=1.0)
     np.testing.assert_array_equal(a.q, b.q)
     np.testing.assert_array_equal(a.valid, b.valid)
+
+
+@pytest.mark.parametrize("name", ["ur5", "puma560", "kr16"])
+def test_poses_handed_back_for_newton_steps_are_solved_with_them(name):
+    """Below 256 unchecked poses the kernels run without Newton steps and hand back a pose
+    whose candidate misses tol; the call then solves it with them. At a tolerance near
+    rounding (3e-16 × the pose's size) candidates miss: the kernel hands poses back, and the
+    result is still the checked batch's (256 poses: Newton steps from the start), bit for bit,
+    every valid slot within tol by kinestat.fk (to its rounding, which is that size here)."""
+    model, T = _poses(name, 256, seed=8)
+    tol = 3e-16 * max(1.0, float(np.abs(T[:, :3, 3]).max()))
+    kind, data = solve._plan(model)
+    compiled = closed_form.solve_pieper_compiled if kind == "pieper" else \
+        closed_form.solve_three_parallel_compiled
+    back = [compiled(model, np.ascontiguousarray(T[i:i + 1]), data, tol=tol, shape=(),
+                     plain=True, checked=False) is None for i in range(40)]
+    assert any(back)
+    batch = ik_all(model, T, tol=tol)
+    for i in range(40):
+        _assert_same(ik_all(model, T[i], tol=tol), batch, i)
+    part = ik_all(model, T[:40], tol=tol)  # fewer than 256: handed back, solved again
+    for f in _FIELDS:
+        np.testing.assert_array_equal(getattr(part, f), getattr(batch, f)[:40], err_msg=f)
+    F = kinestat.fk(model, np.where(batch.valid[..., None], batch.q, 0.0))
+    pos = np.linalg.norm(F[..., :3, 3] - T[:, None, :3, 3], axis=-1)
+    assert batch.valid.sum() > 0 and np.all(pos[batch.valid] <= 2.0 * tol)
