@@ -1,0 +1,192 @@
+"""The contact estimator of the follow task: normal, friction coefficient, curvature, slip.
+
+Measurement model (:mod:`.tuning`): each cycle gives the measured tool tip ``p`` (a point of
+the surface while in contact; noise ``σ_tip`` per coordinate) and the force the tool applies
+to the workpiece ``F`` (noise ``σ_F`` per component).
+
+* **Slip.** The tip slides when it advanced along the travel by more than ``confidence``
+  standard deviations of an advance (``√2 σ_tip``, at least the tool's step resolution) in
+  the last cycle or over the window of the last ``WINDOW`` cycles: a significance test on
+  the measured tips, not a tuned threshold.
+* **Normal and friction while sliding.** Isotropic Coulomb friction on the tool lies
+  against the slip, and the slip is the chord ``ĉ`` of the measured tip path (it lies in the
+  surface), carried to the current tip by the path's curvature. So the normal is the part of
+  ``−F`` across the chord and ``μ = F·ĉ / |F⊥|`` — no μ needed for the normal. Each is a
+  measurement with a variance (force noise over the force, chord noise ``√2 σ_tip/|c|``
+  times μ); both are fused with the estimate by a scalar Kalman update.
+* **While stuck** the force may lie anywhere in the cone and says nothing more: the normal is
+  the prediction (the probe's plane fit or the last slide, turned by the curvature under the
+  tip's advance), with its variance grown; once μ is known a normal further from the force
+  than the cone allows is brought onto the cone's boundary (the force must lie inside it).
+* **Curvature** from a circle fitted to the recent tips in the plane of the normal and the
+  travel (:func:`~kinestat.control.contact_estimate.path_curvature`, with its significance
+  test), with the probe's touches on the line of travel while the path is short.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from kinestat.control.contact_estimate import cone_normal, path_curvature, turn_by_curvature
+from kinestat.control.follower.tuning import FollowTuning
+
+__all__ = ["ContactEstimate", "WINDOW", "slip_test", "slide_measurement", "friction_on_normal",
+           "observe_travel"]
+
+WINDOW = 4
+"""Cycles over which a slow slide (a creep) is tested; not a tuning: the shortest window a
+trend is told from one cycle's jitter in."""
+HISTORY = 60
+"""Measured tips kept (the chord and the curvature fit look back over them)."""
+
+
+@dataclass(frozen=True, eq=False)
+class ContactEstimate:
+    """The contact as estimated (fixed frame; immutable).
+
+    Attributes:
+        normal: (3,) unit normal, out of the material.
+        normal_var: rad², variance of the normal's direction (about any tangent axis).
+        mu: friction coefficient estimate (0 before a slide measured it).
+        mu_var: its variance (inf before a slide).
+        curvature: 1/mm, the normal curvature along the travel (positive convex).
+        sliding: the last cycle's slip test.
+        tips: the recent measured tips in contact during travel, oldest first.
+        line: the probe's touches on the line of travel (the curvature's first points).
+        samples: slides that measured the normal and μ.
+    """
+
+    normal: np.ndarray
+    normal_var: float
+    mu: float = 0.0
+    mu_var: float = math.inf
+    curvature: float = 0.0
+    sliding: bool = False
+    tips: tuple = ()
+    line: tuple = ()
+    samples: int = 0
+
+    def friction_known(self, tun: FollowTuning) -> bool:
+        """μ measured and significantly above zero."""
+        return self.samples > 0 and self.mu > tun.confidence * math.sqrt(self.mu_var)
+
+
+def slip_test(tun: FollowTuning, tips: tuple, tip: np.ndarray, t: np.ndarray) -> bool:
+    """Whether the tip slid along ``t``: its advance over the last cycle or the last
+    ``WINDOW`` cycles exceeds ``confidence`` standard deviations of an advance."""
+    if not tips:
+        return False
+    sd = max(math.sqrt(2.0) * tun.tip_sigma, tun.step_resolution / tun.confidence)
+    lim = tun.confidence * sd
+    if float((tip - tips[-1]) @ t) > lim:
+        return True
+    return len(tips) >= WINDOW and float((tip - tips[-WINDOW]) @ t) > lim
+
+
+def _chord(tips: tuple, tip: np.ndarray, length: float) -> np.ndarray | None:
+    """The chord from the latest earlier tip at least ``length`` mm back to ``tip``."""
+    for old in reversed(tips):
+        c = tip - old
+        if float(np.linalg.norm(c)) >= length:
+            return c
+    return None
+
+
+def slide_measurement(tun: FollowTuning, F: np.ndarray, chord: np.ndarray, n: np.ndarray,
+                      kappa: float) -> tuple[np.ndarray, float, float, float]:
+    """One sliding cycle's measurement ``(normal, its variance, μ, its variance)`` from the
+    force ``F`` and the tip ``chord`` (module docstring); the chord is carried to the current
+    tip by the curvature ``kappa`` (the tangent turns by κ|c|/2 from the chord's middle)."""
+    L = float(np.linalg.norm(chord))
+    s = turn_by_curvature(n, chord / L, kappa * L / 2.0)[1]
+    s /= np.linalg.norm(s)
+    fs = float(F @ s)
+    perp = F - fs * s
+    fp = float(np.linalg.norm(perp))
+    mu = fs / fp
+    sc = math.sqrt(2.0) * tun.tip_sigma / L  # the chord's direction noise (rad)
+    rel = tun.force_sigma / fp
+    var_n = rel ** 2 + (mu * sc) ** 2
+    var_mu = (rel ** 2) * (1.0 + mu * mu) + ((1.0 + mu * mu) * sc) ** 2
+    return -perp / fp, var_n, mu, var_mu
+
+
+def friction_on_normal(tun: FollowTuning, F: np.ndarray, n: np.ndarray, var_n: float,
+                       t: np.ndarray) -> tuple[float, float]:
+    """A sliding cycle's friction measurement against the normal estimate ``n`` (variance
+    ``var_n``): the force's part along the travel over its normal part, with its variance
+    (the force's noise and the normal's error, which tilts the ratio by ``(1 + μ²)`` per
+    radian)."""
+    fn = -float(F @ n)
+    mu = float(F @ t) / fn
+    var = (tun.force_sigma / fn) ** 2 * (1.0 + mu * mu) + (1.0 + mu * mu) ** 2 * var_n
+    return mu, var
+
+
+def _fuse_normal(n: np.ndarray, var: float, m: np.ndarray, var_m: float
+                 ) -> tuple[np.ndarray, float]:
+    g = var / (var + var_m)
+    out = n + g * (m - n)
+    return out / np.linalg.norm(out), (1.0 - g) * var
+
+
+def _in_cone(tun: FollowTuning, est: ContactEstimate, F: np.ndarray) -> np.ndarray:
+    """The normal brought inside the friction cone about the force on the tool, ``−F``
+    (once μ is known; the cone widened by the normal's and the force's noise)."""
+    n = est.normal
+    if not est.friction_known(tun):
+        return n
+    u = -F / np.linalg.norm(F)
+    slack = tun.confidence * math.sqrt(est.normal_var + tun.direction_tol ** 2)
+    lim = math.atan(est.mu) + slack
+    if float(n @ u) >= math.cos(lim):
+        return n
+    return cone_normal(u, n, math.tan(lim))
+
+
+def _curvature(tun: FollowTuning, est: ContactEstimate, tips: tuple, tip: np.ndarray,
+               n: np.ndarray, t: np.ndarray) -> float:
+    pts = np.asarray(tips if len(tips) >= WINDOW else est.line + tips)
+    if len(pts) < 3:
+        return est.curvature
+    return path_curvature(pts, tip, n, t, tun.curvature_span)
+
+
+def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: np.ndarray,
+                   t: np.ndarray) -> ContactEstimate:
+    """One travel cycle's update of ``est`` from the measured ``tip`` and force ``F`` with
+    the travel tangent ``t`` (module docstring)."""
+    tips = est.tips
+    sliding = slip_test(tun, tips, tip, t)
+    adv = float((tip - tips[-1]) @ t) if tips else 0.0
+    # prediction: the normal turns with the surface under the tip's advance
+    n, _ = turn_by_curvature(est.normal, t, est.curvature * adv)
+    var = est.normal_var + (tun.direction_tol * abs(adv) / max(tun.chord, 1e-9)) ** 2
+    est = replace(est, normal=n / np.linalg.norm(n), normal_var=var, sliding=sliding)
+    new_tips = (tips + (tip.copy(),))[-HISTORY:]
+    if sliding:
+        mu_m, var_mu = friction_on_normal(tun, F, est.normal, est.normal_var, t)
+        mu, mvar = _fuse_mu(est, mu_m, var_mu)
+        est = replace(est, mu=mu, mu_var=mvar, samples=est.samples + 1)
+        c = _chord(tips, tip, tun.chord)
+        if c is not None and float(c @ t) > 0.5 * float(np.linalg.norm(c)):
+            m, var_m, mu_m, var_mu = slide_measurement(tun, F, c, est.normal, est.curvature)
+            n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
+            mu, mvar = _fuse_mu(est, mu_m, var_mu)
+            est = replace(est, normal=n, normal_var=var, mu=mu, mu_var=mvar)
+        est = replace(est, mu=min(max(est.mu, 0.0), tun.max_friction))
+    else:
+        est = replace(est, normal=_in_cone(tun, est, F))
+    tt = t - float(t @ est.normal) * est.normal
+    kappa = _curvature(tun, est, new_tips, tip, est.normal, tt / np.linalg.norm(tt))
+    return replace(est, tips=new_tips, curvature=kappa)
+
+
+def _fuse_mu(est: ContactEstimate, mu_m: float, var_m: float) -> tuple[float, float]:
+    if not est.samples:
+        return mu_m, var_m
+    g = est.mu_var / (est.mu_var + var_m)
+    return est.mu + g * (mu_m - est.mu), (1.0 - g) * est.mu_var
