@@ -207,7 +207,8 @@ class FollowConfig:
                              "by the platform inside the safety envelope: " + "; ".join(bad))
         if self.tuning is None:
             object.__setattr__(self, "tuning", derive_tuning(
-                self.base.model, self.base.force_target, self.base.start_tool_point))
+                self.base.model, self.base.force_target, self.base.start_tool_point,
+                self.travel_step))
 
 
 

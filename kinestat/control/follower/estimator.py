@@ -54,7 +54,9 @@ class ContactEstimate:
         mu_var: its variance (inf before a slide).
         curvature: 1/mm, the normal curvature along the travel (positive convex).
         sliding: the last cycle's slip test.
-        tips: the recent measured tips in contact during travel, oldest first.
+        tips: the measured tips of the last ``WINDOW`` travel cycles, oldest first.
+        path: measured tips along the travel, each a significant advance from the one
+            before (a stuck tip adds none), oldest first: the chords and the curvature.
         line: the probe's touches on the line of travel (the curvature's first points).
         samples: slides that measured the normal and μ.
     """
@@ -66,6 +68,7 @@ class ContactEstimate:
     curvature: float = 0.0
     sliding: bool = False
     tips: tuple = ()
+    path: tuple = ()
     line: tuple = ()
     samples: int = 0
 
@@ -74,13 +77,18 @@ class ContactEstimate:
         return self.samples > 0 and self.mu > tun.confidence * math.sqrt(self.mu_var)
 
 
+def advance_limit(tun: FollowTuning) -> float:
+    """mm: the smallest significant advance of the tip: ``confidence`` standard deviations
+    of the difference of two measured tips (at least the tool's step resolution)."""
+    return max(tun.confidence * math.sqrt(2.0) * tun.tip_sigma, tun.step_resolution)
+
+
 def slip_test(tun: FollowTuning, tips: tuple, tip: np.ndarray, t: np.ndarray) -> bool:
     """Whether the tip slid along ``t``: its advance over the last cycle or the last
-    ``WINDOW`` cycles exceeds ``confidence`` standard deviations of an advance."""
+    ``WINDOW`` cycles exceeds :func:`advance_limit`."""
     if not tips:
         return False
-    sd = max(math.sqrt(2.0) * tun.tip_sigma, tun.step_resolution / tun.confidence)
-    lim = tun.confidence * sd
+    lim = advance_limit(tun)
     if float((tip - tips[-1]) @ t) > lim:
         return True
     return len(tips) >= WINDOW and float((tip - tips[-WINDOW]) @ t) > lim
@@ -147,12 +155,16 @@ def _in_cone(tun: FollowTuning, est: ContactEstimate, F: np.ndarray) -> np.ndarr
     return cone_normal(u, n, math.tan(lim))
 
 
-def _curvature(tun: FollowTuning, est: ContactEstimate, tips: tuple, tip: np.ndarray,
+def _curvature(tun: FollowTuning, est: ContactEstimate, path: tuple, tip: np.ndarray,
                n: np.ndarray, t: np.ndarray) -> float:
-    pts = np.asarray(tips if len(tips) >= WINDOW else est.line + tips)
+    """The path's curvature over the span that resolves ``curvature_tol``; with the probe's
+    touches while the path is shorter (the fit's significance test keeps a noisy one 0)."""
+    span = math.sqrt(8.0 * tun.confidence * tun.tip_sigma / tun.curvature_tol)
+    x = (np.asarray(path) - tip) @ t if path else np.zeros(1)
+    pts = path if float(np.ptp(np.append(x, 0.0))) >= span else est.line + path
     if len(pts) < 3:
         return est.curvature
-    return path_curvature(pts, tip, n, t, tun.curvature_span)
+    return path_curvature(np.asarray(pts), tip, n, t, 0.5 * span)
 
 
 def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: np.ndarray,
@@ -164,14 +176,17 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
     adv = float((tip - tips[-1]) @ t) if tips else 0.0
     # prediction: the normal turns with the surface under the tip's advance
     n, _ = turn_by_curvature(est.normal, t, est.curvature * adv)
-    var = est.normal_var + (tun.direction_tol * abs(adv) / max(tun.chord, 1e-9)) ** 2
+    var = est.normal_var + (tun.curvature_tol * adv) ** 2
     est = replace(est, normal=n / np.linalg.norm(n), normal_var=var, sliding=sliding)
-    new_tips = (tips + (tip.copy(),))[-HISTORY:]
+    new_tips = (tips + (tip.copy(),))[-WINDOW:]
+    path = est.path
+    if not path or float(np.linalg.norm(tip - path[-1])) > advance_limit(tun):
+        path = (path + (tip.copy(),))[-HISTORY:]
     if sliding:
         mu_m, var_mu = friction_on_normal(tun, F, est.normal, est.normal_var, t)
         mu, mvar = _fuse_mu(est, mu_m, var_mu)
         est = replace(est, mu=mu, mu_var=mvar, samples=est.samples + 1)
-        c = _chord(tips, tip, tun.chord)
+        c = _chord(est.path, tip, tun.chord)
         if c is not None and float(c @ t) > 0.5 * float(np.linalg.norm(c)):
             m, var_m, mu_m, var_mu = slide_measurement(tun, F, c, est.normal, est.curvature)
             n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
@@ -181,8 +196,8 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
     else:
         est = replace(est, normal=_in_cone(tun, est, F))
     tt = t - float(t @ est.normal) * est.normal
-    kappa = _curvature(tun, est, new_tips, tip, est.normal, tt / np.linalg.norm(tt))
-    return replace(est, tips=new_tips, curvature=kappa)
+    kappa = _curvature(tun, est, path[:-1], tip, est.normal, tt / np.linalg.norm(tt))
+    return replace(est, tips=new_tips, path=path, curvature=kappa)
 
 
 def _fuse_mu(est: ContactEstimate, mu_m: float, var_m: float) -> tuple[float, float]:

@@ -121,7 +121,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
                 tip, st.target.tool_point, st.target.s6, config.travel_dir, config.probe_span))
         return st
     if st.phase != "travel":
-        return replace(st, estimate=replace(st.estimate, tips=(tip.copy(),)))
+        return replace(st, estimate=replace(st.estimate, tips=(tip.copy(),), path=(tip.copy(),)))
     est = observe_travel(tun, st.estimate, tip, F, st.tangent)
     adv = float((tip - st.estimate.tips[-1]) @ st.tangent)
     stuck = st.stuck + 1 if (st.step > 0.0 or st.stuck) and not est.sliding else 0
@@ -152,7 +152,7 @@ def _probe(config: FollowConfig, st: FollowState, meas: Measurement, label: str,
     tun = config.tuning
     var = ((tun.tip_sigma / config.probe_span) ** 2 if fit["used"]
            else st.estimate.normal_var)
-    est = replace(st.estimate, normal=n, normal_var=var, tips=(tip.copy(),),
+    est = replace(st.estimate, normal=n, normal_var=var, tips=(tip.copy(),), path=(tip.copy(),),
                   line=tuple(np.asarray(p).copy() for p in ps.probe.line))
     st = replace(st, phase="settle", estimate=est)
     kw = _report(config, st, meas, meas.estimate(base.estimator), contact)
@@ -240,12 +240,12 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
         step = min(config.travel_step, max(0.5 * remaining, min(4.0 * tun.step_resolution,
                                                                   remaining)))
     omega = turn_towards(meas.s6, axis, math.radians(config.max_turn_deg))
-    if not st.leaning and st.phase == "travel":
+    if not st.leaning:
         omega = tun.turn_gain * omega  # a free tip swings under the turn: half a turn a cycle
     w_surf = est.curvature * step * cross3(n, t)
     omega = omega + w_surf
     F = meas.estimate(base.estimator)
-    stuck = held or st.phase == "settle"
+    stuck = held
     sliding = st.phase == "travel" and est.sliding and not held
     hold = (-F, w_surf) if sliding else None
     if stuck:  # the whole force is the law's: along the lean axis, its normal part F_req

@@ -67,9 +67,10 @@ class FollowTuning:
             normal that moves with the swing converges for a loop gain below 2.
         max_friction: the largest friction coefficient the estimator accepts (a 45° cone:
             the probe's largest cone).
-        curvature_span: mm, shortest span of tips along the travel a curvature is fitted
-            over: the smallest sagitta ``κ s²/8`` it can resolve is ``confidence σ_tip``
-            for ``κ`` = 1/1000 mm⁻¹ (a flatter surface is a plane to the task).
+        curvature_tol: 1/mm, the curvature that turns the normal by ``direction_tol`` over
+            one travel step: the path's curvature is fitted over the span whose sagitta
+            ``κ s²/8`` at this curvature is ``confidence σ_tip``, and the normal's
+            prediction is uncertain by this much per mm of travel.
     """
 
     tip_sigma: float
@@ -85,7 +86,7 @@ class FollowTuning:
     axial_stiffness: float
     turn_gain: float
     max_friction: float
-    curvature_span: float
+    curvature_tol: float
 
     def __post_init__(self) -> None:
         for name, v in vars(self).items():
@@ -156,11 +157,11 @@ def _count_at_tool(model: ControlModel, tool_point) -> float:
     return float(np.max(np.radians(deg) * lever))
 
 
-def derive_tuning(model: ControlModel, force: float, tool_point, noise: float = 0.0
-                  ) -> FollowTuning:
+def derive_tuning(model: ControlModel, force: float, tool_point, travel_step: float,
+                  noise: float = 0.0) -> FollowTuning:
     """The default tuning for ``model`` at the target force ``force`` (N), the tool near
-    ``tool_point`` (mm, fixed frame), with leg sensor ``noise`` (mm, standard deviation; 0:
-    counts only). See :class:`FollowTuning`."""
+    ``tool_point`` (mm, fixed frame), travel steps up to ``travel_step`` (mm), with leg
+    sensor ``noise`` (mm, standard deviation; 0: counts only). See :class:`FollowTuning`."""
     z = 3.0
     leg = _leg_sigma(model, noise)
     tip, fs = _sigmas(model, leg)
@@ -174,4 +175,4 @@ def derive_tuning(model: ControlModel, force: float, tool_point, noise: float = 
         lean_margin=z * dir_tol,
         lean_rate=min(max(z * fs / drop, 1e-4), math.radians(1.0)),
         drop_per_rad=drop, tangential_stiffness=kt, axial_stiffness=ka, turn_gain=0.5,
-        max_friction=1.0, curvature_span=math.sqrt(8.0 * z * tip * 1000.0))
+        max_friction=1.0, curvature_tol=dir_tol / travel_step)
