@@ -34,7 +34,7 @@ from kinestat.control.contact_estimate import cone_normal, path_curvature, turn_
 from kinestat.control.follower.tuning import FollowTuning
 
 __all__ = ["ContactEstimate", "WINDOW", "slip_test", "slide_measurement", "friction_on_normal",
-           "observe_travel"]
+           "cone_measurement",            "observe_travel"]
 
 WINDOW = 4
 """Cycles over which a slow slide (a creep) is tested; not a tuning: the shortest window a
@@ -84,14 +84,17 @@ def advance_limit(tun: FollowTuning) -> float:
 
 
 def slip_test(tun: FollowTuning, tips: tuple, tip: np.ndarray, t: np.ndarray) -> bool:
-    """Whether the tip slid along ``t``: its advance over the last cycle or the last
-    ``WINDOW`` cycles exceeds :func:`advance_limit`."""
+    """Whether the tip slides along ``t``: its advance over the last cycle exceeds
+    :func:`advance_limit`, or it crept: advanced in each of the last ``WINDOW`` − 1 cycles
+    and by more than that limit over them (a stuck tip's jitter rarely does both)."""
     if not tips:
         return False
     lim = advance_limit(tun)
-    if float((tip - tips[-1]) @ t) > lim:
+    x = [float((p - tip) @ t) for p in tips[-(WINDOW - 1):]] + [0.0]
+    if x[-1] - x[-2] > lim:
         return True
-    return len(tips) >= WINDOW and float((tip - tips[-WINDOW]) @ t) > lim
+    return (len(x) == WINDOW and x[-1] - x[0] > lim
+            and all(b > a for a, b in zip(x[:-1], x[1:])))
 
 
 def _chord(tips: tuple, tip: np.ndarray, length: float) -> np.ndarray | None:
@@ -132,6 +135,19 @@ def friction_on_normal(tun: FollowTuning, F: np.ndarray, n: np.ndarray, var_n: f
     mu = float(F @ t) / fn
     var = (tun.force_sigma / fn) ** 2 * (1.0 + mu * mu) + (1.0 + mu * mu) ** 2 * var_n
     return mu, var
+
+
+def cone_measurement(tun: FollowTuning, est: ContactEstimate, F: np.ndarray,
+                     t: np.ndarray) -> tuple[np.ndarray, float]:
+    """A sliding cycle's normal from the force on the cone's edge, ``atan μ̂`` from the force
+    on the tool away from the slip ``t`` (:func:`~kinestat.control.contact_estimate.
+    cone_normal`), with its variance: the force's direction noise, μ̂'s error (``1/(1 + μ²)``
+    rad per unit) and the slip's direction (``direction_tol``, times μ̂)."""
+    u = -F / np.linalg.norm(F)
+    mu = max(est.mu, 0.0)
+    var = ((tun.force_sigma / float(np.linalg.norm(F))) ** 2
+           + est.mu_var / (1.0 + mu * mu) ** 2 + (mu * tun.direction_tol) ** 2)
+    return cone_normal(u, t, mu), var
 
 
 def _fuse_normal(n: np.ndarray, var: float, m: np.ndarray, var_m: float
@@ -183,6 +199,10 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
     if not path or float(np.linalg.norm(tip - path[-1])) > advance_limit(tun):
         path = (path + (tip.copy(),))[-HISTORY:]
     if sliding:
+        if est.samples:  # the force on the cone's edge against the slip: the normal
+            m, var_m = cone_measurement(tun, est, F, t)
+            n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
+            est = replace(est, normal=n, normal_var=var)
         mu_m, var_mu = friction_on_normal(tun, F, est.normal, est.normal_var, t)
         mu, mvar = _fuse_mu(est, mu_m, var_mu)
         est = replace(est, mu=mu, mu_var=mvar, samples=est.samples + 1)

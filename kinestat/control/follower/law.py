@@ -74,23 +74,43 @@ def base_twist(model: ControlModel, meas: Measurement, tip: np.ndarray, n: np.nd
     K = cycle_data(model, meas).K
     w = R.T @ omega
     Tf = np.concatenate([w, R.T @ travel - cross3(w, p)])  # the tip moves by `travel`
-    df = R.T @ dF
+    df = _limited(K, p, nb, R.T @ dF, limits, stuck)
     dw = np.concatenate([df, cross3(p, df)])
-    Tc = np.linalg.solve(K, dw)
-    dp = Tc[3:] + cross3(Tc[:3], p)  # the tip's motion under the compliance twist
-    scale = max(abs(float(dp @ nb)) / limits[0], float(np.linalg.norm(dp)) / limits[1], 1.0)
     if stuck:
         basis = np.column_stack([np.concatenate([e, cross3(p, e)]) for e in np.eye(3)])
-        T = compose_twist(K, basis, Tf, dw / scale)
+        T = compose_twist(K, basis, Tf, dw)
     else:
         fn = float(df @ nb)
         W = np.concatenate([nb, cross3(p, nb)])
-        T = compose_twist(K, W, Tf, (fn / scale) * W) + (Tc - fn * np.linalg.solve(K, W)) / scale
+        T = compose_twist(K, W, Tf, fn * W) + np.linalg.solve(K, dw - fn * W)
     if hold is not None:
         f_tool, w_surf = hold
         dh = cross3(R.T @ w_surf - w, R.T @ f_tool)
         T = T - np.linalg.solve(K, np.concatenate([dh, cross3(p, dh)]))
     return T
+
+
+def _tip_motion(K: np.ndarray, p: np.ndarray, f: np.ndarray) -> np.ndarray:
+    """The tip's motion (base frame) when the base moves by ``K⁻¹ [f; p × f]``."""
+    tc = np.linalg.solve(K, np.concatenate([f, cross3(p, f)]))
+    return tc[3:] + cross3(tc[:3], p)
+
+
+def _limited(K: np.ndarray, p: np.ndarray, nb: np.ndarray, df: np.ndarray, limits: tuple,
+             stuck: bool) -> np.ndarray:
+    """The force change ``df`` (base frame) scaled so that the compliance twist moves the
+    tip by at most ``limits[0]`` along the normal and ``limits[1]`` in all: as a whole for a
+    sliding contact (its force changes along one line), its normal and tangential parts
+    apart for a stuck one (the soft tangential direction would otherwise hold back the
+    normal force's correction)."""
+    fn = float(df @ nb)
+    parts = ((fn * nb, df - fn * nb) if stuck else (df,))
+    out = np.zeros(3)
+    for f in parts:
+        dp = _tip_motion(K, p, f)
+        out += f / max(abs(float(dp @ nb)) / limits[0], float(np.linalg.norm(dp)) / limits[1],
+                       1.0)
+    return out
 
 
 def target_of(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Target:
