@@ -229,6 +229,7 @@ class FollowState(ControllerState):
         leaning: the friction lean is on (the tip stuck under the travel, or asked for).
         lean: rad, the lean of S6 from the normal towards the travel the law aims at.
         stuck: travel cycles in a row the tip did not follow.
+        slides: travel cycles in a row the tip slid.
         probe: the surface probe's progress (:mod:`kinestat.control.probe`), None without.
     """
 
@@ -241,5 +242,6 @@ class FollowState(ControllerState):
     leaning: bool = False
     lean: float = 0.0
     stuck: int = 0
+    slides: int = 0
     probe: Probe | None = None
     turn_gain: float = field(default=1.0)

@@ -127,7 +127,9 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     stuck = st.stuck + 1 if (st.step > 0.0 or st.stuck) and not est.sliding else 0
     leaning = st.leaning or (config.auto_tilt is None and config.tilt_deg == 0.0
                              and stuck >= 2 and _frictional(tun, est))
-    return replace(st, estimate=est, travel=st.travel + adv, stuck=stuck, leaning=leaning)
+    slides = st.slides + 1 if est.sliding else 0
+    return replace(st, estimate=est, travel=st.travel + adv, stuck=stuck, leaning=leaning,
+                   slides=slides)
 
 
 def _frictional(tun, est: ContactEstimate) -> bool:
@@ -223,8 +225,30 @@ def _lean_goal(config: FollowConfig, st: FollowState, meas: Measurement, n: np.n
         rate = config.settle_tol / (drop * max(math.sin(abs(now)), 1e-3))
         return max(now, st.lean) + min(rate, math.radians(config.max_turn_deg)), True
     if est.friction_known(tun):
-        return math.atan(est.mu) + tun.lean_margin, False
+        return math.atan(est.mu) + edge_margin(tun, est, config.base.force_target), False
     return st.lean, False
+
+
+def edge_margin(tun, est: ContactEstimate, force: float) -> float:
+    """rad: how far the tool leans past the estimated cone edge, ``confidence`` standard
+    deviations of where the edge is (the normal's, μ̂'s and the force direction's errors):
+    the tip then slides on the true edge despite the estimate's error."""
+    var = (est.normal_var + est.mu_var / (1.0 + est.mu ** 2) ** 2
+           + (tun.force_sigma / force) ** 2)
+    return tun.confidence * math.sqrt(var)
+
+
+def step_cap(config: FollowConfig, st: FollowState, n: np.ndarray) -> float:
+    """mm: the largest travel step. While leaning on friction, a step that a stuck tip does
+    not follow pushes it along the leaning tool's axis (``k_axial sin θ`` N per mm); the
+    first step after a stick raises the force by at most ``settle_tol``, and each cycle the
+    tip slid doubles it (up to ``travel_step``)."""
+    if not st.leaning:
+        return config.travel_step
+    tun = config.tuning
+    s = max(math.sin(abs(st.lean)), 1e-3)
+    first = config.settle_tol / (tun.axial_stiffness * s)
+    return min(config.travel_step, first * 2.0 ** min(st.slides, 30))
 
 
 def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, kw: dict,
@@ -237,8 +261,8 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
     kw["misalignment_deg"] = mis
     step = 0.0
     if st.phase == "travel" and not held:
-        step = min(config.travel_step, max(0.5 * remaining, min(4.0 * tun.step_resolution,
-                                                                  remaining)))
+        step = min(step_cap(config, st, n), max(0.5 * remaining,
+                                                 min(4.0 * tun.step_resolution, remaining)))
     omega = turn_towards(meas.s6, axis, math.radians(config.max_turn_deg))
     if not st.leaning:
         omega = tun.turn_gain * omega  # a free tip swings under the turn: half a turn a cycle
