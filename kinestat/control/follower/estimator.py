@@ -33,7 +33,7 @@ import numpy as np
 from kinestat.control.contact_estimate import cone_normal, path_curvature, turn_by_curvature
 from kinestat.control.follower.tuning import FollowTuning
 
-__all__ = ["ContactEstimate", "WINDOW", "slip_test", "slide_measurement", "friction_on_normal",
+__all__ = ["ContactEstimate", "WINDOW", "slip_test", "chord_constraint", "friction_on_normal",
            "cone_measurement",            "observe_travel"]
 
 WINDOW = 4
@@ -106,48 +106,48 @@ def _chord(tips: tuple, tip: np.ndarray, length: float) -> np.ndarray | None:
     return None
 
 
-def slide_measurement(tun: FollowTuning, F: np.ndarray, chord: np.ndarray, n: np.ndarray,
-                      kappa: float) -> tuple[np.ndarray, float, float, float]:
-    """One sliding cycle's measurement ``(normal, its variance, μ, its variance)`` from the
-    force ``F`` and the tip ``chord`` (module docstring); the chord is carried to the current
-    tip by the curvature ``kappa`` (the tangent turns by κ|c|/2 from the chord's middle)."""
+def chord_constraint(tun: FollowTuning, est: ContactEstimate, chord: np.ndarray
+                     ) -> tuple[np.ndarray, float]:
+    """The normal made perpendicular to the tip path (pure geometry, whatever the friction
+    does): the ``chord`` carried to the current tip by the curvature (the tangent turns by
+    κ|c|/2 from the chord's middle), and the predicted normal's part across it; variance from
+    the chord's direction noise ``√2 σ_tip/|c|`` and the curvature's tolerance over it."""
     L = float(np.linalg.norm(chord))
-    s = turn_by_curvature(n, chord / L, kappa * L / 2.0)[1]
+    n = est.normal
+    s = turn_by_curvature(n, chord / L, est.curvature * L / 2.0)[1]
     s /= np.linalg.norm(s)
-    fs = float(F @ s)
-    perp = F - fs * s
-    fp = float(np.linalg.norm(perp))
-    mu = fs / fp
-    sc = math.sqrt(2.0) * tun.tip_sigma / L  # the chord's direction noise (rad)
-    rel = tun.force_sigma / fp
-    var_n = rel ** 2 + (mu * sc) ** 2
-    var_mu = (rel ** 2) * (1.0 + mu * mu) + ((1.0 + mu * mu) * sc) ** 2
-    return -perp / fp, var_n, mu, var_mu
+    m = n - float(n @ s) * s
+    var = 2.0 * (tun.tip_sigma / L) ** 2 + (tun.curvature_tol * L / 2.0) ** 2
+    return m / np.linalg.norm(m), var
 
 
-def friction_on_normal(tun: FollowTuning, F: np.ndarray, n: np.ndarray, var_n: float,
-                       t: np.ndarray) -> tuple[float, float]:
+def friction_on_normal(tun: FollowTuning, F: np.ndarray, n: np.ndarray, var_n: float
+                       ) -> tuple[float, float]:
     """A sliding cycle's friction measurement against the normal estimate ``n`` (variance
-    ``var_n``): the force's part along the travel over its normal part, with its variance
-    (the force's noise and the normal's error, which tilts the ratio by ``(1 + μ²)`` per
-    radian)."""
+    ``var_n``): a sliding tip's force is on the cone's edge, so μ is its tangential part over
+    its normal part; with its variance (the force's noise and the normal's error, which tilts
+    the ratio by ``(1 + μ²)`` per radian)."""
     fn = -float(F @ n)
-    mu = float(F @ t) / fn
+    mu = float(np.linalg.norm(F + fn * n)) / fn
     var = (tun.force_sigma / fn) ** 2 * (1.0 + mu * mu) + (1.0 + mu * mu) ** 2 * var_n
     return mu, var
 
 
-def cone_measurement(tun: FollowTuning, est: ContactEstimate, F: np.ndarray,
-                     t: np.ndarray) -> tuple[np.ndarray, float]:
-    """A sliding cycle's normal from the force on the cone's edge, ``atan μ̂`` from the force
-    on the tool away from the slip ``t`` (:func:`~kinestat.control.contact_estimate.
-    cone_normal`), with its variance: the force's direction noise, μ̂'s error (``1/(1 + μ²)``
-    rad per unit) and the slip's direction (``direction_tol``, times μ̂)."""
+def cone_measurement(tun: FollowTuning, est: ContactEstimate, F: np.ndarray
+                     ) -> tuple[np.ndarray, float]:
+    """A sliding cycle's normal from the force on the cone's edge: ``atan μ̂`` from the force
+    on the tool, away from its tangential part (the friction's direction, measured: it need
+    not be the travel's) (:func:`~kinestat.control.contact_estimate.cone_normal`), with its
+    variance: the force's direction noise and μ̂'s error (``1/(1 + μ²)`` rad per unit)."""
     u = -F / np.linalg.norm(F)
+    n = est.normal
+    g = F - float(F @ n) * n  # the tangential force on the workpiece: along the slip
+    if float(np.linalg.norm(g)) < 1e-12:
+        return n, math.inf
     mu = max(est.mu, 0.0)
     var = ((tun.force_sigma / float(np.linalg.norm(F))) ** 2
-           + est.mu_var / (1.0 + mu * mu) ** 2 + (mu * tun.direction_tol) ** 2)
-    return cone_normal(u, t, mu), var
+           + est.mu_var / (1.0 + mu * mu) ** 2)
+    return cone_normal(u, g, mu), var
 
 
 def _fuse_normal(n: np.ndarray, var: float, m: np.ndarray, var_m: float
@@ -199,20 +199,19 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
     if not path or float(np.linalg.norm(tip - path[-1])) > advance_limit(tun):
         path = (path + (tip.copy(),))[-HISTORY:]
     if sliding:
-        if est.samples:  # the force on the cone's edge against the slip: the normal
-            m, var_m = cone_measurement(tun, est, F, t)
-            n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
-            est = replace(est, normal=n, normal_var=var)
-        mu_m, var_mu = friction_on_normal(tun, F, est.normal, est.normal_var, t)
-        mu, mvar = _fuse_mu(est, mu_m, var_mu)
-        est = replace(est, mu=mu, mu_var=mvar, samples=est.samples + 1)
         c = _chord(est.path, tip, tun.chord)
         if c is not None and float(c @ t) > 0.5 * float(np.linalg.norm(c)):
-            m, var_m, mu_m, var_mu = slide_measurement(tun, F, c, est.normal, est.curvature)
+            m, var_m = chord_constraint(tun, est, c)
             n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
-            mu, mvar = _fuse_mu(est, mu_m, var_mu)
-            est = replace(est, normal=n, normal_var=var, mu=mu, mu_var=mvar)
-        est = replace(est, mu=min(max(est.mu, 0.0), tun.max_friction))
+            est = replace(est, normal=n, normal_var=var)
+        if est.samples:  # the force on the cone's edge: the normal atan μ̂ from it
+            m, var_m = cone_measurement(tun, est, F)
+            n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
+            est = replace(est, normal=n, normal_var=var)
+        mu_m, var_mu = friction_on_normal(tun, F, est.normal, est.normal_var)
+        mu, mvar = _fuse_mu(est, mu_m, var_mu)
+        est = replace(est, mu=min(max(mu, 0.0), tun.max_friction), mu_var=mvar,
+                      samples=est.samples + 1)
     else:
         est = replace(est, normal=_in_cone(tun, est, F))
     tt = t - float(t @ est.normal) * est.normal

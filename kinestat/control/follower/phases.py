@@ -220,13 +220,23 @@ def _lean_goal(config: FollowConfig, st: FollowState, meas: Measurement, n: np.n
     if not st.leaning:
         return math.radians(config.tilt_deg), False
     if st.phase == "travel" and st.stuck:
-        now = lean_of(meas.s6, n, t)
-        drop = tun.axial_stiffness / tun.tangential_stiffness * config.base.force_target
-        rate = config.settle_tol / (drop * max(math.sin(abs(now)), 1e-3))
-        return max(now, st.lean) + min(rate, math.radians(config.max_turn_deg)), True
+        F = meas.estimate(config.base.estimator)
+        now = lean_of(F / np.linalg.norm(F), n, t)  # the force's lean: S6 leads it by a step
+        return now + lean_rate(config, now), True
     if est.friction_known(tun):
         return math.atan(est.mu) + edge_margin(tun, est, config.base.force_target), False
     return st.lean, False
+
+
+def lean_rate(config: FollowConfig, lean: float) -> float:
+    """rad per cycle: the largest change of the lean of S6 past a sliding tip's force. Each
+    radian runs the tip ahead in the platform's soft mode by ``F/k_t`` and, the tool leaning
+    by θ, drops the normal force by ``k_a F sin θ / k_t``: the step that drops it by
+    ``settle_tol`` (at most ``max_turn_deg``)."""
+    tun = config.tuning
+    drop = (tun.axial_stiffness / tun.tangential_stiffness * config.base.force_target
+            * max(math.sin(abs(lean)), 1e-3))
+    return min(config.settle_tol / drop, math.radians(config.max_turn_deg))
 
 
 def edge_margin(tun, est: ContactEstimate, force: float) -> float:
@@ -256,7 +266,9 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
     """The law's command for a settle or travel cycle."""
     base, tun, est = config.base, config.tuning, st.estimate
     lean, held = _lean_goal(config, st, meas, n, t)
-    axis = lean_axis(n, t, lean)
+    F = meas.estimate(base.estimator)
+    s = t if held else _friction_dir(config, st, F, n, t)
+    axis = lean_axis(n, s, lean)
     mis = math.degrees(math.acos(max(-1.0, min(1.0, float(meas.s6 @ axis)))))
     kw["misalignment_deg"] = mis
     step = 0.0
@@ -268,7 +280,6 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
         omega = tun.turn_gain * omega  # a free tip swings under the turn: half a turn a cycle
     w_surf = est.curvature * step * cross3(n, t)
     omega = omega + w_surf
-    F = meas.estimate(base.estimator)
     stuck = held
     sliding = st.phase == "travel" and est.sliding and not held
     hold = (-F, w_surf) if sliding else None
@@ -277,7 +288,7 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
         dF = config.gain * (f_des - (F + cross3(omega, F)))
     else:
         mu = est.mu if (sliding and est.friction_known(tun)) else 0.0
-        dF = -config.gain * kw["force_error"] * (n - mu * t)
+        dF = -config.gain * kw["force_error"] * (n - mu * s)
     if st.phase == "settle" and mis > 2.0 * config.max_turn_deg:
         dF = dF - max(float(-(dF @ n)), 0.0) * -n  # turn first: pressing a tilted tool slides it
     try:
@@ -290,6 +301,20 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
     action = "follow" if st.phase == "travel" else "settle"
     return _command(config, st, meas, target_of(base.model, meas, T), label, action, step,
                     math.degrees(float(np.linalg.norm(omega))), kw)
+
+
+def _friction_dir(config: FollowConfig, st: FollowState, F: np.ndarray, n: np.ndarray,
+                  t: np.ndarray) -> np.ndarray:
+    """The direction the tool leans towards: the travel ``t``, or, once the tip slides on a
+    measured cone, the measured tangential force's (the friction's) direction, which need
+    not be the travel's (MuJoCo's soft contact): S6 then stays along the force."""
+    est = st.estimate
+    if not (st.leaning and st.phase == "travel" and est.sliding
+            and est.friction_known(config.tuning)):
+        return t
+    g = F - float(F @ n) * n
+    a = float(np.linalg.norm(g))
+    return g / a if a > 0.0 and float(g @ t) > 0.0 else t
 
 
 def _stop(st: FollowState, label: str, reason: str, **kw) -> tuple[Command, FollowState]:
