@@ -6,7 +6,7 @@ to the workpiece ``F`` (noise ``σ_F`` per component).
 
 * **Slip.** The tip slides when it advanced along the travel by more than ``confidence``
   standard deviations of an advance (``√2 σ_tip``, at least the tool's step resolution) in
-  the last cycle or over the window of the last ``WINDOW`` cycles: a significance test on
+  the last cycle or over the window of the last ``creep_window`` cycles: a significance test on
   the measured tips, not a tuned threshold.
 * **Normal and friction while sliding.** Isotropic Coulomb friction on the tool lies
   against the slip, and the slip is the chord ``ĉ`` of the measured tip path (it lies in the
@@ -31,16 +31,12 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from kinestat.control.contact_estimate import cone_normal, path_curvature, turn_by_curvature
-from kinestat.control.follower.tuning import FollowTuning
+from kinestat.control.follow.tuning import FollowTuning
 
-__all__ = ["ContactEstimate", "WINDOW", "slip_test", "chord_constraint", "friction_on_normal",
-           "cone_measurement",            "observe_travel"]
+__all__ = ["ContactEstimate", "estimate_normal", "advance_limit", "slip_test",
+           "chord_constraint", "cone_measurement", "friction_on_normal", "observe_travel",
+           "curvature_span"]
 
-WINDOW = 4
-"""Cycles over which a slow slide (a creep) is tested; not a tuning: the shortest window a
-trend is told from one cycle's jitter in."""
-HISTORY = 60
-"""Measured tips kept (the chord and the curvature fit look back over them)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -54,7 +50,7 @@ class ContactEstimate:
         mu_var: its variance (inf before a slide).
         curvature: 1/mm, the normal curvature along the travel (positive convex).
         sliding: the last cycle's slip test.
-        tips: the measured tips of the last ``WINDOW`` travel cycles, oldest first.
+        tips: the measured tips of the last ``creep_window`` travel cycles, oldest first.
         path: measured tips along the travel, each a significant advance from the one
             before (a stuck tip adds none), oldest first: the chords and the curvature.
         line: the probe's touches on the line of travel (the curvature's first points).
@@ -77,6 +73,23 @@ class ContactEstimate:
         return self.samples > 0 and self.mu > tun.confidence * math.sqrt(self.mu_var)
 
 
+def estimate_normal(force, path_dir=None) -> np.ndarray:
+    """The contact normal (out of the material) from the tool's force on the workpiece and the
+    slip's direction (a chord of the tip path): ``−(F − (F·ĉ)ĉ)`` normalised. Isotropic
+    Coulomb friction lies along the slip, so the force's part across the chord is the normal
+    force (no μ needed); without a chord, the force's own direction.
+
+    >>> estimate_normal([0.3, 0.0, -1.0], [1.0, 0.0, 0.0]).tolist()
+    [-0.0, -0.0, 1.0]
+    """
+    F = np.asarray(force, dtype=float)
+    if path_dir is not None:
+        c = np.asarray(path_dir, dtype=float)
+        c = c / np.linalg.norm(c)
+        F = F - (F @ c) * c
+    return -F / np.linalg.norm(F)
+
+
 def advance_limit(tun: FollowTuning) -> float:
     """mm: the smallest significant advance of the tip: ``confidence`` standard deviations
     of the difference of two measured tips (at least the tool's step resolution)."""
@@ -85,16 +98,16 @@ def advance_limit(tun: FollowTuning) -> float:
 
 def slip_test(tun: FollowTuning, tips: tuple, tip: np.ndarray, t: np.ndarray) -> bool:
     """Whether the tip slides along ``t``: its advance over the last cycle exceeds
-    :func:`advance_limit`, or it crept: advanced in each of the last ``WINDOW`` − 1 cycles
+    :func:`advance_limit`, or it crept: advanced in each of the last ``creep_window`` − 1 cycles
     and by more than that limit over them (a stuck tip's jitter rarely does both)."""
     if not tips:
         return False
     lim = advance_limit(tun)
-    x = [float((p - tip) @ t) for p in tips[-(WINDOW - 1):]] + [0.0]
+    x = [float((p - tip) @ t) for p in tips[-(tun.creep_window - 1):]] + [0.0]
     if x[-1] - x[-2] > lim:
         return True
-    return (len(x) == WINDOW and x[-1] - x[0] > lim
-            and all(b > a for a, b in zip(x[:-1], x[1:])))
+    return (len(x) == tun.creep_window and x[-1] - x[0] > lim
+            and all(b > a for a, b in zip(x[:-1], x[1:], strict=True)))
 
 
 def _chord(tips: tuple, tip: np.ndarray, length: float) -> np.ndarray | None:
@@ -171,11 +184,17 @@ def _in_cone(tun: FollowTuning, est: ContactEstimate, F: np.ndarray) -> np.ndarr
     return cone_normal(u, n, math.tan(lim))
 
 
+def curvature_span(tun: FollowTuning) -> float:
+    """mm: the span of the path whose sagitta ``κ s²/8`` at ``curvature_tol`` is
+    ``confidence σ_tip`` (at least the chord): the curvature is fitted over it."""
+    return max(math.sqrt(8.0 * tun.confidence * tun.tip_sigma / tun.curvature_tol), tun.chord)
+
+
 def _curvature(tun: FollowTuning, est: ContactEstimate, path: tuple, tip: np.ndarray,
                n: np.ndarray, t: np.ndarray) -> float:
     """The path's curvature over the span that resolves ``curvature_tol``; with the probe's
     touches while the path is shorter (the fit's significance test keeps a noisy one 0)."""
-    span = math.sqrt(8.0 * tun.confidence * tun.tip_sigma / tun.curvature_tol)
+    span = curvature_span(tun)
     x = (np.asarray(path) - tip) @ t if path else np.zeros(1)
     pts = path if float(np.ptp(np.append(x, 0.0))) >= span else est.line + path
     if len(pts) < 3:
@@ -194,10 +213,11 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
     n, _ = turn_by_curvature(est.normal, t, est.curvature * adv)
     var = est.normal_var + (tun.curvature_tol * adv) ** 2
     est = replace(est, normal=n / np.linalg.norm(n), normal_var=var, sliding=sliding)
-    new_tips = (tips + (tip.copy(),))[-WINDOW:]
+    new_tips = (tips + (tip.copy(),))[-tun.creep_window:]
     path = est.path
     if not path or float(np.linalg.norm(tip - path[-1])) > advance_limit(tun):
-        path = (path + (tip.copy(),))[-HISTORY:]
+        span = 2.0 * curvature_span(tun)  # the chord's and the curvature's reach
+        path = tuple(p for p in path if float(np.linalg.norm(tip - p)) <= span) + (tip.copy(),)
     if sliding:
         c = _chord(est.path, tip, tun.chord)
         if c is not None and float(c @ t) > 0.5 * float(np.linalg.norm(c)):

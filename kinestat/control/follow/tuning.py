@@ -48,17 +48,6 @@ class FollowTuning:
         step_resolution: mm, the tool's displacement for one robot encoder count (the
             largest over the axes at the tool's reach): the smallest motion commanded, and
             the remaining travel at which the task is done (three counts).
-        lean_margin: rad, how far the tool leans past the friction cone's edge while the tip
-            slides: ``confidence`` times the force direction's noise, so that the force stays
-            on the edge (the tip slides) despite the estimate's error.
-        lean_rate: rad per cycle, how fast the lean grows while the travel is held by a
-            stuck tip (the breakaway): a lean that overshoots the edge by one increment when
-            the tip breaks away loads the platform's soft mode, which drops the normal
-            force by ``drop_per_rad`` per radian; the increment keeps that drop within the
-            ``confidence`` band of the force noise.
-        drop_per_rad: N/rad, normal force lost per radian the tool leans past a sliding
-            tip's force at the target force (the tip's axial over tangential stiffness
-            times the force).
         tangential_stiffness: N/mm, the tool tip's stiffness across the tool axis (the
             platform's soft direction at the tip).
         axial_stiffness: N/mm, the tool tip's stiffness along the tool axis.
@@ -67,6 +56,9 @@ class FollowTuning:
             normal that moves with the swing converges for a loop gain below 2.
         max_friction: the largest friction coefficient the estimator accepts (a 45° cone:
             the probe's largest cone).
+        creep_window: cycles over which a slow slide is told from a stuck tip's jitter: the
+            tip advanced in each of the last ``creep_window − 1`` cycles (a jitter does so
+            with probability ``2^−(creep_window−1)``) and significantly over them; 4.
         curvature_tol: 1/mm, the curvature that turns the normal by ``direction_tol`` over
             one travel step: the path's curvature is fitted over the span whose sagitta
             ``κ s²/8`` at this curvature is ``confidence σ_tip``, and the normal's
@@ -79,19 +71,20 @@ class FollowTuning:
     chord: float
     direction_tol: float
     step_resolution: float
-    lean_margin: float
-    lean_rate: float
-    drop_per_rad: float
     tangential_stiffness: float
     axial_stiffness: float
     turn_gain: float
     max_friction: float
     curvature_tol: float
+    creep_window: int = 4
 
     def __post_init__(self) -> None:
         for name, v in vars(self).items():
             if not (math.isfinite(v) and v > 0.0):
                 raise InputError(f"follow tuning: {name} must be a positive number, got {v!r}")
+        if self.creep_window < 2 or int(self.creep_window) != self.creep_window:
+            raise InputError(f"follow tuning: creep_window must be an integer >= 2, got "
+                             f"{self.creep_window!r}")
         if self.turn_gain > 1.0:
             raise InputError(f"follow tuning: turn_gain must be in (0, 1], got "
                              f"{self.turn_gain!r}")
@@ -167,12 +160,9 @@ def derive_tuning(model: ControlModel, force: float, tool_point, travel_step: fl
     tip, fs = _sigmas(model, leg)
     kt, ka = _tip_stiffness(model)
     dir_tol = max(fs / force, 1e-4)
-    drop = ka / kt * force  # N/rad: a lean δ past the force runs the tip F δ / k_t ahead
     return FollowTuning(
         tip_sigma=tip, force_sigma=fs, confidence=z,
         chord=max(math.sqrt(2.0) * tip / dir_tol, z * tip),
         direction_tol=dir_tol, step_resolution=_count_at_tool(model, tool_point),
-        lean_margin=z * dir_tol,
-        lean_rate=min(max(z * fs / drop, 1e-4), math.radians(1.0)),
-        drop_per_rad=drop, tangential_stiffness=kt, axial_stiffness=ka, turn_gain=0.5,
-        max_friction=1.0, curvature_tol=dir_tol / travel_step)
+        tangential_stiffness=kt, axial_stiffness=ka, turn_gain=0.5,
+        max_friction=1.0, curvature_tol=dir_tol / travel_step, creep_window=4)

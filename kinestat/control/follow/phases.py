@@ -26,9 +26,9 @@ from kinestat.control.controller import (
 )
 from kinestat.control.cycle import cross3
 from kinestat.control.envelope import check_measurement
-from kinestat.control.follower.config import FollowConfig, FollowState
-from kinestat.control.follower.estimator import ContactEstimate, observe_travel
-from kinestat.control.follower.law import (
+from kinestat.control.follow.config import FollowConfig, FollowState
+from kinestat.control.follow.estimator import ContactEstimate, observe_travel
+from kinestat.control.follow.law import (
     base_twist,
     lean_axis,
     lean_of,

@@ -4,14 +4,14 @@ moves), :class:`FollowState`, the default travel direction and the carry check."
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from kinestat.control.controller import ControllerConfig, ControllerState
 from kinestat.control.envelope import Envelope, check_motion
-from kinestat.control.follower.estimator import ContactEstimate
-from kinestat.control.follower.tuning import FollowTuning, derive_tuning
+from kinestat.control.follow.estimator import ContactEstimate
+from kinestat.control.follow.tuning import FollowTuning, derive_tuning
 from kinestat.control.model import ControlModel
 from kinestat.control.probe import PROBE_SPAN, Probe
 from kinestat.errors import InputError
@@ -133,22 +133,16 @@ class FollowConfig:
         gain: fraction of the normal-force error corrected per cycle (0 < gain ≤ 1).
         settle_tol: normal-force error (N) below which travel starts.
         tilt_deg: S6 tilted from −n̂ towards the travel direction (degrees, 0: along −n̂).
-        auto_tilt: tilt S6 by ``atan(μ̂)`` (the estimated friction ratio) so that it stays
-            along the total force (plus ``AUTO_TILT_MARGIN_DEG``), plus the breakaway tilt
-            that grows while the tip sticks (``BREAKAWAY_FIRST`` × ``max_turn_deg`` a cycle
-            before the first slip, ``BREAKAWAY_DECAY`` after) and decays while it slides:
-            a point contact on the long tool is very soft tangentially (the top turns about
-            the tip), so friction carried across the tool axis turns the top beyond Table
-            3-1's range; along the axis the platform carries it. Once μ is measured, S6
-            turns by ``TILT_RATE_DEG`` a cycle near the cone's edge (faster only inward or
-            well inside it), is first turned back without travel when it is more than
-            ``REALIGN_DEG`` off its axis, and the travel step ramps up (``_step_cap``).
+        auto_tilt: lean S6 onto the friction cone (:mod:`.phases`): a point contact on the
+            long tool is very soft across the tool's axis (the top turns about the tip), so
+            friction carried across the axis turns the top beyond Table 3-1's range; along
+            the axis the platform carries it. While a stuck tip holds the travel the tool
+            leans towards the travel, S6 a bounded step ahead of the force, until the tip
+            slides; then it leans ``atan μ̂`` plus a margin of the estimate's uncertainty.
             True: from the first travel cycle; False: never (a sticking tip then drags the
             top round until the envelope stops the run, with a hint); None (default): it
-            switches itself on the first time the tip does not follow two travel steps in a
-            row of at least ``ENGAGE_STEP`` (:func:`_engages`), unless a tilt is commanded
-            (``tilt_deg``), and the steps the stuck tip did not follow are taken back first.
-            A frictionless run never engages it and keeps its commands.
+            switches itself on when the tip does not follow two travel steps in a row,
+            unless a tilt is commanded (``tilt_deg``) or slides measured no friction.
         max_contact_lost: cycles without contact during travel before a safe stop.
         min_angle_deg: smallest angle between the travel direction and the approach direction
             or the measured normal.
@@ -158,6 +152,9 @@ class FollowConfig:
             the first contact force's direction is taken instead (with friction it can lie
             anywhere in the friction cone, and a normal off by θ costs about |F_t| θ of
             normal force).
+        tuning: the estimator's and the law's parameters (:class:`FollowTuning`); None
+            (default): derived from the platform, the sensor and the robot
+            (:func:`derive_tuning`).
     """
 
     base: ControllerConfig
@@ -244,4 +241,3 @@ class FollowState(ControllerState):
     stuck: int = 0
     slides: int = 0
     probe: Probe | None = None
-    turn_gain: float = field(default=1.0)
