@@ -124,13 +124,14 @@ def chord_constraint(tun: FollowTuning, est: ContactEstimate, chord: np.ndarray
     """The normal made perpendicular to the tip path (pure geometry, whatever the friction
     does): the ``chord`` carried to the current tip by the curvature (the tangent turns by
     κ|c|/2 from the chord's middle), and the predicted normal's part across it; variance from
-    the chord's direction noise ``√2 σ_tip/|c|`` and the curvature's tolerance over it."""
+    the chord's direction noise ``√2 σ_tip/|c|`` and the curvature fit's standard error
+    (``curvature_tol / confidence``) over half the chord."""
     L = float(np.linalg.norm(chord))
     n = est.normal
     s = turn_by_curvature(n, chord / L, est.curvature * L / 2.0)[1]
     s /= np.linalg.norm(s)
     m = n - float(n @ s) * s
-    var = 2.0 * (tun.tip_sigma / L) ** 2 + (tun.curvature_tol * L / 2.0) ** 2
+    var = 2.0 * (tun.tip_sigma / L) ** 2 + (tun.curvature_tol / tun.confidence * L / 2.0) ** 2
     return m / np.linalg.norm(m), var
 
 
@@ -224,14 +225,16 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
             m, var_m = chord_constraint(tun, est, c)
             n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
             est = replace(est, normal=n, normal_var=var)
-        if est.samples:  # the force on the cone's edge: the normal atan μ̂ from it
+        mu_m, var_mu = friction_on_normal(tun, F, est.normal, est.normal_var)
+        mu, mvar = _fuse_mu(est, mu_m, var_mu)
+        # every sample is measured against the same normal: its error is common to them
+        floor = (1.0 + mu * mu) ** 2 * est.normal_var
+        est = replace(est, mu=min(max(mu, 0.0), tun.max_friction), mu_var=max(mvar, floor),
+                      samples=est.samples + 1)
+        if est.samples > 1:  # the force on the cone's edge: the normal atan μ̂ from it
             m, var_m = cone_measurement(tun, est, F)
             n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
             est = replace(est, normal=n, normal_var=var)
-        mu_m, var_mu = friction_on_normal(tun, F, est.normal, est.normal_var)
-        mu, mvar = _fuse_mu(est, mu_m, var_mu)
-        est = replace(est, mu=min(max(mu, 0.0), tun.max_friction), mu_var=mvar,
-                      samples=est.samples + 1)
     else:
         est = replace(est, normal=_in_cone(tun, est, F))
     tt = t - float(t @ est.normal) * est.normal
