@@ -4,14 +4,12 @@ plane fitted to touches around the first contact, and its use on the simulated c
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from kinestat.app.control_run import SimulatedCell
 from kinestat.control.contact_estimate import fit_plane
-from kinestat.control.controller import start
 from kinestat.control.follow import FollowConfig
 from kinestat.control.probe import (
     PROBE_SPAN,

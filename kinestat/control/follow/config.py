@@ -219,8 +219,8 @@ class FollowState(ControllerState):
         phase: "approach", "probe", "settle", "travel" (then the run is done: "finish").
         estimate: the contact estimate (:mod:`.estimator`), None before contact.
         tangent: (3,) the travel direction on the tangent plane, None before travel.
-        travel: distance travelled along the surface (mm, the measured tips' advance along
-            the travel).
+        travel: distance travelled along the surface (mm, the measured tips' path: a
+            slide's length in the tangent plane, a stuck tip's advance along the travel).
         contact_lost: consecutive travel cycles without contact.
         step: the travel commanded by the last move (mm).
         leaning: the friction lean is on (the tip stuck under the travel, or asked for).
