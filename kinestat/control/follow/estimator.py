@@ -8,16 +8,22 @@ to the workpiece ``F`` (noise ``σ_F`` per component).
   standard deviations of an advance (``√2 σ_tip``, at least the tool's step resolution) in
   the last cycle or over the window of the last ``creep_window`` cycles: a significance test on
   the measured tips, not a tuned threshold.
-* **Normal and friction while sliding.** Isotropic Coulomb friction on the tool lies
-  against the slip, and the slip is the chord ``ĉ`` of the measured tip path (it lies in the
-  surface), carried to the current tip by the path's curvature. So the normal is the part of
-  ``−F`` across the chord and ``μ = F·ĉ / |F⊥|`` — no μ needed for the normal. Each is a
-  measurement with a variance (force noise over the force, chord noise ``√2 σ_tip/|c|``
-  times μ); both are fused with the estimate by a scalar Kalman update.
+* **Normal and friction while sliding** (a significant advance within one cycle: a creep,
+  which a soft contact shows under a load inside the cone, is no evidence of the edge).
+  Three measurements, each with its variance, fused by scalar Kalman updates: the normal is
+  perpendicular to the tip path's chord carried to the current tip by the curvature
+  (:func:`chord_constraint`: geometry only); μ is the force's tangential over its normal part
+  (:func:`friction_on_normal`: a sliding tip's force is on the cone's edge; μ's variance never
+  falls below the normal's share, common to every sample); the normal is ``atan μ̂`` from the
+  force, away from its tangential part (:func:`cone_measurement`). Isotropic Coulomb friction
+  would also put the normal as the force's part across the chord (:func:`estimate_normal`),
+  but a plant's friction need not lie along the measured slip (MuJoCo's soft contact, measured
+  at rest after each move, leaves it 25–45° off), so the chord gives only geometry.
 * **While stuck** the force may lie anywhere in the cone and says nothing more: the normal is
   the prediction (the probe's plane fit or the last slide, turned by the curvature under the
-  tip's advance), with its variance grown; once μ is known a normal further from the force
-  than the cone allows is brought onto the cone's boundary (the force must lie inside it).
+  tip's advance), with its variance grown; the force lies inside the cone, so its ratio of
+  tangential to normal part is a lower bound of μ (a slip mistaken for one, the tip's jitter,
+  is corrected so rather than by turning the normal, which the geometry gave).
 * **Curvature** from a circle fitted to the recent tips in the plane of the normal and the
   travel (:func:`~kinestat.control.contact_estimate.path_curvature`, with its significance
   test), with the probe's touches on the line of travel while the path is short.
@@ -171,20 +177,6 @@ def _fuse_normal(n: np.ndarray, var: float, m: np.ndarray, var_m: float
     return out / np.linalg.norm(out), (1.0 - g) * var
 
 
-def _in_cone(tun: FollowTuning, est: ContactEstimate, F: np.ndarray) -> np.ndarray:
-    """The normal brought inside the friction cone about the force on the tool, ``−F``
-    (once μ is known; the cone widened by the normal's and the force's noise)."""
-    n = est.normal
-    if not est.friction_known(tun):
-        return n
-    u = -F / np.linalg.norm(F)
-    slack = tun.confidence * math.sqrt(est.normal_var + tun.direction_tol ** 2)
-    lim = math.atan(est.mu) + slack
-    if float(n @ u) >= math.cos(lim):
-        return n
-    return cone_normal(u, n, math.tan(lim))
-
-
 def curvature_span(tun: FollowTuning) -> float:
     """mm: the span of the path whose sagitta ``κ s²/8`` at ``curvature_tol`` is
     ``confidence σ_tip`` (at least the chord): the curvature is fitted over it."""
@@ -219,7 +211,9 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
     if not path or float(np.linalg.norm(tip - path[-1])) > advance_limit(tun):
         span = 2.0 * curvature_span(tun)  # the chord's and the curvature's reach
         path = tuple(p for p in path if float(np.linalg.norm(tip - p)) <= span) + (tip.copy(),)
-    if sliding:
+    # a creep (a soft contact's micro-slip under a load inside the cone) slides but says
+    # nothing of the edge: only a significant slip within one cycle is measured
+    if sliding and tips and float((tip - tips[-1]) @ t) > advance_limit(tun):
         c = _chord(est.path, tip, tun.chord)
         if c is not None and float(c @ t) > 0.5 * float(np.linalg.norm(c)):
             m, var_m = chord_constraint(tun, est, c)
@@ -235,8 +229,11 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
             m, var_m = cone_measurement(tun, est, F)
             n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
             est = replace(est, normal=n, normal_var=var)
-    else:
-        est = replace(est, normal=_in_cone(tun, est, F))
+    elif est.samples:  # a stuck tip's force is inside the cone: its ratio bounds μ below
+        fn = -float(F @ est.normal)
+        ratio = float(np.linalg.norm(F + fn * est.normal)) / fn if fn > 0.0 else 0.0
+        if ratio > est.mu:
+            est = replace(est, mu=min(ratio, tun.max_friction))
     tt = t - float(t @ est.normal) * est.normal
     kappa = _curvature(tun, est, path[:-1], tip, est.normal, tt / np.linalg.norm(tt))
     return replace(est, tips=new_tips, path=path, curvature=kappa)
