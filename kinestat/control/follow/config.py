@@ -86,22 +86,18 @@ def _tip_load_pose(platform, tip_top: np.ndarray, f_ext: np.ndarray, steps: int 
     return X
 
 
-CARRY_MARGIN = 1.0
-"""N above the requested force the platform must carry (the force control's overshoot): a
-safety margin of the request check, not a tuning of the law."""
-
-
-def carry_check(model: ControlModel, envelope: Envelope, force, s6, a67) -> list[str]:
+def carry_check(model: ControlModel, envelope: Envelope, force, s6, a67,
+                margin: float = 1.0) -> list[str]:
     """Violations of the envelope by the platform carrying ``force`` (N, fixed frame, the tool's
-    force on the workpiece; checked at ``|force| + CARRY_MARGIN`` N) at the tip with S6/a67 as
-    given: an equilibrium must exist (the loaded platform stops carrying load beyond a limit,
+    force on the workpiece; checked at ``|force| + margin`` N, the force control's overshoot)
+    at the tip with S6/a67 as given: an equilibrium must exist (the loaded platform stops carrying load beyond a limit,
     about 8 N along the thesis's direction with its calibrated legs), inside Table 3-1's motion
     ranges and the legs' deflection limit. Empty when it can be carried."""
     R6 = np.column_stack([a67, np.cross(s6, a67), s6])
     RB = R6 @ model.mount[:3, :3]
     plat = model.platform
     F = np.asarray(force, dtype=float)
-    F = F * (1.0 + CARRY_MARGIN / float(np.linalg.norm(F)))
+    F = F * (1.0 + margin / float(np.linalg.norm(F)))
     top = _tip_load_pose(plat, model.tool_tip_top, -(RB.T @ F))
     if top is None:
         return [f"the platform finds no equilibrium carrying {np.linalg.norm(F):.3g} N at the "
