@@ -90,9 +90,10 @@ def carry_check(model: ControlModel, envelope: Envelope, force, s6, a67,
                 margin: float = 1.0) -> list[str]:
     """Violations of the envelope by the platform carrying ``force`` (N, fixed frame, the tool's
     force on the workpiece; checked at ``|force| + margin`` N, the force control's overshoot)
-    at the tip with S6/a67 as given: an equilibrium must exist (the loaded platform stops carrying load beyond a limit,
-    about 8 N along the thesis's direction with its calibrated legs), inside Table 3-1's motion
-    ranges and the legs' deflection limit. Empty when it can be carried."""
+    at the tip with S6/a67 as given: an equilibrium must exist (the loaded platform stops
+    carrying load beyond a limit, about 8 N along the thesis's direction with its calibrated
+    legs), inside Table 3-1's motion ranges and the legs' deflection limit. Empty when it can
+    be carried."""
     R6 = np.column_stack([a67, np.cross(s6, a67), s6])
     RB = R6 @ model.mount[:3, :3]
     plat = model.platform
