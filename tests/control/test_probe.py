@@ -4,14 +4,12 @@ plane fitted to touches around the first contact, and its use on the simulated c
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
 
 from kinestat.app.control_run import SimulatedCell
 from kinestat.control.contact_estimate import fit_plane
-from kinestat.control.controller import start
 from kinestat.control.follow import FollowConfig
 from kinestat.control.probe import (
     PROBE_SPAN,
@@ -251,77 +249,3 @@ def test_probe_step_stops_where_there_is_no_surface():
     assert ps.reason.startswith("probing: no surface within 20 mm") and not ps.done
     assert "offset" in ps.reason and "--probe-span" in ps.reason
     assert max(-float(tp[2]) for tp in commanded) <= 3.0 + 20.0 + 1.0
-
-
-def test_a_creeping_tip_slides_and_a_jittering_one_sticks():
-    # with μ̂ known a tip whose force ratio reads low still slides if it creeps on: 0.06 mm a
-    # cycle (the CLI's R = 200 mm run, thesis sensor) over four cycles; a stuck tip's measured
-    # position jitters by ±0.1 mm (the thesis's counts) but does not advance
-    from kinestat.control.follow import CREEP_SPAN, CREEP_WINDOW, _crept
-
-    s = np.array([0.0, 1.0, 0.0])
-    rng = np.random.default_rng(2)
-    for _ in range(200):
-        stuck = tuple(rng.uniform(-0.1, 0.1, (CREEP_WINDOW + 2, 3)))
-        assert not _crept(stuck, rng.uniform(-0.1, 0.1, 3), s)
-    creep = tuple(np.outer(np.arange(8) * 0.06, s))
-    assert _crept(creep[:-1], creep[-1], s)
-    assert 0.06 * CREEP_WINDOW >= CREEP_SPAN
-    assert not _crept(creep[:2], creep[2], s)  # too few tips yet
-
-
-def test_the_lead_of_s6_past_the_force_shows_the_cone_edge(tmp_path):
-    # before the first slip (the probe's normal known) a stuck tip's force turns with the tool:
-    # S6's lead past it stays near its recent mean, within the jitter of the thesis's counts
-    # (±0.1°) and a slow drift,
-    # and 80 such cycles (20 runs) never read as the edge; a tip on the cone's edge keeps its
-    # force as S6 turns on by 0.2° a cycle, and the lead shows it within three cycles
-    from types import SimpleNamespace
-
-    from kinestat.control.follow import (
-        BREAKAWAY_LEAD,
-        FollowState,
-        _on_edge_by_lead,
-        _tilt_past_force,
-        _track_lead,
-    )
-
-    t = np.array([0.0, 1.0, 0.0])
-    n = np.array([0.0, 0.0, 1.0])
-
-    def meas(tilt_deg):  # S6 tilted from −n towards t
-        a = math.radians(tilt_deg)
-        return SimpleNamespace(s6=-math.cos(a) * n + math.sin(a) * t)
-
-    def force(angle_deg):  # the tool's force on the workpiece, leaning towards t
-        a = math.radians(angle_deg)
-        return 4.0 * (-math.cos(a) * n + math.sin(a) * t)
-
-    rng = np.random.default_rng(5)
-    _, st0 = start(_base(tmp_path), np.zeros(6))
-    base = replace(FollowState(**vars(st0)), probe_trusted=True, tilting=True)
-    for trial in range(20):
-        st, tilt, fa = base, 0.0, 0.0
-        # the hold: S6 turns, the force does not, until S6 leads by BREAKAWAY_LEAD
-        while st.lead_ref is None:
-            assert not _on_edge_by_lead(st, _tilt_past_force(meas(tilt).s6, force(fa), t))
-            st = _track_lead(st, _tilt_past_force(meas(tilt).s6, force(fa), t))
-            tilt += 0.2
-        assert st.lead_ref >= BREAKAWAY_LEAD
-        lead0 = st.lead_ref
-        for k in range(80):  # stuck: both turn (to ~17°), the force's direction jitters, and
-            tilt += 0.2  # the lead drifts (up to 0.025° a cycle, the CLI's R = 200 mm run)
-            lead = lead0 + 0.025 * min(k, 20) * (1 if trial % 2 else -1)
-            m, f = meas(tilt), force(tilt - lead + rng.uniform(-0.1, 0.1))
-            assert not _on_edge_by_lead(st, _tilt_past_force(m.s6, f, t)), trial
-            st = _track_lead(st, _tilt_past_force(m.s6, f, t))
-        edge = tilt - lead
-        seen = []
-        for k in range(1, 4):  # on the edge: the force stays, S6 turns on
-            m, f = meas(tilt + 0.2 * k), force(edge + rng.uniform(-0.1, 0.1))
-            seen.append(_on_edge_by_lead(st, _tilt_past_force(m.s6, f, t)))
-            st = _track_lead(st, _tilt_past_force(m.s6, f, t))
-        assert any(seen), (trial, seen)
-    # μ known, or no probe: not tracked
-    for other in (replace(base, friction_samples=3), replace(base, probe_trusted=False)):
-        assert _track_lead(other, _tilt_past_force(meas(5.0).s6, force(0.0), t)).lead_ref is None
