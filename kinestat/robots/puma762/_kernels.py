@@ -19,12 +19,6 @@ import math
 import numba as nb
 import numpy as np
 
-from kinestat.serial._numba_options import INLINE as _INLINE
-from kinestat.serial._numba_options import OPTS as _OPTS
-from kinestat.serial._numba_options import PI as _PI
-from kinestat.serial._numba_options import SQRT8 as _SQRT8
-from kinestat.serial._numba_options import TWO_PI as _TWO_PI
-
 # mechanism parameters and status codes: defined once, in params (Numba freezes them)
 from kinestat.robots.puma762.params import (
     _A,
@@ -40,6 +34,7 @@ from kinestat.robots.puma762.params import (
     STATUS_TOO_FAR,
     STATUS_TOO_NEAR,
 )
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial._numba_options import PI as _PI
 from kinestat.serial._numba_options import SQRT8 as _SQRT8
