@@ -180,7 +180,7 @@ PARAMETERS = [
         None, "--workpiece-stiffness", metavar="N/MM", help="Normal stiffness of the simulated "
         "workpiece (N/mm): the tip sinks f_n/k into it (e.g. wood, docs/control.md). Default: "
         "rigid.")),
-    _p("top_weight", bool, typer.Option(
+    _p("top_weight", bool, flag(
         False, "--top-weight", help="--sim mujoco: gravity on the top plate + tool (0.35 kg); "
         "the controller is given their weight and centre of mass and subtracts them from "
         "every measurement (docs/mujoco.md). Default: weightless, as the built-in simulator.")),
