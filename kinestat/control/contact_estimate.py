@@ -12,8 +12,8 @@ chord of its measured tip path, which lies in the surface), so the bias can be r
   chord within that plane (its elevation out of the surface: noise, a curved path) does not
   change ``ĝ``; an error across it turns ``n̂`` by only ``μ`` times that error.
 * ``sin α = −û·ŝ`` for a chord in the surface (:func:`friction_sample`): one sample of μ per
-  sliding cycle; μ is a property of the contact, so its running mean
-  (:func:`update_friction`) is far less noisy than one chord.
+  sliding cycle; μ is a property of the contact, so an estimate over many cycles is far less
+  noisy than one chord.
 * the normal force is ``f_n = f·n̂`` and the friction force ``f − f_n n̂``
   (:func:`normal_and_friction`): the friction is measured and reported, not fought.
 
@@ -43,18 +43,13 @@ import numpy as np
 __all__ = [
     "cone_normal",
     "friction_sample",
-    "update_friction",
     "normal_and_friction",
-    "MIN_FRICTION_WEIGHT",
     "fit_circle",
     "circle_centre_radius",
     "path_curvature",
     "turn_by_curvature",
     "fit_plane",
 ]
-
-MIN_FRICTION_WEIGHT = 0.05
-"""The running mean of μ weights a new sample at least this much (it follows a slow change)."""
 
 
 def _unit(v) -> np.ndarray:
@@ -93,14 +88,6 @@ def friction_sample(force_on_tool, chord) -> float:
     c = _unit(chord)
     s = min(max(-float(u @ c), -0.99), 0.99)
     return s / math.sqrt(1.0 - s * s)
-
-
-def update_friction(mu: float, samples: int, sample: float) -> tuple[float, int]:
-    """The running mean of μ with one more sample (weight ``1/k``, at least
-    :data:`MIN_FRICTION_WEIGHT`)."""
-    k = samples + 1
-    w = max(1.0 / k, MIN_FRICTION_WEIGHT)
-    return (1.0 - w) * mu + w * sample, k
 
 
 def normal_and_friction(force_on_tool, normal) -> tuple[float, np.ndarray]:

@@ -3,8 +3,8 @@
 Before the follow task raises the force, the tip sticks where it touched, and with friction its
 force can lie anywhere in the friction cone (16.7° off the normal at μ = 0.3): the normal is
 not observable from the force. A touch's measured tip, though, is a point of the surface. So
-the tool lifts off along −S6 until out of contact and ``PROBE_STEP`` more (``lift``), moves
-across to the next offset (``shift``, in steps of ``PROBE_STEP``; a surface rising into the
+the tool lifts off along −S6 until out of contact and ``ProbeTuning.step_mm`` more (``lift``), moves
+across to the next offset (``shift``, in steps of ``ProbeTuning.step_mm``; a surface rising into the
 tool on the way is touched lightly and recorded as a touch), and is lowered along S6 until
 contact (``descend``); the offsets (:func:`probe_offsets`) lie ``span`` either side of the
 first contact across and along the travel, then at the centre again, where the force is
@@ -29,6 +29,8 @@ from kinestat.spatial.transforms import cross3
 
 __all__ = [
     "PROBE_SPAN",
+    "PROBE_TUNING",
+    "ProbeTuning",
     "Probe",
     "ProbeStep",
     "probe_offsets",
@@ -37,24 +39,34 @@ __all__ = [
     "probe_step",
 ]
 
-PROBE_SPAN = 3.0
-"""Default span (mm): the touches lie this far either side of the first contact. The fitted
-normal's error from a sensor's tip jitter ``e`` is about ``e / span`` rad (the thesis's
-counts: ~0.1 mm, so ~1°)."""
-PROBE_DESCENT = 20.0
-"""Largest descent (mm) along S6 below the first contact's height at an offset before the
-probe gives up: the surface is not there (an edge)."""
-PROBE_STEP = 1.0
-"""The lift above the surface once out of contact and the largest step across (mm; the
-approach step when that is larger). A slope of 10° rises 0.18 mm over a step."""
-PROBE_MAX_CYCLES = 150
-"""Largest number of probing cycles."""
-PROBE_FIT_RMS = 0.5
-"""Largest RMS height residual (mm) of the touches from their plane: beyond it the surface
-is not smooth there (an edge, a step) and the fit is not used."""
-MAX_CONE_DEG = 45.0
-"""Largest angle between the fitted plane's normal and the first contact force's direction
-(the steepest friction cone the follow task's estimator takes, μ = 1)."""
+@dataclass(frozen=True)
+class ProbeTuning:
+    """The probe's settings (one frozen object; mm, cycles, degrees)."""
+
+    span_mm: float = 3.0
+    """Default span: the touches lie this far either side of the first contact. The fitted
+    normal's error from a sensor's tip jitter ``e`` is about ``e / span`` rad (the thesis's
+    counts: ~0.1 mm, so ~1°)."""
+    descent_mm: float = 20.0
+    """Largest descent along S6 below the first contact's height at an offset before the
+    probe gives up: the surface is not there (an edge)."""
+    step_mm: float = 1.0
+    """The lift above the surface once out of contact and the largest step across (the
+    approach step when that is larger). A slope of 10° rises 0.18 mm over a step."""
+    max_cycles: int = 150
+    """Largest number of probing cycles."""
+    fit_rms_mm: float = 0.5
+    """Largest RMS height residual of the touches from their plane: beyond it the surface is
+    not smooth there (an edge, a step) and the fit is not used."""
+    max_cone_deg: float = 45.0
+    """Largest angle between the fitted plane's normal and the first contact force's
+    direction (the steepest friction cone the follow task's estimator takes, μ = 1)."""
+
+
+PROBE_TUNING = ProbeTuning()
+"""The default probe settings."""
+PROBE_SPAN = PROBE_TUNING.span_mm
+"""The default span (mm), :attr:`ProbeTuning.span_mm` (the ``--probe-span`` default)."""
 
 
 @dataclass(frozen=True, eq=False)
@@ -119,8 +131,8 @@ def probe_normal(points, normal_guess, approach) -> tuple[np.ndarray, dict]:
     plane fitted to the touches' heights against ``approach``
     (:func:`~kinestat.control.contact_estimate.fit_plane`, facing against it);
     ``normal_guess`` (the first contact force's direction) instead where the touches are
-    nearly collinear, lie more than ``PROBE_FIT_RMS`` from a plane (an edge or a step), or
-    the plane is more than ``MAX_CONE_DEG`` from the guess.
+    nearly collinear, lie more than ``ProbeTuning.fit_rms_mm`` from a plane (an edge or a step), or
+    the plane is more than ``ProbeTuning.max_cone_deg`` from the guess.
 
     >>> pts = [[0, 0, 0], [3, 0, 0.3], [0, 3, 0], [-3, 0, -0.3], [0, -3, 0]]
     >>> n, fit = probe_normal(pts, [0.0, 0.0, 1.0], [0.0, 0.0, -1.0])
@@ -132,8 +144,8 @@ def probe_normal(points, normal_guess, approach) -> tuple[np.ndarray, dict]:
     n, rms, spread = fit_plane(P, approach)
     fit = {"points": int(len(P)), "fit_rms": float(rms), "normal": n.copy(), "used": True}
     half = 0.5 * float(np.max(np.linalg.norm(P - P.mean(axis=0), axis=1)))
-    if (spread < 0.25 * half or rms > PROBE_FIT_RMS
-            or float(n @ guess) < math.cos(math.radians(MAX_CONE_DEG))):
+    if (spread < 0.25 * half or rms > PROBE_TUNING.fit_rms_mm
+            or float(n @ guess) < math.cos(math.radians(PROBE_TUNING.max_cone_deg))):
         fit["used"] = False
         return guess.copy(), fit
     return n, fit
@@ -154,11 +166,11 @@ def probe_step(probe: Probe, tool_point, contact: bool, tip, approach_step: floa
     tool is in ``contact`` and the measured ``tip``, the next tool point."""
     tp = np.asarray(tool_point, dtype=float)
     d, step = probe.approach, float(approach_step)
-    wide = max(step, PROBE_STEP)
+    wide = max(step, PROBE_TUNING.step_mm)
     pr = replace(probe, cycles=probe.cycles + 1)
-    if pr.cycles > PROBE_MAX_CYCLES:
-        return ProbeStep(pr, None, f"probing the surface did not finish in {PROBE_MAX_CYCLES} "
-                         f"cycles ({len(pr.points)} touches)")
+    if pr.cycles > PROBE_TUNING.max_cycles:
+        return ProbeStep(pr, None, "probing the surface did not finish in "
+                         f"{PROBE_TUNING.max_cycles} cycles ({len(pr.points)} touches)")
     tip = np.asarray(tip, dtype=float).copy()
     mode = pr.mode
     if mode == "descend" and contact:
@@ -171,7 +183,7 @@ def probe_step(probe: Probe, tool_point, contact: bool, tip, approach_step: floa
     if mode == "shift" and contact:  # the surface rose into the tool: a touch too
         pr, mode = replace(pr, points=pr.points + (tip,), mode="lift"), "lift"
     if mode == "lift":
-        if not contact:  # clear of the surface: PROBE_STEP more, then across
+        if not contact:  # clear of the surface: one probe step more, then across
             pr = replace(pr, mode="shift")
         return ProbeStep(pr, tp - (step if contact else wide) * d)
     depth = float((tp - pr.origin) @ d)
@@ -183,9 +195,9 @@ def probe_step(probe: Probe, tool_point, contact: bool, tip, approach_step: floa
                 pr = replace(pr, mode="descend")
             return ProbeStep(pr, tp + rem * min(1.0, wide / dist))
         pr = replace(pr, mode="descend")
-    if depth > PROBE_DESCENT:
-        return ProbeStep(pr, None, f"probing: no surface within {PROBE_DESCENT:g} mm below the "
-                         f"first contact at offset "
+    if depth > PROBE_TUNING.descent_mm:
+        return ProbeStep(pr, None, "probing: no surface within "
+                         f"{PROBE_TUNING.descent_mm:g} mm below the first contact at offset "
                          f"{np.round(pr.offsets[pr.index], 3).tolist()} mm (an edge of the "
                          "workpiece?); use a smaller --probe-span or --probe-span 0")
     return ProbeStep(pr, tp + step * d)

@@ -11,7 +11,6 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from kinestat.control.contact_estimate import (
-    MIN_FRICTION_WEIGHT,
     circle_centre_radius,
     cone_normal,
     fit_circle,
@@ -19,7 +18,6 @@ from kinestat.control.contact_estimate import (
     normal_and_friction,
     path_curvature,
     turn_by_curvature,
-    update_friction,
 )
 
 
@@ -101,19 +99,6 @@ def test_cone_normal_is_batched():
     out = cone_normal(f, t, mu)
     assert out.shape == (7, 3)
     np.testing.assert_allclose(out, n, atol=1e-10)
-
-
-def test_the_running_mean_of_mu_averages_noisy_samples():
-    rng = np.random.default_rng(5)
-    mu, k = 0.0, 0
-    samples = 0.3 + rng.normal(0, 0.03, 400)
-    for s in samples:
-        mu, k = update_friction(mu, k, s)
-    assert k == 400
-    # at most the last 1/MIN_FRICTION_WEIGHT samples weigh: the standard error of ~20 samples
-    assert abs(mu - 0.3) < 4 * 0.03 * math.sqrt(MIN_FRICTION_WEIGHT / 2)
-    # the first sample is taken as it is
-    assert update_friction(0.0, 0, 0.25) == (0.25, 1)
 
 
 # --- the curvature of the tip path (circle fit) --------------------------------------------
