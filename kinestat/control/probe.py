@@ -28,7 +28,6 @@ from kinestat.control.contact_estimate import fit_plane
 from kinestat.spatial.transforms import cross3
 
 __all__ = [
-    "PROBE_SPAN",
     "PROBE_TUNING",
     "ProbeTuning",
     "Probe",
@@ -65,8 +64,7 @@ class ProbeTuning:
 
 PROBE_TUNING = ProbeTuning()
 """The default probe settings."""
-PROBE_SPAN = PROBE_TUNING.span_mm
-"""The default span (mm), :attr:`ProbeTuning.span_mm` (the ``--probe-span`` default)."""
+
 
 
 @dataclass(frozen=True, eq=False)

@@ -18,7 +18,7 @@ Defaults that depend on the task are resolved here too: ``approach_step`` (1 mm 
 0.25 mm for follow: its first contact force stays below 3 N), ``max_iterations`` (60 for the
 press, :data:`~kinestat.control.ceilings.MAX_ITERATIONS` for follow) and the follow task's
 ``travel`` (50 mm), ``travel_step`` (1 mm), ``tilt_deg`` (0) and ``probe_span``
-(:data:`~kinestat.control.probe.PROBE_SPAN`).
+(:attr:`~kinestat.control.probe.ProbeTuning.span_mm`).
 """
 
 from __future__ import annotations
@@ -32,7 +32,7 @@ import numpy as np
 from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.control.controller import ESTIMATORS, METHODS, PROCEDURES, Procedure, StepMethod
 from kinestat.control.defaults import PLANTS, RUN_DEFAULTS, TASKS
-from kinestat.control.probe import PROBE_SPAN
+from kinestat.control.probe import PROBE_TUNING
 from kinestat.control.wrench import Estimator
 from kinestat.errors import InputError
 
@@ -234,7 +234,7 @@ class RunSpec:
             raise InputError(f"--task must be one of {', '.join(TASKS)}, got {self.task!r}")
         follow = self.task == "follow"
         follow_defaults = {"travel": RUN_DEFAULTS.travel, "travel_step": RUN_DEFAULTS.travel_step,
-                           "tilt_deg": RUN_DEFAULTS.tilt_deg, "probe_span": PROBE_SPAN}
+                           "tilt_deg": RUN_DEFAULTS.tilt_deg, "probe_span": PROBE_TUNING.span_mm}
         given = {k: getattr(self, k) for k in (*follow_defaults, "travel_dir", "auto_tilt")}
         if not follow:
             named = [f"--{k.replace('_', '-')}" for k, v in given.items() if v is not None]

@@ -12,7 +12,7 @@ from kinestat.app.control_run import SimulatedCell
 from kinestat.control.contact_estimate import fit_plane
 from kinestat.control.follow import FollowConfig
 from kinestat.control.probe import (
-    PROBE_SPAN,
+    PROBE_TUNING,
     probe_normal,
     probe_offsets,
     probe_step,
@@ -84,7 +84,7 @@ def test_the_probe_pattern_measures_a_curved_surface_normal_at_its_centre(seed):
     approach = F_HAT + rng.uniform(-0.2, 0.2, 3)
     approach /= np.linalg.norm(approach)
     travel = Y + rng.uniform(-0.3, 0.3, 3)
-    offs = [np.zeros(3), *probe_offsets(travel, approach, PROBE_SPAN)]
+    offs = [np.zeros(3), *probe_offsets(travel, approach, PROBE_TUNING.span_mm)]
     grad = rng.uniform(-0.15, 0.15, 2)
     A = rng.uniform(-1 / 150, 1 / 150, (2, 2))
     hess = A + A.T
@@ -169,7 +169,7 @@ def test_with_friction_the_probe_finds_the_normal_the_force_cannot(tmp_path, ide
         assert pre_slip_err(rep) < 0.05 < pre_slip_err(rep0)
 
 
-def _run_probe(surface_height, approach, travel_dir, span=PROBE_SPAN, step=0.25,
+def _run_probe(surface_height, approach, travel_dir, span=PROBE_TUNING.span_mm, step=0.25,
                max_cycles=400):
     """Drive :func:`probe_step` against a rigid height field (no compliance: the tip is the
     surface point under the commanded tool point once that point reaches the surface)."""

@@ -12,7 +12,7 @@ from kinestat.cli import _control_options as opts
 from kinestat.cli._control_params import PARAMETERS
 from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.control.controller import THESIS_FORCE_DIRECTION
-from kinestat.control.probe import PROBE_SPAN
+from kinestat.control.probe import PROBE_TUNING
 from kinestat.control.runspec import CylinderSpec, RealDevices, RunSpec, SimulatedCell
 from kinestat.errors import InputError
 
@@ -48,7 +48,7 @@ def test_task_defaults_are_resolved_once_for_the_task():
     assert (press.approach_step, press.max_iterations) == (1.0, 60)
     assert (follow.approach_step, follow.max_iterations) == (0.25, MAX_ITERATIONS)
     assert (follow.travel, follow.travel_step, follow.tilt_deg, follow.probe_span) == (
-        50.0, 1.0, 0.0, PROBE_SPAN)
+        50.0, 1.0, 0.0, PROBE_TUNING.span_mm)
     assert press.travel is None and press.probe_span is None
     back = follow.replace(task="press")
     assert (back.approach_step, back.max_iterations, back.travel) == (1.0, 60, None)

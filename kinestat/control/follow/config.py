@@ -13,7 +13,7 @@ from kinestat.control.envelope import Envelope, check_motion
 from kinestat.control.follow.estimator import ContactEstimate
 from kinestat.control.follow.tuning import FollowTuning, derive_tuning
 from kinestat.control.model import ControlModel
-from kinestat.control.probe import PROBE_SPAN, Probe
+from kinestat.control.probe import PROBE_TUNING, Probe
 from kinestat.errors import InputError
 from kinestat.parallel.legs import leg_lengths
 from kinestat.parallel.statics import spring_wrench
@@ -166,7 +166,7 @@ class FollowConfig:
     auto_tilt: bool | None = None
     max_contact_lost: int = 3
     min_angle_deg: float = 10.0
-    probe_span: float = PROBE_SPAN
+    probe_span: float = PROBE_TUNING.span_mm
     tuning: FollowTuning | None = None
 
     def __post_init__(self) -> None:
