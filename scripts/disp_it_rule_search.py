@@ -6,7 +6,8 @@ computed from the embedded decks (the screw angle θ, translations of the displa
 hand's size), then every rule form ``R(f(θ/c1, T/c2))`` with R = round, ceil or floor and
 f = max, sum, root-sum-square (and the one-constant forms) is checked on a fine grid of the two
 constants. Prints, per form and feature, whether the five counts can all be met and, when they
-can, the range of each constant; then the same without Illustration 4.
+can, the range of each constant; then the same without Illustration 4, and with Illustration 4
+at each path-step count from 16 to 22.
 
     PYTHONPATH=$PWD python scripts/disp_it_rule_search.py
 
@@ -148,6 +149,14 @@ def main() -> None:
         for r in rest:
             if r[3] != "none":
                 print("   ", " | ".join(r))
+        # Illustration 5's caption counts every solve ("Total 38" = 27 + 10 sub-steps + 1
+        # correction): Illustration 4's 22 then bounds its path steps to 16..21
+        # (scripts/disp_ill4_total_checks.py); which of those can the others' rules give?
+        print("  Illustration 4 at k path steps (the other four counts as published):")
+        for k4 in range(16, 23):
+            fits = [r for r in search(feats, [k4, *counts[1:]], n=600) if r[3] != "none"]
+            print(f"    k = {k4}: {len(fits)} of {len(rows)} rules fit: "
+                  + ("; ".join(" ".join(r[:3]) for r in fits) or "-"))
 
 
 if __name__ == "__main__":

@@ -101,6 +101,7 @@ def print_result(result: GuidanceResult, notes=(), title: str = "Joint variables
     """Human-readable tables of a guidance run (rich)."""
     m = result.model
     from kinestat.mechanism.nadkarni import hand_points  # lazy: start-up (`kinestat --help`)
+    from kinestat.disp.steps import total_steps  # lazy: start-up (numba)
     from kinestat.serial.guidance.run import joint_display  # lazy: start-up (numba)
 
     vals = np.round(joint_display(m, result.q), 3) + 0.0  # no "-0.000"
@@ -123,6 +124,8 @@ def print_result(result: GuidanceResult, notes=(), title: str = "Joint variables
     summary = [
         ["steps per stage", ", ".join(str(k) for k in result.steps) +
          (f" (+{result.substeps} sub-steps)" if result.substeps else "")],
+        ["total steps", f"{total_steps(result)} (path steps, sub-steps and correction rows, "
+                        "as Nadkarni's captions count)"],
         ["final hand origin", ", ".join(f"{v:.4f}" for v in hp[0])],
         ["final hand +z point", ", ".join(f"{v:.4f}" for v in hp[1])],
         ["final hand +x point", ", ".join(f"{v:.4f}" for v in hp[2])],

@@ -5,6 +5,7 @@ from __future__ import annotations
 import math
 
 from kinestat.disp.deck import TYPE_NAMES, DeckRun
+from kinestat.disp.steps import total_steps
 from kinestat.mechanism.nadkarni import hand_points
 from kinestat.serial.guidance.run import GuidanceResult, joint_display
 
@@ -17,7 +18,8 @@ def result_record(result: GuidanceResult, *, hand_points_every_row: bool = False
     Keys: ``columns``, ``units``, ``table`` (joint values per row, initial first, degrees for
     revolute joints), ``hand_origins``, ``final_hand_points`` (origin, unit point on +z, unit
     point on +x), ``target_hand_points``, ``events``, ``steps``, ``substeps``,
-    ``final_pose_error`` and ``max_path_deviation`` (``position``, ``angle_deg``), ``stopped``,
+    ``total_steps`` (every solve, as Nadkarni's captions count them:
+    :func:`~kinestat.disp.steps.total_steps`), ``final_pose_error`` and ``max_path_deviation`` (``position``, ``angle_deg``), ``stopped``,
     ``stop_reason`` (``stop_message``), ``stage_hand_origins`` (the hand origin at the end of
     each stage), ``length_scale`` and, when asked, ``hand_points`` of every row.
     """
@@ -36,6 +38,7 @@ def result_record(result: GuidanceResult, *, hand_points_every_row: bool = False
     rec["events"] = [e.as_dict() for e in result.events]
     rec["steps"] = list(result.steps)
     rec["substeps"] = result.substeps
+    rec["total_steps"] = total_steps(result)
     dp, da = result.final_pose_error()
     rec["final_pose_error"] = {"position": dp, "angle_deg": math.degrees(da)}
     mp, ma = result.max_path_deviation()

@@ -25,9 +25,10 @@ import math
 import numpy as np
 
 from kinestat.serial.guidance.planners import GeneralPath, Path
+from kinestat.serial.guidance.run import GuidanceResult
 from kinestat.spatial.displacement import screw_from_poses
 
-__all__ = ["DISP_STEP_DEG", "DISP_STEP_HAND", "stage_motion", "disp_step_count"]
+__all__ = ["DISP_STEP_DEG", "DISP_STEP_HAND", "stage_motion", "disp_step_count", "total_steps"]
 
 #: Rotation per step (degrees) the inferred rule aims at; published counts allow
 #: (3.333, 3.396].
@@ -62,3 +63,11 @@ def disp_step_count(path: Path, hand_size: float = 1.0) -> int:
     theta, T = stage_motion(path)
     x = max(theta / DISP_STEP_DEG, T / (DISP_STEP_HAND * hand_size))
     return max(1, math.floor(x + 0.5))
+
+
+def total_steps(result: GuidanceResult) -> int:
+    """Every solve of eq. 4-11 in a run: the rows after the initial one (path steps and
+    correction rows) plus the extra sub-steps. That is what Nadkarni's captions count: Table
+    A2-9's "Total 38 steps" are 27 path steps, 10 extra sub-steps and 1 correction
+    (docs/seed-errata.md G1). A perturbation at a singularity is not a solve."""
+    return int(np.asarray(result.q).shape[0]) - 1 + int(result.substeps)

@@ -165,3 +165,102 @@ def test_the_published_counts_fix_the_constants_and_rule_out_illustration_4s_22(
     assert lo1 < DISP_STEP_DEG <= hi1 and lo2 < DISP_STEP_HAND <= hi2
     th4, t4 = motions[("illustration4", 0)]
     assert max(th4 / lo1, t4 / lo2) < 21.5  # the largest count the bounds allow: 16
+
+
+def test_total_steps_counts_every_solve_as_table_a2_9s_caption():
+    """Table A2-9's caption "Total 38 steps" (Illustration 5, published): 27 path steps, the
+    sub-steps and the correction row of the inferred 1977 step (erratum G1); JSON and result
+    agree."""
+    from kinestat.disp import deck_json, disp_options
+    from kinestat.disp.steps import total_steps
+
+    deck = embedded_deck("illustration5-published")
+    run = run_deck(deck, options=disp_options(deck=deck, disp_1977=True))
+    r = run.result
+    assert r.steps == (27,) and len(r.settle_rows()) == 1 and r.substeps > 0
+    assert total_steps(r) == 38 == deck_json(run)["total_steps"]
+
+
+def _frame_ok(P, card=0.005):
+    """Three F10.2 cards fix a frame: unit +z and +x points at right angles to the cards'
+    rounding (each coordinate ±card)."""
+    z, x = P[1] - P[0], P[2] - P[0]
+    t_len = 2 * card * math.sqrt(3.0)
+    t_dot = 2 * card * (np.abs(z).sum() + np.abs(x).sum()) + 3 * (2 * card) ** 2
+    return (abs(np.linalg.norm(z) - 1) <= t_len and abs(np.linalg.norm(x) - 1) <= t_len
+            and abs(z @ x) <= t_dot)
+
+
+def _frame(P):
+    z = (P[1] - P[0]) / np.linalg.norm(P[1] - P[0])
+    y = np.cross(z, P[2] - P[0])
+    y /= np.linalg.norm(y)
+    T = np.eye(4)
+    T[:3, :3] = np.column_stack([np.cross(y, z), y, z])
+    T[:3, 3] = P[0]
+    return T
+
+
+def test_illustration4s_target_cards_and_their_misreadings_do_not_give_22():
+    """Erratum G7, the deck: Table A2-5's target cards are a frame to their precision (the
+    text's −9.29 is not), and no one-character misreading (a digit, a sign) that still is one
+    moves the count near 22."""
+    deck = embedded_deck("illustration4")
+    model, P0, _ = deck_initial_hand(deck, deck_model(deck))
+    H = fk(model, model.q_home)
+    cards = np.array(deck.positions[-1], dtype=float)
+    assert _frame_ok(cards)
+    text = cards.copy()
+    text[1, 1] = -9.29
+    assert not _frame_ok(text)
+    counts = set()
+    for i in range(3):
+        for j in range(3):
+            s = f"{abs(cards[i, j]):.2f}"
+            values = [-cards[i, j]] + [math.copysign(float(s[:n] + d + s[n + 1:]), cards[i, j])
+                                       for n in range(len(s)) if s[n] != "."
+                                       for d in "0123456789" if d != s[n]]
+            for v in values:
+                P = cards.copy()
+                P[i, j] = v
+                if _frame_ok(P):
+                    counts.add(disp_step_count(screw_path(H, _frame(P))))
+    assert counts and max(counts) <= 17
+
+
+def test_illustration4s_count_at_a_new_configuration_is_not_22():
+    """Erratum G7: the count taken where DISP's small increments left the arm (every joint by
+    ±δ, δ ≤ 5°, 64 sign patterns) stays at 13..21: the screw's θ and d change too little."""
+    deck = embedded_deck("illustration4")
+    model, P0, _ = deck_initial_hand(deck, deck_model(deck))
+    q0 = np.asarray(model.q_home, dtype=float)
+    target = resolve_stage(deck_stages(deck, P0)[0], fk(model, q0)).end
+    signs = np.array(np.meshgrid(*[[1.0, -1.0]] * 6)).reshape(6, -1).T
+    counts = {disp_step_count(screw_path(fk(model, q0 + math.radians(d) * s), target))
+              for d in (1.0, 3.0, 5.0) for s in signs}
+    assert max(counts) < 22 and min(counts) >= 13
+
+
+def test_an_illustration4_run_of_eq_4_11_needs_a_correction_row_to_land():
+    """Erratum G7: DISP's run ended on the target; k first-order steps of the screw from a new
+    configuration (every joint ±1.5°, clearing the criterion) end ≥ 0.005 in off, so one
+    correction row at least follows: with the caption counting every solve, "Total 22" leaves
+    at most 21 path steps."""
+    from kinestat.disp.deck import PRINTED_PRECISION, disp_cond_limit
+    from kinestat.serial.guidance.rules import GuidanceOptions
+    from kinestat.serial.guidance.run import run_guidance
+
+    deck = embedded_deck("illustration4")
+    model, P0, _ = deck_initial_hand(deck, deck_model(deck))
+    q0 = np.asarray(model.q_home, dtype=float)
+    target = resolve_stage(deck_stages(deck, P0)[0], fk(model, q0)).end
+    opts = GuidanceOptions(singular="stop", cond_limit=disp_cond_limit(deck), settle=False)
+    ends = []
+    for s in ([1, -1, -1, 1, -1, 1], [1, 1, 1, 1, 1, 1], [-1, 1, -1, 1, 1, -1]):
+        q = q0 + math.radians(1.5) * np.array(s, dtype=float)
+        for k in (16, 22):
+            r = run_guidance(model, q, [lambda H: screw_path(H, target, from_actual=True)],
+                             steps=k, options=opts)
+            if not r.stopped:
+                ends.append(r.final_pose_error()[0])
+    assert ends and min(ends) > 10 * PRINTED_PRECISION
