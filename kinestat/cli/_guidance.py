@@ -100,8 +100,8 @@ def _fmt_event(ev: dict) -> str:
 def print_result(result: GuidanceResult, notes=(), title: str = "Joint variables") -> None:
     """Human-readable tables of a guidance run (rich)."""
     m = result.model
-    from kinestat.mechanism.nadkarni import hand_points  # lazy: start-up (`kinestat --help`)
     from kinestat.disp.steps import total_steps  # lazy: start-up (numba)
+    from kinestat.mechanism.nadkarni import hand_points  # lazy: start-up (`kinestat --help`)
     from kinestat.serial.guidance.run import joint_display  # lazy: start-up (numba)
 
     vals = np.round(joint_display(m, result.q), 3) + 0.0  # no "-0.000"

@@ -19,7 +19,8 @@ def result_record(result: GuidanceResult, *, hand_points_every_row: bool = False
     revolute joints), ``hand_origins``, ``final_hand_points`` (origin, unit point on +z, unit
     point on +x), ``target_hand_points``, ``events``, ``steps``, ``substeps``,
     ``total_steps`` (every solve, as Nadkarni's captions count them:
-    :func:`~kinestat.disp.steps.total_steps`), ``final_pose_error`` and ``max_path_deviation`` (``position``, ``angle_deg``), ``stopped``,
+    :func:`~kinestat.disp.steps.total_steps`), ``final_pose_error`` and
+    ``max_path_deviation`` (``position``, ``angle_deg``), ``stopped``,
     ``stop_reason`` (``stop_message``), ``stage_hand_origins`` (the hand origin at the end of
     each stage), ``length_scale`` and, when asked, ``hand_points`` of every row.
     """
