@@ -13,9 +13,11 @@ with θ the stage's rotation (degrees), T its translation parameter (|d| of the 
 II, III and IV, the origin's straight line D for type I) and the hand size DISP's unit: its
 hand points are one length unit apart. The two constants are fitted to the published counts of
 Illustrations 5, 6 and 7 (27; 9 and 4; 35); see the docs for the evidence and the fit's
-freedom. No rule of this kind gives Illustration 4's "Total 22" with them
-(``scripts/disp_it_rule_search.py``). ``kinestat disp`` also splits a counted step whose joint
-increments exceed :data:`DISP_STEP_DEG` into sub-steps (``GuidanceOptions.counted_substep_deg``).
+freedom. Illustration 4's "Total 22" counts every solve (:func:`total_steps`), not path
+steps; no rule of this kind gives its path steps (at most 21) with the other counts
+(``scripts/disp_it_rule_search.py``, ``scripts/disp_ill4_total_checks.py``). ``kinestat
+disp`` also splits a counted step whose joint increments exceed :data:`DISP_STEP_DEG` into
+sub-steps (``GuidanceOptions.counted_substep_deg``).
 """
 
 from __future__ import annotations
