@@ -149,7 +149,9 @@ TABLE_A2_9 = {
 
 def test_disp_1977_flag_reproduces_table_a2_9(capsys):
     assert main(["disp", "illustration5-published", "--disp-1977", "--json"]) == 0
-    table = json.loads(capsys.readouterr().out)["table"]
+    out = json.loads(capsys.readouterr().out)
+    table = out["table"]
+    assert out["total_steps"] == 38  # the caption: "Total 38 steps"
     for row, values in TABLE_A2_9.items():
         np.testing.assert_allclose(table[row][:4], values, atol=6e-4, err_msg=f"row {row}")
         np.testing.assert_allclose(table[row][4:], [90.0, 0.0], atol=6e-4)
