@@ -14,7 +14,8 @@ remaining readings by computation:
    correction: every solve of eq. 4-11): Illustration 4's total under it, with the rule's 16
    path steps, from new configurations that clear the singularity criterion; it depends on the
    first step out of the near-singular start;
-4. the translations of Illustration 4 DISP knew, against the band 22 would need.
+4. the translations of Illustration 4 DISP knew, against the band 22 would need;
+5. which path-step count gives a total of 22 under that convention.
 
     PYTHONPATH=$PWD python scripts/disp_ill4_total_checks.py
 """
@@ -173,6 +174,19 @@ def check_caption_convention() -> None:
               f"correction row is needed); totals {sorted(tot.items())}")
 
 
+def check_which_k() -> None:
+    starts = new_configurations()
+    print("5. Which path-step count k gives a total of 22 (of the runs that land):")
+    for name in ("eq. 4-11 as printed, no sub-steps", "Illustration 5's step (disp_1977)"):
+        opts, counted = VARIANTS[name]
+        row = []
+        for k in range(16, 22):
+            land = [t for t, _ in (caption_total(q, opts, counted, k) for q in starts)
+                    if t is not None]
+            row.append(f"k = {k}: {land.count(22)}/{len(land)}")
+        print(f"   {name}: " + ", ".join(row))
+
+
 def check_translations() -> None:
     # c1 from 27, 9 and 4 (90, 30 and 15 deg), c2 from 35 (17.72 in): rounding to the nearest
     th_lo = max(90.0 / 27.5, 30.0 / 9.5, 15.0 / 4.5)
@@ -200,6 +214,7 @@ def main() -> None:
     check_new_configuration()
     check_caption_convention()
     check_translations()
+    check_which_k()
 
 
 if __name__ == "__main__":
