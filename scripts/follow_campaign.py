@@ -4,7 +4,8 @@
 axes near z). This campaign also draws, per run: |F_req| uniform in [2, ``--max-force``] N,
 the travel uniform in 20-80 mm, the initial travel direction in any azimuth about F_req (up
 to ±0.3 of it along F_req), friction from ``--friction`` (default 0, 0.3 and 0.5), the ideal
-sensor in 30 % of the runs; even runs a plane (1.5-4 mm ahead, tilted 0-10° in any azimuth),
+sensor in 30 % of the runs; even runs a plane (1.5-4 mm ahead, tilted 0-``--max-tilt`` degrees
+(default 10) in any azimuth),
 odd runs a cylinder of radius uniform in [``--min-radius``, 500] mm whose axis lies in any
 azimuth across F_req (up to ±0.2 of it along F_req). Each run is judged by issue 13's
 acceptance (completed, no contact lost, travel within 1 mm of the request, measured and true
@@ -13,9 +14,12 @@ RMS ≤ 0.2 N, or 0.05 N with the ideal sensor, and max ≤ 0.5 N); requests the
 refuses before any motion (a force the platform cannot carry) are counted apart. In process;
 ``--devices`` runs through the simulated Galil and encoder stream as the CLI does;
 ``--sim mujoco`` on the MuJoCo cell (in process; true figures from MuJoCo's contact force).
+With ``--wood LO HI`` each run is, with even odds, rigid or compliant with a workpiece stiffness
+log-uniform in LO-HI N/mm (a second stream, so the workpieces stay those of the seed).
 
     .venv/bin/python scripts/follow_campaign.py [N] [--seed S] [--max-force F]
         [--min-radius R] [--friction MU ...] [--devices] [--jobs J] [--sim kinestat|mujoco]
+        [--max-tilt DEG] [--wood LO HI]
 """
 
 from __future__ import annotations
@@ -50,7 +54,7 @@ _V = np.cross(F_HAT, _U)
 
 
 def draw(rng: np.random.Generator, k: int, max_force: float, min_radius: float,
-         frictions: tuple[float, ...]) -> dict:
+         frictions: tuple[float, ...], max_tilt: float = 10.0) -> dict:
     """Run ``k``'s request (module docstring)."""
     force = float(rng.uniform(2.0, max_force))
     travel = float(rng.uniform(20.0, 80.0))
@@ -59,7 +63,7 @@ def draw(rng: np.random.Generator, k: int, max_force: float, min_radius: float,
     travel_dir = math.cos(az) * _U + math.sin(az) * _V + rng.uniform(-0.3, 0.3) * F_HAT
     ideal = bool(rng.random() < 0.3)
     if k % 2 == 0:
-        tilt, paz = math.radians(rng.uniform(0.0, 10.0)), rng.uniform(0.0, 2.0 * math.pi)
+        tilt, paz = math.radians(rng.uniform(0.0, max_tilt)), rng.uniform(0.0, 2.0 * math.pi)
         n = -(math.cos(tilt) * F_HAT + math.sin(tilt) * (math.cos(paz) * _U + math.sin(paz) * _V))
         name = f"plane {math.degrees(tilt):.1f}°"
         cell = SimulatedCell(plane_point=START + rng.uniform(1.5, 4.0) * F_HAT, plane_normal=n)
@@ -142,12 +146,22 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--devices", action="store_true")
     ap.add_argument("--jobs", type=int, default=2)
     ap.add_argument("--sim", choices=("kinestat", "mujoco"), default="kinestat")
+    ap.add_argument("--max-tilt", type=float, default=10.0, help="planes' largest tilt, degrees")
+    ap.add_argument("--wood", type=float, nargs=2, metavar=("LO", "HI"),
+                    help="half the runs on a compliant workpiece, stiffness N/mm log-uniform")
     a = ap.parse_args(argv)
     rng = np.random.default_rng(a.seed)
-    draws = [draw(rng, k, a.max_force, a.min_radius, tuple(a.friction)) for k in range(a.n)]
+    draws = [draw(rng, k, a.max_force, a.min_radius, tuple(a.friction), a.max_tilt)
+             for k in range(a.n)]
+    wood_rng = np.random.default_rng([a.seed, 1])
     for d in draws:
-        d["cell"] = dataclasses.replace(d["cell"], plant=a.sim)
-    print(f"seed {a.seed}, |F_req| 2-{a.max_force:g} N, cylinders R >= {a.min_radius:g} mm, "
+        k_wood = None
+        if a.wood and wood_rng.random() < 0.5:
+            k_wood = float(np.exp(wood_rng.uniform(*np.log(a.wood))))
+            d["name"] = f"{d['name'][:18]} k{k_wood:.0f}"
+        d["cell"] = dataclasses.replace(d["cell"], plant=a.sim, workpiece_stiffness=k_wood)
+    print(f"seed {a.seed}, |F_req| 2-{a.max_force:g} N, planes <= {a.max_tilt:g}°, "
+          f"cylinders R >= {a.min_radius:g} mm, wood {a.wood or 'no'}, "
           f"friction {a.friction}, plant {a.sim}, "
           + ("through the devices" if a.devices else "in process"))
     print("| run | workpiece | F N | travel mm | μ | sensor | verdict | travelled (true) | "

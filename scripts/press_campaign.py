@@ -10,10 +10,12 @@ process with ``--in-process``; ``--sim mujoco`` runs each on the MuJoCo cell (in
 whether the goal was attained (|F| within ``force_tol`` of the request and the tool axis within
 ``align_tol_deg`` of the measured force), the cycles, the true force's error and the true
 force's angle to the tool axis, the stop reason; then the counts by workpiece kind.
-docs/control.md ("The press on curved and steep workpieces") quotes its draws.
+docs/control.md ("The press on curved and steep workpieces") quotes its draws. With
+``--wood LO HI`` each run is, with even odds, rigid or compliant with a workpiece stiffness
+log-uniform in LO-HI N/mm (drawn from a second stream, so the workpieces stay those of the seed).
 
     .venv/bin/python scripts/press_campaign.py [N] [--seed S] [--friction MU ...] [--in-process]
-        [--jobs J] [--sim kinestat|mujoco]
+        [--jobs J] [--sim kinestat|mujoco] [--wood LO HI]
 """
 
 from __future__ import annotations
@@ -106,11 +108,18 @@ def main() -> None:
     ap.add_argument("--in-process", action="store_true")
     ap.add_argument("--jobs", type=int, default=1)
     ap.add_argument("--sim", choices=("kinestat", "mujoco"), default="kinestat")
+    ap.add_argument("--wood", type=float, nargs=2, metavar=("LO", "HI"),
+                    help="half the runs on a compliant workpiece, stiffness N/mm log-uniform")
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
     reqs = [draw(rng, k, tuple(a.friction)) for k in range(a.n)]
+    wood_rng = np.random.default_rng([a.seed, 1])
     for r in reqs:
-        r["cell"] = dataclasses.replace(r["cell"], plant=a.sim)
+        k_wood = None
+        if a.wood and wood_rng.random() < 0.5:
+            k_wood = float(np.exp(wood_rng.uniform(*np.log(a.wood))))
+            r["name"] = f"{r['name'][:14]} k{k_wood:.0f}"
+        r["cell"] = dataclasses.replace(r["cell"], plant=a.sim, workpiece_stiffness=k_wood)
     print(f"seed {a.seed}, {a.n} runs, |F_req| 2-6 N, friction {a.friction}, plant {a.sim}, "
           + ("in process" if a.in_process or a.sim == "mujoco"
              else "through the simulated devices"))

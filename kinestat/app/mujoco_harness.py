@@ -19,7 +19,12 @@ from typing import Any
 import numpy as np
 
 from kinestat.app.mujoco_cell import counts_to_q
-from kinestat.app.sim_cell import SIM_STALE_AFTER, SimCheckedReader, stop_devices
+from kinestat.app.sim_cell import (
+    SIM_STALE_AFTER,
+    DeviceWiring,
+    SimCheckedReader,
+    stop_devices,
+)
 from kinestat.control.model import ControlModel
 from kinestat.devices.cell_io import DeviceIO
 from kinestat.devices.encoder_stream import EncoderReader
@@ -37,7 +42,7 @@ PLANT_CHUNK = 4
 """Plant steps between two reads of the Galil's axis positions (2 ms at the 0.5 ms step)."""
 
 
-class MujocoHarness:
+class MujocoHarness(DeviceWiring):
     """The simulated Galil and encoder box on one MuJoCo plant (context manager).
 
     ``plant``: the MuJoCo cell at the robot's start pose; ``model``: the controller's model of
@@ -119,20 +124,6 @@ class MujocoHarness:
         self._stop.set()
         if self._thread is not None:
             self._thread.join(timeout=5.0)
-
-    def __enter__(self) -> MujocoHarness:
-        return self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop()
-
-    @property
-    def galil_address(self) -> tuple[str, int]:
-        return self.server.address
-
-    @property
-    def serial_path(self) -> str:
-        return self.emitter.path
 
     def device_io(self, *, samples: int = 1, settle: float = 0.1, **kw: Any) -> DeviceIO:
         """A :class:`DeviceIO` through the real Galil client and encoder reader (closed with

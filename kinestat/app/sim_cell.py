@@ -49,8 +49,8 @@ from kinestat.sim.sensor import Sensor
 from kinestat.sim.surface import solve as solve_contact
 from kinestat.sim.surface import surface_normal
 
-__all__ = ["CellState", "SimHarness", "stop_devices", "SimCheckedReader", "InProcessIO",
-           "control_model", "simulator_fault", "start_counts"]
+__all__ = ["CellState", "DeviceWiring", "SimHarness", "stop_devices", "SimCheckedReader",
+           "InProcessIO", "control_model", "simulator_fault", "start_counts"]
 
 
 def control_model(cell: Cell, sensor: Sensor, *, coupling: float = AXIS4_TO_5_COUPLING,
@@ -178,7 +178,26 @@ class CellState:
         }
 
 
-class SimHarness:
+class DeviceWiring:
+    """What a simulated cell's harness shares: a context manager over its ``start``/``stop``,
+    and the addresses of its Galil server (``server``) and encoder emitter (``emitter``)."""
+
+    def __enter__(self):
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+    @property
+    def galil_address(self) -> tuple[str, int]:
+        return self.server.address
+
+    @property
+    def serial_path(self) -> str:
+        return self.emitter.path
+
+
+class SimHarness(DeviceWiring):
     """The simulated cell behind real device protocols (context manager).
 
     Args:
@@ -224,21 +243,6 @@ class SimHarness:
     def stop(self) -> None:
         """Close the clients and readers it opened, stop the emitter and the server."""
         stop_devices(self._opened, self.emitter, self.server)
-
-    def __enter__(self) -> SimHarness:
-        return self.start()
-
-    def __exit__(self, *exc: object) -> None:
-        self.stop()
-
-    # -- wiring
-    @property
-    def galil_address(self) -> tuple[str, int]:
-        return self.server.address
-
-    @property
-    def serial_path(self) -> str:
-        return self.emitter.path
 
     def true_q(self) -> np.ndarray:
         """The robot's true joint angles (radians)."""

@@ -113,19 +113,6 @@ def frame_from_tool(tool_point, s6, a67, tool_point_6) -> np.ndarray:
     return T
 
 
-_FEW = 16
-
-
-def _fk_few(model: ChainModel, q: np.ndarray) -> np.ndarray:
-    """``fk`` with a batch of at most :data:`_FEW` joint vectors taken one by one: the
-    single-vector kernel takes microseconds where the batched (threaded) one pays a thread
-    launch of milliseconds on a loaded machine (the controller's candidates, one per cycle)."""
-    if q.ndim < 2 or q.size > _FEW * q.shape[-1]:
-        return fk(model, q)
-    rows = np.ascontiguousarray(q.reshape(-1, q.shape[-1]))
-    return np.stack([fk(model, r) for r in rows]).reshape(q.shape[:-1] + (4, 4))
-
-
 @dataclass(frozen=True, eq=False)
 class ChainArm:
     """Any 6R :class:`ChainModel` with an analytic solver (:func:`kinestat.ik_all`).
@@ -172,7 +159,7 @@ class ChainArm:
         return np.asarray(q, dtype=float) + self.axis_offset
 
     def forward(self, q, tool_point_6=(0.0, 0.0, 0.0)) -> ToolFrame:
-        T = _fk_few(self.model, np.asarray(q, dtype=float))
+        T = fk(self.model, np.asarray(q, dtype=float))
         p = np.einsum("...ij,j->...i", T[..., :3, :3], np.asarray(tool_point_6, float))
         return ToolFrame(tool_point=p + T[..., :3, 3], s6=T[..., :3, 2].copy(),
                          a67=T[..., :3, 0].copy(), pose=T)

@@ -11,11 +11,10 @@ chord of its measured tip path, which lies in the surface), so the bias can be r
   ``n̂`` and ``ŝ``; in it ``n̂ = cos α û + sin α ĝ`` (:func:`cone_normal`). An error of the
   chord within that plane (its elevation out of the surface: noise, a curved path) does not
   change ``ĝ``; an error across it turns ``n̂`` by only ``μ`` times that error.
-* ``sin α = −û·ŝ`` for a chord in the surface (:func:`friction_sample`): one sample of μ per
-  sliding cycle; μ is a property of the contact, so an estimate over many cycles is far less
-  noisy than one chord.
-* the normal force is ``f_n = f·n̂`` and the friction force ``f − f_n n̂``
-  (:func:`normal_and_friction`): the friction is measured and reported, not fought.
+* ``sin α = −û·ŝ`` for a chord in the surface: μ is a property of the contact, so an
+  estimate over many cycles is far less noisy than one chord.
+* the normal force is ``f_n = f·n̂`` and the friction force ``f − f_n n̂``: the friction is
+  measured and reported, not fought.
 
 The controller is not told the surface or μ. Frictionless, ``μ̂ = 0`` and ``n̂ = û``.
 
@@ -42,10 +41,7 @@ import numpy as np
 
 __all__ = [
     "cone_normal",
-    "friction_sample",
-    "normal_and_friction",
     "fit_circle",
-    "circle_centre_radius",
     "path_curvature",
     "turn_by_curvature",
     "fit_plane",
@@ -75,30 +71,6 @@ def cone_normal(force_on_tool, slip, mu) -> np.ndarray:
     return np.cos(a) * u + np.sin(a) * g
 
 
-def friction_sample(force_on_tool, chord) -> float:
-    """One sample of the friction coefficient, ``tan α`` with ``sin α = −û·ĉ``: the force on a
-    sliding tip leans from the normal by α against the slip ``ĉ`` (a chord of the tip path,
-    which lies in the surface). Signed: noise makes it negative at times, and a running mean of
-    signed samples is unbiased where a clipped one is not (frictionless contacts).
-
-    >>> round(friction_sample([-0.3, 0.0, 1.0], [2.0, 0.0, 0.0]), 12)
-    0.3
-    """
-    u = _unit(force_on_tool)
-    c = _unit(chord)
-    s = min(max(-float(u @ c), -0.99), 0.99)
-    return s / math.sqrt(1.0 - s * s)
-
-
-def normal_and_friction(force_on_tool, normal) -> tuple[float, np.ndarray]:
-    """The normal force ``f·n̂`` (N, positive pressing) and the friction force ``f − (f·n̂) n̂``
-    (the tangential part, (3,))."""
-    f = np.asarray(force_on_tool, dtype=float)
-    n = np.asarray(normal, dtype=float)
-    fn = float(f @ n)
-    return fn, f - fn * n
-
-
 def fit_circle(x, y) -> np.ndarray:
     """The algebraic circle ``A (x² + y²) + B x − y + D = 0`` fitted to points (x, y) by linear
     least squares in the residual of ``y`` (a Kåsa fit normalised on the ``y`` coefficient, so
@@ -116,18 +88,6 @@ def fit_circle(x, y) -> np.ndarray:
     M = np.column_stack([x * x + y * y, x, np.ones_like(x)])
     coef, *_ = np.linalg.lstsq(M, y, rcond=None)
     return coef
-
-
-def circle_centre_radius(coef) -> tuple[np.ndarray, float]:
-    """Centre (2,) and radius of the circle ``A (x² + y²) + B x − y + D = 0`` (``A ≠ 0``):
-    centre ``(−B, 1)/(2A)``, radius ``sqrt(B² + 1 − 4AD)/(2|A|)``.
-
-    >>> c, r = circle_centre_radius([-0.5, 0.0, 0.0])
-    >>> np.round(c, 12).tolist(), r
-    ([0.0, -1.0], 1.0)
-    """
-    A, B, D = (float(v) for v in coef)
-    return np.array([-B, 1.0]) / (2.0 * A), math.sqrt(B * B + 1.0 - 4.0 * A * D) / (2 * abs(A))
 
 
 def path_curvature(points, tip, normal, tangent, min_span: float) -> float:

@@ -94,7 +94,7 @@ def cycle_summary(cmd: Command, state: ControllerState, meas: Measurement,
                    truth: dict | None) -> dict:
     """The cycle's entry of the report's ``cycles``: state, action, the commanded tool point
     and S6 (the last commanded ones for measure/done/stop), the measured force (the
-    equivalent wrench's) and, simulated, the true force."""
+    equivalent wrench's) and, simulated, the true force, tip and surface normal."""
     t = cmd.target if cmd.target is not None else state.target
     tf = None if not truth or truth.get("tool_force") is None else np.asarray(
         truth["tool_force"], dtype=float)
@@ -102,9 +102,9 @@ def cycle_summary(cmd: Command, state: ControllerState, meas: Measurement,
            "action": cmd.action if cmd.kind in ("move", "measure") else cmd.kind,
            "tool_point": t.tool_point.copy(), "s6": t.s6.copy(),
            "force": meas.wrench[:3].copy(), "true_force": tf}
-    if cmd.info:  # a task's own figures (the follow task's), with the true normal and tip
+    if cmd.info:  # a task's own figures (the follow task's)
         out.update(cmd.info)
-        for key, src in (("true_normal", "normal"), ("true_tip", "tip")):
-            v = None if not truth else truth.get(src)
-            out[key] = None if v is None else np.asarray(v, dtype=float).copy()
+    for key, src in (("true_normal", "normal"), ("true_tip", "tip")):
+        v = None if not truth else truth.get(src)
+        out[key] = None if v is None else np.asarray(v, dtype=float).copy()
     return out

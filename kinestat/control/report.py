@@ -34,6 +34,8 @@ class RunReport:
     final_leg_lengths: np.ndarray | None = None
     true_force: np.ndarray | None = None
     true_force_magnitude: float | None = None
+    true_tip: np.ndarray | None = None
+    true_normal: np.ndarray | None = None
     axis_error_deg: float | None = None
     log: str | None = None
     elapsed_s: float = 0.0
@@ -61,6 +63,8 @@ class RunReport:
             "torque": arr(self.torque),
             "force_magnitude": self.force_magnitude,
             "true_force": arr(self.true_force),
+            "true_tip": arr(self.true_tip),
+            "true_normal": arr(self.true_normal),
             "tool_axis": arr(self.tool_axis),
             "tool_point": arr(self.tool_point),
             "final_joints_deg": arr(self.final_joints_deg),
@@ -120,6 +124,9 @@ def run_report(config: ControllerConfig, converged, state, states, moves, reason
         tf = np.asarray(truth["tool_force"], dtype=float)
         rep.true_force = tf
         rep.true_force_magnitude = float(np.linalg.norm(tf))
+        for key in ("tip", "normal"):  # the plant's contact point and surface normal
+            if truth.get(key) is not None:
+                setattr(rep, f"true_{key}", np.asarray(truth[key], dtype=float).copy())
         axis = truth.get("tool_axis")
         axis = m.s6 if axis is None and m is not None else axis
         if axis is not None and rep.true_force_magnitude > 0:

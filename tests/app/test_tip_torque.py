@@ -67,3 +67,22 @@ def test_log_and_plot_carry_the_labelled_moments(ideal_run):
     np.testing.assert_allclose(s["torque"], [r["measured"]["torque_about_base"]
                                              for r in cycles])
     assert recs[-1]["report"]["torque_about_tip"] == rep.as_dict()["torque_about_tip"]
+
+
+def test_report_carries_the_plants_true_tip_and_normal(ideal_run):
+    """The truth (the simulator's contact point and surface normal) reaches the report and every
+    cycle of the log; the true tip lies on the default plane and the true normal is its normal."""
+    rep, truth, recs = ideal_run
+    prep = prepare_control(ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION,
+                                          start_tool_point=START,
+                                          cell=SimulatedCell(ideal_sensor=True)))
+    wp = prep.cell.workpiece
+    n = np.asarray(wp.normal, dtype=float)
+    np.testing.assert_allclose(rep.true_normal, n, atol=1e-12)
+    assert abs(float((rep.true_tip - np.asarray(wp.point, dtype=float)) @ n)) <= 1e-6
+    np.testing.assert_allclose(rep.true_tip, truth["tip"], atol=1e-12)
+    d = rep.as_dict()
+    assert len(d["true_tip"]) == 3 and len(d["true_normal"]) == 3
+    last = rep.cycles[-1]  # in contact
+    np.testing.assert_allclose(last["true_tip"], rep.true_tip, atol=1e-12)
+    np.testing.assert_allclose(last["true_normal"], n, atol=1e-12)
