@@ -2,9 +2,10 @@
 is compiled, announced when it takes over a second).
 
 :func:`announce_compiles` watches Numba's ``numba:compile`` events (a compilation, never a load
-from the cache) from the moment Numba is imported; once they add up to :data:`NOTICE_AFTER_S`
-in a process, "kinestat: compiling kernels (first run only)…" goes to stderr, once. Light on
-purpose: ``kinestat --help`` imports this module and must not import NumPy or Numba.
+from the cache) from the moment Numba is imported; once a command's (the compilations since its
+``announce_compiles`` call) add up to :data:`NOTICE_AFTER_S`, "kinestat: compiling kernels
+(first run only)…" goes to stderr, once. Light on purpose: ``kinestat --help`` imports this
+module and must not import NumPy or Numba.
 """
 
 from __future__ import annotations
@@ -108,8 +109,12 @@ _SAID: list[bool] = []
 
 
 def announce_compiles() -> None:
-    """Say on stderr when this process's kernel compilations take more than
-    :data:`NOTICE_AFTER_S` (a compilation, not a load from the cache)."""
+    """Say on stderr, once, when the kernel compilations from now on (a command's) take more
+    than :data:`NOTICE_AFTER_S` (a compilation, not a load from the cache)."""
+    _SAID.clear()
+    if _WATCH:
+        _WATCH[0].spent = 0.0
+        _WATCH[0].said = False
     if "numba" in sys.modules:
         _watch_now()
     elif not any(isinstance(f, _AfterNumba) for f in sys.meta_path):

@@ -39,6 +39,16 @@ def test_the_watch_says_it_once_past_the_threshold(monkeypatch):
     assert said == [1]
 
 
+def test_each_command_starts_its_own_count(monkeypatch):
+    import numba  # noqa: F401  (the watch is installed once Numba is imported)
+
+    _compile_watch.announce_compiles()
+    w = _compile_watch._WATCH[0]
+    w.spent, w.said = 5.0, True
+    _compile_watch.announce_compiles()  # the next command
+    assert w.spent == 0.0 and not w.said
+
+
 def test_announcing_imports_no_numba_and_watches_once_numba_is_imported():
     code = ("import sys, json; from kinestat.cli import _compile_watch as w; "
             "w.announce_compiles(); before = 'numba' in sys.modules; import numba; "
