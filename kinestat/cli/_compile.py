@@ -1,24 +1,28 @@
 """The first run's kernel compilation, said out loud and kept out of anyone's timing (issue 16).
 
 kinestat's kernels are compiled by Numba on first use and cached on disk (``__pycache__`` next
-to the source, or ``NUMBA_CACHE_DIR``). A command that is about to use a kernel group asks
-:func:`compiling_notice`; when none of the group's public kernels has a cache index yet, it
-says "compiling kernels (first run only)…" on stderr (a spinner on a terminal, one line
-otherwise). :func:`warm_kernels` compiles the groups ahead of time: ``kinestat warmup`` (hidden;
-``make run`` calls it) and anything that must not count compile time as its own run time.
+to the source, or ``NUMBA_CACHE_DIR``). Only what a command uses is compiled or loaded: the
+``kinestat`` command watches Numba's compilations (:func:`announce_compiles`) and, once they have
+taken more than :data:`NOTICE_AFTER_S` in a process, says "compiling kernels (first run only)…"
+on stderr. :func:`warm_kernels` compiles kernel groups ahead of time: ``kinestat warmup`` (hidden;
+``make run`` calls it) compiles the groups ``kinestat control`` runs (:data:`RUN_GROUPS`),
+``kinestat warmup --all`` every group, cold groups in parallel processes, one an idle core.
 """
 
 from __future__ import annotations
 
 import contextlib
 import importlib
+import json
 import os
+import subprocess
+import sys
 import time
 from collections.abc import Iterator
 
 import numpy as np
 
-from kinestat.cli._output import err_console
+from kinestat.cli._compile_watch import announce_compiles, say_compiling
 
 #: kernel groups -> the module holding their compiled kernels
 KERNELS: dict[str, str] = {
@@ -30,14 +34,14 @@ KERNELS: dict[str, str] = {
     "platform": "kinestat.parallel._fk_kernels",
     "kinestatic": "kinestat.parallel._kinestatic_kernels",
 }
+#: the groups ``kinestat control`` (the run ``make run`` starts) uses with its defaults: the
+#: platform's forward kinematics and the PUMA 762 closed form; ``kinestat warmup`` compiles these
+RUN_GROUPS: tuple[str, ...] = ("platform", "puma762")
 #: kernel groups compiled on demand by the command that uses them (not by ``kinestat warmup``)
 ON_DEMAND: dict[str, str] = {
     "ik_all_closed": "kinestat.serial.analytic._cf_kernels",
     "ik_all_general": "kinestat.serial.analytic._rr_kernels",
 }
-NOTICE = "compiling kernels (first run only)…"
-
-
 def _index_paths(module_name: str) -> list[str]:
     from numba.core.dispatcher import Dispatcher  # lazy: start-up (Numba ~0.5 s)
 
@@ -60,17 +64,10 @@ def is_cold(group: str) -> bool:
 
 @contextlib.contextmanager
 def compiling_notice(*groups: str) -> Iterator[bool]:
-    """Say on stderr that kernels compile when one of ``groups`` is cold; yields whether."""
-    cold = [g for g in groups if is_cold(g)]
-    if not cold:
-        yield False
-        return
-    if err_console.is_terminal:
-        with err_console.status(NOTICE):
-            yield True
-        return
-    err_console.print(f"kinestat: {NOTICE}", highlight=False)
-    yield True
+    """Announce the compilations of the block once they take over a second
+    (:func:`announce_compiles`); yields whether one of ``groups`` is cold."""
+    announce_compiles()
+    yield any(is_cold(g) for g in groups)
 
 
 def _warm_serial() -> None:
@@ -159,7 +156,8 @@ _WARM = {"serial": _warm_serial, "ik": _warm_ik, "puma762": _warm_puma762,
 
 
 def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:
-    """Compile (or load from the cache) the kernels of ``groups``; seconds per group."""
+    """Compile (or load from the cache) the kernels of ``groups`` in this process; seconds per
+    group."""
     took = {}
     for g in groups:
         t0 = time.perf_counter()
@@ -168,10 +166,69 @@ def warm_kernels(groups: tuple[str, ...] = tuple(KERNELS)) -> dict[str, float]:
     return took
 
 
-def warm_cold_kernels() -> None:
-    """Compile the cold kernel groups of :data:`KERNELS` now, saying so on stderr (a run's
-    first cycle then does not pay for it)."""
-    cold = tuple(g for g in KERNELS if is_cold(g))
+#: compile seconds of each group with an empty cache (2 cores at load ~4, 2026-12-07): only the
+#: order in which :func:`compile_groups` shares the groups out between processes
+_COST_S = {"platform": 17.0, "ik": 9.0, "stiffness": 8.0, "puma762": 7.0, "serial": 5.0,
+           "cycle": 4.0, "kinestatic": 1.0}
+_CHILD = ("import json, sys; from kinestat.cli._compile import warm_kernels; "
+          "print(json.dumps(warm_kernels(tuple(sys.argv[1:]))))")
+
+
+def idle_cores() -> int:
+    """The CPU cores this process may run on less the machine's load (at least 1): on a busy
+    machine a second compiling process only adds its own start-up."""
+    try:
+        n = len(os.sched_getaffinity(0))
+    except AttributeError:  # pragma: no cover - not Linux
+        n = os.cpu_count() or 1
+    try:
+        busy = os.getloadavg()[0]
+    except OSError:  # pragma: no cover - no load average
+        busy = 0.0
+    return max(1, min(n, round(n - busy)))
+
+
+def _shares(groups: list[str], jobs: int) -> list[list[str]]:
+    """``groups`` dealt to ``jobs`` processes, the costliest first to the least loaded."""
+    bins: list[list[str]] = [[] for _ in range(jobs)]
+    load = [0.0] * jobs
+    for g in sorted(groups, key=lambda g: -_COST_S.get(g, 1.0)):
+        k = load.index(min(load))
+        bins[k].append(g)
+        load[k] += _COST_S.get(g, 1.0)
+    return [b for b in bins if b]
+
+
+def _compile_in_processes(groups: list[str], jobs: int) -> dict[str, float]:
+    """Compile ``groups`` in ``jobs`` child processes at once (each writes Numba's cache);
+    the groups of a child that fails are left to the caller."""
+    children = [(share, subprocess.Popen([sys.executable, "-c", _CHILD, *share],
+                                         stdout=subprocess.PIPE, text=True))
+                for share in _shares(groups, jobs)]
+    took: dict[str, float] = {}
+    for _share, child in children:
+        out, _ = child.communicate()
+        if child.returncode == 0:
+            with contextlib.suppress(ValueError):
+                took.update(json.loads(out.strip().splitlines()[-1]))
+    return took
+
+
+def compile_groups(groups: tuple[str, ...], jobs: int | None = None) -> dict[str, float]:
+    """Compile (or load) the kernels of ``groups``, the cold ones in up to ``jobs`` processes
+    (default: one an idle core), saying so on stderr; seconds per group (a child's own time)."""
+    cold = [g for g in groups if is_cold(g)]
     if cold:
-        with compiling_notice(*cold):
-            warm_kernels(cold)
+        say_compiling()
+    jobs = min(jobs or idle_cores(), len(cold))
+    took = _compile_in_processes(cold, jobs) if jobs >= 2 else {}
+    took.update(warm_kernels(tuple(g for g in groups if g not in took)))
+    return {g: took[g] for g in groups}
+
+
+def warm_cold_kernels(groups: tuple[str, ...] = RUN_GROUPS) -> None:
+    """Compile the cold groups among ``groups`` now (default: those ``kinestat control`` runs),
+    saying so on stderr, so that a run's first cycle does not pay for it."""
+    cold = tuple(g for g in groups if is_cold(g))
+    if cold:
+        compile_groups(cold)

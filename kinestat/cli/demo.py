@@ -9,8 +9,14 @@ from __future__ import annotations
 import numpy as np
 import typer
 
-from kinestat.cli._compile import KERNELS, compiling_notice, is_cold, warm_kernels
-from kinestat.cli._options import command_help, json_option
+from kinestat.cli._compile import (
+    KERNELS,
+    RUN_GROUPS,
+    compile_groups,
+    compiling_notice,
+    is_cold,
+)
+from kinestat.cli._options import command_help, flag, json_option
 from kinestat.cli._output import console, print_json, table
 from kinestat.io.disp_deck import embedded_deck
 from kinestat.mechanism.nadkarni import mechanism_frames
@@ -23,22 +29,29 @@ def register(app: typer.Typer) -> None:
 
 
 def warmup_command(
+    every: bool = flag(False, "--all", help="Every kernel group, not only those "
+                       "`kinestat control` runs."),
+    jobs: int = typer.Option(0, "--jobs", min=0, help="Processes compiling at once "
+                             "(0: one an idle core)."),
     as_json: bool = json_option(),
 ) -> None:
-    """Compile kinestat's kernels now (first run only; later runs load them from the cache).
+    """Compile the kernels `kinestat control` runs now (first run only; later runs load them
+    from the cache); `--all` every group.
 
-    `make run` calls this, so that no command, and no control loop, spends its first run
-    compiling. JSON: {"seconds": {group: s}, "compiled": [groups that were cold]}.
+    `make run` calls this, so that its control run does not spend its first cycles compiling;
+    any other command compiles what it uses on first use and says so on stderr when that takes
+    over a second. Cold groups compile in parallel processes, one an idle core. JSON:
+    {"seconds": {group: s}, "compiled": [groups that were cold]}.
     """
-    cold = [g for g in KERNELS if is_cold(g)]
-    with compiling_notice(*KERNELS):
-        took = warm_kernels()
+    groups = tuple(KERNELS) if every else RUN_GROUPS
+    cold = [g for g in groups if is_cold(g)]
+    took = compile_groups(groups, jobs or None)
     if as_json:
         print_json({"seconds": took, "compiled": cold})
         return
     console.print(table("Kernels", ["group", "module", "state", "time (s)"],
                         [[g, KERNELS[g], "compiled now" if g in cold else "cached", took[g]]
-                         for g in KERNELS], fmt="{:.2f}"))
+                         for g in groups], fmt="{:.2f}"))
 
 
 def _screws() -> dict:

@@ -22,6 +22,7 @@ import typer
 from typer._click.exceptions import ClickException, NoArgsIsHelpError, UsageError
 
 import kinestat
+from kinestat.cli._compile_watch import announce_compiles
 from kinestat.cli._lazy import CommandEntry, LazyGroup
 from kinestat.errors import KinestatError
 
@@ -32,8 +33,8 @@ COMMANDS: tuple[CommandEntry, ...] = (
                  "762 also P_tool_F, S6_F and a67_F in the thesis's words (Vibhute eq. 2-34)."),
     CommandEntry("demo", "demo", "Run the thesis illustrations on the embedded data and print "
                  "their results."),
-    CommandEntry("warmup", "demo", "Compile kinestat's kernels now (first run only; later runs "
-                 "load them from the cache).", hidden=True),
+    CommandEntry("warmup", "demo", "Compile the kernels `kinestat control` runs now (first run "
+                 "only; later runs load them from the cache); `--all` every group.", hidden=True),
     CommandEntry("screw", "screw", "Screw axis of the displacement between two positions of a "
                  "body (Nadkarni ch. III)."),
     CommandEntry("disp", "disp", "Run a DISP deck (Nadkarni 1977): MS 1 screw axes, 2 mechanism "
@@ -125,6 +126,7 @@ def main(argv: list[str] | None = None) -> int:
         typer.echo(f"kinestat: error: {n_args} arguments, more than the {MAX_ARGS} a call takes "
                    "(see 'kinestat --help')", err=True)
         return 2
+    announce_compiles()  # a command's first-run compilation says so on stderr
     try:
         code = app(args=argv, prog_name="kinestat", standalone_mode=False)
     except SystemExit as exc:

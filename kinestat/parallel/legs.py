@@ -99,7 +99,8 @@ def line_jacobian_trusted(platform: Platform, T: np.ndarray) -> np.ndarray:
     """
     from kinestat.parallel import _fk_kernels  # lazy: numba (~0.5 s) at start-up
 
-    T = np.ascontiguousarray(T, dtype=float)
+    T = np.ascontiguousarray(T, dtype=float).view()
+    T.flags.writeable = False  # one argument type (read-only, like the platform's points)
     j = np.empty(T.shape[:-2] + (6, 6))
     if not _fk_kernels.line_jacobian_kernel(platform.base_points, platform.top_points,
                                             T.reshape(-1, 4, 4), j.reshape(-1, 6, 6)):

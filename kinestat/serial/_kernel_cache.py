@@ -37,11 +37,13 @@ class KernelData:
         packed: constants, kinds (as floats) and pitches in one vector (``fk_one``,
             ``jacobian_one``).
         lower, upper: joint limits ``(n,)``.
+        jshape: ``(6, n)``, the shape of one Jacobian.
         scale: :func:`~kinestat.serial.lengths.characteristic_length` of the model (no q),
             filled in by :mod:`kinestat.serial.ik` on first use.
     """
 
-    __slots__ = ("n", "constants", "kinds", "pitches", "packed", "lower", "upper", "scale")
+    __slots__ = ("n", "constants", "kinds", "pitches", "packed", "lower", "upper", "scale",
+                 "jshape")
 
     def __init__(self, model: ChainModel) -> None:
         self.n = model.n
@@ -55,6 +57,7 @@ class KernelData:
         self.lower = _ro(model.lower)
         self.upper = _ro(model.upper)
         self.scale: float | None = None  # set by kinestat.serial.ik on first use
+        self.jshape = (6, model.n)
 
     @property
     def args(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -23,6 +23,11 @@ from kinestat.serial._numba_options import OPTS as _OPTS
 #: joint kind codes as plain ints (Numba freezes them at compile time)
 PRISMATIC = int(JointKind.PRISMATIC)
 SCREW = int(JointKind.SCREW)
+#: what the single-configuration kernels return: done, q not finite, q not of the chain's length
+DONE, NOT_FINITE, WRONG_LENGTH = 0, 1, 2
+#: the single-configuration kernels keep the GIL: they run for less than a microsecond, and
+#: releasing and taking it back would add a tenth to a call
+_ONE = {**_OPTS, "nogil": False}
 
 
 
@@ -105,20 +110,28 @@ def _unpack(P, q):
     return P[:o].reshape((n + 1, 4, 4)), o
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
+def _wrong_length(P, q):
+    """True when ``q`` is not as long as the packed chain ``P`` (``16 (n+1) + 2 n`` values)."""
+    return P.shape[0] != 18 * q.shape[0] + 16
+
+
+@nb.njit(**_ONE)
 def fk_one(P, q, out):
     """End pose of one configuration of the packed chain ``P`` into ``out (4, 4)`` (the
-    caller's: an array made in the kernel costs more to hand to Python than to fill); False if
-    q is not finite."""
+    caller's: an array made in the kernel costs more to hand to Python than to fill); returns
+    :data:`DONE`, :data:`NOT_FINITE` or :data:`WRONG_LENGTH` (``out`` untouched)."""
+    if _wrong_length(P, q):
+        return WRONG_LENGTH
     C, o = _unpack(P, q)
     if C is None:
-        return False
+        return NOT_FINITE
     n = q.shape[0]
     t = _start(C[0])
     for i in range(n):
         t = _step(C[i + 1], int(P[o + i]), P[o + n + i], q[i], t)
     _store(t, out)
-    return True
+    return DONE
 
 
 @nb.njit(**_INLINE)
@@ -142,13 +155,15 @@ def _jac_column(t, kind, h, J, j):
         J[5, j] = h * uz + px * uy - py * ux
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_ONE)
 def jacobian_one(P, q, J):
-    """Space Jacobian of one configuration of the packed chain ``P`` into ``J (6, n)``; False
-    if q is not finite."""
+    """Space Jacobian of one configuration of the packed chain ``P`` into ``J (6, n)``; returns
+    :data:`DONE`, :data:`NOT_FINITE` or :data:`WRONG_LENGTH` (``J`` untouched)."""
+    if _wrong_length(P, q):
+        return WRONG_LENGTH
     C, o = _unpack(P, q)
     if C is None:
-        return False
+        return NOT_FINITE
     n = q.shape[0]
     t = _start(C[0])
     for i in range(n):
@@ -156,7 +171,7 @@ def jacobian_one(P, q, J):
         h = P[o + n + i]
         _jac_column(t, kind, h, J, i)
         t = _step(C[i + 1], kind, h, q[i], t)
-    return True
+    return DONE
 
 
 @nb.njit(parallel=True, **_OPTS)
@@ -202,17 +217,16 @@ _ENTRY: dict[str, object] = {}
 
 def single_entry(name: str):
     """The compiled entry point of ``fk_one`` or ``jacobian_one`` for (packed chain: read-only
-    C-contiguous float64, q: C-contiguous float64, out: C-contiguous 2-D float64), bypassing
-    Numba's per-call type dispatch.
+    C-contiguous float64, q: float64 vector of any stride, out: C-contiguous 2-D float64),
+    bypassing Numba's per-call type dispatch (the one specialisation they are compiled for).
 
-    Callers must pass exactly those types (a 1-D float64 ndarray with strides (8,), an output
-    from ``np.empty``); anything else goes through the dispatcher.
+    Callers must pass exactly those types (``q`` a 1-D float64 ndarray, ``out`` from
+    ``np.empty``): the entry point checks no type, only ``q``'s length and values.
     """
     ep = _ENTRY.get(name)
     if ep is None:
         ro = nb.types.Array(nb.float64, 1, "C", readonly=True)
-        rw = nb.types.Array(nb.float64, 1, "C")
+        vec = nb.types.Array(nb.float64, 1, "A")
         out = nb.types.Array(nb.float64, 2, "C")
-        ep = _ENTRY[name] = globals()[name].compile((ro, rw, out))
+        ep = _ENTRY[name] = globals()[name].compile((ro, vec, out))
     return ep
-

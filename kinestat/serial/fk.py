@@ -66,7 +66,6 @@ def _as_q(model: ChainModel, q) -> np.ndarray:
 
 
 _FK_ONE = None
-_JAC_ONE = None
 
 
 def kernels():
@@ -78,30 +77,26 @@ def kernels():
     return k
 
 
-def _entry(name: str):
-    """Fetch (and remember) a compiled single-configuration entry point."""
-    global _FK_ONE, _JAC_ONE
-    ep = kernels().single_entry(name)
-    if name == "fk_one":
-        _FK_ONE = ep
-    else:
-        _JAC_ONE = ep
-    return ep
+def _fk_entry():
+    """The compiled single-configuration FK entry point, fetched once."""
+    global _FK_ONE
+    _FK_ONE = kernels().single_entry("fk_one")
+    return _FK_ONE
 
 
 def _nonfinite() -> InputError:
     return InputError("q contains NaN or infinity")
 
 
-def evaluate(model: ChainModel, q, one, batch, tail: tuple[int, ...]) -> np.ndarray:
-    """Run a compiled chain kernel on checked joint values ``q (..., n)``: ``one(packed, q, out)``
-    for one configuration, ``batch(constants, kinds, pitches, Q, out)`` into ``out (N, *tail)``
-    otherwise; shaped ``(..., *tail)``."""
+def evaluate(model: ChainModel, q, entry, batch, tail: tuple[int, ...]) -> np.ndarray:
+    """Run a compiled chain kernel on checked joint values ``q (..., n)``: the single entry
+    point ``entry()(packed, q, out)`` for one configuration, ``batch(constants, kinds, pitches,
+    Q, out)`` into ``out (N, *tail)`` otherwise; shaped ``(..., *tail)``."""
     q = _as_q(model, q)
     d = kernel_data(model)
     if q.ndim == 1:
         out = np.empty(tail)
-        if not one(d.packed, q, out):
+        if entry()(d.packed, q, out):
             out = None
     else:
         Q = np.ascontiguousarray(q.reshape(-1, model.n))
@@ -115,8 +110,8 @@ def evaluate(model: ChainModel, q, one, batch, tail: tuple[int, ...]) -> np.ndar
 
 _F64 = np.dtype(np.float64)
 _ND = np.ndarray
-_S8 = (8,)
 _S44 = (4, 4)
+_empty = np.empty
 
 
 def fk(model: ChainModel, q) -> np.ndarray:
@@ -132,17 +127,16 @@ def fk(model: ChainModel, q) -> np.ndarray:
     >>> fk(arm, np.zeros((5, 3, 2))).shape
     (5, 3, 4, 4)
     """
-    # fast path for one configuration: a contiguous float64 vector of the right length goes
-    # straight to the compiled entry point (no per-call type dispatch)
-    if type(q) is _ND and q.strides == _S8 and q.dtype is _F64:
+    # one configuration given as a float64 vector goes straight to the compiled entry point (no
+    # per-call type dispatch; it checks q's length and values); anything else, and any error,
+    # through the checked path
+    if type(q) is _ND and q.ndim == 1 and q.dtype is _F64:
         d = _BY_ID.get(id(model))
-        if d is not None and len(q) == d.n:
-            out = np.empty(_S44)
-            if not (_FK_ONE or _entry("fk_one"))(d.packed, q, out):
-                raise _nonfinite()
-            return out
-    k = kernels()
-    return evaluate(model, q, k.fk_one, k.fk_batch, (4, 4))
+        if d is not None:
+            out = _empty(_S44)
+            if not (_FK_ONE or _fk_entry())(d.packed, q, out):
+                return out
+    return evaluate(model, q, lambda: _FK_ONE or _fk_entry(), kernels().fk_batch, _S44)
 
 
 #: the theses' name for :func:`fk`

@@ -14,7 +14,7 @@ from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import fk as _fkmod
 from kinestat.serial._kernel_cache import _BY_ID, kernel_data
-from kinestat.serial.fk import _F64, _ND, _S8, _as_q
+from kinestat.serial.fk import _F64, _ND, _as_q, _empty
 
 __all__ = ["jacobian", "jacobian_from_frames", "fk_and_jacobian"]
 
@@ -49,16 +49,27 @@ def jacobian(model: ChainModel, q) -> np.ndarray:
     >>> J[2], J[4]  # ω_z and v_Oy: joint 2's axis passes through x = 1
     (array([1., 1.]), array([ 0., -1.]))
     """
-    if type(q) is _ND and q.strides == _S8 and q.dtype is _F64:
+    # one configuration given as a float64 vector goes straight to the compiled entry point (no
+    # per-call type dispatch; it checks q's length and values); anything else, and any error,
+    # through the checked path
+    if type(q) is _ND and q.ndim == 1 and q.dtype is _F64:
         d = _BY_ID.get(id(model))
-        if d is not None and len(q) == d.n:
-            J = np.empty((6, d.n))
-            if not (_fkmod._JAC_ONE or _fkmod._entry("jacobian_one"))(d.packed, q, J):
-                raise InputError("q contains NaN or infinity")
-            return J
-    k = _fkmod.kernels()
-    return _fkmod.evaluate(model, q, k.jacobian_one, k.jacobian_batch,
-                           (6, model.n))
+        if d is not None:
+            J = _empty(d.jshape)
+            if not (_JAC_ONE or _jac_entry())(d.packed, q, J):
+                return J
+    return _fkmod.evaluate(model, q, lambda: _JAC_ONE or _jac_entry(),
+                           _fkmod.kernels().jacobian_batch, (6, model.n))
+
+
+_JAC_ONE = None
+
+
+def _jac_entry():
+    """The compiled single-configuration Jacobian entry point, fetched once."""
+    global _JAC_ONE
+    _JAC_ONE = _fkmod.kernels().single_entry("jacobian_one")
+    return _JAC_ONE
 
 
 def fk_and_jacobian(model: ChainModel, q) -> tuple[np.ndarray, np.ndarray]:

@@ -79,11 +79,15 @@ def test_the_first_run_says_it_compiles_and_the_second_does_not(tmp_path):
     assert json.loads(second.stdout) == json.loads(first.stdout)
 
 
-def test_warmup_reports_every_kernel_group(capsys):
-    from kinestat.cli._compile import KERNELS, is_cold
+def test_warmup_reports_the_groups_make_run_uses_and_all_of_them_with_all(capsys):
+    from kinestat.cli._compile import KERNELS, RUN_GROUPS, is_cold
     from kinestat.cli.main import main
 
     assert main(["warmup", "--json"]) == 0
+    rec = json.loads(capsys.readouterr().out)
+    assert set(rec["seconds"]) == set(RUN_GROUPS)
+    assert not any(is_cold(g) for g in RUN_GROUPS)
+    assert main(["warmup", "--all", "--json"]) == 0
     rec = json.loads(capsys.readouterr().out)
     assert set(rec["seconds"]) == set(KERNELS)
     assert set(rec["compiled"]) <= set(KERNELS)

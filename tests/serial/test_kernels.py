@@ -97,3 +97,29 @@ def test_single_configuration_fast_path_edge_cases(rng):
         kinestat.fk(m, np.r_[q[:5], np.nan])
     with pytest.raises(InputError, match="NaN"):
         kinestat.jacobian(m, np.r_[q[:5], np.inf])
+
+
+def test_single_configuration_fast_path_is_bit_identical_and_errs_once(rng):
+    """A float64 vector of any stride takes the compiled entry point; its result is bit for bit
+    the checked path's (a list of the same numbers) and the batch kernel's row, and a wrong
+    length or a NaN still gets the checked path's one error."""
+    m = kinestat.load("puma560")
+    Q = rng.uniform(-3, 3, (20, 6))
+    strided = np.zeros((20, 12))
+    strided[:, ::2] = Q
+    T_batch, J_batch = kinestat.fk(m, Q), kinestat.jacobian(m, Q)
+    for k in range(len(Q)):
+        for v in (Q[k], strided[k, ::2], Q[k][::-1].copy()[::-1]):
+            assert np.array_equal(kinestat.fk(m, v), kinestat.fk(m, list(Q[k])))
+            assert np.array_equal(kinestat.fk(m, v), T_batch[k])
+            assert np.array_equal(kinestat.jacobian(m, v), kinestat.jacobian(m, list(Q[k])))
+            assert np.array_equal(kinestat.jacobian(m, v), J_batch[k])
+    for f in (kinestat.fk, kinestat.jacobian):
+        for bad in (np.zeros(5), np.zeros(7), np.zeros(0)):
+            with pytest.raises(InputError, match="shape"):
+                f(m, bad)
+        with pytest.raises(InputError, match="NaN"):
+            f(m, np.r_[Q[0, :5], np.nan])
+        # a non-native byte order or another dtype is converted by the checked path
+        assert np.array_equal(f(m, Q[0].astype(">f8")), f(m, Q[0]))
+        assert np.array_equal(f(m, Q[0].astype(np.float32)), f(m, Q[0].astype(np.float32).tolist()))

@@ -386,7 +386,8 @@ def _solve_one(T, tol, s5_tol, err, bad):
     for k in range(8):
         if kind[k] == KIND_SOLUTION:
             branches[i] = k
-            sols[i] = q[k]
+            for j in range(6):  # element by element: a row assignment compiles Numba's
+                sols[i, j] = q[k, j]  # shape-mismatch message (seconds at first compile)
             i += 1
     n_bad = 0
     for k in range(8):

@@ -380,8 +380,8 @@ def _same_angles(a: np.ndarray, b: np.ndarray, tol: float) -> bool:
 
 
 def _single_vec3(v, name: str) -> np.ndarray:
-    try:
-        a = np.asarray(v, dtype=np.float64)
+    try:  # a fresh, writeable C-contiguous copy: the one argument type the kernel compiles for
+        a = np.array(v, dtype=np.float64)
     except (TypeError, ValueError):
         a = None
     if a is None or a.shape != (3,):
