@@ -21,7 +21,7 @@ import numpy as np
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import closed_form
-from kinestat.serial.analytic._common import call_compiled, check_poses, plain_poses
+from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses, plain_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.ik_methods import get as _robot_method
@@ -251,7 +251,14 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
             except ModelError as exc:
                 raise ModelError(f"ik_all: method 'decoupled' does not apply to model "
                                  f"{model.name!r}: {exc}") from None
-        res = decoupled.solve_decoupled(model, Tf, tol=tol)
+        if fast:
+            from kinestat.serial.analytic import decoupled_compiled as dc  # lazy: start-up
+
+            res = dc.solve_decoupled_compiled(model, Tf, tol=tol, shape=shape)
+            if shape == () and plain and method == "auto" and "one" not in data:
+                data["one"] = dc.bind_one(model, _ENTRY.get((_kernels().check_rigid, None)))
+        else:
+            res = decoupled.solve_decoupled(model, Tf, tol=tol)
     elif use == "pieper" and "reversed" in data:
         from kinestat.serial.analytic import reversed_chain  # lazy: first-call time
 
@@ -273,6 +280,8 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         from kinestat.serial.analytic import general6r  # lazy: start-up (SciPy's LAPACK)
 
         res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend, shape=shape)
+        if shape == () and plain and method == "auto" and fast and "one" not in data:
+            data["one"] = general6r.bind_one(model, _ENTRY.get((_kernels().check_rigid, None)))
     return _reshape(res, shape)
 
 
