@@ -256,13 +256,14 @@ def _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw):
 @nb.njit(**_OPTS)
 def _companion_eigvals(A, XA, wr, wi, dummy, D):
     """Eigenvalues (into wr, wi) of ``A2 x² + A1 x + A0`` (A normalised in place) through the
-    24x24 companion with the inverse leading coefficient (LAPACK dgeev, eigenvalues only).
+    companion with the inverse leading coefficient, its 8 spurious eigenvalues ±i deflated
+    first (:func:`kinestat.serial.analytic._rr_deflate.deflated_eigvals`: the 16x16 quotient).
 
     When A2 is ill-conditioned (smallest relative pivot below ``_A2_PIVOT_MIN``) the variable
     is changed by the Möbius map ``x = (y + t)/(1 − t y)`` (a shift of the half-angle by
     atan t): ``B(y) = (1 − t y)² A(x)`` has the leading coefficient ``A0 t² − A1 t + A2``,
     regular unless −1/t is itself a root. Returns the leading coefficient's smallest relative
-    pivot, 0 when no tried t gives a regular one (or dgeev fails).
+    pivot, 0 when no tried t gives a regular one (or the eigensolver fails).
     ``XA (12, 36)``: ``[A2 | A0 A1]`` solved in place to ``[· | X]``, ``X = A2⁻¹ [A0 A1]``;
     D: :func:`~kinestat.serial.analytic._rr_deflate.deflate_scratch`."""
     sc = 0.0

@@ -13,7 +13,9 @@ Raghavan & Roth (1993), in the numerically stable form of Manocha & Canny (1994)
 4. ``x3`` are the eigenvalues of the 24x24 companion pencil (the standard problem with
    ``A2⁻¹`` when A2 is well conditioned, otherwise the generalised one, ``scipy.linalg.eig``);
    up to 16 are real (the spurious ``x3 = ±i`` of the half-angle factor are not). The
-   compiled kernel reruns suspect poses with the QZ eigenvalues
+   compiled kernel deflates the 8 spurious ones first (their invariant subspace is known from
+   the null space of ``A(i)``; :mod:`kinestat.serial.analytic._rr_deflate`) and solves the
+   16x16 quotient, and reruns suspect poses with the QZ eigenvalues
    (:mod:`kinestat.serial.analytic._rr_qz`; ``recheck``).
 5. x4, x5 from the eigenvector's power-product ratios; (c1, s1, c2, s2) from the linear
    equations ``Q S = P R`` (least squares); θ6 from the remaining rotation.
