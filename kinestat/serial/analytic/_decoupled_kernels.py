@@ -3,10 +3,11 @@ wrist): the steps of :mod:`kinestat.serial.analytic.decoupled` (the NumPy refere
 at a time, batches split over the cores with ``prange``.
 
 Per pose: the wrist centre p and joint 1's invariants; the eliminant Ψ(q3) at 8 angles (its
-discrete Fourier coefficients, roots of the trigonometric polynomial in ``z = e^{i q3}`` from
-a complex companion matrix) or at 9 Chebyshev nodes (real polynomial roots by
-:func:`kinestat.serial.analytic._hqr.eigvals`); joint 2, joint 1, Newton steps on the
-wrist-centre equation; the spherical wrist (subproblems 2 and 1, the θ5 = 0/π families);
+discrete Fourier coefficients; the real roots of the trigonometric polynomial from the real
+polynomial that the half-angle substitution makes of it) or at 9 Chebyshev nodes (a power
+series), real roots by :func:`kinestat.serial.analytic._hqr.eigvals` on the companion;
+joint 2, joint 1, Newton steps on the wrist-centre equation; the spherical wrist (subproblems
+2 and 1, the θ5 = 0/π families);
 Gauss–Newton steps with a truncated pseudo-inverse on candidates whose centre still misses or
 whose wrist is near θ5 = 0; verification by forward kinematics, de-duplication (revolute
 joints modulo 2π, prismatic ones as lengths) and storage.
@@ -184,7 +185,6 @@ def _polish_position(D, kinds, q, p, live, iters):
     f = _sub(_place(D, kinds, q), p)
     fn = _norm(f)
     small = 1e-14 * (scale + _norm(p))
-    qn = np.empty(3)
     for _ in range(iters):
         if not (live and fn > small):
             break
@@ -218,7 +218,7 @@ def _polish_position(D, kinds, q, p, live, iters):
         d2 = _dot(a, _cross(b, mf)) / det
         if not (math.isfinite(d0) and math.isfinite(d1) and math.isfinite(d2)):
             break
-        qn[0], qn[1], qn[2] = q[0] + d0, q[1] + d1, q[2] + d2
+        qn = (q[0] + d0, q[1] + d1, q[2] + d2)
         fnew = _sub(_place(D, kinds, qn), p)
         nn = _norm(fnew)
         if not nn < fn:
@@ -297,27 +297,88 @@ def _store(n, q, rot, pos, err, sing, sig, fam, dedup, out_q, out_valid, out_pos
     return cnt + 1
 
 
+_COS8 = tuple(math.cos(2.0 * math.pi * j / 8.0) for j in range(8))
+_SIN8 = tuple(math.sin(2.0 * math.pi * j / 8.0) for j in range(8))
+#: the half-angle substitution is taken about this angle (any generic value: a root at
+#: θ = _THETA0 + π, where t = tan(φ/2) is infinite, is then unlikely)
+_THETA0 = 0.4170
+
+
 @nb.njit(**_OPTS)
-def _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, out):
-    """Real roots q3 of the eliminant into ``out``; their count."""
+def _trig_roots(ck, d, out, Sr, Cs):
+    """Real roots θ of the trigonometric polynomial ``Σ_{|k| ≤ d} c_k e^{ikθ}`` (``ck`` holds
+    c_{-3} .. c_3) into ``out``; their count. With ``θ = θ0 + φ``, ``t = tan(φ/2)``:
+    ``e^{ikφ} (1 + t²)^d = (1 + it)^{d+k} (1 − it)^{d−k}``, so the polynomial times
+    ``(1 + t²)^d`` is a real polynomial of degree ≤ 2d in t, whose real roots come from its
+    companion matrix (:func:`kinestat.serial.analytic._hqr.eigvals`). ``Sr``, ``Cs``: the
+    scratch of :func:`_roots`."""
+    n2 = 2 * d
+    P = Sr[9:16]
+    P[:] = 0.0
+    a = Cs[7:14]
+    for k in range(-d, d + 1):
+        ang = k * _THETA0
+        c = ck[k + 3] * complex(math.cos(ang), math.sin(ang))
+        # a = (1 + it)^{d+k} (1 − it)^{d−k}, low powers first
+        a[:] = 0.0
+        a[0] = 1.0
+        deg = 0
+        for f in range(n2):
+            s = 1j if f < d + k else -1j
+            for j in range(deg + 1, 0, -1):
+                a[j] += s * a[j - 1]
+            deg += 1
+        for j in range(n2 + 1):
+            P[j] += (c * a[j]).real
+    big = 0.0
+    for j in range(n2 + 1):
+        big = max(big, abs(P[j]))
+    top = n2
+    while top > 0 and not abs(P[top]) > 1e-14 * big:
+        top -= 1
+    if top == 0:
+        return 0
+    A = Sr[16:52].reshape((6, 6))
+    A[:, :] = 0.0
+    for j in range(top):
+        A[0, j] = -P[top - 1 - j] / P[top]
+    for i in range(1, top):
+        A[i, i - 1] = 1.0
+    wr = Sr[52:58]
+    wi = Sr[58:64]
+    if not eigvals(A, top, wr, wi):
+        return 0
+    m = 0
+    for i in range(top):
+        if abs(wi[i]) <= 1e-5 * (1.0 + math.hypot(wr[i], wi[i])):
+            out[m] = wrap(_THETA0 + 2.0 * math.atan(wr[i]))
+            m += 1
+    return m
+
+
+@nb.njit(**_OPTS)
+def _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, out, Sr, Cs):
+    """Real roots q3 of the eliminant into ``out``; their count. ``Sr (64,)``, ``Cs (16,)``
+    complex: scratch."""
     W, P, w, scale = D[2], D[3], D[4], D[11]
     W2, P2 = _row(W, 2), _row(P, 2)
     wc = (w[0], w[1], w[2])
     m = 0
     if kinds[2] == _R:
-        psi = np.empty(8)
+        psi = Sr[0:8]
         for s in range(8):
-            th = 2.0 * math.pi * s / 8.0
-            y = _rotate(W2, P2, (th, math.cos(th), math.sin(th)), wc)
+            y = _rotate(W2, P2, (2.0 * math.pi * s / 8.0, _COS8[s], _SIN8[s]), wc)
             psi[s] = _eliminant(D, kinds, mode, y, p, h, rho2)
-        ck = np.empty(7, dtype=np.complex128)  # c_{-3} .. c_3
+        ck = Cs[0:7]  # c_{-3} .. c_3
         big = 0.0
         for k in range(-3, 4):
-            acc = 0.0 + 0.0j
-            for s in range(8):
-                a = -2.0 * math.pi * k * s / 8.0
-                acc += psi[s] * complex(math.cos(a), math.sin(a))
-            ck[k + 3] = acc / 8.0
+            re = 0.0
+            im = 0.0
+            for s in range(8):  # e^{−2πiks/8}
+                j = (k * s) % 8
+                re += psi[s] * _COS8[j]
+                im -= psi[s] * _SIN8[j]
+            ck[k + 3] = complex(re, im) / 8.0
             big = max(big, abs(ck[k + 3]))
         d = 0
         for k in range(3, 0, -1):
@@ -326,25 +387,14 @@ def _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, out):
                 break
         if d == 0:
             return 0
-        n2 = 2 * d
-        A = np.zeros((n2, n2), dtype=np.complex128)
-        top = ck[d + 3]
-        for j in range(n2):  # coefficients c_d .. c_{-d}, highest first
-            A[0, j] = -ck[d + 3 - 1 - j] / top
-        for i in range(1, n2):
-            A[i, i - 1] = 1.0
-        z = np.linalg.eigvals(A)
-        for zi in z:
-            if abs(abs(zi) - 1.0) <= 1e-5:
-                out[m] = math.atan2(zi.imag, zi.real)
-                m += 1
-        return m
+        return _trig_roots(ck, d, out, Sr, Cs)
     L = 4.0 * scale + _norm(_sub(p, wc))
-    psi = np.empty(9)
+    psi = Sr[0:9]
     for s in range(9):
         y = _add(wc, _scale(W2, L * cheb_t[s]))
         psi[s] = _eliminant(D, kinds, mode, y, p, h, rho2)
-    power = np.zeros(5)
+    power = Sr[9:14]
+    power[:] = 0.0
     for k in range(5):
         ch = 0.0
         for s in range(9):
@@ -361,13 +411,14 @@ def _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, out):
             break
     if d == 0:
         return 0
-    A = np.zeros((d, d))
+    A = Sr[16:52].reshape((6, 6))
+    A[:, :] = 0.0
     for j in range(d):
         A[0, j] = -power[d - 1 - j] / power[d]
     for i in range(1, d):
         A[i, i - 1] = 1.0
-    wr = np.empty(d)
-    wi = np.empty(d)
+    wr = Sr[52:58]
+    wi = Sr[58:64]
     if not eigvals(A, d, wr, wi):
         return 0
     for i in range(d):
@@ -405,7 +456,8 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
     h = _dot(d1, _row(W, 0))
     rho2 = _dot(d1, d1)
     q3s = np.empty(6)
-    nr = _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, q3s)
+    nr = _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, q3s, np.empty(64),
+                np.empty(16, dtype=np.complex128))
     W0, W1, W2, W3, W4, W5 = (_row(W, 0), _row(W, 1), _row(W, 2), _row(W, 3), _row(W, 4),
                               _row(W, 5))
     xs = (x6[0], x6[1], x6[2])

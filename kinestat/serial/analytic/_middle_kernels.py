@@ -94,7 +94,8 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
     h = _dot(d1, _row(W, 0))
     rho2 = _dot(d1, d1)
     q3s = np.empty(6)
-    nr = _roots(D, kinds, mode, cheb_t, fit, ctp, c, h, rho2, q3s)
+    nr = _roots(D, kinds, mode, cheb_t, fit, ctp, c, h, rho2, q3s, np.empty(64),
+                np.empty(16, dtype=np.complex128))
     W5, W6, W1h = _row(W, 0), _row(W, 1), _row(W, 2)
     W2, W3, W4 = _row(W, 3), _row(W, 4), _row(W, 5)
     xs = (x4[0], x4[1], x4[2])
