@@ -34,6 +34,8 @@ KERNELS: dict[str, str] = {
 ON_DEMAND: dict[str, str] = {
     "ik_all_closed": "kinestat.serial.analytic._cf_kernels",
     "ik_all_general": "kinestat.serial.analytic._rr_kernels",
+    "ik_all_decoupled": "kinestat.serial.analytic._decoupled_kernels",
+    "ik_all_middle": "kinestat.serial.analytic._middle_kernels",
 }
 NOTICE = "compiling kernels (first run only)…"
 
