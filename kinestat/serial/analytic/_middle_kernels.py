@@ -18,11 +18,13 @@ import math
 import numba as nb
 import numpy as np
 
+from kinestat.serial._kernels import _start
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._cf_kernels import (
     _NONE,
     _cross,
     _dot,
+    _link,
     _mm,
     _mmt,
     _mtm,
@@ -49,15 +51,23 @@ from kinestat.serial.analytic._decoupled_kernels import (
 from kinestat.serial.analytic._solution_kernels import pose_errors, wrap
 
 _Z3 = (0.0, 0.0, 0.0)
+_CHUNK = 16  # poses per scratch allocation in the parallel loop
+
+
+@nb.njit(**_OPTS)
+def _scratch():
+    """Work arrays of :func:`_pose` (one set per chunk of poses)."""
+    return (np.empty((6, 3)), np.empty((6, 3)), np.empty(3), np.empty(6), np.empty(6),
+            np.empty(3), np.empty(64), np.empty(16, dtype=np.complex128))
 
 
 @nb.njit(**_OPTS)
 def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
-          out_rot, out_sing, out_sign, out_fam):
+          out_rot, out_sing, out_sign, out_fam, S):
     """All solutions of pose n; returns the count. ``Kp``: the packed data of
     :func:`~kinestat.serial.analytic._decoupled_kernels.pack` with axis rows (5, 6, 1, 2, 3,
     4), points (5, 6, 1, c, c, c), the point c in the wrist slot and the direction across
-    axis 4 in the x slot."""
+    axis 4 in the x slot. ``S``: :func:`_scratch`."""
     D0 = _unpack(Kp)
     C, T0inv, W, P, cw, r1, r2, G2, e, u, x4, scale = D0
     kinds, mode, jk, rot = ints[0:3], ints[3], ints[4:10], ints[10:16]
@@ -78,8 +88,11 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
     Rg = _mm(Rt, Ra)
     tg = _mv(Rt, (T0inv[0, 3], T0inv[1, 3], T0inv[2, 3]))
     tg = (tg[0] + Tn[0, 3], tg[1] + Tn[1, 3], tg[2] + Tn[2, 3])
-    Wv = W.copy()
-    Pv = P.copy()
+    Wv, Pv, wv, q3s, q, q123, Sr, Cs = S
+    for i in range(6):
+        for j in range(3):
+            Wv[i, j] = W[i, j]
+            Pv[i, j] = P[i, j]
     w1 = _mtv(Rg, _row(W, 2))
     p1 = _mtv(Rg, _sub(_row(P, 2), tg))
     c = (cw[0], cw[1], cw[2])
@@ -87,20 +100,16 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
     for i in range(3):
         Wv[2, i] = w1[i]
         Pv[2, i] = p1[i]
-    wv = np.empty(3)
     wv[0], wv[1], wv[2] = wc[0], wc[1], wc[2]
     D = (C, T0inv, Wv, Pv, wv, r1, r2, G2, e, u, x4, scale)
     d1 = _sub(c, (r1[0], r1[1], r1[2]))
     h = _dot(d1, _row(W, 0))
     rho2 = _dot(d1, d1)
-    q3s = np.empty(6)
-    nr = _roots(D, kinds, mode, cheb_t, fit, ctp, c, h, rho2, q3s, np.empty(64),
-                np.empty(16, dtype=np.complex128))
+    nr = _roots(D, kinds, mode, cheb_t, fit, ctp, c, h, rho2, q3s, Sr, Cs)
     W5, W6, W1h = _row(W, 0), _row(W, 1), _row(W, 2)
     W2, W3, W4 = _row(W, 3), _row(W, 4), _row(W, 5)
     xs = (x4[0], x4[1], x4[2])
-    q = np.empty(6)
-    q123 = np.empty(3)
+    f0 = _start(C[0])
     cnt = 0
     for ir in range(nr):
         y = _move(0, w1, p1, q3s[ir], wc)
@@ -114,9 +123,13 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
             q123[1], q123[2] = q2, q3s[ir]
             miss = _polish_position(D, kinds, q123, c, True, 3)
             t5, t6, t1 = q123[0], q123[1], q123[2]
-            R1 = _rot(W1h, (t1, math.cos(t1), math.sin(t1)))
-            R5 = _rot(W5, (t5, math.cos(t5), math.sin(t5)))
-            R6 = _rot(W6, (t6, math.cos(t6), math.sin(t6)))
+            a1 = (t1, math.cos(t1), math.sin(t1))
+            a5 = (t5, math.cos(t5), math.sin(t5))
+            a6 = (t6, math.cos(t6), math.sin(t6))
+            R1 = _rot(W1h, a1)
+            R5 = _rot(W5, a5)
+            R6 = _rot(W6, a6)
+            f1 = _link(C, 1, a1, f0)
             Rp = _mmt(_mmt(_mtm(R1, Rg), R6), R5)  # R2 R3 R4 = R1ᵀ R_G R6ᵀ R5ᵀ
             target = _mv(Rp, W4)
             near = _norm(_cross(W2, target)) < 1e-6
@@ -136,7 +149,11 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
                 q[0], q[1], q[2], q[3], q[4], q[5] = t1, t2[0], t3[0], t4[0], t5, t6
                 if miss > 0.01 * tol or near:
                     _polish_pose(C, jk, Tn, q, 4, 1e-7)
-                pos, err = pose_errors(_fk(C, jk, q), Tn)
+                    pos, err = pose_errors(_fk(C, jk, q), Tn)
+                else:  # FK from the angles' cosines and sines (no cos/sin calls)
+                    f = _link(C, 6, a6, _link(C, 5, a5, _link(C, 4, t4, _link(C, 3, t3,
+                                                                            _link(C, 2, t2, f1)))))
+                    pos, err = pose_errors(f, Tn)
                 if not (pos <= tol and err <= tol):
                     continue
                 sig = 1.0 if _dot(W2, _mv(R3, W4)) >= 0.0 else -1.0
@@ -150,15 +167,19 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
 def solve_batch(Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
                 out_rot, out_sing, out_sign, out_fam, out_cnt):
     """All solutions of N poses into the (uninitialised) outputs."""
-    for n in nb.prange(T.shape[0]):
-        out_cnt[n] = _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q,
-                           out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+    N = T.shape[0]
+    for c in nb.prange((N + _CHUNK - 1) // _CHUNK):
+        S = _scratch()
+        for n in range(c * _CHUNK, min(N, (c + 1) * _CHUNK)):
+            out_cnt[n] = _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q,
+                               out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, S)
 
 
 @nb.njit(**_OPTS)
 def solve_serial(Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
                  out_rot, out_sing, out_sign, out_fam, out_cnt):
     """:func:`solve_batch` on one thread."""
+    S = _scratch()
     for n in range(T.shape[0]):
         out_cnt[n] = _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q,
-                           out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+                           out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, S)
