@@ -8,7 +8,8 @@ Jaco2-type 6R with a 60° wrist (non-Pieper), random general 6Rs (``random1``-``
 Raghavan–Roth eigenvalue method), three spherical-wrist arms with an offset shoulder (KUKA KR16-2
 from rtb-data's URDF, KUKA KR5 and ABB IRB140 from the Robotics Toolbox's DH models) and the
 Stanford arm (RRP: the decoupled solver; its prismatic joint drawn within its limits, no peer
-takes prismatic joints). For every solver and arm:
+takes prismatic joints) and two random DH 6Rs whose axes 2-3-4 (``middle2-1``) or 3-4-5
+(``middle3-1``) meet (the middle-wrist closed form). For every solver and arm:
 single-call time per pose (one pose per call, median over ``--single`` poses), batched poses/s
 (kinestat: one call on ``--n`` poses, the fastest of ``--repeat`` calls; peers have no batch
 call, so their figure is 1/single),
@@ -55,7 +56,7 @@ from kinestat.serial.analytic.geometry import home_axes, meet, parallel  # noqa:
 
 PI = math.pi
 ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1", "kr16", "kr5", "irb140", "stanford",
-        "random2", "random3")
+        "random2", "random3", "middle2-1", "middle3-1")
 
 
 def _wrapdist(a, b):

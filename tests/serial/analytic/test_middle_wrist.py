@@ -12,25 +12,12 @@ import numpy as np
 import pytest
 
 import kinestat
-from kinestat.mechanism.chain import from_standard_dh
 from kinestat.serial.analytic import ik_all, method_for
 from kinestat.serial.analytic.middle_wrist import middle_point
 
-from .arms import PI, newton_solutions, slot_residuals, wrapped_distance
+from .arms import PI, middle_arm, newton_solutions, slot_residuals, wrapped_distance
 
 _ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(__file__))))
-
-
-def middle_arm(seed: int, first: int = 2):
-    """A random standard-DH 6R (angles in [-π, π], lengths in [-1, 1] m) whose axes first,
-    first + 1, first + 2 (1-based) meet: a = 0 between them and no offset along the middle."""
-    rng = np.random.default_rng(seed)
-    rows = np.column_stack([rng.uniform(-PI, PI, 6), rng.uniform(-1, 1, 6),
-                            rng.uniform(-1, 1, 6), rng.uniform(-PI, PI, 6)])
-    i = first - 1  # row of the first joint of the triple (0-based)
-    rows[i, 2] = rows[i + 1, 2] = rows[i + 1, 1] = 0.0
-    return from_standard_dh(rows, ["revolute"] * 6, name=f"middle{first}-{seed}",
-                            length_unit="m")
 
 
 @pytest.mark.parametrize("first,seed", [(2, 1), (2, 2), (2, 3), (3, 1), (3, 4)])
@@ -81,7 +68,7 @@ import json, sys
 import numpy as np
 sys.path[:0] = [{root!r}, {root!r} + "/tests/serial"]
 import kinestat
-from analytic.test_middle_wrist import middle_arm
+from analytic.arms import middle_arm
 from kinestat.serial.analytic.middle_wrist import solve_middle
 m = middle_arm(3)
 T = np.ascontiguousarray(kinestat.fk(m, np.random.default_rng(1).uniform(-3, 3, (4, 6))))
