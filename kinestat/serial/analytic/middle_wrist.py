@@ -13,7 +13,7 @@ import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import decoupled as _dec
-from kinestat.serial.analytic._common import call_compiled
+from kinestat.serial.analytic._common import call_compiled, reasons
 from kinestat.serial.analytic.closed_form import _WRIST_TOL
 from kinestat.serial.analytic.geometry import HomeAxes, home_axes, meet, parallel
 from kinestat.serial.analytic.result import IKAllResult
@@ -54,7 +54,7 @@ def middle_point(model: ChainModel, tol: float = 1e-9):
 @lru_cache(maxsize=64)
 def kernel_args(model: ChainModel) -> tuple:
     """The kernel's pose-independent arguments (see ``_middle_kernels._pose``)."""
-    from kinestat.serial.analytic import _decoupled_kernels as Kd
+    from kinestat.serial.analytic import _decoupled_kernels as Kd  # lazy: Numba start-up
 
     ax = home_axes(model)
     c = middle_point(model)
@@ -78,8 +78,6 @@ def solve_middle(model: ChainModel, T: np.ndarray, *, tol: float = 1e-9,
                  shape: tuple[int, ...] | None = None) -> IKAllResult:
     """All solutions (8 slots) of the middle-wrist ``model`` for rigid poses ``T (N, 4, 4)``
     (C-contiguous float64); ``shape`` the result's batch shape (default ``(N,)``)."""
-    from kinestat.serial.analytic._common import reasons
-
     Km = _kernels()
     N = T.shape[0]
     out = (np.empty((N, 8, 6)), np.empty((N, 8), dtype=bool), np.empty((N, 8)),
