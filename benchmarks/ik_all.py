@@ -4,9 +4,12 @@ Run ``.venv/bin/python benchmarks/ik_all.py [--n 10000] [--single 200] [--json]`
 
 Arms (the same random configurations, uniform in [-π, π]^6, fixed seed): UR5 (three parallel
 axes), PUMA 560 (spherical wrist, embedded), PUMA 762 (embedded, Crane–Duffy frames), a Kinova
-Jaco2-type 6R with a 60° wrist (non-Pieper), a random general 6R, and three spherical-wrist arms
-with an offset shoulder (KUKA KR16-2 from rtb-data's URDF, KUKA KR5 and ABB IRB140 from the
-Robotics Toolbox's DH models). For every solver and arm:
+Jaco2-type 6R with a 60° wrist (non-Pieper), random general 6Rs (``random1``-``random3``: the
+Raghavan–Roth eigenvalue method), three spherical-wrist arms with an offset shoulder (KUKA KR16-2
+from rtb-data's URDF, KUKA KR5 and ABB IRB140 from the Robotics Toolbox's DH models) and the
+Stanford arm (RRP: the decoupled solver; its prismatic joint drawn within its limits, no peer
+takes prismatic joints) and two random DH 6Rs whose axes 2-3-4 (``middle2-1``) or 3-4-5
+(``middle3-1``) meet (the middle-wrist closed form). For every solver and arm:
 single-call time per pose (one pose per call, median over ``--single`` poses), batched poses/s
 (kinestat: one call on ``--n`` poses, the fastest of ``--repeat`` calls; peers have no batch
 call, so their figure is 1/single),
@@ -52,7 +55,8 @@ from kinestat.serial.analytic import ik_all  # noqa: E402
 from kinestat.serial.analytic.geometry import home_axes, meet, parallel  # noqa: E402
 
 PI = math.pi
-ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1", "kr16", "kr5", "irb140")
+ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1", "kr16", "kr5", "irb140", "stanford",
+        "random2", "random3", "middle2-1", "middle3-1")
 
 
 def _wrapdist(a, b):
@@ -216,6 +220,10 @@ def run(n: int, n_single: int, repeat: int = 5, arms=ARMS) -> dict:
         if name not in arms:
             continue
         model = arm(name)
+        prismatic = model.prismatic
+        if prismatic.any():  # within the limits, not an angle
+            lo, hi = model.lower[prismatic], model.upper[prismatic]
+            q[:, prismatic] = lo + (q[:, prismatic] + PI) / (2 * PI) * (hi - lo)
         T = kinestat.fk(model, q)
         ik_all(model, T[:512])  # compile / load the kernels (serial and parallel paths)
         dt = cpu_batch = math.inf
@@ -241,7 +249,7 @@ def run(n: int, n_single: int, repeat: int = 5, arms=ARMS) -> dict:
                            ("ik-geo", lambda m, k=kind: peer_ikgeo(m, k)),
                            ("rtb-ikine_a", lambda m: peer_rtb(m))):
             try:
-                call = make(model)
+                call = None if prismatic.any() else make(model)
                 if call is None:
                     r[peer] = None
                     continue

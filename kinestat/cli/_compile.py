@@ -41,6 +41,8 @@ RUN_GROUPS: tuple[str, ...] = ("platform", "puma762")
 ON_DEMAND: dict[str, str] = {
     "ik_all_closed": "kinestat.serial.analytic._cf_kernels",
     "ik_all_general": "kinestat.serial.analytic._rr_kernels",
+    "ik_all_decoupled": "kinestat.serial.analytic._decoupled_kernels",
+    "ik_all_middle": "kinestat.serial.analytic._middle_kernels",
 }
 def _index_paths(module_name: str) -> list[str]:
     from numba.core.dispatcher import Dispatcher  # lazy: start-up (Numba ~0.5 s)

@@ -398,7 +398,8 @@ def _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg, urd
     locked = _parse_locks(m, lock, self_motion)
     m6 = fold(m, check_locked(m, {j: 0.0 for j in locked})) if locked else m
     groups = {"raghavan-roth": ("ik_all_closed", "ik_all_general"),
-              "decoupled": ("serial",)}.get(method_for(m6), ("ik_all_closed",))
+              "decoupled": ("ik_all_decoupled",),
+              "middle-wrist": ("ik_all_middle",)}.get(method_for(m6), ("ik_all_closed",))
     if self_motion is not None:
         _self_motion(m, T, next(iter(locked)), self_motion, ref, groups, as_json)
         return

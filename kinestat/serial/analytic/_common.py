@@ -43,6 +43,8 @@ def call_compiled(kernel, *args, variant=None):
     if entry is not None:
         return entry(*args)
     out = kernel(*args)
+    if not hasattr(kernel, "overloads"):  # NUMBA_DISABLE_JIT: a plain function
+        return out
     cres = kernel.overloads.get(tuple(kernel.typeof_pyval(a) for a in args))
     if cres is not None:
         _ENTRY[kernel, variant] = cres.entry_point

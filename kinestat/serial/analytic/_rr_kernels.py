@@ -5,7 +5,8 @@ poses the kernel flags), one pose at a time, batches split over the cores with `
 Per pose: the pose link ``C0⁻¹ T C6⁻¹`` (or its inverse) of the formulation, the right side of
 RR eq. 4 (15x15 rigid action), a pivoted Householder QR of Q (its left null space; the
 least-squares back-substitution), the 12x12 matrix quadratic, the eigenvalues of its
-24x24 companion (LAPACK dgeev), the power-product vector of each real root by inverse
+companion with the spurious ±i deflated (:mod:`kinestat.serial.analytic._rr_deflate`; LAPACK
+dgeev on 16x16), the power-product vector of each real root by inverse
 iteration, back-substitution, θ6 (the serial FK kernel's scalar steps), Newton polishing
 against FK, verification and de-duplication
 (:mod:`kinestat.serial.analytic._solution_kernels`). On a suspect pose (``_rr_qz.suspect``: a
@@ -25,19 +26,15 @@ import math
 
 import numba as nb
 import numpy as np
-from numba import types
-from numba.np.linalg import _LAPACK
 
 from kinestat.mechanism.joints import JointKind
 from kinestat.serial._kernels import _step
 from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial.analytic._rr_deflate import deflate_scratch, deflated_eigvals
 from kinestat.serial.analytic._rr_qz import nearly_real, pencil_eigvals_qz, qz_scratch, suspect
 from kinestat.serial.analytic._solution_kernels import polish, store
 from kinestat.spatial._elimination import eliminate
-
-# LAPACK dgeev through Numba's own binding (cacheable, unlike a ctypes pointer)
-_rgeev = _LAPACK().numba_ez_rgeev(types.float64)
 
 REVOLUTE = int(JointKind.REVOLUTE)
 FLAG_OK = 0
@@ -257,17 +254,18 @@ def _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw):
 
 
 @nb.njit(**_OPTS)
-def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
+def _companion_eigvals(A, XA, wr, wi, dummy, D):
     """Eigenvalues (into wr, wi) of ``A2 x² + A1 x + A0`` (A normalised in place) through the
-    24x24 companion with the inverse leading coefficient (LAPACK dgeev, eigenvalues only).
+    companion with the inverse leading coefficient, its 8 spurious eigenvalues ±i deflated
+    first (:func:`kinestat.serial.analytic._rr_deflate.deflated_eigvals`: the 16x16 quotient).
 
     When A2 is ill-conditioned (smallest relative pivot below ``_A2_PIVOT_MIN``) the variable
     is changed by the Möbius map ``x = (y + t)/(1 − t y)`` (a shift of the half-angle by
     atan t): ``B(y) = (1 − t y)² A(x)`` has the leading coefficient ``A0 t² − A1 t + A2``,
     regular unless −1/t is itself a root. Returns the leading coefficient's smallest relative
-    pivot, 0 when no tried t gives a regular one (or dgeev fails).
+    pivot, 0 when no tried t gives a regular one (or the eigensolver fails).
     ``XA (12, 36)``: ``[A2 | A0 A1]`` solved in place to ``[· | X]``, ``X = A2⁻¹ [A0 A1]``;
-    Mc (24, 24): scratch."""
+    D: :func:`~kinestat.serial.analytic._rr_deflate.deflate_scratch`."""
     sc = 0.0
     for k in range(3):
         for i in range(12):
@@ -303,16 +301,7 @@ def _companion_eigvals(A, XA, Mc, wr, wi, dummy):
             big = max(big, abs(X[i, j]))
     if big > 1e10:
         return 0.0
-    # stored transposed (LAPACK is column-major): same eigenvalues
-    for i in range(24):
-        for j in range(12):
-            Mc[i, j] = 0.0
-    for i in range(12):
-        Mc[12 + i, i] = 1.0
-        for j in range(24):
-            Mc[j, 12 + i] = -X[i, j]
-    info = _rgeev(ord("d"), ord("N"), ord("N"), 24, Mc.ctypes, 24, wr.ctypes, wi.ctypes,
-                  dummy.ctypes, 1, dummy.ctypes, 1)
+    info = deflated_eigvals(A, X, wr, wi, dummy, D)
     if t != 0.0:  # back to x = (y + t) / (1 − t y)
         for k in range(24):
             x = (complex(wr[k], wi[k]) + t) / (1.0 - t * complex(wr[k], wi[k]))
@@ -449,10 +438,10 @@ def _scratch():
     """Work arrays of :func:`_solve_pose` (one set per chunk of poses)."""
     return (np.empty((3, 4, 4)), np.empty((15, 9)), np.empty((15, 15)), np.empty((5, 15)),
             np.empty((3, 12, 12)), np.empty((6, 27)), np.empty((12, 36)), np.empty((12, 12)),
-            np.empty((24, 24)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
+            np.empty((1, 1)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
             np.empty(8), np.empty((3, 6, 7)), np.empty((4, 6)), np.empty(6), np.empty(6),
             np.empty((14, 14)), np.empty((8, 8)), np.empty(8, dtype=np.int64), np.empty((8, 14)),
-            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12))
+            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12), deflate_scratch())
 
 
 @nb.njit(**_OPTS)
@@ -500,7 +489,7 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
     which replace the companion's (its solutions are dropped: near a fold a companion root
     can stall at a near-singular point within ``tol`` beside the two true roots).
     ``stats[n]``: see ``general6r.run_kernel``."""
-    Gs, Rh, MA, V15, A, E, XA, Mc, W24 = S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[8], S[9]
+    Gs, Rh, MA, V15, A, E, XA, W24 = S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[9]
     H, R, piv, Vr, Aw = S[17], S[18], S[19], S[20], S[21]
     _rigid_product(form[0], T[n], form[1], Gs[1])
     _rigid_inverse(Gs[1], Gs[2])
@@ -517,7 +506,7 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
         return
     wr, wi = W24[0], W24[1]
     cnt, tried, lost, near, err = 0, 0, 0, np.inf, 0.0
-    pivot = _companion_eigvals(A, XA, Mc, wr, wi, W24[2])
+    pivot = _companion_eigvals(A, XA, wr, wi, W24[2], S[24])
     stats[n, 5] = pivot
     if pivot > 0.0:
         cnt, tried, lost, err = _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links,

@@ -13,7 +13,9 @@ Raghavan & Roth (1993), in the numerically stable form of Manocha & Canny (1994)
 4. ``x3`` are the eigenvalues of the 24x24 companion pencil (the standard problem with
    ``A2⁻¹`` when A2 is well conditioned, otherwise the generalised one, ``scipy.linalg.eig``);
    up to 16 are real (the spurious ``x3 = ±i`` of the half-angle factor are not). The
-   compiled kernel reruns suspect poses with the QZ eigenvalues
+   compiled kernel deflates the 8 spurious ones first (their invariant subspace is known from
+   the null space of ``A(i)``; :mod:`kinestat.serial.analytic._rr_deflate`) and solves the
+   16x16 quotient, and reruns suspect poses with the QZ eigenvalues
    (:mod:`kinestat.serial.analytic._rr_qz`; ``recheck``).
 5. x4, x5 from the eigenvector's power-product ratios; (c1, s1, c2, s2) from the linear
    equations ``Q S = P R`` (least squares); θ6 from the remaining rotation.
@@ -35,6 +37,7 @@ from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _rr_algebra as rr
 from kinestat.serial.analytic._common import (
+    _ENTRY,
     nan_array,
     newton_polish,
     pack,
@@ -387,6 +390,44 @@ def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect",
                              family_sign=np.zeros((N, K16)), family_value=nan_array((N, K16)),
                              family_joints=None, n_solutions=nsol, reason=reason,
                              method=_method_name(form), tol=tol)
+
+
+def bind_one(model: ChainModel, check_entry):
+    """The single-pose call of the compiled kernel for ``model`` with its default formulation,
+    recheck and polishing (``ik_all``'s fast path): ``one(T (1, 4, 4) plain, tol: float)``,
+    the result of :func:`solve_general_6r` with ``shape=()``, or None where that call must run
+    instead (a pose not orthonormal to rounding, a flagged pose, no compiled entry yet).
+    ``check_entry``: the compiled entry of the closed forms' ``check_rigid``. The per-model
+    arguments and entry points are bound once: a few µs of a single call are Python steps."""
+    form, _ = formulation(model)
+    K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
+    entry = _ENTRY.get((K.solve_serial, None)) if K is not None else None
+    if entry is None or check_entry is None or form.shift not in (0, 5):
+        return None
+    C, consts, links, LH, h0, L, off, order, sign = _compiled_data(model, form)
+    method = _method_name(form)
+    K16 = MAX_SOLUTIONS
+    shape = (1, K16)
+
+    def one(T, tol):
+        bad, n_project = check_entry(T, 1e-6)
+        if bad >= 0 or n_project:
+            return None
+        q = nan_array((1, K16, 6))
+        valid = np.zeros(shape, dtype=bool)
+        pos = nan_array(shape)
+        rot = nan_array(shape)
+        flags = np.zeros(1, dtype=np.int64)
+        entry(C, T, consts, links, LH, h0, L, off, order, sign, tol, 8, 1e-6, 1, q, valid, pos,
+              rot, flags, np.zeros((1, 7)))
+        if flags[0] != 0:
+            return None
+        nsol = np.empty(1, dtype=np.int64)
+        nsol[0] = np.count_nonzero(valid)
+        return IKAllResult.build_one(q, valid, pos, rot, np.zeros(shape, dtype=bool),
+                                     np.zeros(shape), nan_array(shape), None, nsol,
+                                     "" if nsol[0] else _REASON_NONE, method, tol)
+    return one
 
 
 def _method_name(form: Formulation) -> str:

@@ -21,7 +21,7 @@ import numpy as np
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import closed_form
-from kinestat.serial.analytic._common import call_compiled, check_poses, plain_poses
+from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses, plain_poses
 from kinestat.serial.analytic.geometry import classify
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.ik_methods import get as _robot_method
@@ -32,7 +32,7 @@ if TYPE_CHECKING:
 
 __all__ = ["ik_all", "ik_self_motion", "METHODS", "BACKENDS", "method_for"]
 
-METHODS = ("auto", "pieper", "three-parallel", "decoupled", "raghavan-roth")
+METHODS = ("auto", "pieper", "three-parallel", "decoupled", "middle-wrist", "raghavan-roth")
 """The generic methods; a robot's own closed form adds its name
 (:func:`kinestat.serial.ik_methods.registered`, e.g. ``"puma762"``)."""
 BACKENDS = ("numba", "numpy")
@@ -68,11 +68,15 @@ def _check_chain(model: ChainModel) -> None:
 def _classified(model: ChainModel):
     kind, data = classify(model)
     if kind == "general":  # axes 1, 2, 3 meeting: the reversed chain is a pieper arm
-        from kinestat.serial.analytic import reversed_chain  # lazy: first-call time
+        from kinestat.serial.analytic import middle_wrist, reversed_chain  # lazy: first call
 
         rev = reversed_chain.reverse(model)
         if classify(rev)[0] == "pieper":
             return "pieper", {"reversed": rev}
+        if middle_wrist.middle_point(model) is not None:  # axes 2, 3, 4 meeting
+            return "middle-wrist", data
+        if middle_wrist.middle_point(rev) is not None:  # axes 3, 4, 5 meeting
+            return "middle-wrist", {"reversed": rev}
     return kind, data
 
 
@@ -213,7 +217,10 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if backend not in BACKENDS:
         raise ModelError(f"ik_all: unknown backend {backend!r}; expected one of {BACKENDS}")
     use = method if method != "auto" else ("raghavan-roth" if kind == "general" else kind)
-    if (use in ("pieper", "three-parallel") or kind == "decoupled") and use != kind:
+    if use == "middle-wrist" and method == "auto" and backend == "numpy":
+        use = "raghavan-roth"  # no NumPy reference of its own
+    if (use in ("pieper", "three-parallel", "middle-wrist") or kind == "decoupled") and \
+            use != kind:
         raise ModelError(f"ik_all: method {use!r} does not apply to model {model.name!r} "
                          f"(its geometry is {kind!r})")
     fast = backend == "numba"
@@ -251,7 +258,22 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
             except ModelError as exc:
                 raise ModelError(f"ik_all: method 'decoupled' does not apply to model "
                                  f"{model.name!r}: {exc}") from None
-        res = decoupled.solve_decoupled(model, Tf, tol=tol)
+        if fast:
+            from kinestat.serial.analytic import decoupled_compiled as dc  # lazy: start-up
+
+            res = dc.solve_decoupled_compiled(model, Tf, tol=tol, shape=shape)
+            if shape == () and plain and method == "auto" and "one" not in data:
+                data["one"] = dc.bind_one(model, _ENTRY.get((_kernels().check_rigid, None)))
+        else:
+            res = decoupled.solve_decoupled(model, Tf, tol=tol)
+    elif use == "middle-wrist":
+        from kinestat.serial.analytic import middle_wrist, reversed_chain  # lazy: first call
+
+        if "reversed" in data:
+            res = ik_all(data["reversed"], reversed_chain.invert_poses(Tf), tol=tol)
+            res = reversed_chain.unreverse(res)
+        else:
+            res = middle_wrist.solve_middle(model, Tf, tol=tol)
     elif use == "pieper" and "reversed" in data:
         from kinestat.serial.analytic import reversed_chain  # lazy: first-call time
 
@@ -273,6 +295,8 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
         from kinestat.serial.analytic import general6r  # lazy: start-up (SciPy's LAPACK)
 
         res = general6r.solve_general_6r(model, Tf, tol=tol, backend=backend, shape=shape)
+        if shape == () and plain and method == "auto" and fast and "one" not in data:
+            data["one"] = general6r.bind_one(model, _ENTRY.get((_kernels().check_rigid, None)))
     return _reshape(res, shape)
 
 

@@ -39,7 +39,22 @@ def random_6r(seed: int):
     return from_standard_dh(rows, name=f"random6r-{seed}", length_unit="m")
 
 
+def middle_arm(seed: int, first: int = 2):
+    """A random standard-DH 6R (angles in [-π, π], lengths in [-1, 1] m) whose axes first,
+    first + 1, first + 2 (1-based) meet: a = 0 between them and no offset along the middle."""
+    rng = np.random.default_rng(seed)
+    rows = np.column_stack([rng.uniform(-PI, PI, 6), rng.uniform(-1, 1, 6),
+                            rng.uniform(-1, 1, 6), rng.uniform(-PI, PI, 6)])
+    i = first - 1  # row of the first joint of the triple (0-based)
+    rows[i, 2] = rows[i + 1, 2] = rows[i + 1, 1] = 0.0
+    return from_standard_dh(rows, ["revolute"] * 6, name=f"middle{first}-{seed}",
+                            length_unit="m")
+
+
 def arm(name: str):
+    if name.startswith("middle"):  # "middle2-1": axes 2-4 meeting, seed 1
+        first, seed = name[6:].split("-")
+        return middle_arm(int(seed), int(first))
     if name == "ur5":
         return ur5()
     if name == "jaco6":
