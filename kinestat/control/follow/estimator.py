@@ -179,8 +179,8 @@ def _fuse_normal(n: np.ndarray, var: float, m: np.ndarray, var_m: float
 
 def curvature_span(tun: FollowTuning) -> float:
     """mm: the span of the path whose sagitta ``κ s²/8`` at ``curvature_tol`` is
-    ``confidence σ_tip`` (at least the chord): the curvature is fitted over it."""
-    return max(math.sqrt(8.0 * tun.confidence * tun.tip_sigma / tun.curvature_tol), tun.chord)
+    ``confidence path_sigma`` (at least the chord): the curvature is fitted over it."""
+    return max(math.sqrt(8.0 * tun.confidence * tun.path_sigma / tun.curvature_tol), tun.chord)
 
 
 def _curvature(tun: FollowTuning, est: ContactEstimate, path: tuple, tip: np.ndarray,
