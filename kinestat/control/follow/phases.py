@@ -227,11 +227,12 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str,
 def _lean_goal(config: FollowConfig, st: FollowState, meas: Measurement, n: np.ndarray,
                t: np.ndarray) -> tuple[float, bool]:
     """The lean the law aims at (rad) and whether the tip is held (the breakaway: no travel
-    step, the lean grows at the rate the soft mode allows)."""
+    step, the lean grows at the rate the soft mode allows) while it sticks, or creeps before
+    a slide measured μ (stick or slip uncertain: a step would run it ahead)."""
     tun, est = config.tuning, st.estimate
     if not st.leaning:
         return math.radians(config.tilt_deg), False
-    if st.phase == "travel" and st.stuck:
+    if st.phase == "travel" and (st.stuck or not est.samples):  # stuck, or creeping
         F = meas.estimate(config.base.estimator)
         now = lean_of(F / np.linalg.norm(F), n, t)  # the force's lean: S6 leads it by a step
         if _force_fell(config, F, n):  # the tip may be breaking away: lean no further
