@@ -90,13 +90,15 @@ def fit_circle(x, y) -> np.ndarray:
     return coef
 
 
-def path_curvature(points, tip, normal, tangent, min_span: float) -> float:
+def path_curvature(points, tip, normal, tangent, min_span: float,
+                   noise: float = 0.0) -> float:
     """The normal curvature (1/mm, positive where the surface is convex: the circle's centre
     inside the material, on the −``normal`` side) of the tip path along ``tangent``: the
     points (and ``tip``) in the plane of ``tangent`` and ``normal`` through ``tip``, a circle
     fitted (:func:`fit_circle`), ``κ = −2A / sqrt(B² + 1 − 4AD)`` (the signed inverse radius).
     0 when the points span less than ``min_span`` mm along the tangent, are fewer than 4, or
-    when the arc's sagitta ``|κ| span²/8`` is below twice the fit's RMS residual (noise).
+    when the arc's sagitta ``|κ| span²/8`` is below twice the fit's RMS residual (noise) or
+    below ``noise`` mm (a scatter of the points that a few of them need not show).
 
     Shapes: points (N, 3), tip/normal/tangent (3,) (unit, perpendicular).
 
@@ -119,7 +121,8 @@ def path_curvature(points, tip, normal, tangent, min_span: float) -> float:
     # (the measured tips' noise); a noisy straight path fits a spurious curvature
     resid = y - (A * (x * x + y * y) + B * x + D)
     span = float(x.max() - x.min())
-    if abs(kappa) * span * span / 8.0 < 2.0 * float(np.sqrt(np.mean(resid * resid))):
+    if abs(kappa) * span * span / 8.0 < max(2.0 * float(np.sqrt(np.mean(resid * resid))),
+                                            noise):
         return 0.0
     return kappa
 

@@ -186,3 +186,16 @@ def test_path_curvature_ignores_noise_on_a_straight_path_and_keeps_a_real_arc():
     P2, n2, t2 = _cylinder_path(rng, 200.0, 11.0, 12)
     P2 = P2 + np.outer(rng.normal(0.0, 0.005, 12), n2)
     assert path_curvature(P2[:-1], P2[-1], n2, t2, 4.0) == pytest.approx(1 / 200.0, rel=0.5)
+
+
+def test_path_curvature_needs_a_sagitta_above_the_stated_noise():
+    """Four exact tips fit a circle exactly (no residual): an R = 200 mm path over 3 mm
+    (sagitta 5.6 µm) is no curvature against 36 µm of stated noise; over 11 mm (sagitta
+    76 µm) it is."""
+    rng = np.random.default_rng(11)
+    P, n, t = _cylinder_path(rng, 200.0, 3.0, 4)
+    assert path_curvature(P[:-1], P[-1], n, t, 0.0) == pytest.approx(1 / 200.0, rel=1e-3)
+    assert path_curvature(P[:-1], P[-1], n, t, 0.0, noise=0.036) == 0.0
+    P2, n2, t2 = _cylinder_path(rng, 200.0, 11.0, 4)
+    assert path_curvature(P2[:-1], P2[-1], n2, t2, 0.0, noise=0.036) == pytest.approx(
+        1 / 200.0, rel=1e-3)

@@ -267,7 +267,8 @@ def test_the_tuning_is_one_object_derived_from_platform_sensor_and_robot(tmp_pat
     other = _base(tmp_path, cell=SimulatedCell(cylinder=CylinderSpec(radius=150.0,
                                                                      axis=np.array([0, 0, 1.0]))))
     assert FollowConfig(base=other, travel=10.0, travel_dir=Y).tuning == tun
-    assert derive_tuning(base.model, 4.0, START, 1.0) == tun
+    assert derive_tuning(base.model, 4.0, START, 1.0, s6=base.start_s6,
+                         a67=base.start_a67) == tun
     # the tip's noise scales with the leg count (1 nm counts against the thesis's 0.0254 mm)
     fine = _tuning(tmp_path, ideal=True)
     assert fine.tip_sigma / tun.tip_sigma == pytest.approx(1e-6 / 0.0257, rel=0.1)
@@ -276,6 +277,53 @@ def test_the_tuning_is_one_object_derived_from_platform_sensor_and_robot(tmp_pat
     assert tun.axial_stiffness > 20.0 * tun.tangential_stiffness
     with pytest.raises(InputError, match="turn_gain"):
         FollowTuning(**{**vars(tun), "turn_gain": 1.5})
+
+
+def test_the_path_noise_adds_the_robot_counts_through_the_arm(tmp_path):
+    # independent check of the robot's share of path_sigma: read each axis to a random
+    # fraction of a count (uniform) and look at the forward-analysed tool tips' scatter
+    base = _base(tmp_path)
+    tun = FollowConfig(base=base, travel=10.0, travel_dir=Y).tuning
+    model = base.model
+    arm = model.arm
+    axis = arm.solve_axis(START, base.start_s6, base.start_a67, model.tool_point_6,
+                          arm.q_from_axis(np.zeros(6)), model.limits_deg)
+    d = np.radians(np.asarray(model.axis_deg_per_count, dtype=float))
+    rng = np.random.default_rng(5)
+    tips = np.array([arm.forward(arm.q_from_axis(axis + d * rng.uniform(-0.5, 0.5, 6)),
+                                 model.tool_point_6).tool_point for _ in range(400)])
+    sd = float(np.sqrt(np.max(np.linalg.eigvalsh(np.cov(tips.T)))))
+    robot = math.sqrt(tun.path_sigma ** 2 - tun.tip_sigma ** 2)
+    assert sd == pytest.approx(robot, rel=0.2)
+    # the fine sensor leaves the robot's counts: the path's noise does not vanish with it
+    fine = _tuning(tmp_path, ideal=True)
+    assert fine.path_sigma == pytest.approx(robot, rel=1e-3)
+    assert fine.direction_tol > 10.0 * fine.force_sigma / 4.0
+
+
+def test_the_tangential_stiffness_is_the_loaded_tips(tmp_path):
+    # independent check: the platform's equilibria carrying the target force along the tool,
+    # and that force plus a small push across the tool; the tip's displacement between them
+    from kinestat.control.follow.tuning import tip_load_pose
+    from kinestat.spatial.transforms import apply_one
+
+    base = _base(tmp_path)
+    tun = FollowConfig(base=base, travel=10.0, travel_dir=Y).tuning
+    model, plat = base.model, base.model.platform
+    s6, a67 = base.start_s6, base.start_a67
+    RB = np.column_stack([a67, np.cross(s6, a67), s6]) @ model.mount[:3, :3]
+    a = RB.T @ s6
+    across = np.cross(a, [1.0, 0.0, 0.0])
+    across /= np.linalg.norm(across)
+    f0 = -4.0 * a
+    tips = [apply_one(tip_load_pose(plat, model.tool_tip_top, f0 + e * across),
+                      model.tool_tip_top) for e in (-0.002, 0.002)]
+    k = 0.004 / float(np.linalg.norm(tips[1] - tips[0]))
+    unloaded = apply_one(tip_load_pose(plat, model.tool_tip_top, 0.002 * across),
+                         model.tool_tip_top) - apply_one(plat.home_pose, model.tool_tip_top)
+    # the load along the long tool makes the tip softer across it than unloaded
+    assert k < 0.002 / float(np.linalg.norm(unloaded))
+    assert k == pytest.approx(tun.tangential_stiffness, rel=0.15)
 
 
 def test_the_tip_noise_is_the_leg_counts_through_the_platform(tmp_path):
@@ -389,3 +437,29 @@ def test_friction_03_leans_the_tool_onto_the_cone_and_meets_the_acceptance(tmp_p
     last = rep.cycles[-1]
     lean = _deg(-np.asarray(last["s6"]), np.asarray(last["true_normal"]))
     assert math.degrees(math.atan(0.3)) < lean < math.degrees(math.atan(0.3)) + 1.5
+
+
+def test_the_lean_past_a_well_known_edge_is_at_least_one_steps_turn(tmp_path):
+    from kinestat.control.follow.phases import edge_margin
+
+    tun = _tuning(tmp_path, ideal=True)
+    n = np.array([0.0, 0.0, 1.0])
+    known = ContactEstimate(normal=n, normal_var=1e-12, mu=0.3, mu_var=1e-12, samples=5)
+    # the edge known to micro-radians: the margin is the turn a 1 mm step gives a stuck tip
+    assert edge_margin(tun, known, 4.0, 1.0) == pytest.approx(
+        tun.tangential_stiffness * 1.0 / 4.0)
+    vague = replace(known, normal_var=1e-3)
+    assert edge_margin(tun, vague, 4.0, 1.0) == pytest.approx(
+        tun.confidence * math.sqrt(1e-3 + 1e-12 / 1.09 ** 2 + (tun.force_sigma / 4.0) ** 2))
+
+
+def test_a_held_lean_stops_growing_when_the_normal_force_falls(tmp_path):
+    from kinestat.control.follow.phases import _force_fell
+
+    config = FollowConfig(base=_base(tmp_path), travel=10.0, travel_dir=Y)
+    n = np.array([0.0, 0.0, 1.0])
+    target = config.base.force_target
+    lim = max(0.5 * config.settle_tol, 3.0 * math.sqrt(2.0) * config.tuning.force_sigma)
+    assert _force_fell(config, -(target - 1.5 * lim) * n + 0.9 * np.array([1.0, 0, 0]), n)
+    assert not _force_fell(config, -(target - 0.5 * lim) * n, n)
+    assert not _force_fell(config, -(target + 1.0) * n, n)  # a rise is no slip

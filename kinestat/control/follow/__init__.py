@@ -5,11 +5,13 @@ One call per cycle, :func:`decide_follow` ``(config, state, meas)``, returns the
 press task's loop (:func:`kinestat.control.loop.run` with ``decide_fn``) on the simulated
 cells (built-in or MuJoCo) or real hardware. The design, one module each:
 
-* :mod:`.tuning` — ONE frozen :class:`FollowTuning` (12 parameters, each with a unit and a
+* :mod:`.tuning` — ONE frozen :class:`FollowTuning` (13 parameters, each with a unit and a
   meaning), derived by :func:`derive_tuning` from the platform (spring rates, geometry, the
-  tool), the leg sensors (count resolution, noise) and the robot (counts at the tool); the
-  measurement model: a leg read to one count, ``σ_l = sqrt(r²/12 + σ_n²)``, propagated to
-  the measured tip (``σ_tip``) and the point-contact force (``σ_F``).
+  tool, the load it carries), the leg sensors (count resolution, noise) and the robot
+  (counts through the arm's Jacobian); the measurement model: a leg read to one count,
+  ``σ_l = sqrt(r²/12 + σ_n²)``, propagated to the measured tip (``σ_tip``) and the
+  point-contact force (``σ_F``), and the robot's axes to one count (the tip path's
+  ``path_sigma``, the floor of ``direction_tol``).
 * :mod:`.estimator` — the contact estimate (normal with its variance, friction coefficient
   with its variance, path curvature, slip): a significance test on the measured tips for the
   slip; while sliding, the normal made perpendicular to the tip path's chord (geometry) and

@@ -11,15 +11,11 @@ import numpy as np
 from kinestat.control.controller import ControllerConfig, ControllerState
 from kinestat.control.envelope import Envelope, check_motion
 from kinestat.control.follow.estimator import ContactEstimate
-from kinestat.control.follow.tuning import FollowTuning, derive_tuning
+from kinestat.control.follow.tuning import FollowTuning, derive_tuning, tip_load_pose
 from kinestat.control.model import ControlModel
 from kinestat.control.probe import PROBE_TUNING, Probe
 from kinestat.errors import InputError
 from kinestat.parallel.legs import leg_lengths
-from kinestat.parallel.statics import spring_wrench
-from kinestat.parallel.stiffness import stiffness
-from kinestat.spatial.se3 import twist_exp
-from kinestat.spatial.transforms import apply, skew
 
 __all__ = ["FollowConfig", "FollowState", "carry_check", "default_travel_dir",
            "DEFAULT_TRAVEL_AXES"]
@@ -57,35 +53,6 @@ def default_travel_dir(approach) -> np.ndarray:
 
 
 
-def _tip_load_pose(platform, tip_top: np.ndarray, f_ext: np.ndarray, steps: int = 8,
-                   max_iter: int = 30) -> np.ndarray | None:
-    """The top pose (base frame) at which the springs carry the force ``f_ext`` (base frame)
-    applied at the tool tip ``tip_top`` (top frame), the tip free to move (a frictionless
-    contact): Newton on ``spring_wrench(X) = [f; p(X) × f]``, the load raised in ``steps``;
-    None where no equilibrium exists (the platform stops carrying load)."""
-    X = platform.home_pose.copy()
-    for k in range(1, steps + 1):
-        f = f_ext * (k / steps)
-        for _ in range(max_iter):
-            p = apply(X, tip_top)
-            r = np.concatenate([f, np.cross(p, f)]) - spring_wrench(platform, X)
-            if float(np.linalg.norm(r)) <= 1e-8 * max(1.0, float(np.linalg.norm(f))):
-                break
-            G = np.zeros((6, 6))  # d[f; p × f]/d[δx; δφ]
-            G[3:, :3] = -skew(f)
-            G[3:, 3:] = skew(f) @ skew(p)
-            try:
-                d = np.linalg.solve(stiffness(platform, X) - G, r)
-            except np.linalg.LinAlgError:
-                return None
-            d /= max(1.0, float(np.linalg.norm(d[3:])) / 0.05,
-                     float(np.linalg.norm(d[:3])) / (0.05 * platform.scale))
-            X = twist_exp(np.concatenate([d[3:], d[:3]])) @ X
-        else:
-            return None
-    return X
-
-
 def carry_check(model: ControlModel, envelope: Envelope, force, s6, a67,
                 margin: float = 1.0) -> list[str]:
     """Violations of the envelope by the platform carrying ``force`` (N, fixed frame, the tool's
@@ -99,7 +66,7 @@ def carry_check(model: ControlModel, envelope: Envelope, force, s6, a67,
     plat = model.platform
     F = np.asarray(force, dtype=float)
     F = F * (1.0 + margin / float(np.linalg.norm(F)))
-    top = _tip_load_pose(plat, model.tool_tip_top, -(RB.T @ F))
+    top = tip_load_pose(plat, model.tool_tip_top, -(RB.T @ F))
     if top is None:
         return [f"the platform finds no equilibrium carrying {np.linalg.norm(F):.3g} N at the "
                 "tool tip (its load limit along this direction)"]
@@ -202,7 +169,7 @@ class FollowConfig:
         if self.tuning is None:
             object.__setattr__(self, "tuning", derive_tuning(
                 self.base.model, self.base.force_target, self.base.start_tool_point,
-                self.travel_step))
+                self.travel_step, s6=self.base.start_s6, a67=self.base.start_a67))
 
 
 

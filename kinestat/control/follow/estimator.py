@@ -179,20 +179,25 @@ def _fuse_normal(n: np.ndarray, var: float, m: np.ndarray, var_m: float
 
 def curvature_span(tun: FollowTuning) -> float:
     """mm: the span of the path whose sagitta ``κ s²/8`` at ``curvature_tol`` is
-    ``confidence σ_tip`` (at least the chord): the curvature is fitted over it."""
-    return max(math.sqrt(8.0 * tun.confidence * tun.tip_sigma / tun.curvature_tol), tun.chord)
+    ``confidence path_sigma`` (at least the chord): the curvature is fitted over it."""
+    return max(math.sqrt(8.0 * tun.confidence * tun.path_sigma / tun.curvature_tol), tun.chord)
 
 
 def _curvature(tun: FollowTuning, est: ContactEstimate, path: tuple, tip: np.ndarray,
                n: np.ndarray, t: np.ndarray) -> float:
     """The path's curvature over the span that resolves ``curvature_tol``; with the probe's
-    touches while the path is shorter (the fit's significance test keeps a noisy one 0)."""
+    touches while the path is shorter. A larger curvature is resolved over less: the fit is
+    taken once its points span half that span or the chord, and its sagitta exceeds twice
+    its residual and ``confidence`` standard deviations of the robot's share of the path's
+    noise (which a few points need not show)."""
     span = curvature_span(tun)
     x = (np.asarray(path) - tip) @ t if path else np.zeros(1)
     pts = path if float(np.ptp(np.append(x, 0.0))) >= span else est.line + path
     if len(pts) < 3:
         return est.curvature
-    return path_curvature(np.asarray(pts), tip, n, t, 0.5 * span)
+    robot = math.sqrt(max(tun.path_sigma ** 2 - tun.tip_sigma ** 2, 0.0))
+    return path_curvature(np.asarray(pts), tip, n, t, min(0.5 * span, tun.chord),
+                          noise=tun.confidence * robot)
 
 
 def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: np.ndarray,

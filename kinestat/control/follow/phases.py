@@ -127,7 +127,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     stuck = st.stuck + 1 if (st.step > 0.0 or st.stuck) and not est.sliding else 0
     leaning = st.leaning or (config.auto_tilt is None and config.tilt_deg == 0.0
                              and stuck >= 2 and _frictional(tun, est))
-    slides = st.slides + 1 if est.sliding else 0
+    settled = abs(config.base.force_target + float(F @ est.normal)) <= config.settle_tol
+    slides = st.slides + 1 if est.sliding and settled else 0
     return replace(st, estimate=est, travel=st.travel + adv, stuck=stuck, leaning=leaning,
                    slides=slides)
 
@@ -226,17 +227,32 @@ def _act(config: FollowConfig, st: FollowState, meas: Measurement, label: str,
 def _lean_goal(config: FollowConfig, st: FollowState, meas: Measurement, n: np.ndarray,
                t: np.ndarray) -> tuple[float, bool]:
     """The lean the law aims at (rad) and whether the tip is held (the breakaway: no travel
-    step, the lean grows at the rate the soft mode allows)."""
+    step, the lean grows at the rate the soft mode allows) while it sticks, or creeps before
+    a slide measured μ (stick or slip uncertain: a step would run it ahead)."""
     tun, est = config.tuning, st.estimate
     if not st.leaning:
         return math.radians(config.tilt_deg), False
-    if st.phase == "travel" and st.stuck:
+    if st.phase == "travel" and (st.stuck or not est.samples):  # stuck, or creeping
         F = meas.estimate(config.base.estimator)
         now = lean_of(F / np.linalg.norm(F), n, t)  # the force's lean: S6 leads it by a step
+        if _force_fell(config, F, n):  # the tip may be breaking away: lean no further
+            return now, True
         return now + lean_rate(config, now), True
     if est.friction_known(tun):
-        return math.atan(est.mu) + edge_margin(tun, est, config.base.force_target), False
+        return math.atan(est.mu) + edge_margin(tun, est, config.base.force_target,
+                                               config.travel_step), False
     return st.lean, False
+
+
+def _force_fell(config: FollowConfig, F: np.ndarray, n: np.ndarray) -> bool:
+    """Whether the normal force fell below the target by more than half the drop a lean step
+    may cause at a slip (``settle_tol``, :func:`lean_rate`) and significantly (``confidence``
+    standard deviations of a change, ``√2 σ_F``): under a held lean the first sign of a slip,
+    the tip running ahead in the platform's soft mode before its advance is significant."""
+    tun = config.tuning
+    drop = config.base.force_target + float(F @ n)
+    return drop > max(0.5 * config.settle_tol,
+                      tun.confidence * math.sqrt(2.0) * tun.force_sigma)
 
 
 def lean_rate(config: FollowConfig, lean: float) -> float:
@@ -250,20 +266,23 @@ def lean_rate(config: FollowConfig, lean: float) -> float:
     return min(config.settle_tol / drop, math.radians(config.max_turn_deg))
 
 
-def edge_margin(tun, est: ContactEstimate, force: float) -> float:
+def edge_margin(tun, est: ContactEstimate, force: float, step: float) -> float:
     """rad: how far the tool leans past the estimated cone edge, ``confidence`` standard
     deviations of where the edge is (the normal's, μ̂'s and the force direction's errors):
-    the tip then slides on the true edge despite the estimate's error."""
+    the tip then slides on the true edge despite the estimate's error; at least the turn a
+    travel step of ``step`` mm gives a stuck tip's force (``k_t step / F``), so that the
+    steps do not stop the tip on the edge (a stick-slip) when the edge is known well."""
     var = (est.normal_var + est.mu_var / (1.0 + est.mu ** 2) ** 2
            + (tun.force_sigma / force) ** 2)
-    return tun.confidence * math.sqrt(var)
+    return max(tun.confidence * math.sqrt(var), tun.tangential_stiffness * step / force)
 
 
-def step_cap(config: FollowConfig, st: FollowState, n: np.ndarray) -> float:
-    """mm: the largest travel step. While leaning on friction, a step that a stuck tip does
-    not follow pushes it along the leaning tool's axis (``k_axial sin θ`` N per mm); the
-    first step after a stick raises the force by at most ``settle_tol``, and each cycle the
-    tip slid doubles it (up to ``travel_step``)."""
+def step_cap(config: FollowConfig, st: FollowState) -> float:
+    """mm: the largest travel step. While leaning on friction, a step the tip does not follow
+    pushes it along the leaning tool's axis, one it runs ahead of relaxes it (``k_axial sin θ``
+    N per mm): the first step after a stick, or after a cycle whose normal force was not
+    settled (beyond ``settle_tol``), changes the force by at most ``settle_tol``, and each
+    cycle the tip slid with the force settled doubles it (up to ``travel_step``)."""
     if not st.leaning:
         return config.travel_step
     tun = config.tuning
@@ -284,7 +303,7 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
     kw["misalignment_deg"] = mis
     step = 0.0
     if st.phase == "travel" and not held:
-        step = min(step_cap(config, st, n), max(0.5 * remaining,
+        step = min(step_cap(config, st), max(0.5 * remaining,
                                                  min(4.0 * tun.step_resolution, remaining)))
     omega = turn_towards(meas.s6, axis, math.radians(config.max_turn_deg))
     if not st.leaning:
