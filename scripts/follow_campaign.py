@@ -7,10 +7,10 @@ to ±0.3 of it along F_req), friction from ``--friction`` (default 0, 0.3 and 0.
 sensor in 30 % of the runs; even runs a plane (1.5-4 mm ahead, tilted 0-``--max-tilt`` degrees
 (default 10) in any azimuth),
 odd runs a cylinder of radius uniform in [``--min-radius``, 500] mm whose axis lies in any
-azimuth across F_req (up to ±0.2 of it along F_req). Each run is judged by issue 13's
+azimuth across F_req (up to ±0.2 of it along F_req). Each run is judged by the
 acceptance (completed, no contact lost, travel within 1 mm of the request, measured and true
-(:func:`true_travel`), true normal-force
-RMS ≤ 0.2 N, or 0.05 N with the ideal sensor, and max ≤ 0.5 N); requests the controller
+(:func:`true_travel`), true normal-force RMS ≤ 0.2 N and max ≤ 0.5 N, issue 40's bounds; the
+campaign also counts the ideal sensor's runs against 0.05 N RMS); requests the controller
 refuses before any motion (a force the platform cannot carry) are counted apart. In process;
 ``--devices`` runs through the simulated Galil and encoder stream as the CLI does;
 ``--sim mujoco`` on the MuJoCo cell (in process; true figures from MuJoCo's contact force).
@@ -111,15 +111,20 @@ def true_travel(d: dict, out: dict) -> float:
 
 
 def verdict(d: dict, out: dict) -> str:
+    """Issue 40's bounds (completed, contact kept, travel within 1 mm measured and true, true
+    normal-force RMS ≤ 0.2 N and max ≤ 0.5 N): "pass" or "FAIL"; "pass*" marks a pass above
+    the campaign's own, stricter RMS bound for the ideal sensor (0.05 N)."""
     if "refused" in out:
         return "refused"
     out["true_travel"] = true_travel(d, out) if out["completed"] else float("nan")
     ok = (out["completed"] and out["contact_lost"] == 0
           and abs(out["travel"] - d["travel"]) <= 1.0
           and abs(out["true_travel"] - d["travel"]) <= 1.0
-          and out["true_normal_force_rms_error"] <= (0.05 if d["ideal"] else 0.2)
+          and out["true_normal_force_rms_error"] <= 0.2
           and out["true_normal_force_max_error"] <= 0.5)
-    return "pass" if ok else "FAIL"
+    if not ok:
+        return "FAIL"
+    return "pass*" if d["ideal"] and out["true_normal_force_rms_error"] > 0.05 else "pass"
 
 
 def _row(k: int, d: dict, out: dict, v: str) -> str:
@@ -174,6 +179,8 @@ def main(argv: list[str] | None = None) -> int:
             counts[v] = counts.get(v, 0) + 1
             print(_row(k, d, out, v), flush=True)
     print(", ".join(f"{v} {c}" for v, c in sorted(counts.items())) + f" of {a.n}")
+    print(f"issue 40's bounds: {counts.get('pass', 0) + counts.get('pass*', 0)}/{a.n}; "
+          f"with the ideal sensor's 0.05 N RMS bound too: {counts.get('pass', 0)}/{a.n}")
     return 0
 
 
