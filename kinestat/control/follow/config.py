@@ -183,8 +183,10 @@ class FollowState(ControllerState):
         phase: "approach", "probe", "settle", "travel" (then the run is done: "finish").
         estimate: the contact estimate (:mod:`.estimator`), None before contact.
         tangent: (3,) the travel direction on the tangent plane, None before travel.
-        travel: distance travelled along the surface (mm, the measured tips' path: a
-            slide's length in the tangent plane, a stuck tip's advance along the travel).
+        travel: distance travelled along the surface (mm): the length of ``developed``.
+        developed: (2,) mm, the measured tips' displacement on the surface developed into a
+            plane, along the travel tangent and across it (``n̂ × t̂``): a wander across the
+            travel and back cancels, as a stuck tip's jitter does; a steady drift counts.
         contact_lost: consecutive travel cycles without contact.
         step: the travel commanded by the last move (mm).
         leaning: the friction lean is on (the tip stuck under the travel, or asked for).
@@ -198,6 +200,7 @@ class FollowState(ControllerState):
     estimate: ContactEstimate | None = None
     tangent: np.ndarray | None = None
     travel: float = 0.0
+    developed: tuple[float, float] = (0.0, 0.0)
     contact_lost: int = 0
     step: float = 0.0
     leaning: bool = False

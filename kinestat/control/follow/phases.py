@@ -123,25 +123,24 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if st.phase != "travel":
         return replace(st, estimate=replace(st.estimate, tips=(tip.copy(),), path=(tip.copy(),)))
     est = observe_travel(tun, st.estimate, tip, F, st.tangent)
-    adv = _advance(est, tip - st.estimate.tips[-1], st.tangent)
+    developed = _developed(st, est, tip - st.estimate.tips[-1], st.tangent)
     stuck = st.stuck + 1 if (st.step > 0.0 or st.stuck) and not est.sliding else 0
     leaning = st.leaning or (config.auto_tilt is None and config.tilt_deg == 0.0
                              and stuck >= 2 and _frictional(tun, est))
     settled = abs(config.base.force_target + float(F @ est.normal)) <= config.settle_tol
     slides = st.slides + 1 if est.sliding and settled else 0
-    return replace(st, estimate=est, travel=st.travel + adv, stuck=stuck, leaning=leaning,
-                   slides=slides)
+    return replace(st, estimate=est, developed=developed, travel=math.hypot(*developed),
+                   stuck=stuck, leaning=leaning, slides=slides)
 
 
-def _advance(est: ContactEstimate, d: np.ndarray, t: np.ndarray) -> float:
-    """mm travelled along the surface by the tip's displacement ``d``: its length in the
-    tangent plane when the tip slid forward (a slide across the travel is travel too), its
-    part along ``t`` otherwise (a stuck tip's jitter then cancels over the cycles)."""
-    along = float(d @ t)
-    if not (est.sliding and along > 0.0):
-        return along
-    n = est.normal
-    return float(np.linalg.norm(d - float(d @ n) * n))
+def _developed(st: FollowState, est: ContactEstimate, d: np.ndarray,
+               t: np.ndarray) -> tuple[float, float]:
+    """The tips' displacement on the surface developed into a plane (mm, along ``t`` and
+    across it, ``n̂ × t̂``) after the tip's displacement ``d``: exact on a plane or a
+    cylinder, whose development keeps lengths, as the chord of each cycle's short arc."""
+    across = np.cross(est.normal, t)
+    a, c = st.developed
+    return a + float(d @ t), c + float(d @ across)
 
 
 def _frictional(tun, est: ContactEstimate) -> bool:
