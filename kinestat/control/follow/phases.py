@@ -39,7 +39,7 @@ from kinestat.control.probe import probe_normal, probe_step, start_probe
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
 
-__all__ = ["decide_follow", "FOLLOW_STATES"]
+__all__ = ["decide_follow", "FOLLOW_STATES", "developed_step"]
 
 FOLLOW_STATES = {
     "a": "approach along S6, no contact",
@@ -123,7 +123,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if st.phase != "travel":
         return replace(st, estimate=replace(st.estimate, tips=(tip.copy(),), path=(tip.copy(),)))
     est = observe_travel(tun, st.estimate, tip, F, st.tangent)
-    developed = _developed(st, est, tip - st.estimate.tips[-1], st.tangent)
+    developed = developed_step(st.developed, est.normal, tip - st.estimate.tips[-1],
+                               st.tangent)
     stuck = st.stuck + 1 if (st.step > 0.0 or st.stuck) and not est.sliding else 0
     leaning = st.leaning or (config.auto_tilt is None and config.tilt_deg == 0.0
                              and stuck >= 2 and _frictional(tun, est))
@@ -133,13 +134,19 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
                    stuck=stuck, leaning=leaning, slides=slides)
 
 
-def _developed(st: FollowState, est: ContactEstimate, d: np.ndarray,
-               t: np.ndarray) -> tuple[float, float]:
-    """The tips' displacement on the surface developed into a plane (mm, along ``t`` and
-    across it, ``n̂ × t̂``) after the tip's displacement ``d``: exact on a plane or a
-    cylinder, whose development keeps lengths, as the chord of each cycle's short arc."""
-    across = np.cross(est.normal, t)
-    a, c = st.developed
+def developed_step(developed: tuple[float, float], normal: np.ndarray, d: np.ndarray,
+                   t: np.ndarray) -> tuple[float, float]:
+    """The tips' displacement on the surface developed into a plane (mm, along the travel
+    tangent ``t`` and across it, ``normal × t``) after the tip's displacement ``d``, from
+    ``developed``: on a plane or a cylinder, whose development keeps lengths, each cycle's
+    chord stands for its short arc.
+
+    >>> developed_step((0.0, 0.0), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.5, 0.0]),
+    ...                np.array([1.0, 0.0, 0.0]))
+    (1.0, 0.5)
+    """
+    across = np.cross(normal, t)
+    a, c = developed
     return a + float(d @ t), c + float(d @ across)
 
 
