@@ -20,6 +20,8 @@ def sim():
 
 @pytest.fixture
 def client(sim):
-    """A :class:`GalilClient` connected to :func:`sim`."""
-    with GalilClient("127.0.0.1", sim.port, timeout=1.0) as g:
+    """A :class:`GalilClient` connected to :func:`sim`. Its reply timeout is generous: on a
+    loaded 2-core machine the simulator's thread can wait over a second for a core, and
+    the tests of the timeout itself use their own clients."""
+    with GalilClient("127.0.0.1", sim.port, timeout=5.0) as g:
         yield g
