@@ -36,7 +36,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from follow_study import START, follow  # noqa: E402
+from follow_study import START, follow, wood_stiffnesses  # noqa: E402
 
 from kinestat.app.control_run import (  # noqa: E402
     DEFAULT_PLANE_DISTANCE,
@@ -158,11 +158,8 @@ def main(argv: list[str] | None = None) -> int:
     rng = np.random.default_rng(a.seed)
     draws = [draw(rng, k, a.max_force, a.min_radius, tuple(a.friction), a.max_tilt)
              for k in range(a.n)]
-    wood_rng = np.random.default_rng([a.seed, 1])
-    for d in draws:
-        k_wood = None
-        if a.wood and wood_rng.random() < 0.5:
-            k_wood = float(np.exp(wood_rng.uniform(*np.log(a.wood))))
+    for d, k_wood in zip(draws, wood_stiffnesses(a.seed, a.n, a.wood), strict=True):
+        if k_wood is not None:
             d["name"] = f"{d['name'][:18]} k{k_wood:.0f}"
         d["cell"] = dataclasses.replace(d["cell"], plant=a.sim, workpiece_stiffness=k_wood)
     print(f"seed {a.seed}, |F_req| 2-{a.max_force:g} N, planes <= {a.max_tilt:g}°, "

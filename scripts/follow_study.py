@@ -74,6 +74,20 @@ def random_cell(rng: np.random.Generator, k: int) -> tuple[str, SimulatedCell]:
 AUTO_TILT = {"auto": None, "on": True, "off": False}
 
 
+def wood_stiffnesses(seed: int, n: int, wood: tuple[float, float] | None) -> list[float | None]:
+    """Per run, None (rigid) or, with even odds when ``wood = (LO, HI)`` is given, a workpiece
+    stiffness log-uniform in LO-HI N/mm; drawn from a stream of its own (``[seed, 1]``), so
+    that the campaigns' workpieces stay those of the seed."""
+    rng = np.random.default_rng([seed, 1])
+    out: list[float | None] = []
+    for _ in range(n):
+        k = None
+        if wood and rng.random() < 0.5:
+            k = float(np.exp(rng.uniform(*np.log(wood))))
+        out.append(k)
+    return out
+
+
 def follow(cell: SimulatedCell, travel_dir, travel: float = 50.0,
            auto_tilt: bool | None = None, devices: bool = False, force: float = 4.0) -> dict:
     """One follow run on ``cell`` (|F_req| = ``force`` N along the thesis's direction): in

@@ -34,7 +34,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from follow_study import F_HAT, START  # noqa: E402
+from follow_study import F_HAT, START, wood_stiffnesses  # noqa: E402
 
 from kinestat.app.control_run import (  # noqa: E402
     ControlRequest,
@@ -113,11 +113,8 @@ def main() -> None:
     a = ap.parse_args()
     rng = np.random.default_rng(a.seed)
     reqs = [draw(rng, k, tuple(a.friction)) for k in range(a.n)]
-    wood_rng = np.random.default_rng([a.seed, 1])
-    for r in reqs:
-        k_wood = None
-        if a.wood and wood_rng.random() < 0.5:
-            k_wood = float(np.exp(wood_rng.uniform(*np.log(a.wood))))
+    for r, k_wood in zip(reqs, wood_stiffnesses(a.seed, a.n, a.wood), strict=True):
+        if k_wood is not None:
             r["name"] = f"{r['name'][:14]} k{k_wood:.0f}"
         r["cell"] = dataclasses.replace(r["cell"], plant=a.sim, workpiece_stiffness=k_wood)
     print(f"seed {a.seed}, {a.n} runs, |F_req| 2-6 N, friction {a.friction}, plant {a.sim}, "
