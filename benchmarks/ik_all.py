@@ -28,6 +28,16 @@ finding about ik-geo.
 Single-call figures of one process can sit 1.3-1.5x high when the host slows this virtual CPU
 (see docs/ik-all.md, "Performance"); ``benchmarks/ik_all_processes.py`` gives their
 distribution over many processes beside a LAPACK probe that shows the machine's state.
+
+7-joint arms with one joint locked (``ARMS7``: ``<arm>-lock<J>``, J numbered from 1 as in
+``kinestat ik --lock J``; the Panda and the xArm7 from example-robot-data, the KUKA iiwa 14
+R820 from rtb-data): one locked value per arm drawn within the joint's limits, the other joints
+uniform in [-π, π]; kinestat's ``ik_all(model, T, locked={j: value})`` beside EAIK's
+``HPRobot(H, P, fixed_axes=[(j, value)]).IK`` and beside kinestat on the folded 6-joint chain
+(``kinestat-6R``: the same geometry without the locking step). Single calls run in
+``--rounds`` interleaved rounds (each solver in turn over the ``--single`` poses; the fastest
+round's median is reported); the EAIK columns count the poses where its verified solutions
+number as many as kinestat's and where every solution it returns reproduces the pose.
 """
 
 from __future__ import annotations
@@ -53,10 +63,12 @@ from arms import arm  # noqa: E402  (test arms, public constructors)
 import kinestat  # noqa: E402
 from kinestat.serial.analytic import ik_all  # noqa: E402
 from kinestat.serial.analytic.geometry import home_axes, meet, parallel  # noqa: E402
+from kinestat.serial.analytic.locked import fold  # noqa: E402
 
 PI = math.pi
 ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1", "kr16", "kr5", "irb140", "stanford",
         "random2", "random3", "middle2-1", "middle3-1")
+ARMS7 = ("panda-lock7", "panda-lock3", "iiwa-lock3", "xarm7-lock3")
 
 
 def _wrapdist(a, b):
@@ -67,7 +79,7 @@ def _score(model, q_true, sols_per_pose):
     """Completeness, mean count and worst residual (pos, rot) of lists of solutions."""
     found, counts, worst = 0, [], 0.0
     for q, sols in zip(q_true, sols_per_pose, strict=True):
-        sols = np.asarray(sols, dtype=float).reshape(-1, 6)
+        sols = np.asarray(sols, dtype=float).reshape(-1, len(q))
         counts.append(len(sols))
         if len(sols):
             found += bool(np.min(_wrapdist(sols, q)) < 1e-6)
@@ -85,7 +97,7 @@ def _agreement(mine, sols_per_pose):
     same, extra = 0, 0
     for m, sols in zip(mine, sols_per_pose, strict=True):
         distinct: list[np.ndarray] = []
-        for s in np.asarray(sols, dtype=float).reshape(-1, 6):
+        for s in np.asarray(sols, dtype=float).reshape(-1, m.shape[-1]):
             if all(_wrapdist(s, d) > 1e-6 for d in distinct):
                 distinct.append(s)
         same += len(distinct) == len(m)
@@ -139,23 +151,10 @@ def peer_eaik(model):
     """EAIK from DH parameters, or (a URDF model) from the home axes (H, P); the solutions it
     does not flag least-squares."""
     from eaik.IK_DH import DhRobot
-    from eaik.IK_HP import HPRobot
 
     dh = _dh(model)
     if dh is None:
-        ax = home_axes(model)
-        pts = np.vstack([ax.r, ax.T0[:3, 3]])
-        bot = HPRobot(ax.w.copy(), np.vstack([pts[0], np.diff(pts, axis=0)]))
-        R0 = ax.T0[:3, :3]
-        if not bot.hasKnownDecomposition():
-            return None
-
-        def call_hp(T):
-            Tp = T.copy()
-            Tp[:3, :3] = T[:3, :3] @ R0.T
-            s = bot.IK(Tp)
-            return [np.asarray(q) for q, ls in zip(s.Q, s.is_LS, strict=True) if not ls]
-        return call_hp
+        return peer_eaik_hp(model)
     th, d, a, al = dh
     bot = DhRobot(al, a, d)
     if not bot.hasKnownDecomposition():
@@ -165,6 +164,30 @@ def peer_eaik(model):
         s = bot.IK(T)
         return [np.asarray(q) - th for q, ls in zip(s.Q, s.is_LS, strict=True) if not ls]
     return call
+
+
+def peer_eaik_hp(model, fixed_axes=(), keep_ls=False):
+    """EAIK's ``HPRobot`` from the home axes (H, P) of a URDF model, with ``fixed_axes``
+    ``[(joint index, value)]`` held (EAIK's locked joints); None without a decomposition.
+    The solutions it does not flag least-squares, or all of them with ``keep_ls`` (its 1-D
+    search decompositions flag exact solutions least-squares too: the caller verifies)."""
+    from eaik.IK_HP import HPRobot
+
+    ax = home_axes(model)
+    pts = np.vstack([ax.r, ax.T0[:3, 3]])
+    bot = HPRobot(ax.w.copy(), np.vstack([pts[0], np.diff(pts, axis=0)]),
+                  fixed_axes=list(fixed_axes))
+    R0 = ax.T0[:3, :3]
+    if not bot.hasKnownDecomposition():
+        return None
+
+    def call_hp(T):
+        Tp = T.copy()
+        Tp[:3, :3] = T[:3, :3] @ R0.T
+        s = bot.IK(Tp)
+        return [np.asarray(q) for q, ls in zip(s.Q, s.is_LS, strict=True)
+                if keep_ls or not ls]
+    return call_hp
 
 
 def peer_ikgeo(model, kind):
@@ -270,8 +293,152 @@ def run(n: int, n_single: int, repeat: int = 5, arms=ARMS) -> dict:
     return rows
 
 
+# -- 7-joint arms, one joint locked ---------------------------------------------------------
+def arm7(name: str):
+    """``<arm>-lock<J>``: the 7-joint model and the locked joint's index (0-based)."""
+    from pathlib import Path
+
+    from tests.urdf_arms import ARMS as URDF_ARMS
+    from tests.urdf_arms import arm_path
+
+    base, j = name.split("-lock")
+    if base == "iiwa":
+        import rtbdata
+
+        path = Path(rtbdata.__file__).parent / "xacro" / "kuka_description" / "kuka_lbr_iiwa" / \
+            "urdf" / "lbr_iiwa_14_r820.urdf"
+        return kinestat.load(path, tip="tool0"), int(j) - 1
+    return kinestat.load(arm_path(base), tip=URDF_ARMS[base][1]), int(j) - 1
+
+
+def _rounds(calls: dict, poses, rounds: int) -> dict:
+    """Interleaved rounds of single calls: per solver, the fastest round's median seconds per
+    call, its CPU seconds and the outputs of the first round. ``poses``: one list for every
+    round, or a list of ``rounds`` lists (fresh inputs each round)."""
+    best, outs = {}, {}
+    for i in range(rounds):
+        for key, call in calls.items():
+            t, out = _single(call, poses[i] if isinstance(poses, list) else poses)
+            outs.setdefault(key, out)
+            if t < best.get(key, (math.inf,))[0]:
+                best[key] = (t, _CPU[id(call)])
+    return {k: (best[k][0], best[k][1], outs[k]) for k in calls}
+
+
+def _verified(model, q, sols):
+    """Every returned solution reproduces the pose of ``q`` (residual < 1e-6), and the
+    distinct ones among them."""
+    ok = [s for s in sols if _score(model, [q], [[s]])[2] < 1e-6]
+    return len(ok) == len(sols), ok
+
+
+def _batch(call, T, repeat: int):
+    """The fastest of ``repeat`` calls on the poses ``T``: wall seconds, CPU µs a pose, result."""
+    best, cpu, res = math.inf, math.inf, None
+    for _ in range(repeat):
+        c, t = time.process_time(), time.perf_counter()
+        out = call(T)
+        w = time.perf_counter() - t
+        if w < best:
+            best, cpu, res = w, (time.process_time() - c) / len(T) * 1e6, out
+    return best, cpu, res
+
+
+def _calls7(model, j: int, v: float, six) -> dict:
+    """The single calls of the 7-joint rows: a pose (fixed value ``v``) or, for the "new
+    value" rows, a pair (pose, locked value)."""
+    calls = {"kinestat": lambda x: ik_all(model, x, locked={j: v}),
+             "kinestat-6R": lambda x: ik_all(six, x)}
+    eaik = peer_eaik_hp(model, [(j, v)], keep_ls=True)
+    if eaik is not None:
+        calls["eaik"] = eaik
+    calls["kinestat new value"] = lambda tv: ik_all(model, tv[0], locked={j: tv[1]})
+    if eaik is not None:  # a robot built for each value: how EAIK changes a fixed axis
+        calls["eaik new value"] = lambda tv: peer_eaik_hp(model, [(j, tv[1])], True)(tv[0])
+    return calls
+
+
+def run7(n: int, n_single: int, repeat: int, rounds: int, arms=ARMS7) -> dict:
+    rows = {}
+    for k, name in enumerate(ARMS7):
+        if name not in arms:
+            continue
+        model, j = arm7(name)
+        rng = np.random.default_rng([20261207, k])
+        q = rng.uniform(-PI, PI, (n, model.n))
+        qv = rng.uniform(-PI, PI, (rounds * n_single, model.n))
+        lo = float(model.lower[j]) if math.isfinite(model.lower[j]) else -PI
+        hi = float(model.upper[j]) if math.isfinite(model.upper[j]) else PI
+        values = lo + rng.random(len(qv)) * (hi - lo)  # a locked value per pose, in the limits
+        v = float(values[0])
+        qv[:, j] = values
+        q[:, j] = v
+        T, Tv = kinestat.fk(model, q), kinestat.fk(model, qv)
+        calls = _calls7(model, j, v, fold(model, ((j, v),)))
+        calls["kinestat"](T[:512])  # compile / load the kernels
+        dt, cpu, res = _batch(calls["kinestat"], T, repeat)
+        dt6, cpu6, _ = _batch(calls["kinestat-6R"], T, repeat)
+        d = _wrapdist(res.q, q[:, None, :])
+        r = {"kinestat": {"method": res.method, "batched_poses_per_s": n / dt,
+                          "batched_cpu_us": cpu,
+                          "complete": float(np.mean(np.any(np.where(res.valid, d, np.inf)
+                                                           < 1e-6, axis=1))),
+                          "mean_solutions": float(res.n_solutions.mean()),
+                          "worst_residual": float(np.nanmax(np.maximum(
+                              res.position_error, res.rotation_error)))},
+             "kinestat-6R": {"method": res.method, "batched_poses_per_s": n / dt6,
+                             "batched_cpu_us": cpu6}}
+        pairs = list(zip(Tv, values.tolist(), strict=True))  # fresh values in every round
+        timed = _rounds({key: c for key, c in calls.items() if "new" not in key},
+                        T[:n_single], rounds)
+        timed.update(_rounds({key: c for key, c in calls.items() if "new" in key},
+                             [pairs[i * n_single:(i + 1) * n_single] for i in range(rounds)],
+                             rounds))
+        if "eaik" not in calls:
+            r["eaik"] = None
+        for key, (t, cpu_s, sols) in timed.items():
+            row = r.setdefault(key, {"method": "", "batched_poses_per_s": None,
+                                     "batched_cpu_us": None})
+            row.update(single_us=t * 1e6, single_cpu_us=cpu_s * 1e6)
+            if key.startswith("eaik"):
+                qq, mine = (q, "kinestat") if key == "eaik" else (qv, "kinestat new value")
+                checks = [_verified(model, x, ss)
+                          for x, ss in zip(qq[:n_single], sols, strict=True)]
+                c, mean, w = _score(model, qq[:n_single], sols)
+                agree, extra = _agreement([m.solutions() for m in timed[mine][2]],
+                                          [ok for _, ok in checks])
+                row.update(batched_poses_per_s=1.0 / t, batched_cpu_us=cpu_s * 1e6, complete=c,
+                           mean_solutions=mean, worst_residual=w,
+                           count_agrees_with_kinestat=agree, peer_solutions_kinestat_lacks=extra,
+                           every_solution_reproduces=float(np.mean([a for a, _ in checks])))
+        rows[name] = r
+    return rows
+
+
 def _fmt(v, spec):
     return "n/a" if v is None else format(v, spec)
+
+
+def _print(rows: dict) -> None:
+    print(f"{'arm':11} {'solver':18} {'method':24} {'single µs':>10} {'cpu µs':>7} "
+          f"{'poses/s':>10} {'cpu µs':>7} {'complete':>8} {'mean #':>7} {'worst res':>10} "
+          f"{'same # as ks':>12} {'ks lacks':>8} {'all reproduce':>13}")
+    for name, r in rows.items():
+        for solver, v in r.items():
+            if v is None:
+                print(f"{name:11} {solver:18} {'n/a (does not apply)':24}")
+                continue
+            if "error" in v:
+                print(f"{name:11} {solver:18} failed: {v['error']}")
+                continue
+            print(f"{name:11} {solver:18} {v.get('method', ''):24} "
+                  f"{_fmt(v.get('single_us'), '10.1f')} {_fmt(v.get('single_cpu_us'), '7.1f')} "
+                  f"{_fmt(v['batched_poses_per_s'], '10.0f')} {_fmt(v['batched_cpu_us'], '7.2f')} "
+                  f"{_fmt(v.get('complete'), '8.4f')} {_fmt(v.get('mean_solutions'), '7.2f')} "
+                  f"{_fmt(v.get('worst_residual'), '10.1e')} "
+                  f"{_fmt(v.get('count_agrees_with_kinestat'), '12.4f')} "
+                  f"{_fmt(v.get('peer_solutions_kinestat_lacks'), '8d')} "
+                  f"{_fmt(v.get('every_solution_reproduces'), '13.4f')}")
 
 
 def main(argv=None) -> int:
@@ -280,34 +447,26 @@ def main(argv=None) -> int:
     ap.add_argument("--single", type=int, default=200, help="poses for single-call timing")
     ap.add_argument("--repeat", type=int, default=5,
                     help="batched kinestat calls per arm; the fastest is reported")
-    ap.add_argument("--arms", default=",".join(ARMS), help=f"comma-separated subset of {ARMS}")
+    ap.add_argument("--rounds", type=int, default=5,
+                    help="interleaved rounds of single calls (7-joint arms); the fastest counts")
+    ap.add_argument("--arms", default=",".join(ARMS + ARMS7),
+                    help=f"comma-separated subset of {ARMS + ARMS7}")
     ap.add_argument("--json", action="store_true")
     a = ap.parse_args(argv)
-    rows = run(a.n, a.single, a.repeat, tuple(a.arms.split(",")))
+    arms = tuple(a.arms.split(","))
+    unknown = sorted(set(arms) - set(ARMS + ARMS7))
+    if unknown:
+        ap.error(f"unknown arm(s) {unknown}; expected some of {ARMS + ARMS7}")
+    rows = run(a.n, a.single, a.repeat, arms)
+    rows.update(run7(a.n, a.single, a.repeat, a.rounds, arms))
     meta = {"cpus": os.cpu_count(), "numba_threads": __import__("numba").get_num_threads(),
             "machine": platform.platform(), "load_avg": os.getloadavg()}
     if a.json:
         print(json.dumps({"meta": meta, "rows": rows}, indent=1))
         return 0
-    print(f"# ik_all benchmark  n={a.n}  single={a.single}  repeat={a.repeat}  {meta}")
-    print(f"{'arm':9} {'solver':12} {'method':24} {'single µs':>10} {'cpu µs':>7} "
-          f"{'poses/s':>10} {'cpu µs':>7} {'complete':>8} {'mean #':>7} {'worst res':>10} "
-          f"{'same # as ks':>12} {'ks lacks':>8}")
-    for name, r in rows.items():
-        for solver, v in r.items():
-            if v is None:
-                print(f"{name:9} {solver:12} {'n/a (does not apply)':24}")
-                continue
-            if "error" in v:
-                print(f"{name:9} {solver:12} failed: {v['error']}")
-                continue
-            print(f"{name:9} {solver:12} {v.get('method', ''):24} "
-                  f"{_fmt(v['single_us'], '10.1f')} {_fmt(v['single_cpu_us'], '7.1f')} "
-                  f"{_fmt(v['batched_poses_per_s'], '10.0f')} {_fmt(v['batched_cpu_us'], '7.2f')} "
-                  f"{_fmt(v['complete'], '8.4f')} {_fmt(v['mean_solutions'], '7.2f')} "
-                  f"{_fmt(v['worst_residual'], '10.1e')} "
-                  f"{_fmt(v.get('count_agrees_with_kinestat'), '12.4f')} "
-                  f"{_fmt(v.get('peer_solutions_kinestat_lacks'), '8d')}")
+    print(f"# ik_all benchmark  n={a.n}  single={a.single}  repeat={a.repeat}  "
+          f"rounds={a.rounds}  {meta}")
+    _print(rows)
     return 0
 
 
