@@ -20,7 +20,7 @@ from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic.result import IKAllResult
 
-__all__ = ["fold", "expand", "SelfMotion", "self_motion_values"]
+__all__ = ["fold", "expand", "plan", "LockedPlan", "SelfMotion", "self_motion_values"]
 
 
 def _joint_motion(kind: str, pitch: float, v: float) -> np.ndarray:
@@ -98,20 +98,79 @@ def _insert(q6: np.ndarray, free: np.ndarray, locked, n: int) -> np.ndarray:
     return q
 
 
+class LockedPlan:
+    """A model with its locked ``(joint, value)`` pairs: the folded 6-joint chain ``six``
+    (solved by :func:`~kinestat.serial.analytic.ik_all`) and :meth:`expand`, which puts the
+    locked values back. Built once per (model, locked values) by :func:`plan`."""
+
+    __slots__ = ("model", "pairs", "six", "free", "_free_array", "_one", "_take")
+
+    def __init__(self, model: ChainModel, pairs: tuple[tuple[int, float], ...]) -> None:
+        self.model, self.pairs = model, pairs
+        self.six = fold(model, pairs)
+        locked_idx = {j for j, _ in pairs}
+        self.free = tuple(i for i in range(model.n) if i not in locked_idx)
+        self._free_array = np.array(self.free)
+        self._one = pairs[0] if len(pairs) == 1 else None
+        self._take = np.array([self.free.index(i) if i in self.free else 0
+                               for i in range(model.n)])
+
+    def _q(self, q6: np.ndarray) -> np.ndarray:
+        if self._one is None:
+            return _insert(q6, self._free_array, self.pairs, self.model.n)
+        # one locked joint: one take (column j a copy of column 0), then 0 · x + v in place:
+        # v, or NaN where the slot is empty (fewer steps: a single call is a few µs)
+        q = q6.take(self._take, axis=-1)
+        col = q[..., self._one[0]]
+        col *= 0.0
+        col += self._one[1]
+        return q
+
+    def expand(self, res: IKAllResult) -> IKAllResult:
+        """The folded chain's result ``res`` in the full chain's joints (locked values put
+        back)."""
+        fields = dict(res.__dict__)
+        fields["q"] = self._q(res.q)
+        fj = res.family_joints
+        if fj is not None:
+            fields["family_joints"] = tuple(self.free[i] for i in fj)
+        if res.family_curve is not None:
+            fields["family_curve"] = _LockedCurve(res.family_curve, self._free_array,
+                                                  self.pairs, self.model.n)
+        obj = object.__new__(IKAllResult)
+        obj.__dict__.update(fields)
+        return obj
+
+
+_PLANS: dict = {}
+_PLANS_MAX = 256  # a self-motion sampled at up to this many values stays cached
+
+
+def plan(model: ChainModel, locked) -> LockedPlan:
+    """The :class:`LockedPlan` of ``model`` with the ``locked`` ``{joint: value}`` (checked by
+    :func:`check_locked` on first use; cached per model and values, the oldest dropped
+    beyond ``_PLANS_MAX``)."""
+    if len(locked) == 1:  # a dict of one int joint and a float value: look up directly
+        (j, v), = locked.items()
+        if type(j) is int and type(v) is float:
+            hit = _PLANS.get((model, j, v))
+            if hit is not None:
+                return hit
+    pairs = check_locked(model, locked)
+    key = (model, *pairs[0]) if len(pairs) == 1 else (model, pairs)
+    hit = _PLANS.get(key)
+    if hit is None:
+        hit = LockedPlan(model, pairs)
+        if len(_PLANS) >= _PLANS_MAX:
+            del _PLANS[next(iter(_PLANS))]
+        _PLANS[key] = hit
+    return hit
+
+
 def expand(model: ChainModel, locked: tuple[tuple[int, float], ...],
            res: IKAllResult) -> IKAllResult:
     """The folded chain's result ``res`` in the full chain's joints (locked values put back)."""
-    locked_idx = {j for j, _ in locked}
-    free = np.array([i for i in range(model.n) if i not in locked_idx])
-    fields = {f: getattr(res, f) for f in ("valid", "position_error", "rotation_error",
-                                           "singular", "family_sign", "family_value",
-                                           "n_solutions", "reason", "method", "tol")}
-    fields["q"] = _insert(res.q, free, locked, model.n)
-    fields["family_joints"] = None if res.family_joints is None else \
-        tuple(int(free[i]) for i in res.family_joints)
-    fields["family_curve"] = None if res.family_curve is None else \
-        _LockedCurve(res.family_curve, free, locked, model.n)
-    return IKAllResult(**fields)
+    return plan(model, dict(locked)).expand(res)
 
 
 def self_motion_values(model: ChainModel, joint: int, n: int) -> np.ndarray:

@@ -16,7 +16,7 @@ import numpy as np
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic.result import IKAllResult
 
-__all__ = ["reverse", "invert_poses", "unreverse"]
+__all__ = ["reverse", "invert_poses", "unreverse", "bind_one"]
 
 _F = np.diag([1.0, -1.0, -1.0, 1.0])
 
@@ -61,3 +61,39 @@ def unreverse(res: IKAllResult) -> IKAllResult:
         tuple(n - 1 - j for j in res.family_joints)
     fields["family_curve"] = None
     return IKAllResult(**fields)
+
+
+_ROW3 = np.array([0.0, 0.0, 0.0, 1.0])
+
+
+def bind_one(rev_data: dict):
+    """The single-pose call of a reversed-chain model: ``one(T (1, 4, 4) plain, tol)`` inverts
+    the pose, runs the reversed chain's bound single call (``rev_data["one"]``, see
+    :func:`kinestat.serial.analytic.closed_form.solve_pieper_compiled`) and puts the joints
+    back in order; None where that call is not bound yet or returns None (the caller then
+    takes the full path)."""
+
+    def one(T, tol):
+        rone = rev_data.get("one")
+        if rone is None:
+            return None
+        Rt = T[0, :3, :3].T
+        Ti = np.empty((1, 4, 4))
+        Ti[0, :3, :3] = Rt
+        Ti[0, :3, 3] = -(Rt @ T[0, :3, 3])
+        Ti[0, 3] = _ROW3
+        res = rone(Ti, tol)
+        if res is None:
+            return None
+        fields = dict(res.__dict__)
+        q = res.q
+        fields["q"] = q[..., ::-1]
+        fj = res.family_joints
+        if fj is not None:
+            n = q.shape[-1]
+            fields["family_joints"] = (n - 1 - fj[0], n - 1 - fj[1])
+        fields["family_curve"] = None
+        obj = object.__new__(IKAllResult)
+        obj.__dict__.update(fields)
+        return obj
+    return one

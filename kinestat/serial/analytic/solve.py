@@ -163,6 +163,16 @@ def _kernels():
     return mod
 
 
+def _locked_plan(model: ChainModel, locked):
+    """:func:`kinestat.serial.analytic.locked.plan` (its module imported on first use)."""
+    mod = sys.modules.get("kinestat.serial.analytic.locked")
+    if mod is None:
+        from kinestat.serial.analytic import locked as mod  # lazy: first-call time
+    if not isinstance(locked, dict):
+        mod.check_locked(model, locked)  # raises, naming the type
+    return mod.plan(model, locked)
+
+
 def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
            backend: str = "numba", locked: dict | None = None) -> IKAllResult:
     """Every IK solution of the 6-joint ``model`` for poses ``T_base_flange (..., 4, 4)``.
@@ -203,12 +213,8 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
     if locked:
-        from kinestat.serial.analytic import locked as _locked  # lazy: first-call time
-
-        pairs = _locked.check_locked(model, locked)
-        res = ik_all(_locked.fold(model, pairs), T_base_flange, method=method, tol=tol,
-                     backend=backend)
-        return _locked.expand(model, pairs, res)
+        lp = _locked_plan(model, locked)
+        return lp.expand(ik_all(lp.six, T_base_flange, method=method, tol=tol, backend=backend))
     kind, data = _plan(model)
     robot = None if method in METHODS else _robot_method(method)
     if method not in METHODS and robot is None:
@@ -277,8 +283,11 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     elif use == "pieper" and "reversed" in data:
         from kinestat.serial.analytic import reversed_chain  # lazy: first-call time
 
-        res = ik_all(data["reversed"], reversed_chain.invert_poses(Tf), tol=tol, backend=backend)
-        res = reversed_chain.unreverse(res)
+        Ti = reversed_chain.invert_poses(Tf)
+        res = reversed_chain.unreverse(ik_all(data["reversed"], Ti[0] if shape == () else Ti,
+                                              tol=tol, backend=backend))
+        if shape == () and plain and method == "auto" and fast and "one" not in data:
+            data["one"] = reversed_chain.bind_one(_plan(data["reversed"])[1])
     elif use == "pieper":
         from kinestat.serial.analytic import pieper_offset  # lazy: NumPy reference only
 

@@ -13,6 +13,7 @@ import kinestat
 from kinestat.errors import InputError, ModelError
 from kinestat.serial.analytic import ik_all, ik_self_motion
 from kinestat.serial.analytic.geometry import home_axes
+from kinestat.serial.analytic.locked import fold, plan
 from tests.urdf_arms import ARMS, arm_path
 
 from .arms import wrapped_distance
@@ -106,3 +107,40 @@ def test_locked_errors():
         ik_all(model, T)
     with pytest.raises(InputError, match="positive integer"):
         ik_self_motion(model, T, 1, 0)
+
+
+@pytest.mark.parametrize("name,j", [("panda", 6), ("panda", 2), ("iiwa", 2)])
+def test_locked_single_calls_equal_the_batch_and_the_folded_chain(name, j):
+    """One pose per call (the cached plan, every key spelling of the same lock) gives the
+    batch's solutions and the folded 6-joint chain's with the locked value put back."""
+    model = _arm(name)
+    q = _configs(model, j, -0.7, 25, seed=30 + j)
+    T = kinestat.fk(model, q)
+    batch = ik_all(model, T, locked={j: -0.7})
+    six = ik_all(fold(model, ((j, -0.7),)), T)
+    assert np.array_equal(batch.n_solutions, six.n_solutions)
+    for i in range(len(q)):
+        for locked in ({j: -0.7}, {np.int64(j): np.float64(-0.7)}, {j: -0.7}):
+            one = ik_all(model, T[i], locked=locked)
+            sols = one.solutions()
+            assert sols.shape[1] == 7 and np.all(sols[:, j] == -0.7)
+            assert np.all(np.isnan(one.q[~one.valid]))
+            assert _same(sols, batch.solutions((i,)))
+            assert _same(np.delete(sols, j, axis=1), six.solutions((i,)))
+            F = kinestat.fk(model, sols)
+            assert np.abs(F - T[i]).max() < 1e-9
+        assert np.min(wrapped_distance(sols, q[i])) < 1e-6
+
+
+def _same(a, b):
+    return len(a) == len(b) and all(np.min(wrapped_distance(b, s)) < 1e-9 for s in a)
+
+
+def test_locked_plans_are_kept_per_value():
+    """A new locked value gives its own folded chain; the same value the same one."""
+    model = _arm("panda")
+    a, b = plan(model, {6: 0.3}), plan(model, {6: 0.5})
+    assert a.six is not b.six and plan(model, {6: 0.3}) is a
+    assert plan(model, {np.int64(6): 0.3}) is a
+    with pytest.raises(InputError, match="not a joint index"):
+        plan(model, {True: 0.3})

@@ -138,3 +138,27 @@ def test_quartic_roots_against_numpy():
         want = np.sort(np.real(roots[np.abs(np.imag(roots)) == 0]))
         assert k == len(want)
         assert np.allclose(np.sort(got[:k]), want, atol=1e-8)
+
+
+def _same_solutions(a: np.ndarray, b: np.ndarray) -> bool:
+    """The two sets of solutions ``(m, 6)`` are equal up to order (wrapped, 1e-9)."""
+    return len(a) == len(b) and all(np.min(wrapped_distance(b, s)) < 1e-9 for s in a)
+
+
+@pytest.mark.parametrize("key", [RANDOM[6], RANDOM[7]], ids=_ids)
+def test_reversed_single_calls_equal_the_batch(key):
+    """A spherical shoulder solved reversed: one pose per call (the bound single call after
+    the first) gives the batch's solutions, family joints and method for every pose."""
+    model = _arm(key)
+    q = np.random.default_rng(7).uniform(-PI, PI, (40, 6))
+    T = kinestat.fk(model, q)
+    batch = ik_all(model, T)
+    for i in range(len(q)):
+        one = ik_all(model, T[i])
+        assert one.q.shape == (8, 6) and one.method == batch.method
+        assert _same_solutions(one.solutions(), batch.solutions((i,)))
+        assert one.family_joints == batch.family_joints
+        assert int(one.n_solutions) == int(batch.n_solutions[i])
+        assert np.min(wrapped_distance(one.solutions(), q[i])) < 1e-6
+    pos, dR = slot_residuals(model, one, T[-1])
+    assert pos.max() <= 1e-9 and dR.max() <= 1e-9
