@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
+from kinestat.serial.analytic.geometry import cross3, norm3
 
 __all__ = ["shoulder", "pack", "REASON"]
 
@@ -19,7 +20,7 @@ def shoulder(W: np.ndarray, P: np.ndarray, w: np.ndarray) -> np.ndarray:
     G = np.zeros(20)
     w1, w2, w3 = W[0], W[1], W[2]
     ca = float(w1 @ w2)
-    if np.linalg.norm(np.cross(w1, w2)) <= 1e-9:
+    if norm3(cross3(w1, w2)) <= 1e-9:
         G[19] = 1.0
         return G
     d = P[1] - P[0]
@@ -29,11 +30,11 @@ def shoulder(W: np.ndarray, P: np.ndarray, w: np.ndarray) -> np.ndarray:
     r2 = P[1] + t * w2
     a = r2 - o1
     A = float(np.linalg.norm(a))
-    e2 = np.cross(w2, a / A)
+    e2 = cross3(w2, a / A)
     m = w - P[2]
     mpar = w3 * float(w3 @ m)
     u1 = m - mpar
-    G[:15] = np.concatenate([o1, r2, P[2] + mpar - r2, u1, np.cross(w3, u1)])
+    G[:15] = np.concatenate([o1, r2, P[2] + mpar - r2, u1, cross3(w3, u1)])
     G[15:18] = A, float(w1 @ e2), ca
     return G
 

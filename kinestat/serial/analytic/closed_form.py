@@ -25,6 +25,7 @@ import numpy as np
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _offset_pack
 from kinestat.serial.analytic._common import _ENTRY, nan_array, pack, reasons, run_kernels
+from kinestat.serial.analytic.geometry import cross3, norm3
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
 
@@ -46,8 +47,8 @@ def _mv(R: np.ndarray, x: np.ndarray) -> np.ndarray:
 
 def _perp(w: np.ndarray) -> np.ndarray:
     e = np.eye(3)[int(np.argmin(np.abs(w)))]
-    x = np.cross(w, e)
-    return x / np.linalg.norm(x)
+    x = cross3(w, e)
+    return x / norm3(x)
 
 
 def _wrap(a):

@@ -15,13 +15,14 @@ axis geometry:
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
 
-__all__ = ["HomeAxes", "home_axes", "meet", "parallel", "classify"]
+__all__ = ["HomeAxes", "home_axes", "meet", "parallel", "classify", "cross3", "norm3"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,22 +49,35 @@ def home_axes(model: ChainModel) -> HomeAxes:
     return HomeAxes(np.array(w), np.array(r), F, scale)
 
 
+def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``a × b`` of two 3-vectors. NumPy's cross spends ~10 µs a call on its axis handling;
+    classifying a model (each new locked value of a 7-joint arm) takes dozens."""
+    a0, a1, a2 = a.tolist()
+    b0, b1, b2 = b.tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
+def norm3(a: np.ndarray) -> float:
+    """The length of a 3-vector (as :func:`cross3`: without ``np.linalg.norm``'s overhead)."""
+    return math.sqrt(float(a @ a))
+
+
 def parallel(ax: HomeAxes, i: int, j: int, tol: float = 1e-9) -> bool:
     """Axes i and j are parallel (or anti-parallel)."""
-    return float(np.linalg.norm(np.cross(ax.w[i], ax.w[j]))) <= tol
+    return norm3(cross3(ax.w[i], ax.w[j])) <= tol
 
 
 def meet(ax: HomeAxes, i: int, j: int, tol: float = 1e-9):
     """The point where non-parallel axes i and j meet, or None."""
     wi, wj, d = ax.w[i], ax.w[j], ax.r[j] - ax.r[i]
-    n = np.cross(wi, wj)
+    n = cross3(wi, wj)
     nn = float(n @ n)
     if nn <= tol ** 2:
         return None
     if abs(float(d @ n)) / np.sqrt(nn) > tol * ax.scale:
         return None
     # r_i + s wi = r_j + t wj  (least squares on the two-line system)
-    s = float(np.cross(d, wj) @ n) / nn
+    s = float(cross3(d, wj) @ n) / nn
     return ax.r[i] + s * wi
 
 
@@ -78,7 +92,7 @@ def classify(model: ChainModel, tol: float = 1e-9) -> tuple[str, dict]:
     ax = home_axes(model)
     w = meet(ax, 3, 4, tol)
     spherical = w is not None and \
-        float(np.linalg.norm(np.cross(w - ax.r[5], ax.w[5]))) <= tol * ax.scale
+        norm3(cross3(w - ax.r[5], ax.w[5])) <= tol * ax.scale
     if "prismatic" in kinds:
         return ("decoupled", {"axes": ax, "wrist": w}) if spherical else ("none", {})
     if spherical:  # shoulder: where axes 1, 2 meet, None for an offset shoulder

@@ -15,7 +15,7 @@ from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import decoupled as _dec
 from kinestat.serial.analytic._common import call_compiled, reasons
 from kinestat.serial.analytic.closed_form import _WRIST_TOL
-from kinestat.serial.analytic.geometry import HomeAxes, home_axes, meet, parallel
+from kinestat.serial.analytic.geometry import HomeAxes, cross3, home_axes, meet, norm3, parallel
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["METHOD", "middle_point", "solve_middle"]
@@ -41,12 +41,11 @@ def middle_point(model: ChainModel, tol: float = 1e-9):
         return None
     ax = home_axes(model)
     c = meet(ax, 1, 2, tol)
-    if c is None or float(np.linalg.norm(np.cross(c - ax.r[3], ax.w[3]))) > tol * ax.scale:
+    if c is None or norm3(cross3(c - ax.r[3], ax.w[3])) > tol * ax.scale:
         return None
     if parallel(ax, 1, 3, tol) or parallel(ax, 2, 3, tol):
         return None
-    if parallel(ax, 4, 5, tol) and float(np.linalg.norm(np.cross(ax.r[5] - ax.r[4], ax.w[4]))) \
-            <= tol * ax.scale:
+    if parallel(ax, 4, 5, tol) and norm3(cross3(ax.r[5] - ax.r[4], ax.w[4])) <= tol * ax.scale:
         return None
     return c
 
