@@ -80,3 +80,12 @@ def test_sp4():
     for k in range(2):
         np.testing.assert_allclose(np.einsum("ni,nij,nj->n", h, rotation_matrix(w, t[:, k]), p),
                                    d, atol=1e-9)
+
+
+def test_cross3_and_norm3_equal_numpy():
+    from kinestat.serial.analytic.geometry import cross3, norm3
+
+    rng = np.random.default_rng(3)
+    for a, b in rng.normal(size=(50, 2, 3)) * rng.uniform(1e-6, 1e3, (50, 1, 1)):
+        assert np.allclose(cross3(a, b), np.cross(a, b), rtol=1e-14, atol=0.0)
+        assert abs(norm3(a) - np.linalg.norm(a)) <= 1e-15 * np.linalg.norm(a)
