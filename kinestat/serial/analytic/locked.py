@@ -61,7 +61,7 @@ def check_locked(model: ChainModel, locked) -> tuple[tuple[int, float], ...]:
 def fold(model: ChainModel, locked: tuple[tuple[int, float], ...]) -> ChainModel:
     """The chain of the free joints with the ``locked`` ``(joint, value)`` pairs folded into
     the constants (cached: a model and its locked values give the same object)."""
-    C = [np.array(c) for c in model.constants]
+    C = list(model.constants)  # read-only views: the products below are new arrays
     joints = list(model.joints)
     for j, v in sorted(locked, reverse=True):
         jt = model.joints[j]

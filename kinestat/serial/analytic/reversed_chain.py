@@ -21,21 +21,25 @@ __all__ = ["reverse", "invert_poses", "unreverse", "bind_one"]
 _F = np.diag([1.0, -1.0, -1.0, 1.0])
 
 
-def _inv(C: np.ndarray) -> np.ndarray:
-    out = np.eye(4)
-    out[:3, :3] = C[:3, :3].T
-    out[:3, 3] = -C[:3, :3].T @ C[:3, 3]
+def _inv_all(C: np.ndarray) -> np.ndarray:
+    """The inverses of rigid transforms ``(k, 4, 4)``."""
+    out = np.zeros(C.shape)
+    Rt = np.swapaxes(C[:, :3, :3], -1, -2)
+    out[:, :3, :3] = Rt
+    out[:, :3, 3] = -(Rt @ C[:, :3, 3:])[..., 0]
+    out[:, 3, 3] = 1.0
     return out
 
 
 @lru_cache(maxsize=64)
 def reverse(model: ChainModel) -> ChainModel:
     """The chain from the flange to the base (joints in reverse order, see the module)."""
-    C = model.constants
-    n = model.n
-    Cr = [_inv(C[n]) @ _F] + [_F @ _inv(C[n - k]) @ _F for k in range(1, n)] + [_F @ _inv(C[0])]
+    Ci = _inv_all(np.asarray(model.constants)[::-1])  # C(n)⁻¹, ..., C0⁻¹ in one step
+    Cr = _F @ Ci @ _F  # C'k = F C(n−k)⁻¹ F, and C'0 = C(n)⁻¹ F, C'n = F C0⁻¹ (F F = I):
+    Cr[0] = Ci[0] @ _F
+    Cr[-1] = _F @ Ci[-1]
     return ChainModel(name=f"{model.name} (reversed)", joints=tuple(reversed(model.joints)),
-                      constants=np.array(Cr), length_unit=model.length_unit,
+                      constants=Cr, length_unit=model.length_unit,
                       q_home=np.asarray(model.q_home)[::-1])
 
 
