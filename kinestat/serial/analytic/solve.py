@@ -201,15 +201,17 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     """
     T = T_base_flange
     if type(T) is np.ndarray and T.shape == _S44 and method == "auto" and backend == "numba" \
-            and not locked and isinstance(model, ChainModel):
-        # one plain pose, defaults: the closed form's bound single call (after the first)
-        one = _plan(model)[1].get("one")
+            and isinstance(model, ChainModel):
+        # one plain pose, defaults: the closed form's bound single call (after the first); with
+        # locked joints, the folded chain's
+        lp = _locked_plan(model, locked) if locked else None
+        one = _plan(model if lp is None else lp.six)[1].get("one")
         if one is not None and T.dtype is _F64:
             f = T.flags
             if f.c_contiguous and f.aligned and f.writeable:
                 res = one(T[None], float(tol))
                 if res is not None:
-                    return res
+                    return res if lp is None else lp.expand(res)
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
     if locked:
