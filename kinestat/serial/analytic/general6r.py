@@ -258,7 +258,9 @@ def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24) -> floa
     lo = np.where(np.isfinite(model.lower), model.lower, -math.pi)
     hi = np.where(np.isfinite(model.upper), model.upper, math.pi)
     q0 = rng.uniform(lo, hi, (n, 6))
-    res = solve_general_6r(model, fk(model, q0), form=form)
+    # one configuration per FK call: the batch kernel runs on every thread, and on a shared
+    # machine a parallel region of a few rows waits milliseconds for a busy core
+    res = solve_general_6r(model, np.stack([fk(model, q) for q in q0]), form=form)
     d = np.abs(np.mod(res.q - q0[:, None, :] + math.pi, 2 * math.pi) - math.pi).max(-1)
     return float(np.mean(np.any(np.where(res.valid, d, np.inf) < 1e-6, axis=1)))
 
