@@ -65,13 +65,20 @@ def _check_chain(model: ChainModel) -> None:
 
 
 @lru_cache(maxsize=64)
+def _classify(model: ChainModel):
+    """:func:`~kinestat.serial.analytic.geometry.classify`, once per model (a reversed chain is
+    classified for its model's plan, then for its own)."""
+    return classify(model)
+
+
+@lru_cache(maxsize=64)
 def _classified(model: ChainModel):
-    kind, data = classify(model)
+    kind, data = _classify(model)
     if kind == "general":  # axes 1, 2, 3 meeting: the reversed chain is a pieper arm
         from kinestat.serial.analytic import middle_wrist, reversed_chain  # lazy: first call
 
         rev = reversed_chain.reverse(model)
-        if classify(rev)[0] == "pieper":
+        if _classify(rev)[0] == "pieper":
             return "pieper", {"reversed": rev}
         if middle_wrist.middle_point(model) is not None:  # axes 2, 3, 4 meeting
             return "middle-wrist", data
