@@ -1,6 +1,7 @@
 """All-solutions IK benchmark: kinestat.ik_all against ssik, EAIK, ik-geo and RTB ``ikine_a``.
 
-Run ``.venv/bin/python benchmarks/ik_all.py [--n 10000] [--single 200] [--json]``.
+Run ``.venv/bin/python benchmarks/ik_all.py [--n 10000] [--single 200] [--rounds 5]
+[--arms ur5,iiwa-lock3,...] [--json]``.
 
 Arms (the same random configurations, uniform in [-π, π]^6, fixed seed): UR5 (three parallel
 axes), PUMA 560 (spherical wrist, embedded), PUMA 762 (embedded, Crane–Duffy frames), a Kinova
