@@ -162,7 +162,10 @@ def plan(model: ChainModel, locked) -> LockedPlan:
     if hit is None:
         hit = LockedPlan(model, pairs)
         if len(_PLANS) >= _PLANS_MAX:
-            del _PLANS[next(iter(_PLANS))]
+            try:  # the oldest; another thread may have dropped it first
+                _PLANS.pop(next(iter(_PLANS)), None)
+            except (RuntimeError, StopIteration):
+                pass
         _PLANS[key] = hit
     return hit
 

@@ -144,3 +144,21 @@ def test_locked_plans_are_kept_per_value():
     assert plan(model, {np.int64(6): 0.3}) is a
     with pytest.raises(InputError, match="not a joint index"):
         plan(model, {True: 0.3})
+
+
+def test_locked_plans_stay_bounded_and_keep_solving(monkeypatch):
+    """Beyond the cache's size the oldest plan goes; a dropped value is planned again and
+    solves as before."""
+    from kinestat.serial.analytic import locked as L
+
+    monkeypatch.setattr(L, "_PLANS_MAX", 4)
+    monkeypatch.setattr(L, "_PLANS", {})
+    model = _arm("iiwa")
+    q = _configs(model, 2, 0.1, 1, seed=5)[0]
+    T = kinestat.fk(model, q)
+    first = ik_all(model, T, locked={2: 0.1}).solutions()
+    for v in (0.2, 0.3, 0.4, 0.5, 0.6):
+        plan(model, {2: v})
+    assert len(L._PLANS) <= 4 and (model, 2, 0.1) not in L._PLANS
+    again = ik_all(model, T, locked={2: 0.1}).solutions()
+    assert _same(first, again) and np.min(wrapped_distance(again, q)) < 1e-6
