@@ -11,7 +11,15 @@ The stable top-level API::
 
 from __future__ import annotations
 
+import os
+
 import lazy_loader
+
+# The batch kernels run over the cores on OpenMP threads (Numba). libgomp's default lets a
+# worker spin for milliseconds before it sleeps, and on a machine whose cores are shared that
+# spinning takes the core from the thread the batch waits for (twice the wall time, measured on
+# 2 cores); the workers sleep instead, unless the user chose otherwise.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 __version__ = "0.2.0"  # the one place the version is written (pyproject reads it)
 
