@@ -15,11 +15,12 @@ import math
 
 import numba as nb
 import numpy as np
+from numba.extending import intrinsic
 
 from kinestat.mechanism.joints import JointKind
 from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
-from kinestat.serial._sincos import sincos, sincos_block
+from kinestat.serial._sincos import sincos, sincos_block, sincos_eight
 
 #: joint kind codes as plain ints (Numba freezes them at compile time)
 PRISMATIC = int(JointKind.PRISMATIC)
@@ -100,38 +101,87 @@ def _row_finite(Q, k, n):
     return True
 
 
+@intrinsic
+def _f64_pointer(typingctx, address):
+    """The ``float64*`` at the integer ``address``."""
+    sig = nb.types.CPointer(nb.float64)(nb.types.intp)
+
+    def codegen(context, builder, signature, args):
+        return builder.inttoptr(args[0], context.get_value_type(signature.return_type))
+
+    return sig, codegen
+
+
 @nb.njit(**_INLINE)
-def _unpack(P, q):
-    """The joint constants ``C (n+1, 4, 4)`` and the offset of the kinds in the packed chain
-    ``P``; ``C`` is None when ``q (n,)`` is not finite."""
-    n = q.shape[0]
-    o = (n + 1) * 16
+def _packed_at(address):
+    """The packed chain at ``address`` (``KernelData.address``: ``n``, then the ``16 (n+1)``
+    constants, the ``n`` kinds, the ``n`` pitches and 16 values of scratch) as ``(n, P, W)``,
+    ``P`` without ``n``, ``W`` the scratch. An address costs the entry point less than one more
+    array to take from Python; the kernels that write ``W`` hold the GIL, so one call at a time
+    uses it."""
+    n = int(nb.carray(_f64_pointer(address), (1,))[0])
+    P = nb.carray(_f64_pointer(address + 8), (18 * n + 16,))
+    return n, P, nb.carray(_f64_pointer(address + 8 * (18 * n + 17)), (16,))
+
+
+@nb.njit(**_INLINE)
+def _refused(n, q):
+    """:data:`WRONG_LENGTH` when ``q`` is not as long as the chain (``n`` joints),
+    :data:`NOT_FINITE` when it holds a value that is not finite, else :data:`DONE`."""
+    if q.shape[0] != n:
+        return WRONG_LENGTH
     for i in range(n):
         if not math.isfinite(q[i]):
-            return None, o
-    return P[:o].reshape((n + 1, 4, 4)), o
+            return NOT_FINITE
+    return DONE
 
 
 @nb.njit(**_INLINE)
-def _wrong_length(P, q):
-    """True when ``q`` is not as long as the packed chain ``P`` (``16 (n+1) + 2 n`` values)."""
-    return P.shape[0] != 18 * q.shape[0] + 16
+def _affine_at(P, o, t):
+    """:func:`_affine` with ``C`` the rigid transform at ``P[o:o+16]`` (row-major)."""
+    r00, r01, r02, p0, r10, r11, r12, p1, r20, r21, r22, p2 = t
+    c00, c01, c02, c03 = P[o], P[o + 1], P[o + 2], P[o + 3]
+    c10, c11, c12, c13 = P[o + 4], P[o + 5], P[o + 6], P[o + 7]
+    c20, c21, c22, c23 = P[o + 8], P[o + 9], P[o + 10], P[o + 11]
+    return (r00 * c00 + r01 * c10 + r02 * c20, r00 * c01 + r01 * c11 + r02 * c21,
+            r00 * c02 + r01 * c12 + r02 * c22, r00 * c03 + r01 * c13 + r02 * c23 + p0,
+            r10 * c00 + r11 * c10 + r12 * c20, r10 * c01 + r11 * c11 + r12 * c21,
+            r10 * c02 + r11 * c12 + r12 * c22, r10 * c03 + r11 * c13 + r12 * c23 + p1,
+            r20 * c00 + r21 * c10 + r22 * c20, r20 * c01 + r21 * c11 + r22 * c21,
+            r20 * c02 + r21 * c12 + r22 * c22, r20 * c03 + r21 * c13 + r22 * c23 + p2)
+
+
+@nb.njit(**_INLINE)
+def _packed_step(P, i, n, s, c, qi, t):
+    """:func:`_step` of joint ``i`` of the packed chain ``P`` with ``sin qi, cos qi = s, c``."""
+    o = 16 * (n + 1)
+    kind = int(P[o + i])
+    if kind != PRISMATIC:
+        t = _turn(c, s, t)
+        if kind == SCREW:
+            d = P[o + n + i] * qi
+            t = (t[0], t[1], t[2], t[3] + d * t[2], t[4], t[5], t[6], t[7] + d * t[6],
+                 t[8], t[9], t[10], t[11] + d * t[10])
+    else:
+        t = (t[0], t[1], t[2], t[3] + qi * t[2], t[4], t[5], t[6], t[7] + qi * t[6],
+             t[8], t[9], t[10], t[11] + qi * t[10])
+    return _affine_at(P, 16 * (i + 1), t)
 
 
 @nb.njit(**_ONE)
-def fk_one(P, q, out):
-    """End pose of one configuration of the packed chain ``P`` into ``out (4, 4)`` (the
+def fk_one(address, q, out):
+    """End pose of one configuration of the packed chain at ``address`` into ``out (4, 4)`` (the
     caller's: an array made in the kernel costs more to hand to Python than to fill); returns
     :data:`DONE`, :data:`NOT_FINITE` or :data:`WRONG_LENGTH` (``out`` untouched)."""
-    if _wrong_length(P, q):
-        return WRONG_LENGTH
-    C, o = _unpack(P, q)
-    if C is None:
-        return NOT_FINITE
-    n = q.shape[0]
-    t = _start(C[0])
-    for i in range(n):
-        t = _step(C[i + 1], int(P[o + i]), P[o + n + i], q[i], t)
+    n, P, W = _packed_at(address)
+    refused = _refused(n, q)
+    if refused:
+        return refused
+    t = (P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], P[9], P[10], P[11])
+    for j0 in range(0, n, 8):
+        sincos_eight(q, j0, W)
+        for i in range(j0, min(n, j0 + 8)):
+            t = _packed_step(P, i, n, W[i - j0], W[8 + i - j0], q[i], t)
     _store(t, out)
     return DONE
 
@@ -158,21 +208,20 @@ def _jac_column(t, kind, h, J, j):
 
 
 @nb.njit(**_ONE)
-def jacobian_one(P, q, J):
-    """Space Jacobian of one configuration of the packed chain ``P`` into ``J (6, n)``; returns
-    :data:`DONE`, :data:`NOT_FINITE` or :data:`WRONG_LENGTH` (``J`` untouched)."""
-    if _wrong_length(P, q):
-        return WRONG_LENGTH
-    C, o = _unpack(P, q)
-    if C is None:
-        return NOT_FINITE
-    n = q.shape[0]
-    t = _start(C[0])
-    for i in range(n):
-        kind = int(P[o + i])
-        h = P[o + n + i]
-        _jac_column(t, kind, h, J, i)
-        t = _step(C[i + 1], kind, h, q[i], t)
+def jacobian_one(address, q, J):
+    """Space Jacobian of one configuration of the packed chain at ``address`` into ``J (6, n)``;
+    returns :data:`DONE`, :data:`NOT_FINITE` or :data:`WRONG_LENGTH` (``J`` untouched)."""
+    n, P, W = _packed_at(address)
+    refused = _refused(n, q)
+    if refused:
+        return refused
+    o = 16 * (n + 1)
+    t = (P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], P[9], P[10], P[11])
+    for j0 in range(0, n, 8):
+        sincos_eight(q, j0, W)
+        for i in range(j0, min(n, j0 + 8)):
+            _jac_column(t, int(P[o + i]), P[o + n + i], J, i)
+            t = _packed_step(P, i, n, W[i - j0], W[8 + i - j0], q[i], t)
     return DONE
 
 
@@ -368,17 +417,18 @@ _ENTRY: dict[str, object] = {}
 
 
 def single_entry(name: str):
-    """The compiled entry point of ``fk_one`` or ``jacobian_one`` for (packed chain: read-only
-    C-contiguous float64, q: float64 vector of any stride, out: C-contiguous 2-D float64),
-    bypassing Numba's per-call type dispatch (the one specialisation they are compiled for).
+    """The compiled entry point of ``fk_one`` or ``jacobian_one`` for (address of a packed
+    chain: ``KernelData.address``, q: float64 vector of any stride, out: C-contiguous 2-D
+    float64), bypassing Numba's per-call type dispatch (the one specialisation they are
+    compiled for).
 
-    Callers must pass exactly those types (``q`` a 1-D float64 ndarray, ``out`` from
-    ``np.empty``): the entry point checks no type, only ``q``'s length and values.
+    Callers must pass exactly those types (an address from a live ``KernelData``, ``q`` a 1-D
+    float64 ndarray, ``out`` from ``np.empty``): the entry point checks no type, only ``q``'s
+    length and values.
     """
     ep = _ENTRY.get(name)
     if ep is None:
-        ro = nb.types.Array(nb.float64, 1, "C", readonly=True)
         vec = nb.types.Array(nb.float64, 1, "A")
         out = nb.types.Array(nb.float64, 2, "C")
-        ep = _ENTRY[name] = globals()[name].compile((ro, vec, out))
+        ep = _ENTRY[name] = globals()[name].compile((nb.types.intp, vec, out))
     return ep

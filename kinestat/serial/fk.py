@@ -90,13 +90,13 @@ def _nonfinite() -> InputError:
 
 def evaluate(model: ChainModel, q, entry, batch, tail: tuple[int, ...]) -> np.ndarray:
     """Run a compiled chain kernel on checked joint values ``q (..., n)``: the single entry
-    point ``entry()(packed, q, out)`` for one configuration, ``batch(constants, kinds, pitches,
+    point ``entry()(address, q, out)`` for one configuration, ``batch(constants, kinds, pitches,
     Q, out)`` into ``out (N, *tail)`` otherwise; shaped ``(..., *tail)``."""
     q = _as_q(model, q)
     d = kernel_data(model)
     if q.ndim == 1:
         out = np.empty(tail)
-        if entry()(d.packed, q, out):
+        if entry()(d.address, q, out):
             out = None
     else:
         Q = np.ascontiguousarray(q.reshape(-1, model.n))
@@ -106,6 +106,21 @@ def evaluate(model: ChainModel, q, entry, batch, tail: tuple[int, ...]) -> np.nd
     if out is None:
         raise _nonfinite()
     return out
+
+
+#: the model of the last one-configuration call and its kernel data, in one tuple (one
+#: assignment: another thread sees the old pair or the new one); holding the model keeps its id
+#: from being reused. An identity test costs less than the cache's lookup by id.
+_last: tuple = (None, None)
+
+
+def remember(model: ChainModel):
+    """The kernel data of ``model`` if built (None otherwise), kept as :data:`_last`."""
+    global _last
+    d = _BY_ID.get(id(model))
+    if d is not None:
+        _last = (model, d)
+    return d
 
 
 _F64 = np.dtype(np.float64)
@@ -131,10 +146,11 @@ def fk(model: ChainModel, q) -> np.ndarray:
     # per-call type dispatch; it checks q's length and values); anything else, and any error,
     # through the checked path
     if type(q) is _ND and q.ndim == 1 and q.dtype is _F64:
-        d = _BY_ID.get(id(model))
+        last = _last
+        d = last[1] if last[0] is model else remember(model)
         if d is not None:
             out = _empty(_S44)
-            if not (_FK_ONE or _fk_entry())(d.packed, q, out):
+            if not (_FK_ONE or _fk_entry())(d.address, q, out):
                 return out
     return evaluate(model, q, lambda: _FK_ONE or _fk_entry(), kernels().fk_batch, _S44)
 
