@@ -35,8 +35,9 @@ class KernelData:
         kinds: ``(n,)`` int64 :class:`~kinestat.mechanism.joints.JointKind` codes.
         pitches: ``(n,)``.
         packed: n, the constants, the kinds (as floats) and the pitches in one vector.
-        address: where ``packed``'s data are, followed by 16 values of scratch (what
-            ``fk_one`` and ``jacobian_one`` take).
+        address: where ``packed``'s data are, as a float (exact: addresses are below
+            2**53; a float reaches a compiled function faster than a large int); what
+            ``fk_one`` and ``jacobian_one`` take.
         lower, upper: joint limits ``(n,)``.
         jshape: ``(6, n)``, the shape of one Jacobian.
         scale: :func:`~kinestat.serial.lengths.characteristic_length` of the model (no q),
@@ -53,12 +54,9 @@ class KernelData:
         kinds.setflags(write=False)
         self.kinds = kinds
         self.pitches = _ro(model.pitches)
-        # the kernels' scratch (16 values) follows the packed chain in one buffer
-        buf = np.concatenate([[float(model.n)], self.constants.ravel(), kinds.astype(float),
-                              self.pitches, np.zeros(16)])
-        self.packed = buf[:-16]
-        self.packed.setflags(write=False)
-        self.address = buf.ctypes.data
+        self.packed = _ro(np.concatenate([[float(model.n)], self.constants.ravel(),
+                                          kinds.astype(float), self.pitches]))
+        self.address = float(self.packed.ctypes.data)
         self.lower = _ro(model.lower)
         self.upper = _ro(model.upper)
         self.scale: float | None = None  # set by kinestat.serial.ik on first use

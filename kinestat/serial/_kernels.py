@@ -20,7 +20,7 @@ from numba.extending import intrinsic
 from kinestat.mechanism.joints import JointKind
 from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
-from kinestat.serial._sincos import sincos, sincos_block, sincos_eight
+from kinestat.serial._sincos import sincos, sincos_block
 
 #: joint kind codes as plain ints (Numba freezes them at compile time)
 PRISMATIC = int(JointKind.PRISMATIC)
@@ -115,13 +115,11 @@ def _f64_pointer(typingctx, address):
 @nb.njit(**_INLINE)
 def _packed_at(address):
     """The packed chain at ``address`` (``KernelData.address``: ``n``, then the ``16 (n+1)``
-    constants, the ``n`` kinds, the ``n`` pitches and 16 values of scratch) as ``(n, P, W)``,
-    ``P`` without ``n``, ``W`` the scratch. An address costs the entry point less than one more
-    array to take from Python; the kernels that write ``W`` hold the GIL, so one call at a time
-    uses it."""
-    n = int(nb.carray(_f64_pointer(address), (1,))[0])
-    P = nb.carray(_f64_pointer(address + 8), (18 * n + 16,))
-    return n, P, nb.carray(_f64_pointer(address + 8 * (18 * n + 17)), (16,))
+    constants, the ``n`` kinds and the ``n`` pitches) as ``(n, P)``, ``P`` without ``n``. An
+    address costs the entry point less than one more array to take from Python."""
+    a = np.intp(address)
+    n = int(nb.carray(_f64_pointer(a), (1,))[0])
+    return n, nb.carray(_f64_pointer(a + 8), (18 * n + 16,))
 
 
 @nb.njit(**_INLINE)
@@ -168,20 +166,30 @@ def _packed_step(P, i, n, s, c, qi, t):
     return _affine_at(P, 16 * (i + 1), t)
 
 
+@nb.njit(**_INLINE)
+def _next_sincos(q, i):
+    """``(sin, cos)`` of ``q[i]``, ``(0, 1)`` past the end: the kernels take the pair of the
+    next joint while the running transform goes through this one (the two overlap)."""
+    if i < q.shape[0]:
+        return sincos(q[i])
+    return 0.0, 1.0
+
+
 @nb.njit(**_ONE)
 def fk_one(address, q, out):
     """End pose of one configuration of the packed chain at ``address`` into ``out (4, 4)`` (the
     caller's: an array made in the kernel costs more to hand to Python than to fill); returns
     :data:`DONE`, :data:`NOT_FINITE` or :data:`WRONG_LENGTH` (``out`` untouched)."""
-    n, P, W = _packed_at(address)
+    n, P = _packed_at(address)
     refused = _refused(n, q)
     if refused:
         return refused
     t = (P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], P[9], P[10], P[11])
-    for j0 in range(0, n, 8):
-        sincos_eight(q, j0, W)
-        for i in range(j0, min(n, j0 + 8)):
-            t = _packed_step(P, i, n, W[i - j0], W[8 + i - j0], q[i], t)
+    s, c = _next_sincos(q, 0)
+    for i in range(n):
+        si, ci = s, c
+        s, c = _next_sincos(q, i + 1)
+        t = _packed_step(P, i, n, si, ci, q[i], t)
     _store(t, out)
     return DONE
 
@@ -211,17 +219,18 @@ def _jac_column(t, kind, h, J, j):
 def jacobian_one(address, q, J):
     """Space Jacobian of one configuration of the packed chain at ``address`` into ``J (6, n)``;
     returns :data:`DONE`, :data:`NOT_FINITE` or :data:`WRONG_LENGTH` (``J`` untouched)."""
-    n, P, W = _packed_at(address)
+    n, P = _packed_at(address)
     refused = _refused(n, q)
     if refused:
         return refused
     o = 16 * (n + 1)
     t = (P[0], P[1], P[2], P[3], P[4], P[5], P[6], P[7], P[8], P[9], P[10], P[11])
-    for j0 in range(0, n, 8):
-        sincos_eight(q, j0, W)
-        for i in range(j0, min(n, j0 + 8)):
-            _jac_column(t, int(P[o + i]), P[o + n + i], J, i)
-            t = _packed_step(P, i, n, W[i - j0], W[8 + i - j0], q[i], t)
+    s, c = _next_sincos(q, 0)
+    for i in range(n):
+        si, ci = s, c
+        s, c = _next_sincos(q, i + 1)
+        _jac_column(t, int(P[o + i]), P[o + n + i], J, i)
+        t = _packed_step(P, i, n, si, ci, q[i], t)
     return DONE
 
 
@@ -430,5 +439,5 @@ def single_entry(name: str):
     if ep is None:
         vec = nb.types.Array(nb.float64, 1, "A")
         out = nb.types.Array(nb.float64, 2, "C")
-        ep = _ENTRY[name] = globals()[name].compile((nb.types.intp, vec, out))
+        ep = _ENTRY[name] = globals()[name].compile((nb.float64, vec, out))
     return ep

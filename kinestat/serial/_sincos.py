@@ -9,9 +9,8 @@ exact), and the Taylor series of ``sin r`` to ``r**15`` and of ``cos r`` to ``r*
 2 units in the last place (the tests check it against ``np.sin``/``np.cos``); larger or
 non-finite angles go to ``math.sin``/``math.cos``.
 
-The kernels of :mod:`kinestat.serial._kernels` use it for every joint angle: eight joints of one
-configuration at a time, or one joint over a block of configurations (LLVM turns both loops into
-SIMD code).
+The kernels of :mod:`kinestat.serial._kernels` use it for every joint angle, one configuration
+at a time and over blocks of configurations (where LLVM turns the loop into SIMD code).
 """
 
 from __future__ import annotations
@@ -24,7 +23,7 @@ import numpy as np
 
 from kinestat.serial._numba_options import INLINE as _INLINE
 
-__all__ = ["sincos", "sincos_block", "sincos_eight", "PIO2_1", "PIO2_2", "PIO2_3", "LARGE"]
+__all__ = ["sincos", "sincos_block", "PIO2_1", "PIO2_2", "PIO2_3", "LARGE"]
 
 #: π to 60 digits, split below into three doubles
 _PI = Fraction("3.14159265358979323846264338327950288419716939937510582097494459")
@@ -59,9 +58,14 @@ def _reduced(x):
     k = math.floor(x * _TWO_OVER_PI + 0.5)
     r = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3
     z = r * r
-    s = r + r * z * (_S3 + z * (_S5 + z * (_S7 + z * (_S9 + z * (_S11 + z * (_S13 + z * _S15))))))
-    c = 1.0 - 0.5 * z + z * z * (_C4 + z * (_C6 + z * (_C8 + z * (_C10 + z * (_C12 + z * (
-        _C14 + z * _C16))))))
+    # the series in z = r² by Estrin's scheme (pairs, then powers z², z⁴): a third of Horner's
+    # chain of dependent operations, which bounds a single call
+    z2 = z * z
+    z4 = z2 * z2
+    s = r + r * z * ((_S3 + _S5 * z) + z2 * (_S7 + _S9 * z)
+                     + z4 * ((_S11 + _S13 * z) + z2 * _S15))
+    c = (1.0 - 0.5 * z) + z2 * ((_C4 + _C6 * z) + z2 * (_C8 + _C10 * z)
+                                + z4 * ((_C12 + _C14 * z) + z2 * _C16))
     # sin x = a sin r + b cos r, cos x = a cos r − b sin r with (a, b) = (1, 0), (0, 1),
     # (−1, 0), (0, −1) by quadrant: exact (products by 0 and ±1), and no branch for a random
     # angle to mispredict
@@ -92,18 +96,3 @@ def sincos_block(x, s, c, m):
             s[b] = math.sin(x[b])
             c[b] = math.cos(x[b])
 
-
-@nb.njit(**_INLINE)
-def sincos_eight(q, j0, W):
-    """The sines and cosines of ``q[j0:j0+8]`` (as many as there are) into ``W[0:8]`` and
-    ``W[8:16]``: eight angles, one SIMD pass (a fixed count the compiler unrolls)."""
-    m = min(8, q.shape[0] - j0)
-    for j in range(8):
-        W[j] = q[j0 + j] if j < m else 0.0
-    for j in range(8):
-        W[j], W[8 + j] = _reduced(W[j])
-    for j in range(m):
-        x = q[j0 + j]
-        if not abs(x) < LARGE:
-            W[j] = math.sin(x)
-            W[8 + j] = math.cos(x)
