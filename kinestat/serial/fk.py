@@ -112,7 +112,7 @@ def evaluate(model: ChainModel, q, entry, batch, tail: tuple[int, ...]) -> np.nd
 #: arguments (address, Jacobian shape), in one tuple (one assignment: another thread sees the
 #: old tuple or the new one); holding the model keeps its id from being reused. An identity test
 #: costs less than the cache's lookup by id.
-_last: tuple = (None, None, 0.0, (6, 0))
+_last: tuple = (object(), None, 0.0, (6, 0))  # matches no argument (not even None)
 
 
 def remember(model: ChainModel) -> tuple | None:

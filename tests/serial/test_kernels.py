@@ -182,3 +182,19 @@ def test_batches_over_many_blocks(rng):
                 kinestat.fk(m, bad)
             with pytest.raises(InputError, match="NaN"):
                 fk_and_jacobian(m, bad)
+
+
+def test_single_calls_alternating_models_use_each_models_chain(rng):
+    """The one-configuration path remembers the last model: calls alternating between models
+    (same and different joint counts, one seen for the first time) each get their own chain."""
+    models = [kinestat.load("puma560"), kinestat.load("puma762"), random_chain(rng),
+              random_chain(rng)]
+    for _ in range(3):
+        for m in models:
+            q = rng.uniform(-3, 3, m.n)
+            np.testing.assert_allclose(kinestat.fk(m, q), fk_reference(m, q), atol=1e-12)
+            np.testing.assert_allclose(kinestat.jacobian(m, q), jacobian_reference(m, q),
+                                       atol=1e-12)
+        models.append(random_chain(rng))
+    with pytest.raises(AttributeError):  # not a model: an error (never the memo's empty slot)
+        kinestat.fk(None, np.zeros(6))
