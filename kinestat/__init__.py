@@ -11,12 +11,22 @@ The stable top-level API::
 
 from __future__ import annotations
 
+import os
+
 import lazy_loader
+
+# The batch kernels run over the cores on OpenMP threads (Numba). libgomp's default lets a
+# worker spin for milliseconds before it sleeps, and on a machine whose cores are shared that
+# spinning takes the core from the thread the batch waits for (twice the wall time, measured on
+# 2 cores); the workers sleep instead, unless the user chose otherwise.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 __version__ = "0.2.0"  # the one place the version is written (pyproject reads it)
 
-# the public names load with their module on first use (PEP 562, lazy_loader)
-__getattr__, __dir__, __all__ = lazy_loader.attach(
+# the public names load with their module on first use (PEP 562, lazy_loader), and are then
+# kept as the module's attributes: later uses do not go through __getattr__ (a twentieth of a
+# one-configuration fk call)
+_lazy_getattr, __dir__, __all__ = lazy_loader.attach(
     __name__,
     submodules=None,
     submod_attrs={
@@ -29,6 +39,12 @@ __getattr__, __dir__, __all__ = lazy_loader.attach(
         'serial.jacobian': ['jacobian'],
     },
 )
+
+
+def __getattr__(name: str):
+    value = _lazy_getattr(name)
+    globals()[name] = value
+    return value
 
 
 def _run_spec(spec, **kw):

@@ -80,6 +80,7 @@ def _warm_serial() -> None:
     m = load("puma762")
     q = np.zeros(m.n)
     fk(m, q), fk(m, q[None]), fk_frames(m, q), jacobian(m, q), jacobian(m, q[None])
+    fk(m, np.zeros((4096, m.n)))  # a batch this large runs over the cores (another kernel)
 
 
 def _warm_ik() -> None:

@@ -34,16 +34,18 @@ class KernelData:
         constants: ``(n+1, 4, 4)`` C-contiguous.
         kinds: ``(n,)`` int64 :class:`~kinestat.mechanism.joints.JointKind` codes.
         pitches: ``(n,)``.
-        packed: constants, kinds (as floats) and pitches in one vector (``fk_one``,
-            ``jacobian_one``).
+        packed: n, the constants, the kinds (as floats) and the pitches in one vector.
+        address: where ``packed``'s data are, as a float (exact: addresses are below
+            2**53; a float reaches a compiled function faster than a large int); what
+            ``fk_one`` and ``jacobian_one`` take.
         lower, upper: joint limits ``(n,)``.
         jshape: ``(6, n)``, the shape of one Jacobian.
         scale: :func:`~kinestat.serial.lengths.characteristic_length` of the model (no q),
             filled in by :mod:`kinestat.serial.ik` on first use.
     """
 
-    __slots__ = ("n", "constants", "kinds", "pitches", "packed", "lower", "upper", "scale",
-                 "jshape")
+    __slots__ = ("n", "constants", "kinds", "pitches", "packed", "address", "lower", "upper",
+                 "scale", "jshape")
 
     def __init__(self, model: ChainModel) -> None:
         self.n = model.n
@@ -52,8 +54,9 @@ class KernelData:
         kinds.setflags(write=False)
         self.kinds = kinds
         self.pitches = _ro(model.pitches)
-        self.packed = _ro(np.concatenate([self.constants.ravel(), kinds.astype(float),
-                                          self.pitches]))
+        self.packed = _ro(np.concatenate([[float(model.n)], self.constants.ravel(),
+                                          kinds.astype(float), self.pitches]))
+        self.address = float(self.packed.ctypes.data)
         self.lower = _ro(model.lower)
         self.upper = _ro(model.upper)
         self.scale: float | None = None  # set by kinestat.serial.ik on first use
@@ -75,7 +78,7 @@ def kernel_data(model: ChainModel) -> KernelData:
     >>> m = from_standard_dh([[0.0, 0.0, 1.0, 0.0]])
     >>> d = kernel_data(m)
     >>> d.n, d.packed.shape, kernel_data(m) is d
-    (1, (34,), True)
+    (1, (35,), True)
     """
     d = _BY_ID.get(id(model))
     if d is None:

@@ -90,13 +90,13 @@ def _nonfinite() -> InputError:
 
 def evaluate(model: ChainModel, q, entry, batch, tail: tuple[int, ...]) -> np.ndarray:
     """Run a compiled chain kernel on checked joint values ``q (..., n)``: the single entry
-    point ``entry()(packed, q, out)`` for one configuration, ``batch(constants, kinds, pitches,
+    point ``entry()(address, q, out)`` for one configuration, ``batch(constants, kinds, pitches,
     Q, out)`` into ``out (N, *tail)`` otherwise; shaped ``(..., *tail)``."""
     q = _as_q(model, q)
     d = kernel_data(model)
     if q.ndim == 1:
         out = np.empty(tail)
-        if entry()(d.packed, q, out):
+        if entry()(d.address, q, out):
             out = None
     else:
         Q = np.ascontiguousarray(q.reshape(-1, model.n))
@@ -106,6 +106,24 @@ def evaluate(model: ChainModel, q, entry, batch, tail: tuple[int, ...]) -> np.nd
     if out is None:
         raise _nonfinite()
     return out
+
+
+#: the model of the last one-configuration call, its kernel data and their entry points'
+#: arguments (address, Jacobian shape), in one tuple (one assignment: another thread sees the
+#: old tuple or the new one); holding the model keeps its id from being reused. An identity test
+#: costs less than the cache's lookup by id.
+_last: tuple = (object(), None, 0.0, (6, 0))  # matches no argument (not even None)
+
+
+def remember(model: ChainModel) -> tuple | None:
+    """Keep ``model`` as :data:`_last` if its kernel data are built, and return that tuple
+    (None if they are not built)."""
+    global _last
+    d = _BY_ID.get(id(model))
+    if d is None:
+        return None
+    _last = last = (model, d, d.address, d.jshape)
+    return last
 
 
 _F64 = np.dtype(np.float64)
@@ -131,10 +149,12 @@ def fk(model: ChainModel, q) -> np.ndarray:
     # per-call type dispatch; it checks q's length and values); anything else, and any error,
     # through the checked path
     if type(q) is _ND and q.ndim == 1 and q.dtype is _F64:
-        d = _BY_ID.get(id(model))
-        if d is not None:
+        last = _last  # read once: another thread may replace it
+        if last[0] is not model:
+            last = remember(model)
+        if last is not None:
             out = _empty(_S44)
-            if not (_FK_ONE or _fk_entry())(d.packed, q, out):
+            if not (_FK_ONE or _fk_entry())(last[2], q, out):
                 return out
     return evaluate(model, q, lambda: _FK_ONE or _fk_entry(), kernels().fk_batch, _S44)
 

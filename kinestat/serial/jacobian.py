@@ -13,7 +13,7 @@ import numpy as np
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial import fk as _fkmod
-from kinestat.serial._kernel_cache import _BY_ID, kernel_data
+from kinestat.serial._kernel_cache import kernel_data
 from kinestat.serial.fk import _F64, _ND, _as_q, _empty
 
 __all__ = ["jacobian", "jacobian_from_frames", "fk_and_jacobian"]
@@ -53,10 +53,12 @@ def jacobian(model: ChainModel, q) -> np.ndarray:
     # per-call type dispatch; it checks q's length and values); anything else, and any error,
     # through the checked path
     if type(q) is _ND and q.ndim == 1 and q.dtype is _F64:
-        d = _BY_ID.get(id(model))
-        if d is not None:
-            J = _empty(d.jshape)
-            if not (_JAC_ONE or _jac_entry())(d.packed, q, J):
+        last = _fkmod._last  # read once: another thread may replace it
+        if last[0] is not model:
+            last = _fkmod.remember(model)
+        if last is not None:
+            J = _empty(last[3])
+            if not (_JAC_ONE or _jac_entry())(last[2], q, J):
                 return J
     return _fkmod.evaluate(model, q, lambda: _JAC_ONE or _jac_entry(),
                            _fkmod.kernels().jacobian_batch, (6, model.n))

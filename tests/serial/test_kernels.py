@@ -123,3 +123,78 @@ def test_single_configuration_fast_path_is_bit_identical_and_errs_once(rng):
         # a non-native byte order or another dtype is converted by the checked path
         assert np.array_equal(f(m, Q[0].astype(">f8")), f(m, Q[0]))
         assert np.array_equal(f(m, Q[0].astype(np.float32)), f(m, Q[0].astype(np.float32).tolist()))
+
+
+def test_sincos_agrees_with_numpy_within_two_ulps(rng):
+    """The kernels' branch-free sine-cosine pair against NumPy's (the reference's), over the
+    joint range, large angles (the C-library fall-back), tiny ones and exact quadrants."""
+    import numba as nb
+
+    from kinestat.serial._sincos import LARGE, PIO2_1, PIO2_2, PIO2_3, sincos, sincos_block
+
+    @nb.njit
+    def both(x):
+        s, c = np.empty_like(x), np.empty_like(x)
+        sincos_block(x, s, c, x.shape[0])
+        s1, c1 = np.empty_like(x), np.empty_like(x)
+        for k in range(x.shape[0]):
+            s1[k], c1[k] = sincos(x[k])
+        return s, c, s1, c1
+
+    x = np.concatenate([rng.uniform(-7, 7, 20000), rng.uniform(-1e4, 1e4, 5000),
+                        rng.normal(0, 1e-9, 100), np.arange(-64, 65) * np.pi / 4,
+                        [0.0, -0.0, LARGE, -LARGE, 1e300, 5e-324]])
+    s, c, s1, c1 = both(x)
+    assert np.array_equal(s, s1) and np.array_equal(c, c1)
+    for got, want in ((s, np.sin(x)), (c, np.cos(x))):
+        ulps = np.abs(got - want) / np.spacing(np.maximum(np.abs(want), 1e-300))
+        assert ulps.max() <= 2.0
+    # π/2 split in three: their sum is π/2 to far beyond double precision
+    from fractions import Fraction
+
+    pi = Fraction("3.14159265358979323846264338327950288419716939937510582097494459")
+    err = Fraction(PIO2_1) + Fraction(PIO2_2) + Fraction(PIO2_3) - pi / 2
+    assert abs(float(err)) < 1e-35
+    s, c, _, _ = both(np.array([np.nan, np.inf, -np.inf]))
+    assert np.isnan(s).all() and np.isnan(c).all()
+
+
+def test_batches_over_many_blocks(rng):
+    """Batches long enough for the parallel kernel (several blocks, a partial last one): the
+    reference's values, the single-configuration kernels' bits, and a non-finite row anywhere
+    rejected."""
+    from kinestat.serial._kernels import _PARALLEL_MIN, BLOCK
+
+    for _ in range(3):
+        m = random_chain(rng)
+        N = _PARALLEL_MIN + BLOCK + 37
+        q = rng.uniform(-4, 4, (N, m.n))
+        T, J = kinestat.fk(m, q), kinestat.jacobian(m, q)
+        np.testing.assert_allclose(T, fk_reference(m, q), atol=1e-12)
+        np.testing.assert_allclose(J, jacobian_reference(m, q), atol=1e-12)
+        for k in (0, BLOCK - 1, BLOCK, N - 1):
+            assert np.array_equal(kinestat.fk(m, q[k]), T[k])
+            assert np.array_equal(kinestat.jacobian(m, q[k]), J[k])
+        for row in (0, N - 1, int(rng.integers(N))):
+            bad = q.copy()
+            bad[row, int(rng.integers(m.n))] = rng.choice([np.nan, np.inf, -np.inf])
+            with pytest.raises(InputError, match="NaN"):
+                kinestat.fk(m, bad)
+            with pytest.raises(InputError, match="NaN"):
+                fk_and_jacobian(m, bad)
+
+
+def test_single_calls_alternating_models_use_each_models_chain(rng):
+    """The one-configuration path remembers the last model: calls alternating between models
+    (same and different joint counts, one seen for the first time) each get their own chain."""
+    models = [kinestat.load("puma560"), kinestat.load("puma762"), random_chain(rng),
+              random_chain(rng)]
+    for _ in range(3):
+        for m in models:
+            q = rng.uniform(-3, 3, m.n)
+            np.testing.assert_allclose(kinestat.fk(m, q), fk_reference(m, q), atol=1e-12)
+            np.testing.assert_allclose(kinestat.jacobian(m, q), jacobian_reference(m, q),
+                                       atol=1e-12)
+        models.append(random_chain(rng))
+    with pytest.raises(AttributeError):  # not a model: an error (never the memo's empty slot)
+        kinestat.fk(None, np.zeros(6))
