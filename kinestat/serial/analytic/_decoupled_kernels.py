@@ -24,13 +24,11 @@ from kinestat.serial._kernels import _jac_column, _start, _step
 from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._cf_kernels import (
-    _NONE,
     _add,
     _cross,
     _dot,
     _mm,
     _mtm,
-    _mtv,
     _mv,
     _norm,
     _rot,
@@ -38,8 +36,8 @@ from kinestat.serial.analytic._cf_kernels import (
     _row,
     _scale,
     _sp1,
-    _sp2,
     _sub,
+    spherical_wrist,
 )
 from kinestat.serial.analytic._hqr import eigvals
 from kinestat.serial.analytic._solution_kernels import (
@@ -486,21 +484,12 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
                 if kinds[i] == _R:
                     R = _mm(R, _rot(_row(W, i), (q123[i], math.cos(q123[i]), math.sin(q123[i]))))
             Rp = _mtm(R, Rg)
-            target = _mv(Rp, W5)
-            near = _norm(_cross(W3, target)) < 1e-6
-            sing = _norm(_cross(W3, target)) < wrist_tol
-            if sing:  # θ4 free: θ4 = 0, align ω6 with θ5 alone
-                t4a = t4b = _NONE
-                t5a = t5b = _sp1(W4, _Z3, W5, target)
-            else:
-                ok45, t4a, t5a, t4b, t5b = _sp2(W3, W4, _Z3, W5, target, tol)
-                if not ok45:
-                    continue
+            ok45, off, sing, branches = spherical_wrist(W3, W4, W5, Rp, xs, tol, wrist_tol)
+            if not ok45:
+                continue
+            near = off < 1e-6
             for i45 in range(2):
-                t4 = t4a if i45 == 0 else t4b
-                t5 = t5a if i45 == 0 else t5b
-                R5 = _rot(W4, t5)
-                t6 = _sp1(W5, _Z3, xs, _mtv(_mm(_rot(W3, t4), R5), _mv(Rp, xs)))
+                t4, t5, t6, sig = branches[i45]
                 q[0], q[1], q[2] = q123[0], q123[1], q123[2]
                 q[3], q[4], q[5] = t4[0], t5[0], t6[0]
                 if miss > 0.01 * tol or near:
@@ -508,7 +497,6 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
                 pos, err = pose_errors(_fk(C, jk, q), Tn)
                 if not (pos <= tol and err <= tol):
                     continue
-                sig = 1.0 if _dot(W3, _mv(R5, W5)) >= 0.0 else -1.0
                 cnt = _store(n, q, rot, pos, err, sing, sig, wrap(t4[0] + sig * t6[0]), dedup,
                              out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
                              cnt)

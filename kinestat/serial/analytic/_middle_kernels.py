@@ -21,8 +21,6 @@ import numpy as np
 from kinestat.serial._kernels import _start
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._cf_kernels import (
-    _NONE,
-    _cross,
     _dot,
     _link,
     _mm,
@@ -30,12 +28,11 @@ from kinestat.serial.analytic._cf_kernels import (
     _mtm,
     _mtv,
     _mv,
-    _norm,
     _rot,
     _row,
     _sp1,
-    _sp2,
     _sub,
+    spherical_wrist,
 )
 from kinestat.serial.analytic._decoupled_kernels import (
     K,
@@ -131,21 +128,12 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
             R6 = _rot(W6, a6)
             f1 = _link(C, 1, a1, f0)
             Rp = _mmt(_mmt(_mtm(R1, Rg), R6), R5)  # R2 R3 R4 = R1ᵀ R_G R6ᵀ R5ᵀ
-            target = _mv(Rp, W4)
-            near = _norm(_cross(W2, target)) < 1e-6
-            sing = _norm(_cross(W2, target)) < wrist_tol
-            if sing:  # θ2 free: θ2 = 0, align ω4 with θ3 alone
-                t2a = t2b = _NONE
-                t3a = t3b = _sp1(W3, _Z3, W4, target)
-            else:
-                ok23, t2a, t3a, t2b, t3b = _sp2(W2, W3, _Z3, W4, target, tol)
-                if not ok23:
-                    continue
+            ok23, off, sing, branches = spherical_wrist(W2, W3, W4, Rp, xs, tol, wrist_tol)
+            if not ok23:
+                continue
+            near = off < 1e-6
             for i23 in range(2):
-                t2 = t2a if i23 == 0 else t2b
-                t3 = t3a if i23 == 0 else t3b
-                R3 = _rot(W3, t3)
-                t4 = _sp1(W4, _Z3, xs, _mtv(_mm(_rot(W2, t2), R3), _mv(Rp, xs)))
+                t2, t3, t4, sig = branches[i23]
                 q[0], q[1], q[2], q[3], q[4], q[5] = t1, t2[0], t3[0], t4[0], t5, t6
                 if miss > 0.01 * tol or near:
                     _polish_pose(C, jk, Tn, q, 4, 1e-7)
@@ -156,7 +144,6 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
                     pos, err = pose_errors(f, Tn)
                 if not (pos <= tol and err <= tol):
                     continue
-                sig = 1.0 if _dot(W2, _mv(R3, W4)) >= 0.0 else -1.0
                 cnt = _store(n, q, rot, pos, err, sing, sig, wrap(t2[0] + sig * t4[0]), dedup,
                              out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
                              cnt)
