@@ -52,6 +52,7 @@ MODES = {"full": 0, "row0": 1, "row1": 2, "lin": 3, "perp": 4, "pp": 5}
 _FULL, _ROW0, _ROW1, _LIN, _PERP, _PP = 0, 1, 2, 3, 4, 5
 _R = 0  # joint kinds of joints 1-3 (1: prismatic)
 _Z3 = (0.0, 0.0, 0.0)
+_I3 = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 K = 8  # solution slots
 
 
@@ -79,7 +80,7 @@ def _move(kind, w, r, q, x):
     return _add(x, _scale(w, q))
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _terms(D, kinds, y, p, h, rho2):
     """``(C0, C1, vp0, vp1)`` of ``g_kᵀ Rot(q2) v⊥ + C_k`` (revolute joint 2)."""
     W, r1, r2, e, u = D[2], D[5], D[6], D[8], D[9]
@@ -101,7 +102,7 @@ def _terms(D, kinds, y, p, h, rho2):
     return c0, c1, vp0, vp1
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _eliminant(D, kinds, mode, y, p, h, rho2):
     """Ψ at the wrist-centre image y (``decoupled._eliminant``)."""
     W, r1, G, u = D[2], D[5], D[7], D[9]
@@ -127,7 +128,7 @@ def _eliminant(D, kinds, mode, y, p, h, rho2):
     return _dot(z, z) - a * a * rho2
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _joint2(D, kinds, mode, y, p, h, rho2, snap):
     """``(count, q2a, q2b, ok)``: joint 2 for the wrist-centre image y (``decoupled._joint2``)."""
     W, r1, G, u = D[2], D[5], D[7], D[9]
@@ -175,7 +176,28 @@ def _place(D, kinds, q):
     return x
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
+def _axis(kind, w, r, qi, R, o):
+    """Joint axis (ω, r) moved by the joints before it (rotation R, offset o): ``(ω', r', R',
+    o')``, R' and o' then including this joint at qi."""
+    ax = _mv(R, w)
+    pt = _add(_mv(R, r), o)
+    if kind == _R:
+        Ri = _rot(w, (qi, math.cos(qi), math.sin(qi)))
+        o = _add(_mv(R, _sub(r, _mv(Ri, r))), o)
+        R = _mm(R, Ri)
+    else:
+        o = _add(o, _scale(ax, qi))
+    return ax, pt, R, o
+
+
+@nb.njit(**_INLINE)
+def _column(kind, ax, pt, x):
+    """The position Jacobian's column of a joint whose axis is (ax, pt), at the point x."""
+    return _cross(ax, _sub(x, pt)) if kind == _R else ax
+
+
+@nb.njit(**_INLINE)
 def _polish_position(D, kinds, q, p, live, iters):
     """Newton steps on ``M1 M2 M3 w = p`` for ``q (3,)`` in place, each kept where it lowers
     the miss; returns the miss ``|M1 M2 M3 w − p|``."""
@@ -187,25 +209,14 @@ def _polish_position(D, kinds, q, p, live, iters):
         if not (live and fn > small):
             break
         # the position Jacobian: each axis moved by the joints before it
-        R = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
-        o = _Z3
-        ax = [_Z3, _Z3, _Z3]
-        pt = [_Z3, _Z3, _Z3]
-        for i in range(3):
-            Wi, Pi = _row(W, i), _row(P, i)
-            ax[i] = _mv(R, Wi)
-            pt[i] = _add(_mv(R, Pi), o)
-            if kinds[i] == _R:
-                Ri = _rot(Wi, (q[i], math.cos(q[i]), math.sin(q[i])))
-                o = _add(_mv(R, _sub(Pi, _mv(Ri, Pi))), o)
-                R = _mm(R, Ri)
-            else:
-                o = _add(o, _scale(ax[i], q[i]))
+        R, o = _I3, _Z3
+        a0, p0, R, o = _axis(kinds[0], _row(W, 0), _row(P, 0), q[0], R, o)
+        a1, p1, R, o = _axis(kinds[1], _row(W, 1), _row(P, 1), q[1], R, o)
+        a2, p2, R, o = _axis(kinds[2], _row(W, 2), _row(P, 2), q[2], R, o)
         x = _add(_mv(R, (w[0], w[1], w[2])), o)
-        cols = [_Z3, _Z3, _Z3]
-        for i in range(3):
-            cols[i] = _cross(ax[i], _sub(x, pt[i])) if kinds[i] == _R else ax[i]
-        a, b, c = cols[0], cols[1], cols[2]
+        a = _column(kinds[0], a0, p0, x)
+        b = _column(kinds[1], a1, p1, x)
+        c = _column(kinds[2], a2, p2, x)
         det = _dot(a, _cross(b, c))
         if not abs(det) > 1e-300:
             break
@@ -266,7 +277,7 @@ def _polish_pose(C, jk, Tn, q, iters, rcond):
             en = nn
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _store(n, q, rot, pos, err, sing, sig, fam, dedup, out_q, out_valid, out_pos, out_rot,
            out_sing, out_sign, out_fam, cnt):
     """Store q (6,) (revolute joints wrapped) unless it repeats a stored one; the new count."""
@@ -300,34 +311,42 @@ _SIN8 = tuple(math.sin(2.0 * math.pi * j / 8.0) for j in range(8))
 #: the half-angle substitution is taken about this angle (any generic value: a root at
 #: θ = _THETA0 + π, where t = tan(φ/2) is infinite, is then unlikely)
 _THETA0 = 0.4170
+#: ``e^{ikθ0}`` for k = -3 .. 3
+_TURN0 = tuple(complex(math.cos(k * _THETA0), math.sin(k * _THETA0)) for k in range(-3, 4))
+
+
+def _half_angle_table() -> np.ndarray:
+    """``[d - 1, k + 3, j]``: the coefficient of t^j in ``(1 + it)^{d+k} (1 − it)^{d−k}``
+    (Gaussian integers, exact in floating point), d = 1 .. 3, |k| ≤ d."""
+    tab = np.zeros((3, 7, 7), dtype=np.complex128)
+    for d in range(1, 4):
+        for k in range(-d, d + 1):
+            a = np.zeros(7, dtype=np.complex128)
+            a[0] = 1.0
+            for f in range(2 * d):
+                a[1:] = a[1:] + (1j if f < d + k else -1j) * a[:-1]
+            tab[d - 1, k + 3] = a
+    return tab
+
+
+_HALF = _half_angle_table()
 
 
 @nb.njit(**_OPTS)
-def _trig_roots(ck, d, out, Sr, Cs):
+def _trig_roots(ck, d, out, Sr):
     """Real roots θ of the trigonometric polynomial ``Σ_{|k| ≤ d} c_k e^{ikθ}`` (``ck`` holds
     c_{-3} .. c_3) into ``out``; their count. With ``θ = θ0 + φ``, ``t = tan(φ/2)``:
-    ``e^{ikφ} (1 + t²)^d = (1 + it)^{d+k} (1 − it)^{d−k}``, so the polynomial times
-    ``(1 + t²)^d`` is a real polynomial of degree ≤ 2d in t, whose real roots come from its
-    companion matrix (:func:`kinestat.serial.analytic._hqr.eigvals`). ``Sr``, ``Cs``: the
-    scratch of :func:`_roots`."""
+    ``e^{ikφ} (1 + t²)^d = (1 + it)^{d+k} (1 − it)^{d−k}`` (:data:`_HALF`), so the polynomial
+    times ``(1 + t²)^d`` is a real polynomial of degree ≤ 2d in t, whose real roots come from
+    its companion matrix (:func:`kinestat.serial.analytic._hqr.eigvals`). ``Sr``: the scratch
+    of :func:`_roots`."""
     n2 = 2 * d
     P = Sr[9:16]
     P[:] = 0.0
-    a = Cs[7:14]
     for k in range(-d, d + 1):
-        ang = k * _THETA0
-        c = ck[k + 3] * complex(math.cos(ang), math.sin(ang))
-        # a = (1 + it)^{d+k} (1 − it)^{d−k}, low powers first
-        a[:] = 0.0
-        a[0] = 1.0
-        deg = 0
-        for f in range(n2):
-            s = 1j if f < d + k else -1j
-            for j in range(deg + 1, 0, -1):
-                a[j] += s * a[j - 1]
-            deg += 1
+        c = ck[k + 3] * _TURN0[k + 3]
         for j in range(n2 + 1):
-            P[j] += (c * a[j]).real
+            P[j] += (c * _HALF[d - 1, k + 3, j]).real
     big = 0.0
     for j in range(n2 + 1):
         big = max(big, abs(P[j]))
@@ -354,7 +373,7 @@ def _trig_roots(ck, d, out, Sr, Cs):
     return m
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, out, Sr, Cs):
     """Real roots q3 of the eliminant into ``out``; their count. ``Sr (64,)``, ``Cs (16,)``
     complex: scratch."""
@@ -385,7 +404,7 @@ def _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, out, Sr, Cs):
                 break
         if d == 0:
             return 0
-        return _trig_roots(ck, d, out, Sr, Cs)
+        return _trig_roots(ck, d, out, Sr)
     L = 4.0 * scale + _norm(_sub(p, wc))
     psi = Sr[0:9]
     for s in range(9):

@@ -19,6 +19,7 @@ import numba as nb
 import numpy as np
 
 from kinestat.serial._kernels import _start
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._cf_kernels import (
     _dot,
@@ -58,16 +59,16 @@ def _scratch():
             np.empty(3), np.empty(64), np.empty(16, dtype=np.complex128))
 
 
-@nb.njit(**_OPTS)
-def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
-          out_rot, out_sing, out_sign, out_fam, S):
-    """All solutions of pose n; returns the count. ``Kp``: the packed data of
+@nb.njit(**_INLINE)
+def _pose(n, D0, D, kinds, mode, jk, rot, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q,
+          out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, S):
+    """All solutions of pose n; returns the count. ``D0``: the unpacked data
+    (:func:`~kinestat.serial.analytic._decoupled_kernels._unpack`) of
     :func:`~kinestat.serial.analytic._decoupled_kernels.pack` with axis rows (5, 6, 1, 2, 3,
     4), points (5, 6, 1, c, c, c), the point c in the wrist slot and the direction across
-    axis 4 in the x slot. ``S``: :func:`_scratch`."""
-    D0 = _unpack(Kp)
+    axis 4 in the x slot; ``D`` the same with the scratch's axes and points (row 2 and the
+    wrist point are the pose's), ``S``: :func:`_scratch`."""
     C, T0inv, W, P, cw, r1, r2, G2, e, u, x4, scale = D0
-    kinds, mode, jk, rot = ints[0:3], ints[3], ints[4:10], ints[10:16]
     for k in range(K):
         for i in range(6):
             out_q[n, k, i] = np.nan
@@ -86,10 +87,6 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
     tg = _mv(Rt, (T0inv[0, 3], T0inv[1, 3], T0inv[2, 3]))
     tg = (tg[0] + Tn[0, 3], tg[1] + Tn[1, 3], tg[2] + Tn[2, 3])
     Wv, Pv, wv, q3s, q, q123, Sr, Cs = S
-    for i in range(6):
-        for j in range(3):
-            Wv[i, j] = W[i, j]
-            Pv[i, j] = P[i, j]
     w1 = _mtv(Rg, _row(W, 2))
     p1 = _mtv(Rg, _sub(_row(P, 2), tg))
     c = (cw[0], cw[1], cw[2])
@@ -98,7 +95,6 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
         Wv[2, i] = w1[i]
         Pv[2, i] = p1[i]
     wv[0], wv[1], wv[2] = wc[0], wc[1], wc[2]
-    D = (C, T0inv, Wv, Pv, wv, r1, r2, G2, e, u, x4, scale)
     d1 = _sub(c, (r1[0], r1[1], r1[2]))
     h = _dot(d1, _row(W, 0))
     rho2 = _dot(d1, d1)
@@ -150,23 +146,41 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
     return cnt
 
 
+@nb.njit(**_OPTS)
+def _poses(lo, hi, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid,
+           out_pos, out_rot, out_sing, out_sign, out_fam, out_cnt):
+    """Poses lo .. hi − 1 (one call per chunk: the arrays' reference counts, the unpacking and
+    the scratch are paid once per chunk, not per pose)."""
+    D0 = _unpack(Kp)
+    C, T0inv, W, P, cw, r1, r2, G2, e, u, x4, scale = D0
+    S = _scratch()
+    Wv, Pv, wv = S[0], S[1], S[2]
+    for i in range(6):
+        for j in range(3):
+            Wv[i, j] = W[i, j]
+            Pv[i, j] = P[i, j]
+    D = (C, T0inv, Wv, Pv, wv, r1, r2, G2, e, u, x4, scale)
+    kinds, mode, jk, rot = ints[0:3], ints[3], ints[4:10], ints[10:16]
+    for n in range(lo, hi):
+        out_cnt[n] = _pose(n, D0, D, kinds, mode, jk, rot, cheb_t, fit, ctp, T, tol, wrist_tol,
+                           dedup, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
+                           S)
+
+
 @nb.njit(parallel=True, **_OPTS)
 def solve_batch(Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
                 out_rot, out_sing, out_sign, out_fam, out_cnt):
     """All solutions of N poses into the (uninitialised) outputs."""
     N = T.shape[0]
     for c in nb.prange((N + _CHUNK - 1) // _CHUNK):
-        S = _scratch()
-        for n in range(c * _CHUNK, min(N, (c + 1) * _CHUNK)):
-            out_cnt[n] = _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q,
-                               out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, S)
+        _poses(c * _CHUNK, min(N, (c + 1) * _CHUNK), Kp, ints, cheb_t, fit, ctp, T, tol,
+               wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
+               out_cnt)
 
 
 @nb.njit(**_OPTS)
 def solve_serial(Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
                  out_rot, out_sing, out_sign, out_fam, out_cnt):
     """:func:`solve_batch` on one thread."""
-    S = _scratch()
-    for n in range(T.shape[0]):
-        out_cnt[n] = _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q,
-                           out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, S)
+    _poses(0, T.shape[0], Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid,
+           out_pos, out_rot, out_sing, out_sign, out_fam, out_cnt)
