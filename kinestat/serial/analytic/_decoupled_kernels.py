@@ -40,6 +40,7 @@ from kinestat.serial.analytic._cf_kernels import (
     spherical_wrist,
 )
 from kinestat.serial.analytic._hqr import eigvals
+from kinestat.serial.analytic._offset_kernels import quartic_real_roots
 from kinestat.serial.analytic._solution_kernels import (
     _twist_error,
     angle_distance,
@@ -330,6 +331,11 @@ def _half_angle_table() -> np.ndarray:
 
 
 _HALF = _half_angle_table()
+#: a quartic in t whose top coefficient is at least this fraction of the largest is solved in
+#: closed form (:func:`~kinestat.serial.analytic._offset_kernels.quartic_real_roots`: its roots
+#: |t| stay below ~1/_QUARTIC_MIN, where Ferrari's method keeps its accuracy), else by the
+#: companion matrix
+_QUARTIC_MIN = 1e-3
 
 
 @nb.njit(**_OPTS)
@@ -355,6 +361,11 @@ def _trig_roots(ck, d, out, Sr):
         top -= 1
     if top == 0:
         return 0
+    if top == 4 and abs(P[4]) >= _QUARTIC_MIN * big:  # Ferrari, not the companion's QR
+        k, r = quartic_real_roots(P[4], P[3], P[2], P[1], P[0])
+        for i in range(k):
+            out[i] = wrap(_THETA0 + 2.0 * math.atan(r[i]))
+        return k
     A = Sr[16:52].reshape((6, 6))
     A[:, :] = 0.0
     for j in range(top):
