@@ -259,9 +259,9 @@ def _sp4(h, w, p, d, tol):
 def spherical_wrist(wa, wb, wc, Rp, xs, tol, wrist_tol):
     """A spherical wrist, axes ωa, ωb, ωc through the origin, turned to ``Ra Rb Rc = Rp``
     (9-tuple): ``Ra Rb ωc = Rp ωc`` (subproblem 2) gives θa, θb, then ``Rc xs = (Ra Rb)ᵀ Rp
-    xs`` (subproblem 1; xs across ωc) θc. Returns ``(ok, off, sing, branches)``: off =
+    xs`` (subproblem 1; xs across ωc) θc. Returns ``(ok, off, sing, a, b)``: off =
     ``|ωa × Rp ωc|``; sing = off < wrist_tol, the singular set (ωc along ωa: θa and θc turn
-    together), where θa = 0 and θb aligns ωc alone; two branches ``(θa, θb, θc, σ)`` (angle
+    together), where θa = 0 and θb aligns ωc alone; a, b the branches ``(θa, θb, θc, σ)`` (angle
     triples; σ the sign of ``ωa · Rb ωc``: on the singular set the family is θa + σ θc); ok
     False when subproblem 2 has no solution."""
     target = _mv(Rp, wc)
@@ -274,7 +274,7 @@ def spherical_wrist(wa, wb, wc, Rp, xs, tol, wrist_tol):
         ok, taa, tba, tab, tbb = _sp2(wa, wb, _Z3, wc, target, tol)
         if not ok:
             none = (_NONE, _NONE, _NONE, 0.0)
-            return False, off, sing, (none, none)
+            return False, off, sing, none, none
     px = _mv(Rp, xs)
     Rba = _rot(wb, tba)
     Rbb = _rot(wb, tbb)
@@ -282,7 +282,7 @@ def spherical_wrist(wa, wb, wc, Rp, xs, tol, wrist_tol):
     tcb = _sp1(wc, _Z3, xs, _mtv(_mm(_rot(wa, tab), Rbb), px))
     sa = 1.0 if _dot(wa, _mv(Rba, wc)) >= 0.0 else -1.0
     sb = 1.0 if _dot(wa, _mv(Rbb, wc)) >= 0.0 else -1.0
-    return True, off, sing, ((taa, tba, tca, sa), (tab, tbb, tcb, sb))
+    return True, off, sing, (taa, tba, tca, sa), (tab, tbb, tcb, sb)
 
 
 # -- verification, de-duplication, storage ------------------------------------------------------
@@ -346,13 +346,13 @@ def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, 
     verified and stored; on the singular set (ω6 along ω4) the family's sign and value are
     recorded. Returns the new count."""
     Rp = _mtm(_mm(_mm(_rot(_row(W, 0), t1), _rot(_row(W, 1), t2)), R3), Rg)
-    ok, _off, sing, branches = spherical_wrist(_row(W, 3), _row(W, 4), _row(W, 5), Rp, xs, tol,
-                                               wrist_tol)
+    ok, _off, sing, wa, wb = spherical_wrist(_row(W, 3), _row(W, 4), _row(W, 5), Rp, xs, tol,
+                                             wrist_tol)
     if not ok:
         return cnt
     f3 = _link(C, 3, t3, _link(C, 2, t2, _link(C, 1, t1, f0)))  # shared by 2 wrists
     for i45 in range(2):
-        t4, t5, t6, sig = branches[i45]
+        t4, t5, t6, sig = wa if i45 == 0 else wb
         f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, f3)))
         q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
         new = _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot, cnt)

@@ -5,9 +5,10 @@ at a time, batches split over the cores with ``prange``.
 Per pose: the wrist centre p and joint 1's invariants; the eliminant Ψ(q3) at 8 angles (its
 discrete Fourier coefficients; the real roots of the trigonometric polynomial from the real
 polynomial that the half-angle substitution makes of it) or at 9 Chebyshev nodes (a power
-series), real roots by :func:`kinestat.serial.analytic._hqr.eigvals` on the companion;
-joint 2, joint 1, Newton steps on the wrist-centre equation; the spherical wrist (subproblems
-2 and 1, the θ5 = 0/π families);
+series), real roots by :func:`kinestat.serial.analytic._hqr.eigvals` on the companion (a
+quartic in closed form); joint 2, joint 1, Newton steps on the wrist-centre equation; the
+spherical wrist (:func:`kinestat.serial.analytic._cf_kernels.spherical_wrist`, the θ5 = 0/π
+families);
 Gauss–Newton steps with a truncated pseudo-inverse on candidates whose centre still misses or
 whose wrist is near θ5 = 0; verification by forward kinematics, de-duplication (revolute
 joints modulo 2π, prismatic ones as lengths) and storage.
@@ -344,8 +345,8 @@ def _trig_roots(ck, d, out, Sr):
     c_{-3} .. c_3) into ``out``; their count. With ``θ = θ0 + φ``, ``t = tan(φ/2)``:
     ``e^{ikφ} (1 + t²)^d = (1 + it)^{d+k} (1 − it)^{d−k}`` (:data:`_HALF`), so the polynomial
     times ``(1 + t²)^d`` is a real polynomial of degree ≤ 2d in t, whose real roots come from
-    its companion matrix (:func:`kinestat.serial.analytic._hqr.eigvals`). ``Sr``: the scratch
-    of :func:`_roots`."""
+    its companion matrix (:func:`kinestat.serial.analytic._hqr.eigvals`) or, a quartic, from
+    Ferrari's method. ``Sr``: the scratch of :func:`_roots`."""
     n2 = 2 * d
     P = Sr[9:16]
     P[:] = 0.0
@@ -514,12 +515,12 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
                 if kinds[i] == _R:
                     R = _mm(R, _rot(_row(W, i), (q123[i], math.cos(q123[i]), math.sin(q123[i]))))
             Rp = _mtm(R, Rg)
-            ok45, off, sing, branches = spherical_wrist(W3, W4, W5, Rp, xs, tol, wrist_tol)
+            ok45, off, sing, wa, wb = spherical_wrist(W3, W4, W5, Rp, xs, tol, wrist_tol)
             if not ok45:
                 continue
             near = off < 1e-6
             for i45 in range(2):
-                t4, t5, t6, sig = branches[i45]
+                t4, t5, t6, sig = wa if i45 == 0 else wb
                 q[0], q[1], q[2] = q123[0], q123[1], q123[2]
                 q[3], q[4], q[5] = t4[0], t5[0], t6[0]
                 if miss > 0.01 * tol or near:

@@ -124,12 +124,12 @@ def _pose(n, D0, D, kinds, mode, jk, rot, cheb_t, fit, ctp, T, tol, wrist_tol, d
             R6 = _rot(W6, a6)
             f1 = _link(C, 1, a1, f0)
             Rp = _mmt(_mmt(_mtm(R1, Rg), R6), R5)  # R2 R3 R4 = R1ᵀ R_G R6ᵀ R5ᵀ
-            ok23, off, sing, branches = spherical_wrist(W2, W3, W4, Rp, xs, tol, wrist_tol)
+            ok23, off, sing, wa, wb = spherical_wrist(W2, W3, W4, Rp, xs, tol, wrist_tol)
             if not ok23:
                 continue
             near = off < 1e-6
             for i23 in range(2):
-                t2, t3, t4, sig = branches[i23]
+                t2, t3, t4, sig = wa if i23 == 0 else wb
                 q[0], q[1], q[2], q[3], q[4], q[5] = t1, t2[0], t3[0], t4[0], t5, t6
                 if miss > 0.01 * tol or near:
                     _polish_pose(C, jk, Tn, q, 4, 1e-7)
