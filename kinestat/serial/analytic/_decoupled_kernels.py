@@ -32,12 +32,14 @@ from kinestat.serial.analytic._cf_kernels import (
     _mtm,
     _mv,
     _norm,
+    _pose_times,
     _rot,
     _rotate,
     _row,
     _scale,
     _sp1,
     _sub,
+    clear_wrist,
     spherical_wrist,
 )
 from kinestat.serial.analytic._hqr import eigvals
@@ -465,21 +467,9 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
     D = _unpack(Kp)
     C, T0inv, W, P, w, r1, x6, scale = D[0], D[1], D[2], D[3], D[4], D[5], D[10], D[11]
     kinds, mode, jk, rot = ints[0:3], ints[3], ints[4:10], ints[10:16]
-    for k in range(K):
-        for i in range(6):
-            out_q[n, k, i] = np.nan
-        out_valid[n, k] = False
-        out_pos[n, k] = np.nan
-        out_rot[n, k] = np.nan
-        out_sing[n, k] = False
-        out_sign[n, k] = 0.0
-        out_fam[n, k] = np.nan
+    clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
     Tn = T[n]
-    Rg = (Tn[0, 0], Tn[0, 1], Tn[0, 2], Tn[1, 0], Tn[1, 1], Tn[1, 2], Tn[2, 0], Tn[2, 1], Tn[2, 2])
-    Ra = (T0inv[0, 0], T0inv[0, 1], T0inv[0, 2], T0inv[1, 0], T0inv[1, 1], T0inv[1, 2],
-          T0inv[2, 0], T0inv[2, 1], T0inv[2, 2])
-    tg = _add(_mv(Rg, (T0inv[0, 3], T0inv[1, 3], T0inv[2, 3])), (Tn[0, 3], Tn[1, 3], Tn[2, 3]))
-    Rg = _mm(Rg, Ra)
+    Rg, tg = _pose_times(Tn, T0inv)
     p = _add(_mv(Rg, (w[0], w[1], w[2])), tg)
     d1 = _sub(p, (r1[0], r1[1], r1[2]))
     h = _dot(d1, _row(W, 0))

@@ -24,19 +24,18 @@ from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._cf_kernels import (
     _dot,
     _link,
-    _mm,
     _mmt,
     _mtm,
     _mtv,
-    _mv,
+    _pose_times,
     _rot,
     _row,
     _sp1,
     _sub,
+    clear_wrist,
     spherical_wrist,
 )
 from kinestat.serial.analytic._decoupled_kernels import (
-    K,
     _fk,
     _joint2,
     _move,
@@ -69,23 +68,10 @@ def _pose(n, D0, D, kinds, mode, jk, rot, cheb_t, fit, ctp, T, tol, wrist_tol, d
     axis 4 in the x slot; ``D`` the same with the scratch's axes and points (row 2 and the
     wrist point are the pose's), ``S``: :func:`_scratch`."""
     C, T0inv, W, P, cw, r1, r2, G2, e, u, x4, scale = D0
-    for k in range(K):
-        for i in range(6):
-            out_q[n, k, i] = np.nan
-        out_valid[n, k] = False
-        out_pos[n, k] = np.nan
-        out_rot[n, k] = np.nan
-        out_sing[n, k] = False
-        out_sign[n, k] = 0.0
-        out_fam[n, k] = np.nan
+    clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
     Tn = T[n]
     # G = T M⁻¹ and, per pose, axis 1' and the moving point G⁻¹ c
-    Rt = (Tn[0, 0], Tn[0, 1], Tn[0, 2], Tn[1, 0], Tn[1, 1], Tn[1, 2], Tn[2, 0], Tn[2, 1], Tn[2, 2])
-    Ra = (T0inv[0, 0], T0inv[0, 1], T0inv[0, 2], T0inv[1, 0], T0inv[1, 1], T0inv[1, 2],
-          T0inv[2, 0], T0inv[2, 1], T0inv[2, 2])
-    Rg = _mm(Rt, Ra)
-    tg = _mv(Rt, (T0inv[0, 3], T0inv[1, 3], T0inv[2, 3]))
-    tg = (tg[0] + Tn[0, 3], tg[1] + Tn[1, 3], tg[2] + Tn[2, 3])
+    Rg, tg = _pose_times(Tn, T0inv)
     Wv, Pv, wv, q3s, q, q123, Sr, Cs = S
     w1 = _mtv(Rg, _row(W, 2))
     p1 = _mtv(Rg, _sub(_row(P, 2), tg))
