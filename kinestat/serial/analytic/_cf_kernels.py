@@ -254,6 +254,37 @@ def _sp4(h, w, p, d, tol):
     return True, _shift(phi, c, s, -1.0), _shift(phi, c, s, 1.0)
 
 
+# -- spherical wrist --------------------------------------------------------------------------
+@nb.njit(**_INLINE)
+def spherical_wrist(wa, wb, wc, Rp, xs, tol, wrist_tol):
+    """A spherical wrist, axes ωa, ωb, ωc through the origin, turned to ``Ra Rb Rc = Rp``
+    (9-tuple): ``Ra Rb ωc = Rp ωc`` (subproblem 2) gives θa, θb, then ``Rc xs = (Ra Rb)ᵀ Rp
+    xs`` (subproblem 1; xs across ωc) θc. Returns ``(ok, off, sing, a, b)``: off =
+    ``|ωa × Rp ωc|``; sing = off < wrist_tol, the singular set (ωc along ωa: θa and θc turn
+    together), where θa = 0 and θb aligns ωc alone; a, b the branches ``(θa, θb, θc, σ)`` (angle
+    triples; σ the sign of ``ωa · Rb ωc``: on the singular set the family is θa + σ θc); ok
+    False when subproblem 2 has no solution."""
+    target = _mv(Rp, wc)
+    off = _norm(_cross(wa, target))
+    sing = off < wrist_tol
+    if sing:  # θa free: θa = 0, align ωc with θb alone
+        taa = tab = _NONE
+        tba = tbb = _sp1(wb, _Z3, wc, target)
+    else:
+        ok, taa, tba, tab, tbb = _sp2(wa, wb, _Z3, wc, target, tol)
+        if not ok:
+            none = (_NONE, _NONE, _NONE, 0.0)
+            return False, off, sing, none, none
+    px = _mv(Rp, xs)
+    Rba = _rot(wb, tba)
+    Rbb = _rot(wb, tbb)
+    tca = _sp1(wc, _Z3, xs, _mtv(_mm(_rot(wa, taa), Rba), px))
+    tcb = _sp1(wc, _Z3, xs, _mtv(_mm(_rot(wa, tab), Rbb), px))
+    sa = 1.0 if _dot(wa, _mv(Rba, wc)) >= 0.0 else -1.0
+    sb = 1.0 if _dot(wa, _mv(Rbb, wc)) >= 0.0 else -1.0
+    return True, off, sing, (taa, tba, tca, sa), (tab, tbb, tcb, sb)
+
+
 # -- verification, de-duplication, storage ------------------------------------------------------
 @nb.njit(**_INLINE)
 def _link(C, i, a, t):
@@ -314,28 +345,18 @@ def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, 
     the rotation of t3): ``R4 R5 ω6 = R' ω6`` (subproblem 2), θ6 (subproblem 1), each candidate
     verified and stored; on the singular set (ω6 along ω4) the family's sign and value are
     recorded. Returns the new count."""
-    W3, W4, W5 = _row(W, 3), _row(W, 4), _row(W, 5)
     Rp = _mtm(_mm(_mm(_rot(_row(W, 0), t1), _rot(_row(W, 1), t2)), R3), Rg)
-    target = _mv(Rp, W5)
-    sing = _norm(_cross(W3, target)) < wrist_tol
-    if sing:  # θ4 free: θ4 = 0, align ω6 with θ5 alone
-        t4a = t4b = _NONE
-        t5a = t5b = _sp1(W4, _Z3, W5, target)
-    else:
-        ok45, t4a, t5a, t4b, t5b = _sp2(W3, W4, _Z3, W5, target, tol)
-        if not ok45:
-            return cnt
+    ok, _off, sing, wa, wb = spherical_wrist(_row(W, 3), _row(W, 4), _row(W, 5), Rp, xs, tol,
+                                             wrist_tol)
+    if not ok:
+        return cnt
     f3 = _link(C, 3, t3, _link(C, 2, t2, _link(C, 1, t1, f0)))  # shared by 2 wrists
     for i45 in range(2):
-        t4 = t4a if i45 == 0 else t4b
-        t5 = t5a if i45 == 0 else t5b
-        R5 = _rot(W4, t5)
-        t6 = _sp1(W5, _Z3, xs, _mtv(_mm(_rot(W3, t4), R5), _mv(Rp, xs)))
+        t4, t5, t6, sig = wa if i45 == 0 else wb
         f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, f3)))
         q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
         new = _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot, cnt)
         if new > cnt and sing:
-            sig = 1.0 if _dot(W3, _mv(R5, W5)) >= 0.0 else -1.0
             out_sing[n, cnt] = True
             out_sign[n, cnt] = sig
             out_fam[n, cnt] = _wrap(out_q[n, cnt, 3] + sig * out_q[n, cnt, 5])

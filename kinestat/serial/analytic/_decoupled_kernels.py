@@ -5,9 +5,10 @@ at a time, batches split over the cores with ``prange``.
 Per pose: the wrist centre p and joint 1's invariants; the eliminant Ψ(q3) at 8 angles (its
 discrete Fourier coefficients; the real roots of the trigonometric polynomial from the real
 polynomial that the half-angle substitution makes of it) or at 9 Chebyshev nodes (a power
-series), real roots by :func:`kinestat.serial.analytic._hqr.eigvals` on the companion;
-joint 2, joint 1, Newton steps on the wrist-centre equation; the spherical wrist (subproblems
-2 and 1, the θ5 = 0/π families);
+series), real roots by :func:`kinestat.serial.analytic._hqr.eigvals` on the companion (a
+quartic in closed form); joint 2, joint 1, Newton steps on the wrist-centre equation; the
+spherical wrist (:func:`kinestat.serial.analytic._cf_kernels.spherical_wrist`, the θ5 = 0/π
+families);
 Gauss–Newton steps with a truncated pseudo-inverse on candidates whose centre still misses or
 whose wrist is near θ5 = 0; verification by forward kinematics, de-duplication (revolute
 joints modulo 2π, prismatic ones as lengths) and storage.
@@ -24,24 +25,25 @@ from kinestat.serial._kernels import _jac_column, _start, _step
 from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._cf_kernels import (
-    _NONE,
     _add,
     _cross,
     _dot,
     _mm,
     _mtm,
-    _mtv,
     _mv,
     _norm,
+    _pose_times,
     _rot,
     _rotate,
     _row,
     _scale,
     _sp1,
-    _sp2,
     _sub,
+    clear_wrist,
+    spherical_wrist,
 )
 from kinestat.serial.analytic._hqr import eigvals
+from kinestat.serial.analytic._offset_kernels import quartic_real_roots
 from kinestat.serial.analytic._solution_kernels import (
     _twist_error,
     angle_distance,
@@ -54,6 +56,7 @@ MODES = {"full": 0, "row0": 1, "row1": 2, "lin": 3, "perp": 4, "pp": 5}
 _FULL, _ROW0, _ROW1, _LIN, _PERP, _PP = 0, 1, 2, 3, 4, 5
 _R = 0  # joint kinds of joints 1-3 (1: prismatic)
 _Z3 = (0.0, 0.0, 0.0)
+_I3 = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
 K = 8  # solution slots
 
 
@@ -81,7 +84,7 @@ def _move(kind, w, r, q, x):
     return _add(x, _scale(w, q))
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _terms(D, kinds, y, p, h, rho2):
     """``(C0, C1, vp0, vp1)`` of ``g_kᵀ Rot(q2) v⊥ + C_k`` (revolute joint 2)."""
     W, r1, r2, e, u = D[2], D[5], D[6], D[8], D[9]
@@ -103,7 +106,7 @@ def _terms(D, kinds, y, p, h, rho2):
     return c0, c1, vp0, vp1
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _eliminant(D, kinds, mode, y, p, h, rho2):
     """Ψ at the wrist-centre image y (``decoupled._eliminant``)."""
     W, r1, G, u = D[2], D[5], D[7], D[9]
@@ -129,7 +132,7 @@ def _eliminant(D, kinds, mode, y, p, h, rho2):
     return _dot(z, z) - a * a * rho2
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _joint2(D, kinds, mode, y, p, h, rho2, snap):
     """``(count, q2a, q2b, ok)``: joint 2 for the wrist-centre image y (``decoupled._joint2``)."""
     W, r1, G, u = D[2], D[5], D[7], D[9]
@@ -177,7 +180,28 @@ def _place(D, kinds, q):
     return x
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
+def _axis(kind, w, r, qi, R, o):
+    """Joint axis (ω, r) moved by the joints before it (rotation R, offset o): ``(ω', r', R',
+    o')``, R' and o' then including this joint at qi."""
+    ax = _mv(R, w)
+    pt = _add(_mv(R, r), o)
+    if kind == _R:
+        Ri = _rot(w, (qi, math.cos(qi), math.sin(qi)))
+        o = _add(_mv(R, _sub(r, _mv(Ri, r))), o)
+        R = _mm(R, Ri)
+    else:
+        o = _add(o, _scale(ax, qi))
+    return ax, pt, R, o
+
+
+@nb.njit(**_INLINE)
+def _column(kind, ax, pt, x):
+    """The position Jacobian's column of a joint whose axis is (ax, pt), at the point x."""
+    return _cross(ax, _sub(x, pt)) if kind == _R else ax
+
+
+@nb.njit(**_INLINE)
 def _polish_position(D, kinds, q, p, live, iters):
     """Newton steps on ``M1 M2 M3 w = p`` for ``q (3,)`` in place, each kept where it lowers
     the miss; returns the miss ``|M1 M2 M3 w − p|``."""
@@ -189,25 +213,14 @@ def _polish_position(D, kinds, q, p, live, iters):
         if not (live and fn > small):
             break
         # the position Jacobian: each axis moved by the joints before it
-        R = (1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0)
-        o = _Z3
-        ax = [_Z3, _Z3, _Z3]
-        pt = [_Z3, _Z3, _Z3]
-        for i in range(3):
-            Wi, Pi = _row(W, i), _row(P, i)
-            ax[i] = _mv(R, Wi)
-            pt[i] = _add(_mv(R, Pi), o)
-            if kinds[i] == _R:
-                Ri = _rot(Wi, (q[i], math.cos(q[i]), math.sin(q[i])))
-                o = _add(_mv(R, _sub(Pi, _mv(Ri, Pi))), o)
-                R = _mm(R, Ri)
-            else:
-                o = _add(o, _scale(ax[i], q[i]))
+        R, o = _I3, _Z3
+        a0, p0, R, o = _axis(kinds[0], _row(W, 0), _row(P, 0), q[0], R, o)
+        a1, p1, R, o = _axis(kinds[1], _row(W, 1), _row(P, 1), q[1], R, o)
+        a2, p2, R, o = _axis(kinds[2], _row(W, 2), _row(P, 2), q[2], R, o)
         x = _add(_mv(R, (w[0], w[1], w[2])), o)
-        cols = [_Z3, _Z3, _Z3]
-        for i in range(3):
-            cols[i] = _cross(ax[i], _sub(x, pt[i])) if kinds[i] == _R else ax[i]
-        a, b, c = cols[0], cols[1], cols[2]
+        a = _column(kinds[0], a0, p0, x)
+        b = _column(kinds[1], a1, p1, x)
+        c = _column(kinds[2], a2, p2, x)
         det = _dot(a, _cross(b, c))
         if not abs(det) > 1e-300:
             break
@@ -268,7 +281,7 @@ def _polish_pose(C, jk, Tn, q, iters, rcond):
             en = nn
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _store(n, q, rot, pos, err, sing, sig, fam, dedup, out_q, out_valid, out_pos, out_rot,
            out_sing, out_sign, out_fam, cnt):
     """Store q (6,) (revolute joints wrapped) unless it repeats a stored one; the new count."""
@@ -302,34 +315,47 @@ _SIN8 = tuple(math.sin(2.0 * math.pi * j / 8.0) for j in range(8))
 #: the half-angle substitution is taken about this angle (any generic value: a root at
 #: θ = _THETA0 + π, where t = tan(φ/2) is infinite, is then unlikely)
 _THETA0 = 0.4170
+#: ``e^{ikθ0}`` for k = -3 .. 3
+_TURN0 = tuple(complex(math.cos(k * _THETA0), math.sin(k * _THETA0)) for k in range(-3, 4))
+
+
+def _half_angle_table() -> np.ndarray:
+    """``[d - 1, k + 3, j]``: the coefficient of t^j in ``(1 + it)^{d+k} (1 − it)^{d−k}``
+    (Gaussian integers, exact in floating point), d = 1 .. 3, |k| ≤ d."""
+    tab = np.zeros((3, 7, 7), dtype=np.complex128)
+    for d in range(1, 4):
+        for k in range(-d, d + 1):
+            a = np.zeros(7, dtype=np.complex128)
+            a[0] = 1.0
+            for f in range(2 * d):
+                a[1:] = a[1:] + (1j if f < d + k else -1j) * a[:-1]
+            tab[d - 1, k + 3] = a
+    return tab
+
+
+_HALF = _half_angle_table()
+#: a quartic in t whose top coefficient is at least this fraction of the largest is solved in
+#: closed form (:func:`~kinestat.serial.analytic._offset_kernels.quartic_real_roots`: its roots
+#: |t| stay below ~1/_QUARTIC_MIN, where Ferrari's method keeps its accuracy), else by the
+#: companion matrix
+_QUARTIC_MIN = 1e-3
 
 
 @nb.njit(**_OPTS)
-def _trig_roots(ck, d, out, Sr, Cs):
+def _trig_roots(ck, d, out, Sr):
     """Real roots θ of the trigonometric polynomial ``Σ_{|k| ≤ d} c_k e^{ikθ}`` (``ck`` holds
     c_{-3} .. c_3) into ``out``; their count. With ``θ = θ0 + φ``, ``t = tan(φ/2)``:
-    ``e^{ikφ} (1 + t²)^d = (1 + it)^{d+k} (1 − it)^{d−k}``, so the polynomial times
-    ``(1 + t²)^d`` is a real polynomial of degree ≤ 2d in t, whose real roots come from its
-    companion matrix (:func:`kinestat.serial.analytic._hqr.eigvals`). ``Sr``, ``Cs``: the
-    scratch of :func:`_roots`."""
+    ``e^{ikφ} (1 + t²)^d = (1 + it)^{d+k} (1 − it)^{d−k}`` (:data:`_HALF`), so the polynomial
+    times ``(1 + t²)^d`` is a real polynomial of degree ≤ 2d in t, whose real roots come from
+    its companion matrix (:func:`kinestat.serial.analytic._hqr.eigvals`) or, a quartic, from
+    Ferrari's method. ``Sr``: the scratch of :func:`_roots`."""
     n2 = 2 * d
     P = Sr[9:16]
     P[:] = 0.0
-    a = Cs[7:14]
     for k in range(-d, d + 1):
-        ang = k * _THETA0
-        c = ck[k + 3] * complex(math.cos(ang), math.sin(ang))
-        # a = (1 + it)^{d+k} (1 − it)^{d−k}, low powers first
-        a[:] = 0.0
-        a[0] = 1.0
-        deg = 0
-        for f in range(n2):
-            s = 1j if f < d + k else -1j
-            for j in range(deg + 1, 0, -1):
-                a[j] += s * a[j - 1]
-            deg += 1
+        c = ck[k + 3] * _TURN0[k + 3]
         for j in range(n2 + 1):
-            P[j] += (c * a[j]).real
+            P[j] += (c * _HALF[d - 1, k + 3, j]).real
     big = 0.0
     for j in range(n2 + 1):
         big = max(big, abs(P[j]))
@@ -338,6 +364,11 @@ def _trig_roots(ck, d, out, Sr, Cs):
         top -= 1
     if top == 0:
         return 0
+    if top == 4 and abs(P[4]) >= _QUARTIC_MIN * big:  # Ferrari, not the companion's QR
+        k, r = quartic_real_roots(P[4], P[3], P[2], P[1], P[0])
+        for i in range(k):
+            out[i] = wrap(_THETA0 + 2.0 * math.atan(r[i]))
+        return k
     A = Sr[16:52].reshape((6, 6))
     A[:, :] = 0.0
     for j in range(top):
@@ -356,7 +387,7 @@ def _trig_roots(ck, d, out, Sr, Cs):
     return m
 
 
-@nb.njit(**_OPTS)
+@nb.njit(**_INLINE)
 def _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, out, Sr, Cs):
     """Real roots q3 of the eliminant into ``out``; their count. ``Sr (64,)``, ``Cs (16,)``
     complex: scratch."""
@@ -387,7 +418,7 @@ def _roots(D, kinds, mode, cheb_t, fit, ctp, p, h, rho2, out, Sr, Cs):
                 break
         if d == 0:
             return 0
-        return _trig_roots(ck, d, out, Sr, Cs)
+        return _trig_roots(ck, d, out, Sr)
     L = 4.0 * scale + _norm(_sub(p, wc))
     psi = Sr[0:9]
     for s in range(9):
@@ -436,21 +467,9 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
     D = _unpack(Kp)
     C, T0inv, W, P, w, r1, x6, scale = D[0], D[1], D[2], D[3], D[4], D[5], D[10], D[11]
     kinds, mode, jk, rot = ints[0:3], ints[3], ints[4:10], ints[10:16]
-    for k in range(K):
-        for i in range(6):
-            out_q[n, k, i] = np.nan
-        out_valid[n, k] = False
-        out_pos[n, k] = np.nan
-        out_rot[n, k] = np.nan
-        out_sing[n, k] = False
-        out_sign[n, k] = 0.0
-        out_fam[n, k] = np.nan
+    clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
     Tn = T[n]
-    Rg = (Tn[0, 0], Tn[0, 1], Tn[0, 2], Tn[1, 0], Tn[1, 1], Tn[1, 2], Tn[2, 0], Tn[2, 1], Tn[2, 2])
-    Ra = (T0inv[0, 0], T0inv[0, 1], T0inv[0, 2], T0inv[1, 0], T0inv[1, 1], T0inv[1, 2],
-          T0inv[2, 0], T0inv[2, 1], T0inv[2, 2])
-    tg = _add(_mv(Rg, (T0inv[0, 3], T0inv[1, 3], T0inv[2, 3])), (Tn[0, 3], Tn[1, 3], Tn[2, 3]))
-    Rg = _mm(Rg, Ra)
+    Rg, tg = _pose_times(Tn, T0inv)
     p = _add(_mv(Rg, (w[0], w[1], w[2])), tg)
     d1 = _sub(p, (r1[0], r1[1], r1[2]))
     h = _dot(d1, _row(W, 0))
@@ -486,21 +505,12 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
                 if kinds[i] == _R:
                     R = _mm(R, _rot(_row(W, i), (q123[i], math.cos(q123[i]), math.sin(q123[i]))))
             Rp = _mtm(R, Rg)
-            target = _mv(Rp, W5)
-            near = _norm(_cross(W3, target)) < 1e-6
-            sing = _norm(_cross(W3, target)) < wrist_tol
-            if sing:  # θ4 free: θ4 = 0, align ω6 with θ5 alone
-                t4a = t4b = _NONE
-                t5a = t5b = _sp1(W4, _Z3, W5, target)
-            else:
-                ok45, t4a, t5a, t4b, t5b = _sp2(W3, W4, _Z3, W5, target, tol)
-                if not ok45:
-                    continue
+            ok45, off, sing, wa, wb = spherical_wrist(W3, W4, W5, Rp, xs, tol, wrist_tol)
+            if not ok45:
+                continue
+            near = off < 1e-6
             for i45 in range(2):
-                t4 = t4a if i45 == 0 else t4b
-                t5 = t5a if i45 == 0 else t5b
-                R5 = _rot(W4, t5)
-                t6 = _sp1(W5, _Z3, xs, _mtv(_mm(_rot(W3, t4), R5), _mv(Rp, xs)))
+                t4, t5, t6, sig = wa if i45 == 0 else wb
                 q[0], q[1], q[2] = q123[0], q123[1], q123[2]
                 q[3], q[4], q[5] = t4[0], t5[0], t6[0]
                 if miss > 0.01 * tol or near:
@@ -508,7 +518,6 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
                 pos, err = pose_errors(_fk(C, jk, q), Tn)
                 if not (pos <= tol and err <= tol):
                     continue
-                sig = 1.0 if _dot(W3, _mv(R5, W5)) >= 0.0 else -1.0
                 cnt = _store(n, q, rot, pos, err, sing, sig, wrap(t4[0] + sig * t6[0]), dedup,
                              out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
                              cnt)

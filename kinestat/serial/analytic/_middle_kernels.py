@@ -19,26 +19,23 @@ import numba as nb
 import numpy as np
 
 from kinestat.serial._kernels import _start
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._cf_kernels import (
-    _NONE,
-    _cross,
     _dot,
     _link,
-    _mm,
     _mmt,
     _mtm,
     _mtv,
-    _mv,
-    _norm,
+    _pose_times,
     _rot,
     _row,
     _sp1,
-    _sp2,
     _sub,
+    clear_wrist,
+    spherical_wrist,
 )
 from kinestat.serial.analytic._decoupled_kernels import (
-    K,
     _fk,
     _joint2,
     _move,
@@ -61,38 +58,21 @@ def _scratch():
             np.empty(3), np.empty(64), np.empty(16, dtype=np.complex128))
 
 
-@nb.njit(**_OPTS)
-def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
-          out_rot, out_sing, out_sign, out_fam, S):
-    """All solutions of pose n; returns the count. ``Kp``: the packed data of
+@nb.njit(**_INLINE)
+def _pose(n, D0, D, kinds, mode, jk, rot, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q,
+          out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, S):
+    """All solutions of pose n; returns the count. ``D0``: the unpacked data
+    (:func:`~kinestat.serial.analytic._decoupled_kernels._unpack`) of
     :func:`~kinestat.serial.analytic._decoupled_kernels.pack` with axis rows (5, 6, 1, 2, 3,
     4), points (5, 6, 1, c, c, c), the point c in the wrist slot and the direction across
-    axis 4 in the x slot. ``S``: :func:`_scratch`."""
-    D0 = _unpack(Kp)
+    axis 4 in the x slot; ``D`` the same with the scratch's axes and points (row 2 and the
+    wrist point are the pose's), ``S``: :func:`_scratch`."""
     C, T0inv, W, P, cw, r1, r2, G2, e, u, x4, scale = D0
-    kinds, mode, jk, rot = ints[0:3], ints[3], ints[4:10], ints[10:16]
-    for k in range(K):
-        for i in range(6):
-            out_q[n, k, i] = np.nan
-        out_valid[n, k] = False
-        out_pos[n, k] = np.nan
-        out_rot[n, k] = np.nan
-        out_sing[n, k] = False
-        out_sign[n, k] = 0.0
-        out_fam[n, k] = np.nan
+    clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
     Tn = T[n]
     # G = T M⁻¹ and, per pose, axis 1' and the moving point G⁻¹ c
-    Rt = (Tn[0, 0], Tn[0, 1], Tn[0, 2], Tn[1, 0], Tn[1, 1], Tn[1, 2], Tn[2, 0], Tn[2, 1], Tn[2, 2])
-    Ra = (T0inv[0, 0], T0inv[0, 1], T0inv[0, 2], T0inv[1, 0], T0inv[1, 1], T0inv[1, 2],
-          T0inv[2, 0], T0inv[2, 1], T0inv[2, 2])
-    Rg = _mm(Rt, Ra)
-    tg = _mv(Rt, (T0inv[0, 3], T0inv[1, 3], T0inv[2, 3]))
-    tg = (tg[0] + Tn[0, 3], tg[1] + Tn[1, 3], tg[2] + Tn[2, 3])
+    Rg, tg = _pose_times(Tn, T0inv)
     Wv, Pv, wv, q3s, q, q123, Sr, Cs = S
-    for i in range(6):
-        for j in range(3):
-            Wv[i, j] = W[i, j]
-            Pv[i, j] = P[i, j]
     w1 = _mtv(Rg, _row(W, 2))
     p1 = _mtv(Rg, _sub(_row(P, 2), tg))
     c = (cw[0], cw[1], cw[2])
@@ -101,7 +81,6 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
         Wv[2, i] = w1[i]
         Pv[2, i] = p1[i]
     wv[0], wv[1], wv[2] = wc[0], wc[1], wc[2]
-    D = (C, T0inv, Wv, Pv, wv, r1, r2, G2, e, u, x4, scale)
     d1 = _sub(c, (r1[0], r1[1], r1[2]))
     h = _dot(d1, _row(W, 0))
     rho2 = _dot(d1, d1)
@@ -131,21 +110,12 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
             R6 = _rot(W6, a6)
             f1 = _link(C, 1, a1, f0)
             Rp = _mmt(_mmt(_mtm(R1, Rg), R6), R5)  # R2 R3 R4 = R1ᵀ R_G R6ᵀ R5ᵀ
-            target = _mv(Rp, W4)
-            near = _norm(_cross(W2, target)) < 1e-6
-            sing = _norm(_cross(W2, target)) < wrist_tol
-            if sing:  # θ2 free: θ2 = 0, align ω4 with θ3 alone
-                t2a = t2b = _NONE
-                t3a = t3b = _sp1(W3, _Z3, W4, target)
-            else:
-                ok23, t2a, t3a, t2b, t3b = _sp2(W2, W3, _Z3, W4, target, tol)
-                if not ok23:
-                    continue
+            ok23, off, sing, wa, wb = spherical_wrist(W2, W3, W4, Rp, xs, tol, wrist_tol)
+            if not ok23:
+                continue
+            near = off < 1e-6
             for i23 in range(2):
-                t2 = t2a if i23 == 0 else t2b
-                t3 = t3a if i23 == 0 else t3b
-                R3 = _rot(W3, t3)
-                t4 = _sp1(W4, _Z3, xs, _mtv(_mm(_rot(W2, t2), R3), _mv(Rp, xs)))
+                t2, t3, t4, sig = wa if i23 == 0 else wb
                 q[0], q[1], q[2], q[3], q[4], q[5] = t1, t2[0], t3[0], t4[0], t5, t6
                 if miss > 0.01 * tol or near:
                     _polish_pose(C, jk, Tn, q, 4, 1e-7)
@@ -156,11 +126,31 @@ def _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_va
                     pos, err = pose_errors(f, Tn)
                 if not (pos <= tol and err <= tol):
                     continue
-                sig = 1.0 if _dot(W2, _mv(R3, W4)) >= 0.0 else -1.0
                 cnt = _store(n, q, rot, pos, err, sing, sig, wrap(t2[0] + sig * t4[0]), dedup,
                              out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
                              cnt)
     return cnt
+
+
+@nb.njit(**_OPTS)
+def _poses(lo, hi, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid,
+           out_pos, out_rot, out_sing, out_sign, out_fam, out_cnt):
+    """Poses lo .. hi − 1 (one call per chunk: the arrays' reference counts, the unpacking and
+    the scratch are paid once per chunk, not per pose)."""
+    D0 = _unpack(Kp)
+    C, T0inv, W, P, cw, r1, r2, G2, e, u, x4, scale = D0
+    S = _scratch()
+    Wv, Pv, wv = S[0], S[1], S[2]
+    for i in range(6):
+        for j in range(3):
+            Wv[i, j] = W[i, j]
+            Pv[i, j] = P[i, j]
+    D = (C, T0inv, Wv, Pv, wv, r1, r2, G2, e, u, x4, scale)
+    kinds, mode, jk, rot = ints[0:3], ints[3], ints[4:10], ints[10:16]
+    for n in range(lo, hi):
+        out_cnt[n] = _pose(n, D0, D, kinds, mode, jk, rot, cheb_t, fit, ctp, T, tol, wrist_tol,
+                           dedup, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
+                           S)
 
 
 @nb.njit(parallel=True, **_OPTS)
@@ -169,17 +159,14 @@ def solve_batch(Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out
     """All solutions of N poses into the (uninitialised) outputs."""
     N = T.shape[0]
     for c in nb.prange((N + _CHUNK - 1) // _CHUNK):
-        S = _scratch()
-        for n in range(c * _CHUNK, min(N, (c + 1) * _CHUNK)):
-            out_cnt[n] = _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q,
-                               out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, S)
+        _poses(c * _CHUNK, min(N, (c + 1) * _CHUNK), Kp, ints, cheb_t, fit, ctp, T, tol,
+               wrist_tol, dedup, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
+               out_cnt)
 
 
 @nb.njit(**_OPTS)
 def solve_serial(Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid, out_pos,
                  out_rot, out_sing, out_sign, out_fam, out_cnt):
     """:func:`solve_batch` on one thread."""
-    S = _scratch()
-    for n in range(T.shape[0]):
-        out_cnt[n] = _pose(n, Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q,
-                           out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, S)
+    _poses(0, T.shape[0], Kp, ints, cheb_t, fit, ctp, T, tol, wrist_tol, dedup, out_q, out_valid,
+           out_pos, out_rot, out_sing, out_sign, out_fam, out_cnt)
