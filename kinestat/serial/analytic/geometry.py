@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
+from kinestat.spatial.transforms import cross3  # NumPy's cross costs ~10 µs a call
 
 __all__ = ["HomeAxes", "home_axes", "meet", "parallel", "classify", "cross3", "norm3"]
 
@@ -47,14 +48,6 @@ def home_axes(model: ChainModel) -> HomeAxes:
         F = F @ C[i + 1]
     scale = max(1.0, float(np.max(np.abs(C[:, :3, 3]))))
     return HomeAxes(np.array(w), np.array(r), F, scale)
-
-
-def cross3(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """``a × b`` of two 3-vectors. NumPy's cross spends ~10 µs a call on its axis handling;
-    classifying a model (each new locked value of a 7-joint arm) takes dozens."""
-    a0, a1, a2 = a.tolist()
-    b0, b1, b2 = b.tolist()
-    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
 
 
 def norm3(a: np.ndarray) -> float:
