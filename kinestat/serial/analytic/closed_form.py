@@ -268,7 +268,10 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
                 plain, newton)
     reason = _offset_pack.REASON if offset else _REASON_PIEPER
     if shape == () and newton is None and plain and "one" not in data:
-        data["one"] = _one_pieper(_ENTRY.get((serial, None)), Kp, float(wrist_tol), reason)
+        entry = _ENTRY.get((serial, None))
+        data["one"] = _one_pieper(entry, Kp, float(wrist_tol), reason)
+        if entry is not None:  # for a caller that maps the pose and the joints around it
+            data["one_parts"] = (entry, Kp, float(wrist_tol), reason)
     if _unchecked(cnt):
         return None
     if shape == ():

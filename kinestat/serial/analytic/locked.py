@@ -18,6 +18,7 @@ import numpy as np
 
 from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
+from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["fold", "expand", "plan", "LockedPlan", "SelfMotion", "self_motion_values"]
@@ -98,22 +99,93 @@ def _insert(q6: np.ndarray, free: np.ndarray, locked, n: int) -> np.ndarray:
     return q
 
 
+def _inverse(M: np.ndarray) -> np.ndarray:
+    Mi = np.eye(4)
+    Mi[:3, :3] = M[:3, :3].T
+    Mi[:3, 3] = -(M[:3, :3].T @ M[:3, 3])
+    return Mi
+
+
+def _end_map(model: ChainModel, j: int, v: float) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """An end joint ``j`` (the first or the last) locked at ``v``: ``(L, R)`` with
+    ``fk_v(q) = T`` ⇔ ``fk_0(q) = L · T · R`` (``fk_0``: the chain folded at 0; None for the
+    identity). The last: ``T = X · Z(v) · Cn`` and ``fk_0 = X · Cn``, so ``R = Cn⁻¹ Z(−v) Cn``;
+    the first: ``L = C0 Z(−v) C0⁻¹``."""
+    if v == 0.0:
+        return None, None
+    jt = model.joints[j]
+    Z = _joint_motion(jt.kind, jt.pitch, -v)
+    C = np.asarray(model.constants)
+    if j == 0:
+        return C[0] @ Z @ _inverse(C[0]), None
+    return None, _inverse(C[-1]) @ Z @ C[-1]
+
+
+_S144 = (1, 4, 4)
+_I4 = np.eye(4)
+
+
+def _locked_kernels():
+    from kinestat.serial.analytic import _locked_kernels as K  # lazy: Numba start-up
+
+    return K
+
+
+def _entries():
+    """The compiled entry points of :mod:`~kinestat.serial.analytic._locked_kernels`' two
+    steps (see :func:`~kinestat.serial.analytic._common.call_compiled`), recorded by one call
+    each on arrays of the types the single call passes."""
+    K = _locked_kernels()
+    pose = _ENTRY.get((K.pose_in, None))
+    if pose is None:
+        call_compiled(K.pose_in, np.eye(4)[None], _I4, _I4, True, np.empty(_S144))
+        pose = _ENTRY.get((K.pose_in, None))
+    joints = _ENTRY.get((K.joints_out, None))
+    if joints is None:
+        call_compiled(K.joints_out, np.zeros((1, 8, 6)), np.zeros(7, dtype=np.int64), 0, 0.0,
+                      np.empty((1, 8, 7)))
+        joints = _ENTRY.get((K.joints_out, None))
+    return pose, joints
+
+
 class LockedPlan:
     """A model with its locked ``(joint, value)`` pairs: the folded 6-joint chain ``six``
-    (solved by :func:`~kinestat.serial.analytic.ik_all`) and :meth:`expand`, which puts the
-    locked values back. Built once per (model, locked values) by :func:`plan`."""
+    (solved by :func:`~kinestat.serial.analytic.ik_all`) for the poses :meth:`poses` gives, and
+    :meth:`expand`, which puts the locked values back. Built once per (model, locked values) by
+    :func:`plan`.
 
-    __slots__ = ("model", "pairs", "six", "free", "_free_array", "_one", "_take")
+    One end joint locked (the first or the last): ``six`` is the chain folded at 0 for every
+    value, and the value moves into the pose (:func:`_end_map`), so that a new value costs no
+    new chain. A joint in between changes the folded chain's geometry: one chain per value.
+    """
+
+    __slots__ = ("model", "pairs", "six", "free", "_free_array", "_one", "_take", "L", "R",
+                 "one")
 
     def __init__(self, model: ChainModel, pairs: tuple[tuple[int, float], ...]) -> None:
         self.model, self.pairs = model, pairs
-        self.six = fold(model, pairs)
+        self.L = self.R = None
+        if len(pairs) == 1 and pairs[0][0] in (0, model.n - 1):
+            j, v = pairs[0]
+            self.six = fold(model, ((j, 0.0),))
+            self.L, self.R = _end_map(model, j, v)
+        else:
+            self.six = fold(model, pairs)
         locked_idx = {j for j, _ in pairs}
         self.free = tuple(i for i in range(model.n) if i not in locked_idx)
         self._free_array = np.array(self.free)
         self._one = pairs[0] if len(pairs) == 1 else None
         self._take = np.array([self.free.index(i) if i in self.free else 0
                                for i in range(model.n)])
+        self.one = None  # the bound single call (:meth:`bind_one`)
+
+    def poses(self, T):
+        """The poses ``T (..., 4, 4)`` the folded chain ``six`` must reach (checked first when
+        they are mapped)."""
+        if self.L is None and self.R is None:
+            return T
+        T = check_poses(T)
+        return self.L @ T if self.L is not None else T @ self.R
 
     def _q(self, q6: np.ndarray) -> np.ndarray:
         if self._one is None:
@@ -140,6 +212,74 @@ class LockedPlan:
         obj = object.__new__(IKAllResult)
         obj.__dict__.update(fields)
         return obj
+
+    def bind_one(self, data: dict, rev_data: dict | None):
+        """The single-pose call ``one(T (1, 4, 4) plain, tol)`` (kept as :attr:`one`), or None
+        while the folded chain has none bound yet. ``data``: the folded chain's plan data,
+        ``rev_data``: its reversed chain's when it is solved reversed. A spherical-wrist
+        closed form runs in one pass: the pose mapped (and inverted for the reversed chain),
+        the kernel, the joints put back; other kinds wrap the folded chain's own single call.
+        Like it, ``one`` returns None where the caller must take the full path."""
+        parts = (rev_data if rev_data is not None else data).get("one_parts")
+        if parts is not None and self._one is not None:
+            self.one = self._fused(parts, rev_data is not None)
+            return self.one
+        one6 = data.get("one")
+        if one6 is None:
+            return None
+        pose_entry = _entries()[0] if self.L is not None or self.R is not None else None
+        L = _I4 if self.L is None else self.L
+        R = _I4 if self.R is None else self.R
+        expand = self.expand
+
+        def one(T, tol):
+            if pose_entry is not None:
+                Tm = np.empty(_S144)
+                pose_entry(T, L, R, False, Tm)
+                T = Tm
+            res = one6(T, tol)
+            return None if res is None else expand(res)
+        self.one = one
+        return one
+
+    def _fused(self, parts: tuple, invert: bool):
+        """:meth:`bind_one` for a spherical-wrist kernel's bound parts (entry point, packed
+        chain, wrist tolerance, reason), one locked joint; ``invert``: the kernel solves the
+        reversed chain."""
+        entry, Kp, wrist_tol, reason = parts
+        pose_entry, joints_entry = _entries()
+        mapped = invert or self.L is not None or self.R is not None
+        L = _I4 if self.L is None else self.L
+        R = _I4 if self.R is None else self.R
+        j, v = self._one
+        n = self.model.n
+        # full joint i <- the kernel's joint: the folded chain's, reversed when inverted
+        k6 = [5 - k if invert else k for k in range(6)]
+        take = np.array([k6[self.free.index(i)] if i in self.free else 0 for i in range(n)],
+                        dtype=np.int64)
+        fj = tuple(self.free[k6[k]] for k in (3, 5))
+        S18, S186, S18n = (1, 8), (1, 8, 6), (1, 8, n)
+        build = IKAllResult.build_one
+
+        def one(T, tol):
+            if mapped:
+                Tm = np.empty(_S144)
+                pose_entry(T, L, R, invert, Tm)
+            else:
+                Tm = T
+            q, valid, pos, rot = np.empty(S186), np.empty(S18, dtype=bool), np.empty(S18), \
+                np.empty(S18)
+            sing, sign, fam, cnt = np.empty(S18, dtype=bool), np.empty(S18), np.empty(S18), \
+                np.empty(1, dtype=np.int64)
+            entry(Kp, Tm, tol, wrist_tol, 1e-6, None, q, valid, pos, rot, sing, sign, fam, cnt)
+            c = cnt[0]
+            if c < 0:
+                return None
+            qn = np.empty(S18n)
+            joints_entry(q, take, j, v, qn)
+            return build(qn, valid, pos, rot, sing, sign, fam, fj, cnt, "" if c else reason,
+                         "pieper", tol)
+        return one
 
 
 _PLANS: dict = {}

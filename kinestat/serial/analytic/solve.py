@@ -180,6 +180,14 @@ def _locked_plan(model: ChainModel, locked):
     return mod.plan(model, locked)
 
 
+def _bind_locked(lp):
+    """The locked plan's single call (:meth:`~kinestat.serial.analytic.locked.LockedPlan.
+    bind_one`), from its folded chain's plan (and its reversed chain's); None until bound."""
+    data = _plan(lp.six)[1]
+    rev = data.get("reversed")
+    return lp.bind_one(data, None if rev is None else _plan(rev)[1])
+
+
 def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
            backend: str = "numba", locked: dict | None = None) -> IKAllResult:
     """Every IK solution of the 6-joint ``model`` for poses ``T_base_flange (..., 4, 4)``.
@@ -211,19 +219,25 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
             and isinstance(model, ChainModel):
         # one plain pose, defaults: the closed form's bound single call (after the first); with
         # locked joints, the folded chain's
-        lp = _locked_plan(model, locked) if locked else None
-        one = _plan(model if lp is None else lp.six)[1].get("one")
+        if locked:
+            lp = _locked_plan(model, locked)
+            one = lp.one
+            if one is None:
+                one = _bind_locked(lp)
+        else:
+            one = _plan(model)[1].get("one")
         if one is not None and T.dtype is _F64:
             f = T.flags
             if f.c_contiguous and f.aligned and f.writeable:
                 res = one(T[None], float(tol))
                 if res is not None:
-                    return res if lp is None else lp.expand(res)
+                    return res
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
     if locked:
         lp = _locked_plan(model, locked)
-        return lp.expand(ik_all(lp.six, T_base_flange, method=method, tol=tol, backend=backend))
+        return lp.expand(ik_all(lp.six, lp.poses(T_base_flange), method=method, tol=tol,
+                                backend=backend))
     kind, data = _plan(model)
     robot = None if method in METHODS else _robot_method(method)
     if method not in METHODS and robot is None:
