@@ -110,15 +110,45 @@ def _end_map(model: ChainModel, j: int, v: float) -> tuple[np.ndarray | None, np
     """An end joint ``j`` (the first or the last) locked at ``v``: ``(L, R)`` with
     ``fk_v(q) = T`` ⇔ ``fk_0(q) = L · T · R`` (``fk_0``: the chain folded at 0; None for the
     identity). The last: ``T = X · Z(v) · Cn`` and ``fk_0 = X · Cn``, so ``R = Cn⁻¹ Z(−v) Cn``;
-    the first: ``L = C0 Z(−v) C0⁻¹``."""
+    the first: ``L = C0 Z(−v) C0⁻¹``. A revolute joint's ``A Z(−v) B`` (``A B = I``) is
+    ``I + (cos v − 1) M1 − sin v M2`` with ``M1 = A (ex exᵀ + ey eyᵀ) B``,
+    ``M2 = A (ey exᵀ − ex eyᵀ) B``, kept per joint (:func:`_joint_info`)."""
     if v == 0.0:
         return None, None
-    jt = model.joints[j]
-    Z = _joint_motion(jt.kind, jt.pitch, -v)
-    C = np.asarray(model.constants)
-    if j == 0:
-        return C[0] @ Z @ _inverse(C[0]), None
-    return None, _inverse(C[-1]) @ Z @ C[-1]
+    info = _joint_info(model, j)
+    if info.M1 is not None:
+        M = _I4 + (math.cos(v) - 1.0) * info.M1 - math.sin(v) * info.M2
+    else:
+        M = info.A @ _joint_motion(info.kind, info.pitch, -v) @ info.B
+    return (M, None) if j == 0 else (None, M)
+
+
+class _JointInfo:
+    """What a locked joint ``j`` of a model gives every value: the free joints, the columns
+    that put the folded chain's joints back, and for an end joint the chain folded at 0 and
+    the terms of :func:`_end_map`."""
+
+    def __init__(self, model: ChainModel, j: int) -> None:
+        self.free = tuple(i for i in range(model.n) if i != j)
+        self.free_array = np.array(self.free)
+        self.take = np.array([self.free.index(i) if i != j else 0 for i in range(model.n)])
+        self.end = j in (0, model.n - 1)
+        self.six0 = fold(model, ((j, 0.0),)) if self.end else None
+        jt = model.joints[j]
+        self.kind, self.pitch = jt.kind, jt.pitch
+        C = np.asarray(model.constants)
+        self.A, self.B = (C[0], _inverse(C[0])) if j == 0 else (_inverse(C[-1]), C[-1])
+        self.M1 = self.M2 = None
+        if jt.kind == "revolute":
+            a, b = self.A, self.B
+            self.M1 = np.outer(a[:, 0], b[0]) + np.outer(a[:, 1], b[1])
+            self.M2 = np.outer(a[:, 1], b[0]) - np.outer(a[:, 0], b[1])
+        self.fused: dict = {}  # invert -> (take, family joints) of the fused single call
+
+
+@lru_cache(maxsize=64)
+def _joint_info(model: ChainModel, j: int) -> _JointInfo:
+    return _JointInfo(model, j)
 
 
 _S144 = (1, 4, 4)
@@ -165,19 +195,24 @@ class LockedPlan:
     def __init__(self, model: ChainModel, pairs: tuple[tuple[int, float], ...]) -> None:
         self.model, self.pairs = model, pairs
         self.L = self.R = None
-        if len(pairs) == 1 and pairs[0][0] in (0, model.n - 1):
-            j, v = pairs[0]
-            self.six = fold(model, ((j, 0.0),))
-            self.L, self.R = _end_map(model, j, v)
-        else:
-            self.six = fold(model, pairs)
+        self.one = None  # the bound single call (:meth:`bind_one`)
+        self._one = pairs[0] if len(pairs) == 1 else None
+        if self._one is not None:
+            j, v = self._one
+            info = _joint_info(model, j)
+            self.free, self._free_array, self._take = info.free, info.free_array, info.take
+            if info.end:
+                self.six = info.six0
+                self.L, self.R = _end_map(model, j, v)
+            else:
+                self.six = fold(model, pairs)
+            return
+        self.six = fold(model, pairs)
         locked_idx = {j for j, _ in pairs}
         self.free = tuple(i for i in range(model.n) if i not in locked_idx)
         self._free_array = np.array(self.free)
-        self._one = pairs[0] if len(pairs) == 1 else None
         self._take = np.array([self.free.index(i) if i in self.free else 0
                                for i in range(model.n)])
-        self.one = None  # the bound single call (:meth:`bind_one`)
 
     def poses(self, T):
         """The poses ``T (..., 4, 4)`` the folded chain ``six`` must reach (checked first when
@@ -253,11 +288,15 @@ class LockedPlan:
         R = _I4 if self.R is None else self.R
         j, v = self._one
         n = self.model.n
-        # full joint i <- the kernel's joint: the folded chain's, reversed when inverted
-        k6 = [5 - k if invert else k for k in range(6)]
-        take = np.array([k6[self.free.index(i)] if i in self.free else 0 for i in range(n)],
-                        dtype=np.int64)
-        fj = tuple(self.free[k6[k]] for k in (3, 5))
+        info = _joint_info(self.model, j)
+        got = info.fused.get(invert)
+        if got is None:
+            # full joint i <- the kernel's joint: the folded chain's, reversed when inverted
+            k6 = [5 - k if invert else k for k in range(6)]
+            take = np.array([k6[self.free.index(i)] if i in self.free else 0
+                             for i in range(n)], dtype=np.int64)
+            got = info.fused[invert] = (take, tuple(self.free[k6[k]] for k in (3, 5)))
+        take, fj = got
         S18, S186, S18n = (1, 8), (1, 8, 6), (1, 8, n)
         build = IKAllResult.build_one
 
