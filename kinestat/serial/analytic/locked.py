@@ -19,6 +19,8 @@ import numpy as np
 from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses
+from kinestat.serial.analytic.closed_form import _perp, pieper_parts
+from kinestat.serial.analytic.geometry import PRESET, HomeAxes, classify, classify_axes, home_axes
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["fold", "expand", "plan", "LockedPlan", "SelfMotion", "self_motion_values"]
@@ -144,6 +146,80 @@ class _JointInfo:
             self.M1 = np.outer(a[:, 0], b[0]) + np.outer(a[:, 1], b[1])
             self.M2 = np.outer(a[:, 1], b[0]) - np.outer(a[:, 0], b[1])
         self.fused: dict = {}  # invert -> (take, family joints) of the fused single call
+        self.G1 = None  # a revolute joint in between of a 7-joint revolute arm: _fast_fold's
+        if not self.end and jt.kind == "revolute" and model.n == 7 and \
+                all(x.kind == "revolute" for x in model.joints):
+            self.ref = fold(model, ((j, 0.0),))
+            self.ref_axes = home_axes(self.ref)
+            self.Cref = np.array(self.ref.constants)
+            self.kinds6 = [x.kind for x in self.ref.joints]
+            self.label = f"{model.name} [{jt.name or j + 1}="
+            self.N0, self.N1, self.N2 = _turn_terms(C[j], C[j + 1])
+            F = C[0]
+            for i in range(1, j + 1):
+                F = F @ C[i]  # joint j's frame at q = 0
+            _, self.G1, self.G2 = _turn_terms(F, _inverse(F))
+            # axes 1, 2 before joint j and 4, 5, 6 after it (j = 2, 3): the spherical wrist
+            # and the shoulder's meeting are the same at every value, and so is a pieper class
+            kind, data = classify(self.ref) if j in (2, 3) else ("general", {})
+            self.pieper = data if kind == "pieper" else None
+            G0 = np.stack([_I4, self.G1, self.G2]).reshape(3, 16)
+            self.terms = np.hstack([np.stack([self.N0, self.N1, self.N2]).reshape(3, 16), G0])
+            ax, k = self.ref_axes, 6 - j
+            wrist = data["wrist"] if self.pieper is not None else np.zeros(3)
+            x6 = _perp(ax.w[5]) if self.pieper is not None else np.zeros(3)
+            self.X = np.vstack([np.hstack([ax.w[j:].T, ax.r[j:].T, ax.T0[:3], wrist[:, None],
+                                           x6[:, None]]),
+                                [0.0] * k + [1.0] * k + [0.0, 0.0, 0.0, 1.0, 1.0, 0.0]])
+            rest = np.delete(self.Cref[:, :3, 3], j, axis=0)
+            self.scale = max(1.0, float(np.abs(rest).max()))
+
+
+def _turn_terms(A: np.ndarray, B: np.ndarray):
+    """``A Z(v) B = N0 + (cos v − 1) N1 + sin v N2`` (``Z``: a turn about z)."""
+    N1 = np.outer(A[:, 0], B[0]) + np.outer(A[:, 1], B[1])
+    N2 = np.outer(A[:, 1], B[0]) - np.outer(A[:, 0], B[1])
+    return A @ B, N1, N2
+
+
+def _fast_fold(info: _JointInfo, j: int, v: float) -> ChainModel | None:
+    """:func:`fold` of a revolute joint ``j`` in between at ``v``, with its geometry class
+    (:data:`~kinestat.serial.analytic.geometry.PRESET`), from the chain folded at 0: the
+    folded constant ``Cj Z(v) Cj+1`` and the axes after joint j turned by ``G = Fj Z(v) Fj⁻¹``
+    about it (``Fj`` its frame at q = 0) are a few products, where building and classifying
+    a new chain is hundreds of µs. The class comes from the turned axes by the same tests
+    as :func:`~kinestat.serial.analytic.geometry.classify`, so a value where axes meet or
+    line up that do not elsewhere is classified as such; where those tests involve no axis
+    pair across joint j (a spherical wrist and the shoulder pair on either side: j = 2, 3),
+    the class found once holds for every value and only its points move. None where the
+    class is not a
+    closed form (the caller then folds and classifies as for any chain: the general 6R
+    costs far more than that)."""
+    CG = np.array([1.0, math.cos(v) - 1.0, math.sin(v)]) @ info.terms  # Cj Z Cj+1 and G
+    C = info.Cref.copy()
+    C[j] = CG[:16].reshape(4, 4)
+    Y = CG[16:].reshape(4, 4) @ info.X  # the points and directions after joint j, moved
+    k = 6 - j
+    ax0 = info.ref_axes
+    w, r = ax0.w.copy(), ax0.r.copy()
+    w[j:] = Y[:3, :k].T
+    r[j:] = Y[:3, k:2 * k].T
+    ax = HomeAxes(w, r, Y[:, 2 * k:2 * k + 4],
+                  max(info.scale, abs(CG[3]), abs(CG[7]), abs(CG[11])))
+    if info.pieper is not None:  # the class holds for every value: its points moved
+        kind = "pieper"
+        data = {"axes": ax, "wrist": Y[:3, 2 * k + 4], "shoulder": info.pieper["shoulder"],
+                "x6": Y[:3, 2 * k + 5]}
+    else:
+        kind, data = classify_axes(info.kinds6, ax)
+    if kind not in ("pieper", "three-parallel"):
+        return None
+    C.flags.writeable = False
+    six = object.__new__(ChainModel)
+    six.__dict__.update(info.ref.__dict__)
+    six.__dict__.update(constants=C, name=f"{info.label}{v:g}]")
+    PRESET[six] = (kind, data)
+    return six
 
 
 @lru_cache(maxsize=64)
@@ -205,7 +281,8 @@ class LockedPlan:
                 self.six = info.six0
                 self.L, self.R = _end_map(model, j, v)
             else:
-                self.six = fold(model, pairs)
+                six = _fast_fold(info, j, v) if info.G1 is not None else None
+                self.six = fold(model, pairs) if six is None else six
             return
         self.six = fold(model, pairs)
         locked_idx = {j for j, _ in pairs}
@@ -248,15 +325,19 @@ class LockedPlan:
         obj.__dict__.update(fields)
         return obj
 
-    def bind_one(self, data: dict, rev_data: dict | None):
+    def bind_one(self, kind: str, data: dict, rev_data: dict | None):
         """The single-pose call ``one(T (1, 4, 4) plain, tol)`` (kept as :attr:`one`), or None
         while the folded chain has none bound yet. ``data``: the folded chain's plan data,
-        ``rev_data``: its reversed chain's when it is solved reversed. A spherical-wrist
+        ``kind``: its geometry class, ``rev_data``: its reversed chain's plan data when it is
+        solved reversed. A spherical-wrist
         closed form runs in one pass: the pose mapped (and inverted for the reversed chain),
         the kernel, the joints put back; other kinds wrap the folded chain's own single call.
         Like it, ``one`` returns None where the caller must take the full path."""
-        parts = (rev_data if rev_data is not None else data).get("one_parts")
-        if parts is not None and self._one is not None:
+        parts = None
+        if kind == "pieper" and self._one is not None:
+            parts = pieper_parts(self.six, data) if rev_data is None else \
+                pieper_parts(data["reversed"], rev_data)
+        if parts is not None:
             self.one = self._fused(parts, rev_data is not None)
             return self.one
         one6 = data.get("one")
