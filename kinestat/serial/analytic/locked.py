@@ -146,6 +146,7 @@ class _JointInfo:
             self.M1 = np.outer(a[:, 0], b[0]) + np.outer(a[:, 1], b[1])
             self.M2 = np.outer(a[:, 1], b[0]) - np.outer(a[:, 0], b[1])
         self.fused: dict = {}  # invert -> (take, family joints) of the fused single call
+        self.form = None  # the general 6R formulation a value of this joint took
         self.G1 = None  # a revolute joint in between of a 7-joint revolute arm: _fast_fold's
         if not self.end and jt.kind == "revolute" and model.n == 7 and \
                 all(x.kind == "revolute" for x in model.joints):
@@ -231,6 +232,12 @@ _S144 = (1, 4, 4)
 _I4 = np.eye(4)
 
 
+def _general6r():
+    from kinestat.serial.analytic import general6r  # lazy: start-up (SciPy's LAPACK)
+
+    return general6r
+
+
 def _locked_kernels():
     from kinestat.serial.analytic import _locked_kernels as K  # lazy: Numba start-up
 
@@ -283,6 +290,8 @@ class LockedPlan:
             else:
                 six = _fast_fold(info, j, v) if info.G1 is not None else None
                 self.six = fold(model, pairs) if six is None else six
+                if six is None and info.form is not None:  # the last value's elimination
+                    _general6r().HINTS[self.six] = info.form
             return
         self.six = fold(model, pairs)
         locked_idx = {j for j, _ in pairs}
@@ -334,6 +343,10 @@ class LockedPlan:
         the kernel, the joints put back; other kinds wrap the folded chain's own single call.
         Like it, ``one`` returns None where the caller must take the full path."""
         parts = None
+        if kind == "general" and self._one is not None and rev_data is None:
+            info = _joint_info(self.model, self._one[0])
+            if not info.end:  # kept for the joint's next value (a hint, checked there)
+                info.form = _general6r().formulation(self.six)[0]
         if kind == "pieper" and self._one is not None:
             parts = pieper_parts(self.six, data) if rev_data is None else \
                 pieper_parts(data["reversed"], rev_data)

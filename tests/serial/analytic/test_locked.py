@@ -168,8 +168,9 @@ def test_locked_plans_stay_bounded_and_keep_solving(monkeypatch):
 
 
 def _solutions_of_the_fresh_fold(model, j, v, T):
-    """The solutions of the chain folded at ``v`` itself, the locked value put back."""
-    S6 = ik_all(fold(model, ((j, v),)), T).solutions()
+    """The solutions of the chain folded at ``v`` itself (a new chain, not the cached one,
+    classified and prepared from scratch), the locked value put back."""
+    S6 = ik_all(fold.__wrapped__(model, ((j, v),)), T).solutions()
     return np.insert(S6, j, v, axis=1)
 
 
@@ -226,7 +227,8 @@ def test_joint_in_between_folds_as_the_fresh_fold(name, j):
     """A joint in between at a new value: the chain built from the per-joint terms has the
     fresh fold's constants and geometry class (classify's tests on the moved axes, or the
     class that holds for every value), special values included (0, ±π/2, π, next to 0), and
-    the same solutions."""
+    the same solutions; where a general 6R remains, the elimination kept from the joint's
+    previous value gives them too."""
     from kinestat.serial.analytic.solve import method_for
 
     model = _arm(name)
@@ -234,7 +236,7 @@ def test_joint_in_between_folds_as_the_fresh_fold(name, j):
     values = [0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-13] + list(rng.uniform(-3.0, 3.0, 3))
     for k, v in enumerate(values):
         v = float(v)
-        six, fresh = plan(model, {j: v}).six, fold(model, ((j, v),))
+        six, fresh = plan(model, {j: v}).six, fold.__wrapped__(model, ((j, v),))
         assert np.allclose(six.constants, fresh.constants, rtol=0.0, atol=1e-12)
         assert method_for(six) == method_for(fresh)
         q = _configs(model, j, v, 2, seed=200 + k)
