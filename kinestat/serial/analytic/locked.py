@@ -305,7 +305,11 @@ class LockedPlan:
         they are mapped)."""
         if self.L is None and self.R is None:
             return T
-        T = check_poses(T)
+        if not (type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and
+                T.shape[-2:] == (4, 4)):
+            T = check_poses(T)  # raises naming the fault (a float64 (..., 4, 4) array keeps
+        # any fault through the rigid map: NaN, a last row other than [0, 0, 0, 1], a
+        # rotation not orthonormal; the folded chain's check then names it)
         return self.L @ T if self.L is not None else T @ self.R
 
     def _q(self, q6: np.ndarray) -> np.ndarray:

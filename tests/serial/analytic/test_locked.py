@@ -250,3 +250,21 @@ def test_joint_in_between_folds_as_the_fresh_fold(name, j):
             assert all(np.min(wrapped_distance(fresh_sols, s)) < 1e-7 for s in sols)
             if len(sols):
                 assert np.abs(kinestat.fk(model, sols) - T[i]).max() < 1e-9
+
+
+@pytest.mark.parametrize("j", [0, 6])
+def test_end_joint_bad_poses_are_named(j):
+    """The value moved into the pose keeps a pose's fault: the error names the pose, one pose
+    or a batch, an array or a list."""
+    model = _arm("panda")
+    T = kinestat.fk(model, _configs(model, j, 0.5, 3, seed=9))
+    for where, bad, match in [((1, 0, 0), np.nan, "NaN"), ((1, 0, 0), 2.0, r"pose \(1,\)"),
+                              ((2, 3, 1), 0.1, r"pose \(2,\)")]:
+        B = T.copy()
+        B[where] = bad
+        with pytest.raises(InputError, match=match):
+            ik_all(model, B, locked={j: 0.5})
+        with pytest.raises(InputError, match="NaN" if match == "NaN" else "not a rigid"):
+            ik_all(model, B[where[0]], locked={j: 0.5})
+    with pytest.raises(InputError, match="shape"):
+        ik_all(model, [[1.0, 2.0]], locked={j: 0.5})
