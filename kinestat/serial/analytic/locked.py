@@ -127,8 +127,10 @@ def _end_map(model: ChainModel, j: int, v: float) -> tuple[np.ndarray | None, np
 
 class _JointInfo:
     """What a locked joint ``j`` of a model gives every value: the free joints, the columns
-    that put the folded chain's joints back, and for an end joint the chain folded at 0 and
-    the terms of :func:`_end_map`."""
+    that put the folded chain's joints back; for an end joint the chain folded at 0 and the
+    terms of :func:`_end_map`; for a revolute joint in between of a 7R arm the chain folded
+    at 0, its axes and the terms of :func:`_fast_fold`; the general 6R formulation the
+    joint's last value took (a hint for the next)."""
 
     def __init__(self, model: ChainModel, j: int) -> None:
         self.free = tuple(i for i in range(model.n) if i != j)
@@ -193,9 +195,8 @@ def _fast_fold(info: _JointInfo, j: int, v: float) -> ChainModel | None:
     line up that do not elsewhere is classified as such; where those tests involve no axis
     pair across joint j (a spherical wrist and the shoulder pair on either side: j = 2, 3),
     the class found once holds for every value and only its points move. None where the
-    class is not a
-    closed form (the caller then folds and classifies as for any chain: the general 6R
-    costs far more than that)."""
+    class is not a closed form (the caller then folds and classifies as for any chain: the
+    general 6R costs far more than that)."""
     CG = np.array([1.0, math.cos(v) - 1.0, math.sin(v)]) @ info.terms  # Cj Z Cj+1 and G
     C = info.Cref.copy()
     C[j] = CG[:16].reshape(4, 4)
