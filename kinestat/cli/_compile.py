@@ -43,6 +43,7 @@ ON_DEMAND: dict[str, str] = {
     "ik_all_general": "kinestat.serial.analytic._rr_kernels",
     "ik_all_decoupled": "kinestat.serial.analytic._decoupled_kernels",
     "ik_all_middle": "kinestat.serial.analytic._middle_kernels",
+    "ik_all_locked": "kinestat.serial.analytic._locked_kernels",
 }
 def _index_paths(module_name: str) -> list[str]:
     from numba.core.dispatcher import Dispatcher  # lazy: start-up (Numba ~0.5 s)

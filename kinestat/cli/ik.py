@@ -400,6 +400,7 @@ def _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg, urd
     groups = {"raghavan-roth": ("ik_all_closed", "ik_all_general"),
               "decoupled": ("ik_all_decoupled",),
               "middle-wrist": ("ik_all_middle",)}.get(method_for(m6), ("ik_all_closed",))
+    groups += ("ik_all_locked",) if locked else ()  # the single call's steps around a kernel
     if self_motion is not None:
         _self_motion(m, T, next(iter(locked)), self_motion, ref, groups, as_json)
         return

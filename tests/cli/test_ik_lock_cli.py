@@ -27,11 +27,11 @@ def _pose(T):
     return ",".join(f"{v:.17g}" for v in np.asarray(T).ravel())
 
 
-@pytest.mark.parametrize("joint", ["3", "panda_joint5"])
+@pytest.mark.parametrize("joint", ["3", "panda_joint5", "7"])
 def test_lock_gives_every_solution_with_the_joint_held(joint, capsys):
     m, args = _panda()
     q = np.array([0.3, 0.5, -0.4, -1.2, 0.2, 0.8, -0.3])
-    j = 2 if joint == "3" else 4
+    j = {"3": 2, "panda_joint5": 4, "7": 6}[joint]
     T = kinestat.fk(m, q)
     out = json.loads(_run(capsys, "ik", *args, "--pose", _pose(T), "--all", "--lock",
                           f"{joint}={float(np.degrees(q[j]))!r}", "--json").out)

@@ -29,7 +29,7 @@ def shoulder(W: np.ndarray, P: np.ndarray, w: np.ndarray) -> np.ndarray:
     o1 = P[0] + s * w1
     r2 = P[1] + t * w2
     a = r2 - o1
-    A = float(np.linalg.norm(a))
+    A = norm3(a)
     e2 = cross3(w2, a / A)
     m = w - P[2]
     mpar = w3 * float(w3 @ m)
@@ -41,5 +41,8 @@ def shoulder(W: np.ndarray, P: np.ndarray, w: np.ndarray) -> np.ndarray:
 
 def pack(model: ChainModel, ax, w: np.ndarray, x6: np.ndarray) -> np.ndarray:
     """The compiled kernel's pose-independent data in one float array."""
-    parts = (model.constants, np.linalg.inv(ax.T0), ax.w, ax.r, w, x6, shoulder(ax.w, ax.r, w))
-    return np.ascontiguousarray(np.concatenate([np.ravel(x) for x in parts]), dtype=np.float64)
+    T0inv = np.eye(4)  # a rigid inverse (np.linalg.inv costs several times as much)
+    T0inv[:3, :3] = ax.T0[:3, :3].T
+    T0inv[:3, 3] = -(T0inv[:3, :3] @ ax.T0[:3, 3])
+    parts = (model.constants, T0inv, ax.w, ax.r, w, x6, shoulder(ax.w, ax.r, w))
+    return np.concatenate([np.ravel(x) for x in parts])

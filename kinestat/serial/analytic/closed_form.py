@@ -30,7 +30,7 @@ from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
 
 __all__ = ["solve_pieper", "solve_three_parallel", "solve_pieper_compiled",
-           "solve_three_parallel_compiled"]
+           "solve_three_parallel_compiled", "pieper_parts"]
 
 _WRIST_TOL = 1e-10
 _PARALLEL_MIN = 256  # smaller batches run on one thread (a pose costs a few µs)
@@ -235,6 +235,39 @@ def _offset_kernels():
     return K
 
 
+def _pieper_args(model: ChainModel, data: dict, K) -> np.ndarray:
+    """The spherical-wrist kernel's packed pose-independent data (``K``: its kernel module),
+    kept with the model's cached geometry."""
+    Kp = data.get("kernel_args")
+    if Kp is None:
+        ax = data["axes"]
+        x6 = data.get("x6")  # a unit vector normal to axis 6 (a caller's, or any)
+        x6 = _perp(ax.w[5]) if x6 is None else x6
+        Kp = data["kernel_args"] = _offset_pack.pack(
+            model, ax, data["wrist"], x6) if data["shoulder"] is None else K.pack(
+            model.constants, np.linalg.inv(ax.T0), ax.w, ax.r, data["wrist"], data["shoulder"],
+            x6)
+    return Kp
+
+
+def pieper_parts(model: ChainModel, data: dict, wrist_tol: float = _WRIST_TOL):
+    """``(entry, packed data, wrist_tol, reason)``: what a caller that maps the pose and the
+    joints around the spherical-wrist kernel's single call needs (a pieper ``model`` and its
+    ``data`` from :func:`~kinestat.serial.analytic.geometry.classify`), or None while the
+    kernel's entry point is not recorded (no single call of its kind has run yet)."""
+    parts = data.get("one_parts")
+    if parts is not None:
+        return parts
+    offset = data["shoulder"] is None
+    K = _offset_kernels() if offset else _cf_kernels()
+    entry = _ENTRY.get((K.offset_serial if offset else K.pieper_serial, None))
+    if entry is None:
+        return None
+    parts = data["one_parts"] = (entry, _pieper_args(model, data, K), float(wrist_tol),
+                                 _offset_pack.REASON if offset else _REASON_PIEPER)
+    return parts
+
+
 def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
                           wrist_tol: float = _WRIST_TOL, shape: tuple[int, ...] | None = None,
                           plain: bool | None = None, checked: bool = True) -> IKAllResult | None:
@@ -253,13 +286,7 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     sing = np.empty((N, 8), dtype=bool)
     sign = np.empty((N, 8))
     fam = np.empty((N, 8))
-    Kp = data.get("kernel_args")
-    if Kp is None:  # pose-independent, kept with the model's cached geometry
-        ax = data["axes"]
-        Kp = data["kernel_args"] = _offset_pack.pack(
-            model, ax, data["wrist"], _perp(ax.w[5])) if offset else K.pack(
-            model.constants, np.linalg.inv(ax.T0), ax.w, ax.r, data["wrist"], data["shoulder"],
-            _perp(ax.w[5]))
+    Kp = _pieper_args(model, data, K)
     newton = _newton(N, checked)
     args = (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos, rot, sing, sign,
             fam, cnt)
@@ -268,7 +295,10 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
                 plain, newton)
     reason = _offset_pack.REASON if offset else _REASON_PIEPER
     if shape == () and newton is None and plain and "one" not in data:
-        data["one"] = _one_pieper(_ENTRY.get((serial, None)), Kp, float(wrist_tol), reason)
+        entry = _ENTRY.get((serial, None))
+        data["one"] = _one_pieper(entry, Kp, float(wrist_tol), reason)
+        if entry is not None:  # for a caller that maps the pose and the joints around it
+            data["one_parts"] = (entry, Kp, float(wrist_tol), reason)
     if _unchecked(cnt):
         return None
     if shape == ():

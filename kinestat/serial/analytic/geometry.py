@@ -16,6 +16,7 @@ axis geometry:
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
@@ -23,7 +24,14 @@ import numpy as np
 from kinestat.mechanism.chain import ChainModel
 from kinestat.spatial.transforms import cross3  # NumPy's cross costs ~10 µs a call
 
-__all__ = ["HomeAxes", "home_axes", "meet", "parallel", "classify", "cross3", "norm3"]
+__all__ = ["HomeAxes", "home_axes", "meet", "parallel", "classify", "classify_axes", "cross3",
+           "norm3", "PRESET"]
+
+
+#: geometry classes found without :func:`classify`, by a caller that built the model from one
+#: already classified (a locked arm's chain folded at a new value: its axes are the folded
+#: chain's moved by the locked joint's turn): model -> ``(kind, data)``
+PRESET: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 @dataclass(frozen=True, eq=False)
@@ -82,7 +90,12 @@ def classify(model: ChainModel, tol: float = 1e-9) -> tuple[str, dict]:
     kinds = [j.kind for j in model.joints]
     if model.n != 6 or "screw" in kinds or "prismatic" in kinds[3:]:
         return "none", {}
-    ax = home_axes(model)
+    return classify_axes(kinds, home_axes(model), tol)
+
+
+def classify_axes(kinds: list[str], ax: HomeAxes, tol: float = 1e-9) -> tuple[str, dict]:
+    """:func:`classify` from the joint kinds (six, none a screw, joints 4-6 revolute) and
+    the axes at q = 0."""
     w = meet(ax, 3, 4, tol)
     spherical = w is not None and \
         norm3(cross3(w - ax.r[5], ax.w[5])) <= tol * ax.scale

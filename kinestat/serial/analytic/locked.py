@@ -18,6 +18,9 @@ import numpy as np
 
 from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
+from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses
+from kinestat.serial.analytic.closed_form import _perp, pieper_parts
+from kinestat.serial.analytic.geometry import PRESET, HomeAxes, classify, classify_axes, home_axes
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["fold", "expand", "plan", "LockedPlan", "SelfMotion", "self_motion_values"]
@@ -98,22 +101,217 @@ def _insert(q6: np.ndarray, free: np.ndarray, locked, n: int) -> np.ndarray:
     return q
 
 
+def _inverse(M: np.ndarray) -> np.ndarray:
+    Mi = np.eye(4)
+    Mi[:3, :3] = M[:3, :3].T
+    Mi[:3, 3] = -(M[:3, :3].T @ M[:3, 3])
+    return Mi
+
+
+def _end_map(model: ChainModel, j: int, v: float) -> tuple[np.ndarray | None, np.ndarray | None]:
+    """An end joint ``j`` (the first or the last) locked at ``v``: ``(L, R)`` with
+    ``fk_v(q) = T`` ⇔ ``fk_0(q) = L · T · R`` (``fk_0``: the chain folded at 0; None for the
+    identity). The last: ``T = X · Z(v) · Cn`` and ``fk_0 = X · Cn``, so ``R = Cn⁻¹ Z(−v) Cn``;
+    the first: ``L = C0 Z(−v) C0⁻¹``. A revolute joint's ``A Z(−v) B`` (``A B = I``) is
+    ``I + (cos v − 1) M1 − sin v M2`` with ``M1 = A (ex exᵀ + ey eyᵀ) B``,
+    ``M2 = A (ey exᵀ − ex eyᵀ) B``, kept per joint (:func:`_joint_info`)."""
+    if v == 0.0:
+        return None, None
+    info = _joint_info(model, j)
+    if info.M1 is not None:
+        M = _I4 + (math.cos(v) - 1.0) * info.M1 - math.sin(v) * info.M2
+    else:
+        M = info.A @ _joint_motion(info.kind, info.pitch, -v) @ info.B
+    return (M, None) if j == 0 else (None, M)
+
+
+class _JointInfo:
+    """What a locked joint ``j`` of a model gives every value: the free joints, the columns
+    that put the folded chain's joints back; for an end joint the chain folded at 0 and the
+    terms of :func:`_end_map`; for a revolute joint in between of a 7R arm the chain folded
+    at 0, its axes and the terms of :func:`_fast_fold`; the general 6R formulation the
+    joint's last value took (a hint for the next)."""
+
+    def __init__(self, model: ChainModel, j: int) -> None:
+        self.free = tuple(i for i in range(model.n) if i != j)
+        self.free_array = np.array(self.free)
+        self.take = np.array([self.free.index(i) if i != j else 0 for i in range(model.n)])
+        self.end = j in (0, model.n - 1)
+        self.six0 = fold(model, ((j, 0.0),)) if self.end else None
+        jt = model.joints[j]
+        self.kind, self.pitch = jt.kind, jt.pitch
+        C = np.asarray(model.constants)
+        self.A, self.B = (C[0], _inverse(C[0])) if j == 0 else (_inverse(C[-1]), C[-1])
+        self.M1 = self.M2 = None
+        if jt.kind == "revolute":
+            a, b = self.A, self.B
+            self.M1 = np.outer(a[:, 0], b[0]) + np.outer(a[:, 1], b[1])
+            self.M2 = np.outer(a[:, 1], b[0]) - np.outer(a[:, 0], b[1])
+        self.fused: dict = {}  # invert -> (take, family joints) of the fused single call
+        self.form = None  # the general 6R formulation a value of this joint took
+        self.G1 = None  # a revolute joint in between of a 7-joint revolute arm: _fast_fold's
+        if not self.end and jt.kind == "revolute" and model.n == 7 and \
+                all(x.kind == "revolute" for x in model.joints):
+            self.ref = fold(model, ((j, 0.0),))
+            self.ref_axes = home_axes(self.ref)
+            self.Cref = np.array(self.ref.constants)
+            self.kinds6 = [x.kind for x in self.ref.joints]
+            self.label = f"{model.name} [{jt.name or j + 1}="
+            self.N0, self.N1, self.N2 = _turn_terms(C[j], C[j + 1])
+            F = C[0]
+            for i in range(1, j + 1):
+                F = F @ C[i]  # joint j's frame at q = 0
+            _, self.G1, self.G2 = _turn_terms(F, _inverse(F))
+            # axes 1, 2 before joint j and 4, 5, 6 after it (j = 2, 3): the spherical wrist
+            # and the shoulder's meeting are the same at every value, and so is a pieper class
+            kind, data = classify(self.ref) if j in (2, 3) else ("general", {})
+            self.pieper = data if kind == "pieper" else None
+            G0 = np.stack([_I4, self.G1, self.G2]).reshape(3, 16)
+            self.terms = np.hstack([np.stack([self.N0, self.N1, self.N2]).reshape(3, 16), G0])
+            ax, k = self.ref_axes, 6 - j
+            wrist = data["wrist"] if self.pieper is not None else np.zeros(3)
+            x6 = _perp(ax.w[5]) if self.pieper is not None else np.zeros(3)
+            self.X = np.vstack([np.hstack([ax.w[j:].T, ax.r[j:].T, ax.T0[:3], wrist[:, None],
+                                           x6[:, None]]),
+                                [0.0] * k + [1.0] * k + [0.0, 0.0, 0.0, 1.0, 1.0, 0.0]])
+            rest = np.delete(self.Cref[:, :3, 3], j, axis=0)
+            self.scale = max(1.0, float(np.abs(rest).max()))
+
+
+def _turn_terms(A: np.ndarray, B: np.ndarray):
+    """``A Z(v) B = N0 + (cos v − 1) N1 + sin v N2`` (``Z``: a turn about z)."""
+    N1 = np.outer(A[:, 0], B[0]) + np.outer(A[:, 1], B[1])
+    N2 = np.outer(A[:, 1], B[0]) - np.outer(A[:, 0], B[1])
+    return A @ B, N1, N2
+
+
+def _fast_fold(info: _JointInfo, j: int, v: float) -> ChainModel | None:
+    """:func:`fold` of a revolute joint ``j`` in between at ``v``, with its geometry class
+    (:data:`~kinestat.serial.analytic.geometry.PRESET`), from the chain folded at 0: the
+    folded constant ``Cj Z(v) Cj+1`` and the axes after joint j turned by ``G = Fj Z(v) Fj⁻¹``
+    about it (``Fj`` its frame at q = 0) are a few products, where building and classifying
+    a new chain is hundreds of µs. The class comes from the turned axes by the same tests
+    as :func:`~kinestat.serial.analytic.geometry.classify`, so a value where axes meet or
+    line up that do not elsewhere is classified as such; where those tests involve no axis
+    pair across joint j (a spherical wrist and the shoulder pair on either side: j = 2, 3),
+    the class found once holds for every value and only its points move. None where the
+    class is not a closed form (the caller then folds and classifies as for any chain: the
+    general 6R costs far more than that)."""
+    CG = np.array([1.0, math.cos(v) - 1.0, math.sin(v)]) @ info.terms  # Cj Z Cj+1 and G
+    C = info.Cref.copy()
+    C[j] = CG[:16].reshape(4, 4)
+    Y = CG[16:].reshape(4, 4) @ info.X  # the points and directions after joint j, moved
+    k = 6 - j
+    ax0 = info.ref_axes
+    w, r = ax0.w.copy(), ax0.r.copy()
+    w[j:] = Y[:3, :k].T
+    r[j:] = Y[:3, k:2 * k].T
+    ax = HomeAxes(w, r, Y[:, 2 * k:2 * k + 4],
+                  max(info.scale, abs(CG[3]), abs(CG[7]), abs(CG[11])))
+    if info.pieper is not None:  # the class holds for every value: its points moved
+        kind = "pieper"
+        data = {"axes": ax, "wrist": Y[:3, 2 * k + 4], "shoulder": info.pieper["shoulder"],
+                "x6": Y[:3, 2 * k + 5]}
+    else:
+        kind, data = classify_axes(info.kinds6, ax)
+    if kind not in ("pieper", "three-parallel"):
+        return None
+    C.flags.writeable = False
+    six = object.__new__(ChainModel)
+    six.__dict__.update(info.ref.__dict__)
+    six.__dict__.update(constants=C, name=f"{info.label}{v:g}]")
+    PRESET[six] = (kind, data)
+    return six
+
+
+@lru_cache(maxsize=64)
+def _joint_info(model: ChainModel, j: int) -> _JointInfo:
+    return _JointInfo(model, j)
+
+
+_S144 = (1, 4, 4)
+_I4 = np.eye(4)
+
+
+def _general6r():
+    from kinestat.serial.analytic import general6r  # lazy: start-up (SciPy's LAPACK)
+
+    return general6r
+
+
+def _locked_kernels():
+    from kinestat.serial.analytic import _locked_kernels as K  # lazy: Numba start-up
+
+    return K
+
+
+def _entries():
+    """The compiled entry points of :mod:`~kinestat.serial.analytic._locked_kernels`' two
+    steps (see :func:`~kinestat.serial.analytic._common.call_compiled`), recorded by one call
+    each on arrays of the types the single call passes."""
+    K = _locked_kernels()
+    pose = _ENTRY.get((K.pose_in, None))
+    if pose is None:
+        call_compiled(K.pose_in, np.eye(4)[None], _I4, _I4, True, np.empty(_S144))
+        pose = _ENTRY.get((K.pose_in, None))
+    joints = _ENTRY.get((K.joints_out, None))
+    if joints is None:
+        call_compiled(K.joints_out, np.zeros((1, 8, 6)), np.zeros(7, dtype=np.int64), 0, 0.0,
+                      np.empty((1, 8, 7)))
+        joints = _ENTRY.get((K.joints_out, None))
+    return pose, joints
+
+
 class LockedPlan:
     """A model with its locked ``(joint, value)`` pairs: the folded 6-joint chain ``six``
-    (solved by :func:`~kinestat.serial.analytic.ik_all`) and :meth:`expand`, which puts the
-    locked values back. Built once per (model, locked values) by :func:`plan`."""
+    (solved by :func:`~kinestat.serial.analytic.ik_all`) for the poses :meth:`poses` gives, and
+    :meth:`expand`, which puts the locked values back. Built once per (model, locked values) by
+    :func:`plan`.
 
-    __slots__ = ("model", "pairs", "six", "free", "_free_array", "_one", "_take")
+    One end joint locked (the first or the last): ``six`` is the chain folded at 0 for every
+    value, and the value moves into the pose (:func:`_end_map`), so that a new value costs no
+    new chain. A joint in between changes the folded chain's geometry: one chain per value.
+    """
+
+    __slots__ = ("model", "pairs", "six", "free", "_free_array", "_one", "_take", "L", "R",
+                 "one")
 
     def __init__(self, model: ChainModel, pairs: tuple[tuple[int, float], ...]) -> None:
         self.model, self.pairs = model, pairs
+        self.L = self.R = None
+        self.one = None  # the bound single call (:meth:`bind_one`)
+        self._one = pairs[0] if len(pairs) == 1 else None
+        if self._one is not None:
+            j, v = self._one
+            info = _joint_info(model, j)
+            self.free, self._free_array, self._take = info.free, info.free_array, info.take
+            if info.end:
+                self.six = info.six0
+                self.L, self.R = _end_map(model, j, v)
+            else:
+                six = _fast_fold(info, j, v) if info.G1 is not None else None
+                self.six = fold(model, pairs) if six is None else six
+                if six is None and info.form is not None:  # the last value's elimination
+                    _general6r().HINTS[self.six] = info.form
+            return
         self.six = fold(model, pairs)
         locked_idx = {j for j, _ in pairs}
         self.free = tuple(i for i in range(model.n) if i not in locked_idx)
         self._free_array = np.array(self.free)
-        self._one = pairs[0] if len(pairs) == 1 else None
         self._take = np.array([self.free.index(i) if i in self.free else 0
                                for i in range(model.n)])
+
+    def poses(self, T):
+        """The poses ``T (..., 4, 4)`` the folded chain ``six`` must reach (checked first when
+        they are mapped)."""
+        if self.L is None and self.R is None:
+            return T
+        if not (type(T) is np.ndarray and T.dtype == np.float64 and T.ndim >= 2 and
+                T.shape[-2:] == (4, 4)):
+            T = check_poses(T)  # raises naming the fault (a float64 (..., 4, 4) array keeps
+        # any fault through the rigid map: NaN, a last row other than [0, 0, 0, 1], a
+        # rotation not orthonormal; the folded chain's check then names it)
+        return self.L @ T if self.L is not None else T @ self.R
 
     def _q(self, q6: np.ndarray) -> np.ndarray:
         if self._one is None:
@@ -140,6 +338,86 @@ class LockedPlan:
         obj = object.__new__(IKAllResult)
         obj.__dict__.update(fields)
         return obj
+
+    def bind_one(self, kind: str, data: dict, rev_data: dict | None):
+        """The single-pose call ``one(T (1, 4, 4) plain, tol)`` (kept as :attr:`one`), or None
+        while the folded chain has none bound yet. ``data``: the folded chain's plan data,
+        ``kind``: its geometry class, ``rev_data``: its reversed chain's plan data when it is
+        solved reversed. A spherical-wrist
+        closed form runs in one pass: the pose mapped (and inverted for the reversed chain),
+        the kernel, the joints put back; other kinds wrap the folded chain's own single call.
+        Like it, ``one`` returns None where the caller must take the full path."""
+        parts = None
+        if kind == "general" and self._one is not None and rev_data is None:
+            info = _joint_info(self.model, self._one[0])
+            if not info.end:  # kept for the joint's next value (a hint, checked there)
+                info.form = _general6r().formulation(self.six)[0]
+        if kind == "pieper" and self._one is not None:
+            parts = pieper_parts(self.six, data) if rev_data is None else \
+                pieper_parts(data["reversed"], rev_data)
+        if parts is not None:
+            self.one = self._fused(parts, rev_data is not None)
+            return self.one
+        one6 = data.get("one")
+        if one6 is None:
+            return None
+        pose_entry = _entries()[0] if self.L is not None or self.R is not None else None
+        L = _I4 if self.L is None else self.L
+        R = _I4 if self.R is None else self.R
+        expand = self.expand
+
+        def one(T, tol):
+            if pose_entry is not None:
+                Tm = np.empty(_S144)
+                pose_entry(T, L, R, False, Tm)
+                T = Tm
+            res = one6(T, tol)
+            return None if res is None else expand(res)
+        self.one = one
+        return one
+
+    def _fused(self, parts: tuple, invert: bool):
+        """:meth:`bind_one` for a spherical-wrist kernel's bound parts (entry point, packed
+        chain, wrist tolerance, reason), one locked joint; ``invert``: the kernel solves the
+        reversed chain."""
+        entry, Kp, wrist_tol, reason = parts
+        pose_entry, joints_entry = _entries()
+        mapped = invert or self.L is not None or self.R is not None
+        L = _I4 if self.L is None else self.L
+        R = _I4 if self.R is None else self.R
+        j, v = self._one
+        n = self.model.n
+        info = _joint_info(self.model, j)
+        got = info.fused.get(invert)
+        if got is None:
+            # full joint i <- the kernel's joint: the folded chain's, reversed when inverted
+            k6 = [5 - k if invert else k for k in range(6)]
+            take = np.array([k6[self.free.index(i)] if i in self.free else 0
+                             for i in range(n)], dtype=np.int64)
+            got = info.fused[invert] = (take, tuple(self.free[k6[k]] for k in (3, 5)))
+        take, fj = got
+        S18, S186, S18n = (1, 8), (1, 8, 6), (1, 8, n)
+        build = IKAllResult.build_one
+
+        def one(T, tol):
+            if mapped:
+                Tm = np.empty(_S144)
+                pose_entry(T, L, R, invert, Tm)
+            else:
+                Tm = T
+            q, valid, pos, rot = np.empty(S186), np.empty(S18, dtype=bool), np.empty(S18), \
+                np.empty(S18)
+            sing, sign, fam, cnt = np.empty(S18, dtype=bool), np.empty(S18), np.empty(S18), \
+                np.empty(1, dtype=np.int64)
+            entry(Kp, Tm, tol, wrist_tol, 1e-6, None, q, valid, pos, rot, sing, sign, fam, cnt)
+            c = cnt[0]
+            if c < 0:
+                return None
+            qn = np.empty(S18n)
+            joints_entry(q, take, j, v, qn)
+            return build(qn, valid, pos, rot, sing, sign, fam, fj, cnt, "" if c else reason,
+                         "pieper", tol)
+        return one
 
 
 _PLANS: dict = {}

@@ -22,7 +22,7 @@ from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import closed_form
 from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses, plain_poses
-from kinestat.serial.analytic.geometry import classify
+from kinestat.serial.analytic.geometry import PRESET, classify
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.ik_methods import get as _robot_method
 from kinestat.serial.ik_methods import registered as _robot_methods
@@ -67,8 +67,10 @@ def _check_chain(model: ChainModel) -> None:
 @lru_cache(maxsize=64)
 def _classify(model: ChainModel):
     """:func:`~kinestat.serial.analytic.geometry.classify`, once per model (a reversed chain is
-    classified for its model's plan, then for its own)."""
-    return classify(model)
+    classified for its model's plan, then for its own; a class already known for the model,
+    :data:`~kinestat.serial.analytic.geometry.PRESET`, is taken as it is)."""
+    hit = PRESET.get(model)
+    return classify(model) if hit is None else hit
 
 
 @lru_cache(maxsize=64)
@@ -89,8 +91,10 @@ def _classified(model: ChainModel):
 
 @lru_cache(maxsize=64)
 def _plan(model: ChainModel):
-    """The model checks and its geometry class, once per model (ik_all's per-call cost)."""
-    _check_chain(model)
+    """The model checks and its geometry class, once per model (ik_all's per-call cost; a
+    model with a class already known was built from a checked one)."""
+    if model not in PRESET:
+        _check_chain(model)
     return _classified(model)
 
 
@@ -180,6 +184,14 @@ def _locked_plan(model: ChainModel, locked):
     return mod.plan(model, locked)
 
 
+def _bind_locked(lp):
+    """The locked plan's single call (:meth:`~kinestat.serial.analytic.locked.LockedPlan.
+    bind_one`), from its folded chain's plan (and its reversed chain's); None until bound."""
+    kind, data = _plan(lp.six)
+    rev = data.get("reversed")
+    return lp.bind_one(kind, data, None if rev is None else _plan(rev)[1])
+
+
 def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
            backend: str = "numba", locked: dict | None = None) -> IKAllResult:
     """Every IK solution of the 6-joint ``model`` for poses ``T_base_flange (..., 4, 4)``.
@@ -211,19 +223,25 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
             and isinstance(model, ChainModel):
         # one plain pose, defaults: the closed form's bound single call (after the first); with
         # locked joints, the folded chain's
-        lp = _locked_plan(model, locked) if locked else None
-        one = _plan(model if lp is None else lp.six)[1].get("one")
+        if locked:
+            lp = _locked_plan(model, locked)
+            one = lp.one
+            if one is None:
+                one = _bind_locked(lp)
+        else:
+            one = _plan(model)[1].get("one")
         if one is not None and T.dtype is _F64:
             f = T.flags
             if f.c_contiguous and f.aligned and f.writeable:
                 res = one(T[None], float(tol))
                 if res is not None:
-                    return res if lp is None else lp.expand(res)
+                    return res
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
     if locked:
         lp = _locked_plan(model, locked)
-        return lp.expand(ik_all(lp.six, T_base_flange, method=method, tol=tol, backend=backend))
+        return lp.expand(ik_all(lp.six, lp.poses(T_base_flange), method=method, tol=tol,
+                                backend=backend))
     kind, data = _plan(model)
     robot = None if method in METHODS else _robot_method(method)
     if method not in METHODS and robot is None:

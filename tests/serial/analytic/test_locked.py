@@ -137,10 +137,13 @@ def _same(a, b):
 
 
 def test_locked_plans_are_kept_per_value():
-    """A new locked value gives its own folded chain; the same value the same one."""
+    """A joint in between: a new locked value gives its own folded chain; an end joint: one
+    chain for every value (the value moves into the pose); the same value the same plan."""
     model = _arm("panda")
     a, b = plan(model, {6: 0.3}), plan(model, {6: 0.5})
-    assert a.six is not b.six and plan(model, {6: 0.3}) is a
+    assert a.six is b.six and plan(model, {6: 0.3}) is a and a is not b
+    c, d = plan(model, {2: 0.3}), plan(model, {2: 0.5})
+    assert c.six is not d.six and plan(model, {2: 0.3}) is c
     assert plan(model, {np.int64(6): 0.3}) is a
     with pytest.raises(InputError, match="not a joint index"):
         plan(model, {True: 0.3})
@@ -162,3 +165,106 @@ def test_locked_plans_stay_bounded_and_keep_solving(monkeypatch):
     assert len(L._PLANS) <= 4 and (model, 2, 0.1) not in L._PLANS
     again = ik_all(model, T, locked={2: 0.1}).solutions()
     assert _same(first, again) and np.min(wrapped_distance(again, q)) < 1e-6
+
+
+def _solutions_of_the_fresh_fold(model, j, v, T):
+    """The solutions of the chain folded at ``v`` itself (a new chain, not the cached one,
+    classified and prepared from scratch), the locked value put back."""
+    S6 = ik_all(fold.__wrapped__(model, ((j, v),)), T).solutions()
+    return np.insert(S6, j, v, axis=1)
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa"])
+@pytest.mark.parametrize("j", [0, 6])
+def test_end_joint_values_share_one_chain(name, j):
+    """An end joint locked at any value, special ones included (0, ±π, a value next to 0):
+    the shared chain with the value in the pose finds the same solutions as the chain folded
+    at that value, one pose or a batch, the first call or a later (bound) one."""
+    model = _arm(name)
+    rng = np.random.default_rng(11 + j)
+    values = [0.0, np.pi, -np.pi, 1e-13, -np.pi / 2] + list(rng.uniform(-3.0, 3.0, 6))
+    for k, v in enumerate(values):
+        q = _configs(model, j, v, 3, seed=100 + k)
+        T = kinestat.fk(model, q)
+        batch = ik_all(model, T, locked={j: float(v)})
+        for i in range(len(q)):
+            fresh = _solutions_of_the_fresh_fold(model, j, float(v), T[i])
+            for _ in range(2):  # the full path, then the bound single call
+                sols = ik_all(model, T[i], locked={j: float(v)}).solutions()
+                assert _same(sols, fresh) and np.all(sols[:, j] == v)
+                assert np.abs(kinestat.fk(model, sols) - T[i]).max() < 1e-9
+            assert _same(batch.solutions((i,)), fresh)
+
+
+@pytest.mark.parametrize("name,j,aligned", [("panda", 6, 1), ("iiwa", 2, 5), ("panda", 2, None)])
+def test_single_call_equals_the_batch(name, j, aligned):
+    """The bound single call (pose mapped, kernel, joints put back in one pass) returns the
+    batch's solutions and family joints for each pose, a singular one included: joint
+    ``aligned`` at 0 lines up the two outer axes of the spherical triple the closed form
+    solves (the Panda's shoulder, solved reversed; the iiwa's wrist)."""
+    model = _arm(name)
+    q = _configs(model, j, 0.7, 8, seed=21)
+    if aligned is not None:
+        q[-1, aligned] = 0.0
+    T = kinestat.fk(model, q)
+    batch = ik_all(model, T, locked={j: 0.7})
+    for i in range(len(q)):
+        for _ in range(2):
+            one = ik_all(model, T[i], locked={j: 0.7})
+        assert one.q.shape == batch.q.shape[1:] and one.family_joints == batch.family_joints
+        assert int(one.n_solutions) == int(batch.n_solutions[i])
+        # isolated solutions equal; a family slot holds one member (any) of the same family
+        iso, iso_b = one.valid & ~one.singular, batch.valid[i] & ~batch.singular[i]
+        assert _same(one.q[iso], batch.q[i][iso_b])
+        fam, fam_b = one.valid & one.singular, batch.valid[i] & batch.singular[i]
+        assert np.allclose(np.sort(one.family_value[fam]), np.sort(batch.family_value[i][fam_b]))
+        assert np.abs(kinestat.fk(model, one.solutions()) - T[i]).max() < 1e-9
+
+
+@pytest.mark.parametrize("name", ["panda", "iiwa"])
+@pytest.mark.parametrize("j", [1, 2, 3, 4, 5])
+def test_joint_in_between_folds_as_the_fresh_fold(name, j):
+    """A joint in between at a new value: the chain built from the per-joint terms has the
+    fresh fold's constants and geometry class (classify's tests on the moved axes, or the
+    class that holds for every value), special values included (0, ±π/2, π, next to 0), and
+    the same solutions; where a general 6R remains, the elimination kept from the joint's
+    previous value gives them too."""
+    from kinestat.serial.analytic.solve import method_for
+
+    model = _arm(name)
+    rng = np.random.default_rng(40 + j)
+    values = [0.0, np.pi / 2, -np.pi / 2, np.pi, 1e-13] + list(rng.uniform(-3.0, 3.0, 3))
+    for k, v in enumerate(values):
+        v = float(v)
+        six, fresh = plan(model, {j: v}).six, fold.__wrapped__(model, ((j, v),))
+        assert np.allclose(six.constants, fresh.constants, rtol=0.0, atol=1e-12)
+        assert method_for(six) == method_for(fresh)
+        q = _configs(model, j, v, 2, seed=200 + k)
+        T = kinestat.fk(model, q)
+        for i in range(len(q)):
+            sols = ik_all(model, T[i], locked={j: v}).solutions()
+            fresh_sols = _solutions_of_the_fresh_fold(model, j, v, T[i])
+            # the constants differ by rounding, which a near-singular pose (the iiwa's elbow
+            # at π) magnifies to ~1e-9 in the joints: equal within 1e-7
+            assert len(sols) == len(fresh_sols)
+            assert all(np.min(wrapped_distance(fresh_sols, s)) < 1e-7 for s in sols)
+            if len(sols):
+                assert np.abs(kinestat.fk(model, sols) - T[i]).max() < 1e-9
+
+
+@pytest.mark.parametrize("j", [0, 6])
+def test_end_joint_bad_poses_are_named(j):
+    """The value moved into the pose keeps a pose's fault: the error names the pose, one pose
+    or a batch, an array or a list."""
+    model = _arm("panda")
+    T = kinestat.fk(model, _configs(model, j, 0.5, 3, seed=9))
+    for where, bad, match in [((1, 0, 0), np.nan, "NaN"), ((1, 0, 0), 2.0, r"pose \(1,\)"),
+                              ((2, 3, 1), 0.1, r"pose \(2,\)")]:
+        B = T.copy()
+        B[where] = bad
+        with pytest.raises(InputError, match=match):
+            ik_all(model, B, locked={j: 0.5})
+        with pytest.raises(InputError, match="NaN" if match == "NaN" else "not a rigid"):
+            ik_all(model, B[where[0]], locked={j: 0.5})
+    with pytest.raises(InputError, match="shape"):
+        ik_all(model, [[1.0, 2.0]], locked={j: 0.5})
