@@ -12,6 +12,11 @@ import pytest
 
 import kinestat  # noqa: F401  (sets NUMBA_CACHE_LOCATOR_CLASSES before Numba's first import)
 
+# a Numba without NUMBA_CACHE_LOCATOR_CLASSES ignores the variable (kinestat's locators unused)
+pytestmark = pytest.mark.skipif(
+    not hasattr(importlib.import_module("numba.core.config"), "CACHE_LOCATOR_CLASSES"),
+    reason="this Numba has no NUMBA_CACHE_LOCATOR_CLASSES")
+
 
 def test_the_value_set_at_import_is_numbas_default_order_with_kinestats_first_two():
     from numba.core import caching, config
