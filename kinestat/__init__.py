@@ -20,6 +20,14 @@ import lazy_loader
 # spinning takes the core from the thread the batch waits for (twice the wall time, measured on
 # 2 cores); the workers sleep instead, unless the user chose otherwise.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+# Numba checks a kernel's cache directory (a directory creation and a temporary file) for every
+# cached kernel it sets up; kinestat's locators check each directory once per process (the
+# value is kinestat.serial._numba_cache.LOCATORS; Numba reads it on its first import)
+os.environ.setdefault(
+    "NUMBA_CACHE_LOCATOR_CLASSES",
+    "kinestat.serial._numba_cache.UserProvidedCacheLocator,"
+    "kinestat.serial._numba_cache.InTreeCacheLocator,"
+    "UserWideCacheLocator,IPythonCacheLocator,ZipCacheLocator")
 
 __version__ = "0.2.0"  # the one place the version is written (pyproject reads it)
 

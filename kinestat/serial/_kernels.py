@@ -27,9 +27,11 @@ PRISMATIC = int(JointKind.PRISMATIC)
 SCREW = int(JointKind.SCREW)
 #: what the single-configuration kernels return: done, q not finite, q not of the chain's length
 DONE, NOT_FINITE, WRONG_LENGTH = 0, 1, 2
-#: the single-configuration kernels keep the GIL: they run for less than a microsecond, and
-#: releasing and taking it back would add a tenth to a call
-_ONE = {**_OPTS, "nogil": False}
+#: the single-configuration kernels keep the GIL (they run for less than a microsecond, and
+#: releasing and taking it back would add a tenth to a call) and run without Numba's reference
+#: counting (they allocate nothing): an array argument then reaches them without a reference
+#: -counted wrapper made and freed on every call, a tenth of a call less
+_ONE = {**_OPTS, "nogil": False, "_nrt": False}
 
 
 
@@ -115,11 +117,11 @@ def _f64_pointer(typingctx, address):
 @nb.njit(**_INLINE)
 def _packed_at(address):
     """The packed chain at ``address`` (``KernelData.address``: ``n``, then the ``16 (n+1)``
-    constants, the ``n`` kinds and the ``n`` pitches) as ``(n, P)``, ``P`` without ``n``. An
-    address costs the entry point less than one more array to take from Python."""
+    constants, the ``n`` kinds and the ``n`` pitches) as ``(n, P)``, ``P`` a pointer to the
+    values after ``n`` (indexed as an array, unchecked). An address costs the entry point less
+    than one more array to take from Python."""
     a = np.intp(address)
-    n = int(nb.carray(_f64_pointer(a), (1,))[0])
-    return n, nb.carray(_f64_pointer(a + 8), (18 * n + 16,))
+    return int(_f64_pointer(a)[0]), _f64_pointer(a + 8)
 
 
 @nb.njit(**_INLINE)

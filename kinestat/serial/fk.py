@@ -18,7 +18,7 @@ import numpy as np
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import JointKind
-from kinestat.serial._kernel_cache import _BY_ID, kernel_data
+from kinestat.serial._kernel_cache import kernel_data
 from kinestat.serial.chunks import CHUNK_ROWS, chunk_slices
 
 __all__ = ["joint_motion", "fk", "forward_analysis", "fk_frames", "joint_axes", "iter_fk",
@@ -108,22 +108,19 @@ def evaluate(model: ChainModel, q, entry, batch, tail: tuple[int, ...]) -> np.nd
     return out
 
 
-#: the model of the last one-configuration call, its kernel data and their entry points'
-#: arguments (address, Jacobian shape), in one tuple (one assignment: another thread sees the
-#: old tuple or the new one); holding the model keeps its id from being reused. An identity test
-#: costs less than the cache's lookup by id.
-_last: tuple = (object(), None, 0.0, (6, 0))  # matches no argument (not even None)
+#: the model of the last one-configuration call, its packed chain's address, the compiled entry
+#: point and the kernel data (which keep the packed chain alive), in one tuple (one assignment:
+#: another thread sees the old tuple or the new one); holding the model keeps its id from being
+#: reused. An identity test costs less than the cache's lookup by id.
+#: :mod:`kinestat.serial.jacobian` keeps its own.
+_last: tuple = (object(), 0.0, None, None)  # matches no argument (not even None)
 
 
-def remember(model: ChainModel) -> tuple | None:
-    """Keep ``model`` as :data:`_last` if its kernel data are built, and return that tuple
-    (None if they are not built)."""
-    global _last
-    d = _BY_ID.get(id(model))
-    if d is None:
-        return None
-    _last = last = (model, d, d.address, d.jshape)
-    return last
+def one_call(model: ChainModel, entry) -> tuple:
+    """The memo tuple of a one-configuration call of ``model`` by ``entry`` (see :data:`_last`);
+    builds the model's kernel data if need be."""
+    d = kernel_data(model)
+    return (model, d.address, entry, d)
 
 
 _F64 = np.dtype(np.float64)
@@ -145,18 +142,24 @@ def fk(model: ChainModel, q) -> np.ndarray:
     >>> fk(arm, np.zeros((5, 3, 2))).shape
     (5, 3, 4, 4)
     """
-    # one configuration given as a float64 vector goes straight to the compiled entry point (no
-    # per-call type dispatch; it checks q's length and values); anything else, and any error,
-    # through the checked path
-    if type(q) is _ND and q.ndim == 1 and q.dtype is _F64:
-        last = _last  # read once: another thread may replace it
-        if last[0] is not model:
-            last = remember(model)
-        if last is not None:
-            out = _empty(_S44)
-            if not (_FK_ONE or _fk_entry())(last[2], q, out):
-                return out
-    return evaluate(model, q, lambda: _FK_ONE or _fk_entry(), kernels().fk_batch, _S44)
+    # the model of the last one-configuration call with q a float64 vector goes straight to the
+    # compiled entry point (no per-call type dispatch; it checks q's length and values);
+    # anything else, and any error, through the checked path
+    last = _last  # read once: another thread may replace it
+    if last[0] is model and type(q) is _ND and q.ndim == 1 and q.dtype is _F64:
+        out = _empty(_S44)
+        if not last[2](last[1], q, out):
+            return out
+    return _fk_checked(model, q)
+
+
+def _fk_checked(model: ChainModel, q) -> np.ndarray:
+    """:func:`fk` by the checked path; a single configuration's model is remembered."""
+    global _last
+    out = evaluate(model, q, _fk_entry, kernels().fk_batch, _S44)
+    if out.ndim == 2:
+        _last = one_call(model, _FK_ONE or _fk_entry())
+    return out
 
 
 #: the theses' name for :func:`fk`

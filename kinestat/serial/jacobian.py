@@ -49,19 +49,28 @@ def jacobian(model: ChainModel, q) -> np.ndarray:
     >>> J[2], J[4]  # ω_z and v_Oy: joint 2's axis passes through x = 1
     (array([1., 1.]), array([ 0., -1.]))
     """
-    # one configuration given as a float64 vector goes straight to the compiled entry point (no
-    # per-call type dispatch; it checks q's length and values); anything else, and any error,
-    # through the checked path
-    if type(q) is _ND and q.ndim == 1 and q.dtype is _F64:
-        last = _fkmod._last  # read once: another thread may replace it
-        if last[0] is not model:
-            last = _fkmod.remember(model)
-        if last is not None:
-            J = _empty(last[3])
-            if not (_JAC_ONE or _jac_entry())(last[2], q, J):
-                return J
-    return _fkmod.evaluate(model, q, lambda: _JAC_ONE or _jac_entry(),
-                           _fkmod.kernels().jacobian_batch, (6, model.n))
+    # as in fk: the last model's one-configuration call with q a float64 vector goes straight to
+    # the compiled entry point
+    last = _last  # read once: another thread may replace it
+    if last[0] is model and type(q) is _ND and q.ndim == 1 and q.dtype is _F64:
+        J = _empty(last[4])
+        if not last[2](last[1], q, J):
+            return J
+    return _jacobian_checked(model, q)
+
+
+#: :data:`kinestat.serial.fk._last` for the Jacobian, with the Jacobian's shape last
+_last: tuple = (object(), 0.0, None, None, (6, 0))  # matches no argument (not even None)
+
+
+def _jacobian_checked(model: ChainModel, q) -> np.ndarray:
+    """:func:`jacobian` by the checked path; a single configuration's model is remembered."""
+    global _last
+    J = _fkmod.evaluate(model, q, _jac_entry, _fkmod.kernels().jacobian_batch, (6, model.n))
+    if J.ndim == 2:
+        last = _fkmod.one_call(model, _JAC_ONE or _jac_entry())
+        _last = (*last, last[3].jshape)
+    return J
 
 
 _JAC_ONE = None

@@ -75,3 +75,24 @@ def test_select_on_singular_family_splits_motion():
     assert sel.ok
     np.testing.assert_allclose(kinestat.fk(model, sel.q), kinestat.fk(model, q), atol=1e-9)
     assert sel.motion <= np.abs(cur - q).sum() + 1e-9
+
+
+def test_a_first_ik_all_call_loads_neither_the_selection_step_nor_the_seven_joint_helpers():
+    """Both load on first use (a fresh process: the first call's time), and the selection step's
+    names resolve alike from the package and from ``result``, where they were before."""
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np, kinestat; m = kinestat.load('puma560'); "
+            "kinestat.ik_all(m, kinestat.fk(m, np.full(6, 0.3))); "
+            "print(' '.join(k for k in sys.modules if k.startswith('kinestat.serial.analytic.')))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    loaded = out.stdout.split()
+    assert "kinestat.serial.analytic.solve" in loaded
+    assert "kinestat.serial.analytic.selection" not in loaded
+    assert "kinestat.serial.analytic.locked" not in loaded
+    from kinestat.serial import analytic
+    from kinestat.serial.analytic import result, selection
+
+    for name in ("Selection", "select_nearest", "wrap_to_limits"):
+        assert getattr(result, name) is getattr(selection, name) is getattr(analytic, name)
