@@ -59,6 +59,12 @@ class ControlModel:
         payload: the top plate's and the tool's weight the legs carry besides the contact
             (:class:`kinestat.control.payload.Payload`), compensated in every measurement;
             None (default, as the thesis's massless top): no compensation.
+        tip_radius: mm, the radius of the tool's ball tip, whose foremost point along the
+            top's axis is the tool tip (``P_tool_6``); 0 (default): a point tip. A ball
+            touches a surface at its centre less the radius along the surface's normal, so
+            where the tool leans the foremost point is off the contact by ``r sin(lean)``
+            while the centre rides on the surface offset by ``r``
+            (:attr:`tip_centre_top`).
     """
 
     platform: Platform
@@ -72,6 +78,7 @@ class ControlModel:
     calibration_name: str = ""
     arm: Arm = THESIS_ARM
     payload: Payload | None = None
+    tip_radius: float = 0.0
 
     def __post_init__(self) -> None:
         if not all(callable(getattr(type(self.arm), n, None)) for n in _ARM_METHODS):
@@ -105,6 +112,9 @@ class ControlModel:
         if self.payload is not None and not isinstance(self.payload, Payload):
             raise ModelError(f"payload must be a kinestat.control.payload.Payload or None, got "
                              f"{type(self.payload).__name__}")
+        if not (math.isfinite(float(self.tip_radius)) and self.tip_radius >= 0.0):
+            raise ModelError(f"tip_radius must be a number of mm >= 0, got {self.tip_radius!r}")
+        object.__setattr__(self, "tip_radius", float(self.tip_radius))
         # the platform's legs must match the calibration's
         self.calibration.platform_order(self.platform.leg_names)
 
@@ -113,6 +123,12 @@ class ControlModel:
         """The tool tip in the top frame (where ``P_tool_6`` sits when the platform is at home;
         computed once, read-only)."""
         return frozen(apply(inv(self.mount @ self.platform.home_pose), self.tool_point_6), float)
+
+    @cached_property
+    def tip_centre_top(self) -> np.ndarray:
+        """The centre of the tool's ball tip in the top frame: :attr:`tool_tip_top` less
+        :attr:`tip_radius` along the top's axis (the tip itself for a point tip)."""
+        return frozen(self.tool_tip_top - np.array([0.0, 0.0, self.tip_radius]), float)
 
     @property
     def limits_rad(self) -> np.ndarray:

@@ -136,6 +136,15 @@ class Measurement:
         return p
 
 
+    def tip_centre(self, model: ControlModel) -> np.ndarray:
+        """The measured centre of the tool's ball tip (``model.tip_radius``), fixed frame: the
+        point of the tool that rides on the surface offset by the radius whatever the tool's
+        lean; :meth:`tip` itself for a point tip."""
+        if model.tip_radius == 0.0:
+            return self.tip(model)
+        return apply_one(self.base_pose @ self.top_pose, model.tip_centre_top)
+
+
 def tool_frame(q, model: ControlModel):
     """Forward analysis of the robot with the model's tool: ``(P_tool_F, S6_F, a67_F, F_6T)``
     of one joint vector ``q`` (6,), from the arm's ``flange_pose``."""

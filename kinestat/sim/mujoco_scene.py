@@ -136,6 +136,12 @@ class Scene:
         com = np.asarray(self.model.body_ipos[b], float) / M_PER_MM
         return mass, com, np.asarray(self.model.opt.gravity, float).copy()
 
+    @property
+    def tip_radius_mm(self) -> float:
+        """The radius of the tool's ball tip (mm), which the controller is told as a user
+        declares a tool's tip."""
+        return self.params.tip_radius / M_PER_MM
+
 
 def length_scale(model: ChainModel) -> float:
     """Metres per unit of ``model``'s lengths."""

@@ -93,3 +93,30 @@ def test_bad_input():
                 PLATFORM.home_pose)
     with pytest.raises(InputError, match="estimator"):
         m.estimate("magic")
+
+
+def test_ball_tip_centre_is_the_radius_behind_the_tip_along_the_tools_axis():
+    """A ball tip: its centre is ``tip_radius`` behind the tip along the top's axis, in the
+    fixed frame whatever the platform's pose; a point tip's centre is the tip."""
+    from dataclasses import replace
+
+    scn = scenario(tilt_deg=6.0)
+    q, eq = _contact(scn, 0.5)
+    c = scn.sensor.counts(PLATFORM, eq.leg_lengths)
+    point = measure(scn.model, q, c, PLATFORM.home_pose)
+    np.testing.assert_array_equal(point.tip_centre(scn.model), point.tip(scn.model))
+    ball = replace(scn.model, tip_radius=1.5)
+    m = measure(ball, q, c, PLATFORM.home_pose)
+    axis = (m.base_pose @ m.top_pose)[:3, 2]
+    np.testing.assert_allclose(m.tip(ball) - m.tip_centre(ball), 1.5 * axis, atol=1e-12)
+
+
+@pytest.mark.parametrize("bad", [-1.0, float("nan"), float("inf")])
+def test_ball_tip_radius_must_be_a_length(bad):
+    from dataclasses import replace
+
+    from kinestat.errors import ModelError
+
+    scn = scenario()
+    with pytest.raises(ModelError, match="tip_radius"):
+        replace(scn.model, tip_radius=bad)

@@ -111,7 +111,7 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if not contact:
         return st
     tun = config.tuning
-    tip = meas.tip(config.base.model)
+    tip = meas.tip_centre(config.base.model)  # a ball tip's centre: on the offset surface
     if st.estimate is None:  # first contact: the force's direction until the probe's fit
         est = ContactEstimate(normal=-F / np.linalg.norm(F), normal_var=math.atan(
             tun.max_friction) ** 2, tips=(tip.copy(),))
@@ -123,8 +123,10 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     if st.phase != "travel":
         return replace(st, estimate=replace(st.estimate, tips=(tip.copy(),), path=(tip.copy(),)))
     est = observe_travel(tun, st.estimate, tip, F, st.tangent)
-    developed = developed_step(st.developed, est.normal, tip - st.estimate.tips[-1],
-                               st.tangent)
+    # the centre's path is the contact's offset by the radius: shorter by 1 − r κ on it
+    shrink = 1.0 - config.base.model.tip_radius * est.curvature
+    developed = developed_step(st.developed, est.normal,
+                               shrink * (tip - st.estimate.tips[-1]), st.tangent)
     stuck = st.stuck + 1 if (st.step > 0.0 or st.stuck) and not est.sliding else 0
     leaning = st.leaning or (config.auto_tilt is None and config.tilt_deg == 0.0
                              and stuck >= 2 and _frictional(tun, est))
@@ -160,7 +162,7 @@ def _probe(config: FollowConfig, st: FollowState, meas: Measurement, label: str,
     """A probing cycle; when the touches are done, the probe's plane is the normal."""
     base = config.base
     tgt = st.target
-    tip = meas.tip(base.model)
+    tip = meas.tip_centre(base.model)
     ps = probe_step(st.probe, tgt.tool_point, contact, tip, base.approach_step)
     st = replace(st, probe=ps.probe)
     if ps.reason:
@@ -328,7 +330,7 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
     if st.phase == "settle" and mis > 2.0 * config.max_turn_deg:
         dF = dF - max(float(-(dF @ n)), 0.0) * -n  # turn first: pressing a tilted tool slides it
     try:
-        T = base_twist(base.model, meas, meas.tip(base.model), n, omega, step * t, dF,
+        T = base_twist(base.model, meas, meas.tip_centre(base.model), n, omega, step * t, dF,
                        (config.max_correction, config.travel_step), stuck, hold)
     except (InputError, np.linalg.LinAlgError) as exc:
         return _stop(st, label, f"the contact basis is singular for the platform stiffness: "
