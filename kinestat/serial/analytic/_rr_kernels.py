@@ -254,7 +254,7 @@ def _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw):
 
 
 @nb.njit(**_OPTS)
-def _companion_eigvals(A, XA, wr, wi, dummy, D):
+def _companion_eigvals(A, XA, wr, wi, dummy, D, basis, index):
     """Eigenvalues (into wr, wi) of ``A2 x² + A1 x + A0`` (A normalised in place) through the
     companion with the inverse leading coefficient, its 8 spurious eigenvalues ±i deflated
     first (:func:`kinestat.serial.analytic._rr_deflate.deflated_eigvals`: the 16x16 quotient).
@@ -265,7 +265,8 @@ def _companion_eigvals(A, XA, wr, wi, dummy, D):
     regular unless −1/t is itself a root. Returns the leading coefficient's smallest relative
     pivot, 0 when no tried t gives a regular one (or the eigensolver fails).
     ``XA (12, 36)``: ``[A2 | A0 A1]`` solved in place to ``[· | X]``, ``X = A2⁻¹ [A0 A1]``;
-    D: :func:`~kinestat.serial.analytic._rr_deflate.deflate_scratch`."""
+    D: :func:`~kinestat.serial.analytic._rr_deflate.deflate_scratch`; ``(basis, index)``: the
+    model's spurious subspace (:func:`~kinestat.serial.analytic._rr_deflate.model_basis`)."""
     sc = 0.0
     for k in range(3):
         for i in range(12):
@@ -301,7 +302,7 @@ def _companion_eigvals(A, XA, wr, wi, dummy, D):
             big = max(big, abs(X[i, j]))
     if big > 1e10:
         return 0.0
-    info = deflated_eigvals(A, X, wr, wi, dummy, D)
+    info = deflated_eigvals(A, X, wr, wi, dummy, D, basis, index)
     if t != 0.0:  # back to x = (y + t) / (1 − t y)
         for k in range(24):
             x = (complex(wr[k], wi[k]) + t) / (1.0 - t * complex(wr[k], wi[k]))
@@ -480,8 +481,8 @@ def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, si
 
 
 @nb.njit(**_OPTS)
-def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
-                out_q, out_valid, out_pos, out_rot, flags, stats, S):
+def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters,
+                dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S):
     """All solutions of pose n. ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant M1 / Ts of the
     formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0 constant, 1
     ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``). ``recheck``: 0 never, 1 on suspect poses
@@ -506,7 +507,7 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
         return
     wr, wi = W24[0], W24[1]
     cnt, tried, lost, near, err = 0, 0, 0, np.inf, 0.0
-    pivot = _companion_eigvals(A, XA, wr, wi, W24[2], S[24])
+    pivot = _companion_eigvals(A, XA, wr, wi, W24[2], S[24], basis, index)
     stats[n, 5] = pivot
     if pivot > 0.0:
         cnt, tried, lost, err = _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links,
@@ -539,23 +540,24 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
 
 
 @nb.njit(parallel=True, **_OPTS)
-def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
-                out_q, out_valid, out_pos, out_rot, flags, stats):
+def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters, dedup,
+                recheck, out_q, out_valid, out_pos, out_rot, flags, stats):
     """All solutions of N poses (see the module docstring); outputs pre-filled by the caller
     (q NaN, valid False, errors NaN)."""
     N = T.shape[0]
     for c in nb.prange((N + _CHUNK - 1) // _CHUNK):
         S = _scratch()
         for n in range(c * _CHUNK, min(N, (c + 1) * _CHUNK)):
-            _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                        recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)
+            _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol,
+                        iters, dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, stats,
+                        S)
 
 
 @nb.njit(**_OPTS)
-def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
-                 out_q, out_valid, out_pos, out_rot, flags, stats):
+def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters, dedup,
+                 recheck, out_q, out_valid, out_pos, out_rot, flags, stats):
     """:func:`solve_batch` on one thread (small batches: no thread start-up)."""
     S = _scratch()
     for n in range(T.shape[0]):
-        _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                    recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)
+        _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters,
+                    dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)

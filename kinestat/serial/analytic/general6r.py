@@ -309,7 +309,11 @@ def _compiled_data(model: ChainModel, form: Formulation):
     """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5,
     whose pose link is M1 or M6): ``form (4, 4, 4)`` = C0⁻¹, C6⁻¹, constant M1, constant Ts;
     the constant links M2..M5; ``L H3``, ``H3[0]``, L; the joint order with the pose-link
-    codes of M1 and Ts appended (0 constant, 1 ``C0⁻¹ T C6⁻¹``, 2 its inverse)."""
+    codes of M1 and Ts appended (0 constant, 1 ``C0⁻¹ T C6⁻¹``, 2 its inverse); the basis of
+    the companion's spurious subspace (:func:`kinestat.serial.analytic._rr_deflate.
+    model_basis`: pose-independent)."""
+    from kinestat.serial.analytic._rr_deflate import model_basis  # lazy: Numba start-up
+
     C = np.ascontiguousarray(model.constants)
     M = form.links(C, np.eye(4)[None])
     M = [m[0] if m.ndim == 3 else m for m in M]
@@ -319,9 +323,11 @@ def _compiled_data(model: ChainModel, form: Formulation):
     at0 = 0 if form.shift == 0 else (2 if not form.reverse else 1)
     at5 = 0 if form.shift == 5 else (1 if not form.reverse else 2)
     consts = np.stack([_inv_rigid(C[0]), _inv_rigid(C[6]), M[0], _inv_rigid(M[5])])
-    return (C, np.ascontiguousarray(consts), np.ascontiguousarray(np.stack(M[1:5])),
-            np.ascontiguousarray(L @ _H3), np.ascontiguousarray(_H3[0]), np.ascontiguousarray(L),
-            np.array(OFFSETS), np.array(list(order) + [at0, at5], dtype=np.int64), float(sign))
+    LH = np.ascontiguousarray(L @ _H3)
+    basis, index = model_basis(LH)
+    return (C, np.ascontiguousarray(consts), np.ascontiguousarray(np.stack(M[1:5])), LH,
+            np.ascontiguousarray(_H3[0]), np.ascontiguousarray(L), np.array(OFFSETS),
+            np.array(list(order) + [at0, at5], dtype=np.int64), float(sign), basis, index)
 
 
 RECHECK = {"never": 0, "suspect": 1, "always": 2}
@@ -341,7 +347,7 @@ def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     if K is None:
         from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
 
-    C, consts, links, LH, h0, L, off, order, sign = _compiled_data(model, form)
+    C, consts, links, LH, h0, L, off, order, sign, basis, index = _compiled_data(model, form)
     N = T.shape[0]
     K16 = MAX_SOLUTIONS
     q = nan_array((N, K16, 6))
@@ -350,8 +356,8 @@ def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     rot = nan_array((N, K16))
     flags = np.zeros(N, dtype=np.int64)
     stats = np.zeros((N, 7))
-    args = (C, T, consts, links, LH, h0, L, off, order, sign, float(tol), int(polish_iters), 1e-6,
-            RECHECK[recheck], q, valid, pos, rot, flags, stats)
+    args = (C, T, consts, links, LH, h0, L, off, order, sign, basis, index, float(tol),
+            int(polish_iters), 1e-6, RECHECK[recheck], q, valid, pos, rot, flags, stats)
     run_kernels(K.solve_batch, K.solve_serial, args, T, _PARALLEL_MIN)
     return q, valid, pos, rot, flags, stats
 
@@ -406,7 +412,7 @@ def bind_one(model: ChainModel, check_entry):
     entry = _ENTRY.get((K.solve_serial, None)) if K is not None else None
     if entry is None or check_entry is None or form.shift not in (0, 5):
         return None
-    C, consts, links, LH, h0, L, off, order, sign = _compiled_data(model, form)
+    C, consts, links, LH, h0, L, off, order, sign, basis, index = _compiled_data(model, form)
     method = _method_name(form)
     K16 = MAX_SOLUTIONS
     shape = (1, K16)
@@ -420,8 +426,8 @@ def bind_one(model: ChainModel, check_entry):
         pos = nan_array(shape)
         rot = nan_array(shape)
         flags = np.zeros(1, dtype=np.int64)
-        entry(C, T, consts, links, LH, h0, L, off, order, sign, tol, 8, 1e-6, 1, q, valid, pos,
-              rot, flags, np.zeros((1, 7)))
+        entry(C, T, consts, links, LH, h0, L, off, order, sign, basis, index, tol, 8, 1e-6, 1, q,
+              valid, pos, rot, flags, np.zeros((1, 7)))
         if flags[0] != 0:
             return None
         nsol = np.empty(1, dtype=np.int64)
