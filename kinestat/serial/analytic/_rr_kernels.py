@@ -373,6 +373,16 @@ def _ratio(v, axis):
     return num / den if den > 0 else np.nan
 
 
+@nb.njit(**_INLINE)
+def _half_angle(x, ph):
+    """``(1, cos φ, sin φ)`` of ``φ = 2 atan x``: rational in x (no trigonometric calls) unless
+    |x| is so large that x² would lose it."""
+    if abs(x) < 1e100:
+        d = 1.0 / (1.0 + x * x)
+        return 1.0, (1.0 - x) * (1.0 + x) * d, 2.0 * x * d
+    return 1.0, math.cos(ph), math.sin(ph)
+
+
 @nb.njit(**_OPTS)
 def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     """θ (6,) of the loop from a real root x3 and its power products ``v (12, 1)``; False if
@@ -384,9 +394,9 @@ def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     ph3 = 2.0 * math.atan(x3)
     ph4 = 2.0 * math.atan(x4)
     ph5 = 2.0 * math.atan(x5)
-    m3 = (1.0, math.cos(ph3), math.sin(ph3))
-    m4 = (1.0, math.cos(ph4), math.sin(ph4))
-    m5 = (1.0, math.cos(ph5), math.sin(ph5))
+    m3 = _half_angle(x3, ph3)
+    m4 = _half_angle(x4, ph4)
+    m5 = _half_angle(x5, ph5)
     for a in range(3):
         for b in range(3):
             for c in range(3):
@@ -482,16 +492,19 @@ def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, si
 
 @nb.njit(**_OPTS)
 def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters,
-                dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S):
-    """All solutions of pose n. ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant M1 / Ts of the
-    formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0 constant, 1
-    ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``). ``recheck``: 0 never, 1 on suspect poses
+                dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, counts, stats, S):
+    """All solutions of pose n (its slots cleared first: q and errors NaN, valid False; the
+    number of solutions into ``counts[n]``). ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant
+    M1 / Ts of the formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0
+    constant, 1 ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``). ``recheck``: 0 never, 1 on suspect poses
     (``_rr_qz.suspect``), 2 always: the roots are recovered again from the QZ eigenvalues,
     which replace the companion's (its solutions are dropped: near a fold a companion root
     can stall at a near-singular point within ``tol`` beside the two true roots).
     ``stats[n]``: see ``general6r.run_kernel``."""
     Gs, Rh, MA, V15, A, E, XA, W24 = S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[9]
     H, R, piv, Vr, Aw = S[17], S[18], S[19], S[20], S[21]
+    _clear(n, out_q, out_valid, out_pos, out_rot)
+    counts[n] = 0
     _rigid_product(form[0], T[n], form[1], Gs[1])
     _rigid_inverse(Gs[1], Gs[2])
     Gs[0] = form[2]
@@ -524,40 +537,49 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index,
     stats[n, 4] = 0.0
     stats[n, 6] = err
     flags[n] = FLAG_OK
+    counts[n] = cnt
     if rerun:
         stats[n, 4] = 1.0
         if not pencil_eigvals_qz(A, wr, wi, qz_scratch()):  # allocated here: rare
             flags[n] = FLAG_ILL_CONDITIONED
             return
-        for j in range(cnt):  # the QZ roots replace the companion's
-            out_valid[n, j] = False
-            out_pos[n, j] = np.nan
-            out_rot[n, j] = np.nan
-            for i in range(6):
-                out_q[n, j, i] = np.nan
-        _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, sign, tol,
-                 iters, dedup, out_q, out_valid, out_pos, out_rot, 0, S)
+        _clear(n, out_q, out_valid, out_pos, out_rot)  # the QZ roots replace the companion's
+        cnt = _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, sign,
+                       tol, iters, dedup, out_q, out_valid, out_pos, out_rot, 0, S)[0]
+        counts[n] = cnt
+
+
+@nb.njit(**_INLINE)
+def _clear(n, out_q, out_valid, out_pos, out_rot):
+    """Empty slots of pose n: q and errors NaN, valid False."""
+    for j in range(out_valid.shape[1]):
+        out_valid[n, j] = False
+        out_pos[n, j] = np.nan
+        out_rot[n, j] = np.nan
+        for i in range(6):
+            out_q[n, j, i] = np.nan
 
 
 @nb.njit(parallel=True, **_OPTS)
 def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters, dedup,
-                recheck, out_q, out_valid, out_pos, out_rot, flags, stats):
-    """All solutions of N poses (see the module docstring); outputs pre-filled by the caller
-    (q NaN, valid False, errors NaN)."""
+                recheck, out_q, out_valid, out_pos, out_rot, flags, counts, stats):
+    """All solutions of N poses (see the module docstring) into the outputs (any contents:
+    every pose's slots are cleared first) and their numbers into ``counts (N,)``."""
     N = T.shape[0]
     for c in nb.prange((N + _CHUNK - 1) // _CHUNK):
         S = _scratch()
         for n in range(c * _CHUNK, min(N, (c + 1) * _CHUNK)):
             _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol,
-                        iters, dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, stats,
-                        S)
+                        iters, dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, counts,
+                        stats, S)
 
 
 @nb.njit(**_OPTS)
 def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters, dedup,
-                 recheck, out_q, out_valid, out_pos, out_rot, flags, stats):
+                 recheck, out_q, out_valid, out_pos, out_rot, flags, counts, stats):
     """:func:`solve_batch` on one thread (small batches: no thread start-up)."""
     S = _scratch()
     for n in range(T.shape[0]):
         _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters,
-                    dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)
+                    dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, counts, stats,
+                    S)

@@ -339,7 +339,8 @@ leading coefficient singular for every Möbius parameter) QZ is the only pass in
 
 def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     """The compiled kernel on poses ``T (N, 4, 4)``: ``q (N, 16, 6)``, valid, position and
-    rotation errors, the per-pose flags and ``stats (N, 7)``: real eigenvalues tried and lost
+    rotation errors, the per-pose flags, the numbers of solutions and ``stats (N, 7)``: real
+    eigenvalues tried and lost
     by the first pass, its nearest-real complex eigenvalue ``|Im x| / (1 + |x|)``, its count,
     1.0 where the QZ pass ran, the smallest relative pivot of the companion's leading
     coefficient (0 where it was unusable), the first pass's largest real-eigenvalue error."""
@@ -350,16 +351,17 @@ def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     C, consts, links, LH, h0, L, off, order, sign, basis, index = _compiled_data(model, form)
     N = T.shape[0]
     K16 = MAX_SOLUTIONS
-    q = nan_array((N, K16, 6))
-    valid = np.zeros((N, K16), dtype=bool)
-    pos = nan_array((N, K16))
-    rot = nan_array((N, K16))
+    q = np.empty((N, K16, 6))  # every pose's slots are cleared by the kernel
+    valid = np.empty((N, K16), dtype=bool)
+    pos = np.empty((N, K16))
+    rot = np.empty((N, K16))
     flags = np.zeros(N, dtype=np.int64)
+    counts = np.zeros(N, dtype=np.int64)
     stats = np.zeros((N, 7))
     args = (C, T, consts, links, LH, h0, L, off, order, sign, basis, index, float(tol),
-            int(polish_iters), 1e-6, RECHECK[recheck], q, valid, pos, rot, flags, stats)
+            int(polish_iters), 1e-6, RECHECK[recheck], q, valid, pos, rot, flags, counts, stats)
     run_kernels(K.solve_batch, K.solve_serial, args, T, _PARALLEL_MIN)
-    return q, valid, pos, rot, flags, stats
+    return q, valid, pos, rot, flags, counts, stats
 
 
 def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect",
@@ -368,17 +370,11 @@ def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect",
     if K is None:
         from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
 
-    q, valid, pos, rot, flags, _ = run_kernel(model, T, form, tol, polish_iters, recheck)
+    q, valid, pos, rot, flags, nsol, _ = run_kernel(model, T, form, tol, polish_iters, recheck)
     N, K16 = valid.shape
-    # result building (a single call is ~70 µs: NumPy's per-call costs matter, so one pose
-    # takes the scalar route and the result is built once, in its final shape)
-    if N == 1:
-        nsol = np.empty(1, dtype=np.int64)
-        nsol[0] = np.count_nonzero(valid)
-        flagged = flags[0] != K.FLAG_OK
-    else:
-        nsol = np.count_nonzero(valid, axis=1)
-        flagged = flags.any()
+    # result building (NumPy's per-call costs matter in a single call, so one pose takes the
+    # scalar route and the result is built once, in its final shape)
+    flagged = flags[0] != K.FLAG_OK if N == 1 else flags.any()
     reason = reasons(nsol, _REASON_NONE)
     if flagged:
         reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
@@ -421,17 +417,16 @@ def bind_one(model: ChainModel, check_entry):
         bad, n_project = check_entry(T, 1e-6)
         if bad >= 0 or n_project:
             return None
-        q = nan_array((1, K16, 6))
-        valid = np.zeros(shape, dtype=bool)
-        pos = nan_array(shape)
-        rot = nan_array(shape)
-        flags = np.zeros(1, dtype=np.int64)
+        q = np.empty((1, K16, 6))  # the kernel clears the slots and sets flags, nsol
+        valid = np.empty(shape, dtype=bool)
+        pos = np.empty(shape)
+        rot = np.empty(shape)
+        flags = np.empty(1, dtype=np.int64)
+        nsol = np.empty(1, dtype=np.int64)
         entry(C, T, consts, links, LH, h0, L, off, order, sign, basis, index, tol, 8, 1e-6, 1, q,
-              valid, pos, rot, flags, np.zeros((1, 7)))
+              valid, pos, rot, flags, nsol, np.empty((1, 7)))
         if flags[0] != 0:
             return None
-        nsol = np.empty(1, dtype=np.int64)
-        nsol[0] = np.count_nonzero(valid)
         return IKAllResult.build_one(q, valid, pos, rot, np.zeros(shape, dtype=bool),
                                      np.zeros(shape), nan_array(shape), None, nsol,
                                      "" if nsol[0] else _REASON_NONE, method, tol)
