@@ -108,3 +108,29 @@ def test_compiled_solutions_reproduce_pose_and_cover_numerical_ik(name):
         for qn in num.q[num.success]:
             dn = np.abs(np.mod(sols - qn + np.pi, 2 * np.pi) - np.pi).max(axis=1)
             assert dn.min() < 1e-5
+
+
+@pytest.mark.parametrize("name", ["random1", "jaco6"])
+def test_structured_null_vector_equals_the_svd_null_vector(name):
+    """At each real eigenvalue x of the pencil, the block-structured null vector of A(x) is the
+    matrix's smallest right singular vector (NumPy's SVD), or the kernel declines it."""
+    from kinestat.serial.analytic._rr_kernels import _null_structured
+
+    used = 0
+    for A in _pencils(name, 8, 7):
+        X = np.linalg.solve(A[2], np.concatenate([A[0], A[1]], axis=1))
+        C = np.zeros((24, 24))
+        C[:12, 12:] = np.eye(12)
+        C[12:] = -X
+        for x in np.linalg.eigvals(C):
+            if abs(x.imag) > 1e-9 * (1 + abs(x)):
+                continue
+            x = x.real
+            S = (A[0] + x * A[1] + x * x * A[2]) / max(1.0, x * x)
+            v = np.empty((12, 1))
+            if not _null_structured(S.copy(), v, np.empty((16, 12)), np.empty(12, np.int64)):
+                continue
+            used += 1
+            u = np.linalg.svd(S)[2][-1]
+            assert abs(abs(u @ v[:, 0]) - 1.0) < 1e-6
+    assert used > 0
