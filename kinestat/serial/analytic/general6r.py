@@ -412,6 +412,11 @@ def bind_one(model: ChainModel, check_entry):
     method = _method_name(form)
     K16 = MAX_SOLUTIONS
     shape = (1, K16)
+    # no singular families here: the same read-only arrays serve every result
+    singular, family_sign, family_value = np.zeros(shape, dtype=bool), np.zeros(shape), \
+        nan_array(shape)
+    for a in (singular, family_sign, family_value):
+        a.flags.writeable = False
 
     def one(T, tol):
         bad, n_project = check_entry(T, 1e-6)
@@ -427,9 +432,8 @@ def bind_one(model: ChainModel, check_entry):
               valid, pos, rot, flags, nsol, np.empty((1, 7)))
         if flags[0] != 0:
             return None
-        return IKAllResult.build_one(q, valid, pos, rot, np.zeros(shape, dtype=bool),
-                                     np.zeros(shape), nan_array(shape), None, nsol,
-                                     "" if nsol[0] else _REASON_NONE, method, tol)
+        return IKAllResult.build_one(q, valid, pos, rot, singular, family_sign, family_value,
+                                     None, nsol, "" if nsol[0] else _REASON_NONE, method, tol)
     return one
 
 
