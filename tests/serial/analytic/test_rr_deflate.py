@@ -114,7 +114,7 @@ def test_compiled_solutions_reproduce_pose_and_cover_numerical_ik(name):
 def test_structured_null_vector_equals_the_svd_null_vector(name):
     """At each real eigenvalue x of the pencil, the block-structured null vector of A(x) is the
     matrix's smallest right singular vector (NumPy's SVD), or the kernel declines it."""
-    from kinestat.serial.analytic._rr_kernels import _null_structured
+    from kinestat.serial.analytic._rr_null import _null_structured
 
     used = 0
     for A in _pencils(name, 8, 7):
