@@ -20,6 +20,13 @@ eigenvalues of C on the quotient ``R²⁴ / W`` are the remaining ones:
 A Möbius change of the variable ``x = (y + t)/(1 − t y)`` maps ±i to ±i and keeps the null
 vectors (``B(y) = (1 − t y)² A(x)``), so the same W deflates the transformed companion. Where
 the null space is not found (nullity 0 or above 4) nothing is deflated.
+
+The null space does not depend on the pose: ``A(x)`` is ``Nᵀ`` (the left null space of Q, per
+pose) times the 14 equations ``L H3 − r0 h0ᵀ`` in the power products, and at ``x = ±i`` the
+pose's part ``r0 h0ᵀ`` vanishes exactly (``h0`` carries the factor ``1 + x3²``). The null
+space of the 14 equations at ``x3 = i`` (28x12 with the x4-shifted copy, pose-independent) is
+therefore contained in every pose's; where it has dimension 4 it is all of it, and
+:func:`model_basis` computes W once per model (an SVD), so steps 1-2 leave the per-pose work.
 """
 
 from __future__ import annotations
@@ -32,7 +39,8 @@ from numba.np.linalg import _LAPACK
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._hqr import eigvals
 
-__all__ = ["RANK_TOL", "deflate_scratch", "deflated_eigvals", "spurious_basis"]
+__all__ = ["RANK_TOL", "deflate_scratch", "deflated_eigvals", "spurious_basis", "model_basis",
+           "no_basis"]
 
 _rgeev = _LAPACK().numba_ez_rgeev(types.float64)
 
@@ -45,11 +53,12 @@ _MAX_NULL = 4  # the factor (1 + x²)⁴
 def deflate_scratch():
     """Work arrays of :func:`deflated_eigvals`: complex A(i) (12, 12), its column order (12,),
     the null basis (12, 4), the real basis transposed (8, 24), pivot rows (8,), the row mask
-    (24,), the quotient matrix (24, 24) and its column-major copy for dgeev (576,)."""
+    (24,), the column-major copy of the quotient for dgeev (576,), the quotient matrix (24, 24)
+    and the quotient's coordinate maps (48,)."""
     return (np.empty((12, 12), dtype=np.complex128), np.empty(12, dtype=np.int64),
             np.empty((12, 4), dtype=np.complex128), np.empty((8, 24)),
             np.empty(8, dtype=np.int64), np.empty(24, dtype=np.int64), np.empty(576),
-            np.empty((24, 24)))
+            np.empty((24, 24)), np.empty(48, dtype=np.int64))
 
 
 @nb.njit(**_OPTS)
@@ -112,8 +121,15 @@ def spurious_basis(A, S):
     """The invariant subspace of ±i as ``Bt (2d, 24)`` (in ``S[3]``) in Gauss–Jordan form:
     ``Bt[:, p] = I`` on the pivot rows ``p = S[4][:2d]``, ``S[5]`` marking them; returns 2d (0:
     no deflation). ``S``: :func:`deflate_scratch`."""
-    U, cperm, Nv, Bt, p, mask = S[0], S[1], S[2], S[3], S[4], S[5]
-    d = _null_at_i(A, U, cperm, Nv)
+    d = _null_at_i(A, S[0], S[1], S[2])
+    return _gauss_jordan(S[2], d, S[3], S[4], S[5])
+
+
+@nb.njit(**_OPTS)
+def _gauss_jordan(Nv, d, Bt, p, mask):
+    """The real basis ``[a; −b]``, ``[b; a]`` of the null vectors ``Nv[:, :d] = a + i b`` into
+    ``Bt (2d, 24)`` in Gauss–Jordan form with complete pivoting (pivot columns into p, marked in
+    mask); returns 2d (0: no deflation)."""
     m = 2 * d
     for e in range(d):
         for i in range(12):
@@ -149,49 +165,96 @@ def spurious_basis(A, S):
     return m
 
 
+def no_basis() -> tuple[np.ndarray, np.ndarray]:
+    """The ``(basis, index)`` arguments of :func:`deflated_eigvals` that make it find the basis
+    per pose (:func:`spurious_basis`)."""
+    return np.zeros((8, 24)), np.zeros(33, dtype=np.int64)
+
+
+def model_basis(LH: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The pose-independent basis of the spurious subspace from the model's ``L H3 (14, 27)``
+    (columns ``k*9 + 3i + j``: powers k of x3, i of x4, j of x5): ``(basis (8, 24), index
+    (33,))``, index = [2d, the pivot columns (8), the pivot mask (24)], as :func:`spurious_basis`
+    leaves them in its scratch; :func:`no_basis` where the null space at ``x3 = i`` is not
+    4-dimensional (the kernel then finds it per pose)."""
+    Ai = LH[:, 0:9] - LH[:, 18:27] + 1j * LH[:, 9:18]  # Σ_k i^k LH_k
+    B = np.zeros((28, 12), dtype=complex)
+    B[:14, :9] = Ai
+    B[14:, 3:] = Ai  # the equations times x4
+    _, s, Vh = np.linalg.svd(B)
+    d = int(np.sum(s <= RANK_TOL * s[0]))
+    if d != _MAX_NULL:
+        return no_basis()
+    Nv = np.ascontiguousarray(Vh[-d:].conj().T)
+    Bt = np.zeros((8, 24))
+    index = np.zeros(33, dtype=np.int64)
+    m = _gauss_jordan(Nv, d, Bt, index[1:9], index[9:])
+    if m != 2 * d:
+        return no_basis()
+    index[0] = m
+    return Bt, index
+
+
 @nb.njit(**_OPTS)
-def deflated_eigvals(A, X, wr, wi, dummy, S):
-    """Eigenvalues (into wr, wi; 24 of them) of the companion ``C = [0 I; −X]`` (``X (12,
-    24)`` = ``A2⁻¹ [A0 A1]``, of A or of its Möbius transform) with the invariant subspace of ±i
-    of ``A (3, 12, 12)`` deflated: the eigenvalues of the (24 − 2d)² quotient (``_hqr``, or
-    LAPACK's dgeev where it fails), the 2d deflated slots set to ±i. Returns 0 on success
-    (else dgeev's info)."""
-    Bt, p, mask, F, Hm = S[3], S[4], S[5], S[6], S[7]
-    m = spurious_basis(A, S)
+def _quotient(X, Bt, p, mask, m, Hm, maps):
+    """The quotient map of the companion ``C = [0 I; −X]`` on the coordinates outside the pivots
+    p (mask) into ``Hm[:24 − m, :24 − m]``: ``C[np, np] − Bt[:, np]ᵀ C[p, np]``; C's rows
+    ``pk < 12`` are unit rows, so their terms are a single entry each. ``maps (48,)``:
+    scratch."""
     n = 24 - m
-    # quotient map on the unmarked coordinates; C[r, c] = δ(c, r + 12) (r < 12), −X[r−12, c];
-    # the pivot rows of C first (Cp, in the free rows of F)
-    Cp = F[:24 * m].reshape((m, 24)) if m > 0 else F[:24].reshape((1, 24))
-    for k in range(m):
-        pk = p[k]
-        for c in range(24):
-            if pk < 12:
-                Cp[k, c] = 1.0 if c == pk + 12 else 0.0
-            else:
-                Cp[k, c] = -X[pk - 12, c]
+    free = maps[:24]
+    col = maps[24:]  # the quotient column of a free coordinate, or −1
     a = 0
     for r in range(24):
-        if mask[r] == 1 and m > 0:
-            continue
-        b = 0
-        for c in range(24):
-            if mask[c] == 1 and m > 0:
-                continue
+        if m > 0 and mask[r] == 1:
+            col[r] = -1
+        else:
+            free[a] = r
+            col[r] = a
+            a += 1
+    for a in range(n):
+        r = free[a]
+        for b in range(n):
+            c = free[b]
             if r < 12:
                 h = 1.0 if c == r + 12 else 0.0
             else:
                 h = -X[r - 12, c]
             for k in range(m):
-                h -= Bt[k, r] * Cp[k, c]
+                pk = p[k]
+                if pk >= 12:
+                    h += Bt[k, r] * X[pk - 12, c]
             Hm[a, b] = h
-            b += 1
-        a += 1
-    for a in range(n):  # a column-major copy (Cp is no longer needed) for LAPACK
-        for b in range(n):
-            F[b * n + a] = Hm[a, b]
+        for k in range(m):
+            pk = p[k]
+            if pk < 12 and col[pk + 12] >= 0:
+                Hm[a, col[pk + 12]] -= Bt[k, r]
+
+
+@nb.njit(**_OPTS)
+def deflated_eigvals(A, X, wr, wi, dummy, S, basis, index):
+    """Eigenvalues (into wr, wi; 24 of them) of the companion ``C = [0 I; −X]`` (``X (12,
+    24)`` = ``A2⁻¹ [A0 A1]``, of A or of its Möbius transform) with the invariant subspace of ±i
+    of ``A (3, 12, 12)`` deflated: the eigenvalues of the (24 − 2d)² quotient (``_hqr``, or
+    LAPACK's dgeev where it fails), the 2d deflated slots set to ±i. ``(basis, index)``: the
+    model's basis (:func:`model_basis`), or :func:`no_basis` to find it from A. Returns 0 on
+    success (else dgeev's info)."""
+    F, Hm = S[6], S[7]
+    if index[0] > 0:
+        m = index[0]
+        Bt, p, mask = basis, index[1:9], index[9:]
+    else:
+        m = spurious_basis(A, S)
+        Bt, p, mask = S[3], S[4], S[5]
+    n = 24 - m
+    _quotient(X, Bt, p, mask, m, Hm, S[8])
     if eigvals(Hm, n, wr, wi):
         info = 0
-    else:  # the QR iteration did not converge: LAPACK
+    else:  # the QR iteration did not converge: LAPACK on a column-major copy
+        _quotient(X, Bt, p, mask, m, Hm, S[8])
+        for a in range(n):
+            for b in range(n):
+                F[b * n + a] = Hm[a, b]
         info = _rgeev(ord("d"), ord("N"), ord("N"), n, F.ctypes, n, wr.ctypes, wi.ctypes,
                       dummy.ctypes, 1, dummy.ctypes, 1)
     for k in range(n, 24):

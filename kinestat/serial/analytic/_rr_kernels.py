@@ -5,10 +5,10 @@ poses the kernel flags), one pose at a time, batches split over the cores with `
 Per pose: the pose link ``C0⁻¹ T C6⁻¹`` (or its inverse) of the formulation, the right side of
 RR eq. 4 (15x15 rigid action), a pivoted Householder QR of Q (its left null space; the
 least-squares back-substitution), the 12x12 matrix quadratic, the eigenvalues of its
-companion with the spurious ±i deflated (:mod:`kinestat.serial.analytic._rr_deflate`; LAPACK
-dgeev on 16x16), the power-product vector of each real root by inverse
-iteration, back-substitution, θ6 (the serial FK kernel's scalar steps), Newton polishing
-against FK, verification and de-duplication
+companion with the spurious ±i deflated (:mod:`kinestat.serial.analytic._rr_deflate`: the
+compiled QR iteration on 16x16), the power-product vector of each real root
+(:mod:`kinestat.serial.analytic._rr_null`), back-substitution, θ6 (the serial FK kernel's
+scalar steps), Newton polishing against FK, verification and de-duplication
 (:mod:`kinestat.serial.analytic._solution_kernels`). On a suspect pose (``_rr_qz.suspect``: a
 lost real root, an odd real count, a complex pair within the double-root split of the
 observed eigenvalue error, a nearly singular leading coefficient; about 1 % of Jaco2-type
@@ -32,6 +32,8 @@ from kinestat.serial._kernels import _step
 from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 from kinestat.serial.analytic._rr_deflate import deflate_scratch, deflated_eigvals
+from kinestat.serial.analytic._rr_null import TINY_PIVOT as _TINY_PIVOT
+from kinestat.serial.analytic._rr_null import null_vector as _null_vector
 from kinestat.serial.analytic._rr_qz import nearly_real, pencil_eigvals_qz, qz_scratch, suspect
 from kinestat.serial.analytic._solution_kernels import polish, store
 from kinestat.spatial._elimination import eliminate
@@ -47,9 +49,6 @@ _CHUNK = 16  # poses per scratch allocation in the parallel loop
 _A2_PIVOT_MIN = 1e-5
 #: the Möbius parameters tried in turn (0: the plain variable)
 _MOBIUS = (0.0, 0.7, -1.3, 2.9)
-#: relative pivot size below which a pivot is replaced (inverse iteration, the companion)
-_TINY_PIVOT = 1e-17
-_B0 = (0.31, -0.72, 0.55, 0.13, -0.94, 0.67, -0.28, 0.81, -0.46, 0.19, 0.73, -0.35)
 
 
 @nb.njit(**_INLINE)
@@ -254,7 +253,7 @@ def _pencil(LH, h0, Rh, A, E, H, R, piv, Vr, Aw):
 
 
 @nb.njit(**_OPTS)
-def _companion_eigvals(A, XA, wr, wi, dummy, D):
+def _companion_eigvals(A, XA, wr, wi, dummy, D, basis, index):
     """Eigenvalues (into wr, wi) of ``A2 x² + A1 x + A0`` (A normalised in place) through the
     companion with the inverse leading coefficient, its 8 spurious eigenvalues ±i deflated
     first (:func:`kinestat.serial.analytic._rr_deflate.deflated_eigvals`: the 16x16 quotient).
@@ -265,7 +264,8 @@ def _companion_eigvals(A, XA, wr, wi, dummy, D):
     regular unless −1/t is itself a root. Returns the leading coefficient's smallest relative
     pivot, 0 when no tried t gives a regular one (or the eigensolver fails).
     ``XA (12, 36)``: ``[A2 | A0 A1]`` solved in place to ``[· | X]``, ``X = A2⁻¹ [A0 A1]``;
-    D: :func:`~kinestat.serial.analytic._rr_deflate.deflate_scratch`."""
+    D: :func:`~kinestat.serial.analytic._rr_deflate.deflate_scratch`; ``(basis, index)``: the
+    model's spurious subspace (:func:`~kinestat.serial.analytic._rr_deflate.model_basis`)."""
     sc = 0.0
     for k in range(3):
         for i in range(12):
@@ -301,56 +301,13 @@ def _companion_eigvals(A, XA, wr, wi, dummy, D):
             big = max(big, abs(X[i, j]))
     if big > 1e10:
         return 0.0
-    info = deflated_eigvals(A, X, wr, wi, dummy, D)
+    info = deflated_eigvals(A, X, wr, wi, dummy, D, basis, index)
     if t != 0.0:  # back to x = (y + t) / (1 − t y)
         for k in range(24):
             x = (complex(wr[k], wi[k]) + t) / (1.0 - t * complex(wr[k], wi[k]))
             wr[k] = x.real
             wi[k] = x.imag
     return pivot if info == 0 else 0.0
-
-
-@nb.njit(**_OPTS)
-def _lu_solve(A, perm, b, y):
-    """``b ← A⁻¹ b`` with the LU factors and row order of :func:`eliminate`; y (n,)
-    scratch."""
-    n = A.shape[0]
-    for i in range(n):
-        acc = b[perm[i], 0]
-        for j in range(i):
-            acc -= A[i, j] * y[j]
-        y[i] = acc
-    for i in range(n - 1, -1, -1):
-        acc = y[i]
-        for j in range(i + 1, n):
-            acc -= A[i, j] * b[j, 0]
-        b[i, 0] = acc / A[i, i]
-
-
-@nb.njit(**_OPTS)
-def _null_vector(A, x, S, v, perm, y):
-    """The power-product vector ``v (12, 1)``: a null vector of ``A2 x² + A1 x + A0`` by two
-    steps of inverse iteration on one LU factorisation (the matrix is singular at an
-    eigenvalue); S (12, 12), perm (12,), y (12,) scratch. For |x| > 1 the matrix is divided by
-    x² (better scaled)."""
-    for i in range(12):
-        v[i, 0] = _B0[i]
-    if abs(x) <= 1.0:
-        c0, c1, c2 = 1.0, x, x * x
-    else:
-        c0, c1, c2 = 1.0 / (x * x), 1.0 / x, 1.0
-    for i in range(12):
-        for j in range(12):
-            S[i, j] = c0 * A[0, i, j] + c1 * A[1, i, j] + c2 * A[2, i, j]
-    eliminate(S, 12, _TINY_PIVOT, perm)  # factors only; tiny pivots replaced
-    for _ in range(2):
-        _lu_solve(S, perm, v, y)
-        nv = 0.0
-        for i in range(12):
-            nv += v[i, 0] * v[i, 0]
-        nv = math.sqrt(nv)
-        for i in range(12):
-            v[i, 0] /= nv
 
 
 @nb.njit(**_INLINE)
@@ -372,6 +329,16 @@ def _ratio(v, axis):
     return num / den if den > 0 else np.nan
 
 
+@nb.njit(**_INLINE)
+def _half_angle(x, ph):
+    """``(1, cos φ, sin φ)`` of ``φ = 2 atan x``: rational in x (no trigonometric calls) unless
+    |x| is so large that x² would lose it."""
+    if abs(x) < 1e100:
+        d = 1.0 / (1.0 + x * x)
+        return 1.0, (1.0 - x) * (1.0 + x) * d, 2.0 * x * d
+    return 1.0, math.cos(ph), math.sin(ph)
+
+
 @nb.njit(**_OPTS)
 def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     """θ (6,) of the loop from a real root x3 and its power products ``v (12, 1)``; False if
@@ -383,9 +350,9 @@ def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     ph3 = 2.0 * math.atan(x3)
     ph4 = 2.0 * math.atan(x4)
     ph5 = 2.0 * math.atan(x5)
-    m3 = (1.0, math.cos(ph3), math.sin(ph3))
-    m4 = (1.0, math.cos(ph4), math.sin(ph4))
-    m5 = (1.0, math.cos(ph5), math.sin(ph5))
+    m3 = _half_angle(x3, ph3)
+    m4 = _half_angle(x4, ph4)
+    m5 = _half_angle(x5, ph5)
     for a in range(3):
         for b in range(3):
             for c in range(3):
@@ -441,7 +408,8 @@ def _scratch():
             np.empty((1, 1)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
             np.empty(8), np.empty((3, 6, 7)), np.empty((4, 6)), np.empty(6), np.empty(6),
             np.empty((14, 14)), np.empty((8, 8)), np.empty(8, dtype=np.int64), np.empty((8, 14)),
-            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12), deflate_scratch())
+            np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12), deflate_scratch(),
+            np.empty((16, 12)))
 
 
 @nb.njit(**_OPTS)
@@ -453,6 +421,7 @@ def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, si
     eigenvalue error ``|x − x*| / (1 + |x*|)`` against the polished root x*)."""
     A2, v, m, coef, Ms, Vs, th, q, perm, y12 = S[7], S[10], S[11], S[12], S[13], S[14], \
         S[15], S[16], S[22], S[23]
+    W = S[25]
     tried = 0
     lost = 0
     err = 0.0
@@ -460,7 +429,7 @@ def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, si
         if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
             continue
         tried += 1
-        _null_vector(A, wr[k], A2, v, perm, y12)
+        _null_vector(A, wr[k], A2, v, perm, y12, W)
         if not _angles(wr[k], v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
             lost += 1
             continue
@@ -480,17 +449,20 @@ def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, si
 
 
 @nb.njit(**_OPTS)
-def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
-                out_q, out_valid, out_pos, out_rot, flags, stats, S):
-    """All solutions of pose n. ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant M1 / Ts of the
-    formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0 constant, 1
-    ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``). ``recheck``: 0 never, 1 on suspect poses
+def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters,
+                dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, counts, stats, S):
+    """All solutions of pose n (its slots cleared first: q and errors NaN, valid False; the
+    number of solutions into ``counts[n]``). ``form (4, 4, 4)``: C0⁻¹, C6⁻¹ and the constant
+    M1 / Ts of the formulation; ``order[6:8]`` say which of M1 and Ts is the pose link (0
+    constant, 1 ``G = C0⁻¹ T C6⁻¹``, 2 ``G⁻¹``). ``recheck``: 0 never, 1 on suspect poses
     (``_rr_qz.suspect``), 2 always: the roots are recovered again from the QZ eigenvalues,
     which replace the companion's (its solutions are dropped: near a fold a companion root
     can stall at a near-singular point within ``tol`` beside the two true roots).
     ``stats[n]``: see ``general6r.run_kernel``."""
     Gs, Rh, MA, V15, A, E, XA, W24 = S[0], S[1], S[2], S[3], S[4], S[5], S[6], S[9]
     H, R, piv, Vr, Aw = S[17], S[18], S[19], S[20], S[21]
+    _clear(n, out_q, out_valid, out_pos, out_rot)
+    counts[n] = 0
     _rigid_product(form[0], T[n], form[1], Gs[1])
     _rigid_inverse(Gs[1], Gs[2])
     Gs[0] = form[2]
@@ -506,7 +478,7 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
         return
     wr, wi = W24[0], W24[1]
     cnt, tried, lost, near, err = 0, 0, 0, np.inf, 0.0
-    pivot = _companion_eigvals(A, XA, wr, wi, W24[2], S[24])
+    pivot = _companion_eigvals(A, XA, wr, wi, W24[2], S[24], basis, index)
     stats[n, 5] = pivot
     if pivot > 0.0:
         cnt, tried, lost, err = _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links,
@@ -523,39 +495,49 @@ def _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, d
     stats[n, 4] = 0.0
     stats[n, 6] = err
     flags[n] = FLAG_OK
+    counts[n] = cnt
     if rerun:
         stats[n, 4] = 1.0
         if not pencil_eigvals_qz(A, wr, wi, qz_scratch()):  # allocated here: rare
             flags[n] = FLAG_ILL_CONDITIONED
             return
-        for j in range(cnt):  # the QZ roots replace the companion's
-            out_valid[n, j] = False
-            out_pos[n, j] = np.nan
-            out_rot[n, j] = np.nan
-            for i in range(6):
-                out_q[n, j, i] = np.nan
-        _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, sign, tol,
-                 iters, dedup, out_q, out_valid, out_pos, out_rot, 0, S)
+        _clear(n, out_q, out_valid, out_pos, out_rot)  # the QZ roots replace the companion's
+        cnt = _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, sign,
+                       tol, iters, dedup, out_q, out_valid, out_pos, out_rot, 0, S)[0]
+        counts[n] = cnt
+
+
+@nb.njit(**_INLINE)
+def _clear(n, out_q, out_valid, out_pos, out_rot):
+    """Empty slots of pose n: q and errors NaN, valid False."""
+    for j in range(out_valid.shape[1]):
+        out_valid[n, j] = False
+        out_pos[n, j] = np.nan
+        out_rot[n, j] = np.nan
+        for i in range(6):
+            out_q[n, j, i] = np.nan
 
 
 @nb.njit(parallel=True, **_OPTS)
-def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
-                out_q, out_valid, out_pos, out_rot, flags, stats):
-    """All solutions of N poses (see the module docstring); outputs pre-filled by the caller
-    (q NaN, valid False, errors NaN)."""
+def solve_batch(C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters, dedup,
+                recheck, out_q, out_valid, out_pos, out_rot, flags, counts, stats):
+    """All solutions of N poses (see the module docstring) into the outputs (any contents:
+    every pose's slots are cleared first) and their numbers into ``counts (N,)``."""
     N = T.shape[0]
     for c in nb.prange((N + _CHUNK - 1) // _CHUNK):
         S = _scratch()
         for n in range(c * _CHUNK, min(N, (c + 1) * _CHUNK)):
-            _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                        recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)
+            _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol,
+                        iters, dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, counts,
+                        stats, S)
 
 
 @nb.njit(**_OPTS)
-def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup, recheck,
-                 out_q, out_valid, out_pos, out_rot, flags, stats):
+def solve_serial(C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters, dedup,
+                 recheck, out_q, out_valid, out_pos, out_rot, flags, counts, stats):
     """:func:`solve_batch` on one thread (small batches: no thread start-up)."""
     S = _scratch()
     for n in range(T.shape[0]):
-        _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, tol, iters, dedup,
-                    recheck, out_q, out_valid, out_pos, out_rot, flags, stats, S)
+        _solve_pose(n, C, T, form, links, LH, h0, L, off, order, sign, basis, index, tol, iters,
+                    dedup, recheck, out_q, out_valid, out_pos, out_rot, flags, counts, stats,
+                    S)

@@ -321,7 +321,11 @@ def _compiled_data(model: ChainModel, form: Formulation):
     """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5,
     whose pose link is M1 or M6): ``form (4, 4, 4)`` = C0⁻¹, C6⁻¹, constant M1, constant Ts;
     the constant links M2..M5; ``L H3``, ``H3[0]``, L; the joint order with the pose-link
-    codes of M1 and Ts appended (0 constant, 1 ``C0⁻¹ T C6⁻¹``, 2 its inverse)."""
+    codes of M1 and Ts appended (0 constant, 1 ``C0⁻¹ T C6⁻¹``, 2 its inverse); the basis of
+    the companion's spurious subspace (:func:`kinestat.serial.analytic._rr_deflate.
+    model_basis`: pose-independent)."""
+    from kinestat.serial.analytic._rr_deflate import model_basis  # lazy: Numba start-up
+
     C = np.ascontiguousarray(model.constants)
     M = form.links(C, np.eye(4)[None])
     M = [m[0] if m.ndim == 3 else m for m in M]
@@ -331,9 +335,11 @@ def _compiled_data(model: ChainModel, form: Formulation):
     at0 = 0 if form.shift == 0 else (2 if not form.reverse else 1)
     at5 = 0 if form.shift == 5 else (1 if not form.reverse else 2)
     consts = np.stack([_inv_rigid(C[0]), _inv_rigid(C[6]), M[0], _inv_rigid(M[5])])
-    return (C, np.ascontiguousarray(consts), np.ascontiguousarray(np.stack(M[1:5])),
-            np.ascontiguousarray(L @ _H3), np.ascontiguousarray(_H3[0]), np.ascontiguousarray(L),
-            np.array(OFFSETS), np.array(list(order) + [at0, at5], dtype=np.int64), float(sign))
+    LH = np.ascontiguousarray(L @ _H3)
+    basis, index = model_basis(LH)
+    return (C, np.ascontiguousarray(consts), np.ascontiguousarray(np.stack(M[1:5])), LH,
+            np.ascontiguousarray(_H3[0]), np.ascontiguousarray(L), np.array(OFFSETS),
+            np.array(list(order) + [at0, at5], dtype=np.int64), float(sign), basis, index)
 
 
 RECHECK = {"never": 0, "suspect": 1, "always": 2}
@@ -345,7 +351,8 @@ leading coefficient singular for every Möbius parameter) QZ is the only pass in
 
 def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     """The compiled kernel on poses ``T (N, 4, 4)``: ``q (N, 16, 6)``, valid, position and
-    rotation errors, the per-pose flags and ``stats (N, 7)``: real eigenvalues tried and lost
+    rotation errors, the per-pose flags, the numbers of solutions and ``stats (N, 7)``: real
+    eigenvalues tried and lost
     by the first pass, its nearest-real complex eigenvalue ``|Im x| / (1 + |x|)``, its count,
     1.0 where the QZ pass ran, the smallest relative pivot of the companion's leading
     coefficient (0 where it was unusable), the first pass's largest real-eigenvalue error."""
@@ -353,19 +360,20 @@ def run_kernel(model, T, form, tol, polish_iters, recheck="suspect"):
     if K is None:
         from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
 
-    C, consts, links, LH, h0, L, off, order, sign = _compiled_data(model, form)
+    C, consts, links, LH, h0, L, off, order, sign, basis, index = _compiled_data(model, form)
     N = T.shape[0]
     K16 = MAX_SOLUTIONS
-    q = nan_array((N, K16, 6))
-    valid = np.zeros((N, K16), dtype=bool)
-    pos = nan_array((N, K16))
-    rot = nan_array((N, K16))
+    q = np.empty((N, K16, 6))  # every pose's slots are cleared by the kernel
+    valid = np.empty((N, K16), dtype=bool)
+    pos = np.empty((N, K16))
+    rot = np.empty((N, K16))
     flags = np.zeros(N, dtype=np.int64)
+    counts = np.zeros(N, dtype=np.int64)
     stats = np.zeros((N, 7))
-    args = (C, T, consts, links, LH, h0, L, off, order, sign, float(tol), int(polish_iters), 1e-6,
-            RECHECK[recheck], q, valid, pos, rot, flags, stats)
+    args = (C, T, consts, links, LH, h0, L, off, order, sign, basis, index, float(tol),
+            int(polish_iters), 1e-6, RECHECK[recheck], q, valid, pos, rot, flags, counts, stats)
     run_kernels(K.solve_batch, K.solve_serial, args, T, _PARALLEL_MIN)
-    return q, valid, pos, rot, flags, stats
+    return q, valid, pos, rot, flags, counts, stats
 
 
 def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect",
@@ -374,17 +382,11 @@ def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect",
     if K is None:
         from kinestat.serial.analytic import _rr_kernels as K  # lazy: Numba start-up
 
-    q, valid, pos, rot, flags, _ = run_kernel(model, T, form, tol, polish_iters, recheck)
+    q, valid, pos, rot, flags, nsol, _ = run_kernel(model, T, form, tol, polish_iters, recheck)
     N, K16 = valid.shape
-    # result building (a single call is ~70 µs: NumPy's per-call costs matter, so one pose
-    # takes the scalar route and the result is built once, in its final shape)
-    if N == 1:
-        nsol = np.empty(1, dtype=np.int64)
-        nsol[0] = np.count_nonzero(valid)
-        flagged = flags[0] != K.FLAG_OK
-    else:
-        nsol = np.count_nonzero(valid, axis=1)
-        flagged = flags.any()
+    # result building (NumPy's per-call costs matter in a single call, so one pose takes the
+    # scalar route and the result is built once, in its final shape)
+    flagged = flags[0] != K.FLAG_OK if N == 1 else flags.any()
     reason = reasons(nsol, _REASON_NONE)
     if flagged:
         reason[(flags == K.FLAG_DEFICIENT) & (nsol == 0)] = _REASON_DEFICIENT
@@ -418,29 +420,32 @@ def bind_one(model: ChainModel, check_entry):
     entry = _ENTRY.get((K.solve_serial, None)) if K is not None else None
     if entry is None or check_entry is None or form.shift not in (0, 5):
         return None
-    C, consts, links, LH, h0, L, off, order, sign = _compiled_data(model, form)
+    C, consts, links, LH, h0, L, off, order, sign, basis, index = _compiled_data(model, form)
     method = _method_name(form)
     K16 = MAX_SOLUTIONS
     shape = (1, K16)
+    # no singular families here: the same read-only arrays serve every result
+    singular, family_sign, family_value = np.zeros(shape, dtype=bool), np.zeros(shape), \
+        nan_array(shape)
+    for a in (singular, family_sign, family_value):
+        a.flags.writeable = False
 
     def one(T, tol):
         bad, n_project = check_entry(T, 1e-6)
         if bad >= 0 or n_project:
             return None
-        q = nan_array((1, K16, 6))
-        valid = np.zeros(shape, dtype=bool)
-        pos = nan_array(shape)
-        rot = nan_array(shape)
-        flags = np.zeros(1, dtype=np.int64)
-        entry(C, T, consts, links, LH, h0, L, off, order, sign, tol, 8, 1e-6, 1, q, valid, pos,
-              rot, flags, np.zeros((1, 7)))
+        q = np.empty((1, K16, 6))  # the kernel clears the slots and sets flags, nsol
+        valid = np.empty(shape, dtype=bool)
+        pos = np.empty(shape)
+        rot = np.empty(shape)
+        flags = np.empty(1, dtype=np.int64)
+        nsol = np.empty(1, dtype=np.int64)
+        entry(C, T, consts, links, LH, h0, L, off, order, sign, basis, index, tol, 8, 1e-6, 1, q,
+              valid, pos, rot, flags, nsol, np.empty((1, 7)))
         if flags[0] != 0:
             return None
-        nsol = np.empty(1, dtype=np.int64)
-        nsol[0] = np.count_nonzero(valid)
-        return IKAllResult.build_one(q, valid, pos, rot, np.zeros(shape, dtype=bool),
-                                     np.zeros(shape), nan_array(shape), None, nsol,
-                                     "" if nsol[0] else _REASON_NONE, method, tol)
+        return IKAllResult.build_one(q, valid, pos, rot, singular, family_sign, family_value,
+                                     None, nsol, "" if nsol[0] else _REASON_NONE, method, tol)
     return one
 
 
