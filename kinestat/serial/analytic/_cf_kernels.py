@@ -19,15 +19,12 @@ import numpy as np
 from kinestat.serial._kernels import _affine, _start, _turn
 from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
-from kinestat.serial.analytic._solution_kernels import polish, pose_errors, scratch, store
+from kinestat.serial.analytic._cf_storage import store_angles, store_pair
 from kinestat.serial.analytic._solution_kernels import wrap as _wrap
 
 _Z3 = (0.0, 0.0, 0.0)
 #: a pose's rotation must be orthonormal with det +1 within this (the NumPy check's default)
 RIGID_TOL = 1e-6
-#: the count of a pose handed back unsolved: a candidate needs Newton steps the kernel was
-#: compiled without (``newton`` None); −1 and −2 are :func:`_pose_status`'s
-HANDED_BACK = -3
 
 
 # -- 3-vectors and rotations as tuples ----------------------------------------------------------
@@ -159,6 +156,13 @@ def _mmt(A, B):
             A[3] * B[6] + A[4] * B[7] + A[5] * B[8],
             A[6] * B[0] + A[7] * B[1] + A[8] * B[2], A[6] * B[3] + A[7] * B[4] + A[8] * B[5],
             A[6] * B[6] + A[7] * B[7] + A[8] * B[8])
+
+
+@nb.njit(**_INLINE)
+def lazy(a):
+    """The angle triple a without its angle (0): for the batch kernels, which store cosines and
+    sines only, so that the compiler drops the ``atan2`` that made it."""
+    return 0.0, a[1], a[2]
 
 
 @nb.njit(**_INLINE)
@@ -304,30 +308,6 @@ def _clear(n, out_q, out_valid, out_pos, out_rot):
         out_rot[n, k] = np.nan
 
 
-@nb.njit(**_OPTS)
-def _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot, cnt):
-    """Verify q (6-tuple) whose forward kinematics f (12 scalars, the chain product at the
-    cosines and sines of q) against Tn and store it unless it repeats a stored one; returns the
-    new count. A candidate that misses tol (rounding near a singular set) takes ``newton``
-    Newton steps; with ``newton`` None (the kernel is then compiled without them: a smaller
-    cache to load) the pose is handed back instead: :data:`HANDED_BACK` from then on."""
-    if cnt < 0:
-        return cnt
-    pos, rot = pose_errors(f, Tn)
-    if not (pos <= tol and rot <= tol):
-        if newton is None:
-            return HANDED_BACK
-        qa = np.empty(6)
-        for i in range(6):
-            qa[i] = q[i]
-        Ms, Vs = scratch()
-        pos, rot = polish(C, Tn, qa, newton, Ms, Vs)
-        if not (pos <= tol and rot <= tol):
-            return cnt
-        q = (qa[0], qa[1], qa[2], qa[3], qa[4], qa[5])
-    return store(n, q, pos, rot, dedup, out_q, out_valid, out_pos, out_rot, cnt)
-
-
 @nb.njit(**_INLINE)
 def clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam):
     """Empty slots of pose n, with no wrist family."""
@@ -340,11 +320,13 @@ def clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_f
 
 @nb.njit(**_OPTS)  # not inlined: the offset shoulder calls it twice (one copy to load)
 def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, newton, out_q,
-                out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, cnt):
+                out_s, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, cnt):
     """The spherical wrist (axes 4, 5, 6 meeting) for the arm angles t1, t2, t3 (triples; R3
     the rotation of t3): ``R4 R5 ω6 = R' ω6`` (subproblem 2), θ6 (subproblem 1), each candidate
     verified and stored; on the singular set (ω6 along ω4) the family's sign and value are
-    recorded. Returns the new count."""
+    recorded. Returns the new count. ``out_s`` None: angles into ``out_q``; else cosines into
+    ``out_q`` and sines into ``out_s`` (:func:`~kinestat.serial.analytic._cf_storage.
+    store_pair`, ``dedup`` then the chord)."""
     Rp = _mtm(_mm(_mm(_rot(_row(W, 0), t1), _rot(_row(W, 1), t2)), R3), Rg)
     ok, _off, sing, wa, wb = spherical_wrist(_row(W, 3), _row(W, 4), _row(W, 5), Rp, xs, tol,
                                              wrist_tol)
@@ -354,20 +336,32 @@ def wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, 
     for i45 in range(2):
         t4, t5, t6, sig = wa if i45 == 0 else wb
         f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, f3)))
-        q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
-        new = _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot, cnt)
+        if out_s is None:
+            q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
+            new = store_angles(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos,
+                               out_rot, cnt)
+            if new > cnt and sing:
+                out_fam[n, cnt] = _wrap(out_q[n, cnt, 3] + sig * out_q[n, cnt, 5])
+        else:
+            new = store_pair(n, C, Tn, (t1[1], t2[1], t3[1], t4[1], t5[1], t6[1]),
+                              (t1[2], t2[2], t3[2], t4[2], t5[2], t6[2]), f, tol, dedup,
+                              newton, out_q, out_s, out_valid, out_pos, out_rot, cnt)
+            if new > cnt and sing:  # θ4 + σ θ6 from the stored cosines and sines
+                c4, s4 = out_q[n, cnt, 3], out_s[n, cnt, 3]
+                c6, s6 = out_q[n, cnt, 5], out_s[n, cnt, 5]
+                out_fam[n, cnt] = _wrap(math.atan2(s4 * c6 + sig * c4 * s6,
+                                                   c4 * c6 - sig * s4 * s6))
         if new > cnt and sing:
             out_sing[n, cnt] = True
             out_sign[n, cnt] = sig
-            out_fam[n, cnt] = _wrap(out_q[n, cnt, 3] + sig * out_q[n, cnt, 5])
         cnt = new
     return cnt
 
 
 # -- spherical wrist, shoulder axes meeting (Pieper) --------------------------------------------
 @nb.njit(**_OPTS)
-def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton, out_q, out_valid,
-                 out_pos, out_rot, out_sing, out_sign, out_fam):
+def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton, out_q, out_s,
+                 out_valid, out_pos, out_rot, out_sing, out_sign, out_fam):
     clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
     status = _pose_status(T, n, RIGID_TOL)
     if status:
@@ -395,9 +389,11 @@ def _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton, 
         for i12 in range(2):
             t1 = t1a if i12 == 0 else t1b
             t2 = t2a if i12 == 0 else t2b
+            if out_s is not None:
+                t1, t2, t3 = lazy(t1), lazy(t2), lazy(t3)
             cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup,
-                              newton, out_q, out_valid, out_pos, out_rot, out_sing, out_sign,
-                              out_fam, cnt)
+                              newton, out_q, out_s, out_valid, out_pos, out_rot, out_sing,
+                              out_sign, out_fam, cnt)
     return cnt
 
 
@@ -416,26 +412,33 @@ def pack(C, T0inv, W, P, a, b, c) -> np.ndarray:
 
 
 @nb.njit(parallel=True, **_OPTS)
-def pieper_batch(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot, out_sing,
-                 out_sign, out_fam, out_cnt):
-    """Spherical-wrist closed form for N poses into the (uninitialised) outputs; ``out_cnt
-    (N,)`` the number of solutions, or minus the pose's :func:`_pose_status` (a pose not
-    orthonormal to rounding is not solved: the caller checks and projects it), or
-    :data:`HANDED_BACK`. ``newton``: Newton steps for a candidate that misses tol, or None."""
+def pieper_batch(Kp, T, tol, wrist_tol, dedup, newton, out_c, out_s, out_valid, out_pos, out_rot,
+                 out_sing, out_sign, out_fam, out_cnt):
+    """Spherical-wrist closed form for N poses into the (uninitialised) outputs, the solutions
+    as cosines ``out_c`` and sines ``out_s`` (NaN in empty slots; angles by
+    :func:`~kinestat.serial.analytic.closed_form.angles_from_pairs`); ``out_cnt (N,)`` the
+    number of solutions, or minus the pose's :func:`_pose_status` (a pose not orthonormal to
+    rounding is not solved: the caller checks and projects it). ``newton``: Newton steps for
+    a candidate that misses tol."""
     C, T0inv, W, P, w, s, x6 = _unpack(Kp)
+    ch = 2.0 * math.sin(0.5 * dedup)
     for n in nb.prange(T.shape[0]):
-        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton,
-                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, ch, newton,
+                                  out_c, out_s, out_valid, out_pos, out_rot, out_sing, out_sign,
+                                  out_fam)
 
 
 @nb.njit(**_OPTS)
 def pieper_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
                   out_sing, out_sign, out_fam, out_cnt):
-    """:func:`pieper_batch` on one thread (small batches: no thread start-up)."""
+    """:func:`pieper_batch` on one thread (small batches: no thread start-up), the angles
+    into ``out_q``; ``newton`` None: a pose whose candidate needs Newton steps is handed back
+    (:data:`~kinestat.serial.analytic._cf_storage.HANDED_BACK`)."""
     C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     for n in range(T.shape[0]):
         out_cnt[n] = _pieper_pose(n, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, dedup, newton,
-                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+                                  out_q, None, out_valid, out_pos, out_rot, out_sing, out_sign,
+                                  out_fam)
 
 
 # -- three parallel axes, wrist pair meeting (UR type) ------------------------------------------
@@ -449,7 +452,7 @@ def _theta4(phi, t2, t3, sg):
 
 @nb.njit(**_OPTS)
 def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedup, newton, out_q,
-                         out_valid, out_pos, out_rot, out_near):
+                         out_s, out_valid, out_pos, out_rot, out_near):
     _clear(n, out_q, out_valid, out_pos, out_rot)
     out_near[n] = False
     status = _pose_status(T, n, RIGID_TOL)
@@ -499,35 +502,43 @@ def _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, dedu
                 t4 = _theta4(phi, t2, t3, sg)
                 f = _link(C, 6, t6, _link(C, 5, t5, _link(C, 4, t4, _link(
                     C, 3, t3, _link(C, 2, t2, f1)))))
-                q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
-                cnt = _store(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
-                             cnt)
+                if out_s is None:
+                    q = (t1[0], t2[0], t3[0], t4[0], t5[0], t6[0])
+                    cnt = store_angles(n, C, Tn, q, f, tol, dedup, newton, out_q, out_valid,
+                                       out_pos, out_rot, cnt)
+                else:  # the angles after the kernel: no atan2 here
+                    cnt = store_pair(n, C, Tn, (t1[1], t2[1], t3[1], t4[1], t5[1], t6[1]),
+                                      (t1[2], t2[2], t3[2], t4[2], t5[2], t6[2]), f, tol,
+                                      dedup, newton, out_q, out_s, out_valid, out_pos, out_rot,
+                                      cnt)
     return cnt
 
 
 @nb.njit(parallel=True, **_OPTS)
-def three_parallel_batch(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
-                         out_cnt, out_near):
-    """Three-parallel-axes (UR-type) closed form for N poses; ``out_cnt (N,)`` the number of
-    solutions (or minus the pose's :func:`_pose_status`, as :func:`pieper_batch`), ``out_near
-    (N,)`` a θ1 branch is near the wrist-singular set (axis 6 within 1e-6 of parallel to axes
-    2-4: where :mod:`~kinestat.serial.analytic.families` looks)."""
+def three_parallel_batch(Kp, T, tol, wrist_tol, dedup, newton, out_c, out_s, out_valid, out_pos,
+                         out_rot, out_cnt, out_near):
+    """Three-parallel-axes (UR-type) closed form for N poses, the solutions as cosines and
+    sines (as :func:`pieper_batch`); ``out_cnt (N,)`` the number of solutions (or minus the
+    pose's :func:`_pose_status`), ``out_near (N,)`` a θ1 branch is near the wrist-singular set
+    (axis 6 within 1e-6 of parallel to axes 2-4: where
+    :mod:`~kinestat.serial.analytic.families` looks)."""
     C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
+    ch = 2.0 * math.sin(0.5 * dedup)
     for n in nb.prange(T.shape[0]):
         out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
-                                          dedup, newton, out_q, out_valid, out_pos, out_rot,
+                                          ch, newton, out_c, out_s, out_valid, out_pos, out_rot,
                                           out_near)
 
 
 @nb.njit(**_OPTS)
 def three_parallel_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
                           out_cnt, out_near):
-    """:func:`three_parallel_batch` on one thread."""
+    """:func:`three_parallel_batch` on one thread, the angles into ``out_q``."""
     C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     for n in range(T.shape[0]):
         out_cnt[n] = _three_parallel_pose(n, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol,
-                                          dedup, newton, out_q, out_valid, out_pos, out_rot,
-                                          out_near)
+                                          dedup, newton, out_q, None, out_valid, out_pos,
+                                          out_rot, out_near)
 
 
 # -- pose checks ------------------------------------------------------------------------------

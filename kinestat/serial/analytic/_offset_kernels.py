@@ -41,6 +41,7 @@ from kinestat.serial.analytic._cf_kernels import (
     _sp4,
     _sub,
     clear_wrist,
+    lazy,
     wrist_store,
 )
 
@@ -181,8 +182,8 @@ def theta3_roots(f):
 
 
 @nb.njit(**_OPTS)
-def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton, out_q, out_valid,
-                 out_pos, out_rot, out_sing, out_sign, out_fam):
+def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton, out_q, out_s,
+                 out_valid, out_pos, out_rot, out_sing, out_sign, out_fam):
     clear_wrist(n, out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
     status = _pose_status(T, n, RIGID_TOL)
     if status:
@@ -213,9 +214,11 @@ def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton, 
                 t2 = t2a if i2 == 0 else t2b
                 q2 = _add(P1, _mv(_rot(W1, t2), _sub(g3, P1)))
                 t1 = _sp1(W0, P0, q2, pw)
+                if out_s is not None:
+                    t1, t2, t3 = lazy(t1), lazy(t2), lazy(t3)
                 cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol,
-                                  dedup, newton, out_q, out_valid, out_pos, out_rot, out_sing,
-                                  out_sign, out_fam, cnt)
+                                  dedup, newton, out_q, out_s, out_valid, out_pos, out_rot,
+                                  out_sing, out_sign, out_fam, cnt)
         return cnt
     o1 = (G[0], G[1], G[2])
     r2 = (G[3], G[4], G[5])
@@ -251,8 +254,11 @@ def _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton, 
         t2 = _pair(_dot(W1, _cross(up, v)), _dot(up, v))
         q2 = _add(r2, _mv(_rot(W1, t2), u))
         t1 = _sp1(W0, o1, q2, pw)
+        if out_s is not None:
+            t1, t2, t3 = lazy(t1), lazy(t2), lazy(t3)
         cnt = wrist_store(n, C, Tn, Rg, W, xs, t1, t2, t3, R3, f0, tol, wrist_tol, dedup, newton,
-                          out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam, cnt)
+                          out_q, out_s, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam,
+                          cnt)
     return cnt
 
 
@@ -266,22 +272,26 @@ def _unpack(Kp):
 
 
 @nb.njit(parallel=True, **_OPTS)
-def offset_batch(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot, out_sing,
-                 out_sign, out_fam, out_cnt):
-    """Spherical wrist, offset shoulder: N poses into the (uninitialised) outputs; ``out_cnt
-    (N,)`` the number of solutions (or minus the pose's status, as
-    :func:`kinestat.serial.analytic._cf_kernels.pieper_batch`)."""
+def offset_batch(Kp, T, tol, wrist_tol, dedup, newton, out_c, out_s, out_valid, out_pos, out_rot,
+                 out_sing, out_sign, out_fam, out_cnt):
+    """Spherical wrist, offset shoulder: N poses into the (uninitialised) outputs, the
+    solutions as cosines and sines; ``out_cnt (N,)`` the number of solutions (or minus the
+    pose's status), as :func:`kinestat.serial.analytic._cf_kernels.pieper_batch`."""
     C, T0inv, W, P, w, x6, G = _unpack(Kp)
+    ch = 2.0 * math.sin(0.5 * dedup)
     for n in nb.prange(T.shape[0]):
-        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton,
-                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, ch, newton,
+                                  out_c, out_s, out_valid, out_pos, out_rot, out_sing, out_sign,
+                                  out_fam)
 
 
 @nb.njit(**_OPTS)
 def offset_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
                   out_sing, out_sign, out_fam, out_cnt):
-    """:func:`offset_batch` on one thread (small batches: no thread start-up)."""
+    """:func:`offset_batch` on one thread (small batches: no thread start-up), the angles
+    into ``out_q``."""
     C, T0inv, W, P, w, x6, G = _unpack(Kp)
     for n in range(T.shape[0]):
         out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton,
-                                  out_q, out_valid, out_pos, out_rot, out_sing, out_sign, out_fam)
+                                  out_q, None, out_valid, out_pos, out_rot, out_sing, out_sign,
+                                  out_fam)

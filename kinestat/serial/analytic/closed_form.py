@@ -19,12 +19,20 @@ from __future__ import annotations
 
 import math
 import sys
+import threading
 
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import _offset_pack
-from kinestat.serial.analytic._common import _ENTRY, nan_array, pack, reasons, run_kernels
+from kinestat.serial.analytic._common import (
+    _ENTRY,
+    call_compiled,
+    nan_array,
+    pack,
+    plain_poses,
+    reasons,
+)
 from kinestat.serial.analytic.geometry import cross3, norm3
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.analytic.subproblems import rotate, rotation_matrix, sp1, sp2, sp3, sp4
@@ -209,6 +217,48 @@ def _one_three_parallel(entry, Kp: np.ndarray, wrist_tol: float):
 _S18 = (1, 8)
 
 
+def angles_from_pairs(c: np.ndarray, s: np.ndarray) -> np.ndarray:
+    """The angles in [-π, π) of the cosines ``c`` and sines ``s`` a batch kernel stored (NaN
+    stays NaN), written over ``c``: one vectorised ``arctan2`` pass (NumPy's SIMD loop, within
+    an ulp of libm) in place of a libm call per angle in the kernel."""
+    np.arctan2(s, c, out=c)
+    np.subtract(c, 2.0 * math.pi, out=c, where=c >= math.pi)
+    return c
+
+
+#: poses per batch-kernel call: the sines of their slots (1.5 MB) are scratch kept per thread,
+#: so that a batch allocates no more than its outputs (a fresh scratch per call made the C
+#: library hand memory back and forth to the system: page faults costing ~0.4 µs a pose)
+_CHUNK = 4096
+_SCRATCH = threading.local()
+
+
+def _run_batch(batch, Kp, T: np.ndarray, tol: float, wrist_tol: float, newton, q: np.ndarray,
+               outs: tuple) -> None:
+    """The parallel kernel ``batch`` on the poses ``T``, in chunks of :data:`_CHUNK`: the
+    cosines into ``q``, the sines into this thread's scratch, then the angles
+    (:func:`angles_from_pairs`); ``outs``: the other outputs (leading axis N)."""
+    s = getattr(_SCRATCH, "sines", None)
+    if s is None:
+        s = _SCRATCH.sines = np.empty((_CHUNK, 8, 6))
+    N = T.shape[0]
+    for a in range(0, N, _CHUNK):
+        b = min(a + _CHUNK, N)
+        sa = s[:b - a]
+        batch(Kp, T[a:b], tol, wrist_tol, 1e-6, newton, q[a:b], sa,
+              *(o[a:b] for o in outs))
+        angles_from_pairs(q[a:b], sa)
+
+
+def _run_serial(serial, args: tuple, T: np.ndarray, plain: bool | None, newton) -> None:
+    """A serial kernel on ``args``, through :func:`~kinestat.serial.analytic._common.
+    call_compiled` (variant ``newton``) when the poses ``T`` are plain."""
+    if plain_poses(T) if plain is None else plain:
+        call_compiled(serial, *args, variant=newton)
+    else:
+        serial(*args)
+
+
 def _newton(N: int, checked: bool) -> int | None:
     """The kernels' Newton steps for a candidate that misses tol: none (the pose is handed
     back) on a few unchecked poses, else two."""
@@ -288,11 +338,13 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     fam = np.empty((N, 8))
     Kp = _pieper_args(model, data, K)
     newton = _newton(N, checked)
-    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos, rot, sing, sign,
-            fam, cnt)
     serial = K.offset_serial if offset else K.pieper_serial
-    run_kernels(K.offset_batch if offset else K.pieper_batch, serial, args, T, _PARALLEL_MIN,
-                plain, newton)
+    if N >= _PARALLEL_MIN:  # over the cores, the angles by one arctan2 pass after the kernel
+        _run_batch(K.offset_batch if offset else K.pieper_batch, Kp, T, float(tol),
+                   float(wrist_tol), newton, q, (valid, pos, rot, sing, sign, fam, cnt))
+    else:
+        _run_serial(serial, (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos,
+                             rot, sing, sign, fam, cnt), T, plain, newton)
     reason = _offset_pack.REASON if offset else _REASON_PIEPER
     if shape == () and newton is None and plain and "one" not in data:
         entry = _ENTRY.get((serial, None))
@@ -331,9 +383,13 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
     q, valid, pos, rot, cnt = _outputs(N, 8)
     near = np.empty(N, dtype=bool)
     newton = _newton(N, checked)
-    args = (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos, rot, cnt, near)
-    run_kernels(K.three_parallel_batch, K.three_parallel_serial, args, T, _PARALLEL_MIN, plain,
-                newton)
+    if N >= _PARALLEL_MIN:  # as solve_pieper_compiled
+        _run_batch(K.three_parallel_batch, Kp, T, float(tol), float(wrist_tol), newton, q,
+                   (valid, pos, rot, cnt, near))
+    else:
+        _run_serial(K.three_parallel_serial, (Kp, T, float(tol), float(wrist_tol), 1e-6,
+                                              newton, q, valid, pos, rot, cnt, near),
+                    T, plain, newton)
     if shape == () and newton is None and plain and "one" not in data:
         data["one"] = _one_three_parallel(_ENTRY.get((K.three_parallel_serial, None)), Kp,
                                           float(wrist_tol))
