@@ -73,6 +73,31 @@ def _pivot_step(M, k, rows, cols, cperm):
     return best
 
 
+@nb.njit(**_INLINE)
+def _eliminate_checked(M, steps, rows, cols, cperm):
+    """``steps`` steps of :func:`_pivot_step` on ``M[:rows, :cols]``; False as soon as a pivot
+    falls below ``_STRUCTURED_PIVOT`` times the first (the rank not clearly ``steps``)."""
+    first = 0.0
+    for k in range(steps):
+        piv = _pivot_step(M, k, rows, cols, cperm)
+        if k == 0:
+            first = piv
+        if not piv > _STRUCTURED_PIVOT * first:
+            return False
+    return True
+
+
+@nb.njit(**_INLINE)
+def _null_back_substitute(U, pivots, cols, z):
+    """The null vector of the eliminated ``U[:pivots, :cols]`` (upper triangular in its first
+    ``pivots`` columns) with the free entries ``z[pivots:cols]`` as given: back-substitution."""
+    for k in range(pivots - 1, -1, -1):
+        acc = 0.0
+        for j in range(k + 1, cols):
+            acc += U[k, j] * z[j]
+        z[k] = -acc / U[k, k]
+
+
 @nb.njit(**_OPTS)
 def _null_structured(S, v, W, ce):
     """The null vector ``v (12, 1)`` of ``S = A(x)`` from its structure: rows 0-5 are
@@ -92,21 +117,12 @@ def _null_structured(S, v, W, ce):
             E[i, j] = S[i, j]
     for j in range(9):
         ce[j] = j
-    first = 0.0
-    for k in range(6):
-        piv = _pivot_step(E, k, 6, 9, ce)
-        if k == 0:
-            first = piv
-        if not piv > _STRUCTURED_PIVOT * first:
-            return False
+    if not _eliminate_checked(E, 6, 6, 9, ce):
+        return False
     for f in range(3):  # the null basis: free column 6 + f
         for j in range(6, 9):
             z[j] = 1.0 if j == 6 + f else 0.0
-        for k in range(5, -1, -1):
-            acc = 0.0
-            for j in range(k + 1, 9):
-                acc += E[k, j] * z[j]
-            z[k] = -acc / E[k, k]
+        _null_back_substitute(E, 6, 9, z)
         for j in range(9):
             Nb[ce[j], f] = z[j]
     for i in range(6):
@@ -116,19 +132,11 @@ def _null_structured(S, v, W, ce):
     cm = ce[:6]
     for j in range(6):
         cm[j] = j
-    for k in range(5):
-        piv = _pivot_step(M6, k, 6, 6, cm)
-        if k == 0:
-            first = piv
-        if not piv > _STRUCTURED_PIVOT * first:
-            return False
+    if not _eliminate_checked(M6, 5, 6, 6, cm):
+        return False
     y = z[:6]
     y[5] = 1.0
-    for k in range(4, -1, -1):
-        acc = 0.0
-        for j in range(k + 1, 6):
-            acc += M6[k, j] * y[j]
-        y[k] = -acc / M6[k, k]
+    _null_back_substitute(M6, 5, 6, y)
     for j in range(6):
         ab[cm[j]] = y[j]
     nv = 0.0
