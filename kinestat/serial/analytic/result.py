@@ -102,6 +102,21 @@ class IKAllResult:
             family_curve=family_curve)
         return obj
 
+    @classmethod
+    def single(cls, q, valid, position_error, rotation_error, singular, family_sign,
+               family_value, family_joints, n_solutions, reason, method, tol) -> IKAllResult:
+        """:meth:`build_one` from arrays already in a one-pose result's shapes (``q (K, n)``,
+        ``(K,)``, ``n_solutions`` an int); ``reason``: the pose's string (its 0-d array is
+        shared by the results with that reason, read-only)."""
+        obj = object.__new__(cls)
+        obj.__dict__.update(
+            q=q, valid=valid, position_error=position_error, rotation_error=rotation_error,
+            singular=singular, family_sign=family_sign, family_value=family_value,
+            family_joints=family_joints, n_solutions=np.array(n_solutions),
+            reason=_REASONS.get(reason) or _reason(reason), method=method, tol=tol,
+            family_curve=None)
+        return obj
+
     @property
     def shape(self) -> tuple[int, ...]:
         """The batch shape ``B``."""
@@ -127,6 +142,18 @@ class IKAllResult:
             return q
         flat = int(np.ravel_multi_index(index, self.shape)) if self.shape else 0
         return self.family_curve.members(flat, k, t)[0]
+
+
+_REASONS: dict[str, np.ndarray] = {}
+
+
+def _reason(text: str) -> np.ndarray:
+    """The read-only 0-d object array of ``text`` (:meth:`IKAllResult.single`)."""
+    a = np.array(text, dtype=object)
+    a.flags.writeable = False
+    if len(_REASONS) < 64:
+        _REASONS[text] = a
+    return a
 
 
 def __getattr__(name: str):
