@@ -18,9 +18,9 @@ def pieper_one(Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam):
     needs Newton steps (the caller takes the full path)."""
     C, T0inv, W, P, w, s, x6 = _unpack(Kp)
     return _pieper_pose(0, C, T, T0inv, W, P, w, s, x6, tol, wrist_tol, 1e-6, None,
-                        q.reshape((1, 8, 6)), None, valid.reshape((1, 8)), pos.reshape((1, 8)),
-                        rot.reshape((1, 8)), sing.reshape((1, 8)), sign.reshape((1, 8)),
-                        fam.reshape((1, 8)))
+                        q[None], None, valid[None], pos[None],
+                        rot[None], sing[None], sign[None],
+                        fam[None])
 
 
 @nb.njit(**_OPTS)
@@ -32,8 +32,8 @@ def three_parallel_one(Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fa
     C, T0inv, W, P, p56, xh, sg = _unpack(Kp)
     near = sing[:1]  # the kernel's flag, in the first slot, cleared below
     cnt = _three_parallel_pose(0, C, T, T0inv, W, P, p56, xh, sg, tol, wrist_tol, 1e-6, None,
-                               q.reshape((1, 8, 6)), None, valid.reshape((1, 8)),
-                               pos.reshape((1, 8)), rot.reshape((1, 8)), near)
+                               q[None], None, valid[None],
+                               pos[None], rot[None], near)
     if near[0]:
         return -1
     for k in range(8):

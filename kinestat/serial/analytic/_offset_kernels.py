@@ -304,6 +304,6 @@ def offset_one(Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam):
     or negative where the caller takes the full path."""
     C, T0inv, W, P, w, x6, G = _unpack(Kp)
     return _offset_pose(0, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, 1e-6, None,
-                        q.reshape((1, 8, 6)), None, valid.reshape((1, 8)), pos.reshape((1, 8)),
-                        rot.reshape((1, 8)), sing.reshape((1, 8)), sign.reshape((1, 8)),
-                        fam.reshape((1, 8)))
+                        q[None], None, valid[None], pos[None],
+                        rot[None], sing[None], sign[None],
+                        fam[None])
