@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import sys
+import threading
 import weakref
 from dataclasses import dataclass
 from functools import lru_cache
@@ -434,6 +435,7 @@ def bind_one(model: ChainModel, check_entry, put=None):
         a.flags.writeable = False
     put_entry, take, j, v = (None, None, 0, 0.0) if put is None else put
     shape_q = (K16, 6 if put is None else take.shape[0])
+    local = threading.local()
     singular, family_sign, family_value = singular[0], family_sign[0], family_value[0]
     single = IKAllResult.single
 
@@ -445,10 +447,13 @@ def bind_one(model: ChainModel, check_entry, put=None):
         valid = np.empty(shape, dtype=bool)
         pos = np.empty(shape)
         rot = np.empty(shape)
-        flags = np.empty(1, dtype=np.int64)
-        nsol = np.empty(1, dtype=np.int64)
+        work = getattr(local, "work", None)  # flags, nsol, stats: read here, kept per thread
+        if work is None:
+            work = local.work = (np.empty(1, dtype=np.int64), np.empty(1, dtype=np.int64),
+                                 np.empty((1, 7)))
+        flags, nsol, stats = work
         entry(C, T, consts, links, LH, h0, L, off, order, sign, basis, index, tol, 8, 1e-6, 1, q,
-              valid, pos, rot, flags, nsol, np.empty((1, 7)))
+              valid, pos, rot, flags, nsol, stats)
         if flags[0] != 0:
             return None
         c = nsol[0]
