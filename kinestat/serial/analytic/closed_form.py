@@ -198,11 +198,12 @@ def _bind_single(kernel, Kp: np.ndarray, wrist_tol: float, reason: str, method: 
             return None
         return single(q, valid, pos, rot, sing, sign, fam, family_joints, c,
                       "" if c else reason, method, tol)
-    one.kernel = kernel
     return one
 
 
 _S86 = (8, 6)
+
+
 def angles_from_pairs(c: np.ndarray, s: np.ndarray) -> np.ndarray:
     """The angles in [-π, π) of the cosines ``c`` and sines ``s`` a batch kernel stored (NaN
     stays NaN), written over ``c``: one vectorised ``arctan2`` pass (NumPy's SIMD loop, within
