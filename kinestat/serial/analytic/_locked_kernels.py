@@ -1,6 +1,6 @@
 """Compiled steps around a locked arm's single call (:mod:`kinestat.serial.analytic.locked`):
 the pose handed to the folded 6-joint chain's kernel, and its solutions put back in the full
-chain's joint order with the locked value. One pose each (``(1, 4, 4)``, ``(1, K, 6)``): a
+chain's joint order with the locked value. One pose each (``(1, 4, 4)``, ``(K, 6)``): a
 single call is a few µs, and each NumPy step would cost a fraction of one."""
 
 from __future__ import annotations
@@ -48,9 +48,9 @@ def pose_in(T, L, R, invert, out):
 
 @nb.njit(**_OPTS)
 def joints_out(q6, take, j, v, out):
-    """``out[0, k, i] = q6[0, k, take[i]]`` for every slot k, and ``out[0, k, j] = v`` (NaN
-    where the slot is empty: its first joint is NaN)."""
-    for k in range(q6.shape[1]):
+    """``out[k, i] = q6[k, take[i]]`` for every slot k, and ``out[k, j] = v`` (NaN where the
+    slot is empty: its first joint is NaN); ``q6 (K, 6)``, ``out (K, n)``."""
+    for k in range(q6.shape[0]):
         for i in range(take.shape[0]):
-            out[0, k, i] = q6[0, k, take[i]]
-        out[0, k, j] = q6[0, k, 0] * 0.0 + v
+            out[k, i] = q6[k, take[i]]
+        out[k, j] = q6[k, 0] * 0.0 + v

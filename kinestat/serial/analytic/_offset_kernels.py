@@ -295,3 +295,15 @@ def offset_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_po
         out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton,
                                   out_q, None, out_valid, out_pos, out_rot, out_sing, out_sign,
                                   out_fam)
+
+
+@nb.njit(**_OPTS)
+def offset_one(Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam):
+    """:func:`offset_serial` on one pose without Newton steps, the outputs in a one-pose
+    result's shapes (as :func:`kinestat.serial.analytic._cf_single.pieper_one`): the count,
+    or negative where the caller takes the full path."""
+    C, T0inv, W, P, w, x6, G = _unpack(Kp)
+    return _offset_pose(0, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, 1e-6, None,
+                        q[None], None, valid[None], pos[None],
+                        rot[None], sing[None], sign[None],
+                        fam[None])

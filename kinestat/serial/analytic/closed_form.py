@@ -171,50 +171,37 @@ def _outputs(N: int, K: int):
             np.empty((N, K)), np.empty(N, dtype=np.int64))
 
 
-def _one_pieper(entry, Kp: np.ndarray, wrist_tol: float, reason: str):
-    """The single-pose call of the spherical-wrist kernel (``entry``: its compiled entry point
-    for plain poses and no Newton steps, see :func:`~kinestat.serial.analytic._common.
-    call_compiled`): ``one(T (1, 4, 4) plain, tol: float)``, the result of
-    :func:`solve_pieper_compiled` with ``shape=()``, ``checked=False``, or None as it. The
-    per-model arguments are bound once: a single call is a few µs, so its Python steps
-    matter."""
-    if entry is None:
-        return None
+def _bind_single(kernel, Kp: np.ndarray, wrist_tol: float, reason: str, method: str,
+                 family_joints):
+    """The single-pose call of a closed form: ``one(T (1, 4, 4) plain, tol: float)``, the
+    result of :func:`solve_pieper_compiled` (or :func:`solve_three_parallel_compiled`) with
+    ``shape=()``, ``checked=False``, or None as it (the caller then takes the full path).
+    ``kernel``: a single-pose kernel (:mod:`kinestat.serial.analytic._cf_single`), called
+    through its compiled entry point once its first call has recorded it (see
+    :func:`~kinestat.serial.analytic._common.call_compiled`). The per-model arguments are bound
+    once and the outputs made in the result's shapes: a single call is a few µs, so its
+    Python steps matter."""
+    entry = _ENTRY.get((kernel, None))
+    single = IKAllResult.single
+    empty = np.empty
 
     def one(T, tol):
-        q, valid, pos, rot, cnt = _outputs(1, 8)
-        sing = np.empty(_S18, dtype=bool)
-        sign = np.empty(_S18)
-        fam = np.empty(_S18)
-        entry(Kp, T, tol, wrist_tol, 1e-6, None, q, valid, pos, rot, sing, sign, fam, cnt)
-        c = cnt[0]
+        nonlocal entry
+        q, valid, pos, rot = empty(_S86), empty(8, dtype=bool), empty(8), empty(8)
+        sing, sign, fam = empty(8, dtype=bool), empty(8), empty(8)
+        if entry is not None:
+            c = entry(Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam)
+        else:
+            c = call_compiled(kernel, Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam)
+            entry = _ENTRY.get((kernel, None))
         if c < 0:
             return None
-        return IKAllResult.build_one(q, valid, pos, rot, sing, sign, fam, (3, 5), cnt,
-                                     "" if c else reason, "pieper", tol)
+        return single(q, valid, pos, rot, sing, sign, fam, family_joints, c,
+                      "" if c else reason, method, tol)
     return one
 
 
-def _one_three_parallel(entry, Kp: np.ndarray, wrist_tol: float):
-    """:func:`_one_pieper` for :func:`solve_three_parallel_compiled` (None also for a pose
-    near the wrist-singular set, whose families the full call adds)."""
-    if entry is None:
-        return None
-
-    def one(T, tol):
-        q, valid, pos, rot, cnt = _outputs(1, 8)
-        near = np.empty(1, dtype=bool)
-        entry(Kp, T, tol, wrist_tol, 1e-6, None, q, valid, pos, rot, cnt, near)
-        c = cnt[0]
-        if c < 0 or near[0]:
-            return None
-        return IKAllResult.build_one(q, valid, pos, rot, np.zeros(_S18, dtype=bool),
-                                     np.zeros(_S18), nan_array(_S18), None, cnt,
-                                     "" if c else _REASON_3P, "three-parallel", tol)
-    return one
-
-
-_S18 = (1, 8)
+_S86 = (8, 6)
 
 
 def angles_from_pairs(c: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -278,6 +265,13 @@ def _cf_kernels():
     return K
 
 
+def _cf_single():
+    K = sys.modules.get("kinestat.serial.analytic._cf_single")
+    if K is None:
+        from kinestat.serial.analytic import _cf_single as K  # lazy: Numba start-up
+    return K
+
+
 def _offset_kernels():
     K = sys.modules.get("kinestat.serial.analytic._offset_kernels")
     if K is None:
@@ -303,19 +297,36 @@ def _pieper_args(model: ChainModel, data: dict, K) -> np.ndarray:
 def pieper_parts(model: ChainModel, data: dict, wrist_tol: float = _WRIST_TOL):
     """``(entry, packed data, wrist_tol, reason)``: what a caller that maps the pose and the
     joints around the spherical-wrist kernel's single call needs (a pieper ``model`` and its
-    ``data`` from :func:`~kinestat.serial.analytic.geometry.classify`), or None while the
-    kernel's entry point is not recorded (no single call of its kind has run yet)."""
+    ``data`` from :func:`~kinestat.serial.analytic.geometry.classify`; ``entry``: the compiled
+    entry of its :mod:`~kinestat.serial.analytic._cf_single` kernel), or None while that entry
+    point is not recorded (no single call of its kind has run yet)."""
     parts = data.get("one_parts")
     if parts is not None:
         return parts
     offset = data["shoulder"] is None
     K = _offset_kernels() if offset else _cf_kernels()
-    entry = _ENTRY.get((K.offset_serial if offset else K.pieper_serial, None))
+    entry = _ENTRY.get((_single_kernel(offset), None))
     if entry is None:
         return None
     parts = data["one_parts"] = (entry, _pieper_args(model, data, K), float(wrist_tol),
                                  _offset_pack.REASON if offset else _REASON_PIEPER)
     return parts
+
+
+def _single_kernel(offset: bool):
+    """The spherical-wrist single-pose kernel (offset shoulder or not)."""
+    if offset:
+        return _offset_kernels().offset_one
+    return _cf_single().pieper_one
+
+
+def _single(data: dict, kernel, Kp, reason: str, method: str, family_joints, T: np.ndarray,
+            tol: float):
+    """One plain pose, unchecked: the model's bound single call (bound here on first use)."""
+    one = data.get("one")
+    if one is None:
+        one = data["one"] = _bind_single(kernel, Kp, _WRIST_TOL, reason, method, family_joints)
+    return one(T, float(tol))
 
 
 def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: float = 1e-9,
@@ -332,6 +343,11 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     offset = data["shoulder"] is None
     K = _offset_kernels() if offset else _cf_kernels()
     N = T.shape[0]
+    if shape == () and N == 1 and not checked and wrist_tol == _WRIST_TOL and \
+            (plain_poses(T) if plain is None else plain):
+        return _single(data, _single_kernel(offset), _pieper_args(model, data, K),
+                       _offset_pack.REASON if offset else _REASON_PIEPER, "pieper", (3, 5), T,
+                       tol)
     q, valid, pos, rot, cnt = _outputs(N, 8)
     sing = np.empty((N, 8), dtype=bool)
     sign = np.empty((N, 8))
@@ -346,11 +362,6 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
         _run_serial(serial, (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos,
                              rot, sing, sign, fam, cnt), T, plain, newton)
     reason = _offset_pack.REASON if offset else _REASON_PIEPER
-    if shape == () and newton is None and plain and "one" not in data:
-        entry = _ENTRY.get((serial, None))
-        data["one"] = _one_pieper(entry, Kp, float(wrist_tol), reason)
-        if entry is not None:  # for a caller that maps the pose and the joints around it
-            data["one_parts"] = (entry, Kp, float(wrist_tol), reason)
     if _unchecked(cnt):
         return None
     if shape == ():
@@ -380,6 +391,10 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
         sg = np.array([float(np.sign(ax.w[i] @ h)) for i in (1, 2, 3)])
         Kp = data["kernel_args"] = K.pack(model.constants, np.linalg.inv(ax.T0), ax.w, ax.r,
                                           data["p56"], _perp(h), sg)
+    if shape == () and N == 1 and not checked and wrist_tol == _WRIST_TOL and \
+            (plain_poses(T) if plain is None else plain):
+        return _single(data, _cf_single().three_parallel_one, Kp, _REASON_3P, "three-parallel",
+                       None, T, tol)
     q, valid, pos, rot, cnt = _outputs(N, 8)
     near = np.empty(N, dtype=bool)
     newton = _newton(N, checked)
@@ -390,9 +405,6 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
         _run_serial(K.three_parallel_serial, (Kp, T, float(tol), float(wrist_tol), 1e-6,
                                               newton, q, valid, pos, rot, cnt, near),
                     T, plain, newton)
-    if shape == () and newton is None and plain and "one" not in data:
-        data["one"] = _one_three_parallel(_ENTRY.get((K.three_parallel_serial, None)), Kp,
-                                          float(wrist_tol))
     if _unchecked(cnt):
         return None
     if shape == () and not near[0]:  # one pose away from the wrist-singular set

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 import sys
+import threading
 import weakref
 from dataclasses import dataclass
 from functools import lru_cache
@@ -408,13 +409,16 @@ def _solve_compiled(model, T, form, tol, polish_iters, recheck="suspect",
                              method=_method_name(form), tol=tol)
 
 
-def bind_one(model: ChainModel, check_entry):
+def bind_one(model: ChainModel, check_entry, put=None):
     """The single-pose call of the compiled kernel for ``model`` with its default formulation,
     recheck and polishing (``ik_all``'s fast path): ``one(T (1, 4, 4) plain, tol: float)``,
     the result of :func:`solve_general_6r` with ``shape=()``, or None where that call must run
     instead (a pose not orthonormal to rounding, a flagged pose, no compiled entry yet).
     ``check_entry``: the compiled entry of the closed forms' ``check_rigid``. The per-model
-    arguments and entry points are bound once: a few µs of a single call are Python steps."""
+    arguments and entry points are bound once: a few µs of a single call are Python steps.
+    ``put``: ``(entry, take, j, v)``, a locked arm's step that puts the joints back
+    (:func:`kinestat.serial.analytic._locked_kernels.joints_out`: ``q`` then holds the full
+    chain's ``take.shape[0]`` joints, joint ``j`` at ``v``), run in the same call."""
     form, _ = formulation(model)
     K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
     entry = _ENTRY.get((K.solve_serial, None)) if K is not None else None
@@ -429,6 +433,11 @@ def bind_one(model: ChainModel, check_entry):
         nan_array(shape)
     for a in (singular, family_sign, family_value):
         a.flags.writeable = False
+    put_entry, take, j, v = (None, None, 0, 0.0) if put is None else put
+    shape_q = (K16, 6 if put is None else take.shape[0])
+    local = threading.local()
+    singular, family_sign, family_value = singular[0], family_sign[0], family_value[0]
+    single = IKAllResult.single
 
     def one(T, tol):
         bad, n_project = check_entry(T, 1e-6)
@@ -438,14 +447,23 @@ def bind_one(model: ChainModel, check_entry):
         valid = np.empty(shape, dtype=bool)
         pos = np.empty(shape)
         rot = np.empty(shape)
-        flags = np.empty(1, dtype=np.int64)
-        nsol = np.empty(1, dtype=np.int64)
+        work = getattr(local, "work", None)  # flags, nsol, stats: read here, kept per thread
+        if work is None:
+            work = local.work = (np.empty(1, dtype=np.int64), np.empty(1, dtype=np.int64),
+                                 np.empty((1, 7)))
+        flags, nsol, stats = work
         entry(C, T, consts, links, LH, h0, L, off, order, sign, basis, index, tol, 8, 1e-6, 1, q,
-              valid, pos, rot, flags, nsol, np.empty((1, 7)))
+              valid, pos, rot, flags, nsol, stats)
         if flags[0] != 0:
             return None
-        return IKAllResult.build_one(q, valid, pos, rot, singular, family_sign, family_value,
-                                     None, nsol, "" if nsol[0] else _REASON_NONE, method, tol)
+        c = nsol[0]
+        if put_entry is not None:
+            qn = np.empty(shape_q)
+            put_entry(q[0], take, j, v, qn)
+            return single(qn, valid[0], pos[0], rot[0], singular, family_sign, family_value,
+                          None, c, "" if c else _REASON_NONE, method, tol)
+        return single(q[0], valid[0], pos[0], rot[0], singular, family_sign, family_value,
+                      None, c, "" if c else _REASON_NONE, method, tol)
     return one
 
 

@@ -11,6 +11,7 @@ class decides the method) and the locked values are put back into every solution
 from __future__ import annotations
 
 import math
+import sys
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -256,8 +257,8 @@ def _entries():
         pose = _ENTRY.get((K.pose_in, None))
     joints = _ENTRY.get((K.joints_out, None))
     if joints is None:
-        call_compiled(K.joints_out, np.zeros((1, 8, 6)), np.zeros(7, dtype=np.int64), 0, 0.0,
-                      np.empty((1, 8, 7)))
+        call_compiled(K.joints_out, np.zeros((8, 6)), np.zeros(7, dtype=np.int64), 0, 0.0,
+                      np.empty((8, 7)))
         joints = _ENTRY.get((K.joints_out, None))
     return pose, joints
 
@@ -352,6 +353,10 @@ class LockedPlan:
             info = _joint_info(self.model, self._one[0])
             if not info.end:  # kept for the joint's next value (a hint, checked there)
                 info.form = _general6r().formulation(self.six)[0]
+            if data.get("one") is not None and self.L is None and self.R is None:
+                self.one = self._fused_general()
+                if self.one is not None:
+                    return self.one
         if kind == "pieper" and self._one is not None:
             parts = pieper_parts(self.six, data) if rev_data is None else \
                 pieper_parts(data["reversed"], rev_data)
@@ -376,6 +381,17 @@ class LockedPlan:
         self.one = one
         return one
 
+    def _fused_general(self):
+        """:meth:`bind_one` for a folded chain solved as a general 6R, one locked joint and
+        no pose map: its bound single call with the joints put back in the same call
+        (:func:`~kinestat.serial.analytic.general6r.bind_one`'s ``put``); None while the
+        entry points are not recorded."""
+        cf = sys.modules.get("kinestat.serial.analytic._cf_kernels")
+        check = None if cf is None else _ENTRY.get((cf.check_rigid, None))
+        j, v = self._one
+        return _general6r().bind_one(self.six, check,
+                                     put=(_entries()[1], _joint_info(self.model, j).take, j, v))
+
     def _fused(self, parts: tuple, invert: bool):
         """:meth:`bind_one` for a spherical-wrist kernel's bound parts (entry point, packed
         chain, wrist tolerance, reason), one locked joint; ``invert``: the kernel solves the
@@ -396,27 +412,25 @@ class LockedPlan:
                              for i in range(n)], dtype=np.int64)
             got = info.fused[invert] = (take, tuple(self.free[k6[k]] for k in (3, 5)))
         take, fj = got
-        S18, S186, S18n = (1, 8), (1, 8, 6), (1, 8, n)
-        build = IKAllResult.build_one
+        S86, S8n = (8, 6), (8, n)
+        single = IKAllResult.single
+        empty = np.empty
 
         def one(T, tol):
             if mapped:
-                Tm = np.empty(_S144)
+                Tm = empty(_S144)
                 pose_entry(T, L, R, invert, Tm)
             else:
                 Tm = T
-            q, valid, pos, rot = np.empty(S186), np.empty(S18, dtype=bool), np.empty(S18), \
-                np.empty(S18)
-            sing, sign, fam, cnt = np.empty(S18, dtype=bool), np.empty(S18), np.empty(S18), \
-                np.empty(1, dtype=np.int64)
-            entry(Kp, Tm, tol, wrist_tol, 1e-6, None, q, valid, pos, rot, sing, sign, fam, cnt)
-            c = cnt[0]
+            q, valid, pos, rot = empty(S86), empty(8, dtype=bool), empty(8), empty(8)
+            sing, sign, fam = empty(8, dtype=bool), empty(8), empty(8)
+            c = entry(Kp, Tm, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam)
             if c < 0:
                 return None
-            qn = np.empty(S18n)
+            qn = empty(S8n)
             joints_entry(q, take, j, v, qn)
-            return build(qn, valid, pos, rot, sing, sign, fam, fj, cnt, "" if c else reason,
-                         "pieper", tol)
+            return single(qn, valid, pos, rot, sing, sign, fam, fj, c, "" if c else reason,
+                          "pieper", tol)
         return one
 
 

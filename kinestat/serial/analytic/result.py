@@ -102,6 +102,23 @@ class IKAllResult:
             family_curve=family_curve)
         return obj
 
+    @classmethod
+    def single(cls, q, valid, position_error, rotation_error, singular, family_sign,
+               family_value, family_joints, n_solutions, reason, method, tol) -> IKAllResult:
+        """:meth:`build_one` from arrays already in a one-pose result's shapes (``q (K, n)``,
+        ``(K,)``, ``n_solutions`` an int); ``reason``: the pose's string. The 0-d arrays of
+        ``n_solutions`` and ``reason`` are shared by the results with the same value,
+        read-only (as Python's small ints: a single call is a few µs, and a fresh 0-d array
+        is 0.15 µs of it)."""
+        obj = object.__new__(cls)
+        obj.__dict__.update(
+            q=q, valid=valid, position_error=position_error, rotation_error=rotation_error,
+            singular=singular, family_sign=family_sign, family_value=family_value,
+            family_joints=family_joints, n_solutions=_COUNTS[n_solutions],
+            reason=_reason(reason), method=method, tol=tol,
+            family_curve=None)
+        return obj
+
     @property
     def shape(self) -> tuple[int, ...]:
         """The batch shape ``B``."""
@@ -127,6 +144,26 @@ class IKAllResult:
             return q
         flat = int(np.ravel_multi_index(index, self.shape)) if self.shape else 0
         return self.family_curve.members(flat, k, t)[0]
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a.flags.writeable = False
+    return a
+
+
+#: the 0-d counts of :meth:`IKAllResult.single` (K ≤ 16 slots)
+_COUNTS = tuple(_read_only(np.array(i, dtype=np.int64)) for i in range(17))
+_REASONS: dict[str, np.ndarray] = {}
+
+
+def _reason(text: str) -> np.ndarray:
+    """The read-only 0-d object array of ``text`` (:meth:`IKAllResult.single`), kept."""
+    a = _REASONS.get(text)
+    if a is None:
+        a = _read_only(np.array(text, dtype=object))
+        if len(_REASONS) < 64:
+            _REASONS[text] = a
+    return a
 
 
 def __getattr__(name: str):

@@ -230,12 +230,11 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
                 one = _bind_locked(lp)
         else:
             one = _plan(model)[1].get("one")
-        if one is not None and T.dtype is _F64:
-            f = T.flags
-            if f.c_contiguous and f.aligned and f.writeable:
-                res = one(T[None], float(tol))
-                if res is not None:
-                    return res
+        # C-contiguous, aligned, writeable (NPY_ARRAY_C_CONTIGUOUS | ALIGNED | WRITEABLE)
+        if one is not None and T.dtype is _F64 and T.flags.num & 0x501 == 0x501:
+            res = one(T[None], float(tol))
+            if res is not None:
+                return res
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
     if locked:
