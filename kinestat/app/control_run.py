@@ -321,17 +321,18 @@ def _plant_figures(figures: dict, report: RunReport) -> dict:
 
 
 def _with_plant(prepared: PreparedRun, plant) -> PreparedRun:
-    """The prepared run on ``plant``, its controller told the top's and the tool's weight and
-    the radius of the tool's ball tip (the scene's, as a user declares a tool's mass, centre of
-    mass and tip)."""
+    """The prepared run on ``plant``, its controller told the top's and the tool's mass, their
+    weight and the radius of the tool's ball tip (the scene's, as a user declares a tool's
+    mass, centre of mass and tip)."""
     mass, com, gravity = plant.scene.top_load()
     config = prepared.config
-    model = replace(config.model, tip_radius=plant.scene.tip_radius_mm)
+    model = replace(config.model, tip_radius=plant.scene.tip_radius_mm,
+                    top_mass=plant.scene.params.top_mass)
     if mass > 0.0:
         model = replace(model, payload=Payload(mass, com, gravity))
     config = replace(config, model=model)
     header = dict(prepared.header, payload={"mass_kg": mass, "com_top_mm": com.tolist()},
-                  tip_radius_mm=model.tip_radius)
+                  tip_radius_mm=model.tip_radius, top_mass_kg=model.top_mass)
     return replace(prepared, plant=plant, config=config, header=header)
 
 

@@ -37,7 +37,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from kinestat.control.contact_estimate import cone_normal, path_curvature, turn_by_curvature
-from kinestat.control.follow.tuning import FollowTuning
+from kinestat.control.follow.tuning import FollowTuning, advance_limit
 
 __all__ = ["ContactEstimate", "estimate_normal", "advance_limit", "slip_test",
            "chord_constraint", "cone_measurement", "friction_on_normal", "observe_travel",
@@ -94,12 +94,6 @@ def estimate_normal(force, path_dir=None) -> np.ndarray:
         c = c / np.linalg.norm(c)
         F = F - (F @ c) * c
     return -F / np.linalg.norm(F)
-
-
-def advance_limit(tun: FollowTuning) -> float:
-    """mm: the smallest significant advance of the tip: ``confidence`` standard deviations
-    of the difference of two measured tips (at least the tool's step resolution)."""
-    return max(tun.confidence * math.sqrt(2.0) * tun.tip_sigma, tun.step_resolution)
 
 
 def slip_test(tun: FollowTuning, tips: tuple, tip: np.ndarray, t: np.ndarray) -> bool:
