@@ -151,6 +151,8 @@ def device_model(calibration: str = "thesis", platform: str | None = None) -> Co
 
 
 def _config(req: RunSpec, model: ControlModel) -> ControllerConfig:
+    if req.top_mass is not None:
+        model = replace(model, top_mass=req.top_mass)
     return ControllerConfig(
         model=model, force=req.force, start_tool_point=req.start_tool_point,
         force_tol=req.force_tol, align_tol_deg=req.align_tol_deg, method=req.method,
@@ -336,16 +338,23 @@ def _with_plant(prepared: PreparedRun, plant) -> PreparedRun:
     return replace(prepared, plant=plant, config=config, header=header)
 
 
+def _scene_params(req: RunSpec):
+    """The MuJoCo scene's settings from the request (``--top-weight``, ``--top-mass``)."""
+    from kinestat.sim.mujoco_scene import SceneParams  # lazy: mujoco only for --sim mujoco
+
+    kw = {} if req.top_mass is None else {"top_mass": req.top_mass}
+    return SceneParams(top_weight=req.cell.top_weight, **kw)
+
+
 def _mujoco_plant(prepared: PreparedRun):
     """The MuJoCo plant of a prepared simulated cell at its start pose (at rest)."""
     from kinestat.app.mujoco_cell import mujoco_plant  # lazy: mujoco only for --sim mujoco
-    from kinestat.sim.mujoco_scene import SceneParams  # lazy: as above
 
     config = prepared.config
     counts = (arm_start_counts(prepared.arm) if prepared.arm is not None
               else start_counts(config))
     return mujoco_plant(prepared.cell, config.model, counts,
-                        params=SceneParams(top_weight=prepared.request.cell.top_weight))
+                        params=_scene_params(prepared.request))
 
 
 def report_dict(prepared: PreparedRun, report: RunReport) -> dict:

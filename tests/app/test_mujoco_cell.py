@@ -147,3 +147,12 @@ def test_the_controller_is_told_the_tops_mass_and_moves_honour_an_accel_limit():
         peaks.append(seen["peak"])
     assert plans[1]["sim_move_s"] > plans[0]["sim_move_s"]
     assert peaks[1] < 0.5 * peaks[0]
+
+
+def test_top_mass_option_sets_the_scenes_mass_and_the_controllers():
+    prepared = prepare_control(ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION,
+                                              start_tool_point=START, top_mass=0.5,
+                                              cell=SimulatedCell(plant="mujoco")))
+    assert prepared.plant.scene.params.top_mass == 0.5
+    assert prepared.config.model.top_mass == 0.5
+    assert prepared.header["top_mass_kg"] == 0.5

@@ -87,3 +87,25 @@ def test_accel_limit_is_tool_accel_over_the_largest_displacement(follow_config, 
     d = max(np.linalg.norm((new - now) @ np.append(p, 1.0)) for p in
             (np.zeros(3), np.asarray(model.tool_point_6)))
     assert rate * d == pytest.approx(20.0, rel=1e-9)
+
+
+@pytest.mark.parametrize("bad", [-0.1, float("nan"), float("inf"), True, "heavy"])
+def test_top_mass_option_refuses_what_is_not_a_mass(bad):
+    from kinestat.errors import InputError
+
+    with pytest.raises(InputError, match="--top-mass"):
+        ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START,
+                       top_mass=bad)
+
+
+def test_top_mass_option_reaches_the_follow_tasks_tuning():
+    from kinestat.control.follow.tuning import advance_limit, tool_accel_limit
+
+    prepared = prepare_control(ControlRequest(
+        force=4.0 * THESIS_FORCE_DIRECTION, start_tool_point=START, task="follow",
+        cell=SimulatedCell(friction=0.3), top_mass=0.35))
+    tun = prepared.follow.tuning
+    assert prepared.config.model.top_mass == 0.35
+    assert tun.tool_accel == pytest.approx(
+        tool_accel_limit(0.35, tun.tangential_stiffness, advance_limit(tun)), rel=1e-12)
+    assert math.isfinite(tun.tool_accel)
