@@ -151,6 +151,8 @@ def device_model(calibration: str = "thesis", platform: str | None = None) -> Co
 
 
 def _config(req: RunSpec, model: ControlModel) -> ControllerConfig:
+    if req.top_mass is not None:
+        model = replace(model, top_mass=req.top_mass)
     return ControllerConfig(
         model=model, force=req.force, start_tool_point=req.start_tool_point,
         force_tol=req.force_tol, align_tol_deg=req.align_tol_deg, method=req.method,
@@ -321,30 +323,38 @@ def _plant_figures(figures: dict, report: RunReport) -> dict:
 
 
 def _with_plant(prepared: PreparedRun, plant) -> PreparedRun:
-    """The prepared run on ``plant``, its controller told the top's and the tool's weight and
-    the radius of the tool's ball tip (the scene's, as a user declares a tool's mass, centre of
-    mass and tip)."""
+    """The prepared run on ``plant``, its controller told the top's and the tool's mass, their
+    weight and the radius of the tool's ball tip (the scene's, as a user declares a tool's
+    mass, centre of mass and tip)."""
     mass, com, gravity = plant.scene.top_load()
     config = prepared.config
-    model = replace(config.model, tip_radius=plant.scene.tip_radius_mm)
+    model = replace(config.model, tip_radius=plant.scene.tip_radius_mm,
+                    top_mass=plant.scene.params.top_mass)
     if mass > 0.0:
         model = replace(model, payload=Payload(mass, com, gravity))
     config = replace(config, model=model)
     header = dict(prepared.header, payload={"mass_kg": mass, "com_top_mm": com.tolist()},
-                  tip_radius_mm=model.tip_radius)
+                  tip_radius_mm=model.tip_radius, top_mass_kg=model.top_mass)
     return replace(prepared, plant=plant, config=config, header=header)
+
+
+def _scene_params(req: RunSpec):
+    """The MuJoCo scene's settings from the request (``--top-weight``, ``--top-mass``)."""
+    from kinestat.sim.mujoco_scene import SceneParams  # lazy: mujoco only for --sim mujoco
+
+    kw = {} if req.top_mass is None else {"top_mass": req.top_mass}
+    return SceneParams(top_weight=req.cell.top_weight, **kw)
 
 
 def _mujoco_plant(prepared: PreparedRun):
     """The MuJoCo plant of a prepared simulated cell at its start pose (at rest)."""
     from kinestat.app.mujoco_cell import mujoco_plant  # lazy: mujoco only for --sim mujoco
-    from kinestat.sim.mujoco_scene import SceneParams  # lazy: as above
 
     config = prepared.config
     counts = (arm_start_counts(prepared.arm) if prepared.arm is not None
               else start_counts(config))
     return mujoco_plant(prepared.cell, config.model, counts,
-                        params=SceneParams(top_weight=prepared.request.cell.top_weight))
+                        params=_scene_params(prepared.request))
 
 
 def report_dict(prepared: PreparedRun, report: RunReport) -> dict:

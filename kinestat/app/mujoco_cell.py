@@ -31,7 +31,7 @@ import numpy as np
 from kinestat.control.model import ControlModel
 from kinestat.devices.cell_io import SensorSample
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX
-from kinestat.devices.motion import MoveRule, move_plan
+from kinestat.devices.motion import MoveRule, limit_accel, move_plan
 from kinestat.errors import DeviceError, KinestatError
 from kinestat.robots.puma762.axes import AXIS_DEG_PER_COUNT
 from kinestat.serial.fk import fk
@@ -153,9 +153,10 @@ class MujocoIO:
 
         return reference, duration
 
-    def move(self, axis_counts) -> dict:
-        """Plan the move as the Galil would, follow it in time, settle; the plan for the log
-        with the simulated seconds of motion and settling."""
+    def move(self, axis_counts, accel_limit: float | None = None) -> dict:
+        """Plan the move as the Galil would (its accelerations capped by ``accel_limit``,
+        :func:`~kinestat.devices.motion.limit_accel`), follow it in time, settle; the plan
+        for the log with the simulated seconds of motion and settling."""
         new = np.asarray(axis_counts, dtype=np.int64)
         now = self.robot_counts()
         if self._guard is not None:
@@ -167,7 +168,8 @@ class MujocoIO:
             raise DeviceError(f"MuJoCo cell: axis {i + 1} commanded to {axis_deg[i]:.3f} deg, "
                               f"outside its limits [{self._lo[i]:g}, {self._hi[i]:g}] deg; "
                               "not moved")
-        plan = move_plan(self.move_rule, now, new, self._vmax, self._amax)
+        plan = limit_accel(move_plan(self.move_rule, now, new, self._vmax, self._amax), now,
+                           accel_limit)
         reference, duration = self._profile(now, plan)
         try:
             self.plant.track(reference, duration)

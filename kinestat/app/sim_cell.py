@@ -31,7 +31,7 @@ from kinestat.control.model import ControlModel
 from kinestat.devices.cell_io import DeviceIO, SensorSample
 from kinestat.devices.encoder_stream import EncoderReader, Format
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
-from kinestat.devices.motion import coordinated_move_plan
+from kinestat.devices.motion import coordinated_move_plan, limit_accel
 from kinestat.errors import DeviceError, JointLimitError, KinestatError, UnreachableError
 from kinestat.robots.puma762.arm import THESIS_ARM
 from kinestat.robots.puma762.axes import (
@@ -386,10 +386,12 @@ class InProcessIO:
         """The exact robot's axis counts A..F."""
         return self._counts.copy()
 
-    def move(self, axis_counts) -> dict:
+    def move(self, axis_counts, accel_limit: float | None = None) -> dict:
         """Reach ``axis_counts`` exactly, solving the cell at ``substeps`` points on the way
-        (the straight joint-space path of a coordinated move); returns the coordinated plan
-        (:func:`kinestat.devices.motion.coordinated_move_plan`, the thesis's maxima)."""
+        (the straight joint-space path of a coordinated move; quasi-static, so the profile
+        does not change the result); returns the coordinated plan
+        (:func:`kinestat.devices.motion.coordinated_move_plan`, the thesis's maxima, its
+        accelerations capped by ``accel_limit``: :func:`~kinestat.devices.motion.limit_accel`)."""
         new = np.asarray(axis_counts, dtype=np.int64)
         old = self._counts.astype(float)
         if self._guard is not None:
@@ -400,7 +402,8 @@ class InProcessIO:
             self.state.solve(self._q(old + s * (new - old)))
         self._counts = new.copy()
         self.moves.append(new.copy())
-        plan = coordinated_move_plan(old, new, THESIS_SPEED_MAX, THESIS_ACCEL)
+        plan = limit_accel(coordinated_move_plan(old, new, THESIS_SPEED_MAX, THESIS_ACCEL), old,
+                           accel_limit)
         return {"delta_counts": (new - old).astype(np.int64).tolist(),
                 "speed": plan.speed.tolist(), "accel": plan.accel.tolist(),
                 "rule": "coordinated"}

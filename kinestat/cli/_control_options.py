@@ -207,7 +207,7 @@ def run_spec(o: dict):
                   o["plane_normal"], o["ideal_sensor"], o["noise"], o["friction"], o["rate"],
                   o["seed"], o["sim_legs"], o["workpiece"], o["sim"],
                   o["workpiece_stiffness"], o["top_weight"]),
-        **tool_and_mount(o["tool_offset"], o["a67"], o["mount"]))
+        top_mass=o["top_mass"], **tool_and_mount(o["tool_offset"], o["a67"], o["mount"]))
 
 
 def paths(log: Path | None, plot: Path | None, no_plot: bool) -> tuple[Path, Path | None]:

@@ -184,6 +184,12 @@ PARAMETERS = [
         False, "--top-weight", help="--sim mujoco: gravity on the top plate + tool (0.35 kg); "
         "the controller is given their weight and centre of mass and subtracts them from "
         "every measurement (docs/mujoco.md). Default: weightless, as the built-in simulator.")),
+    _p("top_mass", float, typer.Option(
+        None, "--top-mass", metavar="KG", help="The top plate + tool's moving mass (kg): the "
+        "follow task keeps its moves' accelerations low enough that this inertia cannot run a "
+        "sliding tip past what its slip test resolves (docs/mujoco.md). Default: 0, the "
+        "thesis's massless model (moves not limited); with --sim mujoco the scene's 0.35 kg, "
+        "which this also sets.")),
     _p("arm", str, typer.Option(
         None, "--arm", metavar="MODEL", help="The robot: an embedded model name (e.g. "
         "puma560), a TOML model or a URDF file, any 6-joint arm with an analytic solver; "

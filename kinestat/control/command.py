@@ -72,6 +72,10 @@ class Command:
             press task.
         waypoints: for the start move, the intermediate axis counts commanded before
             ``axis_counts`` (:func:`kinestat.control.approach.approach_waypoints`).
+        accel_limit: 1/s², the move's largest acceleration per unit of travel (each axis
+            accelerates at most this times its own travel: :func:`kinestat.devices.motion.
+            limit_accel`), set where the top + tool's inertia must not load the contact
+            (the follow task on a massive top); None: the move rule's own.
     """
 
     kind: CommandKind
@@ -90,6 +94,7 @@ class Command:
     violations: tuple[str, ...] = ()
     info: dict = field(default_factory=dict)
     waypoints: tuple[np.ndarray, ...] = ()
+    accel_limit: float | None = None
 
 
 # -- joint-space helpers: kinestat.control.vernier --------------------------------------------

@@ -59,9 +59,11 @@ class CellIO(Protocol):
     def robot_counts(self) -> np.ndarray:
         """The robot's axis positions, encoder counts A..F."""
 
-    def move(self, axis_counts: np.ndarray) -> dict | None:
+    def move(self, axis_counts: np.ndarray, accel_limit: float | None = None) -> dict | None:
         """Move to absolute axis counts and return when the motion is complete; optionally
-        return the move's plan (``{"delta_counts": [6], "speed": [6], ...}``) for the log."""
+        return the move's plan (``{"delta_counts": [6], "speed": [6], ...}``) for the log.
+        ``accel_limit`` (1/s², :attr:`Command.accel_limit`) caps each axis's acceleration at
+        that times its travel (:func:`kinestat.devices.motion.limit_accel`)."""
 
     def sensor(self) -> SensorReading:
         """Leg counts measured after the last motion completed."""
@@ -183,7 +185,8 @@ def _start_move(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run) ->
 
 def _move(io: CellIO, log: CycleLog, cmd: Command, cycle: int, r: _Run) -> None:
     """Send one move; log its plan (per-axis deltas and speeds) when the cell reports one."""
-    plan = io.move(cmd.axis_counts)
+    plan = (io.move(cmd.axis_counts) if cmd.accel_limit is None
+            else io.move(cmd.axis_counts, accel_limit=cmd.accel_limit))
     r.moves += 1
     if plan:
         log.write({"type": "move", "cycle": cycle, "t": r.t(), "move": plan})

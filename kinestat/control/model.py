@@ -65,6 +65,12 @@ class ControlModel:
             where the tool leans the foremost point is off the contact by ``r sin(lean)``
             while the centre rides on the surface offset by ``r``
             (:attr:`tip_centre_top`).
+        top_mass: kg, the moving mass of the top plate and the tool (its inertia, whether or
+            not its weight is compensated: :attr:`payload`); 0 (default, the thesis's
+            quasi-static, massless top): moves are not limited for it. The follow task keeps
+            its moves' accelerations so low that the inertia cannot load the contact beyond
+            what its slip test resolves (:attr:`kinestat.control.follow.FollowTuning.
+            tool_accel`).
     """
 
     platform: Platform
@@ -79,6 +85,7 @@ class ControlModel:
     arm: Arm = THESIS_ARM
     payload: Payload | None = None
     tip_radius: float = 0.0
+    top_mass: float = 0.0
 
     def __post_init__(self) -> None:
         if not all(callable(getattr(type(self.arm), n, None)) for n in _ARM_METHODS):
@@ -115,6 +122,9 @@ class ControlModel:
         if not (math.isfinite(float(self.tip_radius)) and self.tip_radius >= 0.0):
             raise ModelError(f"tip_radius must be a number of mm >= 0, got {self.tip_radius!r}")
         object.__setattr__(self, "tip_radius", float(self.tip_radius))
+        if not (math.isfinite(float(self.top_mass)) and self.top_mass >= 0.0):
+            raise ModelError(f"top_mass must be a number of kg >= 0, got {self.top_mass!r}")
+        object.__setattr__(self, "top_mass", float(self.top_mass))
         # the platform's legs must match the calibration's
         self.calibration.platform_order(self.platform.leg_names)
 

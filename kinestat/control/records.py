@@ -43,7 +43,7 @@ def cmd_record(cmd: Command) -> dict | None:
         return None
     t = cmd.target
     p = cmd.prediction
-    return {
+    rec = {
         "action": cmd.action,
         "tool_point": t.tool_point,
         "tool_axis": t.s6,
@@ -58,6 +58,9 @@ def cmd_record(cmd: Command) -> dict | None:
         "predicted_deflections": None if p is None else p.deflections,
         "predicted_top_pose": None if p is None else p.top_pose,
     }
+    if cmd.accel_limit is not None:  # 1/s²: the move's accelerations capped (Command)
+        rec["accel_limit"] = cmd.accel_limit
+    return rec
 
 
 def config_record(config: ControllerConfig) -> dict:

@@ -176,6 +176,9 @@ class RunSpec:
         arm: another arm (:class:`~kinestat.app.arm_cell.ArmSpec`; None the PUMA 762).
         tool_point_6 (mm, frame 6), a67 (unit, ⟂ S6), mount: the tool and the platform's
             mount on the flange [--tool-offset, --a67, --mount].
+        top_mass: kg, the top plate + tool's moving mass [--top-mass]
+            (:attr:`~kinestat.control.model.ControlModel.top_mass`); None: 0 (the thesis's
+            massless model), or the MuJoCo scene's with ``--sim mujoco``, which it also sets.
     """
 
     force: np.ndarray = field(default_factory=lambda: _default_force())
@@ -206,6 +209,7 @@ class RunSpec:
     tool_point_6: np.ndarray | None = None
     a67: np.ndarray | None = None
     mount: Any = None
+    top_mass: float | None = None
 
     def __post_init__(self) -> None:
         self._check_goal()
@@ -220,6 +224,12 @@ class RunSpec:
                              "(drop --galil/--serial)")
         if self.tool_point_6 is not None:
             self._set("tool_point_6", _vec3(self.tool_point_6, "--tool-offset"))
+        if self.top_mass is not None:
+            m = self.top_mass
+            if isinstance(m, bool) or not isinstance(m, (int, float)) or not (
+                    math.isfinite(m) and m >= 0):
+                raise InputError(f"--top-mass must be a number of kg >= 0, got {m!r}")
+            self._set("top_mass", float(m))
 
     def _set(self, name: str, value) -> None:
         object.__setattr__(self, name, value)

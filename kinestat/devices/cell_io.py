@@ -21,7 +21,7 @@ import numpy as np
 from kinestat.devices.ceilings import MAX_SAMPLES
 from kinestat.devices.encoder_stream import TooManyFaultsError, sampled_after
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
-from kinestat.devices.motion import MOVE_RULES, MoveRule, move_plan
+from kinestat.devices.motion import MOVE_RULES, MoveRule, limit_accel, move_plan
 from kinestat.devices.motion_check import POSITION_TOLERANCE_COUNTS, check_arrival
 from kinestat.devices.safe_stop import RECONNECT_TIMEOUT, StopReport, send_stop
 from kinestat.errors import DeviceError, InputError
@@ -123,7 +123,7 @@ class DeviceIO:
         """The robot's axis positions A..F, encoder counts (``TP``)."""
         return np.asarray(self.client.position_counts(), dtype=np.int64)
 
-    def move(self, axis_counts: np.ndarray) -> dict:
+    def move(self, axis_counts: np.ndarray, accel_limit: float | None = None) -> dict:
         """Move with the axis 4 -> 5 compensation (Vibhute App. D.9), keep reading the sensor
         stream while the axes move (so that the serial buffer never overflows), check the
         read-back positions, then reset the axis-5 encoder (``DP``) as
@@ -131,7 +131,9 @@ class DeviceIO:
         past the reset is carried into the next move's compensation (the thesis discarded it;
         over a long run of small axis-4 moves it added up to tenths of a degree). Returns the
         move's plan:
-        ``{"delta_counts", "speed", "accel", "rule"}`` (what was sent).
+        ``{"delta_counts", "speed", "accel", "rule"}`` (what was sent). ``accel_limit``
+        (1/s²) caps each axis's acceleration and deceleration at that times its travel
+        (:func:`kinestat.devices.motion.limit_accel`).
 
         The final command (axis 5 compensated from the axis-4 position just read) goes through
         ``guard`` before anything is sent.
@@ -141,7 +143,8 @@ class DeviceIO:
         corr = axis45_compensation(c[3], c[4], int(now[3]), self.coupling, self._axis5_carry)
         cmd = c.copy()
         cmd[4] = int(corr.axis5_command)
-        plan = move_plan(self.move_rule, now, cmd, self.profile.speed, self.profile.accel)
+        plan = limit_accel(move_plan(self.move_rule, now, cmd, self.profile.speed,
+                                     self.profile.accel), now, accel_limit)
         if self.guard is not None:
             self.guard(cmd, now)
         self.client.move_absolute(cmd, plan.speed, plan.accel, plan.decel)

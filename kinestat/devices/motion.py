@@ -28,6 +28,7 @@ profile's maxima (``"max"``).
 
 from __future__ import annotations
 
+import math
 from typing import Literal, get_args
 
 import numpy as np
@@ -36,7 +37,7 @@ from kinestat.devices.galil import MovePlan, thesis_move_plan
 from kinestat.errors import InputError
 from kinestat.robots.puma762.axes import as_axes6
 
-__all__ = ["MoveRule", "MOVE_RULES", "coordinated_move_plan", "move_plan"]
+__all__ = ["MoveRule", "MOVE_RULES", "coordinated_move_plan", "move_plan", "limit_accel"]
 
 MoveRule = Literal["coordinated", "thesis", "max"]
 """How a move's per-axis speeds are chosen (see the module docstring)."""
@@ -84,3 +85,26 @@ def move_plan(rule: MoveRule, current, target, speed_max, accel_max) -> MovePlan
                         np.broadcast_to(np.asarray(speed_max, dtype=float), (6,)).copy(), acc,
                         acc.copy())
     raise InputError(f"move rule must be one of {MOVE_RULES}, got {rule!r}")
+
+
+def limit_accel(plan: MovePlan, current, rate: float | None) -> MovePlan:
+    """``plan`` with each moving axis's acceleration and deceleration at most ``rate`` times
+    its travel (``rate`` in 1/s², counts/s² per count moved; rounded up to 1e-4 as above).
+    Under a coordinated plan every point of the arm then accelerates at most ``rate`` times its
+    own displacement: a controller that must not shake what the arm carries gives the rate
+    its largest acceleration over the move's largest displacement. ``None``: ``plan`` as it is.
+
+    >>> p = coordinated_move_plan([0] * 6, [1000, 500, 0, 0, 0, 0], [100] * 6, [1000] * 6)
+    >>> limit_accel(p, [0] * 6, 0.25).accel[:3].tolist()
+    [250.0, 125.0, 1000.0]
+    """
+    if rate is None:
+        return plan
+    r = float(rate)
+    if not (math.isfinite(r) and r > 0.0):
+        raise InputError(f"limit_accel: the acceleration rate must be a positive number of "
+                         f"1/s², got {rate!r}")
+    d = np.abs(np.asarray(plan.target, dtype=float) - as_axes6(current, "limit_accel current"))
+    cap = np.where(d > 0, _up4(r * d), np.inf)
+    return plan._replace(accel=np.minimum(np.asarray(plan.accel, dtype=float), cap),
+                         decel=np.minimum(np.asarray(plan.decel, dtype=float), cap))

@@ -103,3 +103,56 @@ def test_whole_stack_through_the_simulated_devices_converges_on_mujoco(tmp_path)
     assert abs(rep.true_force_magnitude - 4.0) <= cfg.force_tol
     assert rep.axis_error_deg < 1.0
     assert np.linalg.norm(rep.force - rep.true_force) <= 0.1
+
+
+def test_the_controller_is_told_the_tops_mass_and_moves_honour_an_accel_limit():
+    """The MuJoCo run's controller is told the scene's top + tool mass (its follow task then
+    limits its accelerations); a move with ``accel_limit`` keeps every axis at most that
+    times its travel, takes longer, and the top's peak acceleration in MuJoCo falls."""
+    import mujoco
+
+    from kinestat.app.mujoco_cell import MujocoIO
+    from kinestat.sim.mujoco_scene import SceneParams
+
+    prepared = prepare_control(_request())
+    model = prepared.config.model
+    assert model.top_mass == pytest.approx(SceneParams().top_mass)
+    assert prepared.header["top_mass_kg"] == pytest.approx(SceneParams().top_mass)
+    peaks, plans = [], []
+    for limit in (None, 0.5):
+        s0 = prepared.plant.scene
+        plant = MujocoPlant(build_scene(prepared.cell, s0.arm, s0.q_start, s0.top_pose_start))
+        io = MujocoIO(plant, model, prepared.sensor)
+        target = io.robot_counts() + np.array([400, -300, 200, 0, 0, 0])
+        jid = mujoco.mj_name2id(plant.model, mujoco.mjtObj.mjOBJ_JOINT, "top")
+        dof = int(plant.model.jnt_dofadr[jid])
+        dt = plant.model.opt.timestep
+        seen = {"v": None, "peak": 0.0}
+        step = plant.step
+
+        def watched(n=1, _step=step, _seen=seen, _plant=plant, _dof=dof, _dt=dt):
+            _step(n)
+            v = np.array(_plant.data.qvel[_dof:_dof + 3])
+            if _seen["v"] is not None:
+                _seen["peak"] = max(_seen["peak"], float(np.linalg.norm(v - _seen["v"])) / _dt)
+            _seen["v"] = v
+
+        plant.step = watched
+        plan = io.move(target) if limit is None else io.move(target, accel_limit=limit)
+        if limit is not None:
+            delta = np.abs(np.asarray(plan["delta_counts"], dtype=float))
+            moving = delta > 0
+            assert np.all(np.asarray(plan["accel"])[moving] <= limit * delta[moving] + 1e-3)
+        plans.append(plan)
+        peaks.append(seen["peak"])
+    assert plans[1]["sim_move_s"] > plans[0]["sim_move_s"]
+    assert peaks[1] < 0.5 * peaks[0]
+
+
+def test_top_mass_option_sets_the_scenes_mass_and_the_controllers():
+    prepared = prepare_control(ControlRequest(force=4.0 * THESIS_FORCE_DIRECTION,
+                                              start_tool_point=START, top_mass=0.5,
+                                              cell=SimulatedCell(plant="mujoco")))
+    assert prepared.plant.scene.params.top_mass == 0.5
+    assert prepared.config.model.top_mass == 0.5
+    assert prepared.header["top_mass_kg"] == 0.5

@@ -405,10 +405,38 @@ def test_each_measurement_alone_recovers_its_part_of_the_contact(tmp_path):
         assert _deg(got, n) < 1e-6 and var > 0.0
         # the force on the cone's edge with μ known: the normal atan μ from the force
         est = ContactEstimate(normal=off / np.linalg.norm(off), normal_var=1e-4, mu=mu,
-                              mu_var=1e-6, samples=3)
+                              mu_var=1e-6, samples=3, drag=mu)
         got, var = cone_measurement(tun, est, F)
         if mu > 0.01:
             assert _deg(got, n) < 1e-6
+        # no friction measured: the normal is the force's direction
+        got, var = cone_measurement(tun, replace(est, drag=0.0), -fn * n)
+        assert _deg(got, n) < 1e-6
+
+
+def test_a_normal_off_about_the_travel_on_a_frictionless_slide_is_not_friction(tmp_path):
+    """A frictionless surface whose normal turns about the travel (a path along a cylinder,
+    its geodesic torsion): measured against the estimate the force has a tangential part, but
+    across the slip, not along it. Friction opposes the slip, so none is taken, the normal
+    follows the force and the estimate stays on the turning normal."""
+    tun = _tuning(tmp_path)
+    rng = np.random.default_rng(11)
+    t = np.array([0.0, 1.0, 0.0])
+    tau = math.radians(0.08)  # rad per mm about the travel
+    n0 = np.array([0.0, 0.0, 1.0])
+    est = ContactEstimate(normal=n0, normal_var=math.radians(0.5) ** 2, tips=(np.zeros(3),),
+                          path=(np.zeros(3),))
+    worst = 0.0
+    for k in range(1, 45):
+        a = tau * k
+        n_true = np.array([math.sin(a), 0.0, math.cos(a)])  # turned about t
+        tip = k * t + rng.normal(0.0, tun.tip_sigma, 3)
+        F = -4.0 * n_true + rng.normal(0.0, tun.force_sigma, 3)
+        tt = t - float(t @ est.normal) * est.normal
+        est = observe_travel(tun, est, tip, F, tt / np.linalg.norm(tt))
+        worst = max(worst, _deg(est.normal, n_true))
+        assert not est.friction_known(tun), (k, est.mu, est.drag)
+    assert worst < 0.5  # the turn itself is 3.5° over the slide
 
 
 def test_a_run_goes_through_the_phases_in_order(tmp_path):

@@ -96,3 +96,38 @@ def test_the_log_records_every_moves_deltas_and_speeds(tmp_path):
         if mv.sum() > 1:  # speeds proportional to the deltas: one cruise time
             ratio = d[mv] / np.asarray(m["speed"])[mv]
             assert np.ptp(ratio) <= 1e-3 * ratio.max() + 1e-3
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_limit_accel_caps_each_axis_by_its_travel_and_keeps_the_axes_together(seed):
+    """Every moving axis accelerates at most rate × its travel; a coordinated move stays
+    coordinated (its axes still finish together) and lasts at least the triangular profile's
+    2 √(1 / rate) at that rate."""
+    from kinestat.devices.motion import limit_accel
+
+    rng = np.random.default_rng(100 + seed)
+    cur = rng.integers(-50000, 50000, 6)
+    delta = rng.integers(-3000, 3000, 6) * (rng.random(6) < 0.8)
+    delta[0] = int(rng.integers(50, 3000))
+    tgt = cur + delta
+    rate = float(rng.uniform(0.05, 2.0))
+    plan = coordinated_move_plan(cur, tgt, THESIS_SPEED_MAX, THESIS_ACCEL)
+    slow = limit_accel(plan, cur, rate)
+    moving = delta != 0
+    assert np.all(slow.accel[moving] <= rate * np.abs(delta[moving]) + 1e-3)
+    assert np.all(slow.decel[moving] <= rate * np.abs(delta[moving]) + 1e-3)
+    assert np.all(slow.accel <= plan.accel) and np.array_equal(slow.speed, plan.speed)
+    assert np.array_equal(slow.accel[~moving], plan.accel[~moving])
+    dur = _durations(slow, cur, tgt)[moving]
+    assert np.ptp(dur) <= 1e-3 * dur.max() + 1e-6
+    assert dur.max() >= 2.0 * np.sqrt(1.0 / rate) * (1 - 1e-3)
+    assert limit_accel(plan, cur, None) is plan
+
+
+@pytest.mark.parametrize("rate", [0.0, -1.0, float("nan"), float("inf")])
+def test_limit_accel_refuses_a_rate_that_is_not_a_positive_number(rate):
+    from kinestat.devices.motion import limit_accel
+
+    plan = coordinated_move_plan([0] * 6, [100] * 6, THESIS_SPEED_MAX, THESIS_ACCEL)
+    with pytest.raises(InputError, match="acceleration rate"):
+        limit_accel(plan, [0] * 6, rate)

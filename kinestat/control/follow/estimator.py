@@ -37,7 +37,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from kinestat.control.contact_estimate import cone_normal, path_curvature, turn_by_curvature
-from kinestat.control.follow.tuning import FollowTuning
+from kinestat.control.follow.tuning import FollowTuning, advance_limit
 
 __all__ = ["ContactEstimate", "estimate_normal", "advance_limit", "slip_test",
            "chord_constraint", "cone_measurement", "friction_on_normal", "observe_travel",
@@ -61,6 +61,10 @@ class ContactEstimate:
             before (a stuck tip adds none), oldest first: the chords and the curvature.
         line: the probe's touches on the line of travel (the curvature's first points).
         samples: slides that measured the normal and μ.
+        drag: the sliding tip's tangential force along its slip over its normal force (the
+            friction's dissipative part), fused as μ: friction opposes the slip, so a
+            tangential force across the slip (a normal estimated off about the travel) is
+            no evidence of friction.
     """
 
     normal: np.ndarray
@@ -73,10 +77,12 @@ class ContactEstimate:
     path: tuple = ()
     line: tuple = ()
     samples: int = 0
+    drag: float = 0.0
 
     def friction_known(self, tun: FollowTuning) -> bool:
-        """μ measured and significantly above zero."""
-        return self.samples > 0 and self.mu > tun.confidence * math.sqrt(self.mu_var)
+        """μ measured and significantly above zero, the force's part along the slip too."""
+        lim = tun.confidence * math.sqrt(self.mu_var)
+        return self.samples > 0 and self.mu > lim and self.drag > lim
 
 
 def estimate_normal(force, path_dir=None) -> np.ndarray:
@@ -94,12 +100,6 @@ def estimate_normal(force, path_dir=None) -> np.ndarray:
         c = c / np.linalg.norm(c)
         F = F - (F @ c) * c
     return -F / np.linalg.norm(F)
-
-
-def advance_limit(tun: FollowTuning) -> float:
-    """mm: the smallest significant advance of the tip: ``confidence`` standard deviations
-    of the difference of two measured tips (at least the tool's step resolution)."""
-    return max(tun.confidence * math.sqrt(2.0) * tun.tip_sigma, tun.step_resolution)
 
 
 def slip_test(tun: FollowTuning, tips: tuple, tip: np.ndarray, t: np.ndarray) -> bool:
@@ -164,7 +164,7 @@ def cone_measurement(tun: FollowTuning, est: ContactEstimate, F: np.ndarray
     g = F - float(F @ n) * n  # the tangential force on the workpiece: along the slip
     if float(np.linalg.norm(g)) < 1e-12:
         return n, math.inf
-    mu = max(est.mu, 0.0)
+    mu = est.mu if est.friction_known(tun) else 0.0  # no friction measured: along the force
     var = ((tun.force_sigma / float(np.linalg.norm(F))) ** 2
            + est.mu_var / (1.0 + mu * mu) ** 2)
     return cone_normal(u, g, mu), var
@@ -225,11 +225,12 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
             n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
             est = replace(est, normal=n, normal_var=var)
         mu_m, var_mu = friction_on_normal(tun, F, est.normal, est.normal_var)
+        drag = _fuse(est, _drag(F, est.normal, tip - tips[-1]), var_mu)
         mu, mvar = _fuse_mu(est, mu_m, var_mu)
         # every sample is measured against the same normal: its error is common to them
         floor = (1.0 + mu * mu) ** 2 * est.normal_var
         est = replace(est, mu=min(max(mu, 0.0), tun.max_friction), mu_var=max(mvar, floor),
-                      samples=est.samples + 1)
+                      samples=est.samples + 1, drag=drag)
         if est.samples > 1:  # the force on the cone's edge: the normal atan μ̂ from it
             m, var_m = cone_measurement(tun, est, F)
             n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
@@ -242,6 +243,18 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
     tt = t - float(t @ est.normal) * est.normal
     kappa = _curvature(tun, est, path[:-1], tip, est.normal, tt / np.linalg.norm(tt))
     return replace(est, tips=new_tips, path=path, curvature=kappa)
+
+
+def _drag(F: np.ndarray, n: np.ndarray, slip: np.ndarray) -> float:
+    """The tangential force on the workpiece along the tip's ``slip`` over the normal force."""
+    fn = -float(F @ n)
+    s = slip - float(slip @ n) * n
+    return float((F + fn * n) @ s) / (fn * float(np.linalg.norm(s)))
+
+
+def _fuse(est: ContactEstimate, drag_m: float, var_m: float) -> float:
+    """The drag fused as μ is (the same variances)."""
+    return _fuse_mu(replace(est, mu=est.drag), drag_m, var_m)[0]
 
 
 def _fuse_mu(est: ContactEstimate, mu_m: float, var_m: float) -> tuple[float, float]:

@@ -38,6 +38,8 @@ from kinestat.control.follow.law import (
 from kinestat.control.probe import probe_normal, probe_step, start_probe
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
+from kinestat.spatial.se3 import twist_exp
+from kinestat.spatial.transforms import apply_one, inv
 
 __all__ = ["decide_follow", "FOLLOW_STATES", "developed_step"]
 
@@ -338,7 +340,25 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
     st = replace(st, lean=lean)
     action = "follow" if st.phase == "travel" else "settle"
     return _command(config, st, meas, target_of(base.model, meas, T), label, action, step,
-                    math.degrees(float(np.linalg.norm(omega))), kw)
+                    math.degrees(float(np.linalg.norm(omega))), kw,
+                    accel_limit=accel_limit(config, meas, T))
+
+
+def accel_limit(config: FollowConfig, meas: Measurement, T_base: np.ndarray) -> float | None:
+    """1/s²: the move's acceleration per unit of travel (:attr:`Command.accel_limit`) that
+    keeps the top and the tool within :attr:`FollowTuning.tool_accel`: that over the largest
+    displacement of the flange's origin and the tool point when the base moves by the twist
+    ``T_base`` (a small rigid motion moves the points between them, the top and the tool, by
+    no more); None for a massless top or no motion."""
+    a = config.tuning.tool_accel
+    if not math.isfinite(a):
+        return None
+    model = config.base.model
+    now = meas.base_pose @ inv(model.mount)
+    new = meas.base_pose @ twist_exp(T_base) @ inv(model.mount)
+    d = max(float(np.linalg.norm(apply_one(new, p) - apply_one(now, p)))
+            for p in (np.zeros(3), model.tool_point_6))
+    return a / d if d > 0.0 else None
 
 
 def _friction_dir(config: FollowConfig, st: FollowState, F: np.ndarray, n: np.ndarray,
@@ -362,13 +382,16 @@ def _stop(st: FollowState, label: str, reason: str, **kw) -> tuple[Command, Foll
 
 def _command(config: FollowConfig, st: FollowState, meas: Measurement, new: Target, label: str,
              action: str, step: float, rotation_deg: float,
-             kw: dict) -> tuple[Command, FollowState]:
-    """Command ``new`` through the shared move path (or stop)."""
+             kw: dict, accel_limit: float | None = None) -> tuple[Command, FollowState]:
+    """Command ``new`` through the shared move path (or stop), its accelerations capped by
+    ``accel_limit`` (1/s², :attr:`Command.accel_limit`)."""
     base = config.base
     cmd = move_command(base.model, base.envelope, base.vernier, meas, new, st.axis_counts,
                        label=label, action=action, step=step, rotation_deg=rotation_deg, info=kw)
     if isinstance(cmd, Refusal):
         return _stop(st, label, cmd.reason + _lean_hint(config, st, meas), **cmd.extra, **kw)
+    if accel_limit is not None:
+        cmd = replace(cmd, accel_limit=accel_limit)
     return cmd, replace(st, label=label, last_action=action, target=new,
                         axis_counts=cmd.axis_counts, step=step if action == "follow" else 0.0)
 

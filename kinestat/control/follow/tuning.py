@@ -19,7 +19,7 @@ With a fine leg sensor the robot's counts are what is left of the measurement's 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -31,7 +31,8 @@ from kinestat.parallel.stiffness import stiffness, tip_compliance
 from kinestat.spatial.se3 import twist_exp
 from kinestat.spatial.transforms import apply, apply_one, skew
 
-__all__ = ["FollowTuning", "derive_tuning", "tip_load_pose", "loaded_stiffness"]
+__all__ = ["FollowTuning", "derive_tuning", "tip_load_pose", "loaded_stiffness",
+           "tool_accel_limit", "advance_limit"]
 
 
 @dataclass(frozen=True)
@@ -74,6 +75,8 @@ class FollowTuning:
             one travel step: the path's curvature is fitted over the span whose sagitta
             ``κ s²/8`` at this curvature is ``confidence path_sigma``, and the normal's
             prediction is uncertain by this much per mm of travel.
+        tool_accel: mm/s², the largest acceleration of the top and the tool during a move in
+            contact (:func:`tool_accel_limit`); ∞ for a massless top (the thesis's model).
     """
 
     tip_sigma: float
@@ -89,10 +92,11 @@ class FollowTuning:
     max_friction: float
     curvature_tol: float
     creep_window: int = 4
+    tool_accel: float = math.inf
 
     def __post_init__(self) -> None:
         for name, v in vars(self).items():
-            if not (math.isfinite(v) and v > 0.0):
+            if not ((math.isfinite(v) or name == "tool_accel") and v > 0.0):
                 raise InputError(f"follow tuning: {name} must be a positive number, got {v!r}")
         if self.creep_window < 2 or int(self.creep_window) != self.creep_window:
             raise InputError(f"follow tuning: creep_window must be an integer >= 2, got "
@@ -239,6 +243,29 @@ def _robot_sigmas(model: ControlModel, tool_point, s6, a67) -> tuple[float, floa
             math.sqrt(float(np.max(np.linalg.eigvalsh(Cw)))))
 
 
+def advance_limit(tun: FollowTuning) -> float:
+    """mm: the smallest significant advance of the tip: ``confidence`` standard deviations
+    of the difference of two measured tips (at least the tool's step resolution)."""
+    return max(tun.confidence * math.sqrt(2.0) * tun.tip_sigma, tun.step_resolution)
+
+
+def tool_accel_limit(mass: float, tangential_stiffness: float, resolution: float) -> float:
+    """mm/s²: the largest acceleration ``a`` of a top + tool of ``mass`` kg during a move in
+    contact. The law is quasi-static: it predicts where the platform comes to rest. While the
+    top accelerates, its inertia ``m a`` loads the tip across the tool like a force, which the
+    platform's soft tangential stiffness ``k_t`` (N/mm) turns into a run of ``m a / k_t`` mm;
+    on a sliding contact, whose force is on the friction cone's edge, the tip runs that far
+    beyond the rest state. Kept within ``resolution`` mm (the slip test's smallest advance):
+    ``a = k_t resolution / m`` (N/kg = m/s², times 1000); ∞ for a massless top.
+
+    >>> round(tool_accel_limit(0.35, 0.064, 0.13), 1)
+    23.8
+    """
+    if mass <= 0.0:
+        return math.inf
+    return 1000.0 * tangential_stiffness * resolution / mass
+
+
 def derive_tuning(model: ControlModel, force: float, tool_point, travel_step: float,
                   noise: float = 0.0, s6=None, a67=None) -> FollowTuning:
     """The default tuning for ``model`` at the target force ``force`` (N), the tool near
@@ -252,9 +279,10 @@ def derive_tuning(model: ControlModel, force: float, tool_point, travel_step: fl
     tip_robot, turn = _robot_sigmas(model, tool_point, s6, a67)
     kt, ka = _tip_stiffness(model, force, s6, a67)
     dir_tol = math.hypot(fs / force, turn)
-    return FollowTuning(
+    tun = FollowTuning(
         tip_sigma=tip, path_sigma=math.hypot(tip, tip_robot), force_sigma=fs, confidence=z,
         chord=max(math.sqrt(2.0) * tip / dir_tol, z * tip),
         direction_tol=dir_tol, step_resolution=_count_at_tool(model, tool_point),
         tangential_stiffness=kt, axial_stiffness=ka, turn_gain=0.5,
         max_friction=1.0, curvature_tol=dir_tol / travel_step, creep_window=4)
+    return replace(tun, tool_accel=tool_accel_limit(model.top_mass, kt, advance_limit(tun)))
