@@ -18,7 +18,11 @@ to the workpiece ``F`` (noise ``σ_F`` per component).
   force, away from its tangential part (:func:`cone_measurement`). Isotropic Coulomb friction
   would also put the normal as the force's part across the chord (:func:`estimate_normal`),
   but a plant's friction need not lie along the measured slip (MuJoCo's soft contact, measured
-  at rest after each move, leaves it 25–45° off), so the chord gives only geometry.
+  at rest after each move, leaves it 18–45° off), so the chord gives only geometry. Friction
+  opposes the slip, though: it counts only once its part along the slip (the drag) is
+  significant too; a tangential force across the slip is a normal estimated off about the
+  travel (the surface's turn about it, which the tip path does not show), and until friction
+  counts the cone measurement takes the normal along the force.
 * **While stuck** the force may lie anywhere in the cone and says nothing more: the normal is
   the prediction (the probe's plane fit or the last slide, turned by the curvature under the
   tip's advance), with its variance grown; the force lies inside the cone, so its ratio of
