@@ -14,7 +14,7 @@ from scipy.linalg import expm
 
 from kinestat.app.control_run import ControlRequest, SimulatedCell, prepare_control
 from kinestat.control.controller import THESIS_FORCE_DIRECTION
-from kinestat.control.follow.phases import accel_limit
+from kinestat.control.follow.law import accel_limit
 from kinestat.control.follow.tuning import derive_tuning
 from kinestat.control.model import ControlModel
 from kinestat.errors import ModelError

@@ -22,6 +22,7 @@ displaced by ``T = T_f + K⁻¹ δw`` (:func:`kinestat.parallel.kinestatic.compo
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -33,7 +34,10 @@ from kinestat.parallel.kinestatic import compose_twist
 from kinestat.spatial.se3 import twist_exp
 from kinestat.spatial.transforms import apply_one, inv
 
-__all__ = ["lean_axis", "lean_of", "turn_towards", "base_twist", "target_of"]
+if TYPE_CHECKING:
+    from kinestat.control.follow.config import FollowConfig
+
+__all__ = ["lean_axis", "lean_of", "turn_towards", "base_twist", "target_of", "accel_limit"]
 
 
 def lean_axis(n: np.ndarray, t: np.ndarray, lean: float) -> np.ndarray:
@@ -118,3 +122,21 @@ def target_of(model: ControlModel, meas: Measurement, T_base: np.ndarray) -> Tar
     TB_new = meas.base_pose @ twist_exp(T_base)
     T6 = TB_new @ inv(model.mount)
     return Target(apply_one(T6, model.tool_point_6), T6[:3, 2].copy(), T6[:3, 0].copy())
+
+
+def accel_limit(config: FollowConfig, meas: Measurement, T_base: np.ndarray) -> float | None:
+    """1/s²: the move's acceleration per unit of travel (:attr:`Command.accel_limit`) that
+    keeps the top and the tool within :attr:`FollowTuning.tool_accel`: that over the largest
+    displacement of the flange's origin and the tool point when the base moves by the twist
+    ``T_base`` (a small rigid motion moves the points between them, the top and the tool, by
+    no more); None for a massless top or no motion."""
+    a = config.tuning.tool_accel
+    if not math.isfinite(a):
+        return None
+    model = config.base.model
+    now = meas.base_pose @ inv(model.mount)
+    new = meas.base_pose @ twist_exp(T_base) @ inv(model.mount)
+    d = max(float(np.linalg.norm(apply_one(new, p) - apply_one(now, p)))
+            for p in (np.zeros(3), model.tool_point_6))
+    return a / d if d > 0.0 else None
+

@@ -29,6 +29,7 @@ from kinestat.control.envelope import check_measurement
 from kinestat.control.follow.config import FollowConfig, FollowState
 from kinestat.control.follow.estimator import ContactEstimate, observe_travel
 from kinestat.control.follow.law import (
+    accel_limit,
     base_twist,
     lean_axis,
     lean_of,
@@ -38,8 +39,6 @@ from kinestat.control.follow.law import (
 from kinestat.control.probe import probe_normal, probe_step, start_probe
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
-from kinestat.spatial.se3 import twist_exp
-from kinestat.spatial.transforms import apply_one, inv
 
 __all__ = ["decide_follow", "FOLLOW_STATES", "developed_step"]
 
@@ -342,23 +341,6 @@ def _move(config: FollowConfig, st: FollowState, meas: Measurement, label: str, 
     return _command(config, st, meas, target_of(base.model, meas, T), label, action, step,
                     math.degrees(float(np.linalg.norm(omega))), kw,
                     accel_limit=accel_limit(config, meas, T))
-
-
-def accel_limit(config: FollowConfig, meas: Measurement, T_base: np.ndarray) -> float | None:
-    """1/s²: the move's acceleration per unit of travel (:attr:`Command.accel_limit`) that
-    keeps the top and the tool within :attr:`FollowTuning.tool_accel`: that over the largest
-    displacement of the flange's origin and the tool point when the base moves by the twist
-    ``T_base`` (a small rigid motion moves the points between them, the top and the tool, by
-    no more); None for a massless top or no motion."""
-    a = config.tuning.tool_accel
-    if not math.isfinite(a):
-        return None
-    model = config.base.model
-    now = meas.base_pose @ inv(model.mount)
-    new = meas.base_pose @ twist_exp(T_base) @ inv(model.mount)
-    d = max(float(np.linalg.norm(apply_one(new, p) - apply_one(now, p)))
-            for p in (np.zeros(3), model.tool_point_6))
-    return a / d if d > 0.0 else None
 
 
 def _friction_dir(config: FollowConfig, st: FollowState, F: np.ndarray, n: np.ndarray,
