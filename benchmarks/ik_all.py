@@ -68,7 +68,10 @@ from kinestat.serial.analytic.locked import fold  # noqa: E402
 
 PI = math.pi
 ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1", "kr16", "kr5", "irb140", "stanford",
-        "random2", "random3", "middle2-1", "middle3-1")
+        "random2", "random3", "middle2-1", "middle3-1", "ur10", "ur3", "z1", "kinova-j2s6s200")
+#: real 6-joint arms from example-robot-data's URDFs (tests/urdf_arms.py), held out of the
+#: solvers' development
+URDF6 = ("ur10", "ur3", "z1", "kinova-j2s6s200")
 ARMS7 = ("panda-lock7", "panda-lock3", "iiwa-lock3", "xarm7-lock3")
 
 
@@ -243,7 +246,7 @@ def run(n: int, n_single: int, repeat: int = 5, arms=ARMS) -> dict:
         q = rng.uniform(-PI, PI, (n, 6))  # drawn for every arm: the same poses either way
         if name not in arms:
             continue
-        model = arm(name)
+        model = _urdf_arm(name) if name in URDF6 else arm(name)
         prismatic = model.prismatic
         if prismatic.any():  # within the limits, not an angle
             lo, hi = model.lower[prismatic], model.upper[prismatic]
@@ -295,6 +298,15 @@ def run(n: int, n_single: int, repeat: int = 5, arms=ARMS) -> dict:
 
 
 # -- 7-joint arms, one joint locked ---------------------------------------------------------
+def _urdf_arm(name: str):
+    """A real 6-joint arm of :data:`URDF6` from its URDF."""
+    from tests.urdf_arms import ARMS as URDF_ARMS
+    from tests.urdf_arms import arm_path
+
+    tip = "link06" if name == "z1" else URDF_ARMS[name][1]  # the arm, not its gripper
+    return kinestat.load(arm_path(name), tip=tip)
+
+
 def arm7(name: str):
     """``<arm>-lock<J>``: the 7-joint model and the locked joint's index (0-based)."""
     from pathlib import Path
