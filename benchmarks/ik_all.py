@@ -68,7 +68,8 @@ from kinestat.serial.analytic.locked import fold  # noqa: E402
 
 PI = math.pi
 ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1", "kr16", "kr5", "irb140", "stanford",
-        "random2", "random3", "middle2-1", "middle3-1", "ur10", "ur3", "z1", "kinova-j2s6s200")
+        "random2", "random3", "middle2-1", "middle3-1", "ur10", "ur3", "z1", "kinova-j2s6s200",
+        "kr120", "kr210")
 #: real 6-joint arms from example-robot-data's URDFs (tests/urdf_arms.py), held out of the
 #: solvers' development
 URDF6 = ("ur10", "ur3", "z1", "kinova-j2s6s200")
