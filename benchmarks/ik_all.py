@@ -7,8 +7,9 @@ Arms (the same random configurations, uniform in [-π, π]^6, fixed seed): UR5 (
 axes), PUMA 560 (spherical wrist, embedded), PUMA 762 (embedded, Crane–Duffy frames), a Kinova
 Jaco2-type 6R with a 60° wrist (non-Pieper), random general 6Rs (``random1``-``random3``: the
 Raghavan–Roth eigenvalue method), three spherical-wrist arms with an offset shoulder (KUKA KR16-2
-from rtb-data's URDF, KUKA KR5 and ABB IRB140 from the Robotics Toolbox's DH models) and the
-Stanford arm (RRP: the decoupled solver; its prismatic joint drawn within its limits, no peer
+from rtb-data's URDF, KUKA KR5 and ABB IRB140 from the Robotics Toolbox's DH models; KUKA
+KR120 R2500 pro and KR210 L150 from rtb-data's URDFs, held out of the solvers' development) and
+the Stanford arm (RRP: the decoupled solver; its prismatic joint drawn within its limits, no peer
 takes prismatic joints) and two random DH 6Rs whose axes 2-3-4 (``middle2-1``) or 3-4-5
 (``middle3-1``) meet (the middle-wrist closed form). For every solver and arm:
 single-call time per pose (one pose per call, median over ``--single`` poses), batched poses/s
