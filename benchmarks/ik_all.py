@@ -7,8 +7,9 @@ Arms (the same random configurations, uniform in [-π, π]^6, fixed seed): UR5 (
 axes), PUMA 560 (spherical wrist, embedded), PUMA 762 (embedded, Crane–Duffy frames), a Kinova
 Jaco2-type 6R with a 60° wrist (non-Pieper), random general 6Rs (``random1``-``random3``: the
 Raghavan–Roth eigenvalue method), three spherical-wrist arms with an offset shoulder (KUKA KR16-2
-from rtb-data's URDF, KUKA KR5 and ABB IRB140 from the Robotics Toolbox's DH models) and the
-Stanford arm (RRP: the decoupled solver; its prismatic joint drawn within its limits, no peer
+from rtb-data's URDF, KUKA KR5 and ABB IRB140 from the Robotics Toolbox's DH models; KUKA
+KR120 R2500 pro and KR210 L150 from rtb-data's URDFs, held out of the solvers' development) and
+the Stanford arm (RRP: the decoupled solver; its prismatic joint drawn within its limits, no peer
 takes prismatic joints) and two random DH 6Rs whose axes 2-3-4 (``middle2-1``) or 3-4-5
 (``middle3-1``) meet (the middle-wrist closed form). For every solver and arm:
 single-call time per pose (one pose per call, median over ``--single`` poses), batched poses/s
@@ -68,7 +69,8 @@ from kinestat.serial.analytic.locked import fold  # noqa: E402
 
 PI = math.pi
 ARMS = ("ur5", "puma560", "puma762", "jaco6", "random1", "kr16", "kr5", "irb140", "stanford",
-        "random2", "random3", "middle2-1", "middle3-1", "ur10", "ur3", "z1", "kinova-j2s6s200")
+        "random2", "random3", "middle2-1", "middle3-1", "ur10", "ur3", "z1", "kinova-j2s6s200",
+        "kr120", "kr210")
 #: real 6-joint arms from example-robot-data's URDFs (tests/urdf_arms.py), held out of the
 #: solvers' development
 URDF6 = ("ur10", "ur3", "z1", "kinova-j2s6s200")
