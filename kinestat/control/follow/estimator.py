@@ -229,8 +229,10 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
             n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
             est = replace(est, normal=n, normal_var=var)
         mu_m, var_mu = friction_on_normal(tun, F, est.normal, est.normal_var)
-        drag = _fuse(est, _drag(F, est.normal, tip - tips[-1]), var_mu)
-        mu, mvar = _fuse_mu(est, mu_m, var_mu)
+        # μ and the drag share their variance: each measured against the same force and normal
+        first = not est.samples
+        drag, _ = _fuse(est.drag, est.mu_var, _drag(F, est.normal, tip - tips[-1]), var_mu, first)
+        mu, mvar = _fuse(est.mu, est.mu_var, mu_m, var_mu, first)
         # every sample is measured against the same normal: its error is common to them
         floor = (1.0 + mu * mu) ** 2 * est.normal_var
         est = replace(est, mu=min(max(mu, 0.0), tun.max_friction), mu_var=max(mvar, floor),
@@ -256,13 +258,10 @@ def _drag(F: np.ndarray, n: np.ndarray, slip: np.ndarray) -> float:
     return float((F + fn * n) @ s) / (fn * float(np.linalg.norm(s)))
 
 
-def _fuse(est: ContactEstimate, drag_m: float, var_m: float) -> float:
-    """The drag fused as μ is (the same variances)."""
-    return _fuse_mu(replace(est, mu=est.drag), drag_m, var_m)[0]
-
-
-def _fuse_mu(est: ContactEstimate, mu_m: float, var_m: float) -> tuple[float, float]:
-    if not est.samples:
-        return mu_m, var_m
-    g = est.mu_var / (est.mu_var + var_m)
-    return est.mu + g * (mu_m - est.mu), (1.0 - g) * est.mu_var
+def _fuse(x: float, var: float, m: float, var_m: float, first: bool) -> tuple[float, float]:
+    """A scalar Kalman update of ``x`` (variance ``var``) by the measurement ``m`` (``var_m``);
+    the measurement itself when it is the ``first``."""
+    if first:
+        return m, var_m
+    g = var / (var + var_m)
+    return x + g * (m - x), (1.0 - g) * var
