@@ -150,6 +150,7 @@ class _JointInfo:
             self.M2 = np.outer(a[:, 1], b[0]) - np.outer(a[:, 0], b[1])
         self.fused: dict = {}  # invert -> (take, family joints) of the fused single call
         self.form = None  # the general 6R formulation a value of this joint took
+        self.general = None  # a joint in between where a general 6R remains: GeneralLock
         self.G1 = None  # a revolute joint in between of a 7-joint revolute arm: _fast_fold's
         if not self.end and jt.kind == "revolute" and model.n == 7 and \
                 all(x.kind == "revolute" for x in model.joints):
@@ -230,6 +231,18 @@ def _joint_info(model: ChainModel, j: int) -> _JointInfo:
     return _JointInfo(model, j)
 
 
+def _general_lock(model: ChainModel, j: int):
+    """The :class:`~kinestat.serial.analytic.locked_general.GeneralLock` of a revolute joint
+    ``j`` in between of a 7R arm (built on first use)."""
+    info = _joint_info(model, j)
+    gl = info.general
+    if gl is None:
+        from kinestat.serial.analytic.locked_general import GeneralLock  # lazy: SciPy
+
+        gl = info.general = GeneralLock(model, j, lambda v: fold(model, ((j, v),)))
+    return gl
+
+
 _S144 = (1, 4, 4)
 _I4 = np.eye(4)
 
@@ -274,7 +287,7 @@ class LockedPlan:
     new chain. A joint in between changes the folded chain's geometry: one chain per value.
     """
 
-    __slots__ = ("model", "pairs", "six", "free", "_free_array", "_one", "_take", "L", "R",
+    __slots__ = ("model", "pairs", "_six", "free", "_free_array", "_one", "_take", "L", "R",
                  "one")
 
     def __init__(self, model: ChainModel, pairs: tuple[tuple[int, float], ...]) -> None:
@@ -286,21 +299,39 @@ class LockedPlan:
             j, v = self._one
             info = _joint_info(model, j)
             self.free, self._free_array, self._take = info.free, info.free_array, info.take
+            self._six = None
             if info.end:
-                self.six = info.six0
+                self._six = info.six0
                 self.L, self.R = _end_map(model, j, v)
-            else:
-                six = _fast_fold(info, j, v) if info.G1 is not None else None
-                self.six = fold(model, pairs) if six is None else six
-                if six is None and info.form is not None:  # the last value's elimination
-                    _general6r().HINTS[self.six] = info.form
+                return
+            gl = _general_lock(model, j) if info.G1 is not None and info.pieper is None \
+                else None
+            args = None if gl is None else gl.arrays(v)
+            if args is not None:  # a general 6R: the kernel's arrays at v, the chain on demand
+                self.one = gl.bind(args, v, None if gl.run is not None else
+                                   (_entries()[1], info.take, j))
+                return
+            six = _fast_fold(info, j, v) if info.G1 is not None else None
+            self._six = six
             return
-        self.six = fold(model, pairs)
+        self._six = fold(model, pairs)
         locked_idx = {j for j, _ in pairs}
         self.free = tuple(i for i in range(model.n) if i not in locked_idx)
         self._free_array = np.array(self.free)
         self._take = np.array([self.free.index(i) if i in self.free else 0
                                for i in range(model.n)])
+
+    @property
+    def six(self) -> ChainModel:
+        """The folded 6-joint chain (folded on first use where the plan's single call has the
+        kernel's arrays without it)."""
+        six = self._six
+        if six is None:
+            six = self._six = fold(self.model, self.pairs)
+            form = _joint_info(self.model, self._one[0]).form
+            if form is not None:  # the last value's elimination (a hint, checked)
+                _general6r().HINTS[six] = form
+        return six
 
     def poses(self, T):
         """The poses ``T (..., 4, 4)`` the folded chain ``six`` must reach (checked first when
@@ -350,9 +381,12 @@ class LockedPlan:
         Like it, ``one`` returns None where the caller must take the full path."""
         parts = None
         if kind == "general" and self._one is not None and rev_data is None:
-            info = _joint_info(self.model, self._one[0])
+            j, v = self._one
+            info = _joint_info(self.model, j)
             if not info.end:  # kept for the joint's next value (a hint, checked there)
                 info.form = _general6r().formulation(self.six)[0]
+                if info.G1 is not None and info.pieper is None:  # and for the fast path
+                    _general_lock(self.model, j).adopt(self.six, v)
             if data.get("one") is not None and self.L is None and self.R is None:
                 self.one = self._fused_general()
                 if self.one is not None:
