@@ -50,7 +50,7 @@ from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.fk import fk
 
 __all__ = ["solve_general_6r", "Formulation", "FORMULATIONS", "formulation", "MAX_SOLUTIONS",
-           "OFFSETS", "HINTS", "model_arrays", "search", "single_call"]
+           "OFFSETS", "HINTS", "PRESET", "model_arrays", "search", "single_call"]
 
 MAX_SOLUTIONS = 16
 """A general 6R has at most 16 inverse-kinematics solutions (Lee & Liang 1988; RR 1993)."""
@@ -273,6 +273,12 @@ def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24) -> floa
 HINTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _HINT_CHECKS = 12
 
+#: models whose formulation and kernel arrays are known, taken without a search or a check
+#: (a locked arm's chain folded at a value that is not special,
+#: :mod:`kinestat.serial.analytic.locked_general`): model -> (Formulation, the tuple of
+#: :func:`model_arrays`)
+PRESET: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
 
 @lru_cache(maxsize=32)
 def formulation(model: ChainModel) -> tuple[Formulation, float]:
@@ -280,6 +286,9 @@ def formulation(model: ChainModel) -> tuple[Formulation, float]:
     configurations of ``model``, or the best one with its completeness fraction (a
     :data:`HINTS` formulation first, checked on fewer)."""
     check_general(model)
+    preset = PRESET.get(model)
+    if preset is not None:
+        return preset[0], 1.0
     hint = HINTS.get(model)
     if hint is not None and _raw_completeness(model, hint, _HINT_CHECKS) == 1.0:
         return hint, 1.0
@@ -350,7 +359,8 @@ def _compiled_data(model: ChainModel, form: Formulation):
     model_basis`: pose-independent)."""
     from kinestat.serial.analytic._rr_deflate import model_basis  # lazy: Numba start-up
 
-    arrays = model_arrays(model, form)
+    preset = PRESET.get(model)
+    arrays = preset[1] if preset is not None and preset[0] == form else model_arrays(model, form)
     return arrays + model_basis(arrays[3])
 
 

@@ -288,12 +288,13 @@ class LockedPlan:
     """
 
     __slots__ = ("model", "pairs", "_six", "free", "_free_array", "_one", "_take", "L", "R",
-                 "one")
+                 "one", "_args")
 
     def __init__(self, model: ChainModel, pairs: tuple[tuple[int, float], ...]) -> None:
         self.model, self.pairs = model, pairs
         self.L = self.R = None
         self.one = None  # the bound single call (:meth:`bind_one`)
+        self._args = None  # a general 6R's kernel arrays at the value (no chain folded yet)
         self._one = pairs[0] if len(pairs) == 1 else None
         if self._one is not None:
             j, v = self._one
@@ -308,6 +309,7 @@ class LockedPlan:
                 else None
             args = None if gl is None else gl.arrays(v)
             if args is not None:  # a general 6R: the kernel's arrays at v, the chain on demand
+                self._args = args
                 self.one = gl.bind(args, v, None if gl.run is not None else
                                    (_entries()[1], info.take, j))
                 return
@@ -328,9 +330,11 @@ class LockedPlan:
         six = self._six
         if six is None:
             six = self._six = fold(self.model, self.pairs)
-            form = _joint_info(self.model, self._one[0]).form
-            if form is not None:  # the last value's elimination (a hint, checked)
-                _general6r().HINTS[six] = form
+            info = _joint_info(self.model, self._one[0])
+            if self._args is not None:  # class, formulation and arrays as the single call's
+                info.general.preset(six, self._args)
+            elif info.form is not None:  # the last value's elimination (a hint, checked)
+                _general6r().HINTS[six] = info.form
         return six
 
     def poses(self, T):
@@ -476,15 +480,20 @@ def plan(model: ChainModel, locked) -> LockedPlan:
     """The :class:`LockedPlan` of ``model`` with the ``locked`` ``{joint: value}`` (checked by
     :func:`check_locked` on first use; cached per model and values, the oldest dropped
     beyond ``_PLANS_MAX``)."""
+    pairs = None
     if len(locked) == 1:  # a dict of one int joint and a float value: look up directly
         (j, v), = locked.items()
         if type(j) is int and type(v) is float:
-            hit = _PLANS.get((model, j, v))
+            key = (model, j, v)
+            hit = _PLANS.get(key)
             if hit is not None:
                 return hit
-    pairs = check_locked(model, locked)
-    key = (model, *pairs[0]) if len(pairs) == 1 else (model, pairs)
-    hit = _PLANS.get(key)
+            if 0 <= j < model.n == 7 and math.isfinite(v):  # what check_locked checks
+                pairs = ((j, v),)
+    if pairs is None:
+        pairs = check_locked(model, locked)
+        key = (model, *pairs[0]) if len(pairs) == 1 else (model, pairs)
+        hit = _PLANS.get(key)
     if hit is None:
         hit = LockedPlan(model, pairs)
         if len(_PLANS) >= _PLANS_MAX:

@@ -36,7 +36,7 @@ import numpy as np
 
 from kinestat.serial.analytic import general6r
 from kinestat.serial.analytic._common import _ENTRY, call_compiled
-from kinestat.serial.analytic.geometry import HomeAxes, home_axes, meet, parallel
+from kinestat.serial.analytic.geometry import PRESET, HomeAxes, home_axes, meet, parallel
 
 __all__ = ["GeneralLock"]
 
@@ -85,7 +85,7 @@ class GeneralLock:
         self.mode = np.where(coincide, 3, np.where(par, 2, np.where(meets, 1, 0))).astype(np.int64)
         self.tol_len = _TOL_SPECIAL * self.scale
         self.form = None  # the formulation (:meth:`adopt`), False where there is none
-        self.P = self.tail = self.shapes = self.run = None
+        self.P = self.tail = self.shapes = self.run = self._entry = None
         self._none = np.zeros((3, 0))
         self._basis = _no_basis()
         # the terms describe the axes (checked at a fourth value), and no three consecutive
@@ -106,15 +106,17 @@ class GeneralLock:
     def _eval(self, P: np.ndarray, v: float):
         """:func:`~kinestat.serial.analytic._locked_kernels.value_in` at one value: the
         arrays' flat values ``(1, m)`` and whether v is special."""
-        K = _kernels()
-        out, special = np.empty((1, P.shape[1])), np.empty(1, dtype=bool)
-        args = (P, self.R, self.mode, _TOL_SPECIAL, self.tol_len, np.array([v]), out, special)
-        entry = _ENTRY.get((K.value_in, None))
+        out, special, values = np.empty((1, P.shape[1])), np.empty(1, dtype=bool), np.empty(1)
+        values[0] = v
+        entry = self._entry
         if entry is None:
-            call_compiled(K.value_in, *args)
+            K = _kernels()
+            call_compiled(K.value_in, P, self.R, self.mode, _TOL_SPECIAL, self.tol_len, values,
+                          out, special)
+            self._entry = _ENTRY.get((K.value_in, None))
         else:
-            entry(*args)
-        return out, bool(special[0])
+            entry(P, self.R, self.mode, _TOL_SPECIAL, self.tol_len, values, out, special)
+        return out, special[0]
 
     def special(self, v: float) -> bool:
         """Some axis pair across the joint is parallel, meets or coincides at ``v`` where it
@@ -140,7 +142,8 @@ class GeneralLock:
         if np.abs(got[0] - want).max() > 1e-9 * max(1.0, float(np.abs(want).max())):
             self.form = False
             return
-        self.shapes = [own[i].shape for i in _AFFINE]
+        ends = np.cumsum([0] + [own[i].size for i in _AFFINE]).tolist()
+        self.shapes = [(ends[k], ends[k + 1], own[i].shape) for k, i in enumerate(_AFFINE)]
         self.tail = own[4], own[6], own[7], own[8]  # H3[0], offsets, order, sign
         self.P, self.form = P, form
 
@@ -154,20 +157,23 @@ class GeneralLock:
         if special:
             return None
         f = out[0]
-        parts, at = [], 0
-        for shape in self.shapes:
-            size = math.prod(shape)
-            parts.append(f[at:at + size].reshape(shape))
-            at += size
-        C, consts, links, LH, L = parts
+        C, consts, links, LH, L = [f[a:b].reshape(shape) for a, b, shape in self.shapes]
         C.flags.writeable = False  # as a chain's constants (the kernel's argument types)
         h0, off, order, sign = self.tail
         return (C, consts, links, LH, h0, L, off, order, sign) + self._basis
 
+    def preset(self, six, args: tuple) -> None:
+        """``six``, the chain folded at a value with the arrays ``args`` (:meth:`arrays`),
+        takes its geometry class, formulation and arrays from them (the full path's: a batch
+        of poses, a pose the single call leaves)."""
+        PRESET[six] = ("general", {"axes": home_axes(six)})
+        general6r.PRESET[six] = (self.form, args[:9])
+
     def bind(self, args: tuple, v: float, put):
         """The single call ``one(T (1, 4, 4) plain, tol)`` on ``args`` (:meth:`arrays`) with
         the joints put back by ``put = (entry, take, j)``, or None while the compiled entry
-        points are not recorded."""
+        points are not recorded. A value called again gets the spurious subspace's basis
+        (one SVD, about a call's time) in place of the kernel's search per pose (~3 µs)."""
         run = self.run
         if run is None:
             cf = sys.modules.get("kinestat.serial.analytic._cf_kernels")
@@ -175,8 +181,15 @@ class GeneralLock:
             run = self.run = general6r.single_call(check, self.form, put)
             if run is None:
                 return None
+        calls = 0
 
         def one(T, tol):
+            nonlocal args, calls
+            if calls == 1:
+                from kinestat.serial.analytic._rr_deflate import model_basis  # loaded by now
+
+                args = args[:9] + model_basis(args[3])
+            calls += 1
             return run(T, tol, args, v)
         return one
 
