@@ -186,7 +186,7 @@ class GeneralLock:
         def one(T, tol):
             nonlocal args, calls
             if calls == 1:
-                from kinestat.serial.analytic._rr_deflate import model_basis  # loaded by now
+                from kinestat.serial.analytic._rr_deflate import model_basis  # lazy: Numba start-up
 
                 args = args[:9] + model_basis(args[3])
             calls += 1
