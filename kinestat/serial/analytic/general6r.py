@@ -273,10 +273,9 @@ def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24) -> floa
 HINTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _HINT_CHECKS = 12
 
-#: models whose formulation and kernel arrays are known, taken without a search or a check
-#: (a locked arm's chain folded at a value that is not special,
-#: :mod:`kinestat.serial.analytic.locked_general`): model -> (Formulation, the tuple of
-#: :func:`model_arrays`)
+#: models whose kernel arrays are known for a formulation (a locked arm's chain folded at a
+#: value, :mod:`kinestat.serial.analytic.locked_general`): model -> (Formulation, the tuple of
+#: :func:`model_arrays`, trusted); a trusted formulation is taken without a search or a check
 PRESET: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
@@ -287,7 +286,7 @@ def formulation(model: ChainModel) -> tuple[Formulation, float]:
     :data:`HINTS` formulation first, checked on fewer)."""
     check_general(model)
     preset = PRESET.get(model)
-    if preset is not None:
+    if preset is not None and preset[2]:
         return preset[0], 1.0
     hint = HINTS.get(model)
     if hint is not None and _raw_completeness(model, hint, _HINT_CHECKS) == 1.0:

@@ -151,6 +151,7 @@ class _JointInfo:
         self.fused: dict = {}  # invert -> (take, family joints) of the fused single call
         self.form = None  # the general 6R formulation a value of this joint took
         self.general = None  # a joint in between where a general 6R remains: GeneralLock
+        self.pending = None  # (chain, value, formulation) the first general 6R value left
         self.G1 = None  # a revolute joint in between of a 7-joint revolute arm: _fast_fold's
         if not self.end and jt.kind == "revolute" and model.n == 7 and \
                 all(x.kind == "revolute" for x in model.joints):
@@ -305,8 +306,11 @@ class LockedPlan:
                 self._six = info.six0
                 self.L, self.R = _end_map(model, j, v)
                 return
-            gl = _general_lock(model, j) if info.G1 is not None and info.pieper is None \
-                else None
+            gl = info.general
+            if info.pending is not None:  # the joint's second value: the first one's 6R kept
+                pending, info.pending = info.pending, None
+                gl = _general_lock(model, j)
+                gl.adopt(*pending)
             args = None if gl is None else gl.arrays(v)
             if args is not None:  # a general 6R: the kernel's arrays at v, the chain on demand
                 self._args = args
@@ -330,9 +334,11 @@ class LockedPlan:
         six = self._six
         if six is None:
             six = self._six = fold(self.model, self.pairs)
-            info = _joint_info(self.model, self._one[0])
-            if self._args is not None:  # class, formulation and arrays as the single call's
-                info.general.preset(six, self._args)
+            j, v = self._one
+            info = _joint_info(self.model, j)
+            gl = info.general
+            if gl is not None and gl.P is not None:  # the arrays from the joint's terms
+                gl.preset(six, v, self._args)
             elif info.form is not None:  # the last value's elimination (a hint, checked)
                 _general6r().HINTS[six] = info.form
         return six
@@ -388,9 +394,13 @@ class LockedPlan:
             j, v = self._one
             info = _joint_info(self.model, j)
             if not info.end:  # kept for the joint's next value (a hint, checked there)
-                info.form = _general6r().formulation(self.six)[0]
-                if info.G1 is not None and info.pieper is None:  # and for the fast path
-                    _general_lock(self.model, j).adopt(self.six, v)
+                g6 = _general6r()
+                searched = self.six not in g6.HINTS
+                info.form = g6.formulation(self.six)[0]
+                if info.G1 is not None and info.pieper is None and \
+                        (info.general is None or info.general.form is None):
+                    # and, from the next value on, for every value that is not special
+                    info.pending = (self.six, v, g6.formulation(self.six) if searched else None)
             if data.get("one") is not None and self.L is None and self.R is None:
                 self.one = self._fused_general()
                 if self.one is not None:

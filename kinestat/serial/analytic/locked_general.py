@@ -123,13 +123,14 @@ class GeneralLock:
         does not at every value (or the joint has no fast path)."""
         return not self.usable or self._eval(self._none, v)[1]
 
-    def adopt(self, six, v: float) -> None:
+    def adopt(self, six, v: float, found=None) -> None:
         """The chain ``six`` folded at ``v`` (not special) is solved as a general 6R: its
-        formulation (searched as for a new chain) serves every value that is not special;
-        the arrays' terms from the folds at 0, π/2, π, checked against ``six``'s own."""
+        formulation (searched as for a new chain, or ``found`` by that search: ``(form,
+        completeness)``) serves every value that is not special; the arrays' terms from the
+        folds at 0, π/2, π, checked against ``six``'s own."""
         if self.form is not None or self.special(v):
             return
-        form, frac = general6r.search(six)
+        form, frac = general6r.search(six) if found is None else found
         if frac < 1.0 or form.shift not in (0, 5):
             self.form = False
             return
@@ -147,14 +148,14 @@ class GeneralLock:
         self.tail = own[4], own[6], own[7], own[8]  # H3[0], offsets, order, sign
         self.P, self.form = P, form
 
-    def arrays(self, v: float) -> tuple | None:
+    def arrays(self, v: float, special: bool = False) -> tuple | None:
         """The kernel's pose-independent arguments at ``v`` (as
         :func:`~kinestat.serial.analytic.general6r._compiled_data`'s, the basis found per
-        pose), or None: no formulation yet, or a special value."""
+        pose), or None: no formulation yet, or a special value (unless ``special``)."""
         if self.P is None:
             return None
-        out, special = self._eval(self.P, v)
-        if special:
+        out, at_special = self._eval(self.P, v)
+        if at_special and not special:
             return None
         f = out[0]
         C, consts, links, LH, L = [f[a:b].reshape(shape) for a, b, shape in self.shapes]
@@ -162,12 +163,18 @@ class GeneralLock:
         h0, off, order, sign = self.tail
         return (C, consts, links, LH, h0, L, off, order, sign) + self._basis
 
-    def preset(self, six, args: tuple) -> None:
-        """``six``, the chain folded at a value with the arrays ``args`` (:meth:`arrays`),
-        takes its geometry class, formulation and arrays from them (the full path's: a batch
-        of poses, a pose the single call leaves)."""
+    def preset(self, six, v: float, args: tuple | None) -> None:
+        """``six``, the chain folded at ``v`` for the full path (a batch of poses, a pose the
+        single call leaves), takes its geometry class, formulation and arrays from the
+        arrays ``args`` (:meth:`arrays`), or where ``v`` is special (``args`` None) the arrays
+        for a formulation it then checks (a hint, :data:`~kinestat.serial.analytic.general6r.
+        HINTS`) after its class is found."""
+        if args is None:
+            general6r.HINTS[six] = self.form
+            general6r.PRESET[six] = (self.form, self.arrays(v, special=True)[:9], False)
+            return
         PRESET[six] = ("general", {"axes": home_axes(six)})
-        general6r.PRESET[six] = (self.form, args[:9])
+        general6r.PRESET[six] = (self.form, args[:9], True)
 
     def bind(self, args: tuple, v: float, put):
         """The single call ``one(T (1, 4, 4) plain, tol)`` on ``args`` (:meth:`arrays`) with

@@ -26,10 +26,12 @@ def _arm(name):
 
 
 def _adopted(model):
-    """The joint's GeneralLock once a first value has been solved (the full path)."""
+    """The joint's GeneralLock, which a second value takes from the first (solved by the
+    full path)."""
     q = np.random.default_rng(1).uniform(-1.0, 1.0, model.n)
-    q[J] = 0.77
-    ik_all(model, kinestat.fk(model, q), locked={J: 0.77})
+    for v in (0.77, 0.78):
+        q[J] = v
+        ik_all(model, kinestat.fk(model, q), locked={J: v})
     gl = _joint_info(model, J).general
     assert gl is not None and gl.form
     return gl
