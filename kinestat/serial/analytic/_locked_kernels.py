@@ -60,11 +60,11 @@ def joints_out(q6, take, j, v, out):
 def value_in(P, R, mode, tol_dir, tol_len, values, out, special):
     """A locked joint's values ``(S,)``: ``out[k] = P[0] + cos v · P[1] + sin v · P[2]``
     (``P (3, m)``: the terms of arrays that are ``a + b cos v + c sin v``), and ``special[k]``
-    where an axis pair across the joint is parallel, meets or coincides within ``tol_dir``
-    (directions) and ``tol_len`` (lengths) where it does not at a generic value. ``R (p, 7,
-    3)``: per pair ``(a, b)`` the terms of ``n = wa × wb``, of ``(rb − ra) · n`` and of
-    ``(rb − ra) × wa``; ``mode (p,)``: what the pair is at every value (0 neither parallel
-    nor meeting, 1 meeting, 2 parallel, 3 coincident: nothing to test)."""
+    where an axis pair across the joint is parallel, meets or coincides within ``tol_dir[p]``
+    (directions, per pair) and ``tol_len`` (lengths) where it does not at a generic value.
+    ``R (p, 7, 3)``: per pair ``(a, b)`` the terms of ``n = wa × wb``, of ``(rb − ra) · n``
+    and of ``(rb − ra) × wa``; ``mode (p,)``: what the pair is at every value (0 neither
+    parallel nor meeting, 1 meeting, 2 parallel, 3 coincident: nothing to test)."""
     x = np.empty(7)
     for k in range(values.shape[0]):
         c, s = np.cos(values[k]), np.sin(values[k])
@@ -79,7 +79,7 @@ def value_in(P, R, mode, tol_dir, tol_len, values, out, special):
             nn = x[0] * x[0] + x[1] * x[1] + x[2] * x[2]
             if mode[p] == 2:  # parallel: coincident here?
                 hit = x[4] * x[4] + x[5] * x[5] + x[6] * x[6] <= tol_len * tol_len
-            elif nn <= tol_dir * tol_dir:  # parallel here
+            elif nn <= tol_dir[p] * tol_dir[p]:  # parallel here
                 hit = True
             elif mode[p] == 0:  # meeting here?
                 hit = abs(x[3]) <= tol_len * np.sqrt(nn)

@@ -41,8 +41,11 @@ from kinestat.serial.analytic.geometry import PRESET, HomeAxes, home_axes, meet,
 __all__ = ["GeneralLock"]
 
 _ANGLES = (0.0, 0.5 * math.pi, math.pi)
-_TOL = 1e-9  # classify's tolerance: a relation at every value
-_TOL_SPECIAL = 1e-6  # a relation within this at one value: special
+_TOL = 1e-9  # classify's tolerance
+_TOL_SPECIAL = 1e-8  # a relation within this at a value (10 times classify's): special
+_EXACT = 1e-12  # terms this small (rounding): a relation at every value
+_CHECK_VALUES = (-2.3, -0.9, 0.6, 2.2)  # where an adopted formulation is checked too (any)
+_CHECKS = 64  # random configurations it must find at each of them and at the value found at
 _AFFINE = (0, 1, 2, 3, 5)  # the kernel arrays affine in (1, cos v, sin v): C, consts, links, LH, L
 
 
@@ -73,16 +76,25 @@ class GeneralLock:
 
     def __init__(self, model, j: int, fold) -> None:
         self.j, self._fold = j, fold
-        axes = [home_axes(fold(v)) for v in _ANGLES]
-        self.scale = max(ax.scale for ax in axes)
+        folds = [fold(v) for v in _ANGLES]
+        axes = [home_axes(c) for c in folds]
+        # classify's length scale at any value lies within these (|a| ± |(b, c)| of each
+        # translation; only the folded one's depends on v)
+        t = _terms(*[np.asarray(c.constants)[:, :3, 3] for c in folds])
+        self.scale = max(1.0, float((np.abs(t[0]) + np.hypot(t[1], t[2])).max()))
+        low = max(1.0, float((np.abs(t[0]) - np.hypot(t[1], t[2])).max()))
         pairs = [(a, b) for a in range(j) for b in range(j, 6)]
         R = _terms(*[np.array([_pair(ax, a, b) for a, b in pairs]) for ax in axes])
         self.R = np.ascontiguousarray(np.moveaxis(R, 0, -1))  # (pairs, 7, 3)
         size = np.abs(self.R).sum(axis=-1)  # bounds of |x(v)| over v
-        par = size[:, :3].sum(axis=1) <= _TOL
-        coincide = par & (size[:, 4:].sum(axis=1) <= _TOL * self.scale)
-        meets = ~par & (size[:, 3] <= _TOL * self.scale)
+        par = size[:, :3].sum(axis=1) <= _EXACT
+        coincide = par & (size[:, 4:].sum(axis=1) <= _EXACT * self.scale)
+        meets = ~par & (size[:, 3] <= _EXACT * self.scale)
         self.mode = np.where(coincide, 3, np.where(par, 2, np.where(meets, 1, 0))).astype(np.int64)
+        # a pair meeting at every value: classify's meeting test holds while |n| is above
+        # this, and the value is special below it
+        self.tol_dir = np.where(meets, np.maximum(_TOL_SPECIAL, size[:, 3] / (_TOL * low)),
+                                _TOL_SPECIAL)
         self.tol_len = _TOL_SPECIAL * self.scale
         self.form = None  # the formulation (:meth:`adopt`), False where there is none
         self.P = self.tail = self.shapes = self.run = self._entry = None
@@ -111,11 +123,11 @@ class GeneralLock:
         entry = self._entry
         if entry is None:
             K = _kernels()
-            call_compiled(K.value_in, P, self.R, self.mode, _TOL_SPECIAL, self.tol_len, values,
+            call_compiled(K.value_in, P, self.R, self.mode, self.tol_dir, self.tol_len, values,
                           out, special)
             self._entry = _ENTRY.get((K.value_in, None))
         else:
-            entry(P, self.R, self.mode, _TOL_SPECIAL, self.tol_len, values, out, special)
+            entry(P, self.R, self.mode, self.tol_dir, self.tol_len, values, out, special)
         return out, special[0]
 
     def special(self, v: float) -> bool:
@@ -126,12 +138,22 @@ class GeneralLock:
     def adopt(self, six, v: float, found=None) -> None:
         """The chain ``six`` folded at ``v`` (not special) is solved as a general 6R: its
         formulation (searched as for a new chain, or ``found`` by that search: ``(form,
-        completeness)``) serves every value that is not special; the arrays' terms from the
-        folds at 0, π/2, π, checked against ``six``'s own."""
+        completeness)``) serves every value that is not special once it finds every one of
+        :data:`_CHECKS` random configurations at v and at :data:`_CHECK_VALUES` (a
+        formulation that misses a few per cent of the poses passes the search's 24 at some
+        values); else the first that does. The arrays' terms from the folds at 0, π/2, π,
+        checked against ``six``'s own."""
         if self.form is not None or self.special(v):
             return
         form, frac = general6r.search(six) if found is None else found
-        if frac < 1.0 or form.shift not in (0, 5):
+        chains = [six] + [self._fold(w) for w in _CHECK_VALUES if not self.special(w)]
+
+        def complete(f) -> bool:
+            return all(general6r._raw_completeness(c, f, _CHECKS) == 1.0 for c in chains)
+        if frac < 1.0 or not complete(form):
+            form = next((f for f in general6r.FORMULATIONS if f.shift in (0, 5) and
+                         complete(f)), None)
+        if form is None or form.shift not in (0, 5):
             self.form = False
             return
         folds = [general6r.model_arrays(self._fold(a), form) for a in _ANGLES]

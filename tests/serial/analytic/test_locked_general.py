@@ -118,7 +118,7 @@ def test_special_values_are_where_axes_meet_or_line_up(name):
     seen = 0
     for k, v in enumerate(values):
         v = float(v)
-        near = _relations(home_axes(_fresh(model, v)), J, 1e-6)
+        near = _relations(home_axes(_fresh(model, v)), J, 1e-8)  # 10 times classify's
         assert gl.special(v) == (near != generic)
         seen += gl.special(v)
         q = np.random.default_rng(60 + k).uniform(-2.0, 2.0, 7)
@@ -129,7 +129,7 @@ def test_special_values_are_where_axes_meet_or_line_up(name):
         fresh = _fresh_solutions(model, v, T)
         assert len(sols) == len(fresh)
         assert all(np.min(wrapped_distance(fresh, s)) < 1e-7 for s in sols)
-    assert seen >= 3  # ±π/2 and π are special on both arms
+    assert seen >= (5 if name == "panda" else 1)  # the Panda: 0, ±π/2, π, 1e-9; xArm7: π
 
 
 @pytest.mark.parametrize("name", ["panda", "xarm7"])
@@ -156,3 +156,31 @@ def test_self_motion_samples_solve_as_the_fresh_folds():
         sols = res.solutions()
         assert len(sols) == len(fresh) and np.all(sols[:, J] == v)
         assert all(np.min(wrapped_distance(fresh, s)) < 1e-7 for s in sols)
+
+
+def test_a_formulation_missing_a_few_poses_is_not_kept():
+    """The xArm7 with joint 6 locked: the reversed formulation misses a few per cent of the
+    poses at every value, yet passes the search's 24 configurations at some; the kept one
+    finds every one of 64 at random values, and each value's solutions include the freshly
+    folded chain's (the fresh search may keep the weaker one) and reproduce the pose."""
+    model = _arm("xarm7")
+    j = 5
+    rng = np.random.default_rng(55)
+    q = rng.uniform(-np.pi, np.pi, (25, 7))
+    q[:, j] = rng.uniform(-np.pi, np.pi, 25)
+    T = kinestat.fk(model, q)
+    for i in range(2):
+        ik_all(model, T[i], locked={j: float(q[i, j])})
+    gl = _joint_info(model, j).general
+    assert gl is not None and gl.form
+    for i in range(2, len(q)):
+        v = float(q[i, j])
+        sols = ik_all(model, T[i], locked={j: v}).solutions()
+        fresh = np.insert(ik_all(fold.__wrapped__(model, ((j, v),)), T[i]).solutions(), j, v,
+                          axis=1)
+        assert all(np.min(wrapped_distance(sols, s)) < 1e-7 for s in fresh)
+        assert np.abs(kinestat.fk(model, sols) - T[i]).max() < 1e-9
+        assert np.min(wrapped_distance(sols, q[i])) < 1e-6
+    for v in rng.uniform(-np.pi, np.pi, 4):
+        assert general6r._raw_completeness(fold.__wrapped__(model, ((j, float(v)),)), gl.form,
+                                           64) == 1.0
