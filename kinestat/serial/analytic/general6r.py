@@ -254,9 +254,11 @@ def candidates(model: ChainModel, T: np.ndarray, form: Formulation):
     return q, ok, deficient
 
 
-def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24) -> float:
-    """Fraction of random configurations found among a formulation's polished candidates."""
-    rng = np.random.default_rng(20261201)
+def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24,
+                      seed: int = 20261201) -> float:
+    """Fraction of random configurations (``n``, drawn with ``seed``) found among a
+    formulation's polished candidates."""
+    rng = np.random.default_rng(seed)
     lo = np.where(np.isfinite(model.lower), model.lower, -math.pi)
     hi = np.where(np.isfinite(model.upper), model.upper, math.pi)
     q0 = rng.uniform(lo, hi, (n, 6))
