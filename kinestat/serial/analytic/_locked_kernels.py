@@ -54,3 +54,35 @@ def joints_out(q6, take, j, v, out):
         for i in range(take.shape[0]):
             out[k, i] = q6[k, take[i]]
         out[k, j] = q6[k, 0] * 0.0 + v
+
+
+@nb.njit(**_OPTS)
+def value_in(P, R, mode, tol_dir, tol_len, values, out, special):
+    """A locked joint's values ``(S,)``: ``out[k] = P[0] + cos v · P[1] + sin v · P[2]``
+    (``P (3, m)``: the terms of arrays that are ``a + b cos v + c sin v``), and ``special[k]``
+    where an axis pair across the joint is parallel, meets or coincides within ``tol_dir[p]``
+    (directions, per pair) and ``tol_len`` (lengths) where it does not at a generic value.
+    ``R (p, 7, 3)``: per pair ``(a, b)`` the terms of ``n = wa × wb``, of ``(rb − ra) · n``
+    and of ``(rb − ra) × wa``; ``mode (p,)``: what the pair is at every value (0 neither
+    parallel nor meeting, 1 meeting, 2 parallel, 3 coincident: nothing to test)."""
+    x = np.empty(7)
+    for k in range(values.shape[0]):
+        c, s = np.cos(values[k]), np.sin(values[k])
+        for i in range(P.shape[1]):
+            out[k, i] = P[0, i] + c * P[1, i] + s * P[2, i]
+        hit = False
+        for p in range(R.shape[0]):
+            if mode[p] == 3:
+                continue
+            for i in range(7):
+                x[i] = R[p, i, 0] + c * R[p, i, 1] + s * R[p, i, 2]
+            nn = x[0] * x[0] + x[1] * x[1] + x[2] * x[2]
+            if mode[p] == 2:  # parallel: coincident here?
+                hit = x[4] * x[4] + x[5] * x[5] + x[6] * x[6] <= tol_len * tol_len
+            elif nn <= tol_dir[p] * tol_dir[p]:  # parallel here
+                hit = True
+            elif mode[p] == 0:  # meeting here?
+                hit = abs(x[3]) <= tol_len * np.sqrt(nn)
+            if hit:
+                break
+        special[k] = hit

@@ -50,7 +50,7 @@ from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.fk import fk
 
 __all__ = ["solve_general_6r", "Formulation", "FORMULATIONS", "formulation", "MAX_SOLUTIONS",
-           "OFFSETS", "HINTS"]
+           "OFFSETS", "HINTS", "PRESET", "model_arrays", "search", "single_call"]
 
 MAX_SOLUTIONS = 16
 """A general 6R has at most 16 inverse-kinematics solutions (Lee & Liang 1988; RR 1993)."""
@@ -254,9 +254,11 @@ def candidates(model: ChainModel, T: np.ndarray, form: Formulation):
     return q, ok, deficient
 
 
-def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24) -> float:
-    """Fraction of random configurations found among a formulation's polished candidates."""
-    rng = np.random.default_rng(20261201)
+def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24,
+                      seed: int = 20261201) -> float:
+    """Fraction of random configurations (``n``, drawn with ``seed``) found among a
+    formulation's polished candidates."""
+    rng = np.random.default_rng(seed)
     lo = np.where(np.isfinite(model.lower), model.lower, -math.pi)
     hi = np.where(np.isfinite(model.upper), model.upper, math.pi)
     q0 = rng.uniform(lo, hi, (n, 6))
@@ -273,6 +275,11 @@ def _raw_completeness(model: ChainModel, form: Formulation, n: int = 24) -> floa
 HINTS: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 _HINT_CHECKS = 12
 
+#: models whose kernel arrays are known for a formulation (a locked arm's chain folded at a
+#: value, :mod:`kinestat.serial.analytic.locked_general`): model -> (Formulation, the tuple of
+#: :func:`model_arrays`, trusted); a trusted formulation is taken without a search or a check
+PRESET: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
 
 @lru_cache(maxsize=32)
 def formulation(model: ChainModel) -> tuple[Formulation, float]:
@@ -280,9 +287,17 @@ def formulation(model: ChainModel) -> tuple[Formulation, float]:
     configurations of ``model``, or the best one with its completeness fraction (a
     :data:`HINTS` formulation first, checked on fewer)."""
     check_general(model)
+    preset = PRESET.get(model)
+    if preset is not None and preset[2]:
+        return preset[0], 1.0
     hint = HINTS.get(model)
     if hint is not None and _raw_completeness(model, hint, _HINT_CHECKS) == 1.0:
         return hint, 1.0
+    return search(model)
+
+
+def search(model: ChainModel) -> tuple[Formulation, float]:
+    """:func:`formulation` without a hint (not cached)."""
     best = (FORMULATIONS[0], -1.0)
     for form in FORMULATIONS:
         frac = _raw_completeness(model, form)
@@ -317,16 +332,9 @@ _REASON_DEFICIENT = ("degenerate elimination: the θ1-θ2 coefficient matrix Q o
                      "eq. 9 is rank deficient for this pose")
 
 
-@lru_cache(maxsize=64)
-def _compiled_data(model: ChainModel, form: Formulation):
-    """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5,
-    whose pose link is M1 or M6): ``form (4, 4, 4)`` = C0⁻¹, C6⁻¹, constant M1, constant Ts;
-    the constant links M2..M5; ``L H3``, ``H3[0]``, L; the joint order with the pose-link
-    codes of M1 and Ts appended (0 constant, 1 ``C0⁻¹ T C6⁻¹``, 2 its inverse); the basis of
-    the companion's spurious subspace (:func:`kinestat.serial.analytic._rr_deflate.
-    model_basis`: pose-independent)."""
-    from kinestat.serial.analytic._rr_deflate import model_basis  # lazy: Numba start-up
-
+def model_arrays(model: ChainModel, form: Formulation) -> tuple:
+    """:func:`_compiled_data` without the spurious subspace's basis: ``(C, consts, links, LH,
+    h0, L, off, order, sign)``."""
     C = np.ascontiguousarray(model.constants)
     M = form.links(C, np.eye(4)[None])
     M = [m[0] if m.ndim == 3 else m for m in M]
@@ -337,10 +345,24 @@ def _compiled_data(model: ChainModel, form: Formulation):
     at5 = 0 if form.shift == 5 else (1 if not form.reverse else 2)
     consts = np.stack([_inv_rigid(C[0]), _inv_rigid(C[6]), M[0], _inv_rigid(M[5])])
     LH = np.ascontiguousarray(L @ _H3)
-    basis, index = model_basis(LH)
     return (C, np.ascontiguousarray(consts), np.ascontiguousarray(np.stack(M[1:5])), LH,
             np.ascontiguousarray(_H3[0]), np.ascontiguousarray(L), np.array(OFFSETS),
-            np.array(list(order) + [at0, at5], dtype=np.int64), float(sign), basis, index)
+            np.array(list(order) + [at0, at5], dtype=np.int64), float(sign))
+
+
+@lru_cache(maxsize=64)
+def _compiled_data(model: ChainModel, form: Formulation):
+    """Pose-independent arguments of the compiled kernel (formulations with shift 0 or 5,
+    whose pose link is M1 or M6): ``form (4, 4, 4)`` = C0⁻¹, C6⁻¹, constant M1, constant Ts;
+    the constant links M2..M5; ``L H3``, ``H3[0]``, L; the joint order with the pose-link
+    codes of M1 and Ts appended (0 constant, 1 ``C0⁻¹ T C6⁻¹``, 2 its inverse); the basis of
+    the companion's spurious subspace (:func:`kinestat.serial.analytic._rr_deflate.
+    model_basis`: pose-independent)."""
+    from kinestat.serial.analytic._rr_deflate import model_basis  # lazy: Numba start-up
+
+    preset = PRESET.get(model)
+    arrays = preset[1] if preset is not None and preset[0] == form else model_arrays(model, form)
+    return arrays + model_basis(arrays[3])
 
 
 RECHECK = {"never": 0, "suspect": 1, "always": 2}
@@ -420,12 +442,29 @@ def bind_one(model: ChainModel, check_entry, put=None):
     (:func:`kinestat.serial.analytic._locked_kernels.joints_out`: ``q`` then holds the full
     chain's ``take.shape[0]`` joints, joint ``j`` at ``v``), run in the same call."""
     form, _ = formulation(model)
+    if form.shift not in (0, 5):
+        return None
+    run = single_call(check_entry, form, None if put is None else put[:3])
+    if run is None:
+        return None
+    args = _compiled_data(model, form)
+    v = 0.0 if put is None else put[3]
+
+    def one(T, tol):
+        return run(T, tol, args, v)
+    return one
+
+
+def single_call(check_entry, form: Formulation, put=None):
+    """:func:`bind_one`'s call with the pose-independent arguments given per call:
+    ``run(T (1, 4, 4) plain, tol, args, v)``, ``args`` the tuple of :func:`_compiled_data`
+    (of any model solved by ``form``: a locked arm's chain at each value of the joint), ``v``
+    the locked value ``put = (entry, take, j)`` puts back (unused without ``put``); None
+    while the compiled entry points are not recorded."""
     K = sys.modules.get("kinestat.serial.analytic._rr_kernels")
     entry = _ENTRY.get((K.solve_serial, None)) if K is not None else None
-    if entry is None or check_entry is None or form.shift not in (0, 5):
+    if entry is None or check_entry is None:
         return None
-    C, consts, links, LH, h0, L, off, order, sign, basis, index = _compiled_data(model, form)
-    method = _method_name(form)
     K16 = MAX_SOLUTIONS
     shape = (1, K16)
     # no singular families here: the same read-only arrays serve every result
@@ -433,16 +472,18 @@ def bind_one(model: ChainModel, check_entry, put=None):
         nan_array(shape)
     for a in (singular, family_sign, family_value):
         a.flags.writeable = False
-    put_entry, take, j, v = (None, None, 0, 0.0) if put is None else put
+    put_entry, take, j = (None, None, 0) if put is None else put
+    method = _method_name(form)
     shape_q = (K16, 6 if put is None else take.shape[0])
     local = threading.local()
     singular, family_sign, family_value = singular[0], family_sign[0], family_value[0]
     single = IKAllResult.single
 
-    def one(T, tol):
+    def run(T, tol, args, v):
         bad, n_project = check_entry(T, 1e-6)
         if bad >= 0 or n_project:
             return None
+        C, consts, links, LH, h0, L, off, order, sign, basis, index = args
         q = np.empty((1, K16, 6))  # the kernel clears the slots and sets flags, nsol
         valid = np.empty(shape, dtype=bool)
         pos = np.empty(shape)
@@ -464,7 +505,7 @@ def bind_one(model: ChainModel, check_entry, put=None):
                           None, c, "" if c else _REASON_NONE, method, tol)
         return single(q[0], valid[0], pos[0], rot[0], singular, family_sign, family_value,
                       None, c, "" if c else _REASON_NONE, method, tol)
-    return one
+    return run
 
 
 def _method_name(form: Formulation) -> str:

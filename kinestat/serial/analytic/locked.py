@@ -150,6 +150,8 @@ class _JointInfo:
             self.M2 = np.outer(a[:, 1], b[0]) - np.outer(a[:, 0], b[1])
         self.fused: dict = {}  # invert -> (take, family joints) of the fused single call
         self.form = None  # the general 6R formulation a value of this joint took
+        self.general = None  # a joint in between where a general 6R remains: GeneralLock
+        self.pending = None  # (chain, value, formulation) the first general 6R value left
         self.G1 = None  # a revolute joint in between of a 7-joint revolute arm: _fast_fold's
         if not self.end and jt.kind == "revolute" and model.n == 7 and \
                 all(x.kind == "revolute" for x in model.joints):
@@ -230,6 +232,18 @@ def _joint_info(model: ChainModel, j: int) -> _JointInfo:
     return _JointInfo(model, j)
 
 
+def _general_lock(model: ChainModel, j: int):
+    """The :class:`~kinestat.serial.analytic.locked_general.GeneralLock` of a revolute joint
+    ``j`` in between of a 7R arm (built on first use)."""
+    info = _joint_info(model, j)
+    gl = info.general
+    if gl is None:
+        from kinestat.serial.analytic.locked_general import GeneralLock  # lazy: SciPy
+
+        gl = info.general = GeneralLock(model, j, lambda v: fold(model, ((j, v),)))
+    return gl
+
+
 _S144 = (1, 4, 4)
 _I4 = np.eye(4)
 
@@ -274,33 +288,60 @@ class LockedPlan:
     new chain. A joint in between changes the folded chain's geometry: one chain per value.
     """
 
-    __slots__ = ("model", "pairs", "six", "free", "_free_array", "_one", "_take", "L", "R",
-                 "one")
+    __slots__ = ("model", "pairs", "_six", "free", "_free_array", "_one", "_take", "L", "R",
+                 "one", "_args")
 
     def __init__(self, model: ChainModel, pairs: tuple[tuple[int, float], ...]) -> None:
         self.model, self.pairs = model, pairs
         self.L = self.R = None
         self.one = None  # the bound single call (:meth:`bind_one`)
+        self._args = None  # a general 6R's kernel arrays at the value (no chain folded yet)
         self._one = pairs[0] if len(pairs) == 1 else None
         if self._one is not None:
             j, v = self._one
             info = _joint_info(model, j)
             self.free, self._free_array, self._take = info.free, info.free_array, info.take
+            self._six = None
             if info.end:
-                self.six = info.six0
+                self._six = info.six0
                 self.L, self.R = _end_map(model, j, v)
-            else:
-                six = _fast_fold(info, j, v) if info.G1 is not None else None
-                self.six = fold(model, pairs) if six is None else six
-                if six is None and info.form is not None:  # the last value's elimination
-                    _general6r().HINTS[self.six] = info.form
+                return
+            gl = info.general
+            if info.pending is not None:  # the joint's second value: the first one's 6R kept
+                pending, info.pending = info.pending, None
+                gl = _general_lock(model, j)
+                gl.adopt(*pending)
+            args = None if gl is None else gl.arrays(v)
+            if args is not None:  # a general 6R: the kernel's arrays at v, the chain on demand
+                self._args = args
+                self.one = gl.bind(args, v, None if gl.run is not None else
+                                   (_entries()[1], info.take, j))
+                return
+            six = _fast_fold(info, j, v) if info.G1 is not None else None
+            self._six = six
             return
-        self.six = fold(model, pairs)
+        self._six = fold(model, pairs)
         locked_idx = {j for j, _ in pairs}
         self.free = tuple(i for i in range(model.n) if i not in locked_idx)
         self._free_array = np.array(self.free)
         self._take = np.array([self.free.index(i) if i in self.free else 0
                                for i in range(model.n)])
+
+    @property
+    def six(self) -> ChainModel:
+        """The folded 6-joint chain (folded on first use where the plan's single call has the
+        kernel's arrays without it)."""
+        six = self._six
+        if six is None:
+            six = self._six = fold(self.model, self.pairs)
+            j, v = self._one
+            info = _joint_info(self.model, j)
+            gl = info.general
+            if gl is not None and gl.P is not None:  # the arrays from the joint's terms
+                gl.preset(six, v, self._args)
+            elif info.form is not None:  # the last value's elimination (a hint, checked)
+                _general6r().HINTS[six] = info.form
+        return six
 
     def poses(self, T):
         """The poses ``T (..., 4, 4)`` the folded chain ``six`` must reach (checked first when
@@ -350,9 +391,16 @@ class LockedPlan:
         Like it, ``one`` returns None where the caller must take the full path."""
         parts = None
         if kind == "general" and self._one is not None and rev_data is None:
-            info = _joint_info(self.model, self._one[0])
+            j, v = self._one
+            info = _joint_info(self.model, j)
             if not info.end:  # kept for the joint's next value (a hint, checked there)
-                info.form = _general6r().formulation(self.six)[0]
+                g6 = _general6r()
+                searched = self.six not in g6.HINTS
+                info.form = g6.formulation(self.six)[0]
+                if info.G1 is not None and info.pieper is None and \
+                        (info.general is None or info.general.form is None):
+                    # and, from the next value on, for every value that is not special
+                    info.pending = (self.six, v, g6.formulation(self.six) if searched else None)
             if data.get("one") is not None and self.L is None and self.R is None:
                 self.one = self._fused_general()
                 if self.one is not None:
@@ -442,15 +490,20 @@ def plan(model: ChainModel, locked) -> LockedPlan:
     """The :class:`LockedPlan` of ``model`` with the ``locked`` ``{joint: value}`` (checked by
     :func:`check_locked` on first use; cached per model and values, the oldest dropped
     beyond ``_PLANS_MAX``)."""
+    pairs = None
     if len(locked) == 1:  # a dict of one int joint and a float value: look up directly
         (j, v), = locked.items()
         if type(j) is int and type(v) is float:
-            hit = _PLANS.get((model, j, v))
+            key = (model, j, v)
+            hit = _PLANS.get(key)
             if hit is not None:
                 return hit
-    pairs = check_locked(model, locked)
-    key = (model, *pairs[0]) if len(pairs) == 1 else (model, pairs)
-    hit = _PLANS.get(key)
+            if 0 <= j < model.n == 7 and math.isfinite(v):  # what check_locked checks
+                pairs = ((j, v),)
+    if pairs is None:
+        pairs = check_locked(model, locked)
+        key = (model, *pairs[0]) if len(pairs) == 1 else (model, pairs)
+        hit = _PLANS.get(key)
     if hit is None:
         hit = LockedPlan(model, pairs)
         if len(_PLANS) >= _PLANS_MAX:
