@@ -8,12 +8,19 @@ again, as Numba does.
 
 ``import kinestat`` names them in ``NUMBA_CACHE_LOCATOR_CLASSES`` (Numba reads it when it is
 first imported, and imports this module when it sets up the first cached kernel), followed by
-Numba's other locators in Numba's order; a value the user set is kept.
+Numba's other locators in Numba's order; a value the user set is kept (and with it Numba's own
+cache handling throughout). Importing this module also installs the library class of
+:mod:`kinestat.serial._numba_load`, so that every kernel loads from the cache without parsing
+its LLVM bitcode until another kernel links it.
 """
 
 from __future__ import annotations
 
 from numba.core import caching
+
+from kinestat.serial import _numba_load
+
+_numba_load.install()
 
 __all__ = ["UserProvidedCacheLocator", "InTreeCacheLocator", "LOCATORS"]
 

@@ -13,7 +13,7 @@ from kinestat.serial.analytic._cf_kernels import _pieper_pose, _three_parallel_p
 
 @nb.njit(**_OPTS)
 def pieper_one(Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam):
-    """:func:`~kinestat.serial.analytic._cf_kernels.pieper_serial` on one pose without Newton
+    """:func:`~kinestat.serial.analytic._cf_batch.pieper_serial` on one pose without Newton
     steps: the count, or negative where the pose is not orthonormal to rounding or a candidate
     needs Newton steps (the caller takes the full path)."""
     C, T0inv, W, P, w, s, x6 = _unpack(Kp)
@@ -25,7 +25,7 @@ def pieper_one(Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam):
 
 @nb.njit(**_OPTS)
 def three_parallel_one(Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam):
-    """:func:`~kinestat.serial.analytic._cf_kernels.three_parallel_serial` on one pose without
+    """:func:`~kinestat.serial.analytic._cf_batch.three_parallel_serial` on one pose without
     Newton steps, ``sing``, ``sign``, ``fam`` set to no family (False, 0, NaN): the count, or
     negative as :func:`pieper_one`, also where a θ1 branch is near the wrist-singular set
     (whose families the full path adds)."""

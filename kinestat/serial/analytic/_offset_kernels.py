@@ -271,37 +271,12 @@ def _unpack(Kp):
             Kp[146:164].reshape((6, 3)), Kp[164:167], Kp[167:170], Kp[170:190])
 
 
-@nb.njit(parallel=True, **_OPTS)
-def offset_batch(Kp, T, tol, wrist_tol, dedup, newton, out_c, out_s, out_valid, out_pos, out_rot,
-                 out_sing, out_sign, out_fam, out_cnt):
-    """Spherical wrist, offset shoulder: N poses into the (uninitialised) outputs, the
-    solutions as cosines and sines; ``out_cnt (N,)`` the number of solutions (or minus the
-    pose's status), as :func:`kinestat.serial.analytic._cf_kernels.pieper_batch`."""
-    C, T0inv, W, P, w, x6, G = _unpack(Kp)
-    ch = 2.0 * math.sin(0.5 * dedup)
-    for n in nb.prange(T.shape[0]):
-        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, ch, newton,
-                                  out_c, out_s, out_valid, out_pos, out_rot, out_sing, out_sign,
-                                  out_fam)
-
-
-@nb.njit(**_OPTS)
-def offset_serial(Kp, T, tol, wrist_tol, dedup, newton, out_q, out_valid, out_pos, out_rot,
-                  out_sing, out_sign, out_fam, out_cnt):
-    """:func:`offset_batch` on one thread (small batches: no thread start-up), the angles
-    into ``out_q``."""
-    C, T0inv, W, P, w, x6, G = _unpack(Kp)
-    for n in range(T.shape[0]):
-        out_cnt[n] = _offset_pose(n, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, dedup, newton,
-                                  out_q, None, out_valid, out_pos, out_rot, out_sing, out_sign,
-                                  out_fam)
-
-
 @nb.njit(**_OPTS)
 def offset_one(Kp, T, tol, wrist_tol, q, valid, pos, rot, sing, sign, fam):
-    """:func:`offset_serial` on one pose without Newton steps, the outputs in a one-pose
-    result's shapes (as :func:`kinestat.serial.analytic._cf_single.pieper_one`): the count,
-    or negative where the caller takes the full path."""
+    """:func:`~kinestat.serial.analytic._offset_batch.offset_serial` on one pose without
+    Newton steps, the outputs in a one-pose result's shapes (as
+    :func:`kinestat.serial.analytic._cf_single.pieper_one`): the count, or negative where the
+    caller takes the full path."""
     C, T0inv, W, P, w, x6, G = _unpack(Kp)
     return _offset_pose(0, C, T, T0inv, W, P, w, x6, G, tol, wrist_tol, 1e-6, None,
                         q[None], None, valid[None], pos[None],

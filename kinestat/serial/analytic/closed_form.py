@@ -279,6 +279,16 @@ def _offset_kernels():
     return K
 
 
+def _batch_kernels(offset: bool):
+    """The module of the batch kernels (offset shoulder or not), imported on first use: a
+    single call sets none of them up."""
+    if offset:
+        from kinestat.serial.analytic import _offset_batch as B  # lazy: batches only
+    else:
+        from kinestat.serial.analytic import _cf_batch as B  # lazy: batches only
+    return B
+
+
 def _pieper_args(model: ChainModel, data: dict, K) -> np.ndarray:
     """The spherical-wrist kernel's packed pose-independent data (``K``: its kernel module),
     kept with the model's cached geometry."""
@@ -354,9 +364,10 @@ def solve_pieper_compiled(model: ChainModel, T: np.ndarray, data: dict, *, tol: 
     fam = np.empty((N, 8))
     Kp = _pieper_args(model, data, K)
     newton = _newton(N, checked)
-    serial = K.offset_serial if offset else K.pieper_serial
+    B = _batch_kernels(offset)
+    serial = B.offset_serial if offset else B.pieper_serial
     if N >= _PARALLEL_MIN:  # over the cores, the angles by one arctan2 pass after the kernel
-        _run_batch(K.offset_batch if offset else K.pieper_batch, Kp, T, float(tol),
+        _run_batch(B.offset_batch if offset else B.pieper_batch, Kp, T, float(tol),
                    float(wrist_tol), newton, q, (valid, pos, rot, sing, sign, fam, cnt))
     else:
         _run_serial(serial, (Kp, T, float(tol), float(wrist_tol), 1e-6, newton, q, valid, pos,
@@ -398,11 +409,12 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
     q, valid, pos, rot, cnt = _outputs(N, 8)
     near = np.empty(N, dtype=bool)
     newton = _newton(N, checked)
+    B = _batch_kernels(False)
     if N >= _PARALLEL_MIN:  # as solve_pieper_compiled
-        _run_batch(K.three_parallel_batch, Kp, T, float(tol), float(wrist_tol), newton, q,
+        _run_batch(B.three_parallel_batch, Kp, T, float(tol), float(wrist_tol), newton, q,
                    (valid, pos, rot, cnt, near))
     else:
-        _run_serial(K.three_parallel_serial, (Kp, T, float(tol), float(wrist_tol), 1e-6,
+        _run_serial(B.three_parallel_serial, (Kp, T, float(tol), float(wrist_tol), 1e-6,
                                               newton, q, valid, pos, rot, cnt, near),
                     T, plain, newton)
     if _unchecked(cnt):

@@ -96,3 +96,34 @@ def test_a_first_ik_all_call_loads_neither_the_selection_step_nor_the_seven_join
 
     for name in ("Selection", "select_nearest", "wrap_to_limits"):
         assert getattr(result, name) is getattr(selection, name) is getattr(analytic, name)
+
+
+def test_the_written_out_inits_are_the_dataclasses():
+    """IKAllResult and HomeAxes write their __init__ out (a first call's time): the same
+    parameters as the fields, in order and with their defaults, the values set, and frozen."""
+    import dataclasses
+    import inspect
+
+    import pytest
+
+    from kinestat.serial.analytic.geometry import HomeAxes
+    from kinestat.serial.analytic.result import IKAllResult
+
+    for cls in (IKAllResult, HomeAxes):
+        fields = dataclasses.fields(cls)
+        params = list(inspect.signature(cls.__init__).parameters.values())[1:]
+        assert [p.name for p in params] == [f.name for f in fields]
+        assert [p.default for p in params] == [
+            inspect.Parameter.empty if f.default is dataclasses.MISSING else f.default
+            for f in fields]
+        values = {f.name: object() for f in fields}
+        obj = cls(**values)
+        assert all(getattr(obj, k) is v for k, v in values.items())
+        assert all(getattr(cls(*values.values()), k) is v for k, v in values.items())
+        with pytest.raises(dataclasses.FrozenInstanceError):
+            obj.tol = 1.0
+        other = object()
+        name = fields[0].name
+        assert getattr(dataclasses.replace(obj, **{name: other}), name) is other
+    res = ik_all(ur5(), kinestat.fk(ur5(), np.full(6, 0.3)))
+    assert repr(res).startswith("IKAllResult(q=array(")

@@ -117,3 +117,19 @@ def test_poses_handed_back_for_newton_steps_are_solved_with_them(name):
     F = kinestat.fk(model, np.where(batch.valid[..., None], batch.q, 0.0))
     pos = np.linalg.norm(F[..., :3, 3] - T[:, None, :3, 3], axis=-1)
     assert batch.valid.sum() > 0 and np.all(pos[batch.valid] <= 2.0 * tol)
+
+
+def test_a_first_single_call_sets_up_no_batch_kernel():
+    """A fresh process's first single call loads the single-pose kernel, not the batch
+    kernels' modules (their dispatchers cost a first call's time); a batch loads them."""
+    import subprocess
+    import sys
+
+    code = ("import sys, numpy as np, kinestat; m = kinestat.load('puma560'); "
+            "T = kinestat.fk(m, np.full(6, 0.3)); kinestat.ik_all(m, T); "
+            "a = [k for k in sys.modules if k.endswith('_batch')]; "
+            "kinestat.ik_all(m, np.stack([T, T])); "
+            "b = [k for k in sys.modules if k.endswith('_batch')]; print(a, b)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert out.stdout.split() == ["[]", "['kinestat.serial.analytic._cf_batch']"]
