@@ -12,17 +12,19 @@ cache holds, where it lives, how the machine code is loaded.
 Only 64-bit little-endian ELF object files (Linux x86-64 and AArch64) take this path; any other
 object file, or a symbol table that cannot be read, is loaded by Numba's own code.
 :func:`install` puts the class in place once per process (Numba reads the library class each
-time it creates or loads a kernel).
+time it creates or loads a kernel), on the Numba releases it was checked against; other releases
+keep Numba's own load.
 """
 
 from __future__ import annotations
 
 import struct
 
+import numba
 from llvmlite import binding as ll
 from numba.core import codegen
 
-__all__ = ["LazyLinkLibrary", "defined_symbols", "install"]
+__all__ = ["CHECKED_NUMBA", "LazyLinkLibrary", "defined_symbols", "install"]
 
 _ELF64_LE = b"\x7fELF\x02\x01"
 _SHT_SYMTAB = 2
@@ -85,7 +87,15 @@ class LazyLinkLibrary(codegen.JITCodeLibrary):
         return self
 
 
+#: Numba releases whose library class this module was checked against (the class overrides two
+#: of its private methods); any other release keeps Numba's own load
+CHECKED_NUMBA = ("0.68",)
+
+
 def install() -> None:
-    """Make Numba's CPU code generator create and load :class:`LazyLinkLibrary` libraries."""
+    """Make Numba's CPU code generator create and load :class:`LazyLinkLibrary` libraries (on the
+    Numba releases of :data:`CHECKED_NUMBA` only)."""
+    if not numba.__version__.startswith(CHECKED_NUMBA):
+        return
     if codegen.JITCPUCodegen._library_class is codegen.JITCodeLibrary:
         codegen.JITCPUCodegen._library_class = LazyLinkLibrary

@@ -133,3 +133,18 @@ def test_numbas_cpu_code_generator_uses_the_class():
     from kinestat.serial._numba_load import LazyLinkLibrary
 
     assert codegen.JITCPUCodegen._library_class is LazyLinkLibrary
+
+
+def test_an_unchecked_numba_release_keeps_numbas_own_load(monkeypatch):
+    import numba
+    from numba.core import codegen
+
+    from kinestat.serial import _numba_load
+
+    monkeypatch.setattr(codegen.JITCPUCodegen, "_library_class", codegen.JITCodeLibrary)
+    monkeypatch.setattr(numba, "__version__", "0.99.0")
+    _numba_load.install()
+    assert codegen.JITCPUCodegen._library_class is codegen.JITCodeLibrary
+    monkeypatch.setattr(numba, "__version__", _numba_load.CHECKED_NUMBA[0] + ".1")
+    _numba_load.install()
+    assert codegen.JITCPUCodegen._library_class is _numba_load.LazyLinkLibrary
