@@ -271,10 +271,12 @@ def _companion_eigvals(A, XA, wr, wi, dummy, D, basis, index):
         for i in range(12):
             for j in range(12):
                 sc = max(sc, abs(A[k, i, j]))
+    # scaled by the power of 2 at or above the largest entry: exact, a product not a quotient
+    g = math.ldexp(1.0, -math.frexp(sc)[1]) if 0.0 < sc < np.inf else 1.0 / sc
     for k in range(3):
         for i in range(12):
             for j in range(12):
-                A[k, i, j] /= sc
+                A[k, i, j] *= g
     t = 0.0
     regular = False
     pivot = 0.0
