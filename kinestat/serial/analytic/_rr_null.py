@@ -51,12 +51,19 @@ _STRUCTURED_PIVOT = 1e-6
 def _pivot_step(M, k, rows, cols, cperm):
     """Step k of Gaussian elimination with complete pivoting on ``M[:rows, :cols]`` (column
     order into cperm); returns the pivot's modulus."""
-    bi, bj, best = k, k, -1.0
-    for i in range(k, rows):
+    best = -1.0
+    for i in range(k, rows):  # the largest modulus (no branch), then its first place
         for j in range(k, cols):
-            a = abs(M[i, j])
-            if a > best:
-                bi, bj, best = i, j, a
+            best = max(best, abs(M[i, j]))
+    bi, bj = k, k
+    for i in range(k, rows):
+        hit = False
+        for j in range(k, cols):
+            if abs(M[i, j]) == best:
+                bi, bj, hit = i, j, True
+                break
+        if hit:
+            break
     if bi != k:
         for j in range(cols):
             M[k, j], M[bi, j] = M[bi, j], M[k, j]
@@ -163,8 +170,6 @@ def null_vector(A, x, S, v, perm, y, W):
     two steps of inverse iteration on one LU factorisation (the matrix is singular at an
     eigenvalue); S (12, 12), perm (12,), y (12,), W (:func:`_null_structured`) scratch. For
     |x| > 1 the matrix is divided by x² (better scaled)."""
-    for i in range(12):
-        v[i, 0] = _B0[i]
     if abs(x) <= 1.0:
         c0, c1, c2 = 1.0, x, x * x
     else:
@@ -174,6 +179,8 @@ def null_vector(A, x, S, v, perm, y, W):
             W[i, j] = c0 * A[0, i, j] + c1 * A[1, i, j] + c2 * A[2, i, j]
     if _null_structured(v, W, perm):
         return
+    for i in range(12):
+        v[i, 0] = _B0[i]
     for i in range(12):
         for j in range(12):
             S[i, j] = c0 * A[0, i, j] + c1 * A[1, i, j] + c2 * A[2, i, j]
