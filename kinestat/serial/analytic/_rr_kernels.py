@@ -344,7 +344,7 @@ def _half_angle(x, ph):
 @nb.njit(**_OPTS)
 def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     """θ (6,) of the loop from a real root x3 and its power products ``v (12, 1)``; False if
-    not usable. m (27,), coef (8,) scratch; ``links (4, 4, 4)`` the constant M2..M5."""
+    not usable. m (41,), coef (8,) scratch; ``links (4, 4, 4)`` the constant M2..M5."""
     x4 = _ratio(v, 0)
     x5 = _ratio(v, 1)
     if not (np.isfinite(x4) and np.isfinite(x5)):
@@ -360,14 +360,18 @@ def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
             for c in range(3):
                 m[a * 9 + b * 3 + c] = m3[a] * m4[b] * m5[c]
     # (c1, s1, c2, s2) products in least squares (Manocha–Canny eq. 9): R x = H₈ᵀ (L m − r0)
+    r = m[27:]
+    for i in range(14):
+        r[i] = -Rh[i + 1, 0]
+    for c in range(27):  # column by column: 14 independent sums, each in the order of c
+        mc = m[c]
+        for i in range(14):
+            r[i] += L[i, c] * mc
     for j in range(8):
         coef[j] = 0.0
     for i in range(14):
-        r = -Rh[i + 1, 0]
-        for c in range(27):
-            r += L[i, c] * m[c]
         for j in range(8):
-            coef[j] += H[i, j] * r
+            coef[j] += H[i, j] * r[i]
     for k in range(7, -1, -1):
         acc = coef[k]
         for j in range(k + 1, 8):
@@ -407,7 +411,7 @@ def _scratch():
     """Work arrays of :func:`_solve_pose` (one set per chunk of poses)."""
     return (np.empty((3, 4, 4)), np.empty((15, 9)), np.empty((15, 15)), np.empty((5, 15)),
             np.empty((3, 12, 12)), np.empty((6, 27)), np.empty((12, 36)), np.empty((12, 12)),
-            np.empty((1, 1)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
+            np.empty((1, 1)), np.empty((3, 24)), np.empty((12, 1)), np.empty(41),
             np.empty(8), np.empty((3, 6, 7)), np.empty((4, 6)), np.empty(6), np.empty(6),
             np.empty((14, 14)), np.empty((8, 8)), np.empty(8, dtype=np.int64), np.empty((8, 14)),
             np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12), deflate_scratch(),
