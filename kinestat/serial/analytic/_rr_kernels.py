@@ -27,10 +27,10 @@ import math
 import numba as nb
 import numpy as np
 
-from kinestat.mechanism.joints import JointKind
-from kinestat.serial._kernels import _step
+from kinestat.serial._kernels import _affine, _turn
 from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial._sincos import sincos
 from kinestat.serial.analytic._rr_deflate import deflate_scratch, deflated_eigvals
 from kinestat.serial.analytic._rr_null import TINY_PIVOT as _TINY_PIVOT
 from kinestat.serial.analytic._rr_null import null_vector as _null_vector
@@ -38,7 +38,6 @@ from kinestat.serial.analytic._rr_qz import nearly_real, pencil_eigvals_qz, qz_s
 from kinestat.serial.analytic._solution_kernels import polish, store
 from kinestat.spatial._elimination import eliminate
 
-REVOLUTE = int(JointKind.REVOLUTE)
 FLAG_OK = 0
 FLAG_DEFICIENT = 1
 FLAG_ILL_CONDITIONED = 2
@@ -339,10 +338,31 @@ def _half_angle(x, ph):
     return 1.0, math.cos(ph), math.sin(ph)
 
 
+@nb.njit(**_INLINE)
+def _unit(c, s):
+    """``(cos φ, sin φ)`` of ``φ = atan2(s, c)``: ``(c, s)`` normalised, ``(1, 0)`` at the
+    origin."""
+    h = math.sqrt(c * c + s * s)
+    if not h > 0.0:
+        return 1.0, 0.0
+    g = 1.0 / h
+    return c * g, s * g
+
+
+@nb.njit(**_INLINE)
+def _offset_turns(off):
+    """``(cos, sin)`` of the three offsets, flat."""
+    s0, c0 = sincos(off[0])
+    s1, c1 = sincos(off[1])
+    s2, c2 = sincos(off[2])
+    return (c0, s0, c1, s1, c2, s2)
+
+
 @nb.njit(**_OPTS)
-def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
+def _angles(x3, v, off, cs, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     """θ (6,) of the loop from a real root x3 and its power products ``v (12, 1)``; False if
-    not usable. m (41,), coef (8,) scratch; ``links (4, 4, 4)`` the constant M2..M5."""
+    not usable. m (41,), coef (8,) scratch; ``links (4, 4, 4)`` the constant M2..M5; ``cs``
+    the cosines and sines of the offsets ``off`` (:func:`_offset_turns`)."""
     x4 = _ratio(v, 0)
     x5 = _ratio(v, 1)
     if not (np.isfinite(x4) and np.isfinite(x5)):
@@ -390,11 +410,15 @@ def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     th[2] = ph3 + off[0]
     th[3] = ph4 + off[1]
     th[4] = ph5 + off[2]
-    # θ6 from Z6 = (Z1 M1 … Z5 M5)⁻¹ Ts
-    t = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
-    t = _step(M1, REVOLUTE, 0.0, th[0], t)
-    for i in range(4):
-        t = _step(links[i], REVOLUTE, 0.0, th[i + 1], t)
+    # θ6 from Z6 = (Z1 M1 … Z5 M5)⁻¹ Ts; the turns from what is known (no sine or cosine)
+    c, s = _unit(S2, S5)
+    t = (c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    t = _affine(M1, t)
+    c, s = _unit(S0, S1)
+    t = _affine(links[0], _turn(c, s, t))
+    t = _affine(links[1], _turn(m3[1] * cs[0] - m3[2] * cs[1], m3[2] * cs[0] + m3[1] * cs[1], t))
+    t = _affine(links[2], _turn(m4[1] * cs[2] - m4[2] * cs[3], m4[2] * cs[2] + m4[1] * cs[3], t))
+    t = _affine(links[3], _turn(m5[1] * cs[4] - m5[2] * cs[5], m5[2] * cs[4] + m5[1] * cs[5], t))
     # R6 = G_Rᵀ Ts_R: entries (0, 0), (0, 1), (1, 0), (1, 1)
     r00 = t[0] * Ts[0, 0] + t[4] * Ts[1, 0] + t[8] * Ts[2, 0]
     r01 = t[0] * Ts[0, 1] + t[4] * Ts[1, 1] + t[8] * Ts[2, 1]
@@ -429,12 +453,13 @@ def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, si
     tried = 0
     lost = 0
     err = 0.0
+    cs = _offset_turns(off)
     for k in range(24):
         if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
             continue
         tried += 1
         _null_vector(A, wr[k], A2, v, perm, y12, W)
-        if not _angles(wr[k], v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
+        if not _angles(wr[k], v, off, cs, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
             lost += 1
             continue
         for i in range(6):
