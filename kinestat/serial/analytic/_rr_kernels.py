@@ -211,12 +211,13 @@ def _qr_pivoted(Rh, H, R, piv, Vr, Aw):
     for i in range(8):
         for j in range(8):
             R[i, j] = Aw[i, j] if j >= i else 0.0
-    # H = H_1 H_2 … H_8, applied to the identity from the left in reverse order
+    # H = H_1 H_2 … H_8, applied to the identity from the left in reverse order (H_k leaves
+    # the unit columns j < k of H_k+1 … H_8 as they are)
     for i in range(14):
         for j in range(14):
             H[i, j] = 1.0 if i == j else 0.0
     for k in range(7, -1, -1):
-        for j in range(14):
+        for j in range(k, 14):
             d = 0.0
             for i in range(k, 14):
                 d += Vr[k, i] * H[i, j]
@@ -286,9 +287,14 @@ def _companion_eigvals(A, XA, wr, wi, dummy, D, basis, index):
         for i in range(12):
             for j in range(12):
                 a0, a1, a2 = A[0, i, j], A[1, i, j], A[2, i, j]
-                XA[i, 12 + j] = a0 + t * a1 + tt * a2
-                XA[i, 24 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
-                XA[i, j] = tt * a0 - t * a1 + a2
+                if t == 0.0:  # the plain variable (most poses): a copy
+                    XA[i, 12 + j] = a0
+                    XA[i, 24 + j] = a1
+                    XA[i, j] = a2
+                else:
+                    XA[i, 12 + j] = a0 + t * a1 + tt * a2
+                    XA[i, 24 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
+                    XA[i, j] = tt * a0 - t * a1 + a2
         pivot = eliminate(XA, 12, _TINY_PIVOT, None)
         if pivot >= _A2_PIVOT_MIN:
             regular = True
