@@ -14,6 +14,7 @@ import math
 
 import numba as nb
 
+from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
 
 __all__ = ["eigvals", "MAX_ITERATIONS"]
@@ -89,6 +90,63 @@ def _hessenberg(a, n):
 @nb.njit(**_OPTS)
 def _sign(a, b):
     return abs(a) if b >= 0.0 else -abs(a)
+
+
+@nb.njit(**_INLINE)
+def _sweep_step(a, k, l, m, nn, p, q, r):  # noqa: E741 - l as in _hqr
+    """Step k of the double-shift sweep on rows ``l..nn``: the reflector of ``(p, q, r)``
+    (the shift's first column at k = m, the bulge below the subdiagonal after it; r = 0 at
+    the last step) applied to rows k..k+2 and columns k..k+2 of the active block.
+
+    The latency of one step (a square root and two reciprocals) bounds the sweep: the bulge is
+    scaled only where its squares could overflow or underflow, reciprocals are multiplied,
+    and the column update runs bottom-up so that the next bulge is ready first."""
+    x = 1.0
+    if k != m:
+        x = abs(p) + abs(q) + abs(r)
+        if x != 0.0 and not 1e-100 < x < 1e100:
+            g = 1.0 / x
+            p *= g
+            q *= g
+            r *= g
+        else:
+            x = 1.0
+    s = _sign(math.sqrt(p * p + q * q + r * r), p)
+    if s == 0.0:
+        return
+    if k == m:
+        if l != m:
+            a[k, k - 1] = -a[k, k - 1]
+    else:
+        a[k, k - 1] = -s * x
+    p += s
+    g = 1.0 / s
+    x = p * g
+    y = q * g
+    z = r * g
+    g = 1.0 / p
+    q *= g
+    r *= g
+    if k == nn - 1:  # a 2-vector reflector
+        for j in range(k, nn + 1):
+            p = a[k, j] + q * a[k + 1, j]
+            a[k + 1, j] -= p * y
+            a[k, j] -= p * x
+        for i in range(nn, l - 1, -1):
+            p = x * a[i, k] + y * a[i, k + 1]
+            a[i, k + 1] -= p * q
+            a[i, k] -= p
+        return
+    for j in range(k, nn + 1):
+        p = a[k, j] + q * a[k + 1, j] + r * a[k + 2, j]
+        a[k + 2, j] -= p * z
+        a[k + 1, j] -= p * y
+        a[k, j] -= p * x
+    for i in range(min(nn, k + 3), l - 1, -1):
+        p = x * a[i, k] + y * a[i, k + 1] + z * a[i, k + 2]
+        a[i, k + 2] -= p * r
+        a[i, k + 1] -= p * q
+        a[i, k] -= p
 
 
 @nb.njit(**_OPTS)
@@ -173,43 +231,11 @@ def _hqr(a, n, wr, wi):
                 if i != m + 2:
                     a[i, i - 3] = 0.0
             for k in range(m, nn):  # the double-shift QR sweep on rows l..nn
-                if k != m:
-                    p = a[k, k - 1]
-                    q = a[k + 1, k - 1]
-                    r = a[k + 2, k - 1] if k != nn - 1 else 0.0
-                    x = abs(p) + abs(q) + abs(r)
-                    if x != 0.0:
-                        p /= x
-                        q /= x
-                        r /= x
-                s = _sign(math.sqrt(p * p + q * q + r * r), p)
-                if s != 0.0:
-                    if k == m:
-                        if l != m:
-                            a[k, k - 1] = -a[k, k - 1]
-                    else:
-                        a[k, k - 1] = -s * x
-                    p += s
-                    x = p / s
-                    y = q / s
-                    z = r / s
-                    q /= p
-                    r /= p
-                    for j in range(k, nn + 1):
-                        p = a[k, j] + q * a[k + 1, j]
-                        if k != nn - 1:
-                            p += r * a[k + 2, j]
-                            a[k + 2, j] -= p * z
-                        a[k + 1, j] -= p * y
-                        a[k, j] -= p * x
-                    mmin = nn if nn < k + 3 else k + 3
-                    for i in range(l, mmin + 1):
-                        p = x * a[i, k] + y * a[i, k + 1]
-                        if k != nn - 1:
-                            p += z * a[i, k + 2]
-                            a[i, k + 2] -= p * r
-                        a[i, k + 1] -= p * q
-                        a[i, k] -= p
+                _sweep_step(a, k, l, m, nn, p, q, r)
+                if k + 1 < nn:  # the bulge: the next step's reflector
+                    p = a[k + 1, k]
+                    q = a[k + 2, k]
+                    r = a[k + 3, k] if k + 1 != nn - 1 else 0.0
     return True
 
 

@@ -53,12 +53,12 @@ _MAX_NULL = 4  # the factor (1 + x²)⁴
 def deflate_scratch():
     """Work arrays of :func:`deflated_eigvals`: complex A(i) (12, 12), its column order (12,),
     the null basis (12, 4), the real basis transposed (8, 24), pivot rows (8,), the row mask
-    (24,), the column-major copy of the quotient for dgeev (576,), the quotient matrix (24, 24)
-    and the quotient's coordinate maps (48,)."""
+    (24,), the column-major copy of the quotient for dgeev (576,), the quotient matrix (24, 24),
+    the quotient's coordinate maps (48,) and the companion's free columns (12, 24)."""
     return (np.empty((12, 12), dtype=np.complex128), np.empty(12, dtype=np.int64),
             np.empty((12, 4), dtype=np.complex128), np.empty((8, 24)),
             np.empty(8, dtype=np.int64), np.empty(24, dtype=np.int64), np.empty(576),
-            np.empty((24, 24)), np.empty(48, dtype=np.int64))
+            np.empty((24, 24)), np.empty(48, dtype=np.int64), np.empty((12, 24)))
 
 
 @nb.njit(**_OPTS)
@@ -196,11 +196,11 @@ def model_basis(LH: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 @nb.njit(**_OPTS)
-def _quotient(X, Bt, p, mask, m, Hm, maps):
+def _quotient(X, Bt, p, mask, m, Hm, maps, Xf):
     """The quotient map of the companion ``C = [0 I; −X]`` on the coordinates outside the pivots
     p (mask) into ``Hm[:24 − m, :24 − m]``: ``C[np, np] − Bt[:, np]ᵀ C[p, np]``; C's rows
-    ``pk < 12`` are unit rows, so their terms are a single entry each. ``maps (48,)``:
-    scratch."""
+    ``pk < 12`` are unit rows, so their terms are a single entry each. ``maps (48,)``,
+    ``Xf (12, 24)``: scratch."""
     n = 24 - m
     free = maps[:24]
     col = maps[24:]  # the quotient column of a free coordinate, or −1
@@ -212,19 +212,25 @@ def _quotient(X, Bt, p, mask, m, Hm, maps):
             free[a] = r
             col[r] = a
             a += 1
+    for i in range(12):  # X's free columns, contiguous
+        for b in range(n):
+            Xf[i, b] = X[i, free[b]]
     for a in range(n):
         r = free[a]
-        for b in range(n):
-            c = free[b]
-            if r < 12:
-                h = 1.0 if c == r + 12 else 0.0
-            else:
-                h = -X[r - 12, c]
-            for k in range(m):
-                pk = p[k]
-                if pk >= 12:
-                    h += Bt[k, r] * X[pk - 12, c]
-            Hm[a, b] = h
+        if r < 12:
+            for b in range(n):
+                Hm[a, b] = 0.0
+            if col[r + 12] >= 0:
+                Hm[a, col[r + 12]] = 1.0
+        else:
+            for b in range(n):
+                Hm[a, b] = -Xf[r - 12, b]
+        for k in range(m):  # row-wise: independent additions, in the same order per entry
+            pk = p[k]
+            if pk >= 12:
+                f = Bt[k, r]
+                for b in range(n):
+                    Hm[a, b] += f * Xf[pk - 12, b]
         for k in range(m):
             pk = p[k]
             if pk < 12 and col[pk + 12] >= 0:
@@ -247,11 +253,11 @@ def deflated_eigvals(A, X, wr, wi, dummy, S, basis, index):
         m = spurious_basis(A, S)
         Bt, p, mask = S[3], S[4], S[5]
     n = 24 - m
-    _quotient(X, Bt, p, mask, m, Hm, S[8])
+    _quotient(X, Bt, p, mask, m, Hm, S[8], S[9])
     if eigvals(Hm, n, wr, wi):
         info = 0
     else:  # the QR iteration did not converge: LAPACK on a column-major copy
-        _quotient(X, Bt, p, mask, m, Hm, S[8])
+        _quotient(X, Bt, p, mask, m, Hm, S[8], S[9])
         for a in range(n):
             for b in range(n):
                 F[b * n + a] = Hm[a, b]

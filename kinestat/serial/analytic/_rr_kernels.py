@@ -27,10 +27,10 @@ import math
 import numba as nb
 import numpy as np
 
-from kinestat.mechanism.joints import JointKind
-from kinestat.serial._kernels import _step
+from kinestat.serial._kernels import _affine, _turn
 from kinestat.serial._numba_options import INLINE as _INLINE
 from kinestat.serial._numba_options import OPTS as _OPTS
+from kinestat.serial._sincos import sincos
 from kinestat.serial.analytic._rr_deflate import deflate_scratch, deflated_eigvals
 from kinestat.serial.analytic._rr_null import TINY_PIVOT as _TINY_PIVOT
 from kinestat.serial.analytic._rr_null import null_vector as _null_vector
@@ -38,7 +38,6 @@ from kinestat.serial.analytic._rr_qz import nearly_real, pencil_eigvals_qz, qz_s
 from kinestat.serial.analytic._solution_kernels import polish, store
 from kinestat.spatial._elimination import eliminate
 
-REVOLUTE = int(JointKind.REVOLUTE)
 FLAG_OK = 0
 FLAG_DEFICIENT = 1
 FLAG_ILL_CONDITIONED = 2
@@ -212,12 +211,13 @@ def _qr_pivoted(Rh, H, R, piv, Vr, Aw):
     for i in range(8):
         for j in range(8):
             R[i, j] = Aw[i, j] if j >= i else 0.0
-    # H = H_1 H_2 … H_8, applied to the identity from the left in reverse order
+    # H = H_1 H_2 … H_8, applied to the identity from the left in reverse order (H_k leaves
+    # the unit columns j < k of H_k+1 … H_8 as they are)
     for i in range(14):
         for j in range(14):
             H[i, j] = 1.0 if i == j else 0.0
     for k in range(7, -1, -1):
-        for j in range(14):
+        for j in range(k, 14):
             d = 0.0
             for i in range(k, 14):
                 d += Vr[k, i] * H[i, j]
@@ -266,15 +266,19 @@ def _companion_eigvals(A, XA, wr, wi, dummy, D, basis, index):
     ``XA (12, 36)``: ``[A2 | A0 A1]`` solved in place to ``[· | X]``, ``X = A2⁻¹ [A0 A1]``;
     D: :func:`~kinestat.serial.analytic._rr_deflate.deflate_scratch`; ``(basis, index)``: the
     model's spurious subspace (:func:`~kinestat.serial.analytic._rr_deflate.model_basis`)."""
-    sc = 0.0
+    s0 = s1 = s2 = 0.0  # three independent maxima, not one chain
+    for i in range(12):
+        for j in range(12):
+            s0 = max(s0, abs(A[0, i, j]))
+            s1 = max(s1, abs(A[1, i, j]))
+            s2 = max(s2, abs(A[2, i, j]))
+    sc = max(s0, max(s1, s2))
+    # scaled by the power of 2 at or above the largest entry: exact, a product not a quotient
+    g = math.ldexp(1.0, -math.frexp(sc)[1]) if 0.0 < sc < np.inf else 1.0 / sc
     for k in range(3):
         for i in range(12):
             for j in range(12):
-                sc = max(sc, abs(A[k, i, j]))
-    for k in range(3):
-        for i in range(12):
-            for j in range(12):
-                A[k, i, j] /= sc
+                A[k, i, j] *= g
     t = 0.0
     regular = False
     pivot = 0.0
@@ -283,9 +287,14 @@ def _companion_eigvals(A, XA, wr, wi, dummy, D, basis, index):
         for i in range(12):
             for j in range(12):
                 a0, a1, a2 = A[0, i, j], A[1, i, j], A[2, i, j]
-                XA[i, 12 + j] = a0 + t * a1 + tt * a2
-                XA[i, 24 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
-                XA[i, j] = tt * a0 - t * a1 + a2
+                if t == 0.0:  # the plain variable (most poses): a copy
+                    XA[i, 12 + j] = a0
+                    XA[i, 24 + j] = a1
+                    XA[i, j] = a2
+                else:
+                    XA[i, 12 + j] = a0 + t * a1 + tt * a2
+                    XA[i, 24 + j] = -2.0 * t * a0 + (1.0 - tt) * a1 + 2.0 * t * a2
+                    XA[i, j] = tt * a0 - t * a1 + a2
         pivot = eliminate(XA, 12, _TINY_PIVOT, None)
         if pivot >= _A2_PIVOT_MIN:
             regular = True
@@ -293,14 +302,10 @@ def _companion_eigvals(A, XA, wr, wi, dummy, D, basis, index):
     if not regular:
         return 0.0
     X = XA[:, 12:]
-    big = 0.0
     for i in range(12):
         for j in range(24):
-            if not math.isfinite(X[i, j]):
+            if not abs(X[i, j]) <= 1e10:  # not finite, or too large
                 return 0.0
-            big = max(big, abs(X[i, j]))
-    if big > 1e10:
-        return 0.0
     info = deflated_eigvals(A, X, wr, wi, dummy, D, basis, index)
     if t != 0.0:  # back to x = (y + t) / (1 − t y)
         for k in range(24):
@@ -339,10 +344,31 @@ def _half_angle(x, ph):
     return 1.0, math.cos(ph), math.sin(ph)
 
 
+@nb.njit(**_INLINE)
+def _unit(c, s):
+    """``(cos φ, sin φ)`` of ``φ = atan2(s, c)``: ``(c, s)`` normalised, ``(1, 0)`` at the
+    origin."""
+    h = math.sqrt(c * c + s * s)
+    if not h > 0.0:
+        return 1.0, 0.0
+    g = 1.0 / h
+    return c * g, s * g
+
+
+@nb.njit(**_INLINE)
+def _offset_turns(off):
+    """``(cos, sin)`` of the three offsets, flat."""
+    s0, c0 = sincos(off[0])
+    s1, c1 = sincos(off[1])
+    s2, c2 = sincos(off[2])
+    return (c0, s0, c1, s1, c2, s2)
+
+
 @nb.njit(**_OPTS)
-def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
+def _angles(x3, v, off, cs, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     """θ (6,) of the loop from a real root x3 and its power products ``v (12, 1)``; False if
-    not usable. m (27,), coef (8,) scratch; ``links (4, 4, 4)`` the constant M2..M5."""
+    not usable. m (41,), coef (8,) scratch; ``links (4, 4, 4)`` the constant M2..M5; ``cs``
+    the cosines and sines of the offsets ``off`` (:func:`_offset_turns`)."""
     x4 = _ratio(v, 0)
     x5 = _ratio(v, 1)
     if not (np.isfinite(x4) and np.isfinite(x5)):
@@ -358,14 +384,18 @@ def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
             for c in range(3):
                 m[a * 9 + b * 3 + c] = m3[a] * m4[b] * m5[c]
     # (c1, s1, c2, s2) products in least squares (Manocha–Canny eq. 9): R x = H₈ᵀ (L m − r0)
+    r = m[27:]
+    for i in range(14):
+        r[i] = -Rh[i + 1, 0]
+    for c in range(27):  # column by column: 14 independent sums, each in the order of c
+        mc = m[c]
+        for i in range(14):
+            r[i] += L[i, c] * mc
     for j in range(8):
         coef[j] = 0.0
     for i in range(14):
-        r = -Rh[i + 1, 0]
-        for c in range(27):
-            r += L[i, c] * m[c]
         for j in range(8):
-            coef[j] += H[i, j] * r
+            coef[j] += H[i, j] * r[i]
     for k in range(7, -1, -1):
         acc = coef[k]
         for j in range(k + 1, 8):
@@ -386,11 +416,15 @@ def _angles(x3, v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
     th[2] = ph3 + off[0]
     th[3] = ph4 + off[1]
     th[4] = ph5 + off[2]
-    # θ6 from Z6 = (Z1 M1 … Z5 M5)⁻¹ Ts
-    t = (1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
-    t = _step(M1, REVOLUTE, 0.0, th[0], t)
-    for i in range(4):
-        t = _step(links[i], REVOLUTE, 0.0, th[i + 1], t)
+    # θ6 from Z6 = (Z1 M1 … Z5 M5)⁻¹ Ts; the turns from what is known (no sine or cosine)
+    c, s = _unit(S2, S5)
+    t = (c, -s, 0.0, 0.0, s, c, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0)
+    t = _affine(M1, t)
+    c, s = _unit(S0, S1)
+    t = _affine(links[0], _turn(c, s, t))
+    t = _affine(links[1], _turn(m3[1] * cs[0] - m3[2] * cs[1], m3[2] * cs[0] + m3[1] * cs[1], t))
+    t = _affine(links[2], _turn(m4[1] * cs[2] - m4[2] * cs[3], m4[2] * cs[2] + m4[1] * cs[3], t))
+    t = _affine(links[3], _turn(m5[1] * cs[4] - m5[2] * cs[5], m5[2] * cs[4] + m5[1] * cs[5], t))
     # R6 = G_Rᵀ Ts_R: entries (0, 0), (0, 1), (1, 0), (1, 1)
     r00 = t[0] * Ts[0, 0] + t[4] * Ts[1, 0] + t[8] * Ts[2, 0]
     r01 = t[0] * Ts[0, 1] + t[4] * Ts[1, 1] + t[8] * Ts[2, 1]
@@ -405,7 +439,7 @@ def _scratch():
     """Work arrays of :func:`_solve_pose` (one set per chunk of poses)."""
     return (np.empty((3, 4, 4)), np.empty((15, 9)), np.empty((15, 15)), np.empty((5, 15)),
             np.empty((3, 12, 12)), np.empty((6, 27)), np.empty((12, 36)), np.empty((12, 12)),
-            np.empty((1, 1)), np.empty((3, 24)), np.empty((12, 1)), np.empty(27),
+            np.empty((1, 1)), np.empty((3, 24)), np.empty((12, 1)), np.empty(41),
             np.empty(8), np.empty((3, 6, 7)), np.empty((4, 6)), np.empty(6), np.empty(6),
             np.empty((14, 14)), np.empty((8, 8)), np.empty(8, dtype=np.int64), np.empty((8, 14)),
             np.empty((14, 8)), np.empty(12, dtype=np.int64), np.empty(12), deflate_scratch(),
@@ -425,12 +459,13 @@ def _recover(n, wr, wi, C, T, A, off, L, Rh, H, R, piv, M1, links, Ts, order, si
     tried = 0
     lost = 0
     err = 0.0
+    cs = _offset_turns(off)
     for k in range(24):
         if not abs(wi[k]) <= 1e-6 * (1.0 + abs(wr[k])):
             continue
         tried += 1
         _null_vector(A, wr[k], A2, v, perm, y12, W)
-        if not _angles(wr[k], v, off, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
+        if not _angles(wr[k], v, off, cs, L, Rh, H, R, piv, M1, links, Ts, th, m, coef):
             lost += 1
             continue
         for i in range(6):

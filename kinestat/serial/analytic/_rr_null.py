@@ -51,12 +51,19 @@ _STRUCTURED_PIVOT = 1e-6
 def _pivot_step(M, k, rows, cols, cperm):
     """Step k of Gaussian elimination with complete pivoting on ``M[:rows, :cols]`` (column
     order into cperm); returns the pivot's modulus."""
-    bi, bj, best = k, k, -1.0
-    for i in range(k, rows):
+    best = -1.0
+    for i in range(k, rows):  # the largest modulus (no branch), then its first place
         for j in range(k, cols):
-            a = abs(M[i, j])
-            if a > best:
-                bi, bj, best = i, j, a
+            best = max(best, abs(M[i, j]))
+    bi, bj = k, k
+    for i in range(k, rows):
+        hit = False
+        for j in range(k, cols):
+            if abs(M[i, j]) == best:
+                bi, bj, hit = i, j, True
+                break
+        if hit:
+            break
     if bi != k:
         for j in range(cols):
             M[k, j], M[bi, j] = M[bi, j], M[k, j]
@@ -99,22 +106,20 @@ def _null_back_substitute(U, pivots, cols, z):
 
 
 @nb.njit(**_OPTS)
-def _null_structured(S, v, W, ce):
-    """The null vector ``v (12, 1)`` of ``S = A(x)`` from its structure: rows 0-5 are
-    ``E(x) (6, 9)`` on the power products ``v[0:9]``, rows 6-11 the same on ``v[3:12]`` (the
-    equations times x4). With N (9, 3) a null basis of E, ``v[0:9] = N a``, ``v[3:12] = N b``
-    and the overlap ``N[3:9] a = N[0:6] b`` is a 6x6 singular system: two small eliminations
-    with complete pivoting instead of the 12x12 LU. False (v untouched) where E's rank is not
-    clearly 6 or the overlap's nullity not clearly 1 (relative pivots below
-    ``_STRUCTURED_PIVOT``). ``W (16, 12)``, ``ce (9,)`` (int): scratch."""
+def _null_structured(v, W, ce):
+    """The null vector ``v (12, 1)`` of ``A(x)`` from its structure: rows 0-5 are
+    ``E(x) (6, 9)`` (given in ``W[:6, :9]``) on the power products ``v[0:9]``, rows 6-11 the
+    same on ``v[3:12]`` (the equations times x4). With N (9, 3) a null basis of E,
+    ``v[0:9] = N a``, ``v[3:12] = N b`` and the overlap ``N[3:9] a = N[0:6] b`` is a 6x6
+    singular system: two small eliminations with complete pivoting instead of the 12x12 LU.
+    False (v untouched) where E's rank is not clearly 6 or the overlap's nullity not clearly 1
+    (relative pivots below ``_STRUCTURED_PIVOT``). ``W (16, 12)``, ``ce (9,)`` (int):
+    scratch."""
     E = W[:6, :9]
     M6 = W[6:12, :6]
     Nb = W[6:15, 6:9]
     z = W[15, :9]
     ab = W[12, :6]
-    for i in range(6):
-        for j in range(9):
-            E[i, j] = S[i, j]
     for j in range(9):
         ce[j] = j
     if not _eliminate_checked(E, 6, 6, 9, ce):
@@ -165,17 +170,20 @@ def null_vector(A, x, S, v, perm, y, W):
     two steps of inverse iteration on one LU factorisation (the matrix is singular at an
     eigenvalue); S (12, 12), perm (12,), y (12,), W (:func:`_null_structured`) scratch. For
     |x| > 1 the matrix is divided by x² (better scaled)."""
-    for i in range(12):
-        v[i, 0] = _B0[i]
     if abs(x) <= 1.0:
         c0, c1, c2 = 1.0, x, x * x
     else:
         c0, c1, c2 = 1.0 / (x * x), 1.0 / x, 1.0
+    for i in range(6):  # E(x): all the structured path reads
+        for j in range(9):
+            W[i, j] = c0 * A[0, i, j] + c1 * A[1, i, j] + c2 * A[2, i, j]
+    if _null_structured(v, W, perm):
+        return
+    for i in range(12):
+        v[i, 0] = _B0[i]
     for i in range(12):
         for j in range(12):
             S[i, j] = c0 * A[0, i, j] + c1 * A[1, i, j] + c2 * A[2, i, j]
-    if _null_structured(S, v, W, perm):
-        return
     eliminate(S, 12, TINY_PIVOT, perm)  # factors only; tiny pivots replaced
     for _ in range(2):
         _lu_solve(S, perm, v, y)

@@ -103,7 +103,8 @@ def nearly_real(wr, wi):
     near = np.inf
     for k in range(24):
         if abs(wi[k]) > 1e-6 * (1.0 + abs(wr[k])):
-            near = min(near, abs(wi[k]) / (1.0 + abs(complex(wr[k], wi[k]))))
+            modulus = math.sqrt(wr[k] * wr[k] + wi[k] * wi[k])  # no hypot call: a threshold
+            near = min(near, abs(wi[k]) / (1.0 + modulus))
     return near
 
 

@@ -64,3 +64,18 @@ def test_non_finite_input_is_refused():
     a = np.eye(3)
     a[1, 2] = np.nan
     assert not eigvals(a, 3, np.zeros(3), np.zeros(3))
+
+
+@pytest.mark.parametrize("scale", [1e-150, 1e-120, 1e120, 1e150])
+def test_eigenvalues_scale_with_the_matrix(scale):
+    """Eigenvalues of s·a are s times those of a, at scales where the squares of the entries
+    (the reflectors' norms) are far outside 1e±100, where the sweep rescales its reflector."""
+    rng = np.random.default_rng(7)
+    n = 16
+    a = rng.standard_normal((n, n))
+    wr, wi = np.zeros(n), np.zeros(n)
+    assert eigvals(a.copy(), n, wr, wi)
+    w = wr + 1j * wi
+    assert eigvals(a * scale, n, wr, wi)
+    ws = (wr + 1j * wi) / scale
+    assert _matched(ws, w) <= 1e-10 * np.abs(w).max()
