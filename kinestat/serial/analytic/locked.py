@@ -318,6 +318,8 @@ class LockedPlan:
                 self.one = gl.bind(args, v, None if gl.run is not None else
                                    (_entries()[1], info.take, j), seen)
                 if self.one is not None:  # new values from now on: :func:`single`
+                    if len(_FAST) >= 64:  # as many as _joint_info keeps
+                        _FAST.clear()
                     _FAST[model, j] = gl
                 return
             six = _fast_fold(info, j, v) if info.G1 is not None else None
