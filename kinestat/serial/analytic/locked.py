@@ -291,7 +291,8 @@ class LockedPlan:
     __slots__ = ("model", "pairs", "_six", "free", "_free_array", "_one", "_take", "L", "R",
                  "one", "_args")
 
-    def __init__(self, model: ChainModel, pairs: tuple[tuple[int, float], ...]) -> None:
+    def __init__(self, model: ChainModel, pairs: tuple[tuple[int, float], ...],
+                 seen: bool = False) -> None:
         self.model, self.pairs = model, pairs
         self.L = self.R = None
         self.one = None  # the bound single call (:meth:`bind_one`)
@@ -315,7 +316,11 @@ class LockedPlan:
             if args is not None:  # a general 6R: the kernel's arrays at v, the chain on demand
                 self._args = args
                 self.one = gl.bind(args, v, None if gl.run is not None else
-                                   (_entries()[1], info.take, j))
+                                   (_entries()[1], info.take, j), seen)
+                if self.one is not None:  # new values from now on: :func:`single`
+                    if len(_FAST) >= 64:  # as many as _joint_info keeps
+                        _FAST.clear()
+                    _FAST[model, j] = gl
                 return
             six = _fast_fold(info, j, v) if info.G1 is not None else None
             self._six = six
@@ -484,6 +489,40 @@ class LockedPlan:
 
 _PLANS: dict = {}
 _PLANS_MAX = 256  # a self-motion sampled at up to this many values stays cached
+_SEEN = object()  # in _PLANS: a value :func:`single` has solved once (no plan built)
+_FAST: dict = {}  # (model, joint): its GeneralLock once bound (new values without a plan)
+_MISS = object()
+
+
+def single(model: ChainModel, locked, T, tol: float):
+    """:func:`~kinestat.serial.analytic.ik_all`'s single call with ``locked`` (``T (1, 4, 4)``
+    plain): the result, None where the caller must take the full path, or ``_MISS`` where it
+    must take the plan's bound call. A value a general 6R's joint has not had before runs
+    without a plan (:meth:`~kinestat.serial.analytic.locked_general.GeneralLock.new_value`);
+    a plan is built the second time (:func:`plan`), with the basis of its value."""
+    if len(locked) != 1:
+        return _MISS
+    (j, v), = locked.items()
+    key = (model, j, v)
+    if type(j) is not int or type(v) is not float or key in _PLANS:
+        return _MISS
+    gl = _FAST.get((model, j))
+    if gl is None or not math.isfinite(v):  # j: a joint of the model (a key of _FAST)
+        return _MISS
+    res = gl.new_value(T, tol, v)
+    if res is False:  # a special value: the plan's path
+        return _MISS
+    _keep(key, _SEEN)
+    return res
+
+
+def _keep(key, value) -> None:
+    if len(_PLANS) >= _PLANS_MAX:
+        try:  # the oldest; another thread may have dropped it first
+            _PLANS.pop(next(iter(_PLANS)), None)
+        except (RuntimeError, StopIteration):
+            pass
+    _PLANS[key] = value
 
 
 def plan(model: ChainModel, locked) -> LockedPlan:
@@ -496,7 +535,7 @@ def plan(model: ChainModel, locked) -> LockedPlan:
         if type(j) is int and type(v) is float:
             key = (model, j, v)
             hit = _PLANS.get(key)
-            if hit is not None:
+            if hit is not None and hit is not _SEEN:
                 return hit
             if 0 <= j < model.n == 7 and math.isfinite(v):  # what check_locked checks
                 pairs = ((j, v),)
@@ -504,14 +543,9 @@ def plan(model: ChainModel, locked) -> LockedPlan:
         pairs = check_locked(model, locked)
         key = (model, *pairs[0]) if len(pairs) == 1 else (model, pairs)
         hit = _PLANS.get(key)
-    if hit is None:
-        hit = LockedPlan(model, pairs)
-        if len(_PLANS) >= _PLANS_MAX:
-            try:  # the oldest; another thread may have dropped it first
-                _PLANS.pop(next(iter(_PLANS)), None)
-            except (RuntimeError, StopIteration):
-                pass
-        _PLANS[key] = hit
+    if hit is None or hit is _SEEN:
+        hit = LockedPlan(model, pairs, hit is _SEEN)
+        _keep(key, hit)
     return hit
 
 

@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import math
 import sys
+import threading
 
 import numpy as np
 
@@ -100,6 +101,7 @@ class GeneralLock:
         self.P = self.tail = self.shapes = self.run = self._entry = None
         self._none = np.zeros((3, 0))
         self._basis = _no_basis()
+        self._local = threading.local()  # per thread: the arrays of :meth:`new_value`
         # the terms describe the axes (checked at a fourth value), and no three consecutive
         # axes across j are related pairwise at every value
         related = {pair for pair, m in zip(pairs, self.mode, strict=True) if m}
@@ -199,11 +201,38 @@ class GeneralLock:
         PRESET[six] = ("general", {"axes": home_axes(six)})
         general6r.PRESET[six] = (self.form, args[:9], True)
 
-    def bind(self, args: tuple, v: float, put):
+    def new_value(self, T, tol: float, v: float):
+        """The single call at a value ``v`` not yet seen, once :meth:`bind` has bound one
+        (``self.run``): the kernel's arrays evaluated into this thread's buffers (no new
+        arrays, no per-value objects), the basis found per pose. The result, None where the
+        kernel flags the pose (the full path then), or False where ``v`` is special."""
+        scratch = getattr(self._local, "arrays", None)
+        if scratch is None:
+            scratch = self._local.arrays = self._scratch()
+        values, out, special, args = scratch
+        values[0] = v
+        self._entry(self.P, self.R, self.mode, self.tol_dir, self.tol_len, values, out, special)
+        if special[0]:
+            return False
+        return self.run(T, tol, args, v)
+
+    def _scratch(self) -> tuple:
+        """One thread's ``(values (1,), out (1, m), special (1,), args)`` for
+        :meth:`new_value`: ``args`` as :meth:`arrays`', views into ``out``."""
+        out = np.empty((1, self.P.shape[1]))
+        f = out[0]
+        C, consts, links, LH, L = [f[a:b].reshape(shape) for a, b, shape in self.shapes]
+        C.flags.writeable = False
+        h0, off, order, sign = self.tail
+        args = (C, consts, links, LH, h0, L, off, order, sign) + self._basis
+        return np.empty(1), out, np.empty(1, dtype=bool), args
+
+    def bind(self, args: tuple, v: float, put, seen: bool = False):
         """The single call ``one(T (1, 4, 4) plain, tol)`` on ``args`` (:meth:`arrays`) with
         the joints put back by ``put = (entry, take, j)``, or None while the compiled entry
-        points are not recorded. A value called again gets the spurious subspace's basis
-        (one SVD, about a call's time) in place of the kernel's search per pose (~3 µs)."""
+        points are not recorded. A value called again (``seen``: called once by
+        :meth:`new_value`) gets the spurious subspace's basis (one SVD, about a call's time)
+        in place of the kernel's search per pose."""
         run = self.run
         if run is None:
             cf = sys.modules.get("kinestat.serial.analytic._cf_kernels")
@@ -211,7 +240,7 @@ class GeneralLock:
             run = self.run = general6r.single_call(check, self.form, put)
             if run is None:
                 return None
-        calls = 0
+        calls = int(seen)
 
         def one(T, tol):
             nonlocal args, calls

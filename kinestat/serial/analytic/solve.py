@@ -192,6 +192,21 @@ def _bind_locked(lp):
     return lp.bind_one(kind, data, None if rev is None else _plan(rev)[1])
 
 
+def _locked_one(model: ChainModel, locked, T: np.ndarray, tol, plain: bool):
+    """:func:`ik_all`'s single call with ``locked`` joints on one pose ``T (4, 4)``: the
+    result where a value of a joint is solved without a plan
+    (:func:`~kinestat.serial.analytic.locked.single`), else the plan's bound call (None where
+    the full path must solve it)."""
+    mod = sys.modules.get("kinestat.serial.analytic.locked")
+    if plain and mod is not None and type(locked) is dict:
+        res = mod.single(model, locked, T[None], float(tol))
+        if res is not mod._MISS:
+            return res
+    lp = _locked_plan(model, locked)
+    one = lp.one
+    return _bind_locked(lp) if one is None else one
+
+
 def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float = 1e-9,
            backend: str = "numba", locked: dict | None = None) -> IKAllResult:
     """Every IK solution of the 6-joint ``model`` for poses ``T_base_flange (..., 4, 4)``.
@@ -223,16 +238,11 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
             and isinstance(model, ChainModel):
         # one plain pose, defaults: the closed form's bound single call (after the first); with
         # locked joints, the folded chain's
-        if locked:
-            lp = _locked_plan(model, locked)
-            one = lp.one
-            if one is None:
-                one = _bind_locked(lp)
-        else:
-            one = _plan(model)[1].get("one")
         # C-contiguous, aligned, writeable (NPY_ARRAY_C_CONTIGUOUS | ALIGNED | WRITEABLE)
-        if one is not None and T.dtype is _F64 and T.flags.num & 0x501 == 0x501:
-            res = one(T[None], float(tol))
+        plain = T.dtype is _F64 and T.flags.num & 0x501 == 0x501
+        one = _locked_one(model, locked, T, tol, plain) if locked else _plan(model)[1].get("one")
+        if one is not None and plain:
+            res = one if type(one) is IKAllResult else one(T[None], float(tol))
             if res is not None:
                 return res
     if not isinstance(model, ChainModel):

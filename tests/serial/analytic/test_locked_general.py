@@ -184,3 +184,40 @@ def test_a_formulation_missing_a_few_poses_is_not_kept():
     for v in rng.uniform(-np.pi, np.pi, 4):
         assert general6r._raw_completeness(fold.__wrapped__(model, ((j, float(v)),)), gl.form,
                                            64) == 1.0
+
+
+def test_a_new_value_runs_without_a_plan_then_with_its_basis():
+    """A value not seen before is solved without a plan (only its value recorded); called
+    again, its plan is built and takes the value's basis of the spurious subspace: the same
+    solutions each time. Threads solving new values at once (each its own buffers) give
+    each pose the solutions of the freshly folded chain."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from kinestat.serial.analytic import locked
+
+    model = _arm("panda")
+    _adopted(model)
+    rng = np.random.default_rng(51)
+    q = rng.uniform(-np.pi, np.pi, (24, 7))
+    q[:, J] = rng.uniform(-np.pi, np.pi, 24)
+    T = kinestat.fk(model, q)
+    v = float(q[0, J])
+    first = ik_all(model, T[0], locked={J: v}).solutions()
+    assert locked._PLANS[model, J, v] is locked._SEEN
+    second = ik_all(model, T[0], locked={J: v}).solutions()
+    lp = locked._PLANS[model, J, v]
+    assert isinstance(lp, locked.LockedPlan) and lp._six is None
+    third = ik_all(model, T[0], locked={J: v}).solutions()
+    fresh = _fresh_solutions(model, v, T[0])
+    for sols in (first, second, third):
+        assert len(sols) == len(fresh)
+        assert all(np.min(wrapped_distance(fresh, s)) < 1e-7 for s in sols)
+
+    def solve(i):
+        return ik_all(model, T[i], locked={J: float(q[i, J])}).solutions()
+    with ThreadPoolExecutor(4) as pool:
+        got = list(pool.map(solve, range(1, 24)))
+    for i, sols in enumerate(got, start=1):
+        fresh = _fresh_solutions(model, float(q[i, J]), T[i])
+        assert len(sols) == len(fresh)
+        assert all(np.min(wrapped_distance(fresh, s)) < 1e-7 for s in sols)
