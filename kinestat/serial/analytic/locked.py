@@ -529,20 +529,15 @@ def plan(model: ChainModel, locked) -> LockedPlan:
     """The :class:`LockedPlan` of ``model`` with the ``locked`` ``{joint: value}`` (checked by
     :func:`check_locked` on first use; cached per model and values, the oldest dropped
     beyond ``_PLANS_MAX``)."""
-    pairs = None
     if len(locked) == 1:  # a dict of one int joint and a float value: look up directly
         (j, v), = locked.items()
         if type(j) is int and type(v) is float:
-            key = (model, j, v)
-            hit = _PLANS.get(key)
+            hit = _PLANS.get((model, j, v))
             if hit is not None and hit is not _SEEN:
                 return hit
-            if 0 <= j < model.n == 7 and math.isfinite(v):  # what check_locked checks
-                pairs = ((j, v),)
-    if pairs is None:
-        pairs = check_locked(model, locked)
-        key = (model, *pairs[0]) if len(pairs) == 1 else (model, pairs)
-        hit = _PLANS.get(key)
+    pairs = check_locked(model, locked)
+    key = (model, *pairs[0]) if len(pairs) == 1 else (model, pairs)
+    hit = _PLANS.get(key)
     if hit is None or hit is _SEEN:
         hit = LockedPlan(model, pairs, hit is _SEEN)
         _keep(key, hit)

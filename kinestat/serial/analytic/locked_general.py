@@ -15,7 +15,7 @@ building L take ~2 ms. The spurious subspace's basis is left to the kernel (foun
 Which values share the geometry: the axes after joint j turn about it, and for an axis pair
 across j, ``n = wa × wb``, ``(rb − ra) · n`` (the lines' reciprocal product: Plücker
 coordinates move linearly under the turn) and ``(rb − ra) × wa`` are affine in ``(1, cos v,
-sin v)`` too. A value where a pair becomes parallel, meets or coincides (within 1000 times
+sin v)`` too. A value where a pair becomes parallel, meets or coincides (within 10 times
 :func:`~kinestat.serial.analytic.geometry.classify`'s tolerance) that does not at every value
 is special: the geometry class or the elimination may change there, and it takes the path of
 any new chain (fold, classify, formulation search). At every other value the class's tests
@@ -182,6 +182,11 @@ class GeneralLock:
         out, at_special = self._eval(self.P, v)
         if at_special and not special:
             return None
+        return self._views(out)
+
+    def _views(self, out: np.ndarray) -> tuple:
+        """The kernel's pose-independent arguments as views into the flat values ``out (1,
+        m)`` of :meth:`_eval`, the basis found per pose."""
         f = out[0]
         C, consts, links, LH, L = [f[a:b].reshape(shape) for a, b, shape in self.shapes]
         C.flags.writeable = False  # as a chain's constants (the kernel's argument types)
@@ -220,12 +225,7 @@ class GeneralLock:
         """One thread's ``(values (1,), out (1, m), special (1,), args)`` for
         :meth:`new_value`: ``args`` as :meth:`arrays`', views into ``out``."""
         out = np.empty((1, self.P.shape[1]))
-        f = out[0]
-        C, consts, links, LH, L = [f[a:b].reshape(shape) for a, b, shape in self.shapes]
-        C.flags.writeable = False
-        h0, off, order, sign = self.tail
-        args = (C, consts, links, LH, h0, L, off, order, sign) + self._basis
-        return np.empty(1), out, np.empty(1, dtype=bool), args
+        return np.empty(1), out, np.empty(1, dtype=bool), self._views(out)
 
     def bind(self, args: tuple, v: float, put, seen: bool = False):
         """The single call ``one(T (1, 4, 4) plain, tol)`` on ``args`` (:meth:`arrays`) with
