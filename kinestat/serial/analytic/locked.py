@@ -21,7 +21,14 @@ from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses
 from kinestat.serial.analytic.closed_form import _perp, pieper_parts
-from kinestat.serial.analytic.geometry import PRESET, HomeAxes, classify, classify_axes, home_axes
+from kinestat.serial.analytic.geometry import (
+    PRESET,
+    HomeAxes,
+    check_independent,
+    classify,
+    classify_axes,
+    home_axes,
+)
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["fold", "expand", "plan", "LockedPlan", "SelfMotion", "self_motion_values"]
@@ -58,6 +65,7 @@ def check_locked(model: ChainModel, locked) -> tuple[tuple[int, float], ...]:
     if model.n - len(pairs) != 6:
         raise ModelError(f"ik_all: model {model.name!r} has {model.n} joints and {len(pairs)} "
                          f"locked; all-solutions IK needs exactly 6 free joints")
+    check_independent(model, held={j for j, _ in pairs})
     return tuple(sorted(pairs))
 
 

@@ -22,7 +22,7 @@ from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import closed_form
 from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses, plain_poses
-from kinestat.serial.analytic.geometry import PRESET, classify
+from kinestat.serial.analytic.geometry import PRESET, check_independent, classify
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.ik_methods import get as _robot_method
 from kinestat.serial.ik_methods import registered as _robot_methods
@@ -58,6 +58,7 @@ def _check_chain(model: ChainModel) -> None:
                 f"all-solutions solvers handle revolute and prismatic joints only (q and q + 2π "
                 f"of a screw joint are different configurations) — use kinestat.ik for a "
                 f"numerical solution")
+    check_independent(model)
     if model.prismatic.any():
         from kinestat.serial.analytic import decoupled  # lazy: start-up (prismatic arms only)
 
