@@ -30,7 +30,8 @@ from kinestat.io.textfile import read_text_file
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import Joint
 
-__all__ = ["to_urdf", "from_urdf", "read_urdf", "METRES_PER_UNIT", "metres_per_unit"]
+__all__ = ["to_urdf", "from_urdf", "read_urdf", "parse_robot_xml", "METRES_PER_UNIT",
+           "metres_per_unit"]
 
 #: metres in one unit of each length unit a model may use
 METRES_PER_UNIT = {"mm": 1e-3, "cm": 1e-2, "m": 1.0, "in": 0.0254, "ft": 0.3048}
@@ -150,7 +151,7 @@ def _check_joint(j: ET.Element, where: str, source: str) -> None:
                          "the chain before it (tip=, --tip)", file=source)
 
 
-def _parse_xml(text: str, source: str) -> ET.Element:
+def parse_robot_xml(text: str, source: str) -> ET.Element:
     """The ``<robot>`` element of ``text``, its tags without XML namespaces: a file that
     declares a default namespace (``<robot xmlns="...">``) names its elements ``{ns}joint``, and
     URDF readers go by the local names."""
@@ -210,6 +211,8 @@ def _path_to_tip(root: ET.Element, tip: str | None, source: str,
     names: set[str | None] = set()
     for j in root.findall("joint"):
         parent, child = j.find("parent"), j.find("child")
+        if j.get("name") is None:
+            raise ParseError("a <joint> has no name attribute", file=source)
         if parent is None or child is None:
             raise ParseError(f"joint {j.get('name')!r} lacks a parent or child", file=source)
         if j.get("name") in names:
@@ -343,7 +346,7 @@ def from_urdf(
     if scale is None:
         scale = 1.0 / metres_per_unit(length_unit or "m")
     length_unit = length_unit or "m"
-    root = _parse_xml(text, source)
+    root = parse_robot_xml(text, source)
     path = _path_to_tip(root, tip, source, base)
     consts = [np.eye(4)]
     kinds: list[Joint] = []
@@ -369,8 +372,11 @@ def from_urdf(
         ax = j.find("axis")
         axis = _floats(ax.get("xyz") if ax is not None else "1 0 0", 3, where + " axis", source)
         nrm = np.linalg.norm(axis)
-        if nrm < 1e-12:
-            raise ParseError(f"{where}: zero axis", file=source)
+        if nrm < 1e-12:  # an <axis> without xyz is zero too (urdfdom's reading)
+            said = f"xyz={ax.get('xyz')!r}" if ax.get("xyz") else "<axis> without xyz"
+            raise ParseError(f"{where}: the joint axis is zero ({said}); give "
+                             "<axis xyz=\"...\"/> a direction, or drop <axis> for URDF's "
+                             "default 1 0 0", file=source)
         A = _align_z(axis / nrm)
         consts[-1] = consts[-1] @ Tj @ A
         consts.append(A.T.copy())  # the inverse of a rotation

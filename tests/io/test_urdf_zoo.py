@@ -144,6 +144,7 @@ def test_tricky_valid_files_equal_pinocchio(variant, rng):
      "link 'l2' is declared twice"),
     (lambda t: t.replace('<parent link="l3"/>', '<parent link="nowhere"/>'),
      "joint 'j4': its parent link 'nowhere' is not declared"),
+    (lambda t: t.replace(' name="j3"', ""), "a <joint> has no name"),
 ])
 def test_an_ambiguous_or_broken_tree_is_one_parse_error(change, match, rng):
     """Duplicate names and undeclared links: accepted (or the joint ignored) before; one error
@@ -207,3 +208,28 @@ def test_a_locked_joint_of_the_pair_frees_ik_all(rng):
         assert np.abs(data.oMf[fid].homogeneous - T).max() < 1e-9
     with pytest.raises(ModelError, match="joints 6 and 7"):
         kinestat.ik_all(m, T, locked={2: q[2]})
+
+
+def test_an_axis_without_xyz_is_named(rng):
+    """``<axis/>`` is a zero axis (urdfdom reads it so); the error says which joint and why,
+    and no <axis> at all is URDF's default x axis, as Pinocchio reads it."""
+    body, tip = _arm(rng)
+    j3_axis = body.split('name="j3"', 1)[1].split('<axis xyz="', 1)[1].split('"')[0]
+    with pytest.raises(ParseError, match="joint 'j3': the joint axis is zero .<axis> without"):
+        from_urdf(_robot(body.replace(f'<axis xyz="{j3_axis}"/>', "<axis/>")), tip=tip)
+    _, worst = _agree_with_pinocchio(_robot(body.replace(f'<axis xyz="{j3_axis}"/>', "")), tip,
+                                     rng)
+    assert worst < 1e-12
+
+
+def test_visuals_of_a_namespaced_file(tmp_path, rng):
+    """The viewer's mesh reader reads the same elements as the chain loader (a default XML
+    namespace included): a package:// mesh that does not exist is reported, not fatal."""
+    from kinestat.io.urdf_visuals import read_visuals
+
+    body, tip = _arm(rng, mesh=True)
+    p = tmp_path / "ns.urdf"
+    p.write_text(_robot(body, '<robot name="zoo" xmlns="http://x.org/u">'), encoding="utf-8")
+    visuals, _ = read_visuals(p)
+    assert len(visuals) == 7 and all(v.path is None and v.missing for v in visuals)
+    assert kinestat.load(p, tip=tip).n == 6
