@@ -58,11 +58,11 @@ def _check_chain(model: ChainModel) -> None:
                 f"all-solutions solvers handle revolute and prismatic joints only (q and q + 2π "
                 f"of a screw joint are different configurations) — use kinestat.ik for a "
                 f"numerical solution")
-    check_independent(model)
     if model.prismatic.any():
         from kinestat.serial.analytic import decoupled  # lazy: start-up (prismatic arms only)
 
         decoupled.plan(model)  # raises, naming why, outside the decoupled class
+    check_independent(model)
 
 
 @lru_cache(maxsize=64)
