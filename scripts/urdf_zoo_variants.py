@@ -210,10 +210,37 @@ def gripper(root, tip, rng):
     return tip
 
 
+def prismatic_first(root, tip, rng):
+    """The first moving joint made prismatic (travel ±0.3 m along its axis): a spherical-wrist
+    arm then takes the decoupled all-solution solver."""
+    j = _moving(root, tip)[0]
+    j.set("type", "prismatic")
+    lim = j.find("limit")
+    if lim is None:
+        lim = ET.SubElement(j, "limit", effort="1", velocity="1")
+    lim.set("lower", "-0.3")
+    lim.set("upper", "0.3")
+    return tip
+
+
+def prismatic_lateral(root, tip, rng):
+    """The first moving joint made prismatic along the second one's axis (a PRR positioning
+    chain that moves the wrist centre in three directions)."""
+    path = _path(root, tip)
+    moving = [k for k, j in enumerate(path) if j.get("type") != "fixed"]
+    T = np.eye(4)
+    for j in path[moving[0] + 1:moving[1] + 1]:
+        T = T @ _origin(j)
+    prismatic_first(root, tip, rng)
+    _set_axis(path[moving[0]], T[:3, :3] @ _axis(path[moving[1]]))
+    return tip
+
+
 VARIANTS = {"fixed-split": fixed_split, "world-joint": world_joint, "tool-rot": tool_rot,
             "reframed": reframed, "gimbal": gimbal, "negated-axes": negated_axes,
             "continuous": continuous, "wide-limits": wide_limits, "scientific": scientific,
-            "missing-meshes": missing_meshes, "gripper": gripper}
+            "missing-meshes": missing_meshes, "gripper": gripper,
+            "prismatic-first": prismatic_first, "prismatic-lateral": prismatic_lateral}
 
 
 def _decorate(text: str) -> str:
