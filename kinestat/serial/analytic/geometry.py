@@ -26,13 +26,19 @@ from kinestat.mechanism.chain import ChainModel
 from kinestat.spatial.transforms import cross3  # NumPy's cross costs ~10 µs a call
 
 __all__ = ["HomeAxes", "home_axes", "meet", "parallel", "classify", "classify_axes", "cross3",
-           "norm3", "PRESET", "same_line_pairs", "check_independent"]
+           "norm3", "PRESET", "DERIVED", "same_line_pairs", "check_independent"]
 
 
 #: geometry classes found without :func:`classify`, by a caller that built the model from one
 #: already classified (a locked arm's chain folded at a new value: its axes are the folded
 #: chain's moved by the locked joint's turn): model -> ``(kind, data)``
 PRESET: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+#: chains derived from an arm already checked by :func:`check_independent`: reversed, or
+#: folded at locked values (:mod:`kinestat.serial.analytic.locked`), where a pair on one line
+#: only at a locked value (the Panda's joints 1 and 3 at q2 = 0) is a singular value of the
+#: arm, not joints that act as one (the arm's own consecutive pairs are checked before locking)
+DERIVED: weakref.WeakSet = weakref.WeakSet()
 
 
 @dataclass(frozen=True, eq=False, init=False)  # __init__ below: see there
