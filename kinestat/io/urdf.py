@@ -30,7 +30,8 @@ from kinestat.io.textfile import read_text_file
 from kinestat.mechanism.chain import ChainModel
 from kinestat.mechanism.joints import Joint
 
-__all__ = ["to_urdf", "from_urdf", "read_urdf", "METRES_PER_UNIT", "metres_per_unit"]
+__all__ = ["to_urdf", "from_urdf", "read_urdf", "parse_robot_xml", "METRES_PER_UNIT",
+           "metres_per_unit"]
 
 #: metres in one unit of each length unit a model may use
 METRES_PER_UNIT = {"mm": 1e-3, "cm": 1e-2, "m": 1.0, "in": 0.0254, "ft": 0.3048}
@@ -150,6 +151,37 @@ def _check_joint(j: ET.Element, where: str, source: str) -> None:
                          "the chain before it (tip=, --tip)", file=source)
 
 
+def parse_robot_xml(text: str, source: str) -> ET.Element:
+    """The ``<robot>`` element of ``text``, its tags without XML namespaces: a file that
+    declares a default namespace (``<robot xmlns="...">``) names its elements ``{ns}joint``, and
+    URDF readers go by the local names."""
+    try:
+        root = ET.fromstring(text)
+    except ET.ParseError as exc:
+        raise ParseError(f"not valid XML: {exc}", file=source) from exc
+    for el in root.iter():
+        if isinstance(el.tag, str) and el.tag.startswith("{"):
+            el.tag = el.tag.rsplit("}", 1)[1]
+    if root.tag != "robot":
+        raise ParseError(f"the root element must be <robot>, not <{root.tag}>", file=source)
+    return root
+
+
+def _declared_links(root: ET.Element, source: str) -> set[str]:
+    """The names of the ``<link>`` elements; a link without a name or declared twice is a
+    ParseError naming it (the tree would be ambiguous)."""
+    links: set[str] = set()
+    for lk in root.findall("link"):
+        name = lk.get("name")
+        if name is None:
+            raise ParseError("a <link> has no name attribute", file=source)
+        if name in links:
+            raise ParseError(f"link {name!r} is declared twice (<link name={name!r}>); link "
+                             "names must be unique", file=source)
+        links.add(name)
+    return links
+
+
 def _leaves_below(start: str, children: dict[str, list[str]]) -> list[str]:
     """Leaf links below ``start`` (itself if it has no child), depth first, linear time."""
     leaves, stack, seen = [], [start], set()
@@ -175,10 +207,23 @@ def _path_to_tip(root: ET.Element, tip: str | None, source: str,
     """
     joint_to: dict[str, ET.Element] = {}  # child link -> the joint leading to it
     parents_of: dict[str, str | None] = {}  # child link -> its parent link
+    link_set = _declared_links(root, source)
+    names: set[str | None] = set()
     for j in root.findall("joint"):
         parent, child = j.find("parent"), j.find("child")
+        if j.get("name") is None:
+            raise ParseError("a <joint> has no name attribute", file=source)
         if parent is None or child is None:
             raise ParseError(f"joint {j.get('name')!r} lacks a parent or child", file=source)
+        if j.get("name") in names:
+            raise ParseError(f"joint {j.get('name')!r} is declared twice; joint names must be "
+                             "unique", file=source)
+        names.add(j.get("name"))
+        for role, el in (("parent", parent), ("child", child)):
+            if el.get("link") not in link_set:
+                raise ParseError(f"joint {j.get('name')!r}: its {role} link "
+                                 f"{el.get('link')!r} is not declared (no <link "
+                                 f"name={el.get('link')!r}>)", file=source)
         c = child.get("link")
         if c in joint_to:
             raise ParseError(f"joint {j.get('name')!r}: link {c!r} is already the child of "
@@ -187,7 +232,6 @@ def _path_to_tip(root: ET.Element, tip: str | None, source: str,
         joint_to[c] = j
         parents_of[c] = parent.get("link")
     links = [lk.get("name") for lk in root.findall("link")]
-    link_set = set(links)
     if base is None:
         roots = [lk for lk in links if lk not in joint_to]
         if len(roots) != 1:
@@ -302,12 +346,7 @@ def from_urdf(
     if scale is None:
         scale = 1.0 / metres_per_unit(length_unit or "m")
     length_unit = length_unit or "m"
-    try:
-        root = ET.fromstring(text)
-    except ET.ParseError as exc:
-        raise ParseError(f"not valid XML: {exc}", file=source) from exc
-    if root.tag != "robot":
-        raise ParseError("the root element must be <robot>", file=source)
+    root = parse_robot_xml(text, source)
     path = _path_to_tip(root, tip, source, base)
     consts = [np.eye(4)]
     kinds: list[Joint] = []
@@ -333,8 +372,11 @@ def from_urdf(
         ax = j.find("axis")
         axis = _floats(ax.get("xyz") if ax is not None else "1 0 0", 3, where + " axis", source)
         nrm = np.linalg.norm(axis)
-        if nrm < 1e-12:
-            raise ParseError(f"{where}: zero axis", file=source)
+        if nrm < 1e-12:  # an <axis> without xyz is zero too (urdfdom's reading)
+            said = f"xyz={ax.get('xyz')!r}" if ax.get("xyz") else "<axis> without xyz"
+            raise ParseError(f"{where}: the joint axis is zero ({said}); give "
+                             "<axis xyz=\"...\"/> a direction, or drop <axis> for URDF's "
+                             "default 1 0 0", file=source)
         A = _align_z(axis / nrm)
         consts[-1] = consts[-1] @ Tj @ A
         consts.append(A.T.copy())  # the inverse of a rotation

@@ -25,8 +25,8 @@ from pathlib import Path
 
 import numpy as np
 
-from kinestat.errors import ParseError
 from kinestat.io.textfile import read_text_file
+from kinestat.io.urdf import parse_robot_xml
 
 __all__ = ["Visual", "MESH_FORMATS", "read_visuals", "resolve_mesh", "link_poses"]
 
@@ -154,10 +154,7 @@ def _color(visual: ET.Element, materials: dict[str, str]) -> str | None:
 def read_visuals(path: str | os.PathLike) -> tuple[list[Visual], ET.Element]:
     """The visual meshes of a URDF file (and its parsed XML root)."""
     p = Path(path)
-    try:
-        root = ET.fromstring(read_text_file(p, "URDF file"))
-    except ET.ParseError as exc:
-        raise ParseError(f"not valid XML: {exc}", file=str(p)) from exc
+    root = parse_robot_xml(read_text_file(p, "URDF file"), str(p))
     materials = {}
     for m in root.findall("material"):
         c = m.find("color")

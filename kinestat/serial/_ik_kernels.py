@@ -268,17 +268,18 @@ def _ldl_solve(A, x, damp, n):
 
 
 @nb.njit(**_OPTS)
-def _damped_step(J, t, e, mu, L, inv_L, kinds, Js, A, x):
+def _damped_step(J, t, e, mu, L, inv_L, kinds, free, Js, A, x):
     """``δq`` into ``x``: ``(JᵀJ + μ s I) δx = Jᵀ e`` with ``J = [J_ω; (J_v − p × J_ω)/L] · D``
     (prismatic columns scaled by ``D = L``), ``s = trace(JᵀJ)/n``, ``δq = D δx`` — the
     reference's ``damped_step``, solved by Cholesky. ``Js (n, 6)`` holds the scaled Jacobian
-    transposed, ``A (n, n)`` the factor. False when the system is not positive definite in
-    floating point or the step is not finite (the step is then rejected)."""
+    transposed, ``A (n, n)`` the factor; ``free (n,)`` multiplies ``D`` (0: a joint blocked on
+    a limit, :func:`_block`). False when the system is not positive definite in floating
+    point or the step is not finite (the step is then rejected)."""
     n = J.shape[1]
     px, py, pz = t[3], t[7], t[11]
     for j in range(n):
         wx, wy, wz = J[0, j], J[1, j], J[2, j]
-        D = L if kinds[j] == PRISMATIC else 1.0
+        D = (L if kinds[j] == PRISMATIC else 1.0) * free[j]
         sv = inv_L * D
         Js[j, 0] = wx * D
         Js[j, 1] = wy * D
@@ -304,9 +305,24 @@ def _damped_step(J, t, e, mu, L, inv_L, kinds, Js, A, x):
     for j in range(n):
         if kinds[j] == PRISMATIC:
             x[j] *= L
+        x[j] *= free[j]
         if not math.isfinite(x[j]):
             ok = False
     return ok
+
+
+@nb.njit(**_OPTS)
+def _block(q, dq, kinds, lo, hi, free):
+    """The reference's ``blocked_joints``: ``free[j] = 0`` for each joint on a limit that the
+    step ``dq`` pushes it beyond (prismatic, or revolute with less than a turn of range);
+    True when any is."""
+    any_blocked = False
+    for j in range(q.shape[0]):
+        bounded = kinds[j] == PRISMATIC or hi[j] - lo[j] < _TWO_PI
+        if bounded and ((q[j] <= lo[j] and dq[j] < 0) or (q[j] >= hi[j] and dq[j] > 0)):
+            free[j] = 0.0
+            any_blocked = True
+    return any_blocked
 
 
 # -- joint limits --------------------------------------------------------------------------------
@@ -375,6 +391,7 @@ def _solve(C, kinds, pitch, lo, hi, q0, M, L, pos_tol, rot_tol, max_iter, restar
     A = np.empty((n, n))
     e = np.empty(6)
     en = np.empty(6)
+    free = np.ones(n)
 
     _project(q0, q0, kinds, lo, hi, limits, q)
     t = _fk_jac(C, kinds, pitch, q, J)
@@ -394,7 +411,13 @@ def _solve(C, kinds, pitch, lo, hi, q0, M, L, pos_tol, rot_tol, max_iter, restar
         done = pe <= POLISHED * pos_tol_s and re <= POLISHED * rot_tol
         accept = False
         if not done:
-            if _damped_step(J, t, e, mu, L, inv_L, kinds, Js, A, dq):
+            stepped = _damped_step(J, t, e, mu, L, inv_L, kinds, free, Js, A, dq)
+            if stepped and limits and _block(q, dq, kinds, lo, hi, free):
+                # a joint on a limit the step pushes it beyond: solve without it
+                stepped = _damped_step(J, t, e, mu, L, inv_L, kinds, free, Js, A, dq)
+                for j in range(n):
+                    free[j] = 1.0
+            if stepped:
                 for j in range(n):
                     qt[j] = q[j] + dq[j]
                 _project(qt, q, kinds, lo, hi, limits, qn)

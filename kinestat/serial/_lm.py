@@ -16,7 +16,7 @@ from kinestat.serial.fk import fk_frames
 from kinestat.serial.jacobian import jacobian_from_frames
 from kinestat.spatial.se3 import so3_log
 
-__all__ = ["IKResult", "wrap_joints", "wrap_rotating", "damped_step"]
+__all__ = ["IKResult", "wrap_joints", "wrap_rotating", "damped_step", "blocked_joints"]
 
 
 def wrap_joints(model: ChainModel, q, reference=None) -> np.ndarray:
@@ -89,21 +89,35 @@ def _errors(model: ChainModel, q: np.ndarray, Tt: np.ndarray, L: float):
     return F, e, np.sum(e * e, axis=-1)
 
 
+def blocked_joints(model: ChainModel, q: np.ndarray, step: np.ndarray) -> np.ndarray | None:
+    """``free (k, n)``: 0.0 for each joint that sits on a limit the ``step`` pushes it beyond
+    (a prismatic joint, or a revolute one whose limits span less than a turn), 1.0 for the
+    others; None when no joint is blocked. Clipping such a joint leaves a step computed as if
+    it moved, which the others do not make up for: the iteration stalls on the limit (a
+    gripper's finger at the end of its travel); the step is solved again without it."""
+    bounded = model.prismatic | (model.upper - model.lower < 2 * math.pi)
+    out = bounded & (((q <= model.lower) & (step < 0)) | ((q >= model.upper) & (step > 0)))
+    return np.where(out, 0.0, 1.0) if out.any() else None
+
+
 def damped_step(model: ChainModel, frames: np.ndarray, e: np.ndarray, mu: np.ndarray,
-                L: float) -> np.ndarray:
+                L: float, free: np.ndarray | None = None) -> np.ndarray:
     """One Levenberg–Marquardt step ``δq (k, n)`` for the scaled errors ``e = [ω; δp/L]``.
 
     ``(JᵀJ + μ s I) δx = Jᵀ e`` with ``J = [J_ω; (J_v − p × J_ω)/L] · D`` (the space Jacobian's
     velocity rows moved to the end point p, lengths over L, prismatic columns scaled by
-    ``D = L``), ``s = trace(JᵀJ)/n``, and ``δq = D δx``.
+    ``D = L``), ``s = trace(JᵀJ)/n``, and ``δq = D δx``. ``free (k, n)``
+    (:func:`blocked_joints`) multiplies ``D``: a blocked joint's column is zero and its step 0.
     """
     n = model.n
     D = np.where(model.prismatic, L, 1.0)
+    if free is not None:
+        D = D * free
     J = jacobian_from_frames(model, frames)
     p = frames[..., -1, :3, 3]
     Jw = J[..., :3, :]
     Jv = J[..., 3:, :] - np.cross(p[..., None, :], np.swapaxes(Jw, -1, -2)).swapaxes(-1, -2)
-    Js = np.concatenate([Jw, Jv / L], axis=-2) * D
+    Js = np.concatenate([Jw, Jv / L], axis=-2) * D[..., None, :]
     JtJ = np.swapaxes(Js, -1, -2) @ Js
     g = np.einsum("...ji,...j->...i", Js, e)
     s = np.maximum(np.trace(JtJ, axis1=-2, axis2=-1) / n, 1e-12)

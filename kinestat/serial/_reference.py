@@ -14,6 +14,7 @@ from kinestat.serial._lm import (
     IKResult,
     _errors,
     _random_q,
+    blocked_joints,
     damped_step,
     wrap_joints,
     wrap_rotating,
@@ -121,7 +122,11 @@ def _lm_numpy(model: ChainModel, Tt: np.ndarray, qs: np.ndarray, L: float, pos_t
         re = np.linalg.norm(e[:, :3], axis=-1)
         within = (pe <= WITHIN * pos_tol_s) & (re <= WITHIN * rot_tol)
         done = (pe <= POLISHED * pos_tol_s) & (re <= POLISHED * rot_tol)
-        q_new = project(qa + damped_step(model, F, e, mu[idx], L), qa)
+        step = damped_step(model, F, e, mu[idx], L)
+        free = blocked_joints(model, qa, step) if respect_limits else None
+        if free is not None:  # a joint on a limit the step pushes it beyond: solve without it
+            step = damped_step(model, F, e, mu[idx], L, free)
+        q_new = project(qa + step, qa)
         F_new, e_new, cost_new = _errors(model, q_new, Tt[idx], L)
         accept = (cost_new < cost) & ~done
         mu[idx] = np.where(accept, np.maximum(mu[idx] / MU_DOWN, MU_MIN), mu[idx] * MU_UP)

@@ -21,17 +21,24 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.spatial.transforms import cross3  # NumPy's cross costs ~10 µs a call
 
 __all__ = ["HomeAxes", "home_axes", "meet", "parallel", "classify", "classify_axes", "cross3",
-           "norm3", "PRESET"]
+           "norm3", "PRESET", "DERIVED", "same_line_pairs", "check_independent"]
 
 
 #: geometry classes found without :func:`classify`, by a caller that built the model from one
 #: already classified (a locked arm's chain folded at a new value: its axes are the folded
 #: chain's moved by the locked joint's turn): model -> ``(kind, data)``
 PRESET: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+#: chains derived from an arm already checked by :func:`check_independent`: reversed, or
+#: folded at locked values (:mod:`kinestat.serial.analytic.locked`), where a pair on one line
+#: only at a locked value (the Panda's joints 1 and 3 at q2 = 0) is a singular value of the
+#: arm, not joints that act as one (the arm's own consecutive pairs are checked before locking)
+DERIVED: weakref.WeakSet = weakref.WeakSet()
 
 
 @dataclass(frozen=True, eq=False, init=False)  # __init__ below: see there
@@ -113,3 +120,42 @@ def classify_axes(kinds: list[str], ax: HomeAxes, tol: float = 1e-9) -> tuple[st
         if p56 is not None and not parallel(ax, 0, 1, tol) and not parallel(ax, 4, 1, tol):
             return "three-parallel", {"axes": ax, "p56": p56}
     return "general", {"axes": ax}
+
+
+def same_line_pairs(model: ChainModel, tol: float = 1e-9) -> list[tuple[int, int]]:
+    """Consecutive joints ``(i, i + 1)`` that act as one: two revolute joints about one line,
+    or two prismatic joints along parallel lines. The axis of joint i + 1 is fixed in the link
+    joint i moves, so a pair on one line at q = 0 stays so at every q: only ``q_i ± q_(i+1)``
+    counts, the chain has a degree of freedom fewer than joints, and no pose has isolated IK
+    solutions (a gripper's spin joint after a wrist roll; an R-P pair on one line is a
+    cylindrical joint and counts twice)."""
+    ax = home_axes(model)
+    kinds = [j.kind for j in model.joints]
+    out = []
+    for i in range(model.n - 1):
+        if kinds[i] != kinds[i + 1] or kinds[i] not in ("revolute", "prismatic"):
+            continue
+        if not parallel(ax, i, i + 1, tol):
+            continue
+        off = norm3(cross3(ax.r[i + 1] - ax.r[i], ax.w[i]))
+        if kinds[i] == "prismatic" or off <= tol * ax.scale:
+            out.append((i, i + 1))
+    return out
+
+
+def check_independent(model: ChainModel, what: str = "ik_all", held=()) -> None:
+    """A ModelError naming the first pair of :func:`same_line_pairs` of ``model`` (neither of
+    them among the ``held`` joints, 0-based), if any."""
+    pairs = [p for p in same_line_pairs(model) if p[0] not in held and p[1] not in held]
+    if not pairs:
+        return
+    i, k = pairs[0]
+    names = f" ({model.joints[i].name!r}, {model.joints[k].name!r})" \
+        if model.joints[i].name and model.joints[k].name else ""
+    how = "turn about one line" if model.joints[i].kind == "revolute" else \
+        "slide along parallel lines"
+    raise ModelError(
+        f"{what}: joints {i + 1} and {k + 1}{names} of model {model.name!r} {how}: only their "
+        f"sum (or difference) counts, so every pose's solutions form a continuum, not "
+        f"isolated solutions; end the chain before joint {k + 1} (a URDF's tip=, --tip), lock "
+        f"one of them (locked=, --lock) on a longer arm, or use kinestat.ik for one solution")

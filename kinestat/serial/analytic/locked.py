@@ -21,7 +21,15 @@ from kinestat.errors import InputError, ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses
 from kinestat.serial.analytic.closed_form import _perp, pieper_parts
-from kinestat.serial.analytic.geometry import PRESET, HomeAxes, classify, classify_axes, home_axes
+from kinestat.serial.analytic.geometry import (
+    DERIVED,
+    PRESET,
+    HomeAxes,
+    check_independent,
+    classify,
+    classify_axes,
+    home_axes,
+)
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["fold", "expand", "plan", "LockedPlan", "SelfMotion", "self_motion_values"]
@@ -58,6 +66,7 @@ def check_locked(model: ChainModel, locked) -> tuple[tuple[int, float], ...]:
     if model.n - len(pairs) != 6:
         raise ModelError(f"ik_all: model {model.name!r} has {model.n} joints and {len(pairs)} "
                          f"locked; all-solutions IK needs exactly 6 free joints")
+    check_independent(model, held={j for j, _ in pairs})
     return tuple(sorted(pairs))
 
 
@@ -74,9 +83,11 @@ def fold(model: ChainModel, locked: tuple[tuple[int, float], ...]) -> ChainModel
         del joints[j]
     free = [i for i in range(model.n) if i not in dict(locked)]
     label = ", ".join(f"{model.joints[j].name or j + 1}={v:g}" for j, v in locked)
-    return ChainModel(name=f"{model.name} [{label}]", joints=tuple(joints),
-                      constants=np.array(C), length_unit=model.length_unit,
-                      q_home=np.asarray(model.q_home)[free])
+    six = ChainModel(name=f"{model.name} [{label}]", joints=tuple(joints),
+                     constants=np.array(C), length_unit=model.length_unit,
+                     q_home=np.asarray(model.q_home)[free])
+    DERIVED.add(six)
+    return six
 
 
 class _LockedCurve:
@@ -224,6 +235,7 @@ def _fast_fold(info: _JointInfo, j: int, v: float) -> ChainModel | None:
     six.__dict__.update(info.ref.__dict__)
     six.__dict__.update(constants=C, name=f"{info.label}{v:g}]")
     PRESET[six] = (kind, data)
+    DERIVED.add(six)
     return six
 
 

@@ -14,6 +14,7 @@ from functools import lru_cache
 import numpy as np
 
 from kinestat.mechanism.chain import ChainModel
+from kinestat.serial.analytic.geometry import DERIVED
 from kinestat.serial.analytic.result import IKAllResult
 
 __all__ = ["reverse", "invert_poses", "unreverse", "bind_one"]
@@ -38,9 +39,11 @@ def reverse(model: ChainModel) -> ChainModel:
     Cr = _F @ Ci @ _F  # C'k = F C(n−k)⁻¹ F, and C'0 = C(n)⁻¹ F, C'n = F C0⁻¹ (F F = I):
     Cr[0] = Ci[0] @ _F
     Cr[-1] = _F @ Ci[-1]
-    return ChainModel(name=f"{model.name} (reversed)", joints=tuple(reversed(model.joints)),
-                      constants=Cr, length_unit=model.length_unit,
-                      q_home=np.asarray(model.q_home)[::-1])
+    rev = ChainModel(name=f"{model.name} (reversed)", joints=tuple(reversed(model.joints)),
+                     constants=Cr, length_unit=model.length_unit,
+                     q_home=np.asarray(model.q_home)[::-1])
+    DERIVED.add(rev)  # its pairs are the model's
+    return rev
 
 
 def invert_poses(T: np.ndarray) -> np.ndarray:

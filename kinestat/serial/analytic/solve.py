@@ -22,7 +22,7 @@ from kinestat.errors import ModelError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic import closed_form
 from kinestat.serial.analytic._common import _ENTRY, call_compiled, check_poses, plain_poses
-from kinestat.serial.analytic.geometry import PRESET, classify
+from kinestat.serial.analytic.geometry import DERIVED, PRESET, check_independent, classify
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.ik_methods import get as _robot_method
 from kinestat.serial.ik_methods import registered as _robot_methods
@@ -62,6 +62,8 @@ def _check_chain(model: ChainModel) -> None:
         from kinestat.serial.analytic import decoupled  # lazy: start-up (prismatic arms only)
 
         decoupled.plan(model)  # raises, naming why, outside the decoupled class
+    if model not in DERIVED:  # reversed or folded: its arm was checked
+        check_independent(model)
 
 
 @lru_cache(maxsize=64)
