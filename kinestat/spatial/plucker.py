@@ -14,7 +14,7 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.spatial.transforms import as_array
-from kinestat.spatial.validate import as_unit_vector, freeze_fields
+from kinestat.spatial.validate import as_pose, as_unit_vector, freeze_fields
 
 __all__ = [
     "LINE_KINDS",
@@ -139,7 +139,7 @@ def transform_line(T, line) -> np.ndarray:
     >>> transform_line(trans([0.0, 0.0, 5.0]), [1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     array([1., 0., 0., 0., 5., 0.])
     """
-    T = as_array(T, shape_tail=(4, 4), name="T")
+    T = as_pose(T, "T")
     L = normalize_line(line)
     R, p = T[..., :3, :3], T[..., :3, 3]
     S = np.einsum("...ij,...j->...i", R, L[..., :3])

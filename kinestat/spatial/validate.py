@@ -16,8 +16,8 @@ from kinestat.errors import InputError
 from kinestat.spatial.tolerances import LAST_ROW_TOL, ORTHO_TOL, UNIT_TOL
 from kinestat.spatial.transforms import as_array
 
-__all__ = ["as_array", "as_pose", "as_vector3", "as_unit_vector", "batch_index", "frozen",
-           "freeze_fields"]
+__all__ = ["as_array", "as_pose", "as_rotation", "as_vector3", "as_unit_vector", "batch_index",
+           "frozen", "freeze_fields"]
 
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -84,21 +84,53 @@ orthonormal with determinant +1 (max|R Rᵀ − I| = 3, det = 8, tolerance 1e-06
                     f"got shape {T.shape}")
     if not np.all(np.isfinite(T)):
         raise error(f"{name} contains NaN or infinity")
-    R = T[..., :3, :3]
-    ortho = np.max(np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)), axis=(-1, -2), initial=0.0)
-    det = np.linalg.det(R) if R.size else np.ones(R.shape[:-2])
-    bad = (ortho > tol) | (np.abs(det - 1.0) > tol)
-    if np.any(bad):
-        raise error(
-            f"{name}{_pose_index(bad)} is not a rigid pose: its rotation part is not orthonormal "
-            f"with determinant +1 (max|R Rᵀ − I| = {ortho[bad].flat[0]:.3g}, "
-            f"det = {det[bad].flat[0]:.6g}, tolerance {tol:g})"
-        )
+    _check_rotation(T[..., :3, :3], name, " is not a rigid pose: its rotation part", tol, error)
     bottom = np.max(np.abs(T[..., 3, :] - _LAST_ROW), axis=-1, initial=0.0)
     bad = bottom > last_row_tol
     if np.any(bad):
         raise error(f"{name}{_pose_index(bad)}: the last row of a pose must be [0, 0, 0, 1]")
     return T
+
+
+def _check_rotation(R: np.ndarray, name: str, what: str, tol: float,
+                    error: type[Exception]) -> None:
+    """Raise ``error`` when some finite ``R (..., 3, 3)`` is not orthonormal with det +1 to
+    ``tol``; the message starts with ``name``, the batch index, then ``what``."""
+    ortho = np.max(np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)), axis=(-1, -2), initial=0.0)
+    det = np.linalg.det(R) if R.size else np.ones(R.shape[:-2])
+    bad = (ortho > tol) | (np.abs(det - 1.0) > tol)
+    if np.any(bad):
+        raise error(
+            f"{name}{_pose_index(bad)}{what} is not orthonormal with determinant +1 "
+            f"(max|R Rᵀ − I| = {ortho[bad].flat[0]:.3g}, det = {det[bad].flat[0]:.6g}, "
+            f"tolerance {tol:g})"
+        )
+
+
+def as_rotation(R, name: str = "rotation", *, tol: float = ORTHO_TOL,
+                error: type[Exception] = InputError) -> np.ndarray:
+    """Rotation matrices ``(..., 3, 3)``, checked: numbers of that shape, finite, orthonormal
+    with determinant +1 to ``tol``. Raises ``error`` naming ``name`` (and the first offending
+    matrix's batch index).
+
+    >>> as_rotation(np.eye(3), "R_base_tool").shape
+    (3, 3)
+    >>> as_rotation(-np.eye(3), "R_base_tool")
+    Traceback (most recent call last):
+    ...
+    kinestat.errors.InputError: R_base_tool is not orthonormal with determinant +1 \
+(max|R Rᵀ − I| = 0, det = -1, tolerance 1e-06)
+    """
+    try:
+        R = np.asarray(R, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise error(f"{name} must be 3x3 rotation matrices of numbers: {exc}") from exc
+    if R.ndim < 2 or R.shape[-2:] != (3, 3):
+        raise error(f"{name} must be rotation matrices of shape (..., 3, 3), got shape {R.shape}")
+    if not np.all(np.isfinite(R)):
+        raise error(f"{name} contains NaN or infinity")
+    _check_rotation(R, name, "", tol, error)
+    return R
 
 
 def as_vector3(v, name: str = "vector", *, single: bool = False,
