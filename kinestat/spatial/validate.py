@@ -16,8 +16,8 @@ from kinestat.errors import InputError
 from kinestat.spatial.tolerances import LAST_ROW_TOL, ORTHO_TOL, UNIT_TOL
 from kinestat.spatial.transforms import as_array
 
-__all__ = ["as_array", "as_pose", "as_rotation", "as_vector3", "as_unit_vector", "batch_index",
-           "frozen", "freeze_fields"]
+__all__ = ["as_array", "as_number", "as_pose", "as_rotation", "as_vector3", "as_unit_vector",
+           "batch_index", "frozen", "freeze_fields"]
 
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -131,6 +131,28 @@ def as_rotation(R, name: str = "rotation", *, tol: float = ORTHO_TOL,
         raise error(f"{name} contains NaN or infinity")
     _check_rotation(R, name, "", tol, error)
     return R
+
+
+def as_number(value, name: str, *, positive: bool = False,
+              error: type[Exception] = InputError) -> float:
+    """One finite real number (a tolerance, a length), as a float; ``positive``: > 0 too.
+
+    >>> as_number(1e-9, "tol", positive=True)
+    1e-09
+    >>> as_number(float("nan"), "tol")
+    Traceback (most recent call last):
+    ...
+    kinestat.errors.InputError: tol must be a finite number, got nan
+    """
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise error(f"{name} must be a number, got {value!r}") from None
+    if isinstance(value, (bool, np.bool_)) or not math.isfinite(x):
+        raise error(f"{name} must be a finite number, got {value!r}")
+    if positive and not x > 0.0:
+        raise error(f"{name} must be positive, got {value!r}")
+    return x
 
 
 def as_vector3(v, name: str = "vector", *, single: bool = False,
