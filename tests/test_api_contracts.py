@@ -28,7 +28,7 @@ from kinestat.io.library import prototype
 from kinestat.mechanism.chain import from_standard_dh
 from kinestat.serial.analytic import ik_all, select_nearest
 from kinestat.serial.fk import fk_frames, joint_axes
-from kinestat.serial.guidance import joint_rates
+from kinestat.serial.guidance import command_path, joint_rates, run_guidance
 from kinestat.serial.ik import wrap_joints
 from kinestat.serial.jacobian import fk_and_jacobian
 from kinestat.serial.lengths import characteristic_length
@@ -38,6 +38,7 @@ PUMA = kinestat.load("puma560")
 UR5 = kinestat.load("ur5")
 STANFORD = kinestat.load("stanford")
 PLATFORM = prototype()
+NADKARNI = kinestat.load("nadkarni-config2")
 #: a redundant arm with a prismatic joint: its least-squares joint rates depend on the
 #: characteristic length of each configuration
 ARM7P = from_standard_dh(
@@ -306,16 +307,54 @@ SCALARS = [
     ("ik rot_tol", lambda v: kinestat.ik(PUMA, np.eye(4), rot_tol=v), "rot_tol"),
     ("ik pos_tol", lambda v: kinestat.ik(PUMA, np.eye(4), pos_tol=v), "pos_tol"),
     ("special_6_6 height", lambda v: P.special_6_6(height=v), "height"),
+    ("fk_all tol", lambda v: P.fk_all(PLATFORM, PLATFORM.free_lengths, tol=v), "tol"),
+    ("fk_numeric tol", lambda v: P.fk_numeric(PLATFORM, PLATFORM.free_lengths, tol=v), "tol"),
+    ("run_guidance length", lambda v: run_guidance(
+        NADKARNI, NADKARNI.q_home, [lambda H: command_path(H, [0, 0, 1], 1.0, 0.0)], steps=1,
+        length=v), "length"),
+    ("command_path distance", lambda v: command_path(np.eye(4), [0, 0, 1], v, 0.0), "distance"),
+    ("command_path angle", lambda v: command_path(np.eye(4), [0, 0, 1], 1.0, v), "angle"),
+]
+COUNTS = [
+    ("fk_all polish", lambda v: P.fk_all(PLATFORM, PLATFORM.free_lengths, polish=v), "polish"),
+    ("fk_numeric max_iter", lambda v: P.fk_numeric(PLATFORM, PLATFORM.free_lengths, max_iter=v),
+     "max_iter"),
 ]
 
 
 @pytest.mark.parametrize("value", [float("nan"), float("inf"), -1.0, 0.0, "x", None, True])
 @pytest.mark.parametrize("name, call, arg", SCALARS, ids=[s[0] for s in SCALARS])
 def test_bad_scalar_argument_raises_input_error(name, call, arg, value):
-    if value is None and arg == "pos_tol":
-        pytest.skip("None is pos_tol's default")
+    if value is None and arg in ("pos_tol", "length"):
+        pytest.skip(f"None is {arg}'s default")
+    if value == 0.0 and arg in ("distance", "angle"):
+        pytest.skip(f"0 is a valid {arg}")
+    if value == -1.0 and arg in ("distance", "angle"):
+        pytest.skip(f"a negative {arg} is valid")
     with pytest.raises(InputError, match=arg):
         call(value)
+
+
+@pytest.mark.parametrize("value", [-1, 2.5, "x", None, True])
+@pytest.mark.parametrize("name, call, arg", COUNTS, ids=[s[0] for s in COUNTS])
+def test_bad_count_raises_input_error(name, call, arg, value):
+    with pytest.raises(InputError, match=arg):
+        call(value)
+
+
+def test_forces_from_wrench_tolerance_must_be_a_number():
+    for tol in (float("nan"), -1.0, "x"):
+        with pytest.raises(InputError, match="tol"):
+            P.forces_from_wrench(PLATFORM, PLATFORM.home_pose, np.zeros(6), tol=tol)
+
+
+def test_guidance_entries_refuse_bad_stages_and_starts():
+    with pytest.raises(InputError, match="stage"):
+        run_guidance(NADKARNI, NADKARNI.q_home, [42], steps=1)
+    with pytest.raises(InputError, match="q0"):
+        run_guidance(NADKARNI, np.full(NADKARNI.n, np.nan), [], steps=1)
+    with pytest.raises(InputError, match="start pose"):
+        command_path(2.0 * np.eye(4), [0, 0, 1], 1.0, 0.0)
 
 
 def test_selection_weights_must_not_be_negative():

@@ -16,8 +16,8 @@ from kinestat.errors import InputError
 from kinestat.spatial.tolerances import LAST_ROW_TOL, ORTHO_TOL, UNIT_TOL
 from kinestat.spatial.transforms import as_array
 
-__all__ = ["as_array", "as_number", "as_pose", "as_rotation", "as_vector3", "as_unit_vector",
-           "batch_index", "frozen", "freeze_fields"]
+__all__ = ["as_array", "as_count", "as_number", "as_pose", "as_rotation", "as_vector3",
+           "as_unit_vector", "batch_index", "frozen", "freeze_fields"]
 
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -133,9 +133,10 @@ def as_rotation(R, name: str = "rotation", *, tol: float = ORTHO_TOL,
     return R
 
 
-def as_number(value, name: str, *, positive: bool = False,
+def as_number(value, name: str, *, positive: bool = False, nonnegative: bool = False,
               error: type[Exception] = InputError) -> float:
-    """One finite real number (a tolerance, a length), as a float; ``positive``: > 0 too.
+    """One finite real number (a tolerance, a length), as a float; ``positive``: > 0 too,
+    ``nonnegative``: ≥ 0 too.
 
     >>> as_number(1e-9, "tol", positive=True)
     1e-09
@@ -152,7 +153,27 @@ def as_number(value, name: str, *, positive: bool = False,
         raise error(f"{name} must be a finite number, got {value!r}")
     if positive and not x > 0.0:
         raise error(f"{name} must be positive, got {value!r}")
+    if nonnegative and not x >= 0.0:
+        raise error(f"{name} must be ≥ 0, got {value!r}")
     return x
+
+
+def as_count(value, name: str, *, minimum: int = 0,
+             error: type[Exception] = InputError) -> int:
+    """A whole number ≥ ``minimum`` (an iteration budget, a number of steps), as an int.
+
+    >>> as_count(4, "polish")
+    4
+    >>> as_count(2.5, "polish")
+    Traceback (most recent call last):
+    ...
+    kinestat.errors.InputError: polish must be a whole number ≥ 0, got 2.5
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) \
+            or value < minimum:
+        shown = repr(value) if len(repr(value)) <= 40 else "a very long value"
+        raise error(f"{name} must be a whole number ≥ {minimum}, got {shown}")
+    return int(value)
 
 
 def as_vector3(v, name: str = "vector", *, single: bool = False,
