@@ -68,6 +68,10 @@ def _platform_pose(rng: np.random.Generator) -> np.ndarray:
     return T
 
 
+def _line(rng: np.random.Generator) -> np.ndarray:
+    return plucker.line_from_points(rng.uniform(-1.0, 1.0, 3), rng.uniform(2.0, 3.0, 3))
+
+
 def _vec(n: int, lo: float = -1.0, hi: float = 1.0) -> Gen:
     return lambda rng: rng.uniform(lo, hi, n)
 
@@ -112,8 +116,10 @@ CASES = [
     Case("euler_from_matrix", lambda R: euler.euler_from_matrix(R, "zyz"),
          (lambda rng: _pose(rng)[:3, :3],), ("R",)),
     Case("transform_line", lambda T, L: plucker.transform_line(T, L),
-         (_pose, lambda rng: plucker.line_from_points(rng.uniform(-1, 1, 3), rng.uniform(2, 3, 3))),
-         ("T", "line"), (0,)),
+         (_pose, _line), ("T", "line"), (0,)),
+    Case("line_distance", plucker.line_distance, (_line, _line), ("l1", "l2")),
+    Case("common_normal", plucker.common_normal, (_line, _line), ("l1", "l2")),
+    Case("classify_lines", plucker.classify_lines, (_line, _line), ("l1", "l2")),
     Case("leg_lengths", lambda T: P.leg_lengths(PLATFORM, T), (_platform_pose,), ("pose",), (0,)),
     Case("line_jacobian", lambda T: P.line_jacobian(PLATFORM, T), (_platform_pose,), ("pose",),
          (0,)),
@@ -174,7 +180,7 @@ def _batch(items, case: Case, n: int) -> list[np.ndarray]:
 
 
 @pytest.mark.parametrize("case", CASES, ids=IDS)
-@settings(max_examples=4, deadline=None)
+@settings(max_examples=25, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), n=st.sampled_from([0, 1, 3]))
 def test_batch_equals_loop(case, seed, n):
     """A batch of N is the loop over its N items, with the batch's leading shape."""
@@ -276,7 +282,7 @@ def _corruptions(case: Case, k: int, b: np.ndarray, rng: np.random.Generator):
 
 
 @pytest.mark.parametrize("case", CASES, ids=IDS)
-@settings(max_examples=3, deadline=None)
+@settings(max_examples=10, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1))
 def test_bad_input_raises_one_input_error_naming_the_argument(case, seed):
     rng = np.random.default_rng(seed)
