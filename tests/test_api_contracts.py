@@ -26,6 +26,7 @@ from kinestat import parallel as P
 from kinestat.errors import InputError
 from kinestat.io.library import prototype
 from kinestat.mechanism.chain import from_standard_dh
+from kinestat.mechanism.nadkarni import hand_points
 from kinestat.serial.analytic import ik_all, select_nearest
 from kinestat.serial.fk import fk_frames, joint_axes
 from kinestat.serial.guidance import command_path, joint_rates, run_guidance
@@ -120,6 +121,7 @@ CASES = [
     Case("line_distance", plucker.line_distance, (_line, _line), ("l1", "l2")),
     Case("common_normal", plucker.common_normal, (_line, _line), ("l1", "l2")),
     Case("classify_lines", plucker.classify_lines, (_line, _line), ("l1", "l2")),
+    Case("hand_points", hand_points, (_pose,), ("hand_pose",), (0,)),
     Case("leg_lengths", lambda T: P.leg_lengths(PLATFORM, T), (_platform_pose,), ("pose",), (0,)),
     Case("line_jacobian", lambda T: P.line_jacobian(PLATFORM, T), (_platform_pose,), ("pose",),
          (0,)),
@@ -388,3 +390,10 @@ def test_integer_joint_values_are_read_as_float(case):
     want = _call(case, [q_int.astype(float)] + batch[1:])
     _assert_same(_call(case, [q_int] + batch[1:]), want)
     _assert_same(_call(case, [q_int.tolist()] + batch[1:]), want)
+
+
+def test_tip_stiffness_rotation_must_be_a_rotation():
+    from kinestat.parallel.stiffness import tip_stiffness
+
+    with pytest.raises(InputError, match="rotation"):
+        tip_stiffness(PLATFORM, PLATFORM.home_pose, [0.0, 0.0, 0.0], rotation=2.0 * np.eye(3))

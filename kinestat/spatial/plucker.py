@@ -104,8 +104,8 @@ def normalize_line(line, *, tol: float = 1e-6, name: str = "line") -> np.ndarray
     off = np.abs(_dot(S, S0)) > tol * n * np.maximum(np.linalg.norm(S0, axis=-1), 1.0)
     if np.any(off):
         raise InputError(
-            f"{name} is not a line{_where(off)}: S . S0 must be 0 (Plücker condition); build lines with "
-            "line_from_points or line_from_point_direction"
+            f"{name} is not a line{_where(off)}: S . S0 must be 0 (Plücker condition); build "
+            "lines with line_from_points or line_from_point_direction"
         )
     return L / n[..., None]
 
