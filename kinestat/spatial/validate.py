@@ -88,7 +88,8 @@ orthonormal with determinant +1 (max|R Rᵀ − I| = 3, det = 8, tolerance 1e-06
     bottom = np.max(np.abs(T[..., 3, :] - _LAST_ROW), axis=-1, initial=0.0)
     bad = bottom > last_row_tol
     if np.any(bad):
-        raise error(f"{name}{_pose_index(bad)}: the last row of a pose must be [0, 0, 0, 1]")
+        raise error(f"{name}{_pose_index(bad)} is not a rigid pose: the last row of a pose must "
+                    "be [0, 0, 0, 1]")
     return T
 
 
