@@ -52,12 +52,7 @@ from kinestat.serial.guidance.planners import (
     resolve_stage,
     twist_between,
 )
-from kinestat.serial.guidance.rules import (
-    SINGULAR_MODES,
-    GuidanceOptions,
-    StepInput,
-    StepRule,
-)
+from kinestat.serial.guidance.rules import SINGULAR_MODES, GuidanceOptions, StepInput, StepRule
 from kinestat.serial.guidance.step import (
     characteristic_length,
     conditioning,
