@@ -322,6 +322,8 @@ SCALARS = [
     ("special_6_6 height", lambda v: P.special_6_6(height=v), "height"),
     ("fk_all tol", lambda v: P.fk_all(PLATFORM, PLATFORM.free_lengths, tol=v), "tol"),
     ("fk_numeric tol", lambda v: P.fk_numeric(PLATFORM, PLATFORM.free_lengths, tol=v), "tol"),
+    ("fk_tracking tol", lambda v: P.fk_tracking(PLATFORM, PLATFORM.free_lengths,
+                                                PLATFORM.home_pose, tol=v), "tol"),
     ("run_guidance length", lambda v: run_guidance(
         NADKARNI, NADKARNI.q_home, [lambda H: command_path(H, [0, 0, 1], 1.0, 0.0)], steps=1,
         length=v), "length"),
@@ -332,6 +334,8 @@ COUNTS = [
     ("fk_all polish", lambda v: P.fk_all(PLATFORM, PLATFORM.free_lengths, polish=v), "polish"),
     ("fk_numeric max_iter", lambda v: P.fk_numeric(PLATFORM, PLATFORM.free_lengths, max_iter=v),
      "max_iter"),
+    ("fk_tracking max_iter", lambda v: P.fk_tracking(PLATFORM, PLATFORM.free_lengths,
+                                                     PLATFORM.home_pose, max_iter=v), "max_iter"),
 ]
 
 

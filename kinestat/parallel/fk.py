@@ -393,6 +393,7 @@ def fk_tracking(platform: Platform, lengths, previous_pose, *, tol: float = 1e-9
     else:
         backend = "numba"
     L = check_lengths(lengths)
+    tol, max_iter = as_number(tol, "tol", positive=True), as_count(max_iter, "max_iter")
     prev = as_pose(previous_pose, "previous_pose")
     prev = np.broadcast_to(prev, L.shape[:-1] + (4, 4)).copy()
     pose = (_fk_kernels.track_arrays(platform.base_points, platform.top_points, L, prev, tol,
