@@ -158,7 +158,11 @@ class ChainModel:
 
     def check_q(self, q, name: str = "q") -> np.ndarray:
         """Validate joint values ``(..., n)``; returns a float array."""
-        q = np.asarray(q, dtype=float)
+        try:
+            q = np.asarray(q, dtype=float)
+        except (TypeError, ValueError) as exc:  # strings, ragged lists, None in a list...
+            raise InputError(f"{name} must be numbers of shape (..., {self.n}) for model "
+                             f"{self.name!r}: {exc}") from exc
         if q.ndim == 0 or q.shape[-1] != self.n:
             raise InputError(
                 f"{name} must have shape (..., {self.n}) for model {self.name!r}, got {q.shape}"

@@ -20,6 +20,7 @@ import numpy as np
 from kinestat.errors import ModelError
 from kinestat.mechanism.chain import frame_from_three_points
 from kinestat.spatial.transforms import inv, rot_x, rot_z, trans_x, trans_z
+from kinestat.spatial.validate import as_pose
 
 __all__ = ["MechanismFrames", "mechanism_frames", "hand_points"]
 
@@ -107,6 +108,6 @@ def hand_points(hand_pose) -> np.ndarray:
            [0., 0., 1.],
            [1., 0., 0.]])
     """
-    T = np.asarray(hand_pose, dtype=float)
+    T = as_pose(hand_pose, "hand_pose")
     o = T[..., :3, 3]
     return np.stack([o, o + T[..., :3, 2], o + T[..., :3, 0]], axis=-2)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from kinestat.spatial.se3 import so3_exp
+from kinestat.spatial.se3 import so3_exp_trusted
 
 
 def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -14,8 +14,9 @@ def cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=-1)
 
 
-#: Rodrigues' formula, :func:`kinestat.spatial.se3.so3_exp` (old name)
-rotvec_matrix = so3_exp
+#: Rodrigues' formula, :func:`kinestat.spatial.se3.so3_exp` (unchecked: the Newton steps' own
+#: rotation vectors)
+rotvec_matrix = so3_exp_trusted
 
 
 def apply_twist(pose: np.ndarray, twist: np.ndarray) -> np.ndarray:

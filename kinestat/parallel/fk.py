@@ -43,6 +43,7 @@ from kinestat.parallel.fk33 import (
 from kinestat.parallel.legs import as_pose
 from kinestat.parallel.platform import Platform, SpecialLayout
 from kinestat.spatial.transforms import as_array
+from kinestat.spatial.validate import as_count, as_number
 
 __all__ = [
     "FKSolutions",
@@ -229,6 +230,7 @@ def fk_all(platform: Platform, lengths, *, tol: float = 1e-9, polish: int = 4,
     if backend != "numba":
         raise InputError(f"backend must be 'numba' or 'numpy', got {backend!r}")
     L = check_lengths(lengths)
+    tol, polish = as_number(tol, "tol", positive=True), as_count(polish, "polish")
     _layout(platform)
     shape = L.shape[:-1]
     poses, valid, res = _fk_kernels.fk_all_arrays(_kernel_constants(platform),
@@ -341,6 +343,7 @@ def fk_numeric(platform: Platform, lengths, guess=None, *, tol: float = 1e-9,
             or a singular configuration on the way); the message names the batch index.
     """
     L = check_lengths(lengths)
+    tol, max_iter = as_number(tol, "tol", positive=True), as_count(max_iter, "max_iter")
     g = platform.home_pose if guess is None else as_pose(guess, "guess")
     g = np.broadcast_to(g, L.shape[:-1] + (4, 4)).copy()
     pose, res, _ = _newton(platform, L, g, tol, max_iter)
@@ -390,6 +393,7 @@ def fk_tracking(platform: Platform, lengths, previous_pose, *, tol: float = 1e-9
     else:
         backend = "numba"
     L = check_lengths(lengths)
+    tol, max_iter = as_number(tol, "tol", positive=True), as_count(max_iter, "max_iter")
     prev = as_pose(previous_pose, "previous_pose")
     prev = np.broadcast_to(prev, L.shape[:-1] + (4, 4)).copy()
     pose = (_fk_kernels.track_arrays(platform.base_points, platform.top_points, L, prev, tol,

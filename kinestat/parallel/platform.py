@@ -29,6 +29,7 @@ import numpy as np
 from kinestat.errors import InputError, ModelError
 from kinestat.parallel.singularity import check_design, reduction_products
 from kinestat.spatial.transforms import apply, make_pose, rot_z
+from kinestat.spatial.validate import as_number
 
 __all__ = [
     "LEG_NAMES",
@@ -255,9 +256,7 @@ def special_6_6(
     if np.any(toff < 0) or np.any(toff > tside):
         raise InputError(f"top offsets {toff.tolist()} must lie in [0, side] "
                          f"(sides {tside.tolist()})")
-    for v, nm in ((height, "height"), (twist, "twist")):
-        if not math.isfinite(float(v)):
-            raise InputError(f"{nm} must be finite, got {v!r}")
+    height, twist = as_number(height, "height"), as_number(twist, "twist")
     if height <= 0:
         raise InputError(f"home height must be positive, got {height}")
     k = _vec(stiffness, 6, "stiffness")

@@ -32,6 +32,7 @@ from kinestat.parallel.legs import leg_directions, leg_lines, line_jacobian
 from kinestat.parallel.platform import Platform
 from kinestat.parallel.singularity import singularity_measure
 from kinestat.spatial.transforms import as_array
+from kinestat.spatial.validate import as_number
 
 # leg_directions, leg_lines and line_jacobian are defined in kinestat.parallel.legs
 __all__ = [
@@ -71,6 +72,7 @@ def forces_from_wrench(platform: Platform, pose, wrench, *, tol: float = 1e-9) -
         SingularityError: the pose is singular (dimensionless |det j| below ``tol``).
     """
     w = as_array(wrench, shape_tail=(6,), name="wrench")
+    tol = as_number(tol, "tol", nonnegative=True)
     j = line_jacobian(platform, pose)
     m = singularity_measure(platform, pose)
     if np.any(m < tol):

@@ -43,6 +43,7 @@ from kinestat.parallel.legs import as_pose, leg_directions_trusted
 from kinestat.parallel.platform import Platform
 from kinestat.parallel.statics import spring_wrench
 from kinestat.spatial.transforms import as_array, skew
+from kinestat.spatial.validate import as_rotation
 
 __all__ = ["stiffness", "stiffness_axis_trusted", "stiffness_terms", "load_asymmetry",
            "equilibrium_pose",
@@ -209,7 +210,7 @@ def tip_stiffness(platform: Platform, pose, tip, rotation=None, *,
     Kb = np.linalg.inv(tip_compliance(platform, pose, tip, stiffness_axis=stiffness_axis))
     if rotation is None:
         return Kb
-    R = np.asarray(rotation, dtype=float)
+    R = as_rotation(rotation, "rotation")
     return R @ Kb @ np.swapaxes(R, -1, -2)
 
 

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.fk import fk_frames
 from kinestat.serial.jacobian import jacobian_from_frames
@@ -23,11 +24,19 @@ def wrap_joints(model: ChainModel, q, reference=None) -> np.ndarray:
     """Shift rotating joints by whole turns: into their limits when possible (nearest
     ``reference``, default 0), else to [-π, π) about the reference. Prismatic joints are only
     clipped to their limits; rotating joints that cannot be shifted into their limits are
-    clipped too."""
-    q = np.asarray(q, dtype=float)
+    clipped too. ``q (..., n)``; ``reference`` broadcasts against it."""
+    q = model.check_q(q)
     rot = ~model.prismatic
     lo, hi = model.lower, model.upper
-    ref = np.zeros_like(q) if reference is None else np.broadcast_to(reference, q.shape)
+    if reference is None:
+        ref = np.zeros_like(q)
+    else:
+        ref = model.check_q(reference, "reference")
+        try:
+            ref = np.broadcast_to(ref, q.shape)
+        except ValueError:
+            raise InputError(f"reference of shape {ref.shape} does not broadcast to q's shape "
+                             f"{q.shape}") from None
     base = ref + (q - ref + math.pi) % (2 * math.pi) - math.pi
     # the whole-turn shift nearest the reference that lies in [lo, hi]
     ks = np.arange(-3, 4) * (2 * math.pi)
@@ -43,7 +52,7 @@ def wrap_joints(model: ChainModel, q, reference=None) -> np.ndarray:
 
 def wrap_rotating(model: ChainModel, q) -> np.ndarray:
     """Rotating joints wrapped to [-π, π); prismatic joints untouched (limits ignored)."""
-    q = np.asarray(q, dtype=float)
+    q = model.check_q(q)
     return np.where(model.prismatic, q, (q + math.pi) % (2 * math.pi) - math.pi)
 
 

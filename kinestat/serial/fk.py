@@ -53,6 +53,7 @@ def joint_motion(model: ChainModel, q: np.ndarray) -> np.ndarray:
 
 
 def _as_q(model: ChainModel, q) -> np.ndarray:
+    check_model(model)
     if type(q) is not np.ndarray or q.dtype != np.float64:
         try:
             q = np.asarray(q, dtype=np.float64)
@@ -63,6 +64,13 @@ def _as_q(model: ChainModel, q) -> np.ndarray:
             f"q must have shape (..., {model.n}) for model {model.name!r}, got {q.shape}"
         )
     return q
+
+
+def check_model(model) -> None:
+    """Raise :class:`~kinestat.errors.InputError` unless ``model`` is a ChainModel."""
+    if not isinstance(model, ChainModel):
+        raise InputError(f"model must be a ChainModel (use kinestat.load), got "
+                         f"{type(model).__name__}")
 
 
 _FK_ONE = None

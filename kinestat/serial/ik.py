@@ -41,7 +41,7 @@ from kinestat.serial._reference import ik_reference
 from kinestat.serial.chunks import CHUNK_ROWS, chunk_slices
 from kinestat.serial.lengths import characteristic_length
 from kinestat.spatial.se3 import pose_error, so3_log
-from kinestat.spatial.validate import as_pose
+from kinestat.spatial.validate import as_number, as_pose
 
 __all__ = [
     "IKResult",
@@ -212,10 +212,8 @@ def ik(
     _check_effort(max_iter, restarts)
     d = _model_data(model)
     L = d.scale
-    if pos_tol is None:
-        pos_tol = 1e-9 * L
-    if not (pos_tol > 0 and rot_tol > 0):
-        raise InputError("pos_tol and rot_tol must be positive")
+    pos_tol = 1e-9 * L if pos_tol is None else as_number(pos_tol, "pos_tol", positive=True)
+    rot_tol = as_number(rot_tol, "rot_tol", positive=True)
     if q0 is None:
         q0 = model.q_home
     q0 = model.check_q(q0, "q0")
@@ -308,10 +306,8 @@ def _ik_chunk(model: ChainModel, T: np.ndarray, q0, key: np.uint64, offset: int,
     _check_effort(max_iter, restarts)
     d = _model_data(model)
     L, lo, hi = d.scale, d.lower, d.upper
-    if pos_tol is None:
-        pos_tol = 1e-9 * L
-    if not (pos_tol > 0 and rot_tol > 0):
-        raise InputError("pos_tol and rot_tol must be positive")
+    pos_tol = 1e-9 * L if pos_tol is None else as_number(pos_tol, "pos_tol", positive=True)
+    rot_tol = as_number(rot_tol, "rot_tol", positive=True)
     q0 = model.check_q(model.q_home if q0 is None else q0, "q0")
     Q0 = np.ascontiguousarray(q0[None] if q0.ndim == 1 else q0)
     return _ik_compiled(model, np.ascontiguousarray(Tt), Q0, Tt.shape[:-2], L, lo, hi,

@@ -66,6 +66,7 @@ _last: tuple = (object(), 0.0, None, None, (6, 0))  # matches no argument (not e
 def _jacobian_checked(model: ChainModel, q) -> np.ndarray:
     """:func:`jacobian` by the checked path; a single configuration's model is remembered."""
     global _last
+    _fkmod.check_model(model)
     J = _fkmod.evaluate(model, q, _jac_entry, _fkmod.kernels().jacobian_batch, (6, model.n))
     if J.ndim == 2:
         last = _fkmod.one_call(model, _JAC_ONE or _jac_entry())

@@ -14,7 +14,7 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.spatial.transforms import as_array
-from kinestat.spatial.validate import as_unit_vector, freeze_fields
+from kinestat.spatial.validate import as_pose, as_unit_vector, freeze_fields
 
 __all__ = [
     "LINE_KINDS",
@@ -83,28 +83,29 @@ def line_from_point_direction(p, s) -> np.ndarray:
     return np.concatenate(np.broadcast_arrays(S, np.cross(p, S)), axis=-1)
 
 
-def normalize_line(line, *, tol: float = 1e-6) -> np.ndarray:
+def normalize_line(line, *, tol: float = 1e-6, name: str = "line") -> np.ndarray:
     """Scale homogeneous line coordinates so that ``|S| = 1``.
 
     Raises :class:`InputError` if ``S = 0`` (a line at infinity) or the Plücker condition
-    ``S . S0 = 0`` (Vibhute eq. A-8) fails by more than ``tol`` relative to ``|S| |S0|``.
+    ``S . S0 = 0`` (Vibhute eq. A-8) fails by more than ``tol`` relative to ``|S| |S0|``; the
+    message names the argument ``name``.
 
     >>> normalize_line([2.0, 0.0, 0.0, 0.0, 0.0, -2.0])
     array([ 1.,  0.,  0.,  0.,  0., -1.])
     """
-    L = as_array(line, shape_tail=(6,), name="line")
+    L = as_array(line, shape_tail=(6,), name=name)
     S, S0 = L[..., :3], L[..., 3:]
     n = np.linalg.norm(S, axis=-1)
     bad = n == 0.0
     if np.any(bad):
         raise InputError(
-            f"line has zero direction S{_where(bad)}: Plücker coordinates [S; S0] need S != 0"
+            f"{name} has zero direction S{_where(bad)}: Plücker coordinates [S; S0] need S != 0"
         )
     off = np.abs(_dot(S, S0)) > tol * n * np.maximum(np.linalg.norm(S0, axis=-1), 1.0)
     if np.any(off):
         raise InputError(
-            f"not a line{_where(off)}: S . S0 must be 0 (Plücker condition); build lines with "
-            "line_from_points or line_from_point_direction"
+            f"{name} is not a line{_where(off)}: S . S0 must be 0 (Plücker condition); build "
+            "lines with line_from_points or line_from_point_direction"
         )
     return L / n[..., None]
 
@@ -115,7 +116,7 @@ def is_line(line, tol: float = 1e-9) -> np.ndarray:
     >>> bool(is_line([1.0, 0.0, 0.0, 0.0, 0.0, -1.0])), bool(is_line([1.0, 0, 0, 1.0, 0, 0]))
     (True, False)
     """
-    L = np.asarray(line, dtype=float)
+    L = as_array(line, shape_tail=(6,), name="line", finite=False)  # NaN: not a line
     S, S0 = L[..., :3], L[..., 3:]
     n = np.linalg.norm(S, axis=-1)
     return (n > 0) & (np.abs(_dot(S, S0)) <= tol * n * np.maximum(np.linalg.norm(S0, axis=-1), 1.0))
@@ -139,7 +140,7 @@ def transform_line(T, line) -> np.ndarray:
     >>> transform_line(trans([0.0, 0.0, 5.0]), [1.0, 0.0, 0.0, 0.0, 0.0, 0.0])
     array([1., 0., 0., 0., 5., 0.])
     """
-    T = as_array(T, shape_tail=(4, 4), name="T")
+    T = as_pose(T, "T")
     L = normalize_line(line)
     R, p = T[..., :3, :3], T[..., :3, 3]
     S = np.einsum("...ij,...j->...i", R, L[..., :3])
@@ -159,8 +160,8 @@ def mutual_moment(l1, l2) -> np.ndarray:
     >>> float(mutual_moment(x_axis, y_at_z1))  # -distance x sin(angle)
     -1.0
     """
-    a = normalize_line(l1)
-    b = normalize_line(l2)
+    a = normalize_line(l1, name="l1")
+    b = normalize_line(l2, name="l2")
     return _dot(a[..., :3], b[..., 3:]) + _dot(b[..., :3], a[..., 3:])
 
 
@@ -243,7 +244,7 @@ def common_normal(l1, l2, *, tol: float = 1e-9, angle_tol: float = 1e-9) -> Comm
     (array([0., 0., 1.]), 1.0)
     """
     foot1, foot2, direction, dist, _ = _normal(
-        normalize_line(l1), normalize_line(l2), angle_tol, tol
+        normalize_line(l1, name="l1"), normalize_line(l2, name="l2"), angle_tol, tol
     )
     return CommonNormal(foot1, foot2, direction, dist)
 
@@ -255,7 +256,8 @@ def line_distance(l1, l2, *, angle_tol: float = 1e-9) -> np.ndarray:
     >>> float(line_distance([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], y_at_z2))
     2.0
     """
-    return _normal(normalize_line(l1), normalize_line(l2), angle_tol, 0.0)[3]
+    return _normal(normalize_line(l1, name="l1"), normalize_line(l2, name="l2"), angle_tol,
+                   0.0)[3]
 
 
 @dataclass(frozen=True)
@@ -303,7 +305,7 @@ def classify_lines(l1, l2, tol: float = 1e-9, *, angle_tol: float = 1e-9) -> Lin
     >>> LINE_KINDS[int(classify_lines([1.0, 0.0, 0.0, 0.0, 0.0, 0.0], x_at_y1).kind)]
     'parallel'
     """
-    a, b = normalize_line(l1), normalize_line(l2)
+    a, b = normalize_line(l1, name="l1"), normalize_line(l2, name="l2")
     foot1, foot2, _, dist, parallel = _normal(a, b, angle_tol, tol)
     meet = dist <= tol
     kind = np.where(parallel, np.where(meet, COINCIDENT, PARALLEL),

@@ -22,6 +22,7 @@ import numpy as np
 from kinestat.errors import InputError
 from kinestat.spatial.plucker import normalize_line
 from kinestat.spatial.transforms import as_array, skew
+from kinestat.spatial.validate import as_pose
 
 __all__ = [
     "twist",
@@ -80,7 +81,7 @@ def adjoint(T) -> np.ndarray:
     >>> adjoint(trans([1.0, 0.0, 0.0])).shape
     (6, 6)
     """
-    T = as_array(T, shape_tail=(4, 4), name="T")
+    T = as_pose(T, "T")
     R, p = T[..., :3, :3], T[..., :3, 3]
     out = np.zeros(T.shape[:-2] + (6, 6))
     out[..., :3, :3] = R

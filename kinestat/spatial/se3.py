@@ -13,9 +13,10 @@ import numpy as np
 
 from kinestat.spatial.displacement import pose_from_screw
 from kinestat.spatial.transforms import as_array, trans
+from kinestat.spatial.validate import as_pose, as_rotation, as_vector3
 
-__all__ = ["so3_exp", "so3_log", "twist_exp", "twist_exp_one", "rotvec_matrix_one",
-           "pose_error"]
+__all__ = ["so3_exp", "so3_exp_trusted", "so3_log", "twist_exp", "twist_exp_one",
+           "rotvec_matrix_one", "pose_error"]
 
 
 def so3_exp(w) -> np.ndarray:
@@ -27,7 +28,12 @@ def so3_exp(w) -> np.ndarray:
            [ 1.,  0.,  0.],
            [ 0.,  0.,  1.]])
     """
-    w = np.asarray(w, dtype=float)
+    return so3_exp_trusted(as_vector3(w, "w"))
+
+
+def so3_exp_trusted(w: np.ndarray) -> np.ndarray:
+    """:func:`so3_exp` of float rotation vectors ``(..., 3)`` the caller has checked (no
+    validation; the Newton steps of the platform solvers)."""
     th = np.sqrt(np.sum(w * w, axis=-1))
     small = th < 1e-8
     safe = np.where(small, 1.0, th)
@@ -48,7 +54,7 @@ def so3_log(R) -> np.ndarray:
     array([ 0.1, -0.2,  0.3])
     """
     from scipy.spatial.transform import Rotation  # lazy: start-up (scipy.spatial ~0.5 s)
-    R = np.asarray(R, dtype=float)
+    R = as_rotation(R, "R")
     flat = R.reshape(-1, 3, 3)
     if flat.shape[0] == 0:
         return np.zeros(R.shape[:-2] + (3,))
@@ -148,8 +154,8 @@ def pose_error(T, T_target) -> tuple[np.ndarray, np.ndarray]:
     >>> float(pos), round(float(rot), 12)
     (5.0, 0.25)
     """
-    T = np.asarray(T, dtype=float)
-    Tt = np.asarray(T_target, dtype=float)
+    T = as_pose(T, "T")
+    Tt = as_pose(T_target, "T_target")
     pos = np.linalg.norm(T[..., :3, 3] - Tt[..., :3, 3], axis=-1)
     d = np.sqrt(np.sum((T[..., :3, :3] - Tt[..., :3, :3]) ** 2, axis=(-1, -2)))
     rot = 2.0 * np.arcsin(np.minimum(d / _SQRT8, 1.0))

@@ -32,8 +32,10 @@ __all__ = [
 ]
 
 
-def as_array(x, *, shape_tail: tuple[int, ...] = (), name: str = "value") -> np.ndarray:
-    """Convert to a float64 array, checking the trailing shape and finiteness.
+def as_array(x, *, shape_tail: tuple[int, ...] = (), name: str = "value",
+             finite: bool = True) -> np.ndarray:
+    """Convert to a float64 array, checking the trailing shape and (unless ``finite`` is
+    False) finiteness.
 
     >>> as_array([1, 2], name='q')
     array([1., 2.])
@@ -44,7 +46,7 @@ def as_array(x, *, shape_tail: tuple[int, ...] = (), name: str = "value") -> np.
         raise InputError(f"{name} must be an array of numbers: {exc}") from exc
     if shape_tail and a.shape[a.ndim - len(shape_tail):] != shape_tail:
         raise InputError(f"{name} must have trailing shape {shape_tail}, got {a.shape}")
-    if not np.all(np.isfinite(a)):
+    if finite and not np.all(np.isfinite(a)):
         raise InputError(f"{name} contains NaN or infinity")
     return a
 
@@ -164,7 +166,9 @@ def inv(T) -> np.ndarray:
     >>> bool(np.allclose(inv(T_base_tool) @ T_base_tool, np.eye(4)))
     True
     """
-    T = np.asarray(T, dtype=float)
+    T = as_array(T, name="T", finite=False)
+    if T.shape[-2:] != (4, 4):  # the rigidity is the caller's (kinestat.spatial.validate)
+        raise InputError(f"T must be 4x4 transforms of shape (..., 4, 4), got shape {T.shape}")
     R = T[..., :3, :3]
     Rt = np.swapaxes(R, -1, -2)
     return make_pose(Rt, -np.einsum("...ij,...j->...i", Rt, T[..., :3, 3]))

@@ -16,8 +16,8 @@ from kinestat.errors import InputError
 from kinestat.spatial.tolerances import LAST_ROW_TOL, ORTHO_TOL, UNIT_TOL
 from kinestat.spatial.transforms import as_array
 
-__all__ = ["as_array", "as_pose", "as_vector3", "as_unit_vector", "batch_index", "frozen",
-           "freeze_fields"]
+__all__ = ["as_array", "as_count", "as_number", "as_pose", "as_rotation", "as_vector3",
+           "as_unit_vector", "batch_index", "frozen", "freeze_fields"]
 
 _LAST_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
@@ -84,21 +84,97 @@ orthonormal with determinant +1 (max|R Rᵀ − I| = 3, det = 8, tolerance 1e-06
                     f"got shape {T.shape}")
     if not np.all(np.isfinite(T)):
         raise error(f"{name} contains NaN or infinity")
-    R = T[..., :3, :3]
+    _check_rotation(T[..., :3, :3], name, " is not a rigid pose: its rotation part", tol, error)
+    bottom = np.max(np.abs(T[..., 3, :] - _LAST_ROW), axis=-1, initial=0.0)
+    bad = bottom > last_row_tol
+    if np.any(bad):
+        raise error(f"{name}{_pose_index(bad)} is not a rigid pose: the last row of a pose must "
+                    "be [0, 0, 0, 1]")
+    return T
+
+
+def _check_rotation(R: np.ndarray, name: str, what: str, tol: float,
+                    error: type[Exception]) -> None:
+    """Raise ``error`` when some finite ``R (..., 3, 3)`` is not orthonormal with det +1 to
+    ``tol``; the message starts with ``name``, the batch index, then ``what``."""
     ortho = np.max(np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)), axis=(-1, -2), initial=0.0)
     det = np.linalg.det(R) if R.size else np.ones(R.shape[:-2])
     bad = (ortho > tol) | (np.abs(det - 1.0) > tol)
     if np.any(bad):
         raise error(
-            f"{name}{_pose_index(bad)} is not a rigid pose: its rotation part is not orthonormal "
-            f"with determinant +1 (max|R Rᵀ − I| = {ortho[bad].flat[0]:.3g}, "
-            f"det = {det[bad].flat[0]:.6g}, tolerance {tol:g})"
+            f"{name}{_pose_index(bad)}{what} is not orthonormal with determinant +1 "
+            f"(max|R Rᵀ − I| = {ortho[bad].flat[0]:.3g}, det = {det[bad].flat[0]:.6g}, "
+            f"tolerance {tol:g})"
         )
-    bottom = np.max(np.abs(T[..., 3, :] - _LAST_ROW), axis=-1, initial=0.0)
-    bad = bottom > last_row_tol
-    if np.any(bad):
-        raise error(f"{name}{_pose_index(bad)}: the last row of a pose must be [0, 0, 0, 1]")
-    return T
+
+
+def as_rotation(R, name: str = "rotation", *, tol: float = ORTHO_TOL,
+                error: type[Exception] = InputError) -> np.ndarray:
+    """Rotation matrices ``(..., 3, 3)``, checked: numbers of that shape, finite, orthonormal
+    with determinant +1 to ``tol``. Raises ``error`` naming ``name`` (and the first offending
+    matrix's batch index).
+
+    >>> as_rotation(np.eye(3), "R_base_tool").shape
+    (3, 3)
+    >>> as_rotation(-np.eye(3), "R_base_tool")
+    Traceback (most recent call last):
+    ...
+    kinestat.errors.InputError: R_base_tool is not orthonormal with determinant +1 \
+(max|R Rᵀ − I| = 0, det = -1, tolerance 1e-06)
+    """
+    try:
+        R = np.asarray(R, dtype=float)
+    except (TypeError, ValueError) as exc:
+        raise error(f"{name} must be 3x3 rotation matrices of numbers: {exc}") from exc
+    if R.ndim < 2 or R.shape[-2:] != (3, 3):
+        raise error(f"{name} must be rotation matrices of shape (..., 3, 3), got shape {R.shape}")
+    if not np.all(np.isfinite(R)):
+        raise error(f"{name} contains NaN or infinity")
+    _check_rotation(R, name, "", tol, error)
+    return R
+
+
+def as_number(value, name: str, *, positive: bool = False, nonnegative: bool = False,
+              error: type[Exception] = InputError) -> float:
+    """One finite real number (a tolerance, a length), as a float; ``positive``: > 0 too,
+    ``nonnegative``: ≥ 0 too.
+
+    >>> as_number(1e-9, "tol", positive=True)
+    1e-09
+    >>> as_number(float("nan"), "tol")
+    Traceback (most recent call last):
+    ...
+    kinestat.errors.InputError: tol must be a finite number, got nan
+    """
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise error(f"{name} must be a number, got {value!r}") from None
+    if isinstance(value, (bool, np.bool_)) or not math.isfinite(x):
+        raise error(f"{name} must be a finite number, got {value!r}")
+    if positive and not x > 0.0:
+        raise error(f"{name} must be positive, got {value!r}")
+    if nonnegative and not x >= 0.0:
+        raise error(f"{name} must be ≥ 0, got {value!r}")
+    return x
+
+
+def as_count(value, name: str, *, minimum: int = 0,
+             error: type[Exception] = InputError) -> int:
+    """A whole number ≥ ``minimum`` (an iteration budget, a number of steps), as an int.
+
+    >>> as_count(4, "polish")
+    4
+    >>> as_count(2.5, "polish")
+    Traceback (most recent call last):
+    ...
+    kinestat.errors.InputError: polish must be a whole number ≥ 0, got 2.5
+    """
+    if isinstance(value, (bool, np.bool_)) or not isinstance(value, (int, np.integer)) \
+            or value < minimum:
+        shown = repr(value) if len(repr(value)) <= 40 else "a very long value"
+        raise error(f"{name} must be a whole number ≥ {minimum}, got {shown}")
+    return int(value)
 
 
 def as_vector3(v, name: str = "vector", *, single: bool = False,

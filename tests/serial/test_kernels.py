@@ -196,5 +196,5 @@ def test_single_calls_alternating_models_use_each_models_chain(rng):
             np.testing.assert_allclose(kinestat.jacobian(m, q), jacobian_reference(m, q),
                                        atol=1e-12)
         models.append(random_chain(rng))
-    with pytest.raises(AttributeError):  # not a model: an error (never the memo's empty slot)
+    with pytest.raises(InputError, match="ChainModel"):  # never the memo's empty slot
         kinestat.fk(None, np.zeros(6))

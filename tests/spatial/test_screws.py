@@ -121,5 +121,5 @@ def test_errors():
         screw_from_axis([0, 0, 1, 0, 0, 0], np.nan)
     with pytest.raises(InputError, match="NaN"):
         twist([np.nan, 0, 0], [0, 0, 0])
-    with pytest.raises(InputError, match="trailing shape"):
+    with pytest.raises(InputError, match=r"T must be .*shape \(\.\.\., 4, 4\)"):
         adjoint(np.eye(3))

@@ -7,11 +7,11 @@ import math
 
 import numpy as np
 
-from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.fk import fk
 from kinestat.serial.jacobian import fk_and_jacobian
+from kinestat.spatial.validate import as_pose
 
 __all__ = ["check_poses", "pose_residuals", "newton_polish", "wrap_angles", "pack", "nan_array",
            "call_compiled", "plain_poses",
@@ -93,27 +93,10 @@ def wrap_angles(q: np.ndarray, rotates: np.ndarray) -> np.ndarray:
 
 
 def check_poses(T, *, tol: float = 1e-6) -> np.ndarray:
-    """Validate ``T (..., 4, 4)`` as finite rigid transforms; raise :class:`InputError` if not."""
-    try:
-        T = np.asarray(T, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise InputError(f"ik_all: pose must be numbers of shape (..., 4, 4): {exc}") from exc
-    if T.ndim < 2 or T.shape[-2:] != (4, 4):
-        raise InputError(f"ik_all: pose must have shape (..., 4, 4), got {T.shape}")
-    if not np.all(np.isfinite(T)):
-        raise InputError("ik_all: pose contains NaN or infinity")
-    R = T[..., :3, :3]
-    orth = np.max(np.abs(R @ np.swapaxes(R, -1, -2) - np.eye(3)), axis=(-2, -1))
-    det = np.linalg.det(R)
-    last = np.max(np.abs(T[..., 3, :] - [0.0, 0.0, 0.0, 1.0]), axis=-1)
-    bad = (orth > tol) | (np.abs(det - 1.0) > tol) | (last > 0.0)
-    if np.any(bad):
-        i = tuple(int(v) for v in np.argwhere(bad)[0])
-        raise InputError(
-            f"ik_all: pose {i} is not a rigid transform (rotation not orthonormal with det +1 "
-            f"within {tol:g}, or last row not [0, 0, 0, 1])"
-        )
-    return T
+    """Validate ``T (..., 4, 4)`` as finite rigid transforms
+    (:func:`kinestat.spatial.validate.as_pose`, rotations to ``tol``, last row exact); raise
+    :class:`~kinestat.errors.InputError` naming ``T_base_flange`` and the first bad pose."""
+    return as_pose(T, "ik_all: T_base_flange", tol=tol)
 
 
 def pose_residuals(model: ChainModel, q: np.ndarray, T: np.ndarray):

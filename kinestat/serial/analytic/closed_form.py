@@ -427,7 +427,7 @@ def solve_three_parallel_compiled(model: ChainModel, T: np.ndarray, data: dict, 
                   singular=np.zeros((N, 8), dtype=bool), family_sign=np.zeros((N, 8)),
                   family_value=nan_array((N, 8)), family_joints=None, n_solutions=cnt,
                   reason=reasons(cnt, _REASON_3P), method="three-parallel", tol=tol)
-    where = np.flatnonzero(near) if N > 1 else (np.zeros(1, dtype=np.intp) if near[0] else None)
+    where = np.flatnonzero(near) if N != 1 else (np.zeros(1, dtype=np.intp) if near[0] else None)
     if where is not None and where.size:
         from kinestat.serial.analytic.families import add_wrist_families  # lazy: rarely needed
 

@@ -13,6 +13,7 @@ import numpy as np
 
 from kinestat.errors import InputError
 from kinestat.mechanism.chain import ChainModel
+from kinestat.spatial.transforms import as_array
 
 if TYPE_CHECKING:
     from kinestat.serial.analytic.result import IKAllResult
@@ -97,9 +98,14 @@ def select_nearest(model: ChainModel, result: IKAllResult, current=None, *, weig
     if cur.shape[-1:] != (n,) or not np.all(np.isfinite(cur)):
         raise InputError(f"current configuration must be finite with shape (..., {n})")
     cur = np.broadcast_to(cur, shape + (n,))[..., None, :]
-    w = np.ones(n) if weights is None else np.asarray(weights, dtype=float)
-    lo = model.lower if lower is None else np.asarray(lower, dtype=float)
-    hi = model.upper if upper is None else np.asarray(upper, dtype=float)
+    w = np.ones(n) if weights is None else as_array(weights, shape_tail=(n,), name="weights")
+    if np.any(w < 0):
+        raise InputError(f"weights must be ≥ 0, got {w.tolist()}")
+    lo, hi = (default if given is None else as_array(given, shape_tail=(n,), name=nm, finite=False)
+              for given, default, nm in ((lower, model.lower, "lower"),
+                                          (upper, model.upper, "upper")))
+    if np.any(np.isnan(lo)) or np.any(np.isnan(hi)):
+        raise InputError("lower and upper limits must not contain NaN")
     rot = ~model.prismatic
     q = np.where(result.valid[..., None], result.q, 0.0)
     if result.family_joints is not None:

@@ -12,6 +12,7 @@ model with the PUMA 762's geometry.
 
 from __future__ import annotations
 
+import math
 import sys
 from functools import lru_cache
 from typing import TYPE_CHECKING
@@ -26,6 +27,7 @@ from kinestat.serial.analytic.geometry import DERIVED, PRESET, check_independent
 from kinestat.serial.analytic.result import IKAllResult
 from kinestat.serial.ik_methods import get as _robot_method
 from kinestat.serial.ik_methods import registered as _robot_methods
+from kinestat.spatial.validate import as_number
 
 if TYPE_CHECKING:
     from kinestat.serial.analytic.locked import SelfMotion
@@ -138,6 +140,7 @@ def _nearest_rigid(Tf: np.ndarray) -> np.ndarray:
 
 _S44 = (4, 4)
 _F64 = np.dtype(np.float64)
+_INF = math.inf
 
 #: the compiled closed forms (each kernel checks its poses: :func:`ik_all`'s fast path)
 _CLOSED_FORMS = {"pieper": closed_form.solve_pieper_compiled,
@@ -237,7 +240,7 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
     """
     T = T_base_flange
     if type(T) is np.ndarray and T.shape == _S44 and method == "auto" and backend == "numba" \
-            and isinstance(model, ChainModel):
+            and isinstance(model, ChainModel) and type(tol) is float and 0.0 < tol < _INF:
         # one plain pose, defaults: the closed form's bound single call (after the first); with
         # locked joints, the folded chain's
         # C-contiguous, aligned, writeable (NPY_ARRAY_C_CONTIGUOUS | ALIGNED | WRITEABLE)
@@ -249,6 +252,7 @@ def ik_all(model: ChainModel, T_base_flange, *, method: str = "auto", tol: float
                 return res
     if not isinstance(model, ChainModel):
         raise ModelError(f"ik_all: expected a ChainModel, got {type(model).__name__}")
+    tol = as_number(tol, "ik_all: tol", positive=True)
     if locked:
         lp = _locked_plan(model, locked)
         return lp.expand(ik_all(lp.six, lp.poses(T_base_flange), method=method, tol=tol,

@@ -45,6 +45,7 @@ from kinestat.spatial.displacement import (
 )
 from kinestat.spatial.se3 import pose_error, twist_exp
 from kinestat.spatial.transforms import as_array, make_pose
+from kinestat.spatial.validate import as_number, as_pose
 
 __all__ = [
     "Path",
@@ -101,14 +102,16 @@ StageSpec = Path | Callable[[np.ndarray], Path]
 
 def resolve_stage(spec: StageSpec, hand: np.ndarray) -> Path:
     """The path of a stage starting with the hand at ``hand`` ``(4, 4)``."""
-    return spec if isinstance(spec, Path) else spec(hand)
+    if isinstance(spec, Path):
+        return spec
+    if not callable(spec):
+        raise InputError(f"a stage must be a path or a function hand pose -> path, got "
+                         f"{type(spec).__name__}")
+    return spec(hand)
 
 
 def _pose(T, name: str) -> np.ndarray:
-    T = as_array(T, shape_tail=(4, 4), name=name)
-    if T.shape != (4, 4):
-        raise InputError(f"{name} must be one 4x4 pose, got shape {T.shape}")
-    return T
+    return as_pose(T, name, single=True)
 
 
 def twist_between(T1, T2) -> np.ndarray:
@@ -360,8 +363,8 @@ def command_path(start, direction, distance: float, angle: float,
     nR = float(np.linalg.norm(R))
     if nR == 0.0:
         raise InputError("command direction R is the zero vector: give the direction of motion")
-    if not (math.isfinite(distance) and math.isfinite(angle)):
-        raise InputError("command distance and angle must be finite")
+    distance = as_number(distance, "command distance")
+    angle = as_number(angle, "command angle")
     if frame == "hand":
         R = start[:3, :3] @ R
     U = R / nR

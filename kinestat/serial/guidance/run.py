@@ -52,12 +52,7 @@ from kinestat.serial.guidance.planners import (
     resolve_stage,
     twist_between,
 )
-from kinestat.serial.guidance.rules import (
-    SINGULAR_MODES,
-    GuidanceOptions,
-    StepInput,
-    StepRule,
-)
+from kinestat.serial.guidance.rules import SINGULAR_MODES, GuidanceOptions, StepInput, StepRule
 from kinestat.serial.guidance.step import (
     characteristic_length,
     conditioning,
@@ -68,6 +63,7 @@ from kinestat.serial.guidance.step import (
     solve_step,
 )
 from kinestat.serial.jacobian import jacobian
+from kinestat.spatial.validate import as_number
 
 __all__ = [
     "GuidanceOptions",
@@ -559,14 +555,15 @@ def run_guidance(
     (9, True)
     """
     opt = options or GuidanceOptions()
-    q = model.check_q(q0).astype(float)
+    q = model.check_q(q0, "q0").astype(float)
     if q.ndim != 1:
         raise InputError(f"q0 must be one configuration of shape ({model.n},)")
     stages = list(stages)
     if not stages:
         raise InputError("no stages to run: give at least one target or command")
     per_stage = _per_stage_steps(steps, len(stages))
-    L = characteristic_length(model, q) if length is None else float(length)
+    L = characteristic_length(model, q) if length is None else \
+        as_number(length, "length", positive=True)
     notes: list[str] = []
     if model.n != 6:
         notes.append(

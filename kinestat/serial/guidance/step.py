@@ -127,7 +127,7 @@ def solve_step(J, B, *, prismatic, length: float = 1.0, damping=None,
         J: the twist Jacobian ``(..., 6, n)``.
         B: the hand displacement twist ``[δθ u_ω; v_O]`` ``(..., 6)``.
         prismatic: boolean mask ``(n,)`` of prismatic joints (for the dimensionless scaling).
-        length: the characteristic length L.
+        length: the characteristic length L, one number or one per Jacobian ``(...)``.
         damping: ``None`` for the plain solution (exact when n = 6 and J is regular, least
             squares / minimum norm otherwise), ``"auto"`` for damped least squares with
             :func:`damping_for`, or a fixed λ ≥ 0.
@@ -143,12 +143,13 @@ def solve_step(J, B, *, prismatic, length: float = 1.0, damping=None,
         raise InputError(f"B must have shape (..., 6), got {B.shape}")
     if not (np.all(np.isfinite(J)) and np.all(np.isfinite(B))):
         raise InputError("J or B contains NaN or infinity")
-    if not (length > 0 and math.isfinite(length)):
+    L = np.asarray(length, dtype=float)[..., None]
+    if not np.all((L > 0) & np.isfinite(L)):
         raise InputError(f"length must be positive and finite, got {length!r}")
     n = J.shape[-1]
-    row = np.array([1.0, 1.0, 1.0, 1.0 / length, 1.0 / length, 1.0 / length])
-    col = np.where(np.asarray(prismatic, dtype=bool), float(length), 1.0)
-    Js = row[:, None] * J * col[None, :]
+    row = np.concatenate(np.broadcast_arrays(np.ones(3), 1.0 / L), axis=-1)
+    col = np.where(np.asarray(prismatic, dtype=bool), L, 1.0)
+    Js = row[..., :, None] * J * col[..., None, :]
     Bs = row * B
     U, s, Vt = np.linalg.svd(Js, full_matrices=False)
     smin = s[..., -1]

@@ -46,6 +46,6 @@ def joint_rates(model: ChainModel, q, twist, speed, *, angle_tol: float = 1e-12)
         raise InputError("twist is zero: give the direction of the hand motion")
     pure = w <= angle_tol * np.maximum(v, 1e-300)
     mag = np.where(pure, v, w)
-    L = characteristic_length(model, q if q.ndim == 1 else q.reshape(-1, model.n)[0])
+    L = characteristic_length(model, q)  # each configuration's own
     sol = solve_step(jacobian(model, q), V, prismatic=model.prismatic, length=L)
     return sol.dq * (speed / mag)[..., None]

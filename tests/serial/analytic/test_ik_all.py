@@ -161,7 +161,7 @@ def test_errors():
                np.eye(4))
     bad = np.eye(4)
     bad[0, 0] = 2.0
-    with pytest.raises(InputError, match="not a rigid transform"):
+    with pytest.raises(InputError, match="T_base_flange is not a rigid pose"):
         ik_all(model, bad)
     with pytest.raises(InputError, match="shape"):
         ik_all(model, np.eye(3))
@@ -206,9 +206,9 @@ def test_closed_form_kernels_hand_unchecked_poses_to_the_checks(name):
     np.testing.assert_array_equal(one.q, rounded.q[2])
     bad = T.copy()
     bad[3, 0, 0] += 1e-3
-    with pytest.raises(InputError, match=r"pose \(3,\) is not a rigid transform"):
+    with pytest.raises(InputError, match=r"T_base_flange \(pose \(3,\)\) is not a rigid pose"):
         ik_all(model, bad)
-    with pytest.raises(InputError, match="not a rigid transform"):
+    with pytest.raises(InputError, match="not a rigid pose"):
         ik_all(model, np.ascontiguousarray(bad[3]))
 
 
