@@ -18,7 +18,8 @@ from kinestat.errors import InputError
 if TYPE_CHECKING:
     from kinestat.serial.guidance.run import GuidanceResult
 
-__all__ = ["parse_steps", "progress_reporter", "print_result", "singular_mode", "SINGULAR_HELP"]
+__all__ = ["check_cond_limit", "parse_steps", "progress_reporter", "print_result",
+           "singular_mode", "SINGULAR_HELP"]
 
 SINGULAR_HELP = ("At a singular configuration: perturb (small increments, one joint at a time, "
                  "greedy), perturb-all (DISP's way: small increments on all joints at once), "
@@ -42,6 +43,13 @@ def parse_steps(text: str | None) -> list[int] | int | None:
     if any(v < 0 for v in vals):
         raise InputError("--steps: step counts must be ≥ 0 (0 = automatic)")
     return vals[0] if len(vals) == 1 else vals
+
+
+def check_cond_limit(value: float | None) -> None:
+    """``--cond-limit``: a finite condition number > 0 (None: the default), refused before
+    the run with the option's name."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise InputError(f"--cond-limit must be a finite number > 0, got {value}")
 
 
 def singular_mode(text: str, damped: bool) -> str:

@@ -108,7 +108,8 @@ def _one_line(text: str) -> str:
 
 def _usage_error(exc: UsageError) -> str:
     """The one-line message of a usage error, pointing at the command's ``--help``."""
-    msg = _one_line(exc.format_message())
+    # pydantic, which Typer converts values with, puts "Value error, " before a parser's message
+    msg = _one_line(exc.format_message()).replace(": Value error, ", ": ")
     path = exc.ctx.command_path if exc.ctx is not None else "kinestat"
     return f"kinestat: error: {msg} (see '{path} --help')"
 

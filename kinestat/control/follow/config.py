@@ -138,7 +138,7 @@ class FollowConfig:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.travel) and 0.0 < self.travel <= 1000.0):
-            raise InputError(f"travel must be in (0, 1000] mm, got {self.travel!r}")
+            raise InputError(f"travel (--travel) must be in (0, 1000] mm, got {self.travel!r}")
         t = _unit3(self.travel_dir, "travel direction")
         object.__setattr__(self, "travel_dir", t)
         for name in ("travel_step", "max_correction", "max_turn_deg", "settle_tol"):
@@ -154,7 +154,7 @@ class FollowConfig:
             raise InputError(f"auto_tilt must be True, False or None (automatic), got "
                              f"{self.auto_tilt!r}")
         if not (math.isfinite(self.tilt_deg) and abs(self.tilt_deg) < 45.0):
-            raise InputError(f"tilt must be within ±45°, got {self.tilt_deg!r}")
+            raise InputError(f"tilt_deg (--tilt-deg) must be within ±45°, got {self.tilt_deg!r}")
         d = self.base.start_s6
         ang = math.degrees(math.acos(min(1.0, abs(float(t @ d)))))
         if ang < self.min_angle_deg:
