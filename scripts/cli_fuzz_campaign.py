@@ -104,6 +104,14 @@ CASES: list[tuple[str, list[str], str, str | None]] = [
      "--tilt-deg"),
     ("choice", ["control", "--serial-format", "bogus", "--no-plot"], "error",
      "--serial-format"),
+    ("range", ["control", "--task", "follow", "--travel-dir", "0,0,0", "--no-plot"], "error",
+     "--travel-dir"),
+    ("range", ["control", "--task", "follow", "--travel-step", "0", "--no-plot"], "error",
+     "--travel-step"),
+    ("range", ["control", "--task", "follow", "--probe-span", "100", "--no-plot"], "error",
+     "--probe-span"),
+    ("range", ["sweep", "workspace", "--samples", "2", "--workers", "100000", "--output",
+               "{out}"], "error", "--workers"),
     ("pair", ["control", "--plot", "{out}", "--no-plot"], "error", "--plot"),
     ("list", ["control", "--start", "1,2", "--no-plot"], "error", "--start"),
     ("range", ["control", "--samples", "0", "--no-plot"], "error", "--samples"),
@@ -301,6 +309,8 @@ SIGNAL_CASES = [
     ("sweep", ["sweep", "tolerance", "--samples", "2000000", "--threads", "--workers", "1",
                "--output", "{work}/study", "--quiet", "--no-plots"], 8.0, 130, None),
     ("sim galil", ["sim", "galil", "--json"], 3.0, 0, None),
+    ("sim encoders", ["sim", "encoders", "--json"], 3.0, 0, None),
+    ("view serve", ["view", "model", "puma560", "--serve", "--no-open"], 4.0, 130, None),
 ]
 
 

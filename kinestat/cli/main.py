@@ -66,6 +66,16 @@ class _KinestatGroup(LazyGroup):
     entries = COMMANDS
     package = "kinestat.cli"
 
+    def invoke(self, ctx):
+        """Run the command; a Ctrl-C that no command handled itself ends it with one line and
+        status 130 (Typer alone would exit 130 printing only a blank line)."""
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            where = " ".join(str(exc).split())
+            typer.echo(f"kinestat: interrupted{': ' + where if where else ''}", err=True)
+            raise typer.Exit(130) from None
+
 
 app = typer.Typer(
     cls=_KinestatGroup,

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import inspect
 import math
+import os
 import warnings
 from collections.abc import Callable
 
@@ -116,6 +117,11 @@ def _check_run_options(options: dict) -> None:
     t = options.get("timeout")
     if not (isinstance(t, (int, float)) and math.isfinite(t) and t > 0):
         raise InputError(f"--timeout must be a finite number of seconds > 0, got {t}")
+    workers, cores = options.get("workers"), os.cpu_count() or 1
+    if workers is not None and not 1 <= workers <= cores:
+        # a local cluster runs one single-threaded worker per core: more only queue for the
+        # same cores, each a process (--workers 100000 tried to start them all)
+        raise InputError(f"--workers must be in 1..{cores} (this machine's cores), got {workers}")
     check_output_dir(options.get("output"), "--output")
 
 

@@ -39,10 +39,15 @@ BAD = [
     (["control", "--task", "follow", "--tilt-deg", "100", "--no-plot"], "--tilt-deg"),
     (["control", "--serial-format", "bogus", "--no-plot"], "--serial-format"),
     (["control", "--plot", "{out}", "--no-plot"], "--plot"),
+    (["control", "--task", "follow", "--travel-dir", "0,0,0", "--no-plot"], "--travel-dir"),
+    (["control", "--task", "follow", "--travel-step", "0", "--no-plot"], "--travel-step"),
+    (["control", "--task", "follow", "--probe-span", "100", "--no-plot"], "--probe-span"),
     (["home", "--galil", "127.0.0.1:1", "--samples", "0"], "--samples"),
     (["sim", "galil", "--port", "-1", "--duration", "0.1"], "--port"),
     (["sim", "galil", "--rate", "0", "--duration", "0.1"], "--rate"),
     (["view", "model", "puma560", "--no-open", "--meshes", "bogus"], "--meshes"),
+    (["sweep", "workspace", "--samples", "2", "--workers", "100000", "--output", "{out}"],
+     "--workers"),
     (["sweep", "platform-range", "--grid", "2", "--range-deg", "-1,2,3", "--output", "{out}"],
      "--range-deg"),
     (["sweep", "platform-design", "--grid", "2", "--height", "0:70", "--output", "{out}"],
@@ -132,3 +137,26 @@ def test_good_input_at_the_edges_runs(capsys, monkeypatch, tmp_path, fx, argv):
     monkeypatch.setenv("BROWSER", "true")
     (tmp_path / "dir with blanks").mkdir()
     assert main(_fill(argv, fx, tmp_path)) == 0, capsys.readouterr().err
+
+
+def test_ctrl_c_while_serving_is_one_line_and_status_130(tmp_path):
+    """``view --serve`` stops on Ctrl-C: Typer alone exited 130 printing a blank line only."""
+    import os
+    import signal
+    import subprocess
+    import sys
+
+    root = Path(__file__).resolve().parents[2]
+    proc = subprocess.Popen(
+        [sys.executable, "-m", "kinestat.cli.main", "view", "model", "puma560", "--serve",
+         "--no-open"], cwd=tmp_path, env={**os.environ, "PYTHONPATH": str(root)},
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert "serving http://" in proc.stdout.readline()
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=30)
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+    assert proc.returncode == 130
+    assert [ln for ln in err.splitlines() if ln.strip()] == ["kinestat: interrupted"]
