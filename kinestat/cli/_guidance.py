@@ -52,13 +52,20 @@ def check_cond_limit(value: float | None) -> None:
         raise InputError(f"--cond-limit must be a finite number > 0, got {value}")
 
 
-def singular_mode(text: str, damped: bool) -> str:
+def singular_mode(text: str, damped: bool, default: str | None = None) -> str:
     """``--singular`` value (``perturb-all`` → ``perturb_all``); ``--damped`` is short for
-    ``--singular damped``."""
-    mode = "damped" if damped else text.strip().lower().replace("-", "_")
+    ``--singular damped`` and is refused beside another ``--singular`` than the command's
+    ``default`` (``--damped --singular stop`` used to run damped without a word).
+
+    >>> singular_mode("perturb", True, "perturb")
+    'damped'
+    """
+    mode = text.strip().lower().replace("-", "_")
     if mode not in ("perturb", "perturb_all", "damped", "stop"):
         raise InputError(f"--singular must be perturb, perturb-all, damped or stop, got {text!r}")
-    return mode
+    if damped and mode != "damped" and (default is None or text != default):
+        raise InputError(f"--damped is --singular damped: it does not go with --singular {text}")
+    return "damped" if damped else mode
 
 
 @contextlib.contextmanager

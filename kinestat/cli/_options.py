@@ -119,10 +119,12 @@ def _probe_writable(folder: Path, option: str, path: Path) -> None:
                          f"({exc.strerror or exc})") from None
 
 
-def check_output_file(path: Path | None, option: str, *, makes_folders: bool = False) -> None:
+def check_output_file(path: Path | None, option: str, *, makes_folders: bool = False,
+                      what: str = "file") -> None:
     """An output file option (``--html``, ``--log``, ``--write-model``): refused before any
     work when it names a folder, or when its folder does not exist (unless the writer creates
-    it: ``makes_folders``, as the cycle log does) or cannot be written.
+    it: ``makes_folders``, as the cycle log does) or cannot be written. ``what`` names the
+    file in the message (``"model file"``).
 
     >>> check_output_file(None, "--html")
     """
@@ -135,8 +137,8 @@ def check_output_file(path: Path | None, option: str, *, makes_folders: bool = F
         return
     folder = path.parent
     if not folder.is_dir():
-        raise InputError(f"{option} {str(path)!r}: the folder {str(folder)!r} does not exist "
-                         "or is not a folder")
+        raise InputError(f"{option}: cannot write {what} {str(path)!r}: the folder "
+                         f"{str(folder)!r} does not exist or is not a folder")
     _probe_writable(folder, option, path)
 
 

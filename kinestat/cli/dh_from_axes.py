@@ -43,7 +43,7 @@ def dh_from_axes_command(
     "alpha_deg", "relation"}, ...], "base", "tool", "frames", "model_file"} (theta/alpha in
     radians with --rad). "relation" is how z_{i-1} relates to z_i (the last row: to the tool).
     """
-    check_output_file(write_model, "--write-model")
+    check_output_file(write_model, "--write-model", what="model file")
     spec = read_axes_file(file)
     if tol is not None:
         if not (math.isfinite(tol) and tol >= 0):

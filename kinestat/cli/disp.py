@@ -142,8 +142,9 @@ def disp(
     if settle and no_settle:
         raise InputError("give --settle or --no-settle, not both")
     correction = "settle" if settle else ("none" if no_settle else None)
+    mode = singular_mode(singular, damped, "perturb-all")
     opts = disp_options(closed_loop=closed_loop, second_order=second_order,
-                        singular=singular_mode(singular, damped), cond_limit=cond_limit,
+                        singular=mode, cond_limit=cond_limit,
                         disp_1977=disp_1977, correction=correction, deck=d)
     with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         run = run_deck(d, steps=parse_steps(steps), options=opts, progress=prog)

@@ -257,8 +257,9 @@ def guide(
         cmds += read_commands(commands)
     moves = [parse_move(s) for s in (move or [])]
     stages = _stages(m, q0, targets, kind, cmds, moves)
+    mode = singular_mode(singular, damped, "perturb")
     opts = GuidanceOptions(step_rule="second_order" if second_order else "first_order",
-                           closed_loop=closed_loop, singular=singular_mode(singular, damped),
+                           closed_loop=closed_loop, singular=mode,
                            settle=not no_settle, cond_limit=cond_limit)
     with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         result = run_guidance(m, q0, stages, steps=parse_steps(steps), options=opts,

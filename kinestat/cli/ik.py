@@ -147,6 +147,9 @@ def ik_command(
     if closed and pose is not None:
         raise InputError("give either --pose (numerical IK) or --tool-point/--s6/--a67 "
                          "(PUMA 762 closed form), not both")
+    if closed and q0_deg is not None:
+        raise InputError("--q0-deg: a start of numerical IK (--pose); the PUMA 762 closed form "
+                         "picks among its solutions by --current-deg or --current-axis-deg")
     if closed:
         _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_axis_deg,
                      limits, normalize, as_json)

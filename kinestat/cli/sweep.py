@@ -118,6 +118,9 @@ def _check_run_options(options: dict) -> None:
     if not (isinstance(t, (int, float)) and math.isfinite(t) and t > 0):
         raise InputError(f"--timeout must be a finite number of seconds > 0, got {t}")
     workers, cores = options.get("workers"), os.cpu_count() or 1
+    if options.get("scheduler") is not None and (workers is not None or options.get("threads")):
+        raise InputError("--workers and --threads set up the local cluster; with --scheduler "
+                         "the scheduler's own workers run the study")
     if workers is not None and not 1 <= workers <= cores:
         # a local cluster runs one single-threaded worker per core: more only queue for the
         # same cores, each a process (--workers 100000 tried to start them all)
