@@ -121,10 +121,11 @@ def _check_run_options(options: dict) -> None:
     if options.get("scheduler") is not None and (workers is not None or options.get("threads")):
         raise InputError("--workers and --threads set up the local cluster; with --scheduler "
                          "the scheduler's own workers run the study")
-    if workers is not None and not 1 <= workers <= cores:
+    if workers is not None and workers > cores:  # (below 1: the cluster's own check)
         # a local cluster runs one single-threaded worker per core: more only queue for the
         # same cores, each a process (--workers 100000 tried to start them all)
-        raise InputError(f"--workers must be in 1..{cores} (this machine's cores), got {workers}")
+        raise InputError(f"--workers must be at most {cores} (this machine's cores), got "
+                         f"{workers}")
     check_output_dir(options.get("output"), "--output")
 
 

@@ -258,7 +258,8 @@ class RunSpec:
             if follow and getattr(self, key) is None:
                 self._set(key, default)
         if self.travel_dir is not None:
-            self._set("travel_dir", _vec3(self.travel_dir, "--travel-dir", nonzero=True))
+            self._set("travel_dir", _vec3(self.travel_dir, "--travel-dir (the travel direction)",
+                                          nonzero=True))
         if self.approach_step is None:
             self._set("approach_step", RUN_DEFAULTS.follow_approach_step if follow
                       else RUN_DEFAULTS.press_approach_step)
