@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from kinestat.cli._model import load_model
-from kinestat.cli._options import check_seed
+from kinestat.cli._options import check_output_dir, check_output_file, check_seed
 from kinestat.cli._output import parse_floats, parse_pose
 from kinestat.control.defaults import PLANTS
 from kinestat.errors import InputError
@@ -72,7 +72,15 @@ def cell(galil, serial, serial_format, plane_point, plane_normal, ideal_sensor, 
           rate, seed, sim_legs="thesis", workpiece=None, sim="kinestat",
           workpiece_stiffness=None, top_weight=False):
     """The cell the options describe: simulated (no device options) or the real devices."""
-    from kinestat.control.runspec import RealDevices, SimulatedCell  # lazy: start-up (numba)
+    from kinestat.control.runspec import (  # lazy: start-up (numba)
+        SERIAL_FORMATS,
+        RealDevices,
+        SimulatedCell,
+    )
+
+    if serial_format not in SERIAL_FORMATS:  # checked with the simulated cell too
+        raise InputError(f"--serial-format must be one of {', '.join(SERIAL_FORMATS)}, got "
+                         f"{serial_format!r}")
 
     if sim not in PLANTS:  # before the next check names --sim's other values
         raise InputError(f"--sim must be one of {', '.join(PLANTS)}, got {sim!r}")
@@ -156,15 +164,15 @@ def check_rate_and_log(rate: float, log: Path | None) -> None:
 
     if not (math.isfinite(rate) and 0 < rate <= MAX_RATE_HZ):
         raise InputError(f"--rate must be in (0, {MAX_RATE_HZ:g}] Hz, got {rate}")
-    if log is not None and log.is_dir():
-        raise InputError(f"--log {str(log)!r} is a directory; give the cycle log's file name")
+    check_output_file(log, "--log", makes_folders=True)  # the cycle log makes its folder
 
 
 def check_plot_dir(plot: Path | None, no_plot: bool) -> None:
-    """--plot names a directory: refuse an existing file before running (as ``disp --plot``)."""
-    if plot is not None and not no_plot and plot.exists() and not plot.is_dir():
-        raise InputError(f"--plot {str(plot)!r} exists and is not a directory; give a "
-                         "directory for the wrench-vs-state plot")
+    """--plot names a directory that can be written (as ``disp --plot``), and does not go with
+    --no-plot: refused before running."""
+    if plot is not None and no_plot:
+        raise InputError("give --plot DIR or --no-plot, not both")
+    check_output_dir(plot, "--plot")
 
 
 def check_invocation(o: dict) -> None:
@@ -172,6 +180,7 @@ def check_invocation(o: dict) -> None:
     check_seed(o["seed"])
     check_plot_dir(o["plot"], o["no_plot"])
     check_rate_and_log(o["rate"], o["log"])
+    check_output_file(o["html"], "--html")
     if o["serve"] and (not o["view"] or o["html"] is not None):
         raise InputError("--serve goes with --view (and not with --html)")
 

@@ -15,7 +15,7 @@ from kinestat.cli._model import (
     scale_option,
     tip_option,
 )
-from kinestat.cli._options import flag
+from kinestat.cli._options import flag, name_value, path_value
 from kinestat.control.ceilings import MAX_ITERATIONS
 from kinestat.control.defaults import RUN_DEFAULTS as D
 from kinestat.control.defaults import TASKS
@@ -89,25 +89,28 @@ PARAMETERS = [
         help=f"Measurement cycles before giving up (1..{MAX_ITERATIONS}; default 60 for press, "
         f"{MAX_ITERATIONS} for follow).")),
     _p("plot", Path, typer.Option(
-        None, "--plot", help="Directory for the wrench-vs-state plot (default: the run "
+        None, "--plot", parser=path_value,
+        help="Directory for the wrench-vs-state plot (default: the run "
         "directory).")),
     _p("no_plot", bool, flag(False, "--no-plot", help="Do not write the plot.")),
     _p("log", Path, typer.Option(
-        None, "--log", help="Cycle log file, JSON lines (default: "
+        None, "--log", parser=path_value, help="Cycle log file, JSON lines (default: "
         "./kinestat-runs/<timestamp>/log.jsonl).")),
     _p("view", bool, flag(False, "--view", help="Also open a 3D replay in the browser.")),
-    _p("html", Path, typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+    _p("html", Path, typer.Option(None, "--html", parser=path_value,
+                                  metavar="FILE", help="With --view: write the "
                               "3D replay to FILE (self-contained) instead of opening a browser.")),
     _p("serve", bool, flag(False, "--serve", help="With --view: a live view on loopback while the "
                        "run goes (each cycle streamed to the page as it is logged); its address "
                        "goes to stderr, and after the run it serves until Ctrl-C.")),
     _p("calibration", str, typer.Option(
-        "thesis", "--calibration",
+        "thesis", "--calibration", parser=name_value,
         help="Leg calibration the controller uses (counts -> leg length and force): 'thesis' "
         "(the 2011 prototype's maps), 'nominal' (the design springs) or a TOML file "
         "(docs/control.md).", metavar="thesis|nominal|FILE")),
     _p("platform", str, typer.Option(
-        None, "--platform", help="Platform TOML file (default the 2011 prototype); its "
+        None, "--platform", parser=name_value,
+        help="Platform TOML file (default the 2011 prototype); its "
         "\\[mount] table, if any, is the default --mount.", metavar="FILE")),
     _p("tool_offset", str, typer.Option(
         None, "--tool-offset", "--tool-point-6", metavar="X,Y,Z",
@@ -130,7 +133,7 @@ PARAMETERS = [
         "the simulated Galil and encoder box) or 'mujoco' (MuJoCo's rigid-body dynamics and "
         "contact, in process; docs/mujoco.md).", metavar="kinestat|mujoco")),
     _p("sim_legs", str, typer.Option(
-        "thesis", "--sim-legs",
+        "thesis", "--sim-legs", parser=name_value,
         help="The simulated legs' TRUE law: 'thesis', 'nominal' or a calibration TOML file "
         "(simulation only).", metavar="thesis|nominal|FILE")),
     _p("procedure", str, typer.Option(
@@ -191,7 +194,8 @@ PARAMETERS = [
         "thesis's massless model (moves not limited); with --sim mujoco the scene's 0.35 kg, "
         "which this also sets.")),
     _p("arm", str, typer.Option(
-        None, "--arm", metavar="MODEL", help="The robot: an embedded model name (e.g. "
+        None, "--arm", parser=name_value,
+        metavar="MODEL", help="The robot: an embedded model name (e.g. "
         "puma560), a TOML model or a URDF file, any 6-joint arm with an analytic solver; "
         "default the thesis's PUMA 762. Another arm runs on the in-process simulated cell: its "
         "joints are set directly within its limits, its base at --arm-base (docs/control.md).")),

@@ -18,7 +18,8 @@ from kinestat.errors import InputError
 if TYPE_CHECKING:
     from kinestat.serial.guidance.run import GuidanceResult
 
-__all__ = ["parse_steps", "progress_reporter", "print_result", "singular_mode", "SINGULAR_HELP"]
+__all__ = ["check_cond_limit", "parse_steps", "progress_reporter", "print_result",
+           "singular_mode", "SINGULAR_HELP"]
 
 SINGULAR_HELP = ("At a singular configuration: perturb (small increments, one joint at a time, "
                  "greedy), perturb-all (DISP's way: small increments on all joints at once), "
@@ -44,13 +45,27 @@ def parse_steps(text: str | None) -> list[int] | int | None:
     return vals[0] if len(vals) == 1 else vals
 
 
-def singular_mode(text: str, damped: bool) -> str:
+def check_cond_limit(value: float | None) -> None:
+    """``--cond-limit``: a finite condition number > 0 (None: the default), refused before
+    the run with the option's name."""
+    if value is not None and not (math.isfinite(value) and value > 0):
+        raise InputError(f"--cond-limit must be a finite number > 0, got {value}")
+
+
+def singular_mode(text: str, damped: bool, default: str | None = None) -> str:
     """``--singular`` value (``perturb-all`` → ``perturb_all``); ``--damped`` is short for
-    ``--singular damped``."""
-    mode = "damped" if damped else text.strip().lower().replace("-", "_")
+    ``--singular damped`` and is refused beside another ``--singular`` than the command's
+    ``default`` (``--damped --singular stop`` used to run damped without a word).
+
+    >>> singular_mode("perturb", True, "perturb")
+    'damped'
+    """
+    mode = text.strip().lower().replace("-", "_")
     if mode not in ("perturb", "perturb_all", "damped", "stop"):
         raise InputError(f"--singular must be perturb, perturb-all, damped or stop, got {text!r}")
-    return mode
+    if damped and mode != "damped" and (default is None or text != default):
+        raise InputError(f"--damped is --singular damped: it does not go with --singular {text}")
+    return "damped" if damped else mode
 
 
 @contextlib.contextmanager

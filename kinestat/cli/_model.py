@@ -12,7 +12,7 @@ from typing import Any
 import typer
 
 from kinestat.cli._options import help_text
-from kinestat.errors import KinestatWarning
+from kinestat.errors import InputError, KinestatWarning
 
 MODEL_HELP = "Embedded model name (e.g. puma762), a TOML model file or a URDF file (.urdf)."
 
@@ -45,6 +45,9 @@ def load_model(model: str, tip: str | None = None, base: str | None = None,
 
     options = {k: v for k, v in (("tip", tip), ("base", base), ("scale", scale),
                                  ("length_unit", length_unit)) if v is not None}
+    if options and not model.lower().endswith(".urdf"):  # named as the command line has them
+        named = ", ".join(f"--{k.replace('_', '-')}" for k in options)
+        raise InputError(f"{named}: options of URDF models, but {model!r} is not a .urdf file")
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", KinestatWarning)
         m = kinestat.load(model, **options)

@@ -9,8 +9,11 @@ square brackets kept: rich would take ``[dx; dphi]`` for markup and drop it).
 from __future__ import annotations
 
 import inspect
+import os
 import re
+import tempfile
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import typer
@@ -86,3 +89,75 @@ def check_seed(seed: int | None, option: str = "--seed") -> None:
     """
     if seed is not None and seed < 0:
         raise InputError(f"{option} must be a non-negative integer, got {seed}")
+
+
+def path_value(text: str) -> Path:
+    """Typer ``parser=`` of a path option or argument: an empty or blank name is refused (as a
+    usage error naming the option) instead of becoming ``Path("")``, the current folder."""
+    if not str(text).strip():
+        raise ValueError("an empty path; give a file or folder name")
+    return Path(text)
+
+
+def name_value(text: str) -> str:
+    """Typer ``parser=`` of an option or argument naming a file or an embedded item (a model,
+    a deck, a platform): an empty or blank value is refused, naming the option."""
+    if not str(text).strip():
+        raise ValueError("an empty name; give a file path (or an embedded name)")
+    return str(text)
+
+
+def _probe_writable(folder: Path, option: str, path: Path) -> None:
+    """Create and remove a file in ``folder``: the one test that holds for every file system
+    (``os.access`` says yes to root, also under /proc)."""
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=".kinestat-probe-", dir=folder)
+        os.close(fd)
+        os.unlink(tmp)
+    except OSError as exc:
+        raise InputError(f"{option} {str(path)!r}: cannot write in {str(folder)!r} "
+                         f"({exc.strerror or exc})") from None
+
+
+def check_output_file(path: Path | None, option: str, *, makes_folders: bool = False,
+                      what: str = "file") -> None:
+    """An output file option (``--html``, ``--log``, ``--write-model``): refused before any
+    work when it names a folder, or when its folder does not exist (unless the writer creates
+    it: ``makes_folders``, as the cycle log does) or cannot be written. ``what`` names the
+    file in the message (``"model file"``).
+
+    >>> check_output_file(None, "--html")
+    """
+    if path is None:
+        return
+    if path.is_dir():
+        raise InputError(f"{option} {str(path)!r} is a directory; give a file name")
+    if makes_folders:
+        _check_creatable(path.parent, option, path)
+        return
+    folder = path.parent
+    if not folder.is_dir():
+        raise InputError(f"{option}: cannot write {what} {str(path)!r}: the folder "
+                         f"{str(folder)!r} does not exist or is not a folder")
+    _probe_writable(folder, option, path)
+
+
+def check_output_dir(path: Path | None, option: str) -> None:
+    """An output folder option (``--plot``, ``--output``): refused before any work when it is
+    a file, or when neither it nor the folder it would be created in can be written."""
+    if path is None:
+        return
+    if path.exists() and not path.is_dir():
+        raise InputError(f"{option} {str(path)!r} exists and is not a directory; give a "
+                         "directory")
+    _check_creatable(path, option, path)
+
+
+def _check_creatable(folder: Path, option: str, path: Path) -> None:
+    """``folder`` exists and can be written, or can be created: its nearest existing ancestor
+    is a folder that can be written."""
+    while not folder.exists() and folder != folder.parent:
+        folder = folder.parent
+    if not folder.is_dir():
+        raise InputError(f"{option} {str(path)!r}: {str(folder)!r} is not a folder")
+    _probe_writable(folder, option, path)

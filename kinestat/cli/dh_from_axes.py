@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import typer
 
-from kinestat.cli._options import command_help, flag, json_option
+from kinestat.cli._options import check_output_file, command_help, flag, json_option, path_value
 from kinestat.cli._output import console, literal, print_json, table
 from kinestat.errors import InputError, ParseError
 from kinestat.io.axes_file import read_axes_file
@@ -26,10 +26,12 @@ def register(app: typer.Typer) -> None:
 
 
 def dh_from_axes_command(
-    file: Path = typer.Argument(..., help="Axes file (TOML, or JSON if it ends in .json)."),
+    file: Path = typer.Argument(..., parser=path_value,
+                                help="Axes file (TOML, or JSON if it ends in .json)."),
     deg: bool = flag(True, "--deg/--rad", help="Angles θ, α in degrees (default) or "
                              "radians, in the table and the JSON keys (theta_deg or theta)."),
-    write_model: Path = typer.Option(None, "--write-model", help="Save the resulting model as a "
+    write_model: Path = typer.Option(None, "--write-model", parser=path_value,
+                                     help="Save the resulting model as a "
                                      "standard-DH TOML model file."),
     tol: float = typer.Option(None, "--tol", help="Tolerance for parallel/meeting axes "
                               "(overrides the file's tol; default 1e-9)."),
@@ -41,6 +43,7 @@ def dh_from_axes_command(
     "alpha_deg", "relation"}, ...], "base", "tool", "frames", "model_file"} (theta/alpha in
     radians with --rad). "relation" is how z_{i-1} relates to z_i (the last row: to the tool).
     """
+    check_output_file(write_model, "--write-model", what="model file")
     spec = read_axes_file(file)
     if tol is not None:
         if not (math.isfinite(tol) and tol >= 0):

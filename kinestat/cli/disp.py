@@ -15,8 +15,24 @@ import typer
 
 from kinestat.cli import _guidance
 from kinestat.cli._compile import compiling_notice
-from kinestat.cli._guidance import SINGULAR_HELP, parse_steps, print_result, singular_mode
-from kinestat.cli._options import STEPS_METAVAR, command_help, flag, json_option, units
+from kinestat.cli._guidance import (
+    SINGULAR_HELP,
+    check_cond_limit,
+    parse_steps,
+    print_result,
+    singular_mode,
+)
+from kinestat.cli._options import (
+    STEPS_METAVAR,
+    check_output_dir,
+    check_output_file,
+    command_help,
+    flag,
+    json_option,
+    name_value,
+    path_value,
+    units,
+)
 from kinestat.cli._output import console, err_console, literal, print_json, table, to_jsonable
 from kinestat.errors import InputError
 from kinestat.io.disp_deck import DispDeck, embedded_deck, list_embedded_decks, read_deck
@@ -66,7 +82,8 @@ def _print_joints(joints: list[dict]) -> None:
 
 
 def disp(
-    deck: str = typer.Argument(..., help="A DISP deck file, or an embedded deck name "
+    deck: str = typer.Argument(..., parser=name_value,
+                               help="A DISP deck file, or an embedded deck name "
                                "(illustration1 … illustration7, illustration5-corrected, …)."),
     as_json: bool = json_option(),
     steps: str = typer.Option(None, "--steps", help="Step count N for every stage, or "
@@ -86,7 +103,8 @@ def disp(
     singular: str = typer.Option("perturb-all", "--singular", help=SINGULAR_HELP),
     damped: bool = flag(False, "--damped", help="Short for --singular damped (not "
                                 "DISP)."),
-    plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png into "
+    plot: Path = typer.Option(None, "--plot", parser=path_value,
+                              help="Write joints.png and hand-path.png into "
                               "this directory.", metavar="DIR"),
     cond_limit: float = typer.Option(None, "--cond-limit", help="Dimensionless condition "
                                      "number above which a configuration counts as singular "
@@ -100,7 +118,8 @@ def disp(
                                    "reproduces that table with the illustration5-published "
                                    "deck. Not stated in the thesis."),
     view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
-    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+    html: Path = typer.Option(None, "--html", parser=path_value,
+                              metavar="FILE", help="With --view: write the "
                               "3D page to FILE (self-contained) instead of opening a browser."),
 ) -> None:
     """Run a DISP deck (Nadkarni 1977): MS 1 screw axes, 2 mechanism data, 3 both, 0/4/5/6
@@ -114,14 +133,18 @@ def disp(
     Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
     table up to that point is printed first.
     """
+    check_output_file(html, "--html")
+    check_output_dir(plot, "--plot")
+    check_cond_limit(cond_limit)
     from kinestat.disp import deck_json, disp_options, run_deck  # lazy: start-up (numba)
 
     d = load_deck(deck)
     if settle and no_settle:
         raise InputError("give --settle or --no-settle, not both")
     correction = "settle" if settle else ("none" if no_settle else None)
+    mode = singular_mode(singular, damped, "perturb-all")
     opts = disp_options(closed_loop=closed_loop, second_order=second_order,
-                        singular=singular_mode(singular, damped), cond_limit=cond_limit,
+                        singular=mode, cond_limit=cond_limit,
                         disp_1977=disp_1977, correction=correction, deck=d)
     with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         run = run_deck(d, steps=parse_steps(steps), options=opts, progress=prog)

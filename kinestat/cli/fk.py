@@ -15,7 +15,15 @@ from kinestat.cli._model import (
     scale_option,
     tip_option,
 )
-from kinestat.cli._options import Q_METAVAR, XYZ_METAVAR, command_help, flag, json_option, units
+from kinestat.cli._options import (
+    Q_METAVAR,
+    XYZ_METAVAR,
+    command_help,
+    flag,
+    json_option,
+    name_value,
+    units,
+)
 from kinestat.cli._output import console, literal, parse_floats, print_json, table
 from kinestat.errors import InputError
 
@@ -28,7 +36,7 @@ def register(app: typer.Typer) -> None:
 
 
 def fk_command(
-    model: str = typer.Argument(..., help=MODEL_HELP),
+    model: str = typer.Argument(..., parser=name_value, help=MODEL_HELP),
     q: str = typer.Option(None, "--q", help="Joint values, comma-separated (radians / length).",
                           metavar=Q_METAVAR),
     q_deg: str = typer.Option(
@@ -60,8 +68,12 @@ def fk_command(
     the thesis's words) (+ "frames" with --frames, "warning" outside the joint limits).
     """
     from kinestat.serial.fk import fk_frames  # lazy: as above
-    from kinestat.spatial.euler import euler_from_matrix  # lazy: scipy
+    from kinestat.spatial.euler import check_sequence, euler_from_matrix  # lazy: scipy
 
+    try:
+        check_sequence(euler)
+    except InputError as exc:  # the library's message, with the option it came from
+        raise InputError(f"--euler: {exc}") from None
     m = load_model(model, tip, base, scale, length_unit)
     if (q is None) == (q_deg is None):
         raise InputError("give the joint values with exactly one of --q or --q-deg")

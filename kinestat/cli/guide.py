@@ -16,6 +16,7 @@ import typer
 from kinestat.cli._compile import compiling_notice
 from kinestat.cli._guidance import (
     SINGULAR_HELP,
+    check_cond_limit,
     parse_steps,
     print_result,
     progress_reporter,
@@ -33,9 +34,13 @@ from kinestat.cli._options import (
     POSE_FILE_METAVAR,
     Q_METAVAR,
     STEPS_METAVAR,
+    check_output_dir,
+    check_output_file,
     command_help,
     flag,
     json_option,
+    name_value,
+    path_value,
     units,
 )
 from kinestat.cli._output import (
@@ -164,7 +169,8 @@ def _rates(result, speed: float) -> tuple[np.ndarray, list[int]]:
 
 
 def guide(
-    model: str = typer.Argument(..., help="A TOML model file, a URDF file or an embedded "
+    model: str = typer.Argument(..., parser=name_value,
+                                help="A TOML model file, a URDF file or an embedded "
                                 "model name (nadkarni-config1, nadkarni-config2, puma762, …)."),
     to_pose: list[str] = typer.Option(None, "--to-pose", metavar=POSE_FILE_METAVAR,
                                       help="Target hand pose T_base_hand: a pose file or 16 "
@@ -179,7 +185,8 @@ def guide(
     command: list[str] = typer.Option(None, "--command", help="Operator command (type IV), "
                                       "e.g. 'frame=global,dir=0,0,1,d=4,angle=-30'; "
                                       "repeatable, run in order."),
-    commands: Path = typer.Option(None, "--commands", help="File of commands, one per line "
+    commands: Path = typer.Option(None, "--commands", parser=path_value,
+                                  help="File of commands, one per line "
                                   "(key=value or DISP's 'NTY DCx DCy DCz DD THA').",
                                   metavar="FILE"),
     move: list[str] = typer.Option(None, "--move", help="Type I Examples 1-3: "
@@ -204,14 +211,16 @@ def guide(
                                 "(Nadkarni suggestion 1): deg/s of rotation, or length/s for a "
                                 "pure translation."),
     view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
-    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+    html: Path = typer.Option(None, "--html", parser=path_value,
+                              metavar="FILE", help="With --view: write the "
                               "3D page to FILE (self-contained) instead of opening a browser."),
     tip: str = tip_option(),
     base: str = base_option(),
     scale: float = scale_option(),
     length_unit: str = length_unit_option(),
     as_json: bool = json_option(),
-    plot: Path = typer.Option(None, "--plot", help="Write joints.png and hand-path.png here.",
+    plot: Path = typer.Option(None, "--plot", parser=path_value,
+                              help="Write joints.png and hand-path.png here.",
                               metavar="DIR"),
 ) -> None:
     """Guide a manipulator's hand to targets, along commands or moves (Nadkarni ch. IV).
@@ -222,6 +231,9 @@ def guide(
     Exit status 2 when the run stops early (joint limit, singularity, unreachable target); the
     table up to that point is printed first.
     """
+    check_output_file(html, "--html")
+    check_output_dir(plot, "--plot")
+    check_cond_limit(cond_limit)
     from kinestat.disp import result_record  # lazy: start-up (numba)
     from kinestat.serial.guidance.rules import GuidanceOptions  # lazy: start-up (numba)
     from kinestat.serial.guidance.run import run_guidance  # lazy: start-up (numba)
@@ -245,8 +257,9 @@ def guide(
         cmds += read_commands(commands)
     moves = [parse_move(s) for s in (move or [])]
     stages = _stages(m, q0, targets, kind, cmds, moves)
+    mode = singular_mode(singular, damped, "perturb")
     opts = GuidanceOptions(step_rule="second_order" if second_order else "first_order",
-                           closed_loop=closed_loop, singular=singular_mode(singular, damped),
+                           closed_loop=closed_loop, singular=mode,
                            settle=not no_settle, cond_limit=cond_limit)
     with compiling_notice("serial"), progress_reporter(not as_json) as prog:
         result = run_guidance(m, q0, stages, steps=parse_steps(steps), options=opts,

@@ -13,7 +13,7 @@ import typer
 
 from kinestat.app.homing_run import run_home
 from kinestat.app.signals import stop_on_signals
-from kinestat.cli._options import flag
+from kinestat.cli._options import check_output_file, flag, path_value
 from kinestat.cli._output import console, print_json
 from kinestat.errors import InputError, KinestatError
 
@@ -37,7 +37,8 @@ def home_command(
                               "or `kinestat sim galil`).", metavar="HOST:PORT"),
     samples: int = typer.Option(100, "--samples", help=f"Pot readings averaged per axis, "
                                 f"1..{MAX_SAMPLES}.", metavar="N"),
-    log: Path = typer.Option(None, "--log", help="Step log, JSON lines (default: "
+    log: Path = typer.Option(None, "--log", parser=path_value,
+                             help="Step log, JSON lines (default: "
                              "./kinestat-runs/home-<timestamp>.jsonl).", metavar="FILE"),
     as_json: bool = flag(False, "--json", help="Print the report as JSON."),
 ) -> None:
@@ -47,6 +48,7 @@ def home_command(
     JSON keys: homed, axes, stop_reason, elapsed_s, log.
     """
     host, port = _host_port(galil)
+    check_output_file(log, "--log", makes_folders=True)  # the step log makes its folder
     if not 1 <= samples <= MAX_SAMPLES:
         raise InputError(f"--samples must be in 1..{MAX_SAMPLES}, got {samples}")
     log_path = log or Path("kinestat-runs") / f"home-{time.strftime('%Y%m%d-%H%M%S')}.jsonl"

@@ -19,9 +19,11 @@ from kinestat.cli._options import (
     POSE_FILE_METAVAR,
     Q_METAVAR,
     XYZ_METAVAR,
+    check_seed,
     command_help,
     flag,
     json_option,
+    name_value,
     units,
 )
 from kinestat.cli._output import console, literal, parse_floats, parse_pose, print_json, table
@@ -48,7 +50,8 @@ def _deg(x) -> list[float]:
 
 def ik_command(
     model: str = typer.Argument(
-        ..., help="puma762 (closed form with --tool-point/--s6/--a67) or any model name, TOML "
+        ..., parser=name_value,
+        help="puma762 (closed form with --tool-point/--s6/--a67) or any model name, TOML "
         "or URDF file (numerical, or every analytic solution with --all, with --pose)."
     ),
     tool_point: str = typer.Option(
@@ -132,6 +135,9 @@ def ik_command(
     "value_deg", "solutions", ...}]}}.
     """
     closed = any(v is not None for v in (tool_point, s6, a67))
+    check_seed(seed)
+    if limits not in get_args(AxisLimitSet):
+        raise InputError(f"--limits must be 'matlab' or 'table', got {limits!r}")
     if (lock or self_motion is not None) and not all_solutions:
         raise InputError("--lock and --self-motion go with --all")
     if all_solutions:
@@ -141,6 +147,9 @@ def ik_command(
     if closed and pose is not None:
         raise InputError("give either --pose (numerical IK) or --tool-point/--s6/--a67 "
                          "(PUMA 762 closed form), not both")
+    if closed and q0_deg is not None:
+        raise InputError("--q0-deg: a start of numerical IK (--pose); the PUMA 762 closed form "
+                         "picks among its solutions by --current-deg or --current-axis-deg")
     if closed:
         _closed_form(model, tool_point, s6, a67, tool_point_6, current_deg, current_axis_deg,
                      limits, normalize, as_json)
@@ -148,6 +157,13 @@ def ik_command(
     if pose is None:
         raise InputError("give the target: --pose for any model, or --tool-point, --s6 and "
                          "--a67 for the PUMA 762 closed form")
+    closed_only = [name for name, given in (("--current-deg", current_deg is not None),
+                                            ("--current-axis-deg", current_axis_deg is not None),
+                                            ("--normalize", normalize)) if given]
+    if closed_only:
+        raise InputError(f"{', '.join(closed_only)}: options of the PUMA 762 closed form "
+                         "(--tool-point/--s6/--a67) or of --all; numerical IK starts from "
+                         "--q0-deg")
     m = load_model(model, tip, base, scale, length_unit)
     _numerical(m, pose, q0_deg, restarts, max_iter, seed, ignore_limits, as_json)
 

@@ -66,6 +66,16 @@ class _KinestatGroup(LazyGroup):
     entries = COMMANDS
     package = "kinestat.cli"
 
+    def invoke(self, ctx):
+        """Run the command; a Ctrl-C that no command handled itself ends it with one line and
+        status 130 (Typer alone would exit 130 printing only a blank line)."""
+        try:
+            return super().invoke(ctx)
+        except KeyboardInterrupt as exc:
+            where = " ".join(str(exc).split())
+            typer.echo(f"kinestat: interrupted{': ' + where if where else ''}", err=True)
+            raise typer.Exit(130) from None
+
 
 app = typer.Typer(
     cls=_KinestatGroup,
@@ -108,7 +118,8 @@ def _one_line(text: str) -> str:
 
 def _usage_error(exc: UsageError) -> str:
     """The one-line message of a usage error, pointing at the command's ``--help``."""
-    msg = _one_line(exc.format_message())
+    # pydantic, which Typer converts values with, puts "Value error, " before a parser's message
+    msg = _one_line(exc.format_message()).replace(": Value error, ", ": ")
     path = exc.ctx.command_path if exc.ctx is not None else "kinestat"
     return f"kinestat: error: {msg} (see '{path} --help')"
 

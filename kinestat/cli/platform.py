@@ -20,10 +20,13 @@ from kinestat.cli._options import (
     POSE_METAVAR,
     TWIST_METAVAR,
     WRENCH_METAVAR,
+    check_output_file,
     command_help,
     flag,
     help_text,
     json_option,
+    name_value,
+    path_value,
     units,
 )
 from kinestat.cli._output import console, literal, parse_floats, parse_pose, print_json, table
@@ -71,7 +74,8 @@ def _pose_rows(T: np.ndarray) -> list[list]:
 
 @platform_app.command("info")
 def info_command(
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    platform: str = typer.Option(None, "--platform", parser=name_value,
+                                 help=PLATFORM_HELP, metavar="FILE"),
     as_json: bool = json_option(),
 ) -> None:
     """Geometry, springs, free lengths and home pose of the platform.
@@ -138,10 +142,12 @@ def info_command(
 def fk_command(
     legs: str = typer.Option(..., "--legs", help="Six leg lengths in leg order (O,P,Q,R,S,T).",
                              metavar=LEGS_METAVAR),
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    platform: str = typer.Option(None, "--platform", parser=name_value,
+                                 help=PLATFORM_HELP, metavar="FILE"),
     all_poses: bool = flag(False, "--all-poses", help="Also print every mode's 4x4 pose."),
     view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
-    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+    html: Path = typer.Option(None, "--html", parser=path_value,
+                              metavar="FILE", help="With --view: write the "
                               "3D page to FILE (self-contained) instead of opening a browser."),
     as_json: bool = json_option(),
 ) -> None:
@@ -153,6 +159,7 @@ def fk_command(
     top_points are O1..T1 (leg order) in base coordinates; home_distance is |p - p_home| +
     r_top * (rotation angle from home), r_top the top's mean radius.
     """
+    check_output_file(html, "--html")
     from kinestat.parallel.fk import fk_list, fk_numeric  # lazy: start-up (numba)
     from kinestat.parallel.legs import leg_lengths, top_points_in_base  # lazy: start-up
 
@@ -238,7 +245,8 @@ def _print_modes(p, sols: list[dict], method: str, physical: int | None, all_pos
 @platform_app.command("ik")
 def ik_command(
     pose: str = typer.Option(..., "--pose", help=POSE_HELP, metavar=POSE_METAVAR),
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    platform: str = typer.Option(None, "--platform", parser=name_value,
+                                 help=PLATFORM_HELP, metavar="FILE"),
     as_json: bool = json_option(),
 ) -> None:
     """Leg lengths at a pose (reverse kinematics). JSON: {"leg_lengths", "leg_names"}."""
@@ -261,7 +269,8 @@ def ik_command(
 def statics_command(
     pose: str = typer.Option(..., "--pose", help=POSE_HELP, metavar=POSE_METAVAR),
     wrench: str = typer.Option(..., "--wrench", help=WRENCH_HELP, metavar=WRENCH_METAVAR),
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    platform: str = typer.Option(None, "--platform", parser=name_value,
+                                 help=PLATFORM_HELP, metavar="FILE"),
     as_json: bool = json_option(),
 ) -> None:
     """Leg forces balancing an external wrench at a pose, f = j^-1 w (Vibhute eq. 2-8).
@@ -299,7 +308,8 @@ def stiffness_command(
     twist_order: str = typer.Option("ray", "--twist-order",
                                     help=help_text("'ray': dD = [dx; dphi] (default); "
                                                    "'axis': [dphi; dx].")),
-    platform: str = typer.Option(None, "--platform", help=PLATFORM_HELP, metavar="FILE"),
+    platform: str = typer.Option(None, "--platform", parser=name_value,
+                                 help=PLATFORM_HELP, metavar="FILE"),
     as_json: bool = json_option(),
 ) -> None:
     """Spatial stiffness K (dw = K dD, Vibhute eq. 2-17) at a pose, loaded by the springs or w.
@@ -349,7 +359,7 @@ def decompose_command(
     contact: list[str] = typer.Option(..., "--contact", help=CONTACT_HELP, metavar=WRENCH_METAVAR),
     pose: str = typer.Option("home", "--pose", help=POSE_HELP, metavar=POSE_METAVAR),
     wrench: str = typer.Option(None, "--wrench", help=WRENCH_HELP, metavar=WRENCH_METAVAR),
-    platform: str = typer.Option(None, "--platform",
+    platform: str = typer.Option(None, "--platform", parser=name_value,
                                  help="TOML platform file (default: the embedded 2011 prototype).",
                                  metavar="FILE"),
     as_json: bool = json_option(),

@@ -10,9 +10,11 @@ import typer
 from kinestat.cli._options import (
     POINTS3_METAVAR,
     POSE_FILE_METAVAR,
+    check_output_file,
     command_help,
     flag,
     json_option,
+    path_value,
     units,
 )
 from kinestat.cli._output import console, parse_floats, parse_pose, print_json, table
@@ -63,7 +65,8 @@ def screw(
     points2: str = typer.Option(None, "--points2", help="Second position, as --points1.",
                                 metavar=POINTS3_METAVAR),
     view: bool = flag(False, "--view", help="Also open a 3D view in the browser."),
-    html: Path = typer.Option(None, "--html", metavar="FILE", help="With --view: write the "
+    html: Path = typer.Option(None, "--html", parser=path_value,
+                              metavar="FILE", help="With --view: write the "
                               "3D page to FILE (self-contained) instead of opening a browser."),
     as_json: bool = json_option(),
 ) -> None:
@@ -75,6 +78,7 @@ def screw(
     """
     by_pose = pose1 is not None or pose2 is not None
     by_points = points1 is not None or points2 is not None
+    check_output_file(html, "--html")
     if by_pose == by_points:
         raise InputError("give either --pose1 and --pose2, or --points1 and --points2")
     if by_pose:

@@ -11,7 +11,7 @@ import numpy as np
 import typer
 
 from kinestat.app.signals import stop_on_signals
-from kinestat.cli._options import check_seed, flag
+from kinestat.cli._options import check_seed, flag, name_value
 from kinestat.cli._output import console, literal, parse_floats, print_json
 from kinestat.errors import InputError
 from kinestat.hardware.encoder_packets import (
@@ -106,7 +106,8 @@ def galil(
                                     "the plane workpiece (mm)."),
     plane_normal: str = typer.Option(None, "--plane-normal", help="--plant mujoco: the plane's "
                                      "outward normal."),
-    sim_legs: str = typer.Option("thesis", "--sim-legs", help="--plant mujoco: the legs' TRUE "
+    sim_legs: str = typer.Option("thesis", "--sim-legs", parser=name_value,
+                                 help="--plant mujoco: the legs' TRUE "
                                  "law ('thesis', 'nominal' or a calibration TOML file)."),
     rate: float = typer.Option(200.0, "--rate", help="--plant mujoco: encoder packets per "
                                "second."),
@@ -114,6 +115,10 @@ def galil(
     """Run a simulated Galil DMC (six axes, trapezoidal profiles) until Ctrl-C."""
     _check_duration(duration)
     check_seed(seed)
+    if not 0 <= port <= 65535:
+        raise InputError(f"--port must be 0..65535 (0: any free port), got {port}")
+    if not 0 < rate <= 5000:  # also refuses NaN; checked with either plant
+        raise InputError(f"--rate must be in (0, 5000] packets per second, got {rate}")
     if plant not in ("none", "mujoco"):
         raise InputError(f"--plant must be 'none' or 'mujoco', got {plant!r}")
     if plant == "mujoco":

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 import inspect
 import math
+import os
 import warnings
 from collections.abc import Callable
 
@@ -27,7 +28,7 @@ from kinestat.cli._model import (
     scale_option,
     tip_option,
 )
-from kinestat.cli._options import XYZ_METAVAR, flag
+from kinestat.cli._options import XYZ_METAVAR, check_output_dir, flag, name_value, path_value
 from kinestat.cli._output import console, parse_floats, print_json, table
 from kinestat.errors import InputError, KinestatWarning
 
@@ -37,7 +38,7 @@ sweep_app = typer.Typer(
     no_args_is_help=True,
 )
 
-OUTPUT = typer.Option(None, "--output", help="Output directory (default "
+OUTPUT = typer.Option(None, "--output", parser=path_value, help="Output directory (default "
                       "./kinestat-runs/<study>-<spec hash>; an existing one resumes).",
                       metavar="DIR")
 SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler address tcp://HOST:PORT "
@@ -54,7 +55,8 @@ NO_PLOTS = flag(False, "--no-plots", help="Do not write PNG plots.")
 QUIET = flag(False, "--quiet", help="No progress bar.")
 JSON = flag(False, "--json", help='JSON: {"study", "summary", "output", "chunks", '
                     '"elapsed_s", "complete", "plots"}.')
-PLATFORM = typer.Option(None, "--platform", help="TOML platform file (default: the embedded "
+PLATFORM = typer.Option(None, "--platform", parser=name_value,
+                        help="TOML platform file (default: the embedded "
                         "2011 prototype).", metavar="FILE")
 RANGE_MM = typer.Option("3.5,3.5,4", "--range-mm", help="Motion range +- x,y,z (length unit; "
                         "Vibhute Table 3-1).", metavar=XYZ_METAVAR)
@@ -115,6 +117,16 @@ def _check_run_options(options: dict) -> None:
     t = options.get("timeout")
     if not (isinstance(t, (int, float)) and math.isfinite(t) and t > 0):
         raise InputError(f"--timeout must be a finite number of seconds > 0, got {t}")
+    workers, cores = options.get("workers"), os.cpu_count() or 1
+    if options.get("scheduler") is not None and (workers is not None or options.get("threads")):
+        raise InputError("--workers and --threads set up the local cluster; with --scheduler "
+                         "the scheduler's own workers run the study")
+    if workers is not None and workers > cores:  # (below 1: the cluster's own check)
+        # a local cluster runs one single-threaded worker per core: more only queue for the
+        # same cores, each a process (--workers 100000 tried to start them all)
+        raise InputError(f"--workers must be at most {cores} (this machine's cores), got "
+                         f"{workers}")
+    check_output_dir(options.get("output"), "--output")
 
 
 def _chunk(chunk_size: int | None, default: int) -> int:
@@ -123,8 +135,13 @@ def _chunk(chunk_size: int | None, default: int) -> int:
 
 def _ranges(range_mm: str, range_deg: str) -> dict:
     """``--range-mm`` and ``--range-deg`` as the spec builders' ``range_mm``/``range_deg``."""
-    return {"range_mm": parse_floats(range_mm, 3, "range-mm"),
-            "range_deg": parse_floats(range_deg, 3, "range-deg")}
+    out = {"range_mm": parse_floats(range_mm, 3, "range-mm"),
+           "range_deg": parse_floats(range_deg, 3, "range-deg")}
+    for key, vals in out.items():
+        if (vals < 0).any():
+            raise InputError(f"--{key.replace('_', '-')}: half-widths of the motion range must "
+                             f"be >= 0, got {', '.join(f'{v:g}' for v in vals)}")
+    return out
 
 
 def _run(study_name: str, spec: dict, *, output, scheduler, workers, threads, timeout,
@@ -181,7 +198,7 @@ def _samples_default(grid, samples, default):
 
 @_study_command("workspace")
 def workspace_command(
-    model: str = typer.Option("puma762", "--model", help=MODEL_HELP),
+    model: str = typer.Option("puma762", "--model", parser=name_value, help=MODEL_HELP),
     grid: int = typer.Option(None, "--grid", help="N values per joint over its limits."),
     samples: int = typer.Option(None, "--samples", help="Random configurations (default "
                                 "100000 if no --grid)."),

@@ -30,7 +30,10 @@ from kinestat.cli._options import (
     Q_METAVAR,
     STEPS_METAVAR,
     WRENCH_METAVAR,
+    check_output_file,
     flag,
+    name_value,
+    path_value,
 )
 from kinestat.cli._output import console, parse_floats, parse_pose
 from kinestat.errors import InputError
@@ -80,6 +83,7 @@ def _out_options(html: Path | None, serve: bool, host: str, port: int, no_open: 
         raise InputError(f"--port must be 0..65535, got {port}")
     if allow_remote and not serve:
         raise InputError("--allow-remote goes with --serve")
+    check_output_file(html, "--html")
     return _Out(html, serve, host, port, no_open, allow_remote)
 
 
@@ -118,7 +122,7 @@ def _emit(scene: dict, out: _Out, model=None, meshes: str = "embed") -> None:
 
 # The output options, repeated on every command (Typer has no shared option groups).
 def _html_opt():
-    return typer.Option(None, "--html", help=HTML_HELP, metavar="FILE")
+    return typer.Option(None, "--html", parser=path_value, help=HTML_HELP, metavar="FILE")
 
 
 def _serve_opt():
@@ -147,7 +151,8 @@ def _no_open_opt():
 @view_app.callback()
 def view_root(
     ctx: typer.Context,
-    log: Path = typer.Option(None, "--log", help="Replay a control run's cycle log "
+    log: Path = typer.Option(None, "--log", parser=path_value,
+                             help="Replay a control run's cycle log "
                              "(same as `kinestat view log FILE`).", metavar="FILE"),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),
@@ -168,7 +173,7 @@ def view_root(
 
 @view_app.command("model")
 def view_model(
-    model: str = typer.Argument(..., help=MODEL_HELP),
+    model: str = typer.Argument(..., parser=name_value, help=MODEL_HELP),
     q: str = typer.Option(None, "--q", help="Joint values shown first (radians / length).",
                          metavar=Q_METAVAR),
     q_deg: str = typer.Option(None, "--q-deg", help="Joint values, rotating joints in degrees.",
@@ -221,7 +226,8 @@ def view_platform(
     wrench: str = typer.Option(None, "--wrench", help="Legs carry j^-1 w instead of their "
                                "spring forces: fx,fy,fz,mx,my,mz (moment about O0).",
                                metavar=WRENCH_METAVAR),
-    platform: str = typer.Option(None, "--platform", help="TOML platform file (default: the "
+    platform: str = typer.Option(None, "--platform", parser=name_value,
+                                 help="TOML platform file (default: the "
                                  "embedded 2011 prototype).", metavar="FILE"),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),
@@ -298,7 +304,8 @@ def view_screw(
 
 @view_app.command("disp")
 def view_disp(
-    deck: str = typer.Argument(..., help="A DISP deck file or an embedded deck name."),
+    deck: str = typer.Argument(..., parser=name_value,
+                               help="A DISP deck file or an embedded deck name."),
     steps: str = typer.Option(None, "--steps", help="Step count N, or N1,N2,… per stage.",
                               metavar=STEPS_METAVAR),
     disp_1977: bool = flag(False, "--disp-1977", help="The 1977 program's step rule."),
@@ -338,8 +345,10 @@ def disp_result(deck: str, steps: str | None = None, disp_1977: bool = False):
 
 @view_app.command("log")
 def view_log(
-    log: Path = typer.Argument(..., help="A control run's cycle log (RUN/log.jsonl)."),
-    platform: str = typer.Option(None, "--platform", help="TOML platform file of the run "
+    log: Path = typer.Argument(..., parser=path_value,
+                               help="A control run's cycle log (RUN/log.jsonl)."),
+    platform: str = typer.Option(None, "--platform", parser=name_value,
+                                 help="TOML platform file of the run "
                                  "(default: the embedded 2011 prototype).", metavar="FILE"),
     html: Path = _html_opt(), serve: bool = _serve_opt(), host: str = _host_opt(),
     allow_remote: bool = _allow_remote_opt(), port: int = _port_opt(),

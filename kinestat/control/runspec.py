@@ -36,6 +36,9 @@ from kinestat.control.probe import PROBE_TUNING
 from kinestat.control.wrench import Estimator
 from kinestat.errors import InputError
 
+#: ``--serial-format``: the encoder box's packet formats (kinestat's "ks", the thesis's "legacy")
+SERIAL_FORMATS = ("ks", "legacy")
+
 __all__ = ["RunSpec", "SimulatedCell", "RealDevices", "CylinderSpec", "TASKS", "PLANTS"]
 
 def _floats(text: str) -> np.ndarray:
@@ -149,7 +152,7 @@ class RealDevices:
     def __post_init__(self) -> None:
         if not 0 < self.port < 65536:
             raise InputError(f"--galil: port {self.port} outside 1..65535")
-        if self.serial_format not in ("ks", "legacy"):
+        if self.serial_format not in SERIAL_FORMATS:
             raise InputError(f"--serial-format must be 'ks' or 'legacy', got "
                              f"{self.serial_format!r}")
 
@@ -255,7 +258,8 @@ class RunSpec:
             if follow and getattr(self, key) is None:
                 self._set(key, default)
         if self.travel_dir is not None:
-            self._set("travel_dir", _vec3(self.travel_dir, "--travel-dir"))
+            self._set("travel_dir", _vec3(self.travel_dir, "--travel-dir (the travel direction)",
+                                          nonzero=True))
         if self.approach_step is None:
             self._set("approach_step", RUN_DEFAULTS.follow_approach_step if follow
                       else RUN_DEFAULTS.press_approach_step)
@@ -275,6 +279,9 @@ class RunSpec:
                                     ("--approach-step", self.approach_step, "mm"),
                                     ("--max-approach", self.max_approach, "mm")):
             _positive(value, option, unit)
+        if not self.align_tol_deg < 180.0:  # the largest angle between S6 and the force
+            raise InputError(f"--align-tol-deg must be below 180 degrees (the widest angle "
+                             f"between S6 and the force), got {self.align_tol_deg}")
         if not (isinstance(self.max_iterations, (int, np.integer))
                 and 1 <= self.max_iterations <= MAX_ITERATIONS):
             raise InputError(f"--max-iterations must be in 1..{MAX_ITERATIONS}, got "

@@ -44,6 +44,8 @@ __all__ = ["PlatformDesignStudy", "platform_design_spec", "PARAMETERS", "SCORES"
 #: swept parameters (CLI option names), each a single number (equal sides/offsets)
 PARAMETERS = ("base_side", "top_side", "base_offset", "top_offset", "height", "twist_deg",
               "stiffness")
+#: the parameters no design can have zero or below (offsets and the twist can)
+POSITIVE = ("base_side", "top_side", "height", "stiffness")
 DEFAULT_CHUNK = 16
 _BINS = 20
 #: ``--score`` names and the summary key each ranks designs by
@@ -111,6 +113,11 @@ def platform_design_spec(platform: str | None = None, *, values: dict[str, str] 
     lists = {k: (grids.parse_values(values[k], k.replace("_", "-"), grid if samples is None
                                     else 2) if k in values else [base[k]])
              for k in PARAMETERS}
+    for k in POSITIVE:
+        bad = [v for v in lists[k] if not v > 0]
+        if bad:
+            raise InputError(f"--{k.replace('_', '-')} must be > 0 (no platform has a side, "
+                             f"height or spring of zero or less), got {bad[0]:g}")
     if poses < 1:
         raise InputError(f"--poses must be at least 1, got {poses}")
     spec = pc.platform_spec("platform-design", (label, text),

@@ -138,23 +138,26 @@ class FollowConfig:
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.travel) and 0.0 < self.travel <= 1000.0):
-            raise InputError(f"travel must be in (0, 1000] mm, got {self.travel!r}")
+            raise InputError(f"travel (--travel) must be in (0, 1000] mm, got {self.travel!r}")
         t = _unit3(self.travel_dir, "travel direction")
         object.__setattr__(self, "travel_dir", t)
-        for name in ("travel_step", "max_correction", "max_turn_deg", "settle_tol"):
+        if not (math.isfinite(self.travel_step) and self.travel_step > 0):
+            raise InputError(f"travel_step (--travel-step) must be a positive number of mm, "
+                             f"got {self.travel_step!r}")
+        for name in ("max_correction", "max_turn_deg", "settle_tol"):
             v = float(getattr(self, name))
             if not (math.isfinite(v) and v > 0):
                 raise InputError(f"{name} must be a positive number, got {v!r}")
         if not 0.0 < self.gain <= 1.0:
             raise InputError(f"gain must be in (0, 1], got {self.gain!r}")
         if not (math.isfinite(self.probe_span) and 0.0 <= self.probe_span <= 20.0):
-            raise InputError(f"probe_span must be in [0, 20] mm (0: no probing), got "
-                             f"{self.probe_span!r}")
+            raise InputError(f"probe_span (--probe-span) must be in [0, 20] mm (0: no "
+                             f"probing), got {self.probe_span!r}")
         if self.auto_tilt not in (None, True, False):
             raise InputError(f"auto_tilt must be True, False or None (automatic), got "
                              f"{self.auto_tilt!r}")
         if not (math.isfinite(self.tilt_deg) and abs(self.tilt_deg) < 45.0):
-            raise InputError(f"tilt must be within ±45°, got {self.tilt_deg!r}")
+            raise InputError(f"tilt_deg (--tilt-deg) must be within ±45°, got {self.tilt_deg!r}")
         d = self.base.start_s6
         ang = math.degrees(math.acos(min(1.0, abs(float(t @ d)))))
         if ang < self.min_angle_deg:
