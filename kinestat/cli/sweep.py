@@ -43,7 +43,8 @@ OUTPUT = typer.Option(None, "--output", parser=path_value, help="Output director
                       metavar="DIR")
 SCHEDULER = typer.Option(None, "--scheduler", help="Dask scheduler address tcp://HOST:PORT "
                          "(default: an embedded local cluster).", metavar="tcp://HOST:PORT")
-WORKERS = typer.Option(None, "--workers", help="Local cluster: worker count (default: cores).")
+WORKERS = typer.Option(None, "--workers",
+                       help="Local cluster: worker count (default: cores; at most 4 per core).")
 THREADS = flag(False, "--threads", help="Local cluster: thread workers, not processes.")
 TIMEOUT = typer.Option(10.0, "--timeout", help="Seconds to wait for the scheduler and a worker.")
 SEED = typer.Option(0, "--seed", help="Seed of the random inputs (--samples).")
@@ -121,11 +122,11 @@ def _check_run_options(options: dict) -> None:
     if options.get("scheduler") is not None and (workers is not None or options.get("threads")):
         raise InputError("--workers and --threads set up the local cluster; with --scheduler "
                          "the scheduler's own workers run the study")
-    if workers is not None and workers > cores:  # (below 1: the cluster's own check)
-        # a local cluster runs one single-threaded worker per core: more only queue for the
-        # same cores, each a process (--workers 100000 tried to start them all)
-        raise InputError(f"--workers must be at most {cores} (this machine's cores), got "
-                         f"{workers}")
+    if workers is not None and workers > 4 * cores:  # (below 1: the cluster's own check)
+        # each worker is a process; beyond a few per core they only queue for the same cores
+        # (--workers 100000 tried to start them all)
+        raise InputError(f"--workers must be at most {4 * cores} (4 per core on this "
+                         f"machine's {cores}), got {workers}")
     check_output_dir(options.get("output"), "--output")
 
 
