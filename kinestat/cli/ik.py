@@ -140,6 +140,8 @@ def ik_command(
         raise InputError(f"--limits must be 'matlab' or 'table', got {limits!r}")
     if (lock or self_motion is not None) and not all_solutions:
         raise InputError("--lock and --self-motion go with --all")
+    if self_motion is not None and self_motion < 1:
+        raise InputError(f"--self-motion must be a number of samples >= 1, got {self_motion}")
     if all_solutions:
         _all_command(model, closed, pose, current_deg, current_axis_deg, q0_deg,
                      (tip, base, scale, length_unit), as_json, lock or [], self_motion)

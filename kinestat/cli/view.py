@@ -346,7 +346,8 @@ def disp_result(deck: str, steps: str | None = None, disp_1977: bool = False):
 @view_app.command("log")
 def view_log(
     log: Path = typer.Argument(..., parser=path_value,
-                               help="A control run's cycle log (RUN/log.jsonl)."),
+                               help="A control run's cycle log (RUN/log.jsonl) or its "
+                               "folder RUN."),
     platform: str = typer.Option(None, "--platform", parser=name_value,
                                  help="TOML platform file of the run "
                                  "(default: the embedded 2011 prototype).", metavar="FILE"),

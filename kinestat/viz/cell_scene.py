@@ -47,12 +47,17 @@ _CYCLE_KEYS = ("joints_deg", "top_pose", "tip", "force", "leg_lengths")
 
 
 def read_cycle_log(path) -> tuple[dict, list[dict], dict | None]:
-    """The ``start`` record, the ``cycle`` records and the ``end`` record (or None) of a log.
+    """The ``start`` record, the ``cycle`` records and the ``end`` record (or None) of a log
+    (``path``: the ``log.jsonl`` file, or the run's folder that holds it).
 
     Raises:
         InputError: the file is missing, not JSON lines, or not a cycle log of this version.
     """
     p = Path(path)
+    if p.is_dir():  # a run's folder (kinestat-runs/<time>/): its log
+        if not (p / "log.jsonl").is_file():
+            raise InputError(f"cycle log {str(p)!r} is a directory without a log.jsonl")
+        p = p / "log.jsonl"
     if not p.is_file():
         raise InputError(f"cycle log {str(p)!r} not found")
     records = read_log(p)

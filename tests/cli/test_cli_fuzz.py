@@ -31,6 +31,8 @@ BAD = [
     (["ik", "puma560", "--pose", P16, "--seed", "-3"], "--seed"),
     (["ik", "puma560", "--pose", P16, "--limits", "bogus"], "--limits"),
     (["ik", "puma560", "--pose", P16, "--current-deg", "1,2"], "--current-deg"),
+    (["ik", "ur5", "--pose", P16, "--all", "--lock", "6", "--self-motion", "0"],
+     "--self-motion"),
     (["guide", "puma560", "--to-pose", P16, "--cond-limit", "0"], "--cond-limit"),
     (["disp", "illustration5", "--cond-limit", "nan"], "--cond-limit"),
     (["disp", "illustration5", "--steps", "1,,2"], "--steps"),

@@ -180,6 +180,12 @@ def test_bad_logs_are_refused(tmp_path, text, msg):
         read_cycle_log(tmp_path / "missing.jsonl")
 
 
+def test_a_run_folder_reads_as_its_log(control_log, tmp_path):
+    assert read_cycle_log(control_log.parent) == read_cycle_log(control_log)
+    with pytest.raises(InputError, match="directory without a log.jsonl"):
+        read_cycle_log(tmp_path)
+
+
 def test_html_embeds_the_scene_verbatim():
     m = kinestat.load("puma762")
     s = model_scene(m)
