@@ -81,23 +81,28 @@ class FaultProxy(GalilProxy):
         self._last_reply = b":"
         self._held = b""
         self._reset_stop = False
+        self.prefix, self.span = "", 1
 
-    def arm(self, kind: str, at: int) -> None:
+    def arm(self, kind: str, at: int, *, prefix: str = "", span: int = 1) -> None:
+        """Damage the reply to the ``at``-th command (counting only those starting with
+        ``prefix``) and, for good input, to the ``span - 1`` commands after it."""
         if kind not in WIRE_FAULTS + GOOD_WIRE:
             raise ValueError(f"unknown wire fault {kind!r}")
         self.kind, self.at, self._count = kind, int(at), 0
+        self.prefix, self.span = prefix, int(span) if kind in GOOD_WIRE else 1
 
     def _match(self, cmd: str) -> list[dict]:
         rules = super()._match(cmd)
-        if self.kind is None or self.fired is not None and self.kind != "stop_reset":
-            return rules
         if self._reset_stop and cmd == "ST":
             self._reset_stop = False
             return [*rules, {"action": "drop"}]
-        self._count += 1
-        if self._count != self.at or self.fired is not None:
+        if self.kind is None or not cmd.startswith(self.prefix):
             return rules
-        self.fired, self.fired_index = cmd, len(self.forwarded)
+        self._count += 1
+        if not self.at <= self._count < self.at + self.span:
+            return rules
+        if self.fired is None:
+            self.fired, self.fired_index = cmd, len(self.forwarded)
         kind = self.kind
         if kind == "stop_reset":  # a fault that calls for a stop, then the stop's link reset
             self._reset_stop = True
