@@ -141,7 +141,8 @@ def press_case(kind: str, at: float, seed: int, tmp: Path) -> dict:
         if kind in WIRE_FAULTS + GOOD_WIRE:
             proxy.arm(kind, int(at), span=GOOD_SPAN)
         elif kind in STREAM_FAULTS:
-            stream = corrupt_stream(raw_reader, kind, int(at), seed=seed, stall=1.0)
+            stream = corrupt_stream(raw_reader, kind, int(at), seed=seed,
+                                    stall=1.5 * raw_reader.stale_after)
             stream.on_fire = lambda: mark.setdefault("n", len(h.controller.commands))
         timer = _signal_timer(kind, at, h.controller, mark)
         t0 = time.monotonic()

@@ -27,7 +27,8 @@ Encoder stream faults (:data:`STREAM_FAULTS`), applied to one chunk the reader t
 wrapper hands the reader whole lines, the tail of a read waiting for the next):
 ``bitflip``, ``drop_byte``, ``dup_byte``, ``index_repeat`` (a frame re-sent with every leg's
 index flag set), ``index_drop`` (the index flags of the frames of the next 50 ms removed),
-``stale_seq`` (an earlier, valid frame replayed), ``stall`` (nothing arrives for ``stall`` s)
+``stale_seq`` (an earlier, valid frame replayed), ``stall`` (the bytes held back ``stall`` s,
+then delivered at once: a link that stalls)
 and ``jump`` (the frames of the next 50 ms in sequence with a valid CRC, their counts 2^30
 away: the stream's NaN).
 """
@@ -189,11 +190,19 @@ class StreamFault:
         self.fired = False
         self.frames: list[bytes] = []
         self.until = 0.0
+        self.hold_until = 0.0
+        self.held = b""
         self.tail = b""
         self.jump = 1 << 30  # counts added by ``jump``
         self.on_fire: Callable[[], None] | None = None
 
     def __call__(self, data: bytes) -> bytes:
+        if self.hold_until:  # stall: the bytes held back, then let through at once
+            self.held += data
+            if time.monotonic() < self.hold_until:
+                time.sleep(0.005)
+                return b""
+            data, self.held, self.hold_until = self.held, b"", 0.0
         # whole lines only (the reader takes a frame in several reads): the tail waits
         cut = (self.tail + data).rfind(b"\n") + 1
         data, self.tail = (self.tail + data)[:cut], (self.tail + data)[cut:]
@@ -222,8 +231,8 @@ class StreamFault:
         if self.kind == "dup_byte":
             return data[:k + 1] + data[k:]
         if self.kind == "stall":
-            time.sleep(self.stall)
-            return data
+            self.hold_until, self.held = time.monotonic() + self.stall, data
+            return b""
         last = frames[-1]
         if self.kind == "index_repeat":
             return data.replace(last, _reencode(last, mask=0x3F))

@@ -46,7 +46,10 @@ def test_press_wire_fault(tmp_path, kind):
 def test_press_stream_fault(tmp_path, kind):
     """A damaged encoder stream is either tolerated (a checksum, sequence or framing fault
     counted, the sample taken from good frames) or stops the run; never a silent bad move."""
-    _clean(campaign.press_case(kind, 8, seed=7, tmp=tmp_path))
+    case = campaign.press_case(kind, 8, seed=7, tmp=tmp_path)
+    _clean(case)
+    if kind == "stall":  # 1.5 times the reader's staleness limit: the run must stop on it
+        assert case["faulted"] and "stale encoder data" in case["reason"], case
 
 
 def test_press_count_jump_inside_the_sample_stops(tmp_path):
