@@ -168,6 +168,25 @@ def press_case(kind: str, at: float, seed: int, tmp: Path) -> dict:
     return out
 
 
+def press_with(setup, tmp: Path):
+    """One clean press run with ``setup(harness, proxy)`` called before it starts: (report,
+    log records). For combined faults in the tests."""
+    scn = scenario(coupling=COUPLED)
+    cfg = scn.config()
+    path = tmp / "press-with.jsonl"
+    with SimHarness(scn.cell, scn.sensor, start_counts=start_counts(cfg), record=True) as h, \
+            FaultProxy(h.server.port) as proxy:
+        client = GalilClient("127.0.0.1", proxy.port, timeout=TIMEOUT).connect()
+        io = DeviceIO(client, SimCheckedReader(h.reader(), h.emitter), truth=h.truth,
+                      settle=2.5 / h.emitter.rate_hz, profile=FAST,
+                      guard=sent_command_guard(cfg.envelope, cfg.model))
+        setup(h, proxy)
+        with CycleLog(path) as log:
+            rep = run(cfg, io, log)
+        client.close()
+    return rep, read_log_lines(path)[0]
+
+
 def _signal_timer(kind: str, at: float, ctrl, mark: dict) -> threading.Timer | None:
     if kind not in SIGNALS:
         return None

@@ -11,6 +11,8 @@ from 1 over every command forwarded after :meth:`FaultProxy.arm`):
 * ``shift``: the previous command's reply instead of this one's, this one's held back and
   sent before the next (a reply out of order: the link one behind);
 * ``late``: the reply held ``delay`` s (beyond the client's timeout);
+* ``stale``: a reply of the right kind (its numbers zeroed) 30 ms ahead of the real one, in
+  its own TCP segment (a stale reply the client cannot tell from the answer);
 * ``close``: the command reaches the controller, then the link is cut before its reply;
 * ``stop_reset``: one of ``garbage``, ``qmark``, ``close`` at command ``at``, then the first
   ``ST`` after it cuts the link before it reaches the controller (a reset during the stop);
@@ -47,8 +49,8 @@ from kinestat.devices.galil_replies import split_reply
 from kinestat.hardware.encoder_packets import decode_packet, encode_packet
 from tests._galil_proxy import GalilProxy
 
-WIRE_FAULTS = ("garbage", "truncate", "qmark", "shift", "late", "close", "stop_reset",
-               "stop_signal")
+WIRE_FAULTS = ("garbage", "truncate", "qmark", "shift", "late", "close", "stale",
+               "stop_reset", "stop_signal")
 GOOD_WIRE = ("split", "spaces")
 STREAM_FAULTS = ("bitflip", "drop_byte", "dup_byte", "index_repeat", "index_drop",
                  "stale_seq", "stall", "jump")
@@ -150,6 +152,10 @@ class FaultProxy(GalilProxy):
                 out, self._held = held + self._last_reply, reply
             elif "late" in acts:
                 time.sleep(self.delay)
+            elif "stale" in acts:  # a reply of the right kind, zeros, 30 ms ahead of the real one
+                c.sendall(held + re.sub(rb"-?\d+(\.\d+)?", b"0", reply))
+                time.sleep(0.03)
+                out = reply
             elif "spaces" in acts:
                 out = held + _spaced(reply)
             if "split" in acts:

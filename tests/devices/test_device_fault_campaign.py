@@ -111,3 +111,20 @@ def test_homing_accepts_every_reply_split_or_padded(tmp_path):
                            timeout=2.0)
         assert rep.homed, (kind, rep.stop_reason)
         assert proxy._count >= 150
+
+
+@pytest.mark.parametrize("kind", GOOD_WIRE)
+def test_the_stop_is_proved_through_split_or_padded_replies(tmp_path, kind):
+    """Good input during the stop itself: TP rejected mid-run, every reply (the stop's tagged
+    proof included) split byte by byte or padded; the stop is still confirmed."""
+    case = {}
+
+    def reject_tp(h, proxy):
+        proxy.arm(kind, 1, span=10**6)
+        h.server.reject_next("TP", times=1)
+        case["proxy"] = proxy
+
+    rep, recs = campaign.press_with(reject_tp, tmp_path)
+    assert recs[-1]["type"] == "end" and recs[-2]["type"] == "fault"
+    assert recs[-2]["stop_confirmed"] is True and "rejected 'TP'" in rep.stop_reason
+    assert case["proxy"].fired is not None
