@@ -10,6 +10,7 @@ from pathlib import Path
 from kinestat.control.log import CycleLog
 from kinestat.devices.galil import GalilClient
 from kinestat.devices.homing import HomingReport, home
+from kinestat.devices.safe_stop import despite_one_signal
 from kinestat.errors import DeviceError
 
 __all__ = ["run_home"]
@@ -37,5 +38,5 @@ def run_home(host: str, port: int, log_path: Path, *, samples: int = 100,
                            record=log.write)
         finally:
             client.close()
-        log.write({"type": "end", "report": rep.as_dict()})
+        despite_one_signal(log.write, {"type": "end", "report": rep.as_dict()})
     return rep

@@ -20,7 +20,8 @@
 Any fault (a check failing, a ``?``, a dropped link, a motion timeout, a signal) ends with
 ``ST`` confirmed by the controller (:func:`kinestat.devices.safe_stop.confirm_stop`, on a
 fresh connection if the link failed), then ``MO`` (amplifiers off), and a report saying why
-and what the controller confirmed; ``record`` receives a JSON-ready
+and what the controller confirmed (a signal arriving during that stop does not cut it short:
+the stop is run again); ``record`` receives a JSON-ready
 record per step so that the caller's log is complete.
 """
 
@@ -33,7 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from kinestat.devices.galil import GalilClient, GalilCommandError
-from kinestat.devices.safe_stop import confirm_motor_off, confirm_stop
+from kinestat.devices.safe_stop import confirm_motor_off, confirm_stop, despite_one_signal
 from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
 from kinestat.robots.puma762.axes import AXES
 from kinestat.robots.puma762.homing import (
@@ -201,8 +202,10 @@ def home(client: GalilClient, *, samples: int = 100, max_coarse: float = 60000.0
                "interrupted by the user" if isinstance(exc, KeyboardInterrupt) else
                str(exc) if isinstance(exc, SafetyStop) else
                f"{'device fault' if isinstance(exc, DeviceError) else type(exc).__name__}: {exc}")
-        done, confirmed = _amplifiers_off(client)
-        rec({"type": "fault", "reason": why, "action": done, "stop_confirmed": confirmed})
+        # a signal arriving during the stop (the run's first) must not cut it or its record
+        done, confirmed = despite_one_signal(_amplifiers_off, client)
+        despite_one_signal(rec, {"type": "fault", "reason": why, "action": done,
+                                 "stop_confirmed": confirmed})
         return HomingReport(False, f"{why} ({done})", axes, time.monotonic() - t0)
 
 

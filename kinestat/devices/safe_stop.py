@@ -24,14 +24,16 @@ from __future__ import annotations
 import itertools
 import random
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
+from typing import TypeVar
 
 from kinestat.devices.galil import THESIS_ACCEL, THESIS_SPEED_MAX, GalilClient
 from kinestat.errors import KinestatError
 from kinestat.robots.puma762.axes import AXES
 
 __all__ = ["RECONNECT_TIMEOUT", "STOP_TIMEOUT", "MAX_ATTEMPTS", "StopReport", "confirm_stop",
-           "confirm_motor_off", "send_stop"]
+           "confirm_motor_off", "send_stop", "despite_one_signal"]
 
 RECONNECT_TIMEOUT = 1.0
 """Bound (s) on a fresh connection and on each reply during a stop."""
@@ -44,6 +46,7 @@ MAX_ATTEMPTS = 3
 """Connections tried for one stop: the open link, then up to two fresh ones."""
 
 _MOTION_FLAGS = [f"_BG{a}" for a in AXES]
+_T = TypeVar("_T")
 _tags = itertools.count(random.SystemRandom().randrange(1, 500_000))
 
 
@@ -131,3 +134,14 @@ def confirm_motor_off(client: GalilClient) -> tuple[bool, str]:
 def send_stop(client: GalilClient, *, reconnect_timeout: float = RECONNECT_TIMEOUT) -> StopReport:
     """:func:`confirm_stop` with the default stop timeout (the loop's and homing's stop)."""
     return confirm_stop(client, reconnect_timeout=reconnect_timeout)
+
+
+def despite_one_signal(fn: Callable[..., _T], *args: object) -> _T:
+    """``fn(*args)``, run again if a signal interrupted it: a stop that a fault started must not
+    be cut short by the operator's Ctrl-C or a SIGTERM arriving meanwhile
+    (:func:`kinestat.app.signals.stop_on_signals` raises on the first signal only, so the second
+    call runs to its end)."""
+    try:
+        return fn(*args)
+    except KeyboardInterrupt:
+        return fn(*args)
