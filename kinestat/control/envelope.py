@@ -53,6 +53,7 @@ __all__ = [
     "check_motion",
     "check_target",
     "check_measurement",
+    "check_deflection",
     "check_command",
     "check_sent_counts",
     "sent_command_guard",
@@ -199,13 +200,21 @@ def check_measurement(envelope: Envelope, model: ControlModel, meas: Measurement
     F = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
     if F > envelope.max_load:
         out.append(f"measured load {F:.3g} N exceeds the limit {envelope.max_load:g} N")
+    out += check_deflection(envelope, model, lengths)
+    out += check_motion(envelope, model, meas.top_pose, "measured")
+    return out
+
+
+def check_deflection(envelope: Envelope, model: ControlModel, lengths) -> list[str]:
+    """The most deflected leg beyond ``max_deflection`` (mm), as a one-item list, for leg
+    lengths ``(6,)`` (mm, the platform's leg order); finite lengths expected."""
+    lengths = np.asarray(lengths, dtype=float).tolist()
     defl = [x - x0 for x, x0 in zip(lengths, _consts(model).free_lengths, strict=True)]
     k = _largest(defl)
     if abs(defl[k]) > envelope.max_deflection:
-        out.append(f"leg {model.platform.leg_names[k]} is deflected {defl[k]:+.3f} mm, beyond "
-                   f"±{envelope.max_deflection:g} mm")
-    out += check_motion(envelope, model, meas.top_pose, "measured")
-    return out
+        return [f"leg {model.platform.leg_names[k]} is deflected {defl[k]:+.3f} mm, beyond "
+                f"±{envelope.max_deflection:g} mm"]
+    return []
 
 
 def check_command(envelope: Envelope, model: ControlModel, axis_deg_new, axis_deg_now,

@@ -25,13 +25,14 @@ from typing import Protocol
 import numpy as np
 
 from kinestat.control.controller import Command, ControllerConfig, ControllerState, axis_counts_to_q
-from kinestat.control.envelope import require
+from kinestat.control.envelope import check_deflection, require
 from kinestat.control.log import CycleLog
 from kinestat.control.records import cmd_record, config_record, cycle_summary, meas_record
 from kinestat.control.report import RunReport, run_report
 from kinestat.control.task import Task, as_task
 from kinestat.control.wrench import Measurement, measure
 from kinestat.errors import DeviceError, KinestatError, SafetyStop, StopRequested
+from kinestat.hardware.leg_calibration import counts_to_lengths
 
 __all__ = ["SensorReading", "CellIO", "RunReport", "Task", "refuse", "run"]
 
@@ -204,8 +205,17 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
         raise SafetyStop(f"sensor link unreliable: {len(sample.faults)} stream faults "
                          f"while acquiring one measurement (limit "
                          f"{config.envelope.max_stream_faults}); first: {sample.faults[0]}")
-    if not np.all(np.isfinite(np.asarray(sample.counts, dtype=float))):
+    counts = np.asarray(sample.counts, dtype=float)
+    if not np.all(np.isfinite(counts)):
         raise SafetyStop("the sensor returned no valid leg counts for this measurement")
+    model = config.model
+    # the legs' deflection straight from the counts, before the platform's kinematics: a
+    # count the legs cannot reach is named as the sensor's, not as a failed assembly
+    bad = check_deflection(config.envelope, model, counts_to_lengths(
+        counts, model.calibration, model.platform.leg_names))
+    if bad:
+        raise SafetyStop(f"leg counts outside the envelope: {bad[0]} (sensor counts "
+                         f"{[int(c) for c in counts]}: a sensor fault or an overload)")
     counts_r = io.robot_counts()
     r.last_counts = np.asarray(counts_r)
     q = axis_counts_to_q(config.model, counts_r)

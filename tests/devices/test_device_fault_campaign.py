@@ -54,10 +54,13 @@ def test_press_stream_fault(tmp_path, kind):
 
 def test_press_count_jump_inside_the_sample_stops(tmp_path):
     """Frames in sequence with a valid checksum whose counts jumped by 2^30, while the loop
-    samples: the run stops (ST confirmed) rather than measuring through them."""
+    samples: the run stops (ST confirmed) rather than measuring through them, and the stop
+    names the leg counts (checked against the legs' deflection limit before the platform's
+    kinematics), not a failed assembly."""
     case = campaign.press_case("jump", 1, seed=7, tmp=tmp_path)
     _clean(case)
     assert case["faulted"] and "ST confirmed" in case["reason"], case
+    assert "leg counts outside the envelope" in case["reason"], case
 
 
 @pytest.mark.parametrize("sig", ["SIGINT", "SIGTERM"])
