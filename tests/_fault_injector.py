@@ -37,7 +37,6 @@ away: the stream's NaN).
 
 from __future__ import annotations
 
-import contextlib
 import random
 import re
 import signal
@@ -45,7 +44,6 @@ import socket
 import time
 from collections.abc import Callable
 
-from kinestat.devices.galil_replies import split_reply
 from kinestat.hardware.encoder_packets import decode_packet, encode_packet
 from tests._galil_proxy import GalilProxy
 
@@ -115,24 +113,6 @@ class FaultProxy(GalilProxy):
             kind = self.rng.choice(("garbage", "qmark", "close"))
         # the base proxy queues only its own reply actions: ride on "garble", marked
         return [*rules, {"action": "garble", "fault": kind}]
-
-    def _s2c(self, u: socket.socket, c: socket.socket, pending) -> None:
-        buf = b""
-        while True:
-            try:
-                chunk = u.recv(4096)
-            except OSError:
-                return
-            if not chunk:
-                with contextlib.suppress(OSError):
-                    c.shutdown(socket.SHUT_RDWR)
-                return
-            buf += chunk
-            while (parts := split_reply(buf)) is not None:
-                reply, buf = parts
-                rules = pending.popleft() if pending else []
-                if not self._send(c, reply, rules):
-                    return
 
     def _send(self, c: socket.socket, reply: bytes, rules: list[dict]) -> bool:
         acts = {r.get("fault", r["action"]) for r in rules}

@@ -162,17 +162,24 @@ class GalilProxy:
             while (parts := split_reply(buf)) is not None:
                 reply, buf = parts
                 rules = pending.popleft() if pending else []
-                out = reply
-                for r in rules:
-                    if r["action"] == "lose_reply":
-                        out = b""
-                    elif r["action"] == "late":
-                        time.sleep(r["delay"])
-                    elif r["action"] == "dup":
-                        out = out + out
-                    elif r["action"] == "garble":
-                        out = r["garble"](out)
-                try:
-                    c.sendall(out)
-                except OSError:
+                if not self._send(c, reply, rules):
                     return
+
+    def _send(self, c: socket.socket, reply: bytes, rules: list[dict]) -> bool:
+        """Send one reply to the client, altered by its queued rules; False when the client's
+        link is gone."""
+        out = reply
+        for r in rules:
+            if r["action"] == "lose_reply":
+                out = b""
+            elif r["action"] == "late":
+                time.sleep(r["delay"])
+            elif r["action"] == "dup":
+                out = out + out
+            elif r["action"] == "garble":
+                out = r["garble"](out)
+        try:
+            c.sendall(out)
+        except OSError:
+            return False
+        return True
