@@ -211,16 +211,16 @@ def _cycle(config: ControllerConfig, io: CellIO, log: CycleLog, r: _Run,
     model = config.model
     # the legs' deflection straight from the counts, before the platform's kinematics: a
     # count the legs cannot reach is named as the sensor's, not as a failed assembly
-    bad = check_deflection(config.envelope, model, counts_to_lengths(
-        counts, model.calibration, model.platform.leg_names))
+    lengths = counts_to_lengths(counts, model.calibration, model.platform.leg_names)
+    bad = check_deflection(config.envelope, model, lengths)
     if bad:
         raise SafetyStop(f"leg counts outside the envelope: {bad[0]} (sensor counts "
                          f"{[int(c) for c in counts]}: a sensor fault or an overload)")
     counts_r = io.robot_counts()
     r.last_counts = np.asarray(counts_r)
     q = axis_counts_to_q(config.model, counts_r)
-    meas = measure(config.model, q, sample.counts, r.state.top_pose, seq=sample.seq,
-                   age=sample.age)
+    meas = measure(model, q, counts, r.state.top_pose, seq=sample.seq, age=sample.age,
+                   lengths=lengths)
     r.last_meas = meas
     cmd, r.state = r.task.decide(r.state, meas)
     r.states.append(cmd.label)

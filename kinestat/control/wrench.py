@@ -153,13 +153,14 @@ def tool_frame(q, model: ControlModel):
 
 
 def measure(model: ControlModel, q, counts, previous_top_pose, *, seq: int | None = None,
-            age: float | None = None) -> Measurement:
+            age: float | None = None, lengths=None) -> Measurement:
     """Run the measurement chain for one cycle (Vibhute ch. 4 step 2).
 
     Args:
         q: (6,) the robot's joint angles (radians) read from its encoders.
         counts: (6,) leg encoder counts, sensor legs 1..6 (as the reader returns them).
         previous_top_pose: (4, 4) the last measured top pose (start: the platform's home).
+        lengths: (6,) the leg lengths of ``counts`` (mm) when the caller already has them.
 
     Raises:
         InputError: bad shapes or values; the platform's FK errors (no assembly, a crossed
@@ -173,7 +174,8 @@ def measure(model: ControlModel, q, counts, previous_top_pose, *, seq: int | Non
     if not all(map(math.isfinite, q.tolist() + c.tolist())):
         raise InputError("measure: joint angles or leg counts contain NaN or infinity")
     plat = model.platform
-    lengths = counts_to_lengths(c, model.calibration, plat.leg_names)
+    if lengths is None:
+        lengths = counts_to_lengths(c, model.calibration, plat.leg_names)
     # tracking FK from the previous pose (checked: no singularity crossed, nearest mode), then
     # w = j f, the external wrench on the top (base frame, about O0), with the leg tensions f
     # from the calibration's force maps or the springs k (l - l0)
