@@ -32,6 +32,7 @@ from kinestat.control.follow.estimator import (
     ContactEstimate,
     chord_constraint,
     cone_measurement,
+    friction_lower_bound,
     friction_on_normal,
     observe_travel,
     slip_test,
@@ -437,6 +438,48 @@ def test_a_normal_off_about_the_travel_on_a_frictionless_slide_is_not_friction(t
         worst = max(worst, _deg(est.normal, n_true))
         assert not est.friction_known(tun), (k, est.mu, est.drag)
     assert worst < 0.5  # the turn itself is 3.5° over the slide
+
+
+def _stuck_run(tun, est, F_of, rng, cycles):
+    """``cycles`` stuck travel cycles: the tip still (its measurement noise only), the force
+    ``F_of(rng)`` measured with the tuning's noise; returns the estimate after each."""
+    out = []
+    for _ in range(cycles):
+        tip = rng.normal(0.0, tun.tip_sigma, 3)
+        est = observe_travel(tun, est, tip, F_of(rng) + rng.normal(0.0, tun.force_sigma, 3), Y)
+        assert not est.sliding
+        out.append(est)
+    return out
+
+
+def test_a_stuck_tips_noisy_force_does_not_ratchet_mu_up(tmp_path):
+    """A stuck tip's force lies inside the cone, so its tangential over normal part bounds μ
+    below; but that ratio is measured. On the cone's edge (μ̂ right) the noisy ratios scatter
+    about μ, and taking each as a bound would climb to their largest (about μ + 2.7 σ over
+    300 cycles, 300 chances); the bound taken ``confidence`` σ below stays within σ of μ."""
+    tun = _tuning(tmp_path)
+    n, mu, fn = np.array([0.0, 0.0, 1.0]), 0.3, 4.0
+    sigma = math.sqrt(friction_on_normal(tun, -fn * n + mu * fn * Y, n, 0.0)[1])
+    est = ContactEstimate(normal=n, normal_var=0.0, mu=mu, mu_var=sigma ** 2, samples=5,
+                          drag=mu, tips=(np.zeros(3),), path=(np.zeros(3),))
+    ests = _stuck_run(tun, est, lambda rng: -fn * n + mu * fn * Y, np.random.default_rng(2),
+                      300)
+    assert max(e.mu for e in ests) <= mu + sigma
+
+
+def test_a_stuck_force_well_outside_the_estimated_cone_raises_mu(tmp_path):
+    """The bound still corrects a μ̂ measured too low (a jitter taken for a slide): a stuck
+    force whose ratio is 0.45 lifts μ̂ from 0.2 to within ``confidence`` σ below 0.45."""
+    tun = _tuning(tmp_path)
+    n, fn = np.array([0.0, 0.0, 1.0]), 4.0
+    F = -fn * n + 0.45 * fn * Y
+    est = ContactEstimate(normal=n, normal_var=0.0, mu=0.2, mu_var=1e-4, samples=2, drag=0.2,
+                          tips=(np.zeros(3),), path=(np.zeros(3),))
+    ests = _stuck_run(tun, est, lambda rng: F, np.random.default_rng(4), 20)
+    sigma = math.sqrt(friction_on_normal(tun, F, n, 0.0)[1])
+    assert 0.45 - (tun.confidence + 1.0) * sigma <= ests[-1].mu <= 0.45
+    assert friction_lower_bound(tun, F, n, 0.0) == pytest.approx(0.45 - tun.confidence * sigma)
+    assert friction_lower_bound(tun, -F, n, 0.0) == 0.0  # pulling off: no bound
 
 
 def test_a_run_goes_through_the_phases_in_order(tmp_path):

@@ -26,8 +26,9 @@ to the workpiece ``F`` (noise ``σ_F`` per component).
 * **While stuck** the force may lie anywhere in the cone and says nothing more: the normal is
   the prediction (the probe's plane fit or the last slide, turned by the curvature under the
   tip's advance), with its variance grown; the force lies inside the cone, so its ratio of
-  tangential to normal part is a lower bound of μ (a slip mistaken for one, the tip's jitter,
-  is corrected so rather than by turning the normal, which the geometry gave).
+  tangential to normal part, less ``confidence`` standard deviations of the ratio, is a lower
+  bound of μ (:func:`friction_lower_bound`; a slip mistaken for one, the tip's jitter, is
+  corrected so rather than by turning the normal, which the geometry gave).
 * **Curvature** from a circle fitted to the recent tips in the plane of the normal and the
   travel (:func:`~kinestat.control.contact_estimate.path_curvature`, with its significance
   test), with the probe's touches on the line of travel while the path is short.
@@ -44,8 +45,8 @@ from kinestat.control.contact_estimate import cone_normal, path_curvature, turn_
 from kinestat.control.follow.tuning import FollowTuning, advance_limit
 
 __all__ = ["ContactEstimate", "estimate_normal", "advance_limit", "slip_test",
-           "chord_constraint", "cone_measurement", "friction_on_normal", "observe_travel",
-           "curvature_span"]
+           "chord_constraint", "cone_measurement", "friction_on_normal", "friction_lower_bound",
+           "observe_travel", "curvature_span"]
 
 
 
@@ -157,6 +158,27 @@ def friction_on_normal(tun: FollowTuning, F: np.ndarray, n: np.ndarray, var_n: f
     return mu, var
 
 
+def friction_lower_bound(tun: FollowTuning, F: np.ndarray, n: np.ndarray, var_n: float
+                         ) -> float:
+    """A stuck cycle's lower bound of μ: the force lies inside the cone, so its tangential
+    over its normal part (:func:`friction_on_normal`'s ratio) is at most μ; taken
+    ``confidence`` standard deviations below the ratio, since the ratio is measured (the
+    largest of many noisy ratios would climb past μ on its noise alone). 0 when the force
+    does not press on the workpiece.
+
+    >>> tun = FollowTuning(tip_sigma=0.01, path_sigma=0.01, force_sigma=0.01, confidence=3.0,
+    ...     chord=1.0, direction_tol=0.01, step_resolution=0.001, tangential_stiffness=0.05,
+    ...     axial_stiffness=1.0, turn_gain=0.5, max_friction=1.0, curvature_tol=1e-3)
+    >>> F = np.array([1.0, 0.0, -4.0])                 # ratio 0.25 against the normal +z
+    >>> round(friction_lower_bound(tun, F, np.array([0.0, 0.0, 1.0]), 0.0), 4)
+    0.2423
+    """
+    if -float(F @ n) <= 0.0:
+        return 0.0
+    ratio, var = friction_on_normal(tun, F, n, var_n)
+    return ratio - tun.confidence * math.sqrt(var)
+
+
 def cone_measurement(tun: FollowTuning, est: ContactEstimate, F: np.ndarray
                      ) -> tuple[np.ndarray, float]:
     """A sliding cycle's normal from the force on the cone's edge: ``atan μ̂`` from the force
@@ -242,10 +264,9 @@ def observe_travel(tun: FollowTuning, est: ContactEstimate, tip: np.ndarray, F: 
             n, var = _fuse_normal(est.normal, est.normal_var, m, var_m)
             est = replace(est, normal=n, normal_var=var)
     elif est.samples:  # a stuck tip's force is inside the cone: its ratio bounds μ below
-        fn = -float(F @ est.normal)
-        ratio = float(np.linalg.norm(F + fn * est.normal)) / fn if fn > 0.0 else 0.0
-        if ratio > est.mu:
-            est = replace(est, mu=min(ratio, tun.max_friction))
+        bound = friction_lower_bound(tun, F, est.normal, est.normal_var)
+        if bound > est.mu:
+            est = replace(est, mu=min(bound, tun.max_friction))
     tt = t - float(t @ est.normal) * est.normal
     kappa = _curvature(tun, est, path[:-1], tip, est.normal, tt / np.linalg.norm(tt))
     return replace(est, tips=new_tips, path=path, curvature=kappa)
