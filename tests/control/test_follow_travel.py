@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from kinestat.control.follow.phases import developed_step
+from kinestat.control.follow.estimator import developed_step
 
 
 def _walk(steps, n, t):

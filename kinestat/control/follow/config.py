@@ -197,6 +197,8 @@ class FollowState(ControllerState):
         stuck: travel cycles in a row the tip did not follow.
         slides: travel cycles in a row the tip slid.
         probe: the surface probe's progress (:mod:`kinestat.control.probe`), None without.
+        settle_samples: the settle's contact cycles as (normal force N, tip height along the
+            normal mm): the workpiece's compliance at the start of travel.
     """
 
     phase: str = "approach"
@@ -211,3 +213,4 @@ class FollowState(ControllerState):
     stuck: int = 0
     slides: int = 0
     probe: Probe | None = None
+    settle_samples: tuple = ()

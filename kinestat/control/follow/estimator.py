@@ -29,6 +29,13 @@ to the workpiece ``F`` (noise ``σ_F`` per component).
   tangential to normal part, less ``confidence`` standard deviations of the ratio, is a lower
   bound of μ (:func:`friction_lower_bound`; a slip mistaken for one, the tip's jitter, is
   corrected so rather than by turning the normal, which the geometry gave).
+* **The workpiece's compliance.** A compliant workpiece gives under the tip by ``c F_n`` along
+  the normal, so the tip path is the surface only at a steady normal force: a change of force
+  tilts the chord as a turn of the surface would. While the force is raised with the tip
+  stuck (the settle), the tip's height along the normal against the normal force gives ``c``
+  when its slope is significant (:func:`contact_compliance`), and each travel cycle's tip is
+  carried back to the surface by ``c F_n`` before the estimator uses it
+  (:func:`surface_point`).
 * **Curvature** from a circle fitted to the recent tips in the plane of the normal and the
   travel (:func:`~kinestat.control.contact_estimate.path_curvature`, with its significance
   test), with the probe's touches on the line of travel while the path is short.
@@ -46,7 +53,8 @@ from kinestat.control.follow.tuning import FollowTuning, advance_limit
 
 __all__ = ["ContactEstimate", "estimate_normal", "advance_limit", "slip_test",
            "chord_constraint", "cone_measurement", "friction_on_normal", "friction_lower_bound",
-           "observe_travel", "curvature_span"]
+           "observe_travel", "curvature_span", "contact_compliance", "surface_point",
+           "settle_sample", "start_travel", "developed_step"]
 
 
 
@@ -70,6 +78,8 @@ class ContactEstimate:
             friction's dissipative part), fused as μ: friction opposes the slip, so a
             tangential force across the slip (a normal estimated off about the travel) is
             no evidence of friction.
+        compliance: mm/N, the workpiece's give along the normal under the normal force
+            (:func:`contact_compliance`; 0 for a rigid workpiece).
     """
 
     normal: np.ndarray
@@ -83,6 +93,7 @@ class ContactEstimate:
     line: tuple = ()
     samples: int = 0
     drag: float = 0.0
+    compliance: float = 0.0
 
     def friction_known(self, tun: FollowTuning) -> bool:
         """μ measured and significantly above zero, the force's part along the slip too."""
@@ -105,6 +116,79 @@ def estimate_normal(force, path_dir=None) -> np.ndarray:
         c = c / np.linalg.norm(c)
         F = F - (F @ c) * c
     return -F / np.linalg.norm(F)
+
+
+def contact_compliance(normal_forces, heights, height_sigma: float = 0.0,
+                       confidence: float = 3.0) -> float:
+    """mm/N: the workpiece's compliance along the normal from a stuck tip's normal forces
+    (N) and heights along the normal (mm, each measured with standard deviation
+    ``height_sigma``) while the force changes: the least-squares slope of the height against
+    the force, negated (the tip sinks as the force rises). 0 unless it exceeds ``confidence``
+    standard errors of the slope (a rigid workpiece's slope is noise), from fewer than three
+    samples, or from a force that did not change.
+
+    >>> contact_compliance([1.0, 2.0, 3.0, 4.0], [0.0, -0.25, -0.5, -0.75])   # 4 N/mm wood
+    0.25
+    >>> contact_compliance([1.0, 2.0, 3.0, 4.0], [0.0, -0.01, 0.0, -0.01], 0.01)  # noise
+    0.0
+    """
+    f = np.asarray(normal_forces, dtype=float)
+    h = np.asarray(heights, dtype=float)
+    if f.size < 3:
+        return 0.0
+    df = f - f.mean()
+    sxx = float(df @ df)
+    if sxx <= 1e-12:
+        return 0.0
+    c = -float(df @ (h - h.mean())) / sxx
+    return c if c > confidence * height_sigma / math.sqrt(sxx) else 0.0
+
+
+def surface_point(est: ContactEstimate, tip: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """The surface point above a measured ``tip`` pressed into a compliant workpiece by the
+    force ``F`` on it: ``tip + c F_n n̂`` (``c`` the estimate's compliance, ``F_n = −F·n̂``).
+
+    >>> est = ContactEstimate(normal=np.array([0.0, 0.0, 1.0]), normal_var=0.0, compliance=0.25)
+    >>> surface_point(est, np.zeros(3), np.array([0.0, 0.0, -4.0])).tolist()
+    [0.0, 0.0, 1.0]
+    """
+    n = est.normal
+    return tip + est.compliance * max(-float(F @ n), 0.0) * n
+
+
+def developed_step(developed: tuple[float, float], normal: np.ndarray, d: np.ndarray,
+                   t: np.ndarray) -> tuple[float, float]:
+    """The tips' displacement on the surface developed into a plane (mm, along the travel
+    tangent ``t`` and across it, ``normal × t``) after the tip's displacement ``d``, from
+    ``developed``: on a plane or a cylinder, whose development keeps lengths, each cycle's
+    chord stands for its short arc.
+
+    >>> developed_step((0.0, 0.0), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.5, 0.0]),
+    ...                np.array([1.0, 0.0, 0.0]))
+    (1.0, 0.5)
+    """
+    across = np.cross(normal, t)
+    a, c = developed
+    return a + float(d @ t), c + float(d @ across)
+
+
+def settle_sample(est: ContactEstimate, tip: np.ndarray, F: np.ndarray) -> tuple[float, float]:
+    """A settle cycle's (normal force N, tip height along the normal mm) for
+    :func:`contact_compliance`."""
+    return -float(F @ est.normal), float(tip @ est.normal)
+
+
+def start_travel(tun: FollowTuning, est: ContactEstimate, samples: tuple, tip: np.ndarray,
+                 F: np.ndarray) -> tuple[ContactEstimate, np.ndarray]:
+    """A travel cycle's estimate and surface point above the measured ``tip``; on the first
+    (the settle's ``samples`` given) the workpiece's compliance from them, and the settle's
+    last tip carried to the surface as the path's start."""
+    if samples:
+        c = contact_compliance(*zip(*samples, strict=True), tun.path_sigma, tun.confidence)
+        est = replace(est, compliance=c)
+        est = replace(est, tips=tuple(surface_point(est, p, F) for p in est.tips))
+        est = replace(est, path=est.tips[-1:])
+    return est, surface_point(est, tip, F)
 
 
 def slip_test(tun: FollowTuning, tips: tuple, tip: np.ndarray, t: np.ndarray) -> bool:

@@ -27,7 +27,13 @@ from kinestat.control.controller import (
 from kinestat.control.cycle import cross3
 from kinestat.control.envelope import check_measurement
 from kinestat.control.follow.config import FollowConfig, FollowState
-from kinestat.control.follow.estimator import ContactEstimate, observe_travel
+from kinestat.control.follow.estimator import (
+    ContactEstimate,
+    developed_step,
+    observe_travel,
+    settle_sample,
+    start_travel,
+)
 from kinestat.control.follow.law import (
     accel_limit,
     base_twist,
@@ -40,7 +46,7 @@ from kinestat.control.probe import probe_normal, probe_step, start_probe
 from kinestat.control.wrench import Measurement
 from kinestat.errors import InputError
 
-__all__ = ["decide_follow", "FOLLOW_STATES", "developed_step"]
+__all__ = ["decide_follow", "FOLLOW_STATES"]
 
 FOLLOW_STATES = {
     "a": "approach along S6, no contact",
@@ -102,6 +108,7 @@ def _report(config: FollowConfig, st: FollowState, meas: Measurement, F: np.ndar
             "normal_force": fn, "tangential_force": ft, "travel": st.travel,
             "in_contact": contact,
             "friction_ratio": 0.0 if est is None else est.mu,
+            "workpiece_compliance": 0.0 if est is None else est.compliance,
             "curvature": 0.0 if est is None else est.curvature, "auto_tilt": st.leaning}
     return {"force_error": config.base.force_target - fn, "info": info}
 
@@ -122,8 +129,13 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
                 tip, st.target.tool_point, st.target.s6, config.travel_dir, config.probe_span))
         return st
     if st.phase != "travel":
+        if st.phase == "settle":  # the tip stuck while the force rises: the workpiece's give
+            st = replace(st, settle_samples=st.settle_samples + (settle_sample(st.estimate, tip,
+                                                                               F),))
         return replace(st, estimate=replace(st.estimate, tips=(tip.copy(),), path=(tip.copy(),)))
-    est = observe_travel(tun, st.estimate, tip, F, st.tangent)
+    est, tip = start_travel(tun, st.estimate, st.settle_samples, tip, F)
+    st = replace(st, settle_samples=(), estimate=est)
+    est = observe_travel(tun, est, tip, F, st.tangent)
     # the centre's path is the contact's offset by the radius: shorter by 1 − r κ on it
     shrink = 1.0 - config.base.model.tip_radius * est.curvature
     developed = developed_step(st.developed, est.normal,
@@ -135,22 +147,6 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
     slides = st.slides + 1 if est.sliding and settled else 0
     return replace(st, estimate=est, developed=developed, travel=math.hypot(*developed),
                    stuck=stuck, leaning=leaning, slides=slides)
-
-
-def developed_step(developed: tuple[float, float], normal: np.ndarray, d: np.ndarray,
-                   t: np.ndarray) -> tuple[float, float]:
-    """The tips' displacement on the surface developed into a plane (mm, along the travel
-    tangent ``t`` and across it, ``normal × t``) after the tip's displacement ``d``, from
-    ``developed``: on a plane or a cylinder, whose development keeps lengths, each cycle's
-    chord stands for its short arc.
-
-    >>> developed_step((0.0, 0.0), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.5, 0.0]),
-    ...                np.array([1.0, 0.0, 0.0]))
-    (1.0, 0.5)
-    """
-    across = np.cross(normal, t)
-    a, c = developed
-    return a + float(d @ t), c + float(d @ across)
 
 
 def _frictional(tun, est: ContactEstimate) -> bool:

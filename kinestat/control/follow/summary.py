@@ -13,9 +13,11 @@ def follow_summary(cycles: list[dict], target_force: float, travel: float) -> di
     measured path along the surface), the normal-force errors over the travel cycles (from the
     first travel cycle on; measured, and true when simulated), ``contact_lost`` (travel cycles
     without contact), ``auto_tilt`` (whether the automatic tilt was on) and
-    ``auto_tilt_from_travel`` (mm travelled when it came on, None if never), and once the tip
-    slid with friction ``friction_estimate`` (μ̂) and
-    ``friction_force_mean`` (N, the tangential force over those cycles)."""
+    ``auto_tilt_from_travel`` (mm travelled when it came on, None if never),
+    ``workpiece_compliance_estimate`` (mm/N, the workpiece's give under the normal force
+    measured at the settle; 0 when not significant), and once the tip slid with friction
+    ``friction_estimate`` (μ̂) and ``friction_force_mean`` (N, the tangential force over those
+    cycles)."""
     trav = [c for c in cycles if c.get("phase") == "travel"]
     err = [abs(c["normal_force"] - target_force) for c in trav if c.get("in_contact")]
     out = {"travel": float(cycles[-1]["travel"]) if cycles else 0.0,
@@ -25,6 +27,8 @@ def follow_summary(cycles: list[dict], target_force: float, travel: float) -> di
     on = next((c for c in cycles if c.get("auto_tilt")), None)
     out["auto_tilt"] = on is not None  # the automatic tilt was on (set, or switched itself on)
     out["auto_tilt_from_travel"] = None if on is None else float(on["travel"])
+    out["workpiece_compliance_estimate"] = (float(trav[-1].get("workpiece_compliance", 0.0))
+                                            if trav else 0.0)
     slid = [c for c in trav if c.get("in_contact") and c.get("friction_ratio")]
     if slid:  # the friction measured, not fought: mu estimate and mean friction force
         out["friction_estimate"] = float(slid[-1]["friction_ratio"])
