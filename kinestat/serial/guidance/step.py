@@ -291,22 +291,28 @@ def escape_singularity(model: ChainModel, q, *, length: float,
 
 def sigma_min_gradient(model: ChainModel, q, *, length: float, h: float = 1e-6) -> np.ndarray:
     """``∂σ_min/∂q`` ``(n,)`` of the dimensionless Jacobian, per unit of the scaled joint
-    variables (radians; prismatic joints in units of L), by central differences."""
+    variables (radians; prismatic joints in units of L), by central differences. A component
+    within the differences' rounding (σ_min is computed to about ε σ_max, so ``16 ε σ_max / h``)
+    is 0: a joint that cannot change σ_min (the base's turn about its own axis) gets no sign
+    from rounding noise."""
     q = np.asarray(q, dtype=float)
     pris = model.prismatic
     scale = np.where(pris, length, 1.0)
     dq = np.diag(h * scale)
     cand = np.concatenate([q + dq, q - dq])
-    smin, _ = conditioning(scaled_jacobian(jacobian(model, cand), pris, length))
+    smin, cond = conditioning(scaled_jacobian(jacobian(model, cand), pris, length))
     n = q.shape[0]
-    return (smin[:n] - smin[n:]) / (2.0 * h)
+    g = (smin[:n] - smin[n:]) / (2.0 * h)
+    floor = 16.0 * np.finfo(float).eps * float(np.max(smin * cond)) / h
+    return np.where(np.abs(g) <= floor, 0.0, g)
 
 
 def _best_signs(model: ChainModel, q, eps: np.ndarray, signs: np.ndarray, length: float
                 ) -> tuple[np.ndarray, float]:
     """The sign pattern (every joint ±1) that gives ``q + eps·signs`` the smallest condition
-    number: start from ``signs``, flip the one joint that lowers it most while one does.
-    Candidates outside the joint limits count as infinitely ill-conditioned."""
+    number: start from ``signs``, flip the one joint that lowers it most while one does by more
+    than the condition number's rounding (relative ``8 ε κ``). Candidates outside the joint
+    limits count as infinitely ill-conditioned."""
     pris = model.prismatic
     lo, hi = model.lower, model.upper
 
@@ -322,7 +328,7 @@ def _best_signs(model: ChainModel, q, eps: np.ndarray, signs: np.ndarray, length
         flips = np.where(np.eye(model.n, dtype=bool), -s, s)
         c = conds(flips)
         i = int(np.argmin(c))
-        if not c[i] < best:
+        if not c[i] < best * (1.0 - 8.0 * np.finfo(float).eps * best):
             break
         s, best = flips[i], float(c[i])
     return s, best

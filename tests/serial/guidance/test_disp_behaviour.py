@@ -26,6 +26,7 @@ from kinestat.serial.guidance.step import (
     conditioning,
     perturb_all_joints,
     scaled_jacobian,
+    sigma_min_gradient,
 )
 from kinestat.spatial.displacement import screw_from_poses
 
@@ -159,6 +160,26 @@ def test_perturb_all_gives_every_joint_the_smallest_equal_increment(case):
     assert _exhaustive_best_cond(m, q, math.radians(0.1 * (t - 1)), L) >= limit
     q2, _, _ = perturb_all_joints(m, q, length=L, cond_limit=limit, increment_deg=0.1)
     np.testing.assert_array_equal(q1, q2)  # deterministic
+
+
+def test_a_joint_that_cannot_change_sigma_min_gets_no_sign_from_rounding():
+    """Turning the base joint about its own axis turns the whole arm: the Jacobian's singular
+    values cannot change, so ∂σ_min/∂q1 is 0, not rounding noise of either sign (which made
+    the perturbation's first sign, and Illustration 4's sub-step count, depend on the
+    machine). Checked on Illustration 4's arm at random configurations and shifted by any
+    base angle: the gradient's other components are unchanged, its first is exactly 0."""
+    from kinestat.disp import deck_model
+    m = deck_model(embedded_deck("illustration4"))
+    L = characteristic_length(m, m.q_home)
+    rng = np.random.default_rng(5)
+    for q in rng.uniform(-np.pi, np.pi, (20, 6)):
+        g = sigma_min_gradient(m, q, length=L)
+        assert g[0] == 0.0
+        shifted = sigma_min_gradient(m, q + np.array([rng.uniform(-3, 3), 0, 0, 0, 0, 0]),
+                                     length=L)
+        np.testing.assert_allclose(shifted[1:], g[1:], rtol=1e-5, atol=1e-7)
+    q1, _, _ = perturb_all_joints(m, m.q_home, length=L, cond_limit=3919.0)
+    assert np.degrees(q1 - m.q_home)[0] > 0.0  # a tie takes +, as documented
 
 
 def test_perturb_all_gives_up_and_says_so():
