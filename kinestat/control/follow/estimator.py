@@ -186,8 +186,8 @@ def start_travel(tun: FollowTuning, est: ContactEstimate, samples: tuple, tip: n
     if samples:
         c = contact_compliance(*zip(*samples, strict=True), tun.path_sigma, tun.confidence)
         est = replace(est, compliance=c)
-        est = replace(est, tips=tuple(surface_point(est, p, F) for p in est.tips))
-        est = replace(est, path=est.tips[-1:])
+        tips = tuple(surface_point(est, p, F) for p in est.tips)
+        est = replace(est, tips=tips, path=tips[-1:])
     return est, surface_point(est, tip, F)
 
 

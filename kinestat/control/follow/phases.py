@@ -130,8 +130,8 @@ def _observe(config: FollowConfig, st: FollowState, meas: Measurement, F: np.nda
         return st
     if st.phase != "travel":
         if st.phase == "settle":  # the tip stuck while the force rises: the workpiece's give
-            st = replace(st, settle_samples=st.settle_samples + (settle_sample(st.estimate, tip,
-                                                                               F),))
+            sample = settle_sample(st.estimate, tip, F)
+            st = replace(st, settle_samples=st.settle_samples + (sample,))
         return replace(st, estimate=replace(st.estimate, tips=(tip.copy(),), path=(tip.copy(),)))
     est, tip = start_travel(tun, st.estimate, st.settle_samples, tip, F)
     st = replace(st, settle_samples=(), estimate=est)
